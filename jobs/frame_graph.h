@@ -1,0 +1,47 @@
+// FrameGraph: the per-frame tbb::flow::graph, built once and fired every frame.
+//
+//   view -> visibility -> importance -> selection -> vdlod -> geomorph -> publish
+//
+// Nodes only coordinate; the work is the pure stages of runtime/, run data-parallel
+// (parallel_for over object chunks) inside visibility and importance. The flow-graph
+// headers stay in frame_graph.cpp.
+#pragma once
+#include <memory>
+#include <string>
+
+#include "jobs/scene.h"
+#include "runtime/frame.h"
+#include "runtime/initial_levels.h"
+#include "runtime/slc_selection.h"
+
+namespace lod {
+
+struct FrameGraphOptions {
+  uint32_t threads = 0;            // task_arena concurrency; 0 = all cores
+  SelectionParams selection;
+  float pixel_error = 1.0f;
+  float hysteresis = 0.25f;
+  uint32_t grain = 2048;           // objects per parallel chunk
+};
+
+class FrameGraph {
+ public:
+  FrameGraph(const Scene& scene, const FrameGraphOptions& options);
+  ~FrameGraph();
+  FrameGraph(const FrameGraph&) = delete;
+  FrameGraph& operator=(const FrameGraph&) = delete;
+
+  // Runs one frame for `view` and fills `out` (reusing its capacity). Not re-entrant.
+  void run(const View& view, Frame& out);
+
+  void set_budget(uint64_t budget);
+  const FrameGraphOptions& options() const;
+  // The node/edge table as Graphviz DOT, for `lod run --report`.
+  static std::string dot();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lod

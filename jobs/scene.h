@@ -1,0 +1,25 @@
+// Scene: the baked models and the placed objects a frame graph runs over.
+#pragma once
+#include <vector>
+
+#include "jobs/scene_config.h"
+#include "runtime/lod_chain.h"
+#include "runtime/model_table.h"
+#include "runtime/object_set.h"
+
+namespace lod {
+
+struct Scene {
+  std::vector<LodChain> chains;   // one per model, index = ModelConfig order
+  ModelTable models;
+  ObjectSet objects;
+};
+
+// Places every [[instances]] block (seeded random in its box, or a grid filling it) and
+// fills the world bounding spheres from each chain's level-0 sphere. Deterministic.
+ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>& chains);
+
+// Builds models + objects from already baked chains (in config model order).
+Scene make_scene(const SceneConfig& config, std::vector<LodChain> chains);
+
+}  // namespace lod

@@ -1,0 +1,53 @@
+// SceneConfig: everything a configs/*.toml file says, parsed and checked.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "preprocess/lod_bake.h"
+#include "runtime/camera_path.h"
+#include "runtime/slc_selection.h"
+#include "runtime/status.h"
+
+namespace lod {
+
+struct ModelConfig {
+  std::string name;
+  std::filesystem::path file;   // resolved: config folder first, then the data directory
+  BakeSettings bake;
+};
+
+struct InstanceConfig {
+  uint32_t model = 0;          // index into SceneConfig::models
+  uint32_t count = 0;
+  bool grid = false;           // placement = "grid" (else seeded random)
+  float box_min[3] = {-500, 0, -500};
+  float box_max[3] = {500, 0, 500};
+  float scale_min = 1, scale_max = 1;
+  uint64_t seed = 1;
+};
+
+struct SceneConfig {
+  std::filesystem::path file;        // the config itself
+  uint32_t frames = 600;
+  uint32_t threads = 0;              // 0 = all cores
+  double rate_hz = 60;
+  SelectionParams selection;
+  float pixel_error = 1.0f;          // [lod] pixel_error: screen-space threshold of initial levels
+  float hysteresis = 0.25f;          // [lod] hysteresis
+  CameraPath camera;
+  std::vector<ModelConfig> models;
+  std::vector<InstanceConfig> instances;
+};
+
+// Refuses unknown paths, wrong types, absurd values (negative counts, zero size windows,
+// budgets of 0, thread counts over 1024, unknown model names) naming the file and key.
+// `data_dir` is where mesh files are looked for after the config's own folder.
+Status load_scene_config(const std::filesystem::path& file, const std::filesystem::path& data_dir,
+                         SceneConfig& out);
+
+// The data directory the set-up fills (Debian's CGAL meshes), compiled in.
+std::filesystem::path default_data_dir();
+
+}  // namespace lod

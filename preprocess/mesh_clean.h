@@ -1,0 +1,22 @@
+// Input cleaning before simplification: what scanned meshes really contain.
+#pragma once
+#include <cstddef>
+
+#include "preprocess/mesh.h"
+
+namespace lod {
+
+struct CleanReport {
+  size_t degenerate_faces = 0;      // repeated vertex index or zero area
+  size_t duplicate_faces = 0;       // same vertex set as an earlier face
+  size_t unreferenced_vertices = 0;
+  size_t duplicate_vertices = 0;    // bit-identical positions welded together
+  bool changed() const {
+    return degenerate_faces + duplicate_faces + unreferenced_vertices + duplicate_vertices > 0;
+  }
+};
+
+// Cleans in place; deterministic; keeps the first occurrence of everything.
+CleanReport clean_mesh(MeshData& mesh);
+
+}  // namespace lod

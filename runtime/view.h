@@ -1,0 +1,28 @@
+// View: one camera for one frame, with what the stages derive from it.
+#pragma once
+#include <glm/glm.hpp>
+
+namespace lod {
+
+struct View {
+  glm::vec3 eye{0, 0, 0};
+  glm::vec3 target{0, 0, -1};
+  glm::vec3 up{0, 1, 0};
+  float fov_y_deg = 60;
+  int width = 1280;    // pixels
+  int height = 720;
+  float near_plane = 0.5f;
+  float far_plane = 5000.f;
+};
+
+struct Frustum {
+  glm::vec4 planes[6];  // normalized, inside when dot(n, p) + w >= 0
+};
+
+glm::mat4 view_matrix(const View& v);
+glm::mat4 projection_matrix(const View& v);
+Frustum frustum_of(const View& v);
+// Pixels per unit of size at distance 1: (height / 2) / tan(fov_y / 2).
+float focal_pixels(const View& v);
+
+}  // namespace lod
