@@ -1,0 +1,43 @@
+// The `lod` subcommands. Each returns the process exit code.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lod::cli {
+
+struct RunArgs {
+  std::string config;
+  std::string data_dir;      // empty = default_data_dir()
+  std::string cache_dir;     // empty = $LOD_CACHE_DIR or <data_dir>/../cache
+  std::string json_file;
+  std::string report_dir;
+  int64_t frames = -1;       // -1 = config
+  int64_t threads = -1;      // -1 = config
+  bool validate = false;
+  bool quiet = false;
+};
+int run_command(const RunArgs& args);
+
+struct InspectArgs {
+  std::string file;
+  bool json = false;
+  std::string export_dir;
+};
+int inspect_command(const InspectArgs& args);
+
+struct BakeArgs {
+  std::vector<std::string> models;
+  std::string out_dir;
+  std::vector<float> ratios;
+  std::string method = "auto";
+  uint32_t threads = 0;
+  bool measure = false;
+  bool json = false;
+};
+int bake_command(const BakeArgs& args);
+
+// Where baked assets are cached: $LOD_CACHE_DIR, else next to the data directory.
+std::string default_cache_dir(const std::string& data_dir);
+
+}  // namespace lod::cli

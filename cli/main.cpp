@@ -1,0 +1,44 @@
+// lod: bake meshes into LOD assets, run the LOD service along a camera path, inspect assets.
+#include <CLI/CLI.hpp>
+
+#include "cli/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"lodkit: multithreaded level-of-detail runtime"};
+  app.require_subcommand(1);
+
+  lod::cli::RunArgs run;
+  auto* run_cmd = app.add_subcommand("run", "bake what the scene needs (cached), then run the LOD service headless");
+  run_cmd->add_option("--config", run.config, "scene config (TOML)")->required();
+  run_cmd->add_option("--frames", run.frames, "frames along the camera path (default: config)");
+  run_cmd->add_option("--threads", run.threads, "worker threads, 0 = all cores (default: config)");
+  run_cmd->add_option("--data", run.data_dir, "mesh directory searched after the config's folder");
+  run_cmd->add_option("--cache", run.cache_dir, "baked asset cache (default: $LOD_CACHE_DIR or <data>/../cache)");
+  run_cmd->add_option("--json", run.json_file, "write per-frame figures and a summary as JSON");
+  run_cmd->add_option("--report", run.report_dir, "write frames.csv, summary.json, graph.dot and SVG plots here");
+  run_cmd->add_flag("--validate", run.validate, "check every frame's invariants; fail on the first bad one");
+  run_cmd->add_flag("--quiet", run.quiet, "no per-frame table");
+
+  lod::cli::InspectArgs inspect;
+  auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels");
+  inspect_cmd->add_option("file", inspect.file, ".lod file")->required();
+  inspect_cmd->add_flag("--json", inspect.json, "print JSON");
+  inspect_cmd->add_option("--export", inspect.export_dir, "write every level as PLY into this directory");
+
+  lod::cli::BakeArgs bake;
+  auto* bake_cmd = app.add_subcommand("bake", "bake meshes into .lod assets");
+  bake_cmd->add_option("models", bake.models, "mesh files (OBJ, PLY, OFF, STL)")->required();
+  bake_cmd->add_option("-o,--out", bake.out_dir, "output directory")->required();
+  bake_cmd->add_option("--ratios", bake.ratios, "level ratios, 1.0 first (default: by size, as R0)");
+  bake_cmd->add_option("--method", bake.method, "qem | extreme | auto")
+      ->check(CLI::IsMember({"qem", "extreme", "auto"}));
+  bake_cmd->add_option("--threads", bake.threads, "worker threads, 0 = all cores");
+  bake_cmd->add_flag("--measure", bake.measure, "print each level's measured error");
+  bake_cmd->add_flag("--json", bake.json, "print JSON");
+
+  CLI11_PARSE(app, argc, argv);
+  if (run_cmd->parsed()) return lod::cli::run_command(run);
+  if (inspect_cmd->parsed()) return lod::cli::inspect_command(inspect);
+  if (bake_cmd->parsed()) return lod::cli::bake_command(bake);
+  return 2;
+}

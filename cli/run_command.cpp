@@ -1,0 +1,170 @@
+// lod run: the main job. Bake (cached) what the scene needs, then drive lod::Service frame by
+// frame along the config's camera path and report what every frame did.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "cli/commands.h"
+#include "cli/run_report.h"
+#include "jobs/bake_jobs.h"
+#include "jobs/scene.h"
+#include "jobs/scene_config.h"
+#include "jobs/service.h"
+#include "runtime/camera_path.h"
+
+namespace lod::cli {
+namespace {
+
+// --validate: the invariants every published frame must hold.
+bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index, std::string* why) {
+  char buf[256];
+  if (f.index != expected_index) {
+    std::snprintf(buf, sizeof buf, "frame index %llu, expected %llu", (unsigned long long)f.index,
+                  (unsigned long long)expected_index);
+    *why = buf;
+    return false;
+  }
+  if (f.objects.size() != f.visible || f.levels.size() != f.visible || f.morph.size() != f.visible) {
+    *why = "per-object arrays do not match the visible count";
+    return false;
+  }
+  uint64_t tris = 0;
+  for (size_t i = 0; i < f.objects.size(); ++i) {
+    const uint32_t id = f.objects[i];
+    if (id >= scene.objects.size() || (i > 0 && f.objects[i - 1] >= id)) {
+      std::snprintf(buf, sizeof buf, "entry %zu: object id %u out of order or range", i, id);
+      *why = buf;
+      return false;
+    }
+    const uint32_t m = scene.objects.model[id];
+    if (f.levels[i] >= scene.models.level_count[m]) {
+      std::snprintf(buf, sizeof buf, "object %u: level %u of %u", id, f.levels[i], scene.models.level_count[m]);
+      *why = buf;
+      return false;
+    }
+    tris += scene.models.triangles[scene.models.first_level[m] + f.levels[i]];
+  }
+  if (tris != f.tris_selected) {
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels add up to %llu",
+                  (unsigned long long)f.tris_selected, (unsigned long long)tris);
+    *why = buf;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string default_cache_dir(const std::string& data_dir) {
+  if (const char* env = std::getenv("LOD_CACHE_DIR"); env && *env) return env;
+  return (std::filesystem::path(data_dir).parent_path() / "cache").string();
+}
+
+int run_command(const RunArgs& args) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const std::string data_dir = args.data_dir.empty() ? default_data_dir().string() : args.data_dir;
+  SceneConfig config;
+  if (auto st = load_scene_config(args.config, data_dir, config); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  if (args.frames >= 0) {
+    if (args.frames == 0 || args.frames > 100000000) {
+      std::fprintf(stderr, "lod run: --frames %lld: must be between 1 and 100000000\n", (long long)args.frames);
+      return 1;
+    }
+    config.frames = uint32_t(args.frames);
+  }
+  if (args.threads >= 0) {
+    if (args.threads > 1024) {
+      std::fprintf(stderr, "lod run: --threads %lld: at most 1024\n", (long long)args.threads);
+      return 1;
+    }
+    config.threads = uint32_t(args.threads);
+  }
+
+  const std::string cache_dir = args.cache_dir.empty() ? default_cache_dir(data_dir) : args.cache_dir;
+  std::vector<LodChain> chains;
+  BakeSummary bake;
+  auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  if (auto st = bake_scene_models(config.models, cache_dir, config.threads, chains, bake, log); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "bake: %zu models (%zu baked, %zu from cache %s) in %.0f ms\n", chains.size(), bake.baked,
+               bake.cached, cache_dir.c_str(), bake.ms);
+
+  Scene scene = make_scene(config, std::move(chains));
+  FrameGraphOptions options;
+  options.threads = config.threads;
+  options.selection = config.selection;
+  options.pixel_error = config.pixel_error;
+  options.hysteresis = config.hysteresis;
+  Service service(scene, options, config.rate_hz);
+
+  RunSummary summary;
+  summary.config = std::filesystem::path(args.config).filename().string();
+  summary.objects = scene.objects.size();
+  summary.models = scene.chains.size();
+  summary.threads = config.threads;
+  summary.budget = config.selection.budget;
+  summary.budget_count = config.selection.count == BudgetCount::levels ? "levels" : "triangles";
+  summary.bake_ms = bake.ms;
+  summary.baked_models = bake.baked;
+  summary.cached_models = bake.cached;
+
+  std::vector<FrameRecord> records;
+  records.reserve(config.frames);
+  const uint32_t every = config.frames <= 40 ? 1 : (config.frames + 29) / 30;
+  if (!args.quiet) std::printf("%s\n", table_header().c_str());
+  for (uint32_t n = 0; n < config.frames; ++n) {
+    if (!service.step(view_at(config.camera, n))) {
+      std::fprintf(stderr, "lod run: frame %u failed; the service kept the last good frame\n", n);
+      continue;
+    }
+    const Frame& frame = service.latest_frame();
+    if (args.validate) {
+      std::string why;
+      if (!validate_frame(frame, scene, records.empty() ? frame.index : records.back().frame + 1, &why)) {
+        std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
+        return 3;
+      }
+      const uint64_t cost = config.selection.count == BudgetCount::levels ? frame.level_cost : frame.tris_selected;
+      if (!frame.over_budget && cost > frame.budget) {
+        std::fprintf(stderr, "lod run --validate: frame %u: cost %llu exceeds budget %llu without over_budget\n", n,
+                     (unsigned long long)cost, (unsigned long long)frame.budget);
+        return 3;
+      }
+    }
+    records.push_back(record_of(frame));
+    if (!args.quiet && (n % every == 0 || n + 1 == config.frames))
+      std::printf("%s\n", table_row(records.back()).c_str());
+  }
+  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  summarize(records, summary);
+  if (summary.threads == 0) summary.threads = std::max(1u, std::thread::hardware_concurrency());
+  std::printf("%s", summary_text(summary).c_str());
+  const auto stats = service.stats();
+  if (stats.errors) std::printf("  service errors: %llu frames lost\n", (unsigned long long)stats.errors);
+
+  if (!args.json_file.empty()) {
+    if (auto st = write_json(args.json_file, records, summary); !st) {
+      std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+      return 1;
+    }
+    std::printf("  json: %s\n", args.json_file.c_str());
+  }
+  if (!args.report_dir.empty()) {
+    if (auto st = write_report(args.report_dir, records, summary, FrameGraph::dot()); !st) {
+      std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+      return 1;
+    }
+    std::printf("  report: %s/{frames.csv,summary.json,triangles.svg,stage_ms.svg,graph.dot}\n",
+                args.report_dir.c_str());
+  }
+  return stats.errors ? 4 : 0;
+}
+
+}  // namespace lod::cli

@@ -1,0 +1,57 @@
+// RunReport: the per-frame figures of `lod run` and what is written from them
+// (terminal table, JSON, CSV, SVG plots).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "runtime/frame.h"
+#include "runtime/status.h"
+
+namespace lod::cli {
+
+struct FrameRecord {
+  uint64_t frame = 0;
+  uint32_t objects = 0, visible = 0;
+  uint64_t tris_in_view = 0, tris_selected = 0, level_cost = 0, budget = 0, coarsest_cost = 0;
+  bool over_budget = false;
+  uint32_t lowered_steps = 0;
+  std::array<uint32_t, kHistogramLevels> levels{};
+  std::array<double, kStageCount> stage_ms{};
+  double total_ms = 0;
+};
+
+FrameRecord record_of(const Frame& frame);
+
+struct RunSummary {
+  std::string config;
+  size_t frames = 0, over_budget_frames = 0, binding_frames = 0;
+  size_t objects = 0, models = 0;
+  uint32_t threads = 0;
+  uint64_t budget = 0;
+  std::string budget_count;
+  double median_ms = 0, p99_ms = 0, mean_ms = 0, max_ms = 0;
+  std::array<double, kStageCount> median_stage_ms{};
+  double mean_visible = 0, mean_tris_in_view = 0, mean_tris_selected = 0;
+  double bake_ms = 0;
+  size_t baked_models = 0, cached_models = 0;
+  double wall_s = 0;
+};
+
+// Fills the timing and mean fields of `summary` from the records.
+void summarize(const std::vector<FrameRecord>& records, RunSummary& summary);
+
+std::string table_header();
+std::string table_row(const FrameRecord& r);
+std::string summary_text(const RunSummary& s);
+
+Status write_json(const std::filesystem::path& file, const std::vector<FrameRecord>& records,
+                  const RunSummary& summary);
+// frames.csv, summary.json, triangles.svg (R0's Fig. 4: in view, selected, budget),
+// stage_ms.svg (per-stage milliseconds), graph.dot.
+Status write_report(const std::filesystem::path& dir, const std::vector<FrameRecord>& records,
+                    const RunSummary& summary, const std::string& graph_dot);
+
+}  // namespace lod::cli
