@@ -6,6 +6,7 @@
 // (parallel_for over object chunks) inside visibility and importance. The flow-graph
 // headers stay in frame_graph.cpp.
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -22,6 +23,9 @@ struct FrameGraphOptions {
   float pixel_error = 1.0f;
   float hysteresis = 0.25f;
   uint32_t grain = 2048;           // objects per parallel chunk
+  // Called at the start of every stage, on the thread running it (tracing; tests inject
+  // failures by throwing from it). Empty = no call.
+  std::function<void(Stage)> stage_hook;
 };
 
 class FrameGraph {
@@ -32,6 +36,9 @@ class FrameGraph {
   FrameGraph& operator=(const FrameGraph&) = delete;
 
   // Runs one frame for `view` and fills `out` (reusing its capacity). Not re-entrant.
+  // Frame indices start at 1 and increase by one per call. If a stage throws, the graph
+  // and the temporal state (last frame's levels) are reset, `out` is left partly written,
+  // and the exception propagates.
   void run(const View& view, Frame& out);
 
   void set_budget(uint64_t budget);

@@ -1,0 +1,151 @@
+// Bake jobs: one task per model on oneTBB; an asset named by the bake key is a cache hit.
+#include "jobs/bake_jobs.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include "runtime/lod_asset.h"
+
+namespace lod {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string hex64(uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+// Serialises log lines from the bake tasks.
+class LogLines {
+ public:
+  explicit LogLines(const ProgressLog& log) : log_(log) {}
+  void line(const std::string& text) {
+    if (!log_) return;
+    std::lock_guard lock(mutex_);
+    log_(text);
+  }
+
+ private:
+  const ProgressLog& log_;
+  std::mutex mutex_;
+};
+
+struct BakeTask {
+  LodChain chain;
+  BakeJobResult result;
+  Status status;
+};
+
+void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, LogLines& log, BakeTask& task) {
+  const auto t0 = std::chrono::steady_clock::now();
+  task.result.model = model.name;
+  const std::string where = "model " + model.name + " (" + model.file.string() + ")";
+
+  Status key_status;
+  const uint64_t key = bake_key(model.file, model.bake, &key_status);
+  if (!key_status) {
+    task.status = Status::error(where + ": " + key_status.message);
+    return;
+  }
+  const std::filesystem::path asset = cache_dir / (model.name + "-" + hex64(key) + ".lod");
+
+  std::error_code ec;
+  if (std::filesystem::exists(asset, ec)) {
+    LodChain cached;
+    const Status read = read_lod_asset(asset, cached);
+    if (read && cached.source_hash == key) {
+      task.chain = std::move(cached);
+      task.result.from_cache = true;
+      task.result.levels = task.chain.levels.size();
+      task.result.input_triangles = task.chain.levels.empty() ? 0 : task.chain.levels[0].triangles();
+      task.result.ms = ms_since(t0);
+      log.line("bake " + model.name + ": cached " + asset.string());
+      return;
+    }
+    log.line("bake " + model.name + ": cache file " + asset.string() + " unusable (" +
+             (read ? std::string("hash mismatch") : read.message) + "), rebaking");
+  }
+
+  // Progress lines every 10 %, from whichever thread bake_model reports on.
+  std::atomic<int> last_decile{-1};
+  const BakeProgress progress = [&](float fraction, const char* what) {
+    const int decile = static_cast<int>(std::clamp(fraction, 0.f, 1.f) * 10);
+    int seen = last_decile.load();
+    do {
+      if (decile <= seen) return;
+    } while (!last_decile.compare_exchange_weak(seen, decile));
+    log.line("bake " + model.name + " " + std::to_string(decile * 10) + "% " + (what ? what : ""));
+  };
+  LodChain chain;
+  BakeReport report;
+  const Status baked = bake_model(model.file, model.name, model.bake, chain, &report, progress);
+  if (!baked) {
+    task.status = Status::error(where + ": " + baked.message);
+    return;
+  }
+  const Status written = write_lod_asset(asset, chain);
+  if (!written) {
+    task.status = Status::error(where + ": cannot write cache " + asset.string() + ": " + written.message);
+    return;
+  }
+  task.result.levels = chain.levels.size();
+  task.result.input_triangles = report.input_triangles;
+  task.result.report = std::move(report);
+  task.chain = std::move(chain);
+  task.result.ms = ms_since(t0);
+  char ms[32];
+  std::snprintf(ms, sizeof ms, "%.0f", task.result.ms);
+  log.line("bake " + model.name + ": " + std::to_string(task.result.levels) + " levels in " + ms + " ms -> " +
+           asset.string());
+}
+
+}  // namespace
+
+Status bake_scene_models(const std::vector<ModelConfig>& models, const std::filesystem::path& cache_dir,
+                         uint32_t threads, std::vector<LodChain>& chains, BakeSummary& summary,
+                         const ProgressLog& log) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::error_code ec;
+  std::filesystem::create_directories(cache_dir, ec);
+  if (ec) return Status::error(cache_dir.string() + ": cannot create the bake cache directory: " + ec.message());
+
+  std::vector<BakeTask> tasks(models.size());
+  LogLines lines(log);
+  tbb::task_arena arena(threads == 0 ? tbb::task_arena::automatic : static_cast<int>(threads));
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, models.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        try {
+          bake_one(models[i], cache_dir, lines, tasks[i]);
+        } catch (const std::exception& e) {  // e.g. bad_alloc on a huge mesh: a status, not a crash
+          tasks[i].status = Status::error("model " + models[i].name + " (" + models[i].file.string() + "): " + e.what());
+        }
+      }
+    });
+  });
+
+  BakeSummary s;
+  std::vector<LodChain> out;
+  for (BakeTask& t : tasks) {
+    if (!t.status) return t.status;
+    (t.result.from_cache ? s.cached : s.baked) += 1;
+    s.jobs.push_back(std::move(t.result));
+    out.push_back(std::move(t.chain));
+  }
+  s.ms = ms_since(t0);
+  chains = std::move(out);
+  summary = std::move(s);
+  return Status::success();
+}
+
+}  // namespace lod

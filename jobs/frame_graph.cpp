@@ -1,0 +1,314 @@
+// FrameGraph: wiring of the per-frame stages into one tbb::flow::graph.
+//
+//   view -> visibility -> importance -> selection -> vdlod -> geomorph -> publish
+//
+// Each node is a continue_node that coordinates one stage; the data-parallel stages split
+// the objects into fixed chunks of `grain` and run the runtime/ function per chunk inside a
+// parallel_for. Chunk boundaries do not depend on the thread count and every per-chunk
+// result lands in its own slot, merged in chunk order, so 1, 2 or N threads give
+// bit-identical frames. Selection is global (one budget) and runs serially on the whole
+// range. vdlod and geomorph are pass-through until view-dependent objects and geomorphing
+// exist: they time themselves (nothing) and forward.
+#include "jobs/frame_graph.h"
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/flow_graph.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/partitioner.h>
+#include <oneapi/tbb/task_arena.h>
+#include <memory>
+#include <optional>
+#include <span>
+
+#include "runtime/importance.h"
+#include "runtime/visibility.h"
+
+namespace lod {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// What publish sums per chunk before the chunks are merged in order.
+struct ChunkTotals {
+  uint64_t tris_in_view = 0;
+  uint64_t tris_selected = 0;
+  uint64_t level_cost = 0;
+  std::array<uint32_t, kHistogramLevels> histogram{};
+};
+
+template <class T>
+std::span<T> sub(std::vector<T>& v, size_t begin, size_t end) {
+  return std::span<T>(v.data() + begin, end - begin);
+}
+template <class T>
+std::span<const T> sub(const std::vector<T>& v, size_t begin, size_t end) {
+  return std::span<const T>(v.data() + begin, end - begin);
+}
+
+struct StageEntry {
+  const char* name;
+  const char* does;
+};
+// The node/edge table: one node per stage, a chain of edges in this order.
+constexpr StageEntry kStageTable[kStageCount] = {
+    {"view", "frustum planes, focal length, budget"},
+    {"visibility", "cull_spheres, parallel over chunks"},
+    {"importance", "measure_objects + minima, importance_weights + choose_initial_levels, parallel"},
+    {"selection", "select_under_budget, serial over all objects"},
+    {"vdlod", "pass-through (no view-dependent objects yet)"},
+    {"geomorph", "pass-through (morph = 1)"},
+    {"publish", "compact visible objects + totals, parallel; levels -> prev_level"},
+};
+
+}  // namespace
+
+struct FrameGraph::Impl {
+  const Scene& scene;
+  FrameGraphOptions options;
+  size_t count = 0;   // objects
+  size_t grain = 1;
+  size_t chunks = 0;
+
+  ObjectState state;
+  std::vector<HeapEntry> heap;
+  std::vector<uint32_t> chunk_visible;  // visibility: visible objects per chunk
+  std::vector<uint32_t> chunk_offset;   // publish: first output slot per chunk
+  std::vector<ViewMinima> chunk_minima;
+  std::vector<ChunkTotals> chunk_totals;
+
+  // Per frame.
+  View view;
+  Frustum frustum{};
+  float focal = 1;
+  Frame* out = nullptr;
+  ViewMinima minima{};
+  SelectionResult selected;
+  std::array<double, kStageCount> stage_ms{};
+  uint64_t frame_index = 0;
+
+  tbb::task_arena arena;
+  std::optional<tbb::flow::graph> graph;
+  std::vector<std::unique_ptr<Node>> nodes;  // kStageCount, in stage order; destroyed before the graph
+
+  Impl(const Scene& s, const FrameGraphOptions& o)
+      : scene(s),
+        options(o),
+        count(s.objects.size()),
+        grain(std::max<uint32_t>(1, o.grain)),
+        chunks((count + grain - 1) / grain),
+        arena(o.threads == 0 ? tbb::task_arena::automatic : static_cast<int>(o.threads)) {
+    state.resize(count);
+    std::fill(state.prev_level.begin(), state.prev_level.end(), uint8_t{0});
+    std::fill(state.was_visible.begin(), state.was_visible.end(), uint8_t{0});
+    heap.resize(count);
+    chunk_visible.resize(chunks);
+    chunk_offset.resize(chunks);
+    chunk_minima.resize(chunks);
+    chunk_totals.resize(chunks);
+    // Built inside the arena, the graph attaches to it: its tasks run on these threads.
+    arena.execute([&] { build(); });
+  }
+
+  void build() {
+    graph.emplace();
+    nodes.reserve(kStageCount);
+    for (size_t i = 0; i < kStageCount; ++i) {
+      const Stage stage = static_cast<Stage>(i);
+      nodes.push_back(std::make_unique<Node>(*graph, [this, stage](const tbb::flow::continue_msg&) {
+        const auto t0 = Clock::now();
+        if (options.stage_hook) options.stage_hook(stage);
+        run_stage(stage);
+        stage_ms[static_cast<size_t>(stage)] = ms_between(t0, Clock::now());
+      }));
+    }
+    for (size_t i = 0; i + 1 < kStageCount; ++i) tbb::flow::make_edge(*nodes[i], *nodes[i + 1]);
+  }
+
+  void run_stage(Stage stage) {
+    switch (stage) {
+      case Stage::view: return stage_view();
+      case Stage::visibility: return stage_visibility();
+      case Stage::importance: return stage_importance();
+      case Stage::selection: return stage_selection();
+      case Stage::vdlod: return;     // later issue: vertex-front updates of view-dependent objects
+      case Stage::geomorph: return;  // later issue: morph factors; publish writes settled (1)
+      case Stage::publish: return stage_publish();
+      case Stage::count: break;
+    }
+    assert(false);
+  }
+
+  // Runs body(chunk, begin, end) for every chunk; one task per chunk.
+  template <class Body>
+  void for_chunks(const Body& body) {
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, chunks, 1),
+        [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
+        },
+        tbb::simple_partitioner());
+  }
+
+  void stage_view() {
+    frustum = frustum_of(view);
+    focal = focal_pixels(view);
+  }
+
+  void stage_visibility() {
+    const ObjectSet& o = scene.objects;
+    for_chunks([&](size_t c, size_t b, size_t e) {
+      chunk_visible[c] = static_cast<uint32_t>(cull_spheres(sub(state.visible, b, e), sub(o.cx, b, e), sub(o.cy, b, e),
+                                                            sub(o.cz, b, e), sub(o.radius, b, e), frustum));
+    });
+  }
+
+  void stage_importance() {
+    const ObjectSet& o = scene.objects;
+    for_chunks([&](size_t c, size_t b, size_t e) {
+      chunk_minima[c] =
+          measure_objects(sub(state.distance, b, e), sub(state.area, b, e), sub(state.visible, b, e), sub(o.cx, b, e),
+                          sub(o.cy, b, e), sub(o.cz, b, e), sub(o.radius, b, e), view.eye, focal);
+    });
+    // min() is order-free, but merging in chunk order keeps even that obvious.
+    minima = empty_minima();
+    for (const ViewMinima& m : chunk_minima) minima = merge_minima(minima, m);
+    if (minima.visible == 0) return;
+
+    const InitialLevelParams params{focal, options.pixel_error, options.hysteresis};
+    for_chunks([&](size_t, size_t b, size_t e) {
+      importance_weights(sub(state.weight, b, e), sub(state.visible, b, e), sub(state.distance, b, e),
+                         sub(state.area, b, e), minima);
+      choose_initial_levels(sub(state.level, b, e), sub(state.visible, b, e), sub(state.prev_level, b, e),
+                            sub(state.was_visible, b, e), sub(state.distance, b, e), sub(o.scale, b, e),
+                            sub(o.model, b, e), scene.models, params);
+    });
+  }
+
+  void stage_selection() {
+    selected = select_under_budget(state.level, state.visible, state.weight, scene.objects.model, scene.models,
+                                   options.selection, heap);
+  }
+
+  void stage_publish() {
+    Frame& f = *out;
+    uint32_t visible = 0;
+    for (size_t c = 0; c < chunks; ++c) {
+      chunk_offset[c] = visible;
+      visible += chunk_visible[c];
+    }
+    f.objects.resize(visible);
+    f.levels.resize(visible);
+    f.morph.resize(visible);
+    const ModelTable& models = scene.models;
+    const std::vector<uint32_t>& model = scene.objects.model;
+    for_chunks([&](size_t c, size_t b, size_t e) {
+      ChunkTotals t;
+      uint32_t slot = chunk_offset[c];
+      for (size_t i = b; i < e; ++i) {
+        const uint8_t vis = state.visible[i];
+        state.was_visible[i] = vis;
+        state.prev_level[i] = state.level[i];
+        if (!vis) continue;
+        const uint32_t first = models.first_level[model[i]];
+        const uint32_t at = first + state.level[i];
+        const int32_t l = models.level_l[at];
+        t.tris_in_view += models.triangles[first];
+        t.tris_selected += models.triangles[at];
+        t.level_cost += uint64_t{1} << std::clamp(l, 0, 63);
+        ++t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))];
+        f.objects[slot] = static_cast<uint32_t>(i);
+        f.levels[slot] = state.level[i];
+        f.morph[slot] = 1.0f;  // no geomorphing yet: every level is settled
+        ++slot;
+      }
+      assert(slot == chunk_offset[c] + chunk_visible[c]);
+      chunk_totals[c] = t;
+    });
+
+    f.object_count = static_cast<uint32_t>(count);
+    f.visible = visible;
+    f.tris_in_view = f.tris_selected = f.level_cost = 0;
+    f.level_histogram.fill(0);
+    for (const ChunkTotals& t : chunk_totals) {
+      f.tris_in_view += t.tris_in_view;
+      f.tris_selected += t.tris_selected;
+      f.level_cost += t.level_cost;
+      for (size_t l = 0; l < kHistogramLevels; ++l) f.level_histogram[l] += t.histogram[l];
+    }
+    f.budget = options.selection.budget;
+    f.coarsest_cost = visible ? selected.coarsest_cost : 0;
+    f.over_budget = visible ? selected.over_budget : false;
+    f.lowered_steps = visible ? selected.lowered_steps : 0;
+  }
+
+  // Forgets last frame's levels so that the next frame starts from scratch.
+  void reset_temporal_state() {
+    std::fill(state.prev_level.begin(), state.prev_level.end(), uint8_t{0});
+    std::fill(state.was_visible.begin(), state.was_visible.end(), uint8_t{0});
+  }
+};
+
+FrameGraph::FrameGraph(const Scene& scene, const FrameGraphOptions& options)
+    : impl_(std::make_unique<Impl>(scene, options)) {}
+
+FrameGraph::~FrameGraph() = default;
+
+void FrameGraph::run(const View& view, Frame& out) {
+  Impl& m = *impl_;
+  const auto t0 = Clock::now();
+  m.view = view;
+  m.out = &out;
+  m.stage_ms.fill(0);
+  out.index = ++m.frame_index;
+  out.view = view;
+  try {
+    m.arena.execute([&] {
+      m.nodes.front()->try_put(tbb::flow::continue_msg());
+      m.graph->wait_for_all();
+    });
+  } catch (...) {
+    m.graph->reset();
+    m.reset_temporal_state();
+    m.out = nullptr;
+    throw;
+  }
+  m.out = nullptr;
+  out.stage_ms = m.stage_ms;
+  out.total_ms = ms_between(t0, Clock::now());
+}
+
+void FrameGraph::set_budget(uint64_t budget) { impl_->options.selection.budget = budget; }
+
+const FrameGraphOptions& FrameGraph::options() const { return impl_->options; }
+
+std::string FrameGraph::dot() {
+  std::string s = "digraph frame_graph {\n  rankdir=LR;\n  node [shape=box, fontname=\"Helvetica\"];\n";
+  for (const StageEntry& e : kStageTable) {
+    s += "  ";
+    s += e.name;
+    s += " [label=\"";
+    s += e.name;
+    s += "\\n";
+    s += e.does;
+    s += "\"];\n";
+  }
+  for (size_t i = 0; i + 1 < kStageCount; ++i) {
+    s += "  ";
+    s += kStageTable[i].name;
+    s += " -> ";
+    s += kStageTable[i + 1].name;
+    s += ";\n";
+  }
+  s += "}\n";
+  return s;
+}
+
+}  // namespace lod

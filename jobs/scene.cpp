@@ -1,0 +1,89 @@
+// Scene: placing every [[instances]] block and building the model table.
+#include "jobs/scene.h"
+
+#include <cassert>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace lod {
+namespace {
+
+// Uniform in [0, 1) from the top 53 bits: unlike std::uniform_real_distribution, the
+// sequence is the same on every standard library, so a seed names one scene everywhere.
+double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+float lerp(float a, float b, double t) { return static_cast<float>(a + (static_cast<double>(b) - a) * t); }
+
+// Level 0's sphere centre, with a radius that also holds every coarser level: simplified
+// levels may bulge slightly past the original surface, and culling must not cut them.
+Sphere model_sphere(const LodChain& chain) {
+  Sphere s;
+  if (chain.levels.empty()) return s;
+  s = chain.levels[0].bounds;
+  for (const LodLevel& l : chain.levels) {
+    const float dx = l.bounds.center[0] - s.center[0];
+    const float dy = l.bounds.center[1] - s.center[1];
+    const float dz = l.bounds.center[2] - s.center[2];
+    s.radius = std::max(s.radius, std::sqrt(dx * dx + dy * dy + dz * dz) + l.bounds.radius);
+  }
+  return s;
+}
+
+}  // namespace
+
+ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>& chains) {
+  size_t total = 0;
+  for (const InstanceConfig& inst : config.instances) total += inst.count;
+  ObjectSet objects;
+  objects.resize(total);
+
+  size_t o = 0;
+  for (const InstanceConfig& inst : config.instances) {
+    assert(inst.model < chains.size());
+    const Sphere sphere = model_sphere(chains[inst.model]);
+    std::mt19937_64 rng(inst.seed);
+    // Grid: ceil(sqrt(n)) columns along x, as many rows along z as needed, one object per
+    // cell centre; y at the middle of the box.
+    const uint32_t cols = std::max<uint32_t>(1, static_cast<uint32_t>(std::ceil(std::sqrt(double(inst.count)))));
+    const uint32_t rows = std::max<uint32_t>(1, (inst.count + cols - 1) / cols);
+    for (uint32_t i = 0; i < inst.count; ++i, ++o) {
+      float p[3];
+      if (inst.grid) {
+        p[0] = lerp(inst.box_min[0], inst.box_max[0], (i % cols + 0.5) / cols);
+        p[1] = lerp(inst.box_min[1], inst.box_max[1], 0.5);
+        p[2] = lerp(inst.box_min[2], inst.box_max[2], (i / cols + 0.5) / rows);
+      } else {
+        for (int a = 0; a < 3; ++a) p[a] = lerp(inst.box_min[a], inst.box_max[a], unit(rng));
+      }
+      const float yaw = static_cast<float>(2 * std::numbers::pi * unit(rng));
+      const float scale = lerp(inst.scale_min, inst.scale_max, unit(rng));
+
+      objects.model[o] = inst.model;
+      objects.x[o] = p[0];
+      objects.y[o] = p[1];
+      objects.z[o] = p[2];
+      objects.yaw[o] = yaw;
+      objects.scale[o] = scale;
+      // World sphere: rotate the object-space centre about +y (as glm::rotate(yaw, y) does),
+      // scale it, then move it to the position.
+      const float c = std::cos(yaw), s = std::sin(yaw);
+      const float* sc = sphere.center;
+      objects.cx[o] = p[0] + scale * (c * sc[0] + s * sc[2]);
+      objects.cy[o] = p[1] + scale * sc[1];
+      objects.cz[o] = p[2] + scale * (-s * sc[0] + c * sc[2]);
+      objects.radius[o] = sphere.radius * scale;
+    }
+  }
+  return objects;
+}
+
+Scene make_scene(const SceneConfig& config, std::vector<LodChain> chains) {
+  Scene scene;
+  scene.objects = place_instances(config, chains);
+  scene.models = build_model_table(chains);
+  scene.chains = std::move(chains);
+  return scene;
+}
+
+}  // namespace lod

@@ -1,0 +1,416 @@
+// Scene config: configs/*.toml parsed with toml++ into a SceneConfig, every key checked.
+// Errors read "file: key: why" (or "file:line:col: why" for TOML syntax), and `out` is
+// written only when the whole file is good.
+#include "jobs/scene_config.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <initializer_list>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <toml++/toml.h>
+
+namespace lod {
+namespace {
+
+inline constexpr int kMaxWindowPixels = 16384;    // per side
+inline constexpr uint32_t kMaxThreads = 1024;
+inline constexpr uint64_t kMaxObjects = 10000000;  // all [[instances]] together
+
+// Thrown inside the parser only; load_scene_config turns it into a Status.
+struct ConfigError {
+  std::string message;
+};
+
+std::string number_text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& why) const {
+    throw ConfigError{file_ + ": " + key + ": " + why};
+  }
+
+  // Refuses keys a table does not know: a typo must not silently fall back to a default.
+  void only_keys(const toml::table& t, const std::string& where, std::initializer_list<std::string_view> known) const {
+    for (auto&& [k, v] : t) {
+      if (std::find(known.begin(), known.end(), k.str()) != known.end()) continue;
+      std::string list;
+      for (auto n : known) list += (list.empty() ? "" : ", ") + std::string(n);
+      fail(where.empty() ? std::string(k.str()) : where + "." + std::string(k.str()),
+           "unknown key (known here: " + list + ")");
+    }
+  }
+
+  const toml::table* table(const toml::table& t, std::string_view name, const std::string& key) const {
+    const toml::node* n = t.get(name);
+    if (!n) return nullptr;
+    if (!n->is_table()) fail(key, "expected a table");
+    return n->as_table();
+  }
+
+  std::optional<int64_t> integer(const toml::table& t, std::string_view name, const std::string& key) const {
+    const toml::node* n = t.get(name);
+    if (!n) return std::nullopt;
+    if (!n->is_integer()) fail(key, "expected an integer");
+    return n->as_integer()->get();
+  }
+
+  // Integer in [lo, hi]; absent keeps `value`.
+  template <class T>
+  void integer_in(const toml::table& t, std::string_view name, const std::string& key, int64_t lo, int64_t hi,
+                  T& value) const {
+    if (auto v = integer(t, name, key)) {
+      if (*v < lo || *v > hi)
+        fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(*v));
+      value = static_cast<T>(*v);
+    }
+  }
+
+  std::optional<double> number(const toml::node& n, const std::string& key) const {
+    double v = 0;
+    if (n.is_integer())
+      v = static_cast<double>(n.as_integer()->get());
+    else if (n.is_floating_point())
+      v = n.as_floating_point()->get();
+    else
+      fail(key, "expected a number");
+    if (!std::isfinite(v)) fail(key, "must be finite, got " + number_text(v));
+    return v;
+  }
+  std::optional<double> number(const toml::table& t, std::string_view name, const std::string& key) const {
+    const toml::node* n = t.get(name);
+    if (!n) return std::nullopt;
+    return number(*n, key);
+  }
+
+  std::optional<std::string> string(const toml::table& t, std::string_view name, const std::string& key) const {
+    const toml::node* n = t.get(name);
+    if (!n) return std::nullopt;
+    if (!n->is_string()) fail(key, "expected a string");
+    return n->as_string()->get();
+  }
+
+  const toml::array* array(const toml::table& t, std::string_view name, const std::string& key) const {
+    const toml::node* n = t.get(name);
+    if (!n) return nullptr;
+    if (!n->is_array()) fail(key, "expected an array");
+    return n->as_array();
+  }
+
+  // [x, y, z] of numbers.
+  bool vec3(const toml::table& t, std::string_view name, const std::string& key, float out[3]) const {
+    const toml::array* a = array(t, name, key);
+    if (!a) return false;
+    if (a->size() != 3) fail(key, "expected 3 numbers [x, y, z], got " + std::to_string(a->size()));
+    for (size_t i = 0; i < 3; ++i) out[i] = static_cast<float>(*number(*a->get(i), key + "[" + std::to_string(i) + "]"));
+    return true;
+  }
+  bool vec3(const toml::table& t, std::string_view name, const std::string& key, glm::vec3& out) const {
+    float v[3];
+    if (!vec3(t, name, key, v)) return false;
+    out = glm::vec3(v[0], v[1], v[2]);
+    return true;
+  }
+
+  // Array of tables ([[name]]); an empty vector when absent.
+  std::vector<const toml::table*> tables(const toml::table& t, std::string_view name, const std::string& key) const {
+    std::vector<const toml::table*> out;
+    const toml::array* a = array(t, name, key);
+    if (!a) return out;
+    for (size_t i = 0; i < a->size(); ++i) {
+      const toml::node* n = a->get(i);
+      if (!n->is_table()) fail(key + "[" + std::to_string(i) + "]", "expected a table (write [[" + key + "]])");
+      out.push_back(n->as_table());
+    }
+    return out;
+  }
+
+ private:
+  std::string file_;
+};
+
+std::string indexed(const std::string& base, size_t i) { return base + "[" + std::to_string(i) + "]"; }
+
+bool valid_model_name(const std::string& name) {
+  if (name.empty() || name.size() > 64) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           c == '.';
+  });
+}
+
+void read_run(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const toml::table* t = r.table(root, "run", "run");
+  if (!t) return;
+  r.only_keys(*t, "run", {"frames", "threads", "rate_hz"});
+  r.integer_in(*t, "frames", "run.frames", 1, 100000000, c.frames);
+  r.integer_in(*t, "threads", "run.threads", 0, kMaxThreads, c.threads);
+  if (auto v = r.number(*t, "rate_hz", "run.rate_hz")) {
+    if (*v <= 0 || *v > 10000) r.fail("run.rate_hz", "must be in (0, 10000] frames per second, got " + number_text(*v));
+    c.rate_hz = *v;
+  }
+}
+
+void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const toml::table* t = r.table(root, "budget", "budget");
+  if (!t) return;
+  r.only_keys(*t, "budget", {"triangles", "count"});
+  if (auto v = r.integer(*t, "triangles", "budget.triangles")) {
+    if (*v <= 0) r.fail("budget.triangles", "must be at least 1, got " + std::to_string(*v));
+    c.selection.budget = static_cast<uint64_t>(*v);
+  }
+  if (auto v = r.string(*t, "count", "budget.count")) {
+    if (*v == "triangles")
+      c.selection.count = BudgetCount::triangles;
+    else if (*v == "levels")
+      c.selection.count = BudgetCount::levels;
+    else
+      r.fail("budget.count", "must be \"triangles\" or \"levels\", got \"" + *v + "\"");
+  }
+}
+
+void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const toml::table* t = r.table(root, "lod", "lod");
+  if (!t) return;
+  r.only_keys(*t, "lod", {"pixel_error", "hysteresis"});
+  if (auto v = r.number(*t, "pixel_error", "lod.pixel_error")) {
+    if (*v <= 0 || *v > 10000) r.fail("lod.pixel_error", "must be in (0, 10000] pixels, got " + number_text(*v));
+    c.pixel_error = static_cast<float>(*v);
+  }
+  if (auto v = r.number(*t, "hysteresis", "lod.hysteresis")) {
+    if (*v < 0 || *v > 10) r.fail("lod.hysteresis", "must be in [0, 10], got " + number_text(*v));
+    c.hysteresis = static_cast<float>(*v);
+  }
+}
+
+void read_camera(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const toml::table* t = r.table(root, "camera", "camera");
+  if (!t) return;
+  r.only_keys(*t, "camera",
+              {"fov_deg", "width", "height", "path", "center", "radius", "height_above", "period_frames", "near", "far",
+               "keyframe"});
+  CameraPath& cam = c.camera;
+  if (auto v = r.number(*t, "fov_deg", "camera.fov_deg")) {
+    if (*v <= 1 || *v >= 179) r.fail("camera.fov_deg", "must be in (1, 179) degrees, got " + number_text(*v));
+    cam.lens.fov_y_deg = static_cast<float>(*v);
+  }
+  r.integer_in(*t, "width", "camera.width", 1, kMaxWindowPixels, cam.lens.width);
+  r.integer_in(*t, "height", "camera.height", 1, kMaxWindowPixels, cam.lens.height);
+  if (auto v = r.string(*t, "path", "camera.path")) {
+    if (*v == "orbit")
+      cam.kind = PathKind::orbit;
+    else if (*v == "flythrough")
+      cam.kind = PathKind::flythrough;
+    else if (*v == "keyframes")
+      cam.kind = PathKind::keyframes;
+    else
+      r.fail("camera.path", "must be \"orbit\", \"flythrough\" or \"keyframes\", got \"" + *v + "\"");
+  }
+  r.vec3(*t, "center", "camera.center", cam.center);
+  if (auto v = r.number(*t, "radius", "camera.radius")) {
+    if (*v <= 0) r.fail("camera.radius", "must be > 0, got " + number_text(*v));
+    cam.radius = static_cast<float>(*v);
+  }
+  if (auto v = r.number(*t, "height_above", "camera.height_above")) cam.height_above = static_cast<float>(*v);
+  r.integer_in(*t, "period_frames", "camera.period_frames", 1, 100000000, cam.period_frames);
+  if (auto v = r.number(*t, "near", "camera.near")) {
+    if (*v <= 0) r.fail("camera.near", "must be > 0, got " + number_text(*v));
+    cam.lens.near_plane = static_cast<float>(*v);
+  }
+  if (auto v = r.number(*t, "far", "camera.far")) cam.lens.far_plane = static_cast<float>(*v);
+  if (!(cam.lens.far_plane > cam.lens.near_plane))
+    r.fail("camera.far", "must be greater than camera.near (" + number_text(cam.lens.near_plane) + "), got " +
+                             number_text(cam.lens.far_plane));
+
+  const auto keys = r.tables(*t, "keyframe", "camera.keyframe");
+  std::vector<CameraKeyframe> frames;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const std::string key = indexed("camera.keyframe", i);
+    r.only_keys(*keys[i], key, {"frame", "position", "look_at"});
+    CameraKeyframe k;
+    if (!r.integer(*keys[i], "frame", key + ".frame")) r.fail(key + ".frame", "missing");
+    r.integer_in(*keys[i], "frame", key + ".frame", 0, 100000000, k.frame);
+    if (!r.vec3(*keys[i], "position", key + ".position", k.position)) r.fail(key + ".position", "missing");
+    if (!r.vec3(*keys[i], "look_at", key + ".look_at", k.look_at)) r.fail(key + ".look_at", "missing");
+    if (k.position == k.look_at) r.fail(key + ".look_at", "equals position: no view direction");
+    for (const CameraKeyframe& other : frames)
+      if (other.frame == k.frame) r.fail(key + ".frame", "frame " + std::to_string(k.frame) + " appears twice");
+    frames.push_back(k);
+  }
+  std::stable_sort(frames.begin(), frames.end(), [](const auto& a, const auto& b) { return a.frame < b.frame; });
+  if (cam.kind == PathKind::keyframes && frames.empty())
+    r.fail("camera.keyframe", "path = \"keyframes\" needs at least one [[camera.keyframe]]");
+  cam.keyframes = std::move(frames);
+}
+
+// Config folder first, then the data directory; absolute paths are taken as they are.
+std::filesystem::path resolve_mesh(const Reader& r, const std::string& key, const std::string& file,
+                                   const std::filesystem::path& config_dir, const std::filesystem::path& data_dir) {
+  std::error_code ec;
+  const std::filesystem::path p(file);
+  if (p.is_absolute()) {
+    if (!std::filesystem::is_regular_file(p, ec)) r.fail(key, "mesh file not found: " + p.string());
+    return p;
+  }
+  const std::filesystem::path first = (config_dir / p).lexically_normal();
+  if (std::filesystem::is_regular_file(first, ec)) return first;
+  std::string tried = first.string();
+  if (!data_dir.empty()) {
+    const std::filesystem::path second = (data_dir / p).lexically_normal();
+    if (std::filesystem::is_regular_file(second, ec)) return second;
+    tried += " and " + second.string();
+  } else {
+    tried += " (no data directory given)";
+  }
+  r.fail(key, "mesh file \"" + file + "\" not found; tried " + tried);
+}
+
+void read_models(const Reader& r, const toml::table& root, const std::filesystem::path& config_dir,
+                 const std::filesystem::path& data_dir, SceneConfig& c) {
+  const auto models = r.tables(root, "model", "model");
+  if (models.empty()) r.fail("model", "no [[model]] given: a scene needs at least one");
+  for (size_t i = 0; i < models.size(); ++i) {
+    const toml::table& t = *models[i];
+    const std::string key = indexed("model", i);
+    r.only_keys(t, key, {"name", "file", "ratios", "method", "extreme_threshold"});
+    ModelConfig m;
+    auto name = r.string(t, "name", key + ".name");
+    if (!name) r.fail(key + ".name", "missing");
+    if (!valid_model_name(*name))
+      r.fail(key + ".name", "\"" + *name + "\" must be 1-64 characters of A-Z a-z 0-9 _ - . (it names cache files)");
+    for (const ModelConfig& other : c.models)
+      if (other.name == *name) r.fail(key + ".name", "model \"" + *name + "\" is defined twice");
+    m.name = *name;
+    auto file = r.string(t, "file", key + ".file");
+    if (!file || file->empty()) r.fail(key + ".file", "missing");
+    m.file = resolve_mesh(r, key + ".file", *file, config_dir, data_dir);
+
+    if (const toml::array* a = r.array(t, "ratios", key + ".ratios")) {
+      if (a->empty()) r.fail(key + ".ratios", "is empty (omit the key for the default ratios)");
+      if (a->size() > 16) r.fail(key + ".ratios", "has " + std::to_string(a->size()) + " levels; at most 16");
+      for (size_t j = 0; j < a->size(); ++j) {
+        const std::string rk = indexed(key + ".ratios", j);
+        const double v = *r.number(*a->get(j), rk);
+        if (!(v > 0 && v <= 1)) r.fail(rk, "must be in (0, 1], got " + number_text(v));
+        if (j == 0 && v != 1) r.fail(rk, "must be 1.0: level 0 is the full mesh, got " + number_text(v));
+        if (j > 0 && !(v < m.bake.ratios.back()))
+          r.fail(rk, "ratios must decrease, but " + number_text(v) + " follows " + number_text(m.bake.ratios.back()));
+        m.bake.ratios.push_back(static_cast<float>(v));
+      }
+    }
+    if (auto v = r.string(t, "method", key + ".method")) {
+      if (*v == "qem")
+        m.bake.method = SimplifyMethod::qem;
+      else if (*v == "extreme")
+        m.bake.method = SimplifyMethod::extreme;
+      else if (*v == "auto")
+        m.bake.method = SimplifyMethod::automatic;
+      else
+        r.fail(key + ".method", "must be \"qem\", \"extreme\" or \"auto\", got \"" + *v + "\"");
+    }
+    r.integer_in(t, "extreme_threshold", key + ".extreme_threshold", 1, INT64_MAX, m.bake.extreme_threshold);
+    c.models.push_back(std::move(m));
+  }
+}
+
+void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const auto blocks = r.tables(root, "instances", "instances");
+  if (blocks.empty()) r.fail("instances", "no [[instances]] given: a scene needs at least one object");
+  uint64_t total = 0;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    const toml::table& t = *blocks[i];
+    const std::string key = indexed("instances", i);
+    r.only_keys(t, key, {"model", "count", "placement", "box_min", "box_max", "scale", "scale_range", "seed"});
+    InstanceConfig inst;
+    auto model = r.string(t, "model", key + ".model");
+    if (!model) r.fail(key + ".model", "missing");
+    auto it = std::find_if(c.models.begin(), c.models.end(), [&](const ModelConfig& m) { return m.name == *model; });
+    if (it == c.models.end()) r.fail(key + ".model", "unknown model \"" + *model + "\" (no [[model]] has that name)");
+    inst.model = static_cast<uint32_t>(it - c.models.begin());
+
+    if (!r.integer(t, "count", key + ".count")) r.fail(key + ".count", "missing");
+    r.integer_in(t, "count", key + ".count", 1, static_cast<int64_t>(kMaxObjects), inst.count);
+    total += inst.count;
+    if (total > kMaxObjects)
+      r.fail(key + ".count", "brings the scene to " + std::to_string(total) + " objects; at most " +
+                                 std::to_string(kMaxObjects));
+
+    if (auto v = r.string(t, "placement", key + ".placement")) {
+      if (*v == "grid")
+        inst.grid = true;
+      else if (*v != "random")
+        r.fail(key + ".placement", "must be \"random\" or \"grid\", got \"" + *v + "\"");
+    }
+    r.vec3(t, "box_min", key + ".box_min", inst.box_min);
+    r.vec3(t, "box_max", key + ".box_max", inst.box_max);
+    for (int a = 0; a < 3; ++a)
+      if (inst.box_min[a] > inst.box_max[a])
+        r.fail(key + ".box_max", std::string("is below box_min on ") + "xyz"[a] + " (" + number_text(inst.box_max[a]) +
+                                     " < " + number_text(inst.box_min[a]) + ")");
+
+    const bool has_scale = t.contains("scale");
+    if (has_scale && t.contains("scale_range"))
+      r.fail(key + ".scale_range", "give either scale or scale_range, not both");
+    if (auto v = r.number(t, "scale", key + ".scale")) {
+      if (*v <= 0) r.fail(key + ".scale", "must be > 0, got " + number_text(*v));
+      inst.scale_min = inst.scale_max = static_cast<float>(*v);
+    }
+    if (const toml::array* a = r.array(t, "scale_range", key + ".scale_range")) {
+      if (a->size() != 2) r.fail(key + ".scale_range", "expected [min, max], got " + std::to_string(a->size()) + " values");
+      const double lo = *r.number(*a->get(0), key + ".scale_range[0]");
+      const double hi = *r.number(*a->get(1), key + ".scale_range[1]");
+      if (lo <= 0) r.fail(key + ".scale_range[0]", "must be > 0, got " + number_text(lo));
+      if (hi < lo) r.fail(key + ".scale_range[1]", "must be >= scale_range[0], got " + number_text(hi));
+      inst.scale_min = static_cast<float>(lo);
+      inst.scale_max = static_cast<float>(hi);
+    }
+    r.integer_in(t, "seed", key + ".seed", 0, INT64_MAX, inst.seed);
+    c.instances.push_back(inst);
+  }
+}
+
+}  // namespace
+
+Status load_scene_config(const std::filesystem::path& file, const std::filesystem::path& data_dir,
+                         SceneConfig& out) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return Status::error(name + ": config file not found");
+  toml::table root;
+  try {
+    root = toml::parse_file(name);
+  } catch (const toml::parse_error& e) {
+    const auto& at = e.source().begin;
+    return Status::error(name + ":" + std::to_string(at.line) + ":" + std::to_string(at.column) + ": " +
+                         std::string(e.description()));
+  }
+  SceneConfig c;
+  c.file = file;
+  const Reader r(name);
+  try {
+    r.only_keys(root, "", {"run", "budget", "lod", "camera", "model", "instances"});
+    read_run(r, root, c);
+    read_budget(r, root, c);
+    read_lod(r, root, c);
+    read_camera(r, root, c);
+    const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+    read_models(r, root, dir, data_dir, c);
+    read_instances(r, root, c);
+  } catch (const ConfigError& e) {
+    return Status::error(e.message);
+  }
+  out = std::move(c);
+  return Status::success();
+}
+
+std::filesystem::path default_data_dir() { return LOD_DEFAULT_DATA_DIR; }
+
+}  // namespace lod
