@@ -1,5 +1,6 @@
 // Objects as structs of arrays, indexed by object id, so each stage streams over memory.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

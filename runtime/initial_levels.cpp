@@ -1,0 +1,49 @@
+// Initial levels from screen-space error, with a hysteresis band so that an object sitting at
+// a threshold distance does not switch levels every frame.
+#include "runtime/initial_levels.h"
+
+#include <algorithm>
+#include <cassert>
+
+namespace lod {
+
+size_t choose_initial_levels(std::span<uint8_t> level, std::span<const uint8_t> visible,
+                             std::span<const uint8_t> prev_level, std::span<const uint8_t> was_visible,
+                             std::span<const float> distance, std::span<const float> scale,
+                             std::span<const uint32_t> model, const ModelTable& models,
+                             const InitialLevelParams& params) {
+  const size_t n = visible.size();
+  assert(level.size() == n && prev_level.size() == n && was_visible.size() == n &&
+         distance.size() == n && scale.size() == n && model.size() == n);
+  const float fine_limit = params.pixel_error;
+  const float coarse_limit = params.pixel_error * (1.0f + params.hysteresis);
+  const uint32_t* first = models.first_level.data();
+  const uint8_t* counts = models.level_count.data();
+  const float* error = models.error.data();
+  size_t written = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!visible[i]) continue;
+    const uint32_t m = model[i];
+    assert(m < models.model_count());
+    const float* e = error + first[m];
+    const uint32_t count = counts[m];
+    const float pixels_per_unit = scale[i] * params.focal_px / distance[i];
+    // Errors grow with the level index (validate_chain), so "coarsest level within the limit"
+    // is the number of levels after 0 that are within it; level 0 always qualifies.
+    uint32_t k_fine = 0, k_coarse = 0;
+    for (uint32_t k = 1; k < count; ++k) {
+      const float projected = e[k] * pixels_per_unit;
+      k_fine += projected <= fine_limit;
+      k_coarse += projected <= coarse_limit;
+    }
+    uint32_t chosen = k_fine;
+    // Last frame's level survives while it stays inside [k_fine, k_coarse]: refine only when
+    // its error exceeds the threshold by the band, coarsen as soon as a coarser level fits.
+    if (was_visible[i]) chosen = std::clamp<uint32_t>(prev_level[i], k_fine, k_coarse);
+    level[i] = static_cast<uint8_t>(chosen);
+    ++written;
+  }
+  return written;
+}
+
+}  // namespace lod

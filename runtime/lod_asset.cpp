@@ -1,0 +1,372 @@
+// The .lod asset, version 1. All integers and floats little-endian:
+//
+//   magic "LODKIT\x1a\n" (8) | u32 version | u32 section count
+//   section table: count x {u32 tag, u32 flags, u64 offset, u64 size}
+//   sections, each 8-byte aligned: META, LEVL, POSN, NRML, INDX
+//   u64 checksum = hash_bytes(everything before it)
+//
+// META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
+//       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
+//       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
+//       unknown optional sections are skipped, so later versions can add data compatibly.
+// The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
+#include "runtime/lod_asset.h"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <string_view>
+#include <system_error>
+
+namespace lod {
+
+namespace {
+
+constexpr char kMagic[8] = {'L', 'O', 'D', 'K', 'I', 'T', '\x1a', '\n'};
+constexpr size_t kHeaderBytes = 16;
+constexpr size_t kTableEntryBytes = 24;
+constexpr size_t kChecksumBytes = 8;
+constexpr size_t kMetaFixedBytes = 40;
+constexpr size_t kLevelBytes = 44;
+constexpr uint32_t kFlagRequired = 1;
+constexpr uint32_t kMaxSections = 64;
+
+constexpr uint32_t fourcc(const char (&s)[5]) {
+  return uint32_t(uint8_t(s[0])) | uint32_t(uint8_t(s[1])) << 8 | uint32_t(uint8_t(s[2])) << 16 |
+         uint32_t(uint8_t(s[3])) << 24;
+}
+constexpr uint32_t kMeta = fourcc("META");
+constexpr uint32_t kLevl = fourcc("LEVL");
+constexpr uint32_t kPosn = fourcc("POSN");
+constexpr uint32_t kNrml = fourcc("NRML");
+constexpr uint32_t kIndx = fourcc("INDX");
+constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
+
+std::string tag_name(uint32_t tag) {
+  std::string s;
+  for (int i = 0; i < 4; ++i) {
+    const char c = static_cast<char>((tag >> (8 * i)) & 0xff);
+    s += (c >= 0x20 && c < 0x7f) ? c : '?';
+  }
+  return s;
+}
+
+inline uint64_t load_u64(const uint8_t* p) {
+  uint64_t v;
+  std::memcpy(&v, p, 8);
+  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap64(v);
+  return v;
+}
+inline uint32_t load_u32(const uint8_t* p) {
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap32(v);
+  return v;
+}
+inline float load_f32(const uint8_t* p) { return std::bit_cast<float>(load_u32(p)); }
+
+struct Writer {
+  std::vector<uint8_t> bytes;
+  void u32(uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void u64(uint64_t v) {
+    for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
+  void raw(const void* data, size_t size) {
+    const auto* p = static_cast<const uint8_t*>(data);
+    bytes.insert(bytes.end(), p, p + size);
+  }
+  void align8() {
+    while (bytes.size() % 8 != 0) bytes.push_back(0);
+  }
+  void patch_u64(size_t at, uint64_t v) {
+    for (int i = 0; i < 8; ++i) bytes[at + i] = static_cast<uint8_t>(v >> (8 * i));
+  }
+};
+
+void put_level(Writer& w, const LodLevel& lv) {
+  w.u32(lv.first_index);
+  w.u32(lv.index_count);
+  w.u32(lv.first_vertex);
+  w.u32(lv.vertex_count);
+  w.u32(static_cast<uint32_t>(lv.level));
+  w.f32(lv.error);
+  w.f32(lv.error_rms);
+  w.f32(lv.bounds.center[0]);
+  w.f32(lv.bounds.center[1]);
+  w.f32(lv.bounds.center[2]);
+  w.f32(lv.bounds.radius);
+}
+
+LodLevel get_level(const uint8_t* p) {
+  LodLevel lv;
+  lv.first_index = load_u32(p);
+  lv.index_count = load_u32(p + 4);
+  lv.first_vertex = load_u32(p + 8);
+  lv.vertex_count = load_u32(p + 12);
+  lv.level = static_cast<int32_t>(load_u32(p + 16));
+  lv.error = load_f32(p + 20);
+  lv.error_rms = load_f32(p + 24);
+  lv.bounds.center[0] = load_f32(p + 28);
+  lv.bounds.center[1] = load_f32(p + 32);
+  lv.bounds.center[2] = load_f32(p + 36);
+  lv.bounds.radius = load_f32(p + 40);
+  return lv;
+}
+
+void put_floats(Writer& w, const std::vector<float>& v) {
+  if constexpr (std::endian::native == std::endian::little) {
+    w.raw(v.data(), v.size() * sizeof(float));
+  } else {
+    for (float f : v) w.f32(f);
+  }
+}
+
+template <class T>
+void get_words(const uint8_t* p, size_t count, std::vector<T>& out) {
+  static_assert(sizeof(T) == 4);
+  out.resize(count);
+  if constexpr (std::endian::native == std::endian::little) {
+    if (count) std::memcpy(out.data(), p, count * 4);
+  } else {
+    for (size_t i = 0; i < count; ++i) out[i] = std::bit_cast<T>(load_u32(p + 4 * i));
+  }
+}
+
+struct SectionRef {
+  uint64_t offset = 0;
+  uint64_t size = 0;
+  bool present = false;
+};
+
+Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
+
+}  // namespace
+
+uint64_t hash_bytes(const void* data, size_t size, uint64_t seed) {
+  // Four independent lanes of h = rotl(h ^ w * k1, 29) * k2 over 8-byte words, combined and
+  // finished with murmur's fmix64. Every step is a bijection of the word and of the lane, so
+  // changing any single word (in particular any single byte) always changes the hash.
+  constexpr uint64_t k1 = 0x87c37b91114253d5ull, k2 = 0x4cf5ad432745937full;
+  constexpr uint64_t basis = 0xcbf29ce484222325ull, golden = 0x9e3779b97f4a7c15ull;
+  auto step = [](uint64_t h, uint64_t w) { return std::rotl(h ^ (w * k1), 29) * k2; };
+  auto fmix = [](uint64_t k) {
+    k ^= k >> 33;
+    k *= 0xff51afd7ed558ccdull;
+    k ^= k >> 33;
+    k *= 0xc4ceb9fe1a85ec53ull;
+    k ^= k >> 33;
+    return k;
+  };
+  const auto* p = static_cast<const uint8_t*>(data);
+  uint64_t lane[4];
+  for (int i = 0; i < 4; ++i) lane[i] = (basis ^ seed) + golden * static_cast<uint64_t>(i + 1);
+  size_t i = 0;
+  for (; i + 32 <= size; i += 32) {
+    lane[0] = step(lane[0], load_u64(p + i));
+    lane[1] = step(lane[1], load_u64(p + i + 8));
+    lane[2] = step(lane[2], load_u64(p + i + 16));
+    lane[3] = step(lane[3], load_u64(p + i + 24));
+  }
+  int l = 0;
+  for (; i + 8 <= size; i += 8) lane[l] = step(lane[l], load_u64(p + i)), ++l;
+  if (i < size) {
+    uint64_t tail = 0;
+    for (size_t b = 0; i + b < size; ++b) tail |= uint64_t{p[i + b]} << (8 * b);
+    lane[l] = step(lane[l], tail);
+  }
+  uint64_t h = seed ^ golden;
+  for (int j = 0; j < 4; ++j) h = (h ^ fmix(lane[j])) * k2;
+  return fmix(h ^ static_cast<uint64_t>(size));
+}
+
+std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
+  Writer w;
+  const uint32_t tags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
+  constexpr uint32_t section_count = 5;
+  w.raw(kMagic, sizeof(kMagic));
+  w.u32(kLodAssetVersion);
+  w.u32(section_count);
+  const size_t table = w.bytes.size();
+  for (uint32_t s = 0; s < section_count; ++s) {
+    w.u32(tags[s]);
+    w.u32(kFlagRequired);
+    w.u64(0);  // offset, patched below
+    w.u64(0);  // size
+  }
+  auto section = [&](uint32_t s, auto&& body) {
+    w.align8();
+    const size_t begin = w.bytes.size();
+    body();
+    w.patch_u64(table + s * kTableEntryBytes + 8, begin);
+    w.patch_u64(table + s * kTableEntryBytes + 16, w.bytes.size() - begin);
+  };
+  section(0, [&] {
+    w.u64(chain.source_hash);
+    w.u32(static_cast<uint32_t>(chain.levels.size()));
+    w.u32(static_cast<uint32_t>(chain.name.size()));
+    w.u64(chain.positions.size() / 3);
+    w.u64(chain.normals.size() / 3);
+    w.u64(chain.indices.size());
+    w.raw(chain.name.data(), chain.name.size());
+  });
+  section(1, [&] {
+    for (const LodLevel& lv : chain.levels) put_level(w, lv);
+  });
+  section(2, [&] { put_floats(w, chain.positions); });
+  section(3, [&] { put_floats(w, chain.normals); });
+  section(4, [&] {
+    if constexpr (std::endian::native == std::endian::little) {
+      w.raw(chain.indices.data(), chain.indices.size() * sizeof(uint32_t));
+    } else {
+      for (uint32_t v : chain.indices) w.u32(v);
+    }
+  });
+  w.align8();
+  w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
+  return std::move(w.bytes);
+}
+
+Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what, LodChain& out) {
+  const uint8_t* p = bytes.data();
+  const uint64_t size = bytes.size();
+  if (size < kHeaderBytes + kChecksumBytes)
+    return refuse(what, "file is " + std::to_string(size) + " bytes, too short for a lodkit asset (" +
+                            std::to_string(kHeaderBytes + kChecksumBytes) + " at least; truncated?)");
+  if (std::memcmp(p, kMagic, sizeof(kMagic)) != 0)
+    return refuse(what, "not a lodkit asset (bad magic bytes)");
+  const uint32_t version = load_u32(p + 8);
+  if (version != kLodAssetVersion)
+    return refuse(what, "asset version " + std::to_string(version) + " is not supported (this build reads version " +
+                            std::to_string(kLodAssetVersion) + "); re-bake it");
+  const uint32_t section_count = load_u32(p + 12);
+  if (section_count > kMaxSections)
+    return refuse(what, "section count " + std::to_string(section_count) + " exceeds " +
+                            std::to_string(kMaxSections) + " (corrupted header)");
+  const uint64_t table_end = kHeaderBytes + uint64_t{section_count} * kTableEntryBytes;
+  if (table_end + kChecksumBytes > size)
+    return refuse(what, "truncated: file is " + std::to_string(size) + " bytes, its section table alone needs " +
+                            std::to_string(table_end + kChecksumBytes));
+  // Where the sections say the file ends: a shorter file was cut off (reported as such
+  // rather than as a checksum mismatch, which would also catch it).
+  uint64_t sections_end = table_end;
+  for (uint32_t s = 0; s < section_count; ++s) {
+    const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
+    const uint64_t off = load_u64(e + 8), sz = load_u64(e + 16);
+    if (off <= size && sz <= size) sections_end = std::max(sections_end, off + sz);
+    else sections_end = UINT64_MAX;
+  }
+  if (sections_end != UINT64_MAX && sections_end + kChecksumBytes > size)
+    return refuse(what, "truncated: file is " + std::to_string(size) + " bytes, its sections need " +
+                            std::to_string(sections_end + kChecksumBytes));
+  const uint64_t body = size - kChecksumBytes;
+  const uint64_t stored = load_u64(p + body);
+  const uint64_t computed = hash_bytes(p, body);
+  if (stored != computed)
+    return refuse(what, "checksum mismatch (file is corrupted or truncated)");
+
+  SectionRef sec[5];
+  for (uint32_t s = 0; s < section_count; ++s) {
+    const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
+    const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
+    const uint64_t off = load_u64(e + 8), sz = load_u64(e + 16);
+    const std::string name = "section " + std::to_string(s) + " '" + tag_name(tag) + "'";
+    if (off < table_end || off > body || sz > body - off)
+      return refuse(what, name + " [" + std::to_string(off) + ", +" + std::to_string(sz) +
+                              ") lies outside the data area [" + std::to_string(table_end) + ", " +
+                              std::to_string(body) + ")");
+    size_t known = 0;
+    while (known < 5 && kKnownTags[known] != tag) ++known;
+    if (known == 5) {
+      if (flags & kFlagRequired) return refuse(what, name + " is required but unknown to this build");
+      continue;
+    }
+    if (sec[known].present) return refuse(what, name + " appears twice");
+    sec[known] = {off, sz, true};
+  }
+  for (size_t k = 0; k < 5; ++k) {
+    if (!sec[k].present) return refuse(what, "section '" + tag_name(kKnownTags[k]) + "' is missing");
+  }
+
+  const SectionRef& meta = sec[0];
+  if (meta.size < kMetaFixedBytes)
+    return refuse(what, "META section is " + std::to_string(meta.size) + " bytes, needs " +
+                            std::to_string(kMetaFixedBytes));
+  const uint8_t* m = p + meta.offset;
+  LodChain chain;
+  chain.source_hash = load_u64(m);
+  const uint32_t level_count = load_u32(m + 8);
+  const uint32_t name_bytes = load_u32(m + 12);
+  const uint64_t vertices = load_u64(m + 16);
+  const uint64_t normal_vertices = load_u64(m + 24);
+  const uint64_t indices = load_u64(m + 32);
+  if (meta.size != kMetaFixedBytes + uint64_t{name_bytes})
+    return refuse(what, "META section is " + std::to_string(meta.size) + " bytes but its name needs " +
+                            std::to_string(kMetaFixedBytes + uint64_t{name_bytes}));
+  chain.name.assign(reinterpret_cast<const char*>(m + kMetaFixedBytes), name_bytes);
+  // Counts are checked against section sizes before any multiplication can overflow.
+  auto expect = [&](const SectionRef& s, const char* label, uint64_t count, uint64_t stride) -> Status {
+    if (count > s.size || count * stride != s.size)
+      return refuse(what, std::string(label) + " section is " + std::to_string(s.size) + " bytes but META says " +
+                              std::to_string(count) + " x " + std::to_string(stride));
+    return Status::success();
+  };
+  if (Status st = expect(sec[1], "LEVL", level_count, kLevelBytes); !st) return st;
+  if (Status st = expect(sec[2], "POSN", vertices, 12); !st) return st;
+  if (Status st = expect(sec[3], "NRML", normal_vertices, 12); !st) return st;
+  if (Status st = expect(sec[4], "INDX", indices, 4); !st) return st;
+
+  chain.levels.resize(level_count);
+  for (uint32_t k = 0; k < level_count; ++k) chain.levels[k] = get_level(p + sec[1].offset + k * kLevelBytes);
+  get_words(p + sec[2].offset, vertices * 3, chain.positions);
+  get_words(p + sec[3].offset, normal_vertices * 3, chain.normals);
+  get_words(p + sec[4].offset, indices, chain.indices);
+
+  std::string message;
+  if (!validate_chain(chain, &message)) return refuse(what, message);
+  out = std::move(chain);
+  return Status::success();
+}
+
+Status write_lod_asset(const std::filesystem::path& path, const LodChain& chain) {
+  const std::vector<uint8_t> bytes = encode_lod_asset(chain);
+  std::filesystem::path tmp = path;
+  tmp += ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) return refuse(path.string(), std::string("cannot create ") + tmp.string() + ": " + std::strerror(errno));
+    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    f.flush();
+    if (!f) {
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
+      return refuse(path.string(), "write failed after " + std::to_string(bytes.size()) + " bytes requested");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    return refuse(path.string(), "cannot rename " + tmp.string() + ": " + ec.message());
+  }
+  return Status::success();
+}
+
+Status read_lod_asset(const std::filesystem::path& path, LodChain& out) {
+  std::ifstream f(path, std::ios::binary | std::ios::ate);
+  if (!f) return refuse(path.string(), std::string("cannot open: ") + std::strerror(errno));
+  const std::streamoff end = f.tellg();
+  if (end < 0) return refuse(path.string(), "cannot determine its size");
+  std::vector<uint8_t> bytes(static_cast<size_t>(end));
+  f.seekg(0);
+  if (!bytes.empty() && !f.read(reinterpret_cast<char*>(bytes.data()), end))
+    return refuse(path.string(), "read failed");
+  return decode_lod_asset(bytes, path.string(), out);
+}
+
+}  // namespace lod

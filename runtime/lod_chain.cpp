@@ -1,0 +1,99 @@
+// LodChain facts: R0's level l = round(log2(triangles)) and the structural checks every
+// chain passes before the runtime trusts it (asset decode, bake output).
+#include "runtime/lod_chain.h"
+
+#include <cmath>
+#include <string>
+
+#include "runtime/model_table.h"
+
+namespace lod {
+
+int32_t level_of_triangles(uint64_t triangles) {
+  if (triangles == 0) return 0;
+  // log2 of an integer is never exactly k + 0.5, so rounding has no ties to break.
+  return static_cast<int32_t>(std::lround(std::log2(static_cast<double>(triangles))));
+}
+
+namespace {
+
+bool fail(std::string* message, std::string text) {
+  if (message) *message = std::move(text);
+  return false;
+}
+
+bool all_finite(const std::vector<float>& values, size_t* bad) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      *bad = i;
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool validate_chain(const LodChain& chain, std::string* message) {
+  if (chain.levels.empty()) return fail(message, "chain has no levels");
+  if (chain.levels.size() > kMaxLevels)
+    return fail(message, "chain has " + std::to_string(chain.levels.size()) + " levels, at most " +
+                             std::to_string(kMaxLevels) + " are supported");
+  if (chain.positions.size() % 3 != 0)
+    return fail(message, "positions hold " + std::to_string(chain.positions.size()) +
+                             " floats, not a multiple of 3");
+  if (!chain.normals.empty() && chain.normals.size() != chain.positions.size())
+    return fail(message, "normals hold " + std::to_string(chain.normals.size()) + " floats but positions " +
+                             std::to_string(chain.positions.size()));
+  size_t bad = 0;
+  if (!all_finite(chain.positions, &bad))
+    return fail(message, "vertex " + std::to_string(bad / 3) + " has a non-finite position");
+  if (!all_finite(chain.normals, &bad))
+    return fail(message, "vertex " + std::to_string(bad / 3) + " has a non-finite normal");
+
+  const uint64_t vertex_total = chain.positions.size() / 3;
+  const uint64_t index_total = chain.indices.size();
+  for (size_t k = 0; k < chain.levels.size(); ++k) {
+    const LodLevel& lv = chain.levels[k];
+    const std::string at = "level " + std::to_string(k);
+    if (lv.index_count % 3 != 0)
+      return fail(message, at + " has " + std::to_string(lv.index_count) + " indices, not a multiple of 3");
+    if (uint64_t{lv.first_index} + lv.index_count > index_total)
+      return fail(message, at + " indices [" + std::to_string(lv.first_index) + ", " +
+                               std::to_string(uint64_t{lv.first_index} + lv.index_count) +
+                               ") exceed the " + std::to_string(index_total) + " stored");
+    if (uint64_t{lv.first_vertex} + lv.vertex_count > vertex_total)
+      return fail(message, at + " vertices [" + std::to_string(lv.first_vertex) + ", " +
+                               std::to_string(uint64_t{lv.first_vertex} + lv.vertex_count) +
+                               ") exceed the " + std::to_string(vertex_total) + " stored");
+    const uint32_t* idx = chain.indices.data() + lv.first_index;
+    for (uint32_t i = 0; i < lv.index_count; ++i) {
+      if (idx[i] >= lv.vertex_count)
+        return fail(message, at + " index " + std::to_string(i) + " references vertex " +
+                                 std::to_string(idx[i]) + " of " + std::to_string(lv.vertex_count));
+    }
+    if (lv.level != level_of_triangles(lv.triangles()))
+      return fail(message, at + " says l = " + std::to_string(lv.level) + " but its " +
+                               std::to_string(lv.triangles()) + " triangles give l = " +
+                               std::to_string(level_of_triangles(lv.triangles())));
+    if (!std::isfinite(lv.error) || lv.error < 0 || !std::isfinite(lv.error_rms) || lv.error_rms < 0)
+      return fail(message, at + " has an invalid error (" + std::to_string(lv.error) + ", rms " +
+                               std::to_string(lv.error_rms) + ")");
+    const Sphere& s = lv.bounds;
+    if (!std::isfinite(s.center[0]) || !std::isfinite(s.center[1]) || !std::isfinite(s.center[2]) ||
+        !std::isfinite(s.radius) || s.radius < 0)
+      return fail(message, at + " has an invalid bounding sphere");
+    if (k > 0) {
+      const LodLevel& finer = chain.levels[k - 1];
+      if (lv.triangles() > finer.triangles())
+        return fail(message, at + " has " + std::to_string(lv.triangles()) + " triangles, more than level " +
+                                 std::to_string(k - 1) + "'s " + std::to_string(finer.triangles()));
+      if (lv.error < finer.error)
+        return fail(message, at + " error " + std::to_string(lv.error) + " is below level " +
+                                 std::to_string(k - 1) + "'s " + std::to_string(finer.error));
+    }
+  }
+  return true;
+}
+
+}  // namespace lod

@@ -1,0 +1,173 @@
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+
+#include "runtime/lod_asset.h"
+#include "test_support.h"
+#include "unit/runtime/runtime_fixtures.h"
+
+namespace lod {
+namespace {
+
+LodChain sample_chain() {
+  LodChain c = test::fan_chain("bunny", {9, 4, 2});
+  c.normals[1] = -0.0f;  // bit-exact means the sign of zero survives too
+  c.positions[4] = 1e-40f;  // a denormal
+  return c;
+}
+
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+void expect_same_chain(const LodChain& a, const LodChain& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.source_hash, b.source_hash);
+  ASSERT_EQ(a.levels.size(), b.levels.size());
+  for (size_t k = 0; k < a.levels.size(); ++k) EXPECT_EQ(std::memcmp(&a.levels[k], &b.levels[k], sizeof(LodLevel)), 0);
+  EXPECT_TRUE(same_bits(a.positions, b.positions));
+  EXPECT_TRUE(same_bits(a.normals, b.normals));
+  EXPECT_EQ(a.indices, b.indices);
+}
+
+// What `decode` must leave alone when it refuses.
+LodChain sentinel() {
+  LodChain s;
+  s.name = "untouched";
+  return s;
+}
+
+TEST(LodAsset, RoundTripIsBitExact) {
+  const LodChain c = sample_chain();
+  const std::vector<uint8_t> bytes = encode_lod_asset(c);
+  EXPECT_EQ(bytes.size() % 8, 0u);
+  LodChain back;
+  const Status st = decode_lod_asset(bytes, "bunny.lod", back);
+  ASSERT_TRUE(st) << st.message;
+  expect_same_chain(c, back);
+  EXPECT_EQ(encode_lod_asset(back), bytes);
+}
+
+TEST(LodAsset, RoundTripsChainWithoutNormalsOrName) {
+  LodChain c = test::fan_chain("", {1});
+  c.normals.clear();
+  LodChain back;
+  ASSERT_TRUE(decode_lod_asset(encode_lod_asset(c), "x.lod", back));
+  expect_same_chain(c, back);
+}
+
+TEST(LodAsset, WritesThroughTemporaryFileAndReadsBack) {
+  const auto dir = test::temp_dir("asset");
+  const auto path = dir / "bunny.lod";
+  const LodChain c = sample_chain();
+  ASSERT_TRUE(write_lod_asset(path, c));
+  EXPECT_FALSE(std::filesystem::exists(dir / "bunny.lod.tmp"));
+  LodChain back;
+  const Status st = read_lod_asset(path, back);
+  ASSERT_TRUE(st) << st.message;
+  expect_same_chain(c, back);
+  ASSERT_TRUE(write_lod_asset(path, test::fan_chain("other", {2})));  // replaces
+  ASSERT_TRUE(read_lod_asset(path, back));
+  EXPECT_EQ(back.name, "other");
+}
+
+TEST(LodAsset, RefusesTruncationAtEveryOffset) {
+  const std::vector<uint8_t> bytes = encode_lod_asset(sample_chain());
+  for (size_t len = 0; len < bytes.size(); ++len) {
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(std::span(bytes).first(len), "bunny.lod", out);
+    ASSERT_FALSE(st) << "accepted a file cut to " << len << " of " << bytes.size() << " bytes";
+    EXPECT_EQ(st.message.rfind("bunny.lod: ", 0), 0u) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+}
+
+TEST(LodAsset, RefusesEverySingleFlippedByte) {
+  const std::vector<uint8_t> bytes = encode_lod_asset(sample_chain());
+  for (size_t at = 0; at < bytes.size(); ++at) {
+    for (uint8_t mask : {0x01, 0x80, 0xff}) {
+      std::vector<uint8_t> bad = bytes;
+      bad[at] ^= mask;
+      LodChain out = sentinel();
+      ASSERT_FALSE(decode_lod_asset(bad, "bunny.lod", out)) << "byte " << at << " ^ " << int(mask);
+      EXPECT_EQ(out.name, "untouched");
+    }
+  }
+}
+
+TEST(LodAsset, RefusesWrongVersionSayingWhichVersions) {
+  std::vector<uint8_t> bytes = encode_lod_asset(sample_chain());
+  bytes[8] = 2;
+  LodChain out;
+  const Status st = decode_lod_asset(bytes, "old.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("old.lod"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("version 2"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("version 1"), std::string::npos) << st.message;
+}
+
+TEST(LodAsset, RefusesWrongMagicSayingSo) {
+  std::vector<uint8_t> bytes = encode_lod_asset(sample_chain());
+  bytes[6] = '\r';  // as a text-mode transfer would
+  LodChain out;
+  const Status st = decode_lod_asset(bytes, "model.ply", out);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("magic"), std::string::npos) << st.message;
+  const std::vector<uint8_t> text(64, 'a');
+  EXPECT_FALSE(decode_lod_asset(text, "t.txt", out));
+}
+
+TEST(LodAsset, RefusesInvalidChainWithCorrectChecksumNamingTheElement) {
+  LodChain c = test::fan_chain("bunny", {6, 3});
+  c.indices[c.levels[1].first_index + 4] = 9;
+  LodChain out = sentinel();
+  const Status st = decode_lod_asset(encode_lod_asset(c), "bunny.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.message, "bunny.lod: level 1 index 4 references vertex 9 of 5");
+  EXPECT_EQ(out.name, "untouched");
+}
+
+TEST(LodAsset, ReadingMissingOrEmptyFileNamesIt) {
+  const auto dir = test::temp_dir("asset-missing");
+  LodChain out;
+  Status st = read_lod_asset(dir / "nope.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("nope.lod"), std::string::npos) << st.message;
+  test::write_bytes(dir / "empty.lod", {});
+  st = read_lod_asset(dir / "empty.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("empty.lod"), std::string::npos) << st.message;
+}
+
+TEST(HashBytes, IsDeterministicAndSeeded) {
+  std::vector<uint8_t> data(1000);
+  for (size_t i = 0; i < data.size(); ++i) data[i] = static_cast<uint8_t>(i * 37 + 11);
+  EXPECT_EQ(hash_bytes(data.data(), data.size()), hash_bytes(data.data(), data.size()));
+  EXPECT_NE(hash_bytes(data.data(), data.size(), 1), hash_bytes(data.data(), data.size(), 2));
+  EXPECT_EQ(hash_bytes(nullptr, 0), hash_bytes(data.data(), 0));
+  const uint8_t a[2] = {'a', 0};
+  EXPECT_NE(hash_bytes(a, 1), hash_bytes(a, 2));  // trailing zero bytes count
+}
+
+TEST(HashBytes, ChangesWithEverySingleByteOfAnyLength) {
+  for (size_t n : {1u, 7u, 8u, 9u, 31u, 32u, 33u, 70u}) {
+    std::vector<uint8_t> data(n, 0x5a);
+    const uint64_t h = hash_bytes(data.data(), n);
+    for (size_t at = 0; at < n; ++at) {
+      data[at] ^= 0x10;
+      EXPECT_NE(hash_bytes(data.data(), n), h) << n << " " << at;
+      data[at] ^= 0x10;
+    }
+  }
+}
+
+TEST(HashBytes, SwappedWordsDoNotCollide) {
+  uint64_t w[4] = {1, 2, 3, 4}, s[4] = {2, 1, 3, 4}, t[4] = {1, 2, 4, 3};
+  EXPECT_NE(hash_bytes(w, 32), hash_bytes(s, 32));
+  EXPECT_NE(hash_bytes(w, 32), hash_bytes(t, 32));
+}
+
+}  // namespace
+}  // namespace lod
