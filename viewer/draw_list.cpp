@@ -1,0 +1,67 @@
+// Counting sort of a frame's visible objects by (model, level): two passes over the frame,
+// no per-frame allocation once the list has grown to the scene's size.
+#include "viewer/draw_list.h"
+
+#include <algorithm>
+
+namespace lod::viewer {
+
+void build_draw_list(const Frame& frame, const ObjectSet& objects, const MeshLayout& layout, DrawList& out) {
+  out.batches.clear();
+  out.triangles = 0;
+  out.indices = 0;
+  out.rejected = 0;
+  std::vector<uint32_t>& slot = out.per_batch_slot;
+  slot.assign(layout.ranges.size() + 1, 0);
+
+  // A torn frame could have arrays of different lengths; draw only the common prefix.
+  const size_t n = std::min({frame.objects.size(), frame.levels.size(), frame.morph.size()});
+  auto range_of = [&](size_t i, uint32_t* range) {
+    const uint32_t id = frame.objects[i];
+    if (id >= objects.size()) return false;
+    const uint32_t model = objects.model[id];
+    if (model >= layout.level_count.size() || frame.levels[i] >= layout.level_count[model]) return false;
+    *range = layout.range_of(model, frame.levels[i]);
+    return true;
+  };
+
+  uint32_t drawn = 0;
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t r;
+    if (range_of(i, &r)) {
+      ++slot[r + 1];
+      ++drawn;
+    } else {
+      ++out.rejected;
+    }
+  }
+  for (size_t r = 1; r < slot.size(); ++r) slot[r] += slot[r - 1];  // slot[r] = first instance of range r
+
+  for (uint32_t model = 0; model < layout.level_count.size(); ++model) {
+    for (uint32_t level = 0; level < layout.level_count[model]; ++level) {
+      const uint32_t r = layout.range_of(model, level);
+      const uint32_t count = slot[r + 1] - slot[r];
+      if (count == 0) continue;
+      out.batches.push_back({r, model, level, slot[r], count});
+      const uint64_t idx = uint64_t(layout.ranges[r].index_count) * count;
+      out.indices += idx;
+      out.triangles += idx / 3;
+    }
+  }
+
+  out.instances.resize(drawn);
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t r;
+    if (!range_of(i, &r)) continue;
+    const uint32_t id = frame.objects[i];
+    InstanceData& d = out.instances[slot[r]++];
+    d.position_scale[0] = objects.x[id];
+    d.position_scale[1] = objects.y[id];
+    d.position_scale[2] = objects.z[id];
+    d.position_scale[3] = objects.scale[id];
+    d.yaw = objects.yaw[id];
+    d.morph = frame.morph[i];
+  }
+}
+
+}  // namespace lod::viewer

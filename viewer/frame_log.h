@@ -1,0 +1,46 @@
+// FrameLog: one row per viewer frame (what was drawn, from which LOD frame, how long it took),
+// written as CSV with --stats and summarised at exit (viewer frame-time percentiles).
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "runtime/status.h"
+
+namespace lod::viewer {
+
+struct FrameRow {
+  uint64_t viewer_frame = 0;
+  uint64_t lod_frame = 0;        // Frame::index drawn
+  uint32_t visible = 0;
+  uint64_t tris_selected = 0;    // Frame::tris_selected
+  uint64_t drawn = 0;            // triangles submitted
+  int64_t gpu_primitives = -1;   // GL_PRIMITIVES_GENERATED, -1 when not queried
+  uint32_t draws = 0;
+  uint32_t levels_drawn = 0;     // distinct chain levels among the draws
+  uint32_t rejected = 0;         // frame entries the draw list refused
+  int whole = 1;                 // frame_is_whole()
+  double viewer_ms = 0;          // this viewer frame, CPU wall time
+  double lod_ms = 0;             // Frame::total_ms
+};
+
+struct FrameTimeSummary {
+  size_t frames = 0;
+  double mean_ms = 0, p50_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0;
+  uint64_t lod_frames_seen = 0;  // distinct LOD frames drawn
+};
+
+class FrameLog {
+ public:
+  void add(const FrameRow& row) { rows_.push_back(row); }
+  const std::vector<FrameRow>& rows() const { return rows_; }
+  // `skip` first frames (start-up) are left out of the percentiles.
+  FrameTimeSummary summary(size_t skip) const;
+  Status write_csv(const std::filesystem::path& path) const;
+
+ private:
+  std::vector<FrameRow> rows_;
+};
+
+}  // namespace lod::viewer

@@ -1,0 +1,33 @@
+// FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
+// clear, build the draw list, one instanced draw per (model, level).
+#pragma once
+#include <span>
+#include <string>
+
+#include "jobs/scene.h"
+#include "runtime/frame.h"
+#include "runtime/view.h"
+#include "viewer/draw_list.h"
+#include "viewer/instance_renderer.h"
+#include "viewer/mesh_buffers.h"
+
+namespace lod::viewer {
+
+class FrameRenderer {
+ public:
+  // Uploads every level of every chain; false with the reason in `message`.
+  bool init(const Scene& scene, std::string* message);
+  // `viewing` also gives the viewport size (width x height pixels).
+  DrawStats render(const Frame& frame, const View& viewing, const RenderSettings& settings);
+
+  const DrawList& draw_list() const { return list_; }
+  const MeshBuffers& meshes() const { return meshes_; }
+
+ private:
+  const Scene* scene_ = nullptr;
+  MeshBuffers meshes_;
+  InstanceRenderer instances_;
+  DrawList list_;
+};
+
+}  // namespace lod::viewer

@@ -1,0 +1,131 @@
+#include "viewer/instance_renderer.h"
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "viewer/level_palette.h"
+#include "viewer/shader_program.h"
+
+namespace lod::viewer {
+
+namespace {
+
+// world = R_y(yaw) * (scale * p) + position, the transform place_instances gives objects.
+const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec4 i_position_scale;
+layout(location = 3) in vec2 i_yaw_morph;
+uniform mat4 u_view;
+uniform mat4 u_projection;
+out vec3 v_position_view;
+out vec3 v_normal_view;
+out float v_morph;
+vec3 rotate_y(vec3 p, float c, float s) { return vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z); }
+void main() {
+  float c = cos(i_yaw_morph.x), s = sin(i_yaw_morph.x);
+  vec3 world = rotate_y(a_position * i_position_scale.w, c, s) + i_position_scale.xyz;
+  vec4 view_pos = u_view * vec4(world, 1.0);
+  v_position_view = view_pos.xyz;
+  v_normal_view = mat3(u_view) * rotate_y(a_normal, c, s);
+  // Geomorph factor towards the selected level: the morph target stream plugs in here,
+  // position = mix(from, to, morph); until then only the colour shows it.
+  v_morph = i_yaw_morph.y;
+  gl_Position = u_projection * view_pos;
+}
+)";
+
+const char* kFragmentShader = R"(#version 330 core
+in vec3 v_position_view;
+in vec3 v_normal_view;
+in float v_morph;
+uniform vec3 u_colour;
+uniform int u_flat;
+uniform int u_show_morph;
+out vec4 o_colour;
+void main() {
+  vec3 face = normalize(cross(dFdx(v_position_view), dFdy(v_position_view)));
+  vec3 n = (u_flat != 0 || dot(v_normal_view, v_normal_view) < 1e-12) ? face : normalize(v_normal_view);
+  vec3 to_eye = normalize(-v_position_view);
+  float lambert = abs(dot(n, to_eye));  // headlight; abs so either winding is lit
+  vec3 base = u_colour;
+  if (u_show_morph != 0) base = mix(base, vec3(1.0), 0.5 * clamp(1.0 - v_morph, 0.0, 1.0));
+  o_colour = vec4(base * (0.25 + 0.75 * lambert), 1.0);
+}
+)";
+
+}  // namespace
+
+InstanceRenderer::~InstanceRenderer() {
+  if (query_) glDeleteQueries(1, &query_);
+  if (instance_vbo_) glDeleteBuffers(1, &instance_vbo_);
+  if (program_) glDeleteProgram(program_);
+}
+
+bool InstanceRenderer::init(std::string* message) {
+  program_ = build_program("instance", kVertexShader, kFragmentShader, message);
+  if (!program_) return false;
+  u_view_ = glGetUniformLocation(program_, "u_view");
+  u_projection_ = glGetUniformLocation(program_, "u_projection");
+  u_colour_ = glGetUniformLocation(program_, "u_colour");
+  u_flat_ = glGetUniformLocation(program_, "u_flat");
+  u_show_morph_ = glGetUniformLocation(program_, "u_show_morph");
+  glGenBuffers(1, &instance_vbo_);
+  glGenQueries(1, &query_);
+  return true;
+}
+
+DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, const glm::mat4& view,
+                                 const glm::mat4& projection, const RenderSettings& settings) {
+  DrawStats stats;
+  glUseProgram(program_);
+  glUniformMatrix4fv(u_view_, 1, GL_FALSE, glm::value_ptr(view));
+  glUniformMatrix4fv(u_projection_, 1, GL_FALSE, glm::value_ptr(projection));
+  glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
+  glUniform1i(u_show_morph_, settings.colour_by_level ? 1 : 0);
+
+  glBindVertexArray(meshes.vao());
+  glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
+  const size_t bytes = list.instances.size() * sizeof(InstanceData);
+  if (bytes > instance_capacity_) instance_capacity_ = bytes + bytes / 2;
+  // Fresh (orphaned) storage every frame, so the driver never waits for last frame's draws.
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(instance_capacity_), nullptr, GL_STREAM_DRAW);
+  if (bytes) glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), list.instances.data());
+  glEnableVertexAttribArray(kAttribInstancePositionScale);
+  glEnableVertexAttribArray(kAttribInstanceYawMorph);
+  glVertexAttribDivisor(kAttribInstancePositionScale, 1);
+  glVertexAttribDivisor(kAttribInstanceYawMorph, 1);
+
+  glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
+  if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
+
+  for (const DrawBatch& b : list.batches) {
+    // GL 3.3 has no base instance: point the instance attributes at the batch's first one.
+    const size_t offset = size_t(b.first_instance) * sizeof(InstanceData);
+    glVertexAttribPointer(kAttribInstancePositionScale, 4, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
+                          reinterpret_cast<const void*>(offset));
+    glVertexAttribPointer(kAttribInstanceYawMorph, 2, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
+                          reinterpret_cast<const void*>(offset + 4 * sizeof(float)));
+    const auto& c = settings.colour_by_level ? level_colour(b.level) : kModelColour;
+    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    const LevelRange& r = meshes.layout().ranges[b.range];
+    glDrawElementsInstancedBaseVertex(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,
+                                      reinterpret_cast<const void*>(size_t(r.first_index) * sizeof(uint32_t)),
+                                      GLsizei(b.instance_count), r.base_vertex);
+    ++stats.draws;
+    stats.instances += b.instance_count;
+    stats.triangles += uint64_t(r.index_count / 3) * b.instance_count;
+  }
+
+  if (settings.count_primitives) {
+    glEndQuery(GL_PRIMITIVES_GENERATED);
+    GLuint64 generated = 0;
+    glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &generated);
+    stats.gpu_primitives = int64_t(generated);
+  }
+  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  return stats;
+}
+
+}  // namespace lod::viewer

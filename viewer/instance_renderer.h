@@ -1,0 +1,50 @@
+// InstanceRenderer: draws a DrawList with one glDrawElementsInstancedBaseVertex per
+// (model, level) batch; per-instance position, scale, yaw and geomorph factor are vertex
+// attributes with divisor 1. Lighting is a headlight Lambert term.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include <epoxy/gl.h>
+#include <glm/glm.hpp>
+
+#include "viewer/draw_list.h"
+#include "viewer/mesh_buffers.h"
+
+namespace lod::viewer {
+
+struct RenderSettings {
+  bool colour_by_level = false;
+  bool wireframe = false;
+  bool flat_normals = false;      // face normals from screen-space derivatives
+  bool count_primitives = false;  // GL_PRIMITIVES_GENERATED query around the draws (waits for the GPU)
+};
+
+struct DrawStats {
+  uint32_t draws = 0;
+  uint64_t instances = 0;
+  uint64_t triangles = 0;        // submitted: sum of index_count / 3 * instances
+  int64_t gpu_primitives = -1;   // what the GL counted, when count_primitives; else -1
+};
+
+class InstanceRenderer {
+ public:
+  InstanceRenderer() = default;
+  ~InstanceRenderer();
+  InstanceRenderer(const InstanceRenderer&) = delete;
+  InstanceRenderer& operator=(const InstanceRenderer&) = delete;
+
+  // Compiles the shaders; false with the driver's log in `message`.
+  bool init(std::string* message);
+  DrawStats draw(const DrawList& list, const MeshBuffers& meshes, const glm::mat4& view, const glm::mat4& projection,
+                 const RenderSettings& settings);
+
+ private:
+  GLuint program_ = 0;
+  GLuint instance_vbo_ = 0;
+  GLuint query_ = 0;
+  size_t instance_capacity_ = 0;
+  GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1;
+};
+
+}  // namespace lod::viewer

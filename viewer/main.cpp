@@ -1,0 +1,105 @@
+// lod-viewer: a GLFW + OpenGL 3.3 window drawing what lod::Service publishes.
+//
+// Exit codes: 0 done; 1 bad command line, config, assets or output file; 2 no display, no
+// OpenGL 3.3, or the GL refused a resource.
+#include <cstdio>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+
+#include "viewer/frame_renderer.h"
+#include "viewer/gl_context.h"
+#include "viewer/scene_loader.h"
+#include "viewer/viewer_session.h"
+
+namespace {
+
+constexpr int kExitBadInput = 1;
+constexpr int kExitNoGl = 2;
+
+int run(const lod::viewer::ViewerOptions& o) {
+  using namespace lod::viewer;
+  if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384) {
+    std::fprintf(stderr, "lod-viewer: --width/--height %dx%d: each must be in 1..16384\n", o.width, o.height);
+    return kExitBadInput;
+  }
+
+  // Scene first: a bad config is reported the same way with or without a display.
+  LoadedScene loaded;
+  auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  if (lod::Status st = load_scene(o.config, o.data_dir, o.cache_dir, loaded, log); !st) {
+    std::fprintf(stderr, "lod-viewer: %s\n", st.message.c_str());
+    return kExitBadInput;
+  }
+  if (o.threads >= 0) loaded.config.threads = uint32_t(o.threads);
+  std::fprintf(stderr, "lod-viewer: %zu models, %zu objects (bake %.0f ms: %zu baked, %zu cached in %s)\n",
+               loaded.scene.chains.size(), loaded.scene.objects.size(), loaded.bake.ms, loaded.bake.baked,
+               loaded.bake.cached, loaded.cache_dir.c_str());
+
+  GlWindow window;
+  WindowOptions wo;
+  wo.width = o.width;
+  wo.height = o.height;
+  wo.visible = o.screenshot.empty();
+  wo.vsync = o.vsync && o.screenshot.empty();
+  std::string message;
+  if (window.open(wo, &message) != GlFailure::none) {
+    std::fprintf(stderr, "lod-viewer: %s\n", message.c_str());
+    return kExitNoGl;
+  }
+  std::fprintf(stderr, "lod-viewer: OpenGL %s%s\n", window.description().c_str(),
+               window.core_profile() ? "" : " (not a core profile: the driver refused 3.3 core)");
+
+  FrameRenderer renderer;
+  if (!renderer.init(loaded.scene, &message)) {
+    std::fprintf(stderr, "lod-viewer: %s\n", message.c_str());
+    return kExitNoGl;
+  }
+
+  ViewerSession session{o, loaded, window, renderer, {}, 0, {}};
+  session.graph.threads = loaded.config.threads;
+  session.graph.selection = loaded.config.selection;
+  if (o.budget > 0) session.graph.selection.budget = uint64_t(o.budget);
+  session.graph.pixel_error = loaded.config.pixel_error;
+  session.graph.hysteresis = loaded.config.hysteresis;
+  session.threads = loaded.config.threads ? loaded.config.threads : std::max(1u, std::thread::hardware_concurrency());
+  return o.screenshot.empty() ? run_interactive(session) : run_screenshot(session);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  lod::viewer::ViewerOptions o;
+  CLI::App app{"lod-viewer: draws the frames lod::Service publishes (GLFW + OpenGL 3.3 core)"};
+  app.add_option("--config", o.config, "scene config (TOML)")->required();
+  app.add_option("--data", o.data_dir, "mesh directory searched after the config's folder");
+  app.add_option("--cache", o.cache_dir, "bake cache (default: LOD_CACHE_DIR, else <data>/../cache)");
+  app.add_option("--screenshot", o.screenshot, "render --frames frames along the camera path, write this PNG, exit");
+  app.add_option("--frames", o.frames, "frames to render (screenshot default 1; interactive: stop after N)");
+  app.add_option("--width", o.width, "window / picture width in pixels");
+  app.add_option("--height", o.height, "window / picture height in pixels");
+  app.add_option("--threads", o.threads, "LOD thread pool size (0 = all cores; default: the config's)");
+  app.add_option("--budget", o.budget, "triangle budget M (default: the config's)");
+  app.add_option("--lod-rate", o.lod_rate_hz, "interactive: LOD service rate in Hz (default: the config's rate_hz)");
+  app.add_option("--stats", o.stats, "write one CSV row per viewer frame");
+  app.add_flag("--color-by-level,--colour-by-level", o.colour_by_level, "colour objects by their chain level");
+  app.add_flag("--wireframe", o.wireframe, "draw triangle edges only");
+  app.add_flag("--overlay", o.overlay, "screenshot: draw the statistics overlay too");
+  bool no_vsync = false;
+  app.add_flag("--no-vsync", no_vsync, "interactive: do not wait for vertical sync");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : kExitBadInput;
+  }
+  o.vsync = !no_vsync;
+  if (o.frames == 0 || o.frames < -1) {
+    std::fprintf(stderr, "lod-viewer: --frames %lld: must be at least 1\n", (long long)o.frames);
+    return kExitBadInput;
+  }
+  if (o.threads > 1024 || o.threads < -1 || o.budget == 0 || o.budget < -1) {
+    std::fprintf(stderr, "lod-viewer: --threads must be 0..1024 and --budget at least 1\n");
+    return kExitBadInput;
+  }
+  return run(o);
+}

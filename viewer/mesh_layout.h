@@ -1,0 +1,35 @@
+// MeshLayout: where every (model, level) of the scene's chains sits once all of them are
+// uploaded back to back into one vertex buffer and one index buffer, as offsets + counts
+// (zeux/niagara style), so a draw is one range and a base vertex.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "runtime/lod_chain.h"
+
+namespace lod::viewer {
+
+struct LevelRange {
+  uint32_t first_index = 0;  // into the shared index buffer, in indices
+  uint32_t index_count = 0;
+  int32_t base_vertex = 0;   // added to the level-local indices
+};
+
+struct MeshLayout {
+  std::vector<uint32_t> first_range;  // per model: offset into `ranges`
+  std::vector<uint32_t> level_count;  // per model
+  std::vector<LevelRange> ranges;     // per (model, level), models back to back
+  uint64_t vertex_count = 0;
+  uint64_t index_count = 0;
+
+  uint32_t range_of(uint32_t model, uint32_t level) const { return first_range[model] + level; }
+};
+
+MeshLayout layout_meshes(std::span<const LodChain> chains);
+
+// Interleaved position + normal (6 floats per vertex) and the shared index buffer, in the
+// layout's order. Chains without normals get zeros (the shader falls back to face normals).
+void pack_vertices(std::span<const LodChain> chains, std::vector<float>& vertices, std::vector<uint32_t>& indices);
+
+}  // namespace lod::viewer

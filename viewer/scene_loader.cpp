@@ -1,0 +1,26 @@
+#include "viewer/scene_loader.h"
+
+#include <cstdlib>
+#include <utility>
+#include <vector>
+
+namespace lod::viewer {
+
+std::filesystem::path default_cache_dir(const std::filesystem::path& data_dir) {
+  if (const char* env = std::getenv("LOD_CACHE_DIR"); env && *env) return env;
+  return data_dir.parent_path() / "cache";
+}
+
+Status load_scene(const std::filesystem::path& config_file, const std::filesystem::path& data_dir,
+                  const std::filesystem::path& cache_dir, LoadedScene& out, const ProgressLog& log) {
+  const std::filesystem::path data = data_dir.empty() ? default_data_dir() : data_dir;
+  out.cache_dir = cache_dir.empty() ? default_cache_dir(data) : cache_dir;
+  if (Status st = load_scene_config(config_file, data, out.config); !st) return st;
+  std::vector<LodChain> chains;
+  if (Status st = bake_scene_models(out.config.models, out.cache_dir, out.config.threads, chains, out.bake, log); !st)
+    return st;
+  out.scene = make_scene(out.config, std::move(chains));
+  return Status::success();
+}
+
+}  // namespace lod::viewer

@@ -1,0 +1,29 @@
+// The viewer's way to a Scene, the same as `lod run`: parse the config, bake what it needs
+// (cached by content hash), place the instances.
+#pragma once
+#include <filesystem>
+#include <string>
+
+#include "jobs/bake_jobs.h"
+#include "jobs/scene.h"
+#include "jobs/scene_config.h"
+#include "runtime/status.h"
+
+namespace lod::viewer {
+
+struct LoadedScene {
+  SceneConfig config;
+  Scene scene;
+  BakeSummary bake;
+  std::filesystem::path cache_dir;
+};
+
+// LOD_CACHE_DIR when set, else <data_dir>/../cache, as `lod run` does.
+std::filesystem::path default_cache_dir(const std::filesystem::path& data_dir);
+
+// `data_dir` empty = lod::default_data_dir(); `cache_dir` empty = default_cache_dir(data_dir).
+// On failure the status carries the config's or the baker's message unchanged.
+Status load_scene(const std::filesystem::path& config_file, const std::filesystem::path& data_dir,
+                  const std::filesystem::path& cache_dir, LoadedScene& out, const ProgressLog& log);
+
+}  // namespace lod::viewer

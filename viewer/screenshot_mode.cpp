@@ -1,0 +1,105 @@
+// --screenshot: the service in driven mode, N frames along the config's camera path, each
+// stepped then drawn into an offscreen target of the requested size, then the last picture
+// written as PNG. Deterministic: the same config and N give the same frame and picture.
+#include <chrono>
+#include <cstdio>
+
+#include "jobs/service.h"
+#include "runtime/camera_path.h"
+#include "viewer/overlay.h"
+#include "viewer/render_target.h"
+#include "viewer/screenshot.h"
+#include "viewer/viewer_session.h"
+
+namespace lod::viewer {
+
+int run_screenshot(ViewerSession& s) {
+  const ViewerOptions& o = s.options;
+  std::string message;
+  OffscreenTarget target;
+  if (!target.create(o.width, o.height, &message)) {
+    std::fprintf(stderr, "lod-viewer: %s\n", message.c_str());
+    return 2;
+  }
+  Overlay overlay;
+  if (o.overlay && !overlay.init(s.window.handle())) {
+    std::fprintf(stderr, "lod-viewer: Dear ImGui could not start on this context\n");
+    return 2;
+  }
+
+  CameraPath path = s.loaded.config.camera;
+  path.lens = s.lens(o.width, o.height);
+  Service service(s.loaded.scene, s.graph, s.loaded.config.rate_hz);
+  RenderSettings settings;
+  settings.colour_by_level = o.colour_by_level;
+  settings.wireframe = o.wireframe;
+  settings.count_primitives = true;  // every drawn frame is checked against the GL's own count
+
+  ViewerControls controls;  // the overlay shows them; nothing reads them back here
+  controls.colour_by_level = o.colour_by_level;
+  controls.wireframe = o.wireframe;
+  controls.budget = s.graph.selection.budget;
+
+  const uint32_t frames = o.frames < 0 ? 1 : uint32_t(o.frames);
+  uint64_t failed = 0, mismatched = 0;
+  DrawStats last;
+  const auto start = std::chrono::steady_clock::now();
+  for (uint32_t n = 0; n < frames; ++n) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const View view = view_at(path, n);
+    if (!service.step(view)) ++failed;
+    const Frame& frame = service.latest_frame();
+    target.bind();
+    last = s.renderer.render(frame, view, settings);
+    if (o.overlay) {
+      OverlayFacts facts;
+      facts.time_s = std::chrono::duration<double>(t0 - start).count();
+      facts.viewer_ms = s.log.rows().empty() ? 0 : s.log.rows().back().viewer_ms;
+      facts.frame = &frame;
+      facts.drawn = last;
+      facts.service = service.stats();
+      facts.threads = s.threads;
+      facts.objects = s.loaded.scene.objects.size();
+      facts.levels_in_scene = s.max_levels();
+      facts.gl = s.window.description();
+      overlay.draw(facts, controls);
+    }
+    glfwPollEvents();
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const FrameRow& row = s.record(n, frame, last, ms);
+    if (row.gpu_primitives != int64_t(row.drawn) || row.drawn != row.tris_selected) {
+      ++mismatched;
+      std::fprintf(stderr, "lod-viewer: frame %u: selected %llu, submitted %llu, GL counted %lld triangles\n", n,
+                   (unsigned long long)row.tris_selected, (unsigned long long)row.drawn,
+                   (long long)row.gpu_primitives);
+    }
+  }
+
+  target.bind();
+  const std::vector<uint8_t> rgb = read_pixels_top_down(o.width, o.height);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (Status st = write_png(o.screenshot, o.width, o.height, rgb); !st) {
+    std::fprintf(stderr, "lod-viewer: %s\n", st.message.c_str());
+    return 1;
+  }
+  const FrameRow& row = s.log.rows().back();
+  std::fprintf(stderr,
+               "lod-viewer: wrote %s (%dx%d) after %u frames: %u visible, %llu triangles selected, %llu drawn "
+               "in %u draws, %u levels\n",
+               o.screenshot.c_str(), o.width, o.height, frames, row.visible, (unsigned long long)row.tris_selected,
+               (unsigned long long)row.drawn, row.draws, row.levels_drawn);
+  if (!s.finish("screenshot")) return 1;
+  if (failed) {
+    std::fprintf(stderr, "lod-viewer: %llu of %u LOD frames failed (last good frame kept)\n",
+                 (unsigned long long)failed, frames);
+    return 1;
+  }
+  if (mismatched) {
+    std::fprintf(stderr, "lod-viewer: %llu frames drew a different triangle count than selected\n",
+                 (unsigned long long)mismatched);
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace lod::viewer

@@ -1,0 +1,24 @@
+// ViewerControls: what the person at the viewer has chosen (keys and overlay widgets both
+// write here; the frame loop reads it).
+#pragma once
+#include <cstdint>
+
+namespace lod::viewer {
+
+enum class CameraMode : uint8_t { path, fly, orbit };
+inline constexpr const char* kCameraModeNames[] = {"camera path", "fly", "orbit"};
+
+struct ViewerControls {
+  CameraMode mode = CameraMode::path;
+  bool paused = false;          // camera path stops advancing
+  bool wireframe = false;
+  bool colour_by_level = false;
+  bool flat_normals = false;
+  bool freeze_lod = false;      // the LOD camera stays where it was; the viewing camera moves on
+  bool show_overlay = true;
+  uint64_t budget = 0;          // M, as last sent to the service
+  bool budget_changed = false;  // set by a widget or key, cleared once the service has it
+  bool quit = false;
+};
+
+}  // namespace lod::viewer

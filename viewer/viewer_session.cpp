@@ -1,0 +1,64 @@
+#include "viewer/viewer_session.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+
+#include "viewer/frame_check.h"
+
+namespace lod::viewer {
+
+View ViewerSession::lens(int width, int height) const {
+  View v = loaded.config.camera.lens;
+  v.width = width;
+  v.height = height;
+  return v;
+}
+
+size_t ViewerSession::max_levels() const {
+  size_t n = 0;
+  for (uint8_t c : loaded.scene.models.level_count) n = std::max<size_t>(n, c);
+  return n;
+}
+
+const FrameRow& ViewerSession::record(uint64_t viewer_frame, const Frame& frame, const DrawStats& drawn,
+                                      double viewer_ms) {
+  FrameRow row;
+  row.viewer_frame = viewer_frame;
+  row.lod_frame = frame.index;
+  row.visible = frame.visible;
+  row.tris_selected = frame.tris_selected;
+  row.drawn = drawn.triangles;
+  row.gpu_primitives = drawn.gpu_primitives;
+  row.draws = drawn.draws;
+  std::set<uint32_t> levels;
+  for (const DrawBatch& b : renderer.draw_list().batches) levels.insert(b.level);
+  row.levels_drawn = uint32_t(levels.size());
+  row.rejected = renderer.draw_list().rejected;
+  std::string why;
+  row.whole = frame_is_whole(frame, loaded.scene, &why) ? 1 : 0;
+  if (!row.whole)
+    std::fprintf(stderr, "lod-viewer: viewer frame %llu drew LOD frame %llu that is not whole: %s\n",
+                 (unsigned long long)viewer_frame, (unsigned long long)frame.index, why.c_str());
+  row.viewer_ms = viewer_ms;
+  row.lod_ms = frame.total_ms;
+  log.add(row);
+  return log.rows().back();
+}
+
+bool ViewerSession::finish(const char* mode_name) {
+  const FrameTimeSummary s = log.summary(log.rows().size() > 20 ? 10 : 0);
+  std::fprintf(stderr,
+               "lod-viewer %s: %zu frames, viewer frame ms mean %.2f p50 %.2f p95 %.2f p99 %.2f max %.2f; "
+               "%llu distinct LOD frames drawn\n",
+               mode_name, s.frames, s.mean_ms, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms,
+               (unsigned long long)s.lod_frames_seen);
+  if (options.stats.empty()) return true;
+  if (Status st = log.write_csv(options.stats); !st) {
+    std::fprintf(stderr, "lod-viewer: %s\n", st.message.c_str());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace lod::viewer
