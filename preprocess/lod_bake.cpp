@@ -1,0 +1,244 @@
+// Baking one model: load -> clean -> simplify to every ratio -> measure each level against
+// level 0 -> fill the LodChain. Levels per R0: l = round(log2 triangles); ratios per R0 by
+// model size unless the config gives them.
+#include "preprocess/lod_bake.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "preprocess/decimater_chain.h"
+#include "preprocess/mesh_io.h"
+#include "preprocess/surface_error.h"
+#include "runtime/lod_asset.h"
+
+namespace lod {
+namespace {
+
+// Bump when anything that changes baked output changes (simplifier, measurement, layout):
+// it is part of every cache key.
+constexpr uint32_t kBakeFormatVersion = 1;
+
+// Up to these sizes a model gets the reference's cow / bunny ratios (R0).
+constexpr size_t kSmallModelTriangles = 20000;
+constexpr size_t kMediumModelTriangles = 200000;
+
+// Ritter's bounding sphere: start from a far pair, grow over the stragglers.
+Sphere bounding_sphere(const float* p, size_t n) {
+  Sphere s;
+  if (n == 0) return s;
+  auto dist2 = [&](size_t a, const double* c) {
+    const double dx = p[3 * a] - c[0], dy = p[3 * a + 1] - c[1], dz = p[3 * a + 2] - c[2];
+    return dx * dx + dy * dy + dz * dz;
+  };
+  auto farthest = [&](const double* from) {
+    size_t best = 0;
+    double bd = -1;
+    for (size_t i = 0; i < n; ++i)
+      if (double d = dist2(i, from); d > bd) bd = d, best = i;
+    return best;
+  };
+  const double p0[3] = {p[0], p[1], p[2]};
+  const size_t a = farthest(p0);
+  const double pa[3] = {p[3 * a], p[3 * a + 1], p[3 * a + 2]};
+  const size_t b = farthest(pa);
+  double c[3] = {(pa[0] + p[3 * b]) / 2, (pa[1] + p[3 * b + 1]) / 2, (pa[2] + p[3 * b + 2]) / 2};
+  double r = std::sqrt(dist2(b, c));
+  for (size_t i = 0; i < n; ++i) {
+    const double d = std::sqrt(dist2(i, c));
+    if (d <= r) continue;
+    const double nr = (r + d) / 2, k = (nr - r) / d;
+    for (int j = 0; j < 3; ++j) c[j] += (p[3 * i + j] - c[j]) * k;
+    r = nr;
+  }
+  // Float rounding must not leave a vertex outside.
+  double max_d = 0;
+  for (size_t i = 0; i < n; ++i) max_d = std::max(max_d, std::sqrt(dist2(i, c)));
+  for (int j = 0; j < 3; ++j) s.center[j] = float(c[j]);
+  s.radius = float(std::max(r, max_d) * (1 + 1e-6));
+  return s;
+}
+
+const char* method_name(SimplifyMethod m) {
+  switch (m) {
+    case SimplifyMethod::qem: return "qem";
+    case SimplifyMethod::extreme: return "extreme";
+    case SimplifyMethod::automatic: return "auto";
+  }
+  return "?";
+}
+
+// Ratios as given (or defaults), checked; sorted from fine to coarse, 1.0 first, unique.
+Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std::string& what,
+                      std::vector<float>& out) {
+  out = settings.ratios.empty() ? default_ratios(triangles) : settings.ratios;
+  for (float r : out)
+    if (!(r > 0.0f && r <= 1.0f))
+      return Status::error(what + ": LOD ratio " + std::to_string(r) + " is outside (0, 1]");
+  out.push_back(1.0f);
+  std::sort(out.begin(), out.end(), std::greater<float>());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return Status::success();
+}
+
+}  // namespace
+
+std::vector<float> default_ratios(size_t triangles) {
+  if (triangles <= kSmallModelTriangles) return {1.0f, 0.5f, 0.25f, 0.12f, 0.06f};
+  if (triangles <= kMediumModelTriangles) return {1.0f, 0.5f, 0.25f, 0.12f, 0.06f, 0.03f};
+  return {1.0f, 0.25f, 0.12f, 0.06f, 0.03f, 0.015f, 0.0075f, 0.0037f, 0.0018f};
+}
+
+uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& settings, Status* status) {
+  std::ifstream f(mesh_file, std::ios::binary);
+  if (!f) {
+    if (status) *status = Status::error(mesh_file.string() + ": cannot be opened for reading");
+    return 0;
+  }
+  const std::vector<char> bytes{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+  if (f.bad()) {
+    if (status) *status = Status::error(mesh_file.string() + ": read error");
+    return 0;
+  }
+  const uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  // Settings as explicit little records, so padding never enters the hash.
+  std::vector<uint8_t> s;
+  auto put = [&s](const void* p, size_t n) {
+    const auto* b = static_cast<const uint8_t*>(p);
+    s.insert(s.end(), b, b + n);
+  };
+  put(&kBakeFormatVersion, sizeof kBakeFormatVersion);
+  const uint8_t method = static_cast<uint8_t>(settings.method);
+  put(&method, 1);
+  put(&settings.extreme_threshold, sizeof settings.extreme_threshold);
+  const uint64_t n = settings.ratios.size();
+  put(&n, sizeof n);
+  for (float r : settings.ratios) put(&r, sizeof r);
+  if (status) *status = Status::success();
+  return hash_bytes(s.data(), s.size(), content);
+}
+
+Status bake_model(const std::filesystem::path& mesh_file, const std::string& name, const BakeSettings& settings,
+                  LodChain& out, BakeReport* report_out, const BakeProgress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  auto say = [&progress](float f, const char* what) {
+    if (progress) progress(std::clamp(f, 0.0f, 1.0f), what);
+  };
+  BakeReport report;
+  const std::string what = name.empty() ? mesh_file.string() : name + " (" + mesh_file.string() + ")";
+
+  say(0.0f, "load");
+  MeshData mesh;
+  Status s = load_mesh(mesh_file, mesh);
+  if (!s) return s;
+  report.input_triangles = mesh.triangle_count();
+
+  say(0.04f, "clean");
+  report.cleaned = clean_mesh(mesh);
+  if (mesh.triangle_count() == 0)
+    return Status::error(mesh_file.string() + ": no triangles left after cleaning (all degenerate)");
+
+  std::vector<float> ratios;
+  s = resolve_ratios(settings, mesh.triangle_count(), what, ratios);
+  if (!s) return s;
+
+  SimplifyMethod method = settings.method;
+  if (method == SimplifyMethod::automatic)
+    method = report.input_triangles > settings.extreme_threshold ? SimplifyMethod::extreme : SimplifyMethod::qem;
+  report.method = std::string("openmesh-decimater-quadric (") + method_name(method) + ")";
+  if (method == SimplifyMethod::extreme)
+    report.notes.push_back("method 'extreme' is not implemented yet: OpenMesh's Decimater (QEM) baked this model");
+
+  say(0.06f, "simplify");
+  std::vector<ChainLevel> levels;
+  DecimaterChainStats chain_stats;
+  s = bake_decimater_chain(mesh, ratios, levels, &chain_stats,
+                           [&](float f) { say(0.06f + 0.54f * f, "simplify"); });
+  if (!s) return s;
+  for (std::string& note : chain_stats.notes) report.notes.push_back(std::move(note));
+  if (chain_stats.refused_faces)
+    report.notes.push_back(std::to_string(chain_stats.refused_faces) +
+                           " non-manifold faces kept on " + std::to_string(chain_stats.copied_vertices) +
+                           " copied vertices");
+  {
+    std::ostringstream note;
+    note.precision(3);
+    note << chain_stats.collapses << " collapses in " << chain_stats.decimate_seconds << " s";
+    if (chain_stats.decimate_seconds > 0) note << " (" << double(chain_stats.collapses) / chain_stats.decimate_seconds << "/s)";
+    report.notes.push_back(note.str());
+  }
+
+  // A level no smaller than the one before it adds nothing: drop it.
+  for (size_t i = 1; i < levels.size();) {
+    if (levels[i].triangle_count() >= levels[i - 1].triangle_count()) {
+      report.notes.push_back("dropped the level for ratio " + std::to_string(ratios[i]) + ": no fewer triangles (" +
+                             std::to_string(levels[i].triangle_count()) + ") than the level before");
+      levels.erase(levels.begin() + std::ptrdiff_t(i));
+      ratios.erase(ratios.begin() + std::ptrdiff_t(i));
+    } else {
+      ++i;
+    }
+  }
+
+  say(0.6f, "measure");
+  std::vector<SurfaceError> errors(levels.size());
+  if (levels.size() > 1) {
+    SurfaceErrorMeter meter;
+    const ChainLevel& l0 = levels[0];
+    s = meter.set_reference({l0.positions.data(), l0.vertex_count(), l0.indices.data(), l0.indices.size()},
+                            SurfaceErrorSettings{}, what);
+    if (!s) return s;
+    for (size_t i = 1; i < levels.size(); ++i) {
+      const ChainLevel& l = levels[i];
+      s = meter.measure({l.positions.data(), l.vertex_count(), l.indices.data(), l.indices.size()}, errors[i]);
+      if (!s) return s;
+      say(0.6f + 0.38f * float(i) / float(levels.size() - 1), "measure");
+    }
+  }
+  // A coarser level never reports less error than a finer one: selection relies on it.
+  for (size_t i = 1; i < errors.size(); ++i) {
+    errors[i].max = std::max(errors[i].max, errors[i - 1].max);
+    errors[i].rms = std::max(errors[i].rms, errors[i - 1].rms);
+  }
+
+  LodChain chain;
+  chain.name = name;
+  Status key_status;
+  chain.source_hash = bake_key(mesh_file, settings, &key_status);
+  if (!key_status) return key_status;
+  size_t total_vertices = 0, total_indices = 0;
+  for (const ChainLevel& l : levels) total_vertices += l.vertex_count(), total_indices += l.indices.size();
+  if (total_vertices > UINT32_MAX || total_indices > UINT32_MAX)
+    return Status::error(what + ": the chain has more than 2^32 vertices or indices");
+  chain.positions.reserve(3 * total_vertices);
+  chain.normals.reserve(3 * total_vertices);
+  chain.indices.reserve(total_indices);
+  for (size_t i = 0; i < levels.size(); ++i) {
+    const ChainLevel& l = levels[i];
+    LodLevel level;
+    level.first_index = uint32_t(chain.indices.size());
+    level.index_count = uint32_t(l.indices.size());
+    level.first_vertex = uint32_t(chain.positions.size() / 3);
+    level.vertex_count = uint32_t(l.vertex_count());
+    level.level = level_of_triangles(l.triangle_count());
+    level.error = errors[i].max;
+    level.error_rms = errors[i].rms;
+    level.bounds = bounding_sphere(l.positions.data(), l.vertex_count());
+    chain.positions.insert(chain.positions.end(), l.positions.begin(), l.positions.end());
+    chain.normals.insert(chain.normals.end(), l.normals.begin(), l.normals.end());
+    chain.indices.insert(chain.indices.end(), l.indices.begin(), l.indices.end());
+    chain.levels.push_back(level);
+  }
+  std::string problem;
+  if (!validate_chain(chain, &problem)) return Status::error(what + ": baked chain is invalid: " + problem);
+
+  say(1.0f, "done");
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out = std::move(chain);
+  if (report_out) *report_out = std::move(report);
+  return Status::success();
+}
+
+}  // namespace lod

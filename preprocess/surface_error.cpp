@@ -1,0 +1,261 @@
+// Symmetric Hausdorff approximation by closest-point queries (Embree 3 rtcPointQuery with a
+// point-triangle distance callback; closest point on a triangle after Ericson, "Real-Time
+// Collision Detection", 5.1.5). Samples: every vertex plus area-weighted random points
+// (uniform on each triangle by the square-root parametrisation), seeded, so a measurement
+// is reproducible.
+#include "preprocess/surface_error.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace lod {
+namespace {
+
+struct Vec3 {
+  float x, y, z;
+};
+inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 load(const float* p) { return {p[0], p[1], p[2]}; }
+
+Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const float d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - c;
+  const float d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const float denom = va + vb + vc;
+  if (!(denom > 0)) {  // degenerate triangle: nearest of its three edges' endpoints is close enough
+    const Vec3 q[3] = {a, b, c};
+    Vec3 best = a;
+    float bd = std::numeric_limits<float>::max();
+    for (const Vec3& v : q) {
+      const Vec3 d = p - v;
+      if (dot(d, d) < bd) bd = dot(d, d), best = v;
+    }
+    return best;
+  }
+  const float v = vb / denom, w = vc / denom;
+  return a + ab * v + ac * w;
+}
+
+// A mesh copied into an Embree scene, plus the arrays the query callback reads.
+struct QueryMesh {
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  RTCScene scene = nullptr;
+
+  ~QueryMesh() { release(); }
+  void release() {
+    if (scene) rtcReleaseScene(scene);
+    scene = nullptr;
+  }
+};
+
+struct QueryState {
+  const QueryMesh* mesh;
+  Vec3 point;
+  float best_sq;
+};
+
+bool closest_point_callback(RTCPointQueryFunctionArguments* args) {
+  auto* st = static_cast<QueryState*>(args->userPtr);
+  const uint32_t* t = &st->mesh->indices[3 * size_t(args->primID)];
+  const float* pos = st->mesh->positions.data();
+  const Vec3 q = closest_point_on_triangle(st->point, load(pos + 3 * t[0]), load(pos + 3 * t[1]), load(pos + 3 * t[2]));
+  const Vec3 d = st->point - q;
+  const float dsq = dot(d, d);
+  if (dsq < st->best_sq) {
+    st->best_sq = dsq;
+    args->query->radius = std::sqrt(dsq);
+    return true;  // the query sphere shrank
+  }
+  return false;
+}
+
+std::string device_error_text(RTCDevice device) {
+  switch (rtcGetDeviceError(device)) {
+    case RTC_ERROR_NONE: return "no error";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+    default: return "unknown error";
+  }
+}
+
+Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const std::string& what, QueryMesh& out) {
+  out.release();
+  if (view.index_count % 3 != 0 || view.index_count == 0)
+    return Status::error(what + ": no triangles to measure against");
+  for (size_t i = 0; i < view.index_count; ++i)
+    if (view.indices[i] >= view.vertex_count)
+      return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
+                           std::to_string(view.indices[i]) + " of " + std::to_string(view.vertex_count));
+  out.positions.assign(view.positions, view.positions + 3 * view.vertex_count);
+  out.indices.assign(view.indices, view.indices + view.index_count);
+
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  if (!geom) return Status::error(what + ": Embree could not create a geometry (" + device_error_text(device) + ")");
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                         3 * sizeof(float), view.vertex_count));
+  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                            3 * sizeof(uint32_t), view.index_count / 3));
+  if (!vb || !ib) {
+    rtcReleaseGeometry(geom);
+    return Status::error(what + ": Embree could not allocate buffers (" + device_error_text(device) + ")");
+  }
+  std::memcpy(vb, out.positions.data(), out.positions.size() * sizeof(float));
+  std::memcpy(ib, out.indices.data(), out.indices.size() * sizeof(uint32_t));
+  rtcCommitGeometry(geom);
+  out.scene = rtcNewScene(device);
+  rtcSetSceneFlags(out.scene, RTC_SCENE_FLAG_ROBUST);
+  rtcAttachGeometry(out.scene, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(out.scene);
+  if (rtcGetDeviceError(device) != RTC_ERROR_NONE)
+    return Status::error(what + ": Embree failed to build its BVH (" + device_error_text(device) + ")");
+  return Status::success();
+}
+
+// Every vertex, then `count` area-weighted surface points.
+std::vector<float> sample_surface(const TriangleMeshView& view, size_t count, uint64_t seed) {
+  std::vector<float> samples(view.positions, view.positions + 3 * view.vertex_count);
+  const size_t nt = view.index_count / 3;
+  std::vector<double> cumulative(nt);
+  double total = 0;
+  for (size_t t = 0; t < nt; ++t) {
+    const Vec3 a = load(view.positions + 3 * view.indices[3 * t]);
+    const Vec3 b = load(view.positions + 3 * view.indices[3 * t + 1]);
+    const Vec3 c = load(view.positions + 3 * view.indices[3 * t + 2]);
+    const Vec3 e0 = b - a, e1 = c - a;
+    const double cx = double(e0.y) * e1.z - double(e0.z) * e1.y;
+    const double cy = double(e0.z) * e1.x - double(e0.x) * e1.z;
+    const double cz = double(e0.x) * e1.y - double(e0.y) * e1.x;
+    total += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+    cumulative[t] = total;
+  }
+  if (!(total > 0)) return samples;
+  std::mt19937_64 rng(seed);
+  auto uniform = [&rng] { return double(rng() >> 11) * 0x1.0p-53; };  // same on every platform
+  samples.reserve(samples.size() + 3 * count);
+  for (size_t i = 0; i < count; ++i) {
+    const double pick = uniform() * total;
+    const size_t t = std::min<size_t>(nt - 1, size_t(std::upper_bound(cumulative.begin(), cumulative.end(), pick) -
+                                                     cumulative.begin()));
+    const double r1 = std::sqrt(uniform()), r2 = uniform();
+    const float wa = float(1 - r1), wb = float(r1 * (1 - r2)), wc = float(r1 * r2);
+    const Vec3 a = load(view.positions + 3 * view.indices[3 * t]);
+    const Vec3 b = load(view.positions + 3 * view.indices[3 * t + 1]);
+    const Vec3 c = load(view.positions + 3 * view.indices[3 * t + 2]);
+    const Vec3 p = a * wa + b * wb + c * wc;
+    samples.insert(samples.end(), {p.x, p.y, p.z});
+  }
+  return samples;
+}
+
+// Distances from every sample to `mesh`: updates max and the sum of squares.
+void query_distances(const std::vector<float>& samples, const QueryMesh& mesh, double& max_d, double& sum_sq,
+                     size_t& n) {
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  for (size_t i = 0; i + 2 < samples.size(); i += 3) {
+    QueryState st{&mesh, load(&samples[i]), std::numeric_limits<float>::infinity()};
+    RTCPointQuery q;
+    q.x = st.point.x;
+    q.y = st.point.y;
+    q.z = st.point.z;
+    q.time = 0;
+    q.radius = std::numeric_limits<float>::infinity();
+    rtcPointQuery(mesh.scene, &q, &context, closest_point_callback, &st);
+    const double d = std::sqrt(double(st.best_sq));
+    max_d = std::max(max_d, d);
+    sum_sq += d * d;
+    ++n;
+  }
+}
+
+}  // namespace
+
+struct SurfaceErrorMeter::Impl {
+  RTCDevice device = nullptr;
+  QueryMesh reference;
+  std::vector<float> reference_samples;
+  SurfaceErrorSettings settings;
+  std::string what;
+  bool ready = false;
+
+  ~Impl() {
+    reference.release();
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+SurfaceErrorMeter::SurfaceErrorMeter() : impl_(std::make_unique<Impl>()) {}
+SurfaceErrorMeter::~SurfaceErrorMeter() = default;
+
+Status SurfaceErrorMeter::set_reference(const TriangleMeshView& reference, const SurfaceErrorSettings& settings,
+                                        const std::string& what) {
+  Impl& m = *impl_;
+  m.ready = false;
+  m.settings = settings;
+  m.what = what;
+  if (!m.device) {
+    m.device = rtcNewDevice(nullptr);
+    if (!m.device) return Status::error(what + ": Embree device could not be created");
+  }
+  Status s = build_query_mesh(m.device, reference, what, m.reference);
+  if (!s) return s;
+  m.reference_samples = sample_surface(reference, settings.surface_samples, settings.seed);
+  m.ready = true;
+  return Status::success();
+}
+
+Status SurfaceErrorMeter::measure(const TriangleMeshView& mesh, SurfaceError& out) {
+  Impl& m = *impl_;
+  if (!m.ready) return Status::error("surface error: no reference set");
+  QueryMesh other;
+  Status s = build_query_mesh(m.device, mesh, m.what + " (level)", other);
+  if (!s) return s;
+  const std::vector<float> samples = sample_surface(mesh, m.settings.surface_samples, m.settings.seed + 1);
+  double max_d = 0, sum_sq = 0;
+  size_t n = 0;
+  query_distances(samples, m.reference, max_d, sum_sq, n);
+  query_distances(m.reference_samples, other, max_d, sum_sq, n);
+  if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
+    return Status::error(m.what + ": Embree point query failed (" + device_error_text(m.device) + ")");
+  out.max = float(max_d);
+  out.rms = n ? float(std::sqrt(sum_sq / double(n))) : 0.0f;
+  out.samples = n;
+  return Status::success();
+}
+
+Status measure_surface_error(const TriangleMeshView& a, const TriangleMeshView& b,
+                             const SurfaceErrorSettings& settings, SurfaceError& out) {
+  SurfaceErrorMeter meter;
+  Status s = meter.set_reference(a, settings, "surface error reference");
+  if (!s) return s;
+  return meter.measure(b, out);
+}
+
+}  // namespace lod
