@@ -8,6 +8,7 @@ namespace lod::viewer {
 namespace {
 constexpr float kMaxElevation = 1.55f;
 constexpr float kMinDistance = 0.01f;
+constexpr float kMaxDistance = 1e7f;  // a wheel spun far stays finite
 }  // namespace
 
 glm::vec3 OrbitCamera::eye() const {
@@ -18,7 +19,7 @@ glm::vec3 OrbitCamera::eye() const {
 void OrbitCamera::look_like(const View& view) {
   target = view.target;
   const glm::vec3 d = view.eye - view.target;
-  distance = std::max(glm::length(d), kMinDistance);
+  distance = std::clamp(glm::length(d), kMinDistance, kMaxDistance);
   elevation = std::clamp(std::asin(std::clamp(d.y / distance, -1.f, 1.f)), -kMaxElevation, kMaxElevation);
   azimuth = std::atan2(d.x, d.z);
 }
@@ -29,7 +30,7 @@ void OrbitCamera::rotate(float dx_pixels, float dy_pixels) {
 }
 
 void OrbitCamera::zoom(float wheel_steps) {
-  distance = std::max(distance * std::pow(0.9f, wheel_steps), kMinDistance);
+  distance = std::clamp(distance * std::pow(0.9f, wheel_steps), kMinDistance, kMaxDistance);
 }
 
 View OrbitCamera::view(const View& lens) const {

@@ -1,0 +1,166 @@
+// DrawList and MeshLayout: what the viewer would submit for a frame, without a GL context.
+#include <gtest/gtest.h>
+
+#include "viewer/draw_list.h"
+#include "viewer/mesh_layout.h"
+
+namespace {
+
+using namespace lod;
+using namespace lod::viewer;
+
+// A chain whose level k has `tris[k]` triangles over its own `3 * tris[k]` vertices.
+LodChain chain_with_levels(std::vector<uint32_t> tris) {
+  LodChain c;
+  for (uint32_t t : tris) {
+    LodLevel l;
+    l.first_index = uint32_t(c.indices.size());
+    l.index_count = 3 * t;
+    l.first_vertex = uint32_t(c.positions.size() / 3);
+    l.vertex_count = 3 * t;
+    for (uint32_t i = 0; i < 3 * t; ++i) {
+      c.indices.push_back(i);
+      c.positions.insert(c.positions.end(), {float(i), 0, 0});
+      c.normals.insert(c.normals.end(), {0, 1, 0});
+    }
+    c.levels.push_back(l);
+  }
+  return c;
+}
+
+ObjectSet objects_of_models(std::vector<uint32_t> models) {
+  ObjectSet o;
+  o.resize(models.size());
+  for (size_t i = 0; i < models.size(); ++i) {
+    o.model[i] = models[i];
+    o.x[i] = float(i);
+    o.y[i] = 2 * float(i);
+    o.z[i] = 3 * float(i);
+    o.scale[i] = 1 + float(i);
+    o.yaw[i] = 0.5f * float(i);
+  }
+  return o;
+}
+
+Frame frame_of(std::vector<uint32_t> objects, std::vector<uint8_t> levels) {
+  Frame f;
+  f.objects = objects;
+  f.levels = levels;
+  f.morph.assign(objects.size(), 1.f);
+  f.visible = uint32_t(objects.size());
+  return f;
+}
+
+TEST(MeshLayout, OffsetsAddEachChainsBases) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2}), chain_with_levels({5, 3, 1})};
+  const MeshLayout m = layout_meshes(chains);
+  ASSERT_EQ(m.ranges.size(), 5u);
+  EXPECT_EQ(m.first_range, (std::vector<uint32_t>{0, 2}));
+  EXPECT_EQ(m.level_count, (std::vector<uint32_t>{2, 3}));
+  // Chain 0: 18 indices over 18 vertices; chain 1 starts after them.
+  EXPECT_EQ(m.ranges[1].first_index, 12u);
+  EXPECT_EQ(m.ranges[1].base_vertex, 12);
+  EXPECT_EQ(m.ranges[2].first_index, 18u);
+  EXPECT_EQ(m.ranges[2].base_vertex, 18);
+  EXPECT_EQ(m.ranges[4].first_index, 18u + 24u);
+  EXPECT_EQ(m.ranges[4].index_count, 3u);
+  EXPECT_EQ(m.vertex_count, 18u + 27u);
+  EXPECT_EQ(m.index_count, 18u + 27u);
+
+  std::vector<float> vertices;
+  std::vector<uint32_t> indices;
+  pack_vertices(chains, vertices, indices);
+  EXPECT_EQ(vertices.size(), 6 * m.vertex_count);
+  EXPECT_EQ(indices.size(), m.index_count);
+  // Vertex 20 is chain 1's vertex 2: x = 2, normal +y.
+  EXPECT_EQ(vertices[6 * 20 + 0], 2.f);
+  EXPECT_EQ(vertices[6 * 20 + 4], 1.f);
+}
+
+TEST(MeshLayout, ChainWithoutNormalsGetsZeroNormals) {
+  LodChain c = chain_with_levels({1});
+  c.normals.clear();
+  std::vector<float> vertices;
+  std::vector<uint32_t> indices;
+  pack_vertices(std::vector<LodChain>{c}, vertices, indices);
+  ASSERT_EQ(vertices.size(), 18u);
+  EXPECT_EQ(vertices[3], 0.f);
+  EXPECT_EQ(vertices[4], 0.f);
+  EXPECT_EQ(vertices[5], 0.f);
+}
+
+TEST(DrawList, OneBatchPerModelAndLevelWithInstancesGrouped) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2}), chain_with_levels({5, 3, 1})};
+  const MeshLayout m = layout_meshes(chains);
+  const ObjectSet objects = objects_of_models({0, 1, 0, 1, 0, 1});
+  // Objects 0, 2 at model 0 level 1; object 4 at model 0 level 0; 1, 5 at model 1 level 2; 3 at level 0.
+  Frame f = frame_of({0, 1, 2, 3, 4, 5}, {1, 2, 1, 0, 0, 2});
+  f.morph = {1, 0.25f, 1, 1, 1, 0.5f};
+  DrawList list;
+  build_draw_list(f, objects, m, list);
+  ASSERT_EQ(list.batches.size(), 4u);
+  EXPECT_EQ(list.rejected, 0u);
+  // In (model, level) order.
+  EXPECT_EQ(list.batches[0].model, 0u);
+  EXPECT_EQ(list.batches[0].level, 0u);
+  EXPECT_EQ(list.batches[0].instance_count, 1u);
+  EXPECT_EQ(list.batches[1].level, 1u);
+  EXPECT_EQ(list.batches[1].instance_count, 2u);
+  EXPECT_EQ(list.batches[2].model, 1u);
+  EXPECT_EQ(list.batches[2].level, 0u);
+  EXPECT_EQ(list.batches[3].level, 2u);
+  EXPECT_EQ(list.batches[3].range, m.range_of(1, 2));
+  // Instances of a batch are contiguous and carry their object's transform and morph.
+  const DrawBatch& b = list.batches[3];
+  const InstanceData& a = list.instances[b.first_instance];
+  const InstanceData& c = list.instances[b.first_instance + 1];
+  EXPECT_EQ(a.position_scale[0], 1.f);   // object 1
+  EXPECT_EQ(a.morph, 0.25f);
+  EXPECT_EQ(c.position_scale[2], 15.f);  // object 5: z = 3 * 5
+  EXPECT_EQ(c.position_scale[3], 6.f);
+  EXPECT_EQ(c.yaw, 2.5f);
+  EXPECT_EQ(c.morph, 0.5f);
+  // Triangles: 4 + 2*2 + 5 + 2*1.
+  EXPECT_EQ(list.triangles, 4u + 4u + 5u + 2u);
+  EXPECT_EQ(list.indices, 3 * list.triangles);
+}
+
+TEST(DrawList, RefusesUnknownObjectsAndLevelsAndCountsThem) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2})};
+  const MeshLayout m = layout_meshes(chains);
+  const ObjectSet objects = objects_of_models({0, 0});
+  const Frame f = frame_of({0, 1, 9}, {1, 2, 0});  // level 2 does not exist; object 9 neither
+  DrawList list;
+  build_draw_list(f, objects, m, list);
+  EXPECT_EQ(list.rejected, 2u);
+  ASSERT_EQ(list.batches.size(), 1u);
+  EXPECT_EQ(list.instances.size(), 1u);
+  EXPECT_EQ(list.triangles, 2u);
+}
+
+TEST(DrawList, ArraysOfDifferentLengthDrawOnlyTheCommonPrefix) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2})};
+  const MeshLayout m = layout_meshes(chains);
+  const ObjectSet objects = objects_of_models({0, 0, 0});
+  Frame f = frame_of({0, 1, 2}, {0, 0, 0});
+  f.levels.pop_back();
+  DrawList list;
+  build_draw_list(f, objects, m, list);
+  EXPECT_EQ(list.instances.size(), 2u);
+  EXPECT_EQ(list.triangles, 8u);
+}
+
+TEST(DrawList, EmptyFrameDrawsNothingAndReusesTheList) {
+  const std::vector<LodChain> chains = {chain_with_levels({4})};
+  const MeshLayout m = layout_meshes(chains);
+  const ObjectSet objects = objects_of_models({0});
+  DrawList list;
+  build_draw_list(frame_of({0}, {0}), objects, m, list);
+  EXPECT_EQ(list.batches.size(), 1u);
+  build_draw_list(Frame{}, objects, m, list);
+  EXPECT_TRUE(list.batches.empty());
+  EXPECT_TRUE(list.instances.empty());
+  EXPECT_EQ(list.triangles, 0u);
+}
+
+}  // namespace

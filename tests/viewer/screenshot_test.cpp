@@ -1,0 +1,193 @@
+// lod-viewer --screenshot under xvfb-run: the picture has the requested size, shows objects
+// where the camera looks at them and background elsewhere, and colour-by-level shows levels.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <map>
+#include <cmath>
+#include <set>
+
+#include "runtime/view.h"
+#include "viewer/level_palette.h"
+#include "viewer/viewer_harness.h"
+
+namespace {
+
+using lod::test::CsvTable;
+using lod::test::Image;
+
+const char* kRun = R"([run]
+frames = 1
+threads = 1
+rate_hz = 60
+[budget]
+triangles = 1000000
+)";
+
+// Camera at z = 30 looking at the origin; sphere at x = -8, box at x = +8, nothing between.
+const char* kFrontCamera = R"([camera]
+fov_deg = 60
+width = 1280
+height = 720
+path = "keyframes"
+near = 0.5
+far = 500.0
+[[camera.keyframe]]
+frame = 0
+position = [0.0, 0.0, 30.0]
+look_at = [0.0, 0.0, 0.0]
+)";
+
+const char* kTwoObjects = R"([[instances]]
+model = "sphere"
+count = 1
+placement = "grid"
+box_min = [-8.0, 0.0, 0.0]
+box_max = [-8.0, 0.0, 0.0]
+scale = 4.0
+[[instances]]
+model = "box"
+count = 1
+placement = "grid"
+box_min = [8.0, 0.0, 0.0]
+box_max = [8.0, 0.0, 0.0]
+scale = 3.0
+)";
+
+// Pixel (x, y from the top) where a world point lands in a width x height picture.
+std::array<int, 2> project(glm::vec3 p, int width, int height) {
+  lod::View v;
+  v.eye = {0, 0, 30};
+  v.target = {0, 0, 0};
+  v.fov_y_deg = 60;
+  v.width = width;
+  v.height = height;
+  const glm::vec4 clip = lod::projection_matrix(v) * lod::view_matrix(v) * glm::vec4(p, 1);
+  const float nx = clip.x / clip.w, ny = clip.y / clip.w;
+  return {int((nx * 0.5f + 0.5f) * float(width)), int((0.5f - ny * 0.5f) * float(height))};
+}
+
+bool is_background(const uint8_t* px) {
+  for (int c = 0; c < 3; ++c)
+    if (std::abs(int(px[c]) - int(std::lround(lod::viewer::kBackground[size_t(c)] * 255))) > 1) return false;
+  return true;
+}
+
+// Index of the palette colour this pixel is a shade of, or -1. Shading scales all channels
+// alike, so colours are compared after dividing by their largest channel.
+int palette_entry(const uint8_t* px) {
+  const int top = std::max({px[0], px[1], px[2]});
+  if (top < 40) return -1;  // too dark to tell
+  int best = -1;
+  float best_d = 0.1f;
+  for (size_t i = 0; i < lod::viewer::kLevelPalette.size(); ++i) {
+    const auto& col = lod::viewer::kLevelPalette[i];
+    const float ctop = std::max({col[0], col[1], col[2]});
+    float d = 0;
+    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(float(px[c]) / float(top) - col[size_t(c)] / ctop));
+    if (d < best_d) best_d = d, best = int(i);
+  }
+  return best;
+}
+
+std::map<int, int> palette_histogram(const Image& img) {
+  std::map<int, int> counts;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (int e = palette_entry(img.at(x, y)); e >= 0) ++counts[e];
+  return counts;
+}
+
+TEST(ViewerScreenshot, HasRequestedSizeObjectsWhereLookedAtAndBackgroundElsewhere) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("placement", kRun, kFrontCamera, kTwoObjects);
+  const auto png = scene.dir / "shot.png";
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 320 --height 200");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(png, img)) << png;
+  EXPECT_EQ(img.width, 320);
+  EXPECT_EQ(img.height, 200);
+
+  size_t drawn = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) drawn += is_background(img.at(x, y)) ? 0 : 1;
+  const size_t total = size_t(img.width) * size_t(img.height);
+  EXPECT_GT(drawn, total / 50) << "picture is (nearly) blank";
+  EXPECT_LT(drawn, total / 2) << "the two small objects cannot cover half the picture";
+
+  for (glm::vec3 object : {glm::vec3(-8, 0, 0), glm::vec3(8, 0, 0)}) {
+    const auto [x, y] = project(object, img.width, img.height);
+    EXPECT_FALSE(is_background(img.at(x, y))) << "no object drawn at (" << x << ", " << y << ")";
+  }
+  for (glm::vec3 empty : {glm::vec3(0, 0, 0), glm::vec3(0, 10, 0), glm::vec3(-8, -10, 0), glm::vec3(8, 10, 0)}) {
+    const auto [x, y] = project(empty, img.width, img.height);
+    EXPECT_TRUE(is_background(img.at(x, y))) << "something drawn at empty (" << x << ", " << y << ")";
+  }
+  // The picture is upright: the sphere (at -x) is in the left half, the box to the right.
+  const auto [sx, sy] = project({-8, 0, 0}, img.width, img.height);
+  EXPECT_LT(sx, img.width / 2);
+  EXPECT_EQ(sy, img.height / 2);
+}
+
+// Sixty objects receding from the camera under a tight budget: near ones fine, far ones coarse.
+const char* kDepthCamera = R"([camera]
+fov_deg = 60
+width = 1280
+height = 720
+path = "keyframes"
+near = 0.5
+far = 1000.0
+[[camera.keyframe]]
+frame = 0
+position = [0.0, 6.0, 12.0]
+look_at = [0.0, 0.0, -60.0]
+)";
+
+const char* kReceding = R"([[instances]]
+model = "sphere"
+count = 30
+box_min = [-20.0, 0.0, -150.0]
+box_max = [20.0, 0.0, -5.0]
+scale = 2.0
+seed = 11
+[[instances]]
+model = "box"
+count = 30
+box_min = [-20.0, 0.0, -150.0]
+box_max = [20.0, 0.0, -5.0]
+scale = 1.5
+seed = 12
+)";
+
+TEST(ViewerScreenshot, ColourByLevelShowsAtLeastTwoLevelColours) {
+  LOD_REQUIRE_XVFB();
+  const std::string run = "[run]\nframes = 1\nthreads = 1\n[budget]\ntriangles = 30000\n";
+  const auto scene = lod::test::write_viewer_scene("levels", run, kDepthCamera, kReceding);
+  const auto coloured = scene.dir / "levels.png";
+  const auto plain = scene.dir / "plain.png";
+  const auto stats = scene.dir / "levels.csv";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + coloured.string() + "' --color-by-level --frames 3 " +
+                                            "--width 400 --height 240 --stats '" + stats.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = lod::test::run_viewer(scene, "--screenshot '" + plain.string() + "' --frames 3 --width 400 --height 240");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(coloured, img));
+  const auto counts = palette_histogram(img);
+  int levels_seen = 0;
+  for (auto [entry, pixels] : counts) levels_seen += pixels >= 20 ? 1 : 0;
+  EXPECT_GE(levels_seen, 2) << "level colours in the picture: " << counts.size();
+
+  CsvTable table;
+  ASSERT_TRUE(lod::test::load_csv(stats, table));
+  EXPECT_GE(table.get(table.rows.size() - 1, "levels_drawn"), 2);
+
+  // Without the mode no pixel is a level colour: the colours come from the mode.
+  Image grey;
+  ASSERT_TRUE(lod::test::load_png(plain, grey));
+  EXPECT_TRUE(palette_histogram(grey).empty());
+}
+
+}  // namespace

@@ -1,0 +1,54 @@
+// Helpers for the lod-viewer tests: generated scenes (OFF meshes written from code), running
+// the viewer binary under xvfb-run, and reading back its PNG and per-frame CSV.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace lod::test {
+
+// Closed cube [-1, 1]^3 as OFF text, each face an n x n grid of quads (welded along edges).
+std::string box_off(int n);
+
+struct ViewerScene {
+  std::filesystem::path dir;     // holds config.toml, the meshes, the cache and outputs
+  std::filesystem::path config;
+};
+
+// A scene of one generated sphere (2,304 triangles) and one generated box (3,072 triangles).
+// `instances` and `camera` are TOML text appended after the [[model]] blocks.
+ViewerScene write_viewer_scene(const std::string& tag, const std::string& budget_and_run, const std::string& camera,
+                               const std::string& instances);
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout + stderr
+};
+
+bool have_xvfb();
+// Runs lod-viewer with `args`, under `xvfb-run -a` when `headless`. The bake cache is the
+// scene's own folder.
+RunResult run_viewer(const ViewerScene& scene, const std::string& args, bool under_xvfb = true,
+                     const std::string& env_prefix = "");
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+  const uint8_t* at(int x, int y) const { return &rgb[(size_t(y) * size_t(width) + size_t(x)) * 3]; }
+};
+bool load_png(const std::filesystem::path& path, Image& out);
+
+// One row of --stats, by column name.
+struct CsvTable {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+  double get(size_t row, const std::string& column) const;
+};
+bool load_csv(const std::filesystem::path& path, CsvTable& out);
+
+}  // namespace lod::test
+
+#define LOD_REQUIRE_XVFB()                                                                    \
+  if (!::lod::test::have_xvfb())                                                              \
+  GTEST_SKIP() << "needs xvfb-run (Debian package xvfb) and Mesa's libgl1-mesa-dri to run lod-viewer headless"
