@@ -1,0 +1,110 @@
+#include "preprocess/mesh_clean.h"
+
+#include <gtest/gtest.h>
+
+namespace lod {
+namespace {
+
+MeshData make(std::vector<float> positions, std::vector<uint32_t> indices) {
+  MeshData m;
+  m.positions = std::move(positions);
+  m.indices = std::move(indices);
+  return m;
+}
+
+TEST(MeshClean, LeavesACleanMeshAlone) {
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, {0, 1, 2, 1, 3, 2});
+  const MeshData before = m;
+  const CleanReport r = clean_mesh(m);
+  EXPECT_FALSE(r.changed());
+  EXPECT_EQ(m.positions, before.positions);
+  EXPECT_EQ(m.indices, before.indices);
+}
+
+TEST(MeshClean, DropsFacesWithARepeatedIndex) {
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2, 0, 0, 1, 2, 1, 2});
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.degenerate_faces, 2u);
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+TEST(MeshClean, DropsZeroAreaFaces) {
+  // Collinear corners, all distinct.
+  MeshData m = make({0, 0, 0, 1, 1, 1, 2, 2, 2, 0, 1, 0}, {0, 1, 2, 0, 1, 3});
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.degenerate_faces, 1u);
+  EXPECT_EQ(r.unreferenced_vertices, 1u);  // vertex 2 only belonged to the degenerate face
+  EXPECT_EQ(m.triangle_count(), 1u);
+  EXPECT_EQ(m.vertex_count(), 3u);
+}
+
+TEST(MeshClean, DropsDuplicateFacesWhateverTheirOrientation) {
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, {0, 1, 2, 1, 2, 0, 2, 1, 0, 1, 3, 2});
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.duplicate_faces, 2u);
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
+}
+
+TEST(MeshClean, WeldsBitIdenticalVerticesOntoTheFirst) {
+  // Vertex 3 repeats vertex 1; vertex 4 is -0 where vertex 0 has +0 (the same point).
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, -0.0f, 0, 0, 1, 1, 0}, {0, 1, 2, 4, 5, 3});
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.duplicate_vertices, 2u);
+  EXPECT_EQ(r.unreferenced_vertices, 0u);
+  EXPECT_EQ(m.vertex_count(), 4u);
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 3, 1}));
+}
+
+TEST(MeshClean, NearlyEqualVerticesAreNotWelded) {
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1.0000001f, 0, 0, 1, 1, 0}, {0, 1, 2, 3, 4, 2});
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.duplicate_vertices, 0u);
+  EXPECT_EQ(m.vertex_count(), 5u);
+}
+
+TEST(MeshClean, WeldingCanMakeFacesDegenerateOrDuplicate) {
+  // Vertices 3,4,5 repeat 0,1,2: face 1 becomes a duplicate of face 0; face 2 (0,3,1)
+  // becomes (0,0,1), degenerate.
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2, 3, 4, 5, 0, 3, 1});
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.duplicate_vertices, 3u);
+  EXPECT_EQ(r.duplicate_faces, 1u);
+  EXPECT_EQ(r.degenerate_faces, 1u);
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+TEST(MeshClean, RemovesUnreferencedVerticesKeepingOrder) {
+  MeshData m = make({9, 9, 9, 0, 0, 0, 8, 8, 8, 1, 0, 0, 0, 1, 0, 7, 7, 7}, {1, 3, 4});
+  m.normals = {1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 1, 0, 1, 0, 0};
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.unreferenced_vertices, 3u);
+  EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(m.normals, (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 1, 0}));
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+TEST(MeshClean, IsDeterministicAndIdempotent) {
+  MeshData a = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 5, 5, 5, 1, 1, 0},
+                    {0, 1, 2, 2, 1, 0, 3, 5, 2, 0, 0, 2, 1, 5, 2});
+  MeshData b = a;
+  const CleanReport ra = clean_mesh(a);
+  const CleanReport rb = clean_mesh(b);
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.indices, b.indices);
+  EXPECT_EQ(ra.duplicate_faces, rb.duplicate_faces);
+  EXPECT_TRUE(ra.changed());
+  const CleanReport again = clean_mesh(a);
+  EXPECT_FALSE(again.changed());
+}
+
+TEST(MeshClean, EverythingDegenerateLeavesAnEmptyMesh) {
+  MeshData m = make({0, 0, 0, 1, 0, 0}, {0, 0, 1, 1, 1, 1});
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.degenerate_faces, 2u);
+  EXPECT_EQ(r.unreferenced_vertices, 2u);
+  EXPECT_EQ(m.triangle_count(), 0u);
+  EXPECT_EQ(m.vertex_count(), 0u);
+}
+
+}  // namespace
+}  // namespace lod

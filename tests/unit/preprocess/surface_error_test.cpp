@@ -1,0 +1,104 @@
+#include "preprocess/surface_error.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "preprocess/mesh_io.h"
+#include "test_support.h"
+
+namespace lod {
+namespace {
+
+TriangleMeshView view(const std::vector<float>& p, const std::vector<uint32_t>& i) {
+  return {p.data(), p.size() / 3, i.data(), i.size()};
+}
+
+const std::vector<float> kSquare = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+const std::vector<uint32_t> kSquareTris = {0, 1, 2, 0, 2, 3};
+
+TEST(SurfaceError, OfAMeshAgainstItselfIsZero) {
+  SurfaceError e;
+  ASSERT_TRUE(measure_surface_error(view(kSquare, kSquareTris), view(kSquare, kSquareTris), {}, e).ok);
+  EXPECT_LT(e.max, 1e-6f);
+  EXPECT_LT(e.rms, 1e-6f);
+  EXPECT_GT(e.samples, 2 * SurfaceErrorSettings{}.surface_samples);
+}
+
+TEST(SurfaceError, OfAShiftedCopyIsTheShift) {
+  std::vector<float> shifted = kSquare;
+  for (size_t v = 0; v < 4; ++v) shifted[3 * v + 2] += 0.25f;
+  SurfaceError e;
+  ASSERT_TRUE(measure_surface_error(view(kSquare, kSquareTris), view(shifted, kSquareTris), {}, e).ok);
+  EXPECT_NEAR(e.max, 0.25f, 1e-6f);
+  EXPECT_NEAR(e.rms, 0.25f, 1e-6f);
+}
+
+TEST(SurfaceError, IsSymmetricAndSeesWhatOnlyOneSideHas) {
+  // b = a plus a far triangle: h(a,b) = 0 but h(b,a) is large; both orders report it.
+  std::vector<float> b = kSquare;
+  b.insert(b.end(), {0, 0, 3, 1, 0, 3, 0, 1, 3});
+  std::vector<uint32_t> bt = kSquareTris;
+  bt.insert(bt.end(), {4, 5, 6});
+  SurfaceError ab, ba;
+  ASSERT_TRUE(measure_surface_error(view(kSquare, kSquareTris), view(b, bt), {}, ab).ok);
+  ASSERT_TRUE(measure_surface_error(view(b, bt), view(kSquare, kSquareTris), {}, ba).ok);
+  EXPECT_NEAR(ab.max, 3.0f, 1e-5f);
+  EXPECT_NEAR(ba.max, 3.0f, 1e-5f);
+}
+
+TEST(SurfaceError, MeasuresTheGapToAnEdgeNotJustToPlanes) {
+  // A point beside a triangle's edge: its closest point lies on the edge.
+  const std::vector<float> tri = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const std::vector<uint32_t> t = {0, 1, 2};
+  const std::vector<float> far = {2, 0, 0, 3, 0, 0, 2, 1, 0};
+  SurfaceError e;
+  ASSERT_TRUE(measure_surface_error(view(tri, t), view(far, t), {}, e).ok);
+  // Farthest point of `far` from `tri` is (3,0,0): 2 from the corner (1,0,0).
+  EXPECT_NEAR(e.max, 2.0f, 1e-5f);
+}
+
+TEST(SurfaceError, IsReproducibleForOneSeed) {
+  const auto dir = test::temp_dir("surface-seed");
+  test::write_text(dir / "s.off", test::sphere_off(12, 16));
+  test::write_text(dir / "t.off", test::sphere_off(6, 8));
+  MeshData a, b;
+  ASSERT_TRUE(load_mesh(dir / "s.off", a).ok);
+  ASSERT_TRUE(load_mesh(dir / "t.off", b).ok);
+  const TriangleMeshView va{a.positions.data(), a.vertex_count(), a.indices.data(), a.indices.size()};
+  const TriangleMeshView vb{b.positions.data(), b.vertex_count(), b.indices.data(), b.indices.size()};
+  SurfaceError e1, e2;
+  ASSERT_TRUE(measure_surface_error(va, vb, {5000, 7}, e1).ok);
+  ASSERT_TRUE(measure_surface_error(va, vb, {5000, 7}, e2).ok);
+  EXPECT_EQ(e1.max, e2.max);
+  EXPECT_EQ(e1.rms, e2.rms);
+  EXPECT_GT(e1.max, 0.0f);
+  EXPECT_LT(e1.max, 0.3f);  // both inscribed in the unit sphere
+  EXPECT_LE(e1.rms, e1.max);
+}
+
+TEST(SurfaceError, MeterReusesItsReference) {
+  std::vector<float> up = kSquare;
+  for (size_t v = 0; v < 4; ++v) up[3 * v + 2] += 0.5f;
+  SurfaceErrorMeter meter;
+  ASSERT_TRUE(meter.set_reference(view(kSquare, kSquareTris), {}, "square").ok);
+  SurfaceError same, shifted;
+  ASSERT_TRUE(meter.measure(view(kSquare, kSquareTris), same).ok);
+  ASSERT_TRUE(meter.measure(view(up, kSquareTris), shifted).ok);
+  EXPECT_LT(same.max, 1e-6f);
+  EXPECT_NEAR(shifted.max, 0.5f, 1e-6f);
+}
+
+TEST(SurfaceError, RefusesBadInput) {
+  SurfaceErrorMeter meter;
+  SurfaceError e;
+  EXPECT_FALSE(meter.measure(view(kSquare, kSquareTris), e).ok);  // no reference yet
+  const std::vector<uint32_t> bad = {0, 1, 7};
+  const Status s = meter.set_reference(view(kSquare, bad), {}, "square");
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("square"), std::string::npos);
+  EXPECT_FALSE(meter.set_reference(view(kSquare, {}), {}, "empty").ok);
+}
+
+}  // namespace
+}  // namespace lod
