@@ -2,6 +2,7 @@
 //
 // Exit codes: 0 done; 1 bad command line, config, assets or output file; 2 no display, no
 // OpenGL 3.3, or the GL refused a resource.
+#include <chrono>
 #include <cstdio>
 #include <thread>
 
@@ -62,6 +63,13 @@ int run(const lod::viewer::ViewerOptions& o) {
   if (o.budget > 0) session.graph.selection.budget = uint64_t(o.budget);
   session.graph.pixel_error = loaded.config.pixel_error;
   session.graph.hysteresis = loaded.config.hysteresis;
+  if (o.lod_delay_ms > 0) {
+    // Through the graph's stage hook, so the delay sits inside the LOD frame, on its thread.
+    const auto delay = std::chrono::duration<double, std::milli>(o.lod_delay_ms);
+    session.graph.stage_hook = [delay](lod::Stage stage) {
+      if (stage == lod::Stage::view) std::this_thread::sleep_for(delay);
+    };
+  }
   session.threads = loaded.config.threads ? loaded.config.threads : std::max(1u, std::thread::hardware_concurrency());
   return o.screenshot.empty() ? run_interactive(session) : run_screenshot(session);
 }
@@ -81,6 +89,7 @@ int main(int argc, char** argv) {
   app.add_option("--threads", o.threads, "LOD thread pool size (0 = all cores; default: the config's)");
   app.add_option("--budget", o.budget, "triangle budget M (default: the config's)");
   app.add_option("--lod-rate", o.lod_rate_hz, "interactive: LOD service rate in Hz (default: the config's rate_hz)");
+  app.add_option("--lod-delay-ms", o.lod_delay_ms, "slow the LOD thread down: sleep this long in every LOD frame");
   app.add_option("--stats", o.stats, "write one CSV row per viewer frame");
   app.add_flag("--color-by-level,--colour-by-level", o.colour_by_level, "colour objects by their chain level");
   app.add_flag("--wireframe", o.wireframe, "draw triangle edges only");
@@ -95,6 +104,10 @@ int main(int argc, char** argv) {
   o.vsync = !no_vsync;
   if (o.frames == 0 || o.frames < -1) {
     std::fprintf(stderr, "lod-viewer: --frames %lld: must be at least 1\n", (long long)o.frames);
+    return kExitBadInput;
+  }
+  if (o.lod_delay_ms < 0 || o.lod_delay_ms > 60000) {
+    std::fprintf(stderr, "lod-viewer: --lod-delay-ms must be 0..60000\n");
     return kExitBadInput;
   }
   if (o.threads > 1024 || o.threads < -1 || o.budget == 0 || o.budget < -1) {

@@ -65,16 +65,22 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c) {
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.8f);
   ImGui::Begin("lod-viewer", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::Text("%.1f fps  (%.2f ms)   %s", f.viewer_ms > 0 ? 1000.0 / f.viewer_ms : 0.0, f.viewer_ms, f.gl.c_str());
+  ImGui::Text("%.1f fps  (%.2f ms per viewer frame)", f.viewer_ms > 0 ? 1000.0 / f.viewer_ms : 0.0, f.viewer_ms);
+  ImGui::TextDisabled("%s", f.gl.c_str());
   ImGui::Text("LOD thread: %u threads, %llu frames, %.2f ms mean, %llu errors", f.threads,
               (unsigned long long)f.service.frames, f.service.mean_ms, (unsigned long long)f.service.errors);
 
   if (const Frame* fr = f.frame) {
     ImGui::Separator();
     ImGui::Text("LOD frame %llu: %.3f ms", (unsigned long long)fr->index, fr->total_ms);
-    for (size_t s = 0; s < kStageCount; ++s) {
-      ImGui::Text("  %-10s %7.3f ms", kStageNames[s], fr->stage_ms[s]);
-      if (s % 2 == 0 && s + 1 < kStageCount) ImGui::SameLine(180);
+    if (ImGui::BeginTable("stages", 4, ImGuiTableFlags_SizingFixedFit)) {
+      for (size_t s = 0; s < kStageCount; ++s) {
+        ImGui::TableNextColumn();
+        ImGui::Text("%s", kStageNames[s]);
+        ImGui::TableNextColumn();
+        ImGui::Text("%7.3f ms", fr->stage_ms[s]);
+      }
+      ImGui::EndTable();
     }
     ImGui::Text("visible      %s / %s objects", thousands(fr->visible).c_str(), thousands(f.objects).c_str());
     ImGui::Text("tris in view %s", thousands(fr->tris_in_view).c_str());

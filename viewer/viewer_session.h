@@ -26,6 +26,7 @@ struct ViewerOptions {
   int64_t threads = -1;              // -1 = the config's
   int64_t budget = -1;               // -1 = the config's
   double lod_rate_hz = -1;           // -1 = the config's rate_hz
+  double lod_delay_ms = 0;           // sleep added to every LOD frame (measuring that the viewer never waits)
   bool colour_by_level = false;
   bool wireframe = false;
   bool overlay = false;              // screenshot: draw the overlay too (interactive always has it)
