@@ -1,0 +1,27 @@
+// ThreadSanitizer suppressions compiled into test_jobs (the sanitizer asks for them at start).
+//
+// Debian's libtbb is not built with ThreadSanitizer, so the synchronisation of its scheduler
+// (work stealing, task hand-over, waiting) is invisible, and TSan reports TBB's own task and
+// node objects, written on one thread and read on another. Suppressed here: races whose
+// innermost frame is in oneTBB's headers, and races with a stack inside one of TBB's internal
+// helpers under which lodkit code never runs. A race between two accesses made by lodkit
+// code is still reported; the frame graph marks TBB's spawn and join edges for TSan itself
+// (frame_graph.cpp).
+#if defined(__SANITIZE_THREAD__)
+#define LOD_TEST_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define LOD_TEST_TSAN 1
+#endif
+#endif
+
+#ifdef LOD_TEST_TSAN
+extern "C" const char* __tsan_default_suppressions() {
+  return "race_top:/oneapi/tbb/\n"
+         "race:tbb::detail::d1::fold_tree\n"          // parallel_for's partition tree
+         "race:tbb::detail::d1::tree_node::\n"
+         "race:tbb::detail::d1::wait_context::\n"     // completion counters
+         "race:tbb::detail::d1::broadcast_cache\n"    // flow-graph successor lists
+         "race:tbb::detail::d1::spin_rw_mutex\n";
+}
+#endif
