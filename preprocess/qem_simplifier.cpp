@@ -1,0 +1,848 @@
+// QEM edge collapse in sorted passes (see qem_simplifier.h for the papers).
+//
+// Each pass: build vertex->triangle lists (CSR) and classify vertices (manifold / border /
+// locked) from the current index buffer; give every collapsible edge its optimal position and
+// quadric cost; radix-sort the costs; collapse in order, skipping an edge when either end was
+// already touched this pass (its cost is stale) or when the collapse would break the link
+// condition or flip/fold a face; then rewrite the index buffer through the remap table. Every
+// array is sized once per call and reused by every pass.
+#include "preprocess/qem_simplifier.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace lod {
+namespace {
+
+constexpr uint8_t kManifold = 0;
+constexpr uint8_t kBorder = 1;
+constexpr uint8_t kLocked = 2;
+
+// A collapse must not turn a face by more than this (cosine between old and new normal):
+// 0 would only refuse flips; a margin also refuses folds that create near-vertical slivers.
+constexpr float kMinNormalCos = 0.2f;
+// Optimal placement is regularised towards the edge midpoint by this fraction of trace(A), so
+// flat and crease regions (rank-deficient A) still get a well-defined, nearby optimum.
+constexpr double kRegularisation = 1e-3;
+// An optimum farther than this many edge lengths from the midpoint is distrusted.
+constexpr double kMaxPlacementDistance = 1.5;
+
+void quadric_add_plane(Quadric& q, double nx, double ny, double nz, double d, double w) {
+  q.a00 += w * nx * nx;
+  q.a11 += w * ny * ny;
+  q.a22 += w * nz * nz;
+  q.a01 += w * nx * ny;
+  q.a02 += w * nx * nz;
+  q.a12 += w * ny * nz;
+  q.b0 += w * nx * d;
+  q.b1 += w * ny * d;
+  q.b2 += w * nz * d;
+  q.c += w * d * d;
+  q.w += w;
+}
+
+inline __attribute__((always_inline)) void quadric_add(Quadric& q, const Quadric& r) {
+  q.a00 += r.a00;
+  q.a11 += r.a11;
+  q.a22 += r.a22;
+  q.a01 += r.a01;
+  q.a02 += r.a02;
+  q.a12 += r.a12;
+  q.b0 += r.b0;
+  q.b1 += r.b1;
+  q.b2 += r.b2;
+  q.c += r.c;
+  q.w += r.w;
+}
+
+inline __attribute__((always_inline)) Quadric quadric_sum(const Quadric& a, const Quadric& b) {
+  Quadric q = a;
+  quadric_add(q, b);
+  return q;
+}
+
+double quadric_eval(const Quadric& q, double x, double y, double z) {
+  const double ax = q.a00 * x + q.a01 * y + q.a02 * z;
+  const double ay = q.a01 * x + q.a11 * y + q.a12 * z;
+  const double az = q.a02 * x + q.a12 * y + q.a22 * z;
+  const double r = x * ax + y * ay + z * az + 2 * (q.b0 * x + q.b1 * y + q.b2 * z) + q.c;
+  return r > 0 ? r : 0;
+}
+
+// Normalised error: area-weighted mean squared plane distance.
+float quadric_cost(const Quadric& q, const float* p) {
+  const double e = quadric_eval(q, p[0], p[1], p[2]);
+  return q.w > 0 ? float(e / q.w) : float(e);
+}
+
+// Best point on the segment a-b (1D quadratic, clamped), midpoint when flat along it.
+void place_on_segment(const Quadric& q, const float* a, const float* b, float* out) {
+  const double d[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+  const double ad[3] = {q.a00 * d[0] + q.a01 * d[1] + q.a02 * d[2], q.a01 * d[0] + q.a11 * d[1] + q.a12 * d[2],
+                        q.a02 * d[0] + q.a12 * d[1] + q.a22 * d[2]};
+  const double dad = d[0] * ad[0] + d[1] * ad[1] + d[2] * ad[2];
+  double t = 0.5;
+  if (dad > 1e-30) {
+    const double num = a[0] * ad[0] + a[1] * ad[1] + a[2] * ad[2] + q.b0 * d[0] + q.b1 * d[1] + q.b2 * d[2];
+    t = std::clamp(-num / dad, 0.0, 1.0);
+  }
+  for (int k = 0; k < 3; ++k) out[k] = float(a[k] + t * d[k]);
+}
+
+// Minimiser of q (+ a small pull to the midpoint) by Cramer's rule; falls back to the segment.
+void place_optimal(const Quadric& q, const float* a, const float* b, float* out) {
+  const double m[3] = {0.5 * (double(a[0]) + b[0]), 0.5 * (double(a[1]) + b[1]), 0.5 * (double(a[2]) + b[2])};
+  const double lambda = kRegularisation * (q.a00 + q.a11 + q.a22) + 1e-30;
+  const double a00 = q.a00 + lambda, a11 = q.a11 + lambda, a22 = q.a22 + lambda;
+  const double a01 = q.a01, a02 = q.a02, a12 = q.a12;
+  const double r0 = -q.b0 + lambda * m[0], r1 = -q.b1 + lambda * m[1], r2 = -q.b2 + lambda * m[2];
+  const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+  const double det = a00 * c00 + a01 * c01 + a02 * c02;
+  if (det > 1e-300) {
+    const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+    const double inv = 1.0 / det;
+    const double x = (c00 * r0 + c01 * r1 + c02 * r2) * inv;
+    const double y = (c01 * r0 + c11 * r1 + c12 * r2) * inv;
+    const double z = (c02 * r0 + c12 * r1 + c22 * r2) * inv;
+    const double dx = double(b[0]) - a[0], dy = double(b[1]) - a[1], dz = double(b[2]) - a[2];
+    const double len2 = dx * dx + dy * dy + dz * dz;
+    const double ox = x - m[0], oy = y - m[1], oz = z - m[2];
+    if (std::isfinite(x + y + z) &&
+        ox * ox + oy * oy + oz * oz <= kMaxPlacementDistance * kMaxPlacementDistance * len2) {
+      out[0] = float(x);
+      out[1] = float(y);
+      out[2] = float(z);
+      return;
+    }
+  }
+  place_on_segment(q, a, b, out);
+}
+
+struct Candidate {
+  uint32_t from, to;
+  float cost;
+  float p[3];
+};
+
+// Scratch for one simplification call, sized once for the mesh it starts from.
+struct Work {
+  std::vector<uint32_t> offset, fill;  // CSR vertex -> faces
+  std::vector<uint32_t> ring;          // per CSR entry: the face's next and previous corner
+  std::vector<uint8_t> kind;
+  std::vector<uint32_t> next, prev;    // border loops, for border vertices
+  std::vector<uint32_t> stamp;
+  std::vector<uint8_t> out_count, in_count;
+  std::vector<uint32_t> remap;
+  std::vector<uint8_t> pass_lock;
+  std::vector<uint32_t> mark;
+  uint32_t mark_value = 0;
+  std::vector<Candidate> cands;
+  std::vector<uint32_t> keys, order, order_tmp;
+  std::vector<uint32_t> vmap;
+
+  void reserve(size_t v, size_t t) {
+    offset.reserve(v + 1);
+    fill.reserve(v);
+    ring.reserve(6 * t);
+    remap.reserve(v);
+    pass_lock.reserve(v);
+    mark.reserve(v);
+    cands.reserve(3 * t);
+    keys.reserve(3 * t);
+    order.reserve(3 * t);
+    order_tmp.reserve(3 * t);
+    vmap.reserve(v);
+  }
+};
+
+// CSR lists for the current index buffer: each face of v as its (next, previous) corners.
+void build_lists(Work& w, const QemMesh& mesh) {
+  const size_t nv = mesh.positions.size() / 3;
+  const size_t nt = mesh.indices.size() / 3;
+  const uint32_t* idx = mesh.indices.data();
+  w.offset.assign(nv + 1, 0);
+  for (size_t i = 0; i < 3 * nt; ++i) w.offset[idx[i] + 1]++;
+  for (size_t v = 0; v < nv; ++v) w.offset[v + 1] += w.offset[v];
+  w.fill.assign(w.offset.begin(), w.offset.end() - 1);
+  w.ring.resize(6 * nt);
+  for (size_t t = 0; t < nt; ++t) {
+    const uint32_t a = idx[3 * t], b = idx[3 * t + 1], c = idx[3 * t + 2];
+    uint32_t* ra = &w.ring[2 * size_t(w.fill[a]++)];
+    ra[0] = b, ra[1] = c;
+    uint32_t* rb = &w.ring[2 * size_t(w.fill[b]++)];
+    rb[0] = c, rb[1] = a;
+    uint32_t* rc = &w.ring[2 * size_t(w.fill[c]++)];
+    rc[0] = a, rc[1] = b;
+  }
+}
+
+// Vertex kinds and border loops, once per call: collapses that pass the link condition keep
+// every vertex's kind, and border collapses update the loops as they go.
+void classify(Work& w, const QemMesh& mesh, bool lock_border) {
+  const size_t nv = mesh.positions.size() / 3;
+  w.kind.assign(nv, kLocked);
+  w.next.assign(nv, ~0u);
+  w.prev.assign(nv, ~0u);
+  w.stamp.assign(nv, 0);
+  w.out_count.assign(nv, 0);
+  w.in_count.assign(nv, 0);
+  for (size_t v = 0; v < nv; ++v) {
+    const uint32_t begin = w.offset[v], end = w.offset[v + 1];
+    if (begin == end) continue;
+    const uint32_t s = uint32_t(v) + 1;
+    for (uint32_t i = begin; i < end; ++i) {
+      const uint32_t n = w.ring[2 * i], p = w.ring[2 * i + 1];
+      if (w.stamp[n] != s) w.stamp[n] = s, w.out_count[n] = 0, w.in_count[n] = 0;
+      if (w.stamp[p] != s) w.stamp[p] = s, w.out_count[p] = 0, w.in_count[p] = 0;
+      if (w.out_count[n] < 255) w.out_count[n]++;
+      if (w.in_count[p] < 255) w.in_count[p]++;
+    }
+    unsigned border_out = 0, border_in = 0;
+    bool complex = false;
+    for (uint32_t i = begin; i < end; ++i) {
+      const uint32_t n = w.ring[2 * i], p = w.ring[2 * i + 1];
+      if (w.out_count[n] == 1 && w.in_count[n] == 0) border_out++, w.next[v] = n;
+      if (w.in_count[p] == 1 && w.out_count[p] == 0) border_in++, w.prev[v] = p;
+      complex |= w.out_count[n] > 1 || w.in_count[n] > 1 || w.out_count[p] > 1 || w.in_count[p] > 1;
+    }
+    uint8_t kind = kLocked;
+    if (!complex && border_out == 0 && border_in == 0) kind = kManifold;
+    if (!complex && border_out == 1 && border_in == 1) kind = lock_border ? kLocked : kBorder;
+    if (mesh.lock[v]) kind = kLocked;
+    w.kind[v] = kind;
+  }
+}
+
+void radix_sort(Work& w, size_t n) {
+  w.keys.resize(n);
+  w.order.resize(n);
+  w.order_tmp.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t bits;
+    std::memcpy(&bits, &w.cands[i].cost, 4);  // costs are >= 0, so bits sort like values
+    w.keys[i] = bits;
+    w.order[i] = uint32_t(i);
+  }
+  uint32_t hist[3][2048] = {};
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t k = w.keys[i];
+    hist[0][k & 2047]++;
+    hist[1][(k >> 11) & 2047]++;
+    hist[2][k >> 22]++;
+  }
+  for (int pass = 0; pass < 3; ++pass) {
+    uint32_t sum = 0;
+    for (uint32_t& h : hist[pass]) {
+      const uint32_t c = h;
+      h = sum;
+      sum += c;
+    }
+    const int shift = 11 * pass;
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t o = w.order[i];
+      w.order_tmp[hist[pass][(w.keys[o] >> shift) & 2047]++] = o;
+    }
+    std::swap(w.order, w.order_tmp);
+  }
+}
+
+bool normal_kept(const float* p0, const float* p1, const float* p2, const float* q0) {
+  // The face (p0, p1, p2) with p0 moved to q0.
+  const float e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+  const float e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+  const float f1[3] = {p1[0] - q0[0], p1[1] - q0[1], p1[2] - q0[2]};
+  const float f2[3] = {p2[0] - q0[0], p2[1] - q0[1], p2[2] - q0[2]};
+  const float n0[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  const float n1[3] = {f1[1] * f2[2] - f1[2] * f2[1], f1[2] * f2[0] - f1[0] * f2[2], f1[0] * f2[1] - f1[1] * f2[0]};
+  const float d = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2];
+  if (d <= 0) return false;
+  const float l0 = n0[0] * n0[0] + n0[1] * n0[1] + n0[2] * n0[2];
+  const float l1 = n1[0] * n1[0] + n1[1] * n1[1] + n1[2] * n1[2];
+  return d * d >= kMinNormalCos * kMinNormalCos * l0 * l1;
+}
+
+// Faces of v (other than those also holding `other`) keep their orientation when v moves to p.
+bool faces_kept(const Work& w, const QemMesh& mesh, uint32_t v, uint32_t other, const float* p) {
+  const float* pos = mesh.positions.data();
+  for (uint32_t i = w.offset[v]; i < w.offset[v + 1]; ++i) {
+    const uint32_t n = w.remap[w.ring[2 * i]], q = w.remap[w.ring[2 * i + 1]];
+    if (n == q || n == other || q == other || n == v || q == v) continue;  // removed or collapsing
+    if (!normal_kept(pos + 3 * v, pos + 3 * size_t(n), pos + 3 * size_t(q), p)) return false;
+  }
+  return true;
+}
+
+// Link condition (common neighbours of a and b are exactly the apexes of the faces on edge
+// a-b) and enough faces left around the merged vertex. Sets `removed` to those faces' count.
+bool topology_kept(Work& w, uint32_t a, uint32_t b, uint8_t result_kind, size_t& removed) {
+  w.mark_value += 2;
+  const uint32_t na = w.mark_value, counted = w.mark_value + 1;
+  size_t faces_a = 0, faces_b = 0, shared = 0, common = 0;
+  for (uint32_t i = w.offset[a]; i < w.offset[a + 1]; ++i) {
+    const uint32_t y = w.remap[w.ring[2 * i]], z = w.remap[w.ring[2 * i + 1]];
+    if (y == z || y == a || z == a) continue;
+    faces_a++;
+    w.mark[y] = na;
+    w.mark[z] = na;
+  }
+  for (uint32_t i = w.offset[b]; i < w.offset[b + 1]; ++i) {
+    const uint32_t y = w.remap[w.ring[2 * i]], z = w.remap[w.ring[2 * i + 1]];
+    if (y == z || y == b || z == b) continue;
+    faces_b++;
+    if (y == a || z == a) shared++;
+    if (y != a && w.mark[y] == na) w.mark[y] = counted, common++;
+    if (z != a && w.mark[z] == na) w.mark[z] = counted, common++;
+  }
+  removed = shared;
+  if (shared == 0 || common != shared) return false;
+  const size_t left = faces_a + faces_b - 2 * shared;
+  return result_kind == kManifold ? left >= 3 : left >= 1;
+}
+
+// Pass over the current mesh: returns the number of faces removed.
+size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, bool& hit_limit,
+                     bool lists_current) {
+  const size_t nv = mesh.positions.size() / 3;
+  const size_t nt = mesh.indices.size() / 3;
+  if (!lists_current) build_lists(w, mesh);
+  const uint32_t* idx = mesh.indices.data();
+  float* pos = mesh.positions.data();
+
+  // Every collapsible edge once, with its direction, position and cost.
+  w.cands.clear();
+  for (size_t t = 0; t < nt; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = idx[3 * t + k], b = idx[3 * t + (k + 1) % 3];
+      const uint8_t ka = w.kind[a], kb = w.kind[b];
+      const bool border = (ka == kBorder && w.next[a] == b) || (kb == kBorder && w.prev[b] == a) ||
+                          (ka == kLocked && kb == kLocked);
+      if (!border && a > b) continue;  // an interior edge is seen from both faces
+      if (ka == kLocked && kb == kLocked) continue;
+      Candidate c;
+      const Quadric q = quadric_sum(mesh.quadrics[a], mesh.quadrics[b]);
+      if (ka == kManifold && kb == kManifold) {
+        c.from = a, c.to = b;
+        place_optimal(q, pos + 3 * a, pos + 3 * b, c.p);
+      } else if (ka == kManifold || kb == kManifold) {
+        c.from = ka == kManifold ? a : b;
+        c.to = ka == kManifold ? b : a;
+        std::memcpy(c.p, pos + 3 * c.to, sizeof c.p);
+      } else if (!border || (ka == kLocked && kb == kLocked)) {
+        continue;  // border vertices only slide along their border; locked ones never move
+      } else if (ka == kBorder && kb == kBorder) {
+        // Along a border the vertex stays on one end: a point inside the chord would pull
+        // both ends off the outline.
+        const float ea = quadric_cost(q, pos + 3 * a), eb = quadric_cost(q, pos + 3 * b);
+        c.from = ea < eb ? b : a;
+        c.to = ea < eb ? a : b;
+        std::memcpy(c.p, pos + 3 * c.to, sizeof c.p);
+      } else {
+        c.from = ka == kBorder ? a : b;
+        c.to = ka == kBorder ? b : a;
+        std::memcpy(c.p, pos + 3 * c.to, sizeof c.p);
+      }
+      c.cost = quadric_cost(q, c.p);
+      w.cands.push_back(c);
+    }
+  }
+  const size_t n = w.cands.size();
+  if (n == 0) return 0;
+  radix_sort(w, n);
+
+  // Collapse in cost order. Each success locks ~6 other edges for this pass, so the error
+  // allowed per pass follows the goal-th cheapest edge (meshoptimizer's pass limit).
+  const size_t face_goal = nt - target;
+  const size_t edge_goal = face_goal / 2;
+  // Close to the target the remaining few collapses go in one pass, not in a long tail of them.
+  const bool last_stretch = face_goal * 50 < nt;
+  const float error_goal = edge_goal < n && !last_stretch ? 1.5f * w.cands[w.order[edge_goal]].cost
+                                                          : std::numeric_limits<float>::max();
+  const size_t collapse_floor = edge_goal / 6;
+
+  w.remap.resize(nv);
+  for (size_t v = 0; v < nv; ++v) w.remap[v] = uint32_t(v);
+  w.pass_lock.assign(nv, 0);
+  if (w.mark.size() < nv) w.mark.assign(nv, 0), w.mark_value = 0;
+  if (w.mark_value > 0xfffffff0u) std::fill(w.mark.begin(), w.mark.end(), 0), w.mark_value = 0;
+
+  // Candidates are gathered into sorted order a chunk at a time: independent loads overlap,
+  // where the collapse loop below would wait on each one.
+  constexpr size_t kChunk = 512;
+  constexpr size_t kAhead = 8;
+  Candidate chunk[kChunk];
+  size_t removed_total = 0, collapses = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (i % kChunk == 0) {
+      const size_t m = std::min(kChunk, n - i);
+      for (size_t j = 0; j < m; ++j) chunk[j] = w.cands[w.order[i + j]];
+    }
+    if (i % kChunk + kAhead < kChunk && i + kAhead < n) {
+      const Candidate& f = chunk[i % kChunk + kAhead];
+      __builtin_prefetch(&w.offset[f.from]);
+      __builtin_prefetch(&w.offset[f.to]);
+      __builtin_prefetch(&w.pass_lock[f.from]);
+    }
+    const Candidate& c = chunk[i % kChunk];
+    if (c.cost > cost_limit) {
+      hit_limit = true;
+      break;
+    }
+    if (removed_total >= face_goal) break;
+    if (c.cost > error_goal && collapses > collapse_floor) break;
+    const uint32_t a = c.from, b = c.to;
+    if (w.pass_lock[a] || w.pass_lock[b]) continue;
+    size_t removed = 0;
+    if (!topology_kept(w, a, b, w.kind[b], removed)) continue;
+    if (!faces_kept(w, mesh, a, b, c.p)) continue;
+    const bool b_moves = std::memcmp(c.p, pos + 3 * b, sizeof c.p) != 0;
+    if (b_moves && !faces_kept(w, mesh, b, a, c.p)) continue;
+
+    if (mesh.attribute_count) {
+      // Attribute at the new position: interpolated along the edge by the projection.
+      const float* pa = pos + 3 * a;
+      const float* pb = pos + 3 * b;
+      const float d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
+      const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      float t = 1;
+      if (len2 > 0)
+        t = std::clamp(((c.p[0] - pa[0]) * d[0] + (c.p[1] - pa[1]) * d[1] + (c.p[2] - pa[2]) * d[2]) / len2,
+                       0.f, 1.f);
+      float* at = mesh.attributes.data();
+      const size_t ac = mesh.attribute_count;
+      for (size_t k = 0; k < ac; ++k) at[b * ac + k] = at[a * ac + k] * (1 - t) + at[b * ac + k] * t;
+    }
+    if (w.kind[a] == kBorder) {
+      // a leaves its border loop
+      const uint32_t pa = w.prev[a], na = w.next[a];
+      if (na == b) {
+        w.next[pa] = b;
+        w.prev[b] = pa;
+      } else {
+        w.prev[na] = b;
+        w.next[b] = na;
+      }
+    }
+    std::memcpy(pos + 3 * b, c.p, sizeof c.p);
+    quadric_add(mesh.quadrics[b], mesh.quadrics[a]);
+    w.remap[a] = b;
+    w.pass_lock[a] = w.pass_lock[b] = 1;
+    removed_total += removed;
+    collapses++;
+    mesh.error = std::max(mesh.error, double(c.cost));
+  }
+
+  // Rewrite the faces through the remap table; drop the ones that collapsed.
+  size_t kept = 0;
+  uint32_t* out = mesh.indices.data();
+  for (size_t t = 0; t < nt; ++t) {
+    const uint32_t x = w.remap[out[3 * t]], y = w.remap[out[3 * t + 1]], z = w.remap[out[3 * t + 2]];
+    if (x == y || y == z || x == z) continue;
+    out[3 * kept] = x, out[3 * kept + 1] = y, out[3 * kept + 2] = z;
+    kept++;
+  }
+  mesh.indices.resize(3 * kept);
+  return nt - kept;
+}
+
+// Drops unreferenced vertices so later passes touch only live ones.
+void compact_vertices(Work& w, QemMesh& mesh) {
+  const size_t nv = mesh.positions.size() / 3;
+  const size_t ac = mesh.attribute_count;
+  w.vmap.assign(nv, ~0u);
+  uint32_t next = 0;
+  for (uint32_t& i : mesh.indices) {
+    if (w.vmap[i] == ~0u) w.vmap[i] = next++;
+    i = w.vmap[i];
+  }
+  std::vector<uint32_t>& order = w.fill;  // reuse: old id per new id
+  order.resize(next);
+  for (size_t v = 0; v < nv; ++v)
+    if (w.vmap[v] != ~0u) order[w.vmap[v]] = uint32_t(v);
+  // New ids follow first use, not old id order, so copy through fresh arrays.
+  QemMesh tmp;
+  tmp.positions.resize(3 * size_t(next));
+  tmp.attributes.resize(ac * size_t(next));
+  tmp.quadrics.resize(next);
+  tmp.source_vertex.resize(next);
+  tmp.lock.resize(next);
+  for (uint32_t n = 0; n < next; ++n) {
+    const uint32_t o = order[n];
+    std::memcpy(&tmp.positions[3 * size_t(n)], &mesh.positions[3 * size_t(o)], 12);
+    if (ac) std::memcpy(&tmp.attributes[ac * n], &mesh.attributes[ac * o], ac * sizeof(float));
+    tmp.quadrics[n] = mesh.quadrics[o];
+    tmp.source_vertex[n] = mesh.source_vertex[o];
+    tmp.lock[n] = mesh.lock[o];
+  }
+  std::vector<uint8_t> kind(next);
+  std::vector<uint32_t> nx(next), pv(next);
+  for (uint32_t n = 0; n < next; ++n) {
+    const uint32_t o = order[n];
+    kind[n] = w.kind[o];
+    nx[n] = w.next[o] == ~0u ? ~0u : w.vmap[w.next[o]];
+    pv[n] = w.prev[o] == ~0u ? ~0u : w.vmap[w.prev[o]];
+  }
+  w.kind.swap(kind);
+  w.next.swap(nx);
+  w.prev.swap(pv);
+  mesh.positions.swap(tmp.positions);
+  mesh.attributes.swap(tmp.attributes);
+  mesh.quadrics.swap(tmp.quadrics);
+  mesh.source_vertex.swap(tmp.source_vertex);
+  mesh.lock.swap(tmp.lock);
+}
+
+void snapshot(ChainLevelOut& level, Work& w, const QemMesh& mesh) {
+  const size_t nv = mesh.positions.size() / 3;
+  const size_t ac = mesh.attribute_count;
+  w.vmap.assign(nv, ~0u);
+  level.indices.resize(mesh.indices.size());
+  level.positions.clear();
+  level.attributes.clear();
+  level.source_vertex.clear();
+  uint32_t next = 0;
+  for (size_t i = 0; i < mesh.indices.size(); ++i) {
+    const uint32_t v = mesh.indices[i];
+    if (w.vmap[v] == ~0u) {
+      w.vmap[v] = next++;
+      for (int k = 0; k < 3; ++k) level.positions.push_back(mesh.positions[3 * v + k] * mesh.scale + mesh.offset[k]);
+      for (size_t k = 0; k < ac; ++k) level.attributes.push_back(mesh.attributes[v * ac + k]);
+      level.source_vertex.push_back(mesh.source_vertex[v]);
+    }
+    level.indices[i] = w.vmap[v];
+  }
+  level.error = float(std::sqrt(mesh.error) * mesh.scale);
+}
+
+}  // namespace
+
+void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, const uint32_t* indices,
+                 size_t index_count, const QemOptions& options) {
+  out = QemMesh{};
+  out.input_vertex_count = vertex_count;
+  out.attribute_count = options.attributes ? options.attribute_count : 0;
+  const size_t ac = out.attribute_count;
+
+  // Frame: a power-of-two scale and no offset, so normalising is exact and vertices that
+  // never move come out bit-identical.
+  std::vector<uint8_t> finite(vertex_count);
+  float max_abs = 0;
+  for (size_t v = 0; v < vertex_count; ++v) {
+    const float* p = positions + 3 * v;
+    finite[v] = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+    if (!finite[v]) continue;
+    for (int k = 0; k < 3; ++k) max_abs = std::max(max_abs, std::fabs(p[k]));
+  }
+  out.scale = max_abs > 0 ? std::exp2(std::ceil(std::log2(max_abs))) : 1.f;
+  const float inv = 1 / out.scale;
+
+  out.positions.resize(3 * vertex_count);
+  for (size_t v = 0; v < vertex_count; ++v)
+    for (int k = 0; k < 3; ++k)
+      out.positions[3 * v + k] = finite[v] ? positions[3 * v + k] * inv : 0;
+  if (ac) out.attributes.assign(options.attributes, options.attributes + ac * vertex_count);
+  out.source_vertex.resize(vertex_count);
+  for (size_t v = 0; v < vertex_count; ++v) out.source_vertex[v] = uint32_t(v);
+  out.lock.assign(vertex_count, 0);
+  if (options.vertex_lock)
+    for (size_t v = 0; v < vertex_count; ++v) out.lock[v] = options.vertex_lock[v] ? QemMesh::kLockUser : 0;
+
+  // Faces that cannot be simplified meaningfully are dropped: bad indices, repeats, NaNs.
+  out.indices.reserve(index_count);
+  for (size_t t = 0; t + 2 < index_count; t += 3) {
+    const uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];
+    if (a >= vertex_count || b >= vertex_count || c >= vertex_count) continue;
+    if (a == b || b == c || a == c || !finite[a] || !finite[b] || !finite[c]) continue;
+    out.indices.insert(out.indices.end(), {a, b, c});
+  }
+
+  // Vertices sharing a position (attribute seams, unwelded input) are locked: moving one copy
+  // alone would tear the surface open.
+  {
+    size_t cap = 16;
+    while (cap < 2 * vertex_count) cap *= 2;
+    std::vector<uint32_t> table(cap, ~0u);
+    for (size_t v = 0; v < vertex_count; ++v) {
+      if (!finite[v]) continue;
+      const float* p = &out.positions[3 * v];
+      uint32_t h[3];
+      std::memcpy(h, p, 12);
+      size_t slot = (h[0] * 73856093u ^ h[1] * 19349663u ^ h[2] * 83492791u) & (cap - 1);
+      for (;;) {
+        const uint32_t o = table[slot];
+        if (o == ~0u) {
+          table[slot] = uint32_t(v);
+          break;
+        }
+        if (std::memcmp(&out.positions[3 * size_t(o)], p, 12) == 0) {
+          out.lock[v] |= QemMesh::kLockUser;
+          out.lock[o] |= QemMesh::kLockUser;
+          break;
+        }
+        slot = (slot + 1) & (cap - 1);
+      }
+    }
+  }
+
+  // Area-weighted face planes, plus constraint planes through border edges.
+  out.quadrics.assign(vertex_count, Quadric{});
+  const size_t nt = out.indices.size() / 3;
+  for (size_t t = 0; t < nt; ++t) {
+    const float* p0 = &out.positions[3 * size_t(out.indices[3 * t])];
+    const float* p1 = &out.positions[3 * size_t(out.indices[3 * t + 1])];
+    const float* p2 = &out.positions[3 * size_t(out.indices[3 * t + 2])];
+    const double e1[3] = {double(p1[0]) - p0[0], double(p1[1]) - p0[1], double(p1[2]) - p0[2]};
+    const double e2[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
+    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (len <= 0) continue;  // zero-area faces carry no plane
+    for (double& x : n) x /= len;
+    const double d = -(n[0] * p0[0] + n[1] * p0[1] + n[2] * p0[2]);
+    for (int k = 0; k < 3; ++k) quadric_add_plane(out.quadrics[out.indices[3 * t + k]], n[0], n[1], n[2], d, 0.5 * len);
+  }
+  if (nt > 0 && options.border_weight > 0) {
+    Work w;
+    build_lists(w, out);
+    classify(w, out, false);
+    for (size_t v = 0; v < vertex_count; ++v) {
+      const uint32_t b = w.next[v];
+      if (b == ~0u) continue;
+      uint32_t c = ~0u;  // apex of the border edge's face
+      for (uint32_t i = w.offset[v]; i < w.offset[v + 1]; ++i)
+        if (w.ring[2 * i] == b) c = w.ring[2 * i + 1];
+      const float* pa = &out.positions[3 * v];
+      const float* pb = &out.positions[3 * size_t(b)];
+      const float* pc = &out.positions[3 * size_t(c)];
+      const double e[3] = {double(pb[0]) - pa[0], double(pb[1]) - pa[1], double(pb[2]) - pa[2]};
+      const double f[3] = {double(pc[0]) - pa[0], double(pc[1]) - pa[1], double(pc[2]) - pa[2]};
+      const double n[3] = {e[1] * f[2] - e[2] * f[1], e[2] * f[0] - e[0] * f[2], e[0] * f[1] - e[1] * f[0]};
+      // The constraint plane contains the edge and is perpendicular to the face.
+      double m[3] = {e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2], e[0] * n[1] - e[1] * n[0]};
+      const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+      if (!(len > 0)) continue;
+      for (double& x : m) x /= len;
+      const double d = -(m[0] * pa[0] + m[1] * pa[1] + m[2] * pa[2]);
+      const double wgt = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) * options.border_weight;
+      // Constraint planes add error but no area: the cost stays a mean over the surface.
+      for (uint32_t x : {uint32_t(v), b}) {
+        const double keep = out.quadrics[x].w;
+        quadric_add_plane(out.quadrics[x], m[0], m[1], m[2], d, wgt);
+        out.quadrics[x].w = keep;
+      }
+    }
+  }
+}
+
+size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* target_triangles,
+                         size_t level_count, const QemOptions& options) {
+  Work w;
+  w.reserve(mesh.positions.size() / 3, mesh.indices.size() / 3);
+  const double limit = options.max_error > 0 ? double(options.max_error) / mesh.scale : 0;
+  const double cost_limit = options.max_error > 0 ? limit * limit : std::numeric_limits<double>::max();
+  size_t compacted_at = mesh.triangle_count();
+  bool hit_limit = false;
+  size_t previous_target = mesh.triangle_count();
+  build_lists(w, mesh);
+  classify(w, mesh, options.lock_border);
+  bool lists_current = true;
+  for (size_t l = 0; l < level_count; ++l) {
+    const size_t target = std::min(target_triangles[l], previous_target);
+    previous_target = target;
+    while (mesh.triangle_count() > target && !hit_limit) {
+      if (2 * mesh.triangle_count() < compacted_at) {
+        compact_vertices(w, mesh);
+        compacted_at = mesh.triangle_count();
+        lists_current = false;
+      }
+      // no edges can be collapsed any more: topology, locks or the error limit
+      const size_t removed = collapse_pass(w, mesh, target, cost_limit, hit_limit, lists_current);
+      lists_current = false;
+      if (removed == 0) break;
+    }
+    levels[l].target_triangles = target_triangles[l];
+    levels[l].reached = mesh.triangle_count() <= target;
+    snapshot(levels[l], w, mesh);
+  }
+  return level_count;
+}
+
+size_t qem_simplify_chain(ChainLevelOut* levels, const float* positions, size_t vertex_count,
+                          const uint32_t* indices, size_t index_count, const size_t* target_triangles,
+                          size_t level_count, const QemOptions& options) {
+  QemMesh mesh;
+  qem_prepare(mesh, positions, vertex_count, indices, index_count, options);
+  return qem_simplify_mesh(levels, mesh, target_triangles, level_count, options);
+}
+
+size_t qem_split(QemMesh* parts, const QemMesh& whole) {
+  const size_t nt = whole.triangle_count();
+  const size_t nv = whole.positions.size() / 3;
+  constexpr size_t kMinSplitTriangles = 20000;  // below this a split costs more than it saves
+  if (nt < kMinSplitTriangles) {
+    parts[0] = whole;
+    return 1;
+  }
+  // Longest axis of the used vertices.
+  float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+  for (uint32_t v : whole.indices)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min(lo[k], whole.positions[3 * size_t(v) + k]), hi[k] = std::max(hi[k], whole.positions[3 * size_t(v) + k]);
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  std::vector<float> centre(nt);
+  for (size_t t = 0; t < nt; ++t) {
+    float s = 0;
+    for (int k = 0; k < 3; ++k) s += whole.positions[3 * size_t(whole.indices[3 * t + k]) + axis];
+    centre[t] = s;
+  }
+  std::vector<float> sorted = centre;
+  std::nth_element(sorted.begin(), sorted.begin() + nt / 2, sorted.end());
+  const float median = sorted[nt / 2];
+
+  std::vector<uint8_t> side(nt), used(nv, 0);
+  for (size_t t = 0; t < nt; ++t) {
+    side[t] = centre[t] < median ? 0 : 1;
+    for (int k = 0; k < 3; ++k) used[whole.indices[3 * t + k]] |= uint8_t(1u << side[t]);
+  }
+  const size_t ac = whole.attribute_count;
+  for (int p = 0; p < 2; ++p) {
+    QemMesh& part = parts[p];
+    part = QemMesh{};
+    part.attribute_count = ac;
+    part.input_vertex_count = whole.input_vertex_count;
+    std::memcpy(part.offset, whole.offset, sizeof part.offset);
+    part.scale = whole.scale;
+    part.error = whole.error;
+    std::vector<uint32_t> local(nv, ~0u);
+    for (size_t v = 0; v < nv; ++v) {
+      if (!(used[v] & (1u << p))) continue;
+      local[v] = uint32_t(part.source_vertex.size());
+      const bool seam = used[v] == 3;
+      part.positions.insert(part.positions.end(), &whole.positions[3 * v], &whole.positions[3 * v] + 3);
+      if (ac) part.attributes.insert(part.attributes.end(), &whole.attributes[ac * v], &whole.attributes[ac * v] + ac);
+      // A shared vertex's quadric goes to part 0 only, so merging can simply add them.
+      part.quadrics.push_back(seam && p == 1 ? Quadric{} : whole.quadrics[v]);
+      part.source_vertex.push_back(whole.source_vertex[v]);
+      part.lock.push_back(uint8_t(whole.lock[v] | (seam ? QemMesh::kLockSeam : 0)));
+    }
+    for (size_t t = 0; t < nt; ++t) {
+      if (side[t] != p) continue;
+      for (int k = 0; k < 3; ++k) part.indices.push_back(local[whole.indices[3 * t + k]]);
+    }
+  }
+  return 2;
+}
+
+void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
+  out = QemMesh{};
+  if (part_count == 0) return;
+  const size_t ac = parts[0].attribute_count;
+  out.attribute_count = ac;
+  out.input_vertex_count = parts[0].input_vertex_count;
+  std::memcpy(out.offset, parts[0].offset, sizeof out.offset);
+  out.scale = parts[0].scale;
+  std::vector<uint32_t> merged(out.input_vertex_count, ~0u);
+  for (size_t p = 0; p < part_count; ++p) {
+    const QemMesh& part = parts[p];
+    out.error = std::max(out.error, part.error);
+    const size_t nv = part.source_vertex.size();
+    std::vector<uint32_t> local(nv, ~0u);
+    // Only live vertices survive the merge.
+    for (uint32_t v : part.indices) local[v] = 0;
+    for (size_t v = 0; v < nv; ++v) {
+      if (local[v] == ~0u) continue;
+      const uint32_t src = part.source_vertex[v];
+      if ((part.lock[v] & QemMesh::kLockSeam) && merged[src] != ~0u) {
+        local[v] = merged[src];
+        quadric_add(out.quadrics[merged[src]], part.quadrics[v]);
+        continue;
+      }
+      local[v] = uint32_t(out.source_vertex.size());
+      merged[src] = local[v];
+      out.positions.insert(out.positions.end(), &part.positions[3 * v], &part.positions[3 * v] + 3);
+      if (ac) out.attributes.insert(out.attributes.end(), &part.attributes[ac * v], &part.attributes[ac * v] + ac);
+      out.quadrics.push_back(part.quadrics[v]);
+      out.source_vertex.push_back(src);
+      out.lock.push_back(uint8_t(part.lock[v] & ~QemMesh::kLockSeam));
+    }
+    for (uint32_t v : part.indices) out.indices.push_back(local[v]);
+  }
+}
+
+void chain_level_merge(ChainLevelOut& out, const ChainLevelOut* parts, size_t part_count) {
+  out = ChainLevelOut{};
+  if (part_count == 0) return;
+  uint32_t max_source = 0;
+  for (size_t p = 0; p < part_count; ++p)
+    for (uint32_t s : parts[p].source_vertex) max_source = std::max(max_source, s);
+  std::vector<uint32_t> merged(size_t(max_source) + 1, ~0u);
+  const size_t ac = parts[0].positions.empty() ? 0 : parts[0].attributes.size() / (parts[0].positions.size() / 3);
+  out.target_triangles = 0;
+  out.reached = true;
+  for (size_t p = 0; p < part_count; ++p) {
+    const ChainLevelOut& part = parts[p];
+    out.target_triangles += part.target_triangles;
+    out.reached = out.reached && part.reached;
+    out.error = std::max(out.error, part.error);
+    const size_t nv = part.source_vertex.size();
+    std::vector<uint32_t> local(nv);
+    for (size_t v = 0; v < nv; ++v) {
+      const uint32_t src = part.source_vertex[v];
+      if (merged[src] != ~0u) {
+        local[v] = merged[src];  // a shared (locked) vertex: same position in every part
+        continue;
+      }
+      local[v] = merged[src] = uint32_t(out.source_vertex.size());
+      out.positions.insert(out.positions.end(), &part.positions[3 * v], &part.positions[3 * v] + 3);
+      if (ac) out.attributes.insert(out.attributes.end(), &part.attributes[ac * v], &part.attributes[ac * v] + ac);
+      out.source_vertex.push_back(src);
+    }
+    for (uint32_t v : part.indices) out.indices.push_back(local[v]);
+  }
+}
+
+size_t qem_simplify_chain_split(ChainLevelOut* levels, const float* positions, size_t vertex_count,
+                                const uint32_t* indices, size_t index_count,
+                                const size_t* target_triangles, size_t level_count,
+                                const QemOptions& options, const ParallelFor& parallel_for) {
+  QemMesh whole;
+  qem_prepare(whole, positions, vertex_count, indices, index_count, options);
+  QemMesh parts[2];
+  if (qem_split(parts, whole) < 2)
+    return qem_simplify_mesh(levels, parts[0], target_triangles, level_count, options);
+
+  // The halves run alone while their locked shared border is small next to the target.
+  constexpr size_t kSeamFactor = 12;
+  size_t seam = 0;
+  for (uint8_t l : parts[0].lock) seam += (l & QemMesh::kLockSeam) != 0;
+  const size_t nt = whole.triangle_count();
+  const size_t handoff = std::min(nt, kSeamFactor * seam);
+  size_t parallel_levels = 0;
+  while (parallel_levels < level_count && target_triangles[parallel_levels] >= handoff) parallel_levels++;
+
+  std::vector<ChainLevelOut> part_levels[2];
+  parallel_for(2, [&](size_t p) {
+    const double share = double(parts[p].triangle_count()) / double(nt);
+    std::vector<size_t> targets;
+    for (size_t l = 0; l < parallel_levels; ++l) targets.push_back(size_t(std::llround(target_triangles[l] * share)));
+    const size_t last = parallel_levels ? target_triangles[parallel_levels - 1] : nt;
+    if (parallel_levels < level_count && handoff < last) targets.push_back(size_t(std::llround(handoff * share)));
+    part_levels[p].resize(targets.size());
+    qem_simplify_mesh(part_levels[p].data(), parts[p], targets.data(), targets.size(), options);
+  });
+  for (size_t l = 0; l < parallel_levels; ++l) {
+    const ChainLevelOut pair[2] = {std::move(part_levels[0][l]), std::move(part_levels[1][l])};
+    chain_level_merge(levels[l], pair, 2);
+    levels[l].target_triangles = target_triangles[l];
+  }
+  whole = QemMesh{};
+  qem_merge(whole, parts, 2);
+  parts[0] = parts[1] = QemMesh{};
+  qem_simplify_mesh(levels + parallel_levels, whole, target_triangles + parallel_levels,
+                    level_count - parallel_levels, options);
+  return level_count;
+}
+
+}  // namespace lod
