@@ -23,11 +23,13 @@ struct FrameRow {
   int whole = 1;                 // frame_is_whole()
   double viewer_ms = 0;          // this viewer frame, CPU wall time
   double lod_ms = 0;             // Frame::total_ms
+  double service_ms = 0;         // time in lod::Service calls this viewer frame (driven: includes step)
 };
 
 struct FrameTimeSummary {
   size_t frames = 0;
   double mean_ms = 0, p50_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0;
+  double service_max_ms = 0;     // longest time one viewer frame spent in lod::Service calls
   uint64_t lod_frames_seen = 0;  // distinct LOD frames drawn
 };
 

@@ -162,6 +162,7 @@ int run_interactive(ViewerSession& s) {
         viewing = orbit.view(path.lens);
         break;
     }
+    const auto service_start = std::chrono::steady_clock::now();
     if (!controls.freeze_lod) {
       lod_view = viewing;
       service.set_view(lod_view);
@@ -172,6 +173,9 @@ int run_interactive(ViewerSession& s) {
     }
 
     const Frame& frame = service.latest_frame();  // newest complete frame; never waits
+    const ServiceStats service_stats = service.stats();
+    const double service_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - service_start).count();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     settings.colour_by_level = controls.colour_by_level;
     settings.wireframe = controls.wireframe;
@@ -184,7 +188,7 @@ int run_interactive(ViewerSession& s) {
       facts.viewer_ms = last_ms;
       facts.frame = &frame;
       facts.drawn = drawn;
-      facts.service = service.stats();
+      facts.service = service_stats;
       facts.threads = s.threads;
       facts.objects = s.loaded.scene.objects.size();
       facts.levels_in_scene = s.max_levels();
@@ -193,7 +197,7 @@ int run_interactive(ViewerSession& s) {
     }
     glfwSwapBuffers(window);
     last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - now).count();
-    s.record(n, frame, drawn, last_ms);
+    s.record(n, frame, drawn, last_ms, service_ms);
   }
   service.stop();
   const ServiceStats st = service.stats();

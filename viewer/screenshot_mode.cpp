@@ -49,6 +49,8 @@ int run_screenshot(ViewerSession& s) {
     const View view = view_at(path, n);
     if (!service.step(view)) ++failed;
     const Frame& frame = service.latest_frame();
+    const double service_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     target.bind();
     last = s.renderer.render(frame, view, settings);
     if (o.overlay) {
@@ -66,7 +68,7 @@ int run_screenshot(ViewerSession& s) {
     }
     glfwPollEvents();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    const FrameRow& row = s.record(n, frame, last, ms);
+    const FrameRow& row = s.record(n, frame, last, ms, service_ms);
     if (row.gpu_primitives != int64_t(row.drawn) || row.drawn != row.tris_selected) {
       ++mismatched;
       std::fprintf(stderr, "lod-viewer: frame %u: selected %llu, submitted %llu, GL counted %lld triangles\n", n,

@@ -47,7 +47,8 @@ struct ViewerSession {
   // Most levels any model has.
   size_t max_levels() const;
   // Checks the frame, fills a row from the draw, appends it to the log.
-  const FrameRow& record(uint64_t viewer_frame, const Frame& frame, const DrawStats& drawn, double viewer_ms);
+  const FrameRow& record(uint64_t viewer_frame, const Frame& frame, const DrawStats& drawn, double viewer_ms,
+                         double service_ms);
   // Writes --stats if asked; prints the frame-time summary. Returns false if the CSV failed.
   bool finish(const char* mode_name);
 };
