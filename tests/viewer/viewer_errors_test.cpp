@@ -19,6 +19,20 @@ TEST(ViewerErrors, NoDisplayExitsTwoWithAMessage) {
   EXPECT_NE(r.output.find("xvfb-run"), std::string::npos) << "the message says how to run headless";
 }
 
+TEST(ViewerErrors, OpenGlOlderThan33ExitsTwoNamingTheVersion) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("oldgl", kRun, kCamera, kOne);
+  // Mesa honours this override; other drivers ignore it and the run succeeds.
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + (scene.dir / "x.png").string() + "'", true,
+                                       "MESA_GL_VERSION_OVERRIDE=3.0");
+  if (r.exit_code == 0 && r.output.find("Mesa") == std::string::npos)
+    GTEST_SKIP() << "the GL driver is not Mesa, so its version cannot be lowered";
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("OpenGL 3.3 is needed"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("3.0"), std::string::npos) << "the message names what the display offers";
+  EXPECT_FALSE(std::filesystem::exists(scene.dir / "x.png"));
+}
+
 TEST(ViewerErrors, MissingMeshExitsOneNamingTheFile) {
   auto scene = lod::test::write_viewer_scene("nomesh", kRun, kCamera, kOne);
   lod::test::write_text(scene.config, std::string(kRun) + kCamera +

@@ -5,7 +5,6 @@
 #include <map>
 #include <stdexcept>
 #include <sstream>
-#include <sys/wait.h>
 #include <tuple>
 
 #include <stb_image.h>
@@ -76,14 +75,24 @@ bool have_xvfb() { return std::system("command -v xvfb-run > /dev/null 2>&1") ==
 
 RunResult run_viewer(const ViewerScene& scene, const std::string& args, bool under_xvfb, const std::string& env_prefix) {
   const std::filesystem::path log = scene.dir / "viewer-output.txt";
-  std::ostringstream cmd;
-  cmd << env_prefix << " ";
-  if (under_xvfb) cmd << "xvfb-run -a -s '-screen 0 1280x1024x24' ";
-  cmd << "'" << LOD_VIEWER_BINARY << "' --config '" << scene.config.string() << "' --cache '"
-      << (scene.dir / "cache").string() << "' " << args << " > '" << log.string() << "' 2>&1";
+  const std::filesystem::path rc = scene.dir / "viewer-exit-code.txt";
+  std::filesystem::remove(rc);
+  std::ostringstream viewer;
+  viewer << env_prefix << " '" << LOD_VIEWER_BINARY << "' --config '" << scene.config.string() << "' --cache '"
+         << (scene.dir / "cache").string() << "' " << args << " > '" << log.string() << "' 2>&1; echo $? > '"
+         << rc.string() << "'";
+  // The viewer's own exit code goes through a file: xvfb-run's can differ (it reports its
+  // own clean-up trouble).
+  std::string cmd = viewer.str();
+  if (under_xvfb) {
+    std::string quoted;
+    for (char ch : cmd) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    cmd = "xvfb-run -a -s '-screen 0 1280x1024x24' sh -c '" + quoted + "' > /dev/null 2>&1";
+  }
   RunResult r;
-  const int status = std::system(cmd.str().c_str());
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (std::system(cmd.c_str()) == -1) return r;  // no shell: exit_code stays -1
+  std::ifstream code(rc);
+  if (!(code >> r.exit_code)) r.exit_code = -1;
   std::ifstream f(log);
   r.output.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
   return r;
