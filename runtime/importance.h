@@ -26,9 +26,9 @@ struct ViewMinima {
 ViewMinima merge_minima(const ViewMinima& a, const ViewMinima& b);
 ViewMinima empty_minima();
 
-// For visible objects: distance from eye to sphere centre (clamped to >= radius, so a
+// For visible objects: distance from eye to sphere centre (clamped to >= radius and > 0, so a
 // camera inside a sphere does not divide by zero) and projected area pi * (r * focal / D)^2
-// in pixels. Invisible objects are left untouched. Sub-range safe; merge the minima.
+// in pixels (> 0). Invisible objects are left untouched. Sub-range safe; merge the minima.
 ViewMinima measure_objects(std::span<float> distance, std::span<float> area,
                            std::span<const uint8_t> visible, std::span<const float> cx,
                            std::span<const float> cy, std::span<const float> cz,

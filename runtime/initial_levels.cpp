@@ -7,6 +7,18 @@
 
 namespace lod {
 
+namespace {
+
+// The coarsest level k with error[k] * pixels_per_unit <= limit, searched from `k`.
+inline uint32_t last_within(const float* error, uint32_t count, uint32_t k, float pixels_per_unit,
+                            float limit) {
+  while (k + 1 < count && error[k + 1] * pixels_per_unit <= limit) ++k;
+  while (k > 0 && error[k] * pixels_per_unit > limit) --k;
+  return k;
+}
+
+}  // namespace
+
 size_t choose_initial_levels(std::span<uint8_t> level, std::span<const uint8_t> visible,
                              std::span<const uint8_t> prev_level, std::span<const uint8_t> was_visible,
                              std::span<const float> distance, std::span<const float> scale,
@@ -16,7 +28,8 @@ size_t choose_initial_levels(std::span<uint8_t> level, std::span<const uint8_t> 
   assert(level.size() == n && prev_level.size() == n && was_visible.size() == n &&
          distance.size() == n && scale.size() == n && model.size() == n);
   const float fine_limit = params.pixel_error;
-  const float coarse_limit = params.pixel_error * (1.0f + params.hysteresis);
+  // A negative hysteresis would invert the band; it means "none".
+  const float coarse_limit = std::max(fine_limit, params.pixel_error * (1.0f + params.hysteresis));
   const uint32_t* first = models.first_level.data();
   const uint8_t* counts = models.level_count.data();
   const float* error = models.error.data();
@@ -28,14 +41,13 @@ size_t choose_initial_levels(std::span<uint8_t> level, std::span<const uint8_t> 
     const float* e = error + first[m];
     const uint32_t count = counts[m];
     const float pixels_per_unit = scale[i] * params.focal_px / distance[i];
-    // Errors grow with the level index (validate_chain), so "coarsest level within the limit"
-    // is the number of levels after 0 that are within it; level 0 always qualifies.
-    uint32_t k_fine = 0, k_coarse = 0;
-    for (uint32_t k = 1; k < count; ++k) {
-      const float projected = e[k] * pixels_per_unit;
-      k_fine += projected <= fine_limit;
-      k_coarse += projected <= coarse_limit;
-    }
+    // Errors grow with the level index (validate_chain), so the levels within a limit are a
+    // prefix and the answer is its last level. Walk there from last frame's level: between
+    // frames that is zero or one step, so the branches stay predictable; level 0 always
+    // qualifies.
+    const uint32_t start = prev_level[i] < count ? prev_level[i] : count - 1u;
+    const uint32_t k_fine = last_within(e, count, start, pixels_per_unit, fine_limit);
+    const uint32_t k_coarse = last_within(e, count, k_fine, pixels_per_unit, coarse_limit);
     uint32_t chosen = k_fine;
     // Last frame's level survives while it stays inside [k_fine, k_coarse]: refine only when
     // its error exceeds the threshold by the band, coarsen as soon as a coarser level fits.

@@ -1,7 +1,9 @@
 // Initial levels: before the budget, each visible object takes the coarsest level whose
-// object-space error projects to at most `pixel_error` pixels. Hysteresis: an object keeps
-// last frame's level while that level's projected error stays within [pixel_error / (1 + h),
-// pixel_error * (1 + h)]-band, so levels do not flicker at a threshold.
+// object-space error projects (error * scale * focal / distance) to at most `pixel_error`
+// pixels: k_fine. Hysteresis: k_coarse is the coarsest level within pixel_error * (1 + h);
+// an object visible last frame keeps its level clamped into [k_fine, k_coarse], so it refines
+// only once its level's error exceeds the threshold by the band, and levels do not flicker
+// at a threshold. Level 0 always qualifies.
 #pragma once
 #include <cstddef>
 #include <cstdint>

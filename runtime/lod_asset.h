@@ -21,7 +21,8 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
 Status write_lod_asset(const std::filesystem::path& path, const LodChain& chain);
 Status read_lod_asset(const std::filesystem::path& path, LodChain& out);
 
-// 64-bit content hash (FNV-1a over 8-byte words, then mixed); used by checksums and caches.
+// 64-bit content hash over 8-byte words in four lanes, then mixed; any single changed byte
+// changes it. Deterministic across runs and machines. Used by checksums and caches.
 uint64_t hash_bytes(const void* data, size_t size, uint64_t seed = 0);
 
 }  // namespace lod

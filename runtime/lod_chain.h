@@ -39,7 +39,10 @@ struct LodChain {
 // Zero triangles gives level 0.
 int32_t level_of_triangles(uint64_t triangles);
 
-// Checks ranges, index bounds, monotonic triangle counts and errors; message names `what`.
+// Checks ranges, index bounds (indices < the level's vertex_count), triangle counts
+// non-increasing, errors non-decreasing, l = level_of_triangles, finite values, at most
+// kMaxLevels levels. On failure `message` names the element ("level 3 index 812 references
+// vertex 90211 of 35947"); callers prefix the file.
 bool validate_chain(const LodChain& chain, std::string* message);
 
 }  // namespace lod

@@ -1,12 +1,17 @@
 // Budgeted selection (R0, Fig. 3): while the visible objects cost more than M, lower the
 // object of highest importance f = (d / S) * SLC(l_cur -> l_next) by one level.
-// Passes: (1) cost of the initial and of the coarsest levels, one streaming loop;
-// (2) only when over M: gather lowerable objects into the caller's scratch and heapify, O(m);
+// Passes: (1) one branch-free streaming loop counts visible objects per chain level (the
+// costs of the initial and of the coarsest levels follow from those counts) and writes each
+// lowerable object's key into the caller's scratch; (2) only when over M: heapify, O(m);
 // (3) pop-lower-reinsert with a replace-top sift-down, O(pops log m). No allocation.
+// Selection is the serial part of a frame, so pass 1 is kept to a handful of instructions
+// per object: per-level lookups are folded into small tables on the stack first.
 #include "runtime/slc_selection.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <type_traits>
 
 #include "runtime/importance.h"
 
@@ -39,6 +44,112 @@ void make_heap(HeapEntry* heap, size_t size) {
 
 inline uint64_t pow2(int32_t l) { return uint64_t{1} << l; }
 
+struct Gathered {
+  uint64_t tri_sum = 0, lev_sum = 0;        // initial levels
+  uint64_t tri_coarse = 0, lev_coarse = 0;  // coarsest levels
+  size_t heap_size = 0;                     // lowerable visible objects written to the heap
+};
+
+struct Columns {
+  std::span<const uint8_t> level, visible;
+  std::span<const float> weight;
+  std::span<const uint32_t> model;
+};
+
+// Per-level lookup tables live on the stack when the chains fit, with room past the end so
+// that a stale level of an invisible object (at most 255 past its chain's start) still
+// indexes inside them without a clamp.
+constexpr size_t kStaleLevelRoom = 256;
+constexpr size_t kSlotTableSize = 2048;
+
+Gathered gather_by_slots(const Columns& c, const ModelTable& models, HeapEntry* heap, size_t capacity) {
+  const size_t levels = models.triangles.size();
+  const size_t slots = levels + kStaleLevelRoom;
+  assert(slots <= kSlotTableSize);
+  uint32_t visible_at[kSlotTableSize];  // visible objects per chain level
+  float slc_next[kSlotTableSize];       // SLC of lowering one step from this level
+  uint8_t lowerable[kSlotTableSize];    // 1 unless this is its chain's coarsest level
+  std::fill_n(visible_at, slots, 0u);
+  std::fill_n(slc_next, slots, 0.f);
+  std::fill_n(lowerable, slots, uint8_t{0});
+  const uint32_t* first = models.first_level.data();
+  const int32_t* ls = models.level_l.data();
+  for (size_t m = 0; m < models.model_count(); ++m) {
+    for (uint32_t k = first[m]; k + 1 < first[m] + models.level_count[m]; ++k) {
+      slc_next[k] = static_cast<float>(span_of_level_changed(ls[k], ls[k + 1]));
+      lowerable[k] = 1;
+    }
+  }
+
+  const size_t n = c.visible.size();
+  const uint8_t* __restrict visible = c.visible.data();
+  const uint8_t* __restrict level = c.level.data();
+  const uint32_t* __restrict model = c.model.data();
+  const float* __restrict weight = c.weight.data();
+  size_t size = 0;
+  auto one = [&](size_t i, auto bounded) {
+    assert(!visible[i] || level[i] < models.level_count[model[i]]);
+    const uint32_t at = first[model[i]] + level[i];
+    const uint32_t v = visible[i] != 0;
+    visible_at[at] += v;
+    const HeapEntry e{weight[i] * slc_next[at], static_cast<uint32_t>(i)};
+    if (!bounded || size < capacity) heap[size] = e;
+    size += v & lowerable[at];
+  };
+  // With room for every object (the usual case) the write needs no bound check.
+  if (capacity >= n) {
+    for (size_t i = 0; i < n; ++i) one(i, std::false_type{});
+  } else {
+    for (size_t i = 0; i < n; ++i) one(i, std::true_type{});
+  }
+
+  Gathered g;
+  g.heap_size = size;
+  const uint32_t* tris = models.triangles.data();
+  for (size_t m = 0; m < models.model_count(); ++m) {
+    const uint32_t begin = first[m], last = begin + models.level_count[m] - 1u;
+    uint64_t count = 0;
+    for (uint32_t k = begin; k <= last; ++k) {
+      count += visible_at[k];
+      g.tri_sum += uint64_t{visible_at[k]} * tris[k];
+      g.lev_sum += uint64_t{visible_at[k]} * pow2(ls[k]);
+    }
+    g.tri_coarse += count * tris[last];
+    g.lev_coarse += count * pow2(ls[last]);
+  }
+  return g;
+}
+
+// The same without tables, for scenes with more chain levels than the stack tables hold.
+Gathered gather_direct(const Columns& c, const ModelTable& models, HeapEntry* heap, size_t capacity) {
+  const uint32_t* first = models.first_level.data();
+  const uint8_t* counts = models.level_count.data();
+  const uint32_t* tris = models.triangles.data();
+  const int32_t* ls = models.level_l.data();
+  Gathered g;
+  size_t size = 0;
+  for (size_t i = 0; i < c.visible.size(); ++i) {
+    const uint64_t keep = c.visible[i] ? ~uint64_t{0} : 0;
+    const uint32_t m = c.model[i];
+    const uint32_t last = counts[m] - 1u;
+    assert(!c.visible[i] || c.level[i] <= last);
+    const uint32_t cur = std::min<uint32_t>(c.level[i], last);  // invisible levels may be stale
+    const uint32_t at = first[m] + cur;
+    const uint32_t coarse = first[m] + last;
+    const uint32_t lowerable = cur < last;
+    g.tri_sum += tris[at] & keep;
+    g.lev_sum += pow2(ls[at]) & keep;
+    g.tri_coarse += tris[coarse] & keep;
+    g.lev_coarse += pow2(ls[coarse]) & keep;
+    const HeapEntry e{c.weight[i] * static_cast<float>(span_of_level_changed(ls[at], ls[at + lowerable])),
+                      static_cast<uint32_t>(i)};
+    if (size < capacity) heap[size] = e;
+    size += lowerable & keep;
+  }
+  g.heap_size = size;
+  return g;
+}
+
 }  // namespace
 
 uint64_t level_cost(const ModelTable& models, uint32_t model, uint32_t level, BudgetCount count) {
@@ -59,51 +170,34 @@ SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const ui
   const int32_t* ls = models.level_l.data();
   const bool by_triangles = params.count == BudgetCount::triangles;
 
-  // Pass 1: totals of the initial and of the coarsest levels, in both units.
-  uint64_t tri_sum = 0, lev_sum = 0, tri_coarse = 0, lev_coarse = 0;
-  size_t lowerable = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (!visible[i]) continue;
-    const uint32_t m = model[i];
-    const uint32_t last = counts[m] - 1u;
-    assert(level[i] <= last);
-    const uint32_t at = first[m] + level[i];
-    const uint32_t coarse = first[m] + last;
-    tri_sum += tris[at];
-    lev_sum += pow2(ls[at]);
-    tri_coarse += tris[coarse];
-    lev_coarse += pow2(ls[coarse]);
-    lowerable += level[i] < last;
-  }
+  // Pass 1: totals, and every lowerable visible object's key. Keys are written even when
+  // the budget holds: in the frames where it binds (most of them) this saves a second pass.
+  HeapEntry* h = heap.data();
+  const Columns columns{level, visible, weight, model};
+  const Gathered g = models.triangles.size() + kStaleLevelRoom <= kSlotTableSize
+                         ? gather_by_slots(columns, models, h, heap.size())
+                         : gather_direct(columns, models, h, heap.size());
+  uint64_t tri_sum = g.tri_sum, lev_sum = g.lev_sum;
+
   SelectionResult r;
-  r.coarsest_cost = by_triangles ? tri_coarse : lev_coarse;
+  r.coarsest_cost = by_triangles ? g.tri_coarse : g.lev_coarse;
   if (r.coarsest_cost > params.budget) {
     // Even the coarsest levels do not fit: use them and say so.
     for (size_t i = 0; i < n; ++i) {
-      if (visible[i]) level[i] = static_cast<uint8_t>(counts[model[i]] - 1u);
+      const uint8_t last = static_cast<uint8_t>(counts[model[i]] - 1u);
+      level[i] = visible[i] ? last : level[i];
     }
     r.cost = r.coarsest_cost;
-    r.triangles = tri_coarse;
-    r.level_cost = lev_coarse;
+    r.triangles = g.tri_coarse;
+    r.level_cost = g.lev_coarse;
     r.over_budget = true;
     return r;
   }
   uint64_t cost = by_triangles ? tri_sum : lev_sum;
   if (cost > params.budget) {
-    // Pass 2: every object that can still be lowered, keyed by f of its next step.
-    assert(heap.size() >= lowerable);
-    HeapEntry* h = heap.data();
-    size_t size = 0;
-    for (size_t i = 0; i < n; ++i) {
-      if (!visible[i]) continue;
-      const uint32_t m = model[i];
-      const uint32_t cur = level[i];
-      if (cur + 1u >= counts[m]) continue;
-      const uint32_t at = first[m] + cur;
-      h[size++] = {weight[i] * static_cast<float>(span_of_level_changed(ls[at], ls[at + 1])),
-                   static_cast<uint32_t>(i)};
-    }
-    assert(size == lowerable);
+    // Pass 2: heapify, O(m).
+    assert(g.heap_size <= heap.size() && "heap scratch needs room for every visible object");
+    size_t size = g.heap_size;
     make_heap(h, size);
 
     // Pass 3: lower the top one level at a time until the budget holds. The coarsest levels

@@ -39,7 +39,9 @@ struct SelectionResult {
 uint64_t level_cost(const ModelTable& models, uint32_t model, uint32_t level, BudgetCount count);
 
 // `level` holds the initial levels of visible objects on entry and the selected ones on
-// exit. `heap` is caller-owned scratch with room for every visible object.
+// exit. `heap` is caller-owned scratch with room for every visible object (room for every
+// object saves a bound check per object). Invisible objects' levels are left as they are.
+// Deterministic: equal keys are taken in increasing object id.
 SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
                                     std::span<const float> weight, std::span<const uint32_t> model,
                                     const ModelTable& models, const SelectionParams& params,

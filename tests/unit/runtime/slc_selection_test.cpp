@@ -125,6 +125,50 @@ TEST(Selection, MeetsBudgetWheneverCoarsestLevelsFitInBothUnits) {
   EXPECT_GT(binding, 300);  // the budget really bound in most trials
 }
 
+TEST(Selection, MatchesReferenceWithManyModelsAndTightScratch) {
+  // 400 chains of 2 to 9 levels: more levels than selection's stack tables hold, so the
+  // table-free path runs; and scratch with room for exactly the visible objects.
+  std::mt19937 rng(5);
+  std::vector<std::vector<test::LevelSpec>> chains;
+  for (int m = 0; m < 400; ++m) {
+    std::vector<test::LevelSpec> levels;
+    uint32_t tris = 1000 + rng() % 500000;
+    for (uint32_t k = 0, count = 2 + rng() % 8; k < count; ++k, tris = tris * (1 + rng() % 9) / 10 + 1)
+      levels.push_back({tris, 0.01f * k});
+    chains.push_back(levels);
+  }
+  const ModelTable many = test::table_of(chains);
+  ASSERT_GT(many.triangles.size(), 2048u);
+  const ModelTable few = paper_table();
+  int compared = 0;
+  for (const ModelTable* t : {&many, &few}) {
+    for (BudgetCount unit : {BudgetCount::triangles, BudgetCount::levels}) {
+      for (int trial = 0; trial < 30; ++trial) {
+        Scene s = random_scene(*t, 1 + rng() % 2000, rng);
+        for (size_t i = 0; i < s.level.size(); ++i) {
+          // Invisible objects may carry any stale level; selection must not trip over it.
+          if (!s.visible[i]) s.level[i] = static_cast<uint8_t>(rng());
+        }
+        const Scene initial = s;
+        size_t visible = 0;
+        for (uint8_t v : s.visible) visible += v;
+        s.heap.assign(visible, HeapEntry{});
+        SelectionParams p;
+        p.count = unit;
+        const uint64_t start = cost_of(s, *t, unit);
+        p.budget = start / 2 + rng() % (start / 2 + 1);
+        const SelectionResult r = select_under_budget(s.level, s.visible, s.weight, s.model, *t, p, s.heap);
+        if (r.over_budget) continue;
+        ++compared;
+        EXPECT_LE(r.cost, p.budget);
+        EXPECT_EQ(r.triangles, cost_of(s, *t, BudgetCount::triangles));
+        EXPECT_EQ(s.level, reference_select(initial, *t, p)) << "trial " << trial;
+      }
+    }
+  }
+  EXPECT_GT(compared, 80);
+}
+
 TEST(Selection, FlagsAndUsesCoarsestWhenEvenTheyExceedBudget) {
   const ModelTable t = paper_table();
   std::mt19937 rng(99);
