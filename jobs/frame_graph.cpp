@@ -6,8 +6,8 @@
 // the objects into fixed chunks of `grain` and run the runtime/ function per chunk inside a
 // parallel_for. Chunk boundaries do not depend on the thread count and every per-chunk
 // result lands in its own slot, merged in chunk order, so 1, 2 or N threads give
-// bit-identical frames. Selection is global (one budget) and runs serially on the whole
-// range. vdlod and geomorph are pass-through until view-dependent objects and geomorphing
+// bit-identical frames. Selection is global (one budget) and runs serially, on the visible
+// objects that importance compacts in object order. vdlod and geomorph are pass-through until view-dependent objects and geomorphing
 // exist: they time themselves (nothing) and forward.
 #include "jobs/frame_graph.h"
 
@@ -88,11 +88,11 @@ struct StageEntry {
 constexpr StageEntry kStageTable[kStageCount] = {
     {"view", "frustum planes, focal length, budget"},
     {"visibility", "cull_spheres, parallel over chunks"},
-    {"importance", "measure_objects + minima, importance_weights + choose_initial_levels, parallel"},
-    {"selection", "select_under_budget, serial over all objects"},
+    {"importance", "measure_objects + minima, importance_weights + choose_initial_levels, compaction, parallel"},
+    {"selection", "select_under_budget, serial over the visible set"},
     {"vdlod", "pass-through (no view-dependent objects yet)"},
     {"geomorph", "pass-through (morph = 1)"},
-    {"publish", "compact visible objects + totals, parallel; levels -> prev_level"},
+    {"publish", "totals, levels -> prev_level, parallel"},
 };
 
 }  // namespace
@@ -105,11 +105,17 @@ struct FrameGraph::Impl {
   size_t chunks = 0;
 
   ObjectState state;
+  // Visible objects compacted in object order (slot k <-> Frame::objects[k]), so that the
+  // serial selection streams over the visible set only, without a branch per object.
+  std::vector<float> visible_weight;
+  std::vector<uint32_t> visible_model;
+  std::vector<uint8_t> all_ones;        // the `visible` column of the compacted set
   std::vector<HeapEntry> heap;
   std::vector<uint32_t> chunk_visible;  // visibility: visible objects per chunk
-  std::vector<uint32_t> chunk_offset;   // publish: first output slot per chunk
+  std::vector<uint32_t> chunk_offset;   // first compacted slot of each chunk
   std::vector<ViewMinima> chunk_minima;
   std::vector<ChunkTotals> chunk_totals;
+  uint32_t visible_total = 0;
 
   // Per frame.
   View view;
@@ -135,6 +141,9 @@ struct FrameGraph::Impl {
     state.resize(count);
     std::fill(state.prev_level.begin(), state.prev_level.end(), uint8_t{0});
     std::fill(state.was_visible.begin(), state.was_visible.end(), uint8_t{0});
+    visible_weight.resize(count);
+    visible_model.resize(count);
+    all_ones.assign(count, 1);
     heap.resize(count);
     chunk_visible.resize(chunks);
     chunk_offset.resize(chunks);
@@ -206,6 +215,12 @@ struct FrameGraph::Impl {
       chunk_visible[c] = static_cast<uint32_t>(cull_spheres(sub(state.visible, b, e), sub(o.cx, b, e), sub(o.cy, b, e),
                                                             sub(o.cz, b, e), sub(o.radius, b, e), frustum));
     });
+    // Exclusive prefix sum over the chunks: where each chunk's visible objects go.
+    visible_total = 0;
+    for (size_t c = 0; c < chunks; ++c) {
+      chunk_offset[c] = visible_total;
+      visible_total += chunk_visible[c];
+    }
   }
 
   void stage_importance() {
@@ -218,61 +233,75 @@ struct FrameGraph::Impl {
     // min() is order-free, but merging in chunk order keeps even that obvious.
     minima = empty_minima();
     for (const ViewMinima& m : chunk_minima) minima = merge_minima(minima, m);
-    if (minima.visible == 0) return;
+    assert(minima.visible == visible_total);
 
+    Frame& f = *out;
+    f.objects.resize(visible_total);
+    f.levels.resize(visible_total);
+    if (visible_total == 0) return;
     const InitialLevelParams params{focal, options.pixel_error, options.hysteresis};
-    for_chunks([&](size_t, size_t b, size_t e) {
+    for_chunks([&](size_t c, size_t b, size_t e) {
       importance_weights(sub(state.weight, b, e), sub(state.visible, b, e), sub(state.distance, b, e),
                          sub(state.area, b, e), minima);
       choose_initial_levels(sub(state.level, b, e), sub(state.visible, b, e), sub(state.prev_level, b, e),
                             sub(state.was_visible, b, e), sub(state.distance, b, e), sub(o.scale, b, e),
                             sub(o.model, b, e), scene.models, params);
+      // Compact this chunk's visible objects into their slots. Branch-free (visibility is
+      // random in object order): every object is written to the next free slot, which only
+      // advances past visible ones. Stopping once the chunk's slots are full keeps the
+      // writes inside them; every object left is then invisible.
+      const uint32_t end_slot = chunk_offset[c] + chunk_visible[c];
+      uint32_t slot = chunk_offset[c];
+      uint32_t* __restrict ids = f.objects.data();
+      uint8_t* __restrict levels = f.levels.data();
+      for (size_t i = b; i < e && slot < end_slot; ++i) {
+        ids[slot] = static_cast<uint32_t>(i);
+        levels[slot] = state.level[i];
+        visible_weight[slot] = state.weight[i];
+        visible_model[slot] = o.model[i];
+        slot += state.visible[i];
+      }
+      assert(slot == end_slot);
     });
   }
 
+  // On the compacted visible set: the same result as on the whole range (selection breaks
+  // ties by position, and compaction keeps object order), with less to stream through.
   void stage_selection() {
-    selected = select_under_budget(state.level, state.visible, state.weight, scene.objects.model, scene.models,
-                                   options.selection, heap);
+    const size_t v = visible_total;
+    selected = select_under_budget(std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
+                                   std::span<const float>(visible_weight.data(), v),
+                                   std::span<const uint32_t>(visible_model.data(), v), scene.models, options.selection,
+                                   std::span<HeapEntry>(heap.data(), v));
   }
 
   void stage_publish() {
     Frame& f = *out;
-    uint32_t visible = 0;
-    for (size_t c = 0; c < chunks; ++c) {
-      chunk_offset[c] = visible;
-      visible += chunk_visible[c];
-    }
-    f.objects.resize(visible);
-    f.levels.resize(visible);
-    f.morph.resize(visible);
+    f.morph.resize(visible_total);
     const ModelTable& models = scene.models;
-    const std::vector<uint32_t>& model = scene.objects.model;
     for_chunks([&](size_t c, size_t b, size_t e) {
+      // Temporal state for the next frame: who was visible, at which level.
+      std::copy(state.visible.begin() + b, state.visible.begin() + e, state.was_visible.begin() + b);
       ChunkTotals t;
-      uint32_t slot = chunk_offset[c];
-      for (size_t i = b; i < e; ++i) {
-        const uint8_t vis = state.visible[i];
-        state.was_visible[i] = vis;
-        state.prev_level[i] = state.level[i];
-        if (!vis) continue;
-        const uint32_t first = models.first_level[model[i]];
-        const uint32_t at = first + state.level[i];
+      const uint32_t first_slot = chunk_offset[c], end_slot = first_slot + chunk_visible[c];
+      for (uint32_t k = first_slot; k < end_slot; ++k) {
+        const uint8_t level = f.levels[k];
+        state.prev_level[f.objects[k]] = level;
+        const uint32_t first = models.first_level[visible_model[k]];
+        const uint32_t at = first + level;
         const int32_t l = models.level_l[at];
         t.tris_in_view += models.triangles[first];
         t.tris_selected += models.triangles[at];
         t.level_cost += uint64_t{1} << std::clamp(l, 0, 63);
         ++t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))];
-        f.objects[slot] = static_cast<uint32_t>(i);
-        f.levels[slot] = state.level[i];
-        f.morph[slot] = 1.0f;  // no geomorphing yet: every level is settled
-        ++slot;
       }
-      assert(slot == chunk_offset[c] + chunk_visible[c]);
+      // No geomorphing yet: every level is settled.
+      std::fill(f.morph.begin() + first_slot, f.morph.begin() + end_slot, 1.0f);
       chunk_totals[c] = t;
     });
 
     f.object_count = static_cast<uint32_t>(count);
-    f.visible = visible;
+    f.visible = visible_total;
     f.tris_in_view = f.tris_selected = f.level_cost = 0;
     f.level_histogram.fill(0);
     for (const ChunkTotals& t : chunk_totals) {
@@ -282,9 +311,9 @@ struct FrameGraph::Impl {
       for (size_t l = 0; l < kHistogramLevels; ++l) f.level_histogram[l] += t.histogram[l];
     }
     f.budget = options.selection.budget;
-    f.coarsest_cost = visible ? selected.coarsest_cost : 0;
-    f.over_budget = visible ? selected.over_budget : false;
-    f.lowered_steps = visible ? selected.lowered_steps : 0;
+    f.coarsest_cost = selected.coarsest_cost;
+    f.over_budget = selected.over_budget;
+    f.lowered_steps = selected.lowered_steps;
   }
 
   // Forgets last frame's levels so that the next frame starts from scratch.
