@@ -31,3 +31,27 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
 }
 
 }  // namespace lod::viewer
+
+namespace lod::viewer {
+
+void FrameRenderer::render_culled(const Frame& frame, const View& viewing) {
+  const ObjectSet& objects = scene_->objects;
+  culled_.objects.clear();
+  culled_.levels.clear();
+  culled_.morph.clear();
+  size_t next = 0;  // frame.objects is sorted by id
+  for (uint32_t id = 0; id < objects.size(); ++id) {
+    while (next < frame.objects.size() && frame.objects[next] < id) ++next;
+    if (next < frame.objects.size() && frame.objects[next] == id) continue;
+    culled_.objects.push_back(id);
+    culled_.levels.push_back(uint8_t(scene_->models.level_count[objects.model[id]] - 1));
+    culled_.morph.push_back(1.f);
+  }
+  build_draw_list(culled_, objects, meshes_.layout(), culled_list_);
+  RenderSettings dark;
+  dark.colour_override = true;
+  dark.colour = kCulledColour;
+  instances_.draw(culled_list_, meshes_, view_matrix(viewing), projection_matrix(viewing), dark);
+}
+
+}  // namespace lod::viewer

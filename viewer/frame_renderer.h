@@ -20,6 +20,10 @@ class FrameRenderer {
   // `viewing` also gives the viewport size (width x height pixels).
   DrawStats render(const Frame& frame, const View& viewing, const RenderSettings& settings);
 
+  // Objects the frame culled, drawn dark at their coarsest level, for views from outside the
+  // LOD camera (bird's-eye, frozen LOD). Call after render(); not counted in DrawStats.
+  void render_culled(const Frame& frame, const View& viewing);
+
   const DrawList& draw_list() const { return list_; }
   const MeshBuffers& meshes() const { return meshes_; }
 
@@ -28,6 +32,8 @@ class FrameRenderer {
   MeshBuffers meshes_;
   InstanceRenderer instances_;
   DrawList list_;
+  Frame culled_;        // scratch: the culled objects as a frame
+  DrawList culled_list_;
 };
 
 }  // namespace lod::viewer

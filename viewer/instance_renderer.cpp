@@ -105,7 +105,9 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
                           reinterpret_cast<const void*>(offset));
     glVertexAttribPointer(kAttribInstanceYawMorph, 2, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
                           reinterpret_cast<const void*>(offset + 4 * sizeof(float)));
-    const auto& c = settings.colour_by_level ? level_colour(b.level) : kModelColour;
+    const auto& c = settings.colour_override ? settings.colour
+                    : settings.colour_by_level ? level_colour(b.level)
+                                               : kModelColour;
     glUniform3f(u_colour_, c[0], c[1], c[2]);
     const LevelRange& r = meshes.layout().ranges[b.range];
     glDrawElementsInstancedBaseVertex(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,

@@ -2,6 +2,7 @@
 // (model, level) batch; per-instance position, scale, yaw and geomorph factor are vertex
 // attributes with divisor 1. Lighting is a headlight Lambert term.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -18,6 +19,8 @@ struct RenderSettings {
   bool wireframe = false;
   bool flat_normals = false;      // face normals from screen-space derivatives
   bool count_primitives = false;  // GL_PRIMITIVES_GENERATED query around the draws (waits for the GPU)
+  bool colour_override = false;   // every batch in `colour`
+  std::array<float, 3> colour{};
 };
 
 struct DrawStats {

@@ -12,6 +12,7 @@
 #include "viewer/fly_camera.h"
 #include "viewer/frustum_lines.h"
 #include "viewer/orbit_camera.h"
+#include "viewer/overhead_camera.h"
 #include "viewer/overlay.h"
 #include "viewer/viewer_session.h"
 
@@ -110,6 +111,7 @@ int run_interactive(ViewerSession& s) {
       if (keys.pressed(window, GLFW_KEY_1)) controls.mode = CameraMode::path;
       if (keys.pressed(window, GLFW_KEY_2)) controls.mode = CameraMode::fly;
       if (keys.pressed(window, GLFW_KEY_3)) controls.mode = CameraMode::orbit;
+      if (keys.pressed(window, GLFW_KEY_4)) controls.mode = CameraMode::overhead;
       if (keys.pressed(window, GLFW_KEY_P)) controls.paused = !controls.paused;
       if (keys.pressed(window, GLFW_KEY_L)) controls.freeze_lod = !controls.freeze_lod;
       if (keys.pressed(window, GLFW_KEY_Z)) controls.wireframe = !controls.wireframe;
@@ -137,10 +139,16 @@ int run_interactive(ViewerSession& s) {
       orbit.look_like(viewing);
       last_mode = controls.mode;
     }
+    if (!controls.paused && (controls.mode == CameraMode::path || controls.mode == CameraMode::overhead))
+      path_frame += double(dt) * path_rate;
+    const View path_view = view_at(path, uint32_t(std::fmod(path_frame, 4294967296.0)));
+    View lod_camera = path_view;  // what the LOD thread should see, unless frozen
     switch (controls.mode) {
       case CameraMode::path:
-        if (!controls.paused) path_frame += double(dt) * path_rate;
-        viewing = view_at(path, uint32_t(std::fmod(path_frame, 4294967296.0)));
+        viewing = path_view;
+        break;
+      case CameraMode::overhead:
+        viewing = overhead_view(s.loaded.scene.objects, path.lens);
         break;
       case CameraMode::fly: {
         FlyInput in;
@@ -154,17 +162,19 @@ int run_interactive(ViewerSession& s) {
         fly.speed *= std::pow(1.2f, wheel);
         fly.update(in, dt);
         viewing = fly.view(path.lens);
+        lod_camera = viewing;
         break;
       }
       case CameraMode::orbit:
         if (dragging) orbit.rotate(dx, dy);
         orbit.zoom(wheel);
         viewing = orbit.view(path.lens);
+        lod_camera = viewing;
         break;
     }
     const auto service_start = std::chrono::steady_clock::now();
     if (!controls.freeze_lod) {
-      lod_view = viewing;
+      lod_view = lod_camera;
       service.set_view(lod_view);
     }
     if (controls.budget_changed) {
@@ -181,7 +191,10 @@ int run_interactive(ViewerSession& s) {
     settings.wireframe = controls.wireframe;
     settings.flat_normals = controls.flat_normals;
     const DrawStats drawn = s.renderer.render(frame, viewing, settings);
-    if (controls.freeze_lod) frustum_lines.draw(lod_view, viewing);
+    if (controls.freeze_lod || controls.mode == CameraMode::overhead) {
+      s.renderer.render_culled(frame, viewing);
+      frustum_lines.draw(lod_view, viewing);
+    }
     if (controls.show_overlay) {
       OverlayFacts facts;
       facts.time_s = std::chrono::duration<double>(now - start).count();

@@ -21,6 +21,8 @@ inline const std::array<float, 3>& level_colour(size_t level) { return kLevelPal
 
 // Neutral grey-blue for the normal (not colour-by-level) mode.
 inline constexpr std::array<float, 3> kModelColour = {0.72f, 0.74f, 0.78f};
+// Objects the LOD frame culled, seen from outside (bird's-eye, frozen LOD).
+inline constexpr std::array<float, 3> kCulledColour = {0.30f, 0.30f, 0.33f};
 inline constexpr std::array<float, 3> kBackground = {0.08f, 0.09f, 0.11f};
 
 }  // namespace lod::viewer

@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
   app.add_option("--stats", o.stats, "write one CSV row per viewer frame");
   app.add_flag("--color-by-level,--colour-by-level", o.colour_by_level, "colour objects by their chain level");
   app.add_flag("--wireframe", o.wireframe, "draw triangle edges only");
+  app.add_flag("--bird-eye", o.bird_eye, "look from above the scene at what the path camera's LOD frames select");
   app.add_flag("--overlay", o.overlay, "screenshot: draw the statistics overlay too");
   bool no_vsync = false;
   app.add_flag("--no-vsync", no_vsync, "interactive: do not wait for vertical sync");

@@ -120,7 +120,7 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c) {
   ImGui::Separator();
   int mode = int(c.mode);
   ImGui::Text("camera");
-  for (int m = 0; m < 3; ++m) {
+  for (int m = 0; m < kCameraModeCount; ++m) {
     ImGui::SameLine();
     ImGui::RadioButton(kCameraModeNames[m], &mode, m);
   }
@@ -148,7 +148,7 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c) {
       ImGui::TextColored(ImVec4(col[0], col[1], col[2], 1), "%zu", l);
     }
   }
-  ImGui::TextDisabled("1/2/3 path/fly/orbit, WASD QE + right mouse, wheel zoom, Esc quit");
+  ImGui::TextDisabled("1/2/3/4 path/fly/orbit/bird's-eye, WASD QE + right mouse, wheel, H hides, Esc quits");
   ImGui::End();
 
   ImGui::Render();

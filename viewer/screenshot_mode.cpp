@@ -6,6 +6,8 @@
 
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
+#include "viewer/frustum_lines.h"
+#include "viewer/overhead_camera.h"
 #include "viewer/overlay.h"
 #include "viewer/render_target.h"
 #include "viewer/screenshot.h"
@@ -18,6 +20,11 @@ int run_screenshot(ViewerSession& s) {
   std::string message;
   OffscreenTarget target;
   if (!target.create(o.width, o.height, &message)) {
+    std::fprintf(stderr, "lod-viewer: %s\n", message.c_str());
+    return 2;
+  }
+  FrustumLines frustum_lines;
+  if (o.bird_eye && !frustum_lines.init(&message)) {
     std::fprintf(stderr, "lod-viewer: %s\n", message.c_str());
     return 2;
   }
@@ -39,6 +46,7 @@ int run_screenshot(ViewerSession& s) {
   controls.colour_by_level = o.colour_by_level;
   controls.wireframe = o.wireframe;
   controls.budget = s.graph.selection.budget;
+  controls.mode = o.bird_eye ? CameraMode::overhead : CameraMode::path;
 
   const uint32_t frames = o.frames < 0 ? 1 : uint32_t(o.frames);
   uint64_t failed = 0, mismatched = 0;
@@ -52,7 +60,12 @@ int run_screenshot(ViewerSession& s) {
     const double service_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     target.bind();
-    last = s.renderer.render(frame, view, settings);
+    const View viewing = o.bird_eye ? overhead_view(s.loaded.scene.objects, path.lens) : view;
+    last = s.renderer.render(frame, viewing, settings);
+    if (o.bird_eye) {
+      s.renderer.render_culled(frame, viewing);
+      frustum_lines.draw(view, viewing);
+    }
     if (o.overlay) {
       OverlayFacts facts;
       facts.time_s = std::chrono::duration<double>(t0 - start).count();

@@ -5,8 +5,10 @@
 
 namespace lod::viewer {
 
-enum class CameraMode : uint8_t { path, fly, orbit };
-inline constexpr const char* kCameraModeNames[] = {"camera path", "fly", "orbit"};
+// overhead: the LOD camera follows the path while the picture is seen from above the scene.
+enum class CameraMode : uint8_t { path, fly, orbit, overhead };
+inline constexpr const char* kCameraModeNames[] = {"camera path", "fly", "orbit", "bird's-eye"};
+inline constexpr int kCameraModeCount = 4;
 
 struct ViewerControls {
   CameraMode mode = CameraMode::path;

@@ -29,6 +29,7 @@ struct ViewerOptions {
   double lod_delay_ms = 0;           // sleep added to every LOD frame (measuring that the viewer never waits)
   bool colour_by_level = false;
   bool wireframe = false;
+  bool bird_eye = false;             // draw from above the scene; the LOD camera still follows the path
   bool overlay = false;              // screenshot: draw the overlay too (interactive always has it)
   bool vsync = true;
 };

@@ -2,10 +2,13 @@
 // goes where the controls say.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <glm/glm.hpp>
 
 #include "viewer/fly_camera.h"
 #include "viewer/orbit_camera.h"
+#include "viewer/overhead_camera.h"
 
 namespace {
 
@@ -80,6 +83,45 @@ TEST(OrbitCamera, RotateKeepsDistanceAndZoomShrinksIt) {
   EXPECT_TRUE(std::isfinite(orbit.distance));
   orbit.zoom(1e4f);
   EXPECT_GT(orbit.distance, 0.f);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(OverheadCamera, FramesEveryObjectFromAbove) {
+  lod::ObjectSet objects;
+  objects.resize(3);
+  const float cx[3] = {-500, 700, 20}, cz[3] = {-100, 300, 900}, r[3] = {10, 25, 5};
+  for (size_t i = 0; i < 3; ++i) {
+    objects.cx[i] = cx[i];
+    objects.cy[i] = 2;
+    objects.cz[i] = cz[i];
+    objects.radius[i] = r[i];
+  }
+  lod::View lens;
+  lens.width = 640;
+  lens.height = 360;
+  const lod::View v = lod::viewer::overhead_view(objects, lens);
+  EXPECT_GT(v.eye.y, 2.f);
+  const glm::mat4 m = lod::projection_matrix(v) * lod::view_matrix(v);
+  for (size_t i = 0; i < 3; ++i) {
+    for (glm::vec3 edge : {glm::vec3(-r[i], 0, 0), glm::vec3(r[i], 0, 0), glm::vec3(0, 0, -r[i]), glm::vec3(0, 0, r[i])}) {
+      const glm::vec4 clip = m * glm::vec4(glm::vec3(cx[i], 2, cz[i]) + edge, 1);
+      EXPECT_LE(std::abs(clip.x / clip.w), 1.f) << "object " << i;
+      EXPECT_LE(std::abs(clip.y / clip.w), 1.f) << "object " << i;
+      EXPECT_LE(std::abs(clip.z / clip.w), 1.f) << "object " << i << " clipped by near/far";
+    }
+  }
+  // North (-z) is up in the picture.
+  const glm::vec4 north = m * glm::vec4(20, 2, -100, 1), south = m * glm::vec4(20, 2, 900, 1);
+  EXPECT_GT(north.y / north.w, south.y / south.w);
+}
+
+TEST(OverheadCamera, EmptySceneGivesAFiniteView) {
+  const lod::View v = lod::viewer::overhead_view(lod::ObjectSet{}, lod::View{});
+  EXPECT_TRUE(std::isfinite(v.eye.y));
+  EXPECT_GT(glm::length(v.eye - v.target), 0.f);
 }
 
 }  // namespace

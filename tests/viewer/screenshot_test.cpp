@@ -191,3 +191,48 @@ TEST(ViewerScreenshot, ColourByLevelShowsAtLeastTwoLevelColours) {
 }
 
 }  // namespace
+
+namespace {
+
+bool near_colour(const uint8_t* px, std::array<float, 3> c, int tol) {
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(int(px[k]) - int(std::lround(c[size_t(k)] * 255))) > tol) return false;
+  return true;
+}
+
+// From above: the objects the LOD camera culled are drawn dark, the visible ones in level
+// colours, and the LOD camera's frustum as yellow lines.
+TEST(ViewerScreenshot, BirdEyeShowsCulledObjectsAndTheLodFrustum) {
+  LOD_REQUIRE_XVFB();
+  const std::string behind = std::string(kTwoObjects) + R"([[instances]]
+model = "box"
+count = 1
+placement = "grid"
+box_min = [0.0, 0.0, 80.0]
+box_max = [0.0, 0.0, 80.0]
+scale = 4.0
+)";
+  const auto scene = lod::test::write_viewer_scene("birdeye", kRun, kFrontCamera, behind);
+  const auto png = scene.dir / "bird.png";
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() +
+                                                  "' --bird-eye --color-by-level --width 320 --height 240");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(png, img));
+  size_t culled = 0, frustum = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* px = img.at(x, y);
+      // Culled objects: a shade of the dark grey (lit between 25 % and 100 %).
+      const int top = std::max({px[0], px[1], px[2]});
+      if (top > 25 && top <= 90 && std::abs(int(px[0]) - int(px[1])) <= 3 && px[2] >= px[0] && px[2] - px[0] <= 8 &&
+          !near_colour(px, lod::viewer::kBackground, 2))
+        ++culled;
+      if (near_colour(px, {1.0f, 0.9f, 0.2f}, 2)) ++frustum;
+    }
+  EXPECT_GT(culled, 10u) << "the box behind the LOD camera is not drawn as culled";
+  EXPECT_GT(frustum, 20u) << "no frustum lines";
+  EXPECT_FALSE(palette_histogram(img).empty()) << "the visible objects lost their level colours";
+}
+
+}  // namespace
