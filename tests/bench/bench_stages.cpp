@@ -58,7 +58,8 @@ struct BenchScene {
   ViewMinima minima{};
   std::vector<uint8_t> initial;  // levels after choose_initial_levels
   std::vector<HeapEntry> heap;
-  SelectionParams selection;
+  std::vector<uint8_t> full;     // level 0 everywhere: a selection start with heavy lowering
+  uint64_t start_cost = 0, full_cost = 0, coarsest_cost = 0;  // triangles
   size_t visible = 0;
 };
 
@@ -97,14 +98,16 @@ const BenchScene& scene_of(size_t n) {
   choose_initial_levels(st.level, st.visible, st.prev_level, st.was_visible, st.distance, o.scale, o.model,
                         s->models, ip);
   s->initial = st.level;
-  // A budget halfway between the coarsest and the initial cost: selection has real work.
   uint64_t start = 0, coarsest = 0;
   for (size_t i = 0; i < n; ++i) {
     if (!st.visible[i]) continue;
     start += level_cost(s->models, o.model[i], st.level[i], BudgetCount::triangles);
+    s->full_cost += level_cost(s->models, o.model[i], 0, BudgetCount::triangles);
     coarsest += level_cost(s->models, o.model[i], s->models.level_count[o.model[i]] - 1u, BudgetCount::triangles);
   }
-  s->selection.budget = coarsest + (start - coarsest) / 2;
+  s->full.assign(n, 0);
+  s->start_cost = start;
+  s->coarsest_cost = coarsest;
   s->heap.resize(n);
   cache.push_back(std::move(s));
   return *cache.back();
@@ -179,15 +182,27 @@ void BM_InitialLevels(benchmark::State& state) {
   common_counters(state, s);
 }
 
+// range(1) picks the start: 0 = the screen-space initial levels (a few hundred pops at 100k),
+// 1 = full detail everywhere (tens of thousands of pops: heap-bound). The budget sits halfway
+// between the start's cost and the coarsest levels' cost.
+const std::vector<uint8_t>& start_of(const BenchScene& s, int64_t which) { return which ? s.full : s.initial; }
+SelectionParams budget_of(const BenchScene& s, int64_t which) {
+  SelectionParams p;
+  p.budget = s.coarsest_cost + ((which ? s.full_cost : s.start_cost) - s.coarsest_cost) / 2;
+  return p;
+}
+
 // Both selection benchmarks restore the initial levels each iteration (a memcpy of n bytes).
 void BM_Select(benchmark::State& state) {
   const BenchScene& s = scene_of(static_cast<size_t>(state.range(0)));
+  const SelectionParams params = budget_of(s, state.range(1));
+  const std::vector<uint8_t>& start = start_of(s, state.range(1));
   std::vector<uint8_t> level(s.objects.size());
   std::vector<HeapEntry> heap(s.objects.size());
   SelectionResult r;
   for (auto _ : state) {
-    std::copy(s.initial.begin(), s.initial.end(), level.begin());
-    r = select_under_budget(level, s.state.visible, s.state.weight, s.objects.model, s.models, s.selection, heap);
+    std::copy(start.begin(), start.end(), level.begin());
+    r = select_under_budget(level, s.state.visible, s.state.weight, s.objects.model, s.models, params, heap);
     benchmark::DoNotOptimize(r);
   }
   common_counters(state, s);
@@ -199,7 +214,7 @@ void BM_SelectWithinBudget(benchmark::State& state) {
   const BenchScene& s = scene_of(static_cast<size_t>(state.range(0)));
   std::vector<uint8_t> level(s.initial);
   std::vector<HeapEntry> heap(s.objects.size());
-  SelectionParams loose = s.selection;
+  SelectionParams loose;
   loose.budget = UINT64_MAX;
   for (auto _ : state) {
     benchmark::DoNotOptimize(
@@ -210,6 +225,8 @@ void BM_SelectWithinBudget(benchmark::State& state) {
 
 void BM_SelectPriorityQueue(benchmark::State& state) {
   const BenchScene& s = scene_of(static_cast<size_t>(state.range(0)));
+  const SelectionParams params = budget_of(s, state.range(1));
+  const std::vector<uint8_t>& start = start_of(s, state.range(1));
   const ModelTable& t = s.models;
   const std::vector<uint32_t>& model = s.objects.model;
   const std::vector<float>& weight = s.state.weight;
@@ -219,7 +236,7 @@ void BM_SelectPriorityQueue(benchmark::State& state) {
     return a.key < b.key || (a.key == b.key && a.object > b.object);
   };
   for (auto _ : state) {
-    std::copy(s.initial.begin(), s.initial.end(), level.begin());
+    std::copy(start.begin(), start.end(), level.begin());
     auto key = [&](uint32_t i) {
       const uint32_t at = t.first_level[model[i]] + level[i];
       return weight[i] * static_cast<float>(span_of_level_changed(t.level_l[at], t.level_l[at + 1]));
@@ -228,15 +245,15 @@ void BM_SelectPriorityQueue(benchmark::State& state) {
     uint64_t cost = 0;
     for (uint32_t i = 0; i < level.size(); ++i) {
       if (!s.state.visible[i]) continue;
-      cost += level_cost(t, model[i], level[i], s.selection.count);
+      cost += level_cost(t, model[i], level[i], params.count);
       if (level[i] + 1u < t.level_count[model[i]]) q.push({key(i), i});
     }
     pops = 0;
-    while (cost > s.selection.budget && !q.empty()) {
+    while (cost > params.budget && !q.empty()) {
       const uint32_t i = q.top().object;
       q.pop();
-      cost -= level_cost(t, model[i], level[i], s.selection.count) -
-              level_cost(t, model[i], level[i] + 1u, s.selection.count);
+      cost -= level_cost(t, model[i], level[i], params.count) -
+              level_cost(t, model[i], level[i] + 1u, params.count);
       ++level[i];
       ++pops;
       if (level[i] + 1u < t.level_count[model[i]]) q.push({key(i), i});
@@ -253,9 +270,10 @@ BENCHMARK(BM_Cull) LOD_SIZES;
 BENCHMARK(BM_Measure) LOD_SIZES;
 BENCHMARK(BM_Weights) LOD_SIZES;
 BENCHMARK(BM_InitialLevels) LOD_SIZES;
-BENCHMARK(BM_Select) LOD_SIZES;
+#define LOD_SIZES_AND_BUDGETS ->ArgsProduct({{1000, 10000, 100000}, {0, 1}})
+BENCHMARK(BM_Select) LOD_SIZES_AND_BUDGETS;
 BENCHMARK(BM_SelectWithinBudget) LOD_SIZES;
-BENCHMARK(BM_SelectPriorityQueue) LOD_SIZES;
+BENCHMARK(BM_SelectPriorityQueue) LOD_SIZES_AND_BUDGETS;
 
 }  // namespace
 
