@@ -2,10 +2,10 @@
 // sends the LOD camera with set_view() and draws service.latest_frame(), whatever frame that
 // is. Nothing here waits on the LOD thread.
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
@@ -20,23 +20,15 @@ namespace lod::viewer {
 
 namespace {
 
-double g_scroll = 0;  // wheel steps since the last frame; GLFW delivers them by callback
+// GLFW delivers wheel steps and key presses by callback; a press and its release can both
+// arrive within one frame, so toggles are queued rather than polled.
+double g_scroll = 0;
+std::vector<int> g_pressed_keys;
 
 void on_scroll(GLFWwindow*, double, double dy) { g_scroll += dy; }
-
-// Key presses as edges (down now, up last frame), for toggles.
-class KeyEdges {
- public:
-  bool pressed(GLFWwindow* w, int key) {
-    const bool down = glfwGetKey(w, key) == GLFW_PRESS;
-    const bool edge = down && !was_down_[size_t(key)];
-    was_down_[size_t(key)] = down;
-    return edge;
-  }
-
- private:
-  std::array<bool, GLFW_KEY_LAST + 1> was_down_{};
-};
+void on_key(GLFWwindow*, int key, int, int action, int) {
+  if (action == GLFW_PRESS) g_pressed_keys.push_back(key);
+}
 
 float axis(GLFWwindow* w, int plus, int minus) {
   return (glfwGetKey(w, plus) == GLFW_PRESS ? 1.f : 0.f) - (glfwGetKey(w, minus) == GLFW_PRESS ? 1.f : 0.f);
@@ -47,7 +39,8 @@ float axis(GLFWwindow* w, int plus, int minus) {
 int run_interactive(ViewerSession& s) {
   const ViewerOptions& o = s.options;
   GLFWwindow* window = s.window.handle();
-  glfwSetScrollCallback(window, on_scroll);  // before ImGui, which chains it
+  glfwSetScrollCallback(window, on_scroll);  // before ImGui, which chains them
+  glfwSetKeyCallback(window, on_key);
   Overlay overlay;
   if (!overlay.init(window)) {
     std::fprintf(stderr, "lod-viewer: Dear ImGui could not start on this context\n");
@@ -72,7 +65,6 @@ int run_interactive(ViewerSession& s) {
   CameraMode last_mode = controls.mode;
   FlyCamera fly;
   OrbitCamera orbit;
-  KeyEdges keys;
   double path_frame = 0;
   double cursor_x = 0, cursor_y = 0;
   glfwGetCursorPos(window, &cursor_x, &cursor_y);
@@ -81,6 +73,10 @@ int run_interactive(ViewerSession& s) {
   glfwGetFramebufferSize(window, &width, &height);
   path.lens = s.lens(std::max(width, 1), std::max(height, 1));
   View viewing = view_at(path, 0);
+  {  // fly at about a tenth of the scene per second
+    const View top = overhead_view(s.loaded.scene.objects, path.lens);
+    fly.speed = std::max(1.f, 0.1f * glm::length(top.eye - top.target));
+  }
   View lod_view = viewing;
   service.set_view(lod_view);
   service.start();
@@ -106,27 +102,32 @@ int run_interactive(ViewerSession& s) {
     const bool dragging = !overlay.wants_mouse() && glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
     const float wheel = overlay.wants_mouse() ? 0.f : float(g_scroll);
     g_scroll = 0;
-    if (!overlay.wants_keyboard()) {
-      if (keys.pressed(window, GLFW_KEY_ESCAPE)) controls.quit = true;
-      if (keys.pressed(window, GLFW_KEY_1)) controls.mode = CameraMode::path;
-      if (keys.pressed(window, GLFW_KEY_2)) controls.mode = CameraMode::fly;
-      if (keys.pressed(window, GLFW_KEY_3)) controls.mode = CameraMode::orbit;
-      if (keys.pressed(window, GLFW_KEY_4)) controls.mode = CameraMode::overhead;
-      if (keys.pressed(window, GLFW_KEY_P)) controls.paused = !controls.paused;
-      if (keys.pressed(window, GLFW_KEY_L)) controls.freeze_lod = !controls.freeze_lod;
-      if (keys.pressed(window, GLFW_KEY_Z)) controls.wireframe = !controls.wireframe;
-      if (keys.pressed(window, GLFW_KEY_C)) controls.colour_by_level = !controls.colour_by_level;
-      if (keys.pressed(window, GLFW_KEY_F)) controls.flat_normals = !controls.flat_normals;
-      if (keys.pressed(window, GLFW_KEY_H)) controls.show_overlay = !controls.show_overlay;
-      if (keys.pressed(window, GLFW_KEY_LEFT_BRACKET)) {
-        controls.budget = std::max<uint64_t>(controls.budget / 2, 1);
-        controls.budget_changed = true;
-      }
-      if (keys.pressed(window, GLFW_KEY_RIGHT_BRACKET)) {
-        controls.budget = std::min<uint64_t>(controls.budget * 2, uint64_t(1) << 40);
-        controls.budget_changed = true;
+    for (int key : g_pressed_keys) {
+      if (overlay.wants_keyboard()) break;
+      switch (key) {
+        case GLFW_KEY_ESCAPE: controls.quit = true; break;
+        case GLFW_KEY_1: controls.mode = CameraMode::path; break;
+        case GLFW_KEY_2: controls.mode = CameraMode::fly; break;
+        case GLFW_KEY_3: controls.mode = CameraMode::orbit; break;
+        case GLFW_KEY_4: controls.mode = CameraMode::overhead; break;
+        case GLFW_KEY_P: controls.paused = !controls.paused; break;
+        case GLFW_KEY_L: controls.freeze_lod = !controls.freeze_lod; break;
+        case GLFW_KEY_Z: controls.wireframe = !controls.wireframe; break;
+        case GLFW_KEY_C: controls.colour_by_level = !controls.colour_by_level; break;
+        case GLFW_KEY_F: controls.flat_normals = !controls.flat_normals; break;
+        case GLFW_KEY_H: controls.show_overlay = !controls.show_overlay; break;
+        case GLFW_KEY_LEFT_BRACKET:
+          controls.budget = std::max<uint64_t>(controls.budget / 2, 1);
+          controls.budget_changed = true;
+          break;
+        case GLFW_KEY_RIGHT_BRACKET:
+          controls.budget = std::min<uint64_t>(controls.budget * 2, uint64_t(1) << 40);
+          controls.budget_changed = true;
+          break;
+        default: break;
       }
     }
+    g_pressed_keys.clear();
 
     glfwGetFramebufferSize(window, &width, &height);
     if (width <= 0 || height <= 0) {  // minimised: nothing to draw, keep the LOD thread running
