@@ -90,7 +90,10 @@ RunResult run_viewer(const ViewerScene& scene, const std::string& args, bool und
     cmd = "xvfb-run -a -s '-screen 0 1280x1024x24' sh -c '" + quoted + "' > /dev/null 2>&1";
   }
   RunResult r;
-  if (std::system(cmd.c_str()) == -1) return r;  // no shell: exit_code stays -1
+  // No exit-code file means the viewer never ran (xvfb-run could not start a server, e.g. a
+  // display number taken in between): try once more.
+  for (int attempt = 0; attempt < 2 && !std::filesystem::exists(rc); ++attempt)
+    if (std::system(cmd.c_str()) == -1) return r;  // no shell: exit_code stays -1
   std::ifstream code(rc);
   if (!(code >> r.exit_code)) r.exit_code = -1;
   std::ifstream f(log);
