@@ -34,26 +34,38 @@ size_t choose_initial_levels(std::span<uint8_t> level, std::span<const uint8_t> 
   const uint8_t* counts = models.level_count.data();
   const float* error = models.error.data();
   size_t written = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (!visible[i]) continue;
-    const uint32_t m = model[i];
-    assert(m < models.model_count());
-    const float* e = error + first[m];
-    const uint32_t count = counts[m];
-    const float pixels_per_unit = scale[i] * params.focal_px / distance[i];
-    // Errors grow with the level index (validate_chain), so the levels within a limit are a
-    // prefix and the answer is its last level. Walk there from last frame's level: between
-    // frames that is zero or one step, so the branches stay predictable; level 0 always
-    // qualifies.
-    const uint32_t start = prev_level[i] < count ? prev_level[i] : count - 1u;
-    const uint32_t k_fine = last_within(e, count, start, pixels_per_unit, fine_limit);
-    const uint32_t k_coarse = last_within(e, count, k_fine, pixels_per_unit, coarse_limit);
-    uint32_t chosen = k_fine;
-    // Last frame's level survives while it stays inside [k_fine, k_coarse]: refine only when
-    // its error exceeds the threshold by the band, coarsen as soon as a coarser level fits.
-    if (was_visible[i]) chosen = std::clamp<uint32_t>(prev_level[i], k_fine, k_coarse);
-    level[i] = static_cast<uint8_t>(chosen);
-    ++written;
+  // Visibility is data the branch predictor cannot learn, so each block first lists its
+  // visible objects without branching, then walks only those.
+  constexpr size_t kBlock = 256;
+  uint32_t listed[kBlock];
+  for (size_t block = 0; block < n; block += kBlock) {
+    const size_t end = std::min(n, block + kBlock);
+    size_t count_listed = 0;
+    for (size_t i = block; i < end; ++i) {
+      listed[count_listed] = static_cast<uint32_t>(i);
+      count_listed += visible[i] != 0;
+    }
+    for (size_t j = 0; j < count_listed; ++j) {
+      const size_t i = listed[j];
+      const uint32_t m = model[i];
+      assert(m < models.model_count());
+      const float* e = error + first[m];
+      const uint32_t count = counts[m];
+      const float pixels_per_unit = scale[i] * params.focal_px / distance[i];
+      // Errors grow with the level index (validate_chain), so the levels within a limit are
+      // a prefix and the answer is its last level. Walk there from last frame's level:
+      // between frames that is zero or one step, so the branches stay predictable; level 0
+      // always qualifies.
+      const uint32_t prev = prev_level[i] < count ? prev_level[i] : count - 1u;
+      const uint32_t k_fine = last_within(e, count, prev, pixels_per_unit, fine_limit);
+      const uint32_t k_coarse = last_within(e, count, k_fine, pixels_per_unit, coarse_limit);
+      // Last frame's level survives while it stays inside [k_fine, k_coarse]: refine only
+      // when its error exceeds the threshold by the band, coarsen as soon as a coarser level
+      // fits.
+      const uint32_t kept = std::clamp<uint32_t>(prev_level[i], k_fine, k_coarse);
+      level[i] = static_cast<uint8_t>(was_visible[i] ? kept : k_fine);
+    }
+    written += count_listed;
   }
   return written;
 }

@@ -111,6 +111,7 @@ Gathered gather_by_slots(const Columns& c, const ModelTable& models, HeapEntry* 
     const uint32_t v = visible[i] != 0;
     visible_at[at] += v;
     const HeapEntry e{weight[i] * slc_next[at], static_cast<uint32_t>(i)};
+    assert(!(v && lowerable[at]) || e.key >= 0.f);  // rank() needs keys >= 0 (and not NaN)
     if (!bounded || size < capacity) heap[size] = e;
     size += v & lowerable[at];
   };
@@ -161,6 +162,7 @@ Gathered gather_direct(const Columns& c, const ModelTable& models, HeapEntry* he
     g.lev_coarse += pow2(ls[coarse]) & keep;
     const HeapEntry e{c.weight[i] * static_cast<float>(span_of_level_changed(ls[at], ls[at + lowerable])),
                       static_cast<uint32_t>(i)};
+    assert(!(lowerable && keep) || e.key >= 0.f);
     if (size < capacity) heap[size] = e;
     size += lowerable & keep;
   }
