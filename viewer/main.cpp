@@ -79,6 +79,11 @@ int run(const lod::viewer::ViewerOptions& o) {
 int main(int argc, char** argv) {
   lod::viewer::ViewerOptions o;
   CLI::App app{"lod-viewer: draws the frames lod::Service publishes (GLFW + OpenGL 3.3 core)"};
+  app.footer("Keys: 1/2/3/4 camera path/fly/orbit/bird's-eye, WASD QE + right mouse to fly, wheel zooms, L freezes\n"
+             "LOD, Z wireframe, C colour by level, F flat shading, [ ] halve/double M, P pauses, H hides the\n"
+             "overlay, Esc quits.\n"
+             "Exit codes: 0 done; 1 bad command line, config, assets or output file; 2 no display or no\n"
+             "OpenGL 3.3 (headless: xvfb-run -a lod-viewer ...).");
   app.add_option("--config", o.config, "scene config (TOML)")->required();
   app.add_option("--data", o.data_dir, "mesh directory searched after the config's folder");
   app.add_option("--cache", o.cache_dir, "bake cache (default: LOD_CACHE_DIR, else <data>/../cache)");
@@ -87,7 +92,7 @@ int main(int argc, char** argv) {
   app.add_option("--width", o.width, "window / picture width in pixels");
   app.add_option("--height", o.height, "window / picture height in pixels");
   app.add_option("--threads", o.threads, "LOD thread pool size (0 = all cores; default: the config's)");
-  app.add_option("--budget", o.budget, "triangle budget M (default: the config's)");
+  app.add_option("--budget", o.budget, "budget M, in the config's budget unit (default: the config's)");
   app.add_option("--lod-rate", o.lod_rate_hz, "interactive: LOD service rate in Hz (default: the config's rate_hz)");
   app.add_option("--lod-delay-ms", o.lod_delay_ms, "slow the LOD thread down: sleep this long in every LOD frame");
   app.add_option("--stats", o.stats, "write one CSV row per viewer frame");
