@@ -236,3 +236,26 @@ scale = 4.0
 }
 
 }  // namespace
+
+namespace {
+
+// Driven mode makes the picture a function of the config and N: two runs, same pixels.
+TEST(ViewerScreenshot, SameConfigAndFrameCountGiveTheSamePicture) {
+  LOD_REQUIRE_XVFB();
+  const std::string run = "[run]\nframes = 1\nthreads = 2\n[budget]\ntriangles = 30000\n";
+  const auto scene = lod::test::write_viewer_scene("determinism", run, kDepthCamera, kReceding);
+  Image a, b;
+  for (Image* img : {&a, &b}) {
+    const auto png = scene.dir / (img == &a ? "a.png" : "b.png");
+    const auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() +
+                                                    "' --frames 4 --color-by-level --width 256 --height 160");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    ASSERT_TRUE(lod::test::load_png(png, *img));
+  }
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) differing += a.rgb[i] != b.rgb[i] ? 1 : 0;
+  EXPECT_EQ(differing, 0u);
+}
+
+}  // namespace
