@@ -31,7 +31,8 @@ class Service {
   bool running() const;
 
   // Driven mode: run exactly one frame on the caller's thread and publish it.
-  // Must not be mixed with start(). Returns false if the frame failed (error counted).
+  // Must not be mixed with start(). Returns false if the frame failed (error counted), or
+  // without doing anything while the service thread is running.
   bool step(const View& view);
 
   void set_view(const View& view);        // any thread
