@@ -1,0 +1,172 @@
+#include "preprocess/cluster_simplifier.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <tuple>
+
+#include "preprocess/mesh_clean.h"
+#include "preprocess/mesh_io.h"
+#include "test_support.h"
+
+namespace lod {
+namespace {
+
+struct Soup {
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  size_t vertex_count() const { return positions.size() / 3; }
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// Closed UV sphere built directly (big ones are too slow to go through OFF text).
+Soup uv_sphere(int rings, int segments, float radius = 1) {
+  Soup s;
+  s.positions.insert(s.positions.end(), {0, radius, 0, 0, -radius, 0});
+  for (int r = 1; r < rings; ++r) {
+    const double phi = M_PI * r / rings;
+    for (int k = 0; k < segments; ++k) {
+      const double th = 2 * M_PI * k / segments;
+      s.positions.insert(s.positions.end(), {float(radius * std::sin(phi) * std::cos(th)), float(radius * std::cos(phi)),
+                                             float(radius * std::sin(phi) * std::sin(th))});
+    }
+  }
+  auto ring = [&](int r, int k) { return uint32_t(2 + (r - 1) * segments + (k % segments)); };
+  for (int k = 0; k < segments; ++k) s.indices.insert(s.indices.end(), {0, ring(1, k + 1), ring(1, k)});
+  for (int r = 1; r < rings - 1; ++r)
+    for (int k = 0; k < segments; ++k) {
+      s.indices.insert(s.indices.end(), {ring(r, k), ring(r, k + 1), ring(r + 1, k + 1)});
+      s.indices.insert(s.indices.end(), {ring(r, k), ring(r + 1, k + 1), ring(r + 1, k)});
+    }
+  for (int k = 0; k < segments; ++k) s.indices.insert(s.indices.end(), {1, ring(rings - 1, k), ring(rings - 1, k + 1)});
+  return s;
+}
+
+struct Out {
+  std::vector<uint32_t> indices;
+  std::vector<float> positions;
+  ClusterResult result;
+};
+
+Out run(const Soup& s, size_t target, const ClusterOptions& o = {}) {
+  Out out;
+  out.indices.resize(s.indices.size());
+  out.positions.resize(s.positions.size());
+  const size_t n = cluster_simplify(out.indices.data(), out.positions.data(), s.positions.data(), s.vertex_count(),
+                                    s.indices.data(), s.indices.size(), target, o, &out.result);
+  EXPECT_EQ(n, out.result.triangles);
+  out.indices.resize(3 * n);
+  out.positions.resize(3 * out.result.vertices);
+  return out;
+}
+
+void expect_valid_unique_faces(const Out& out) {
+  std::set<std::tuple<uint32_t, uint32_t, uint32_t>> seen;
+  for (size_t t = 0; t < out.indices.size() / 3; ++t) {
+    uint32_t a = out.indices[3 * t], b = out.indices[3 * t + 1], c = out.indices[3 * t + 2];
+    ASSERT_LT(std::max({a, b, c}), out.result.vertices);
+    ASSERT_TRUE(a != b && b != c && a != c) << "degenerate face " << t;
+    while (a > b || a > c) std::tie(a, b, c) = std::make_tuple(b, c, a);  // same rotation rule
+    EXPECT_TRUE(seen.insert({a, b, c}).second) << "duplicate face " << t;
+  }
+  for (float x : out.positions) ASSERT_TRUE(std::isfinite(x));
+}
+
+TEST(ClusterSimplifier, LandsWithinFivePercentOfTargets) {
+  const Soup s = uv_sphere(150, 200);  // 59,600 faces
+  for (double ratio : {0.5, 0.25, 0.1, 0.03, 0.01, 0.004}) {
+    const size_t target = size_t(ratio * double(s.triangle_count()));
+    const Out out = run(s, target);
+    EXPECT_NEAR(double(out.result.triangles), double(target), 0.05 * double(target)) << "ratio " << ratio;
+    expect_valid_unique_faces(out);
+  }
+}
+
+TEST(ClusterSimplifier, ReachesPointEighteenPercentOfAMillionFaces) {
+  const Soup s = uv_sphere(708, 708);  // 1,000,000 faces
+  ASSERT_GE(s.triangle_count(), 999000u);
+  const size_t target = size_t(0.0018 * double(s.triangle_count()));
+  const Out out = run(s, target);
+  EXPECT_NEAR(double(out.result.triangles), double(target), 0.05 * double(target));
+  expect_valid_unique_faces(out);
+  // Cells' vertices stay on the unit sphere within about a cell.
+  for (size_t v = 0; v < out.result.vertices; ++v) {
+    const float* p = &out.positions[3 * v];
+    EXPECT_NEAR(std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]), 1.0, out.result.cell_size);
+  }
+}
+
+TEST(ClusterSimplifier, ErrorGrowsAlongTheChainAndAttributesFollow) {
+  const Soup s = uv_sphere(80, 100);
+  std::vector<float> normals = s.positions;
+  ClusterOptions o;
+  o.attributes = normals.data();
+  o.attribute_count = 3;
+  const size_t targets[] = {8000, 2000, 500, 100};
+  std::vector<ChainLevelOut> levels(4);
+  EXPECT_EQ(cluster_simplify_chain(levels.data(), s.positions.data(), s.vertex_count(), s.indices.data(),
+                                   s.indices.size(), targets, 4, o),
+            4u);
+  for (size_t l = 0; l < 4; ++l) {
+    EXPECT_NEAR(double(levels[l].triangle_count()), double(targets[l]), 0.05 * double(targets[l]));
+    EXPECT_TRUE(levels[l].reached);
+    ASSERT_EQ(levels[l].attributes.size(), levels[l].positions.size());
+    ASSERT_EQ(levels[l].source_vertex.size(), levels[l].positions.size() / 3);
+    for (size_t v = 0; v < levels[l].positions.size() / 3; ++v) {
+      const float* p = &levels[l].positions[3 * v];
+      const float* n = &levels[l].attributes[3 * v];
+      EXPECT_GT(p[0] * n[0] + p[1] * n[1] + p[2] * n[2], 0.5f);  // averaged normal still points out
+    }
+    if (l) {
+      EXPECT_GE(levels[l].error, levels[l - 1].error);
+    }
+  }
+}
+
+TEST(ClusterSimplifier, SameInputGivesIdenticalOutput) {
+  const Soup s = uv_sphere(60, 80);
+  const Out a = run(s, 900), b = run(s, 900);
+  EXPECT_EQ(a.indices, b.indices);
+  EXPECT_EQ(a.positions, b.positions);
+}
+
+TEST(ClusterSimplifier, TargetAboveInputReturnsTheValidFaces) {
+  Soup s = uv_sphere(10, 12);
+  const size_t faces = s.triangle_count();
+  s.indices.insert(s.indices.end(), {0, 0, 1, 0, 1, 12345});  // degenerate and out of range
+  const Out out = run(s, faces * 2);
+  EXPECT_EQ(out.result.triangles, faces);
+  expect_valid_unique_faces(out);
+}
+
+TEST(ClusterSimplifier, DegenerateAndEmptyInputsNeverCrash) {
+  std::vector<uint32_t> di(3);
+  std::vector<float> dp(3);
+  ClusterResult r;
+  EXPECT_EQ(cluster_simplify(di.data(), dp.data(), nullptr, 0, nullptr, 0, 10, {}, &r), 0u);
+  // All vertices on one spot, a NaN vertex, a flat line of faces.
+  Soup s;
+  s.positions = {1, 1, 1, 1, 1, 1, 1, 1, 1, std::nanf(""), 0, 0, 0, 0, 0, 1, 0, 0, 2, 0, 0};
+  s.indices = {0, 1, 2, 3, 4, 5, 4, 5, 6, 0, 4, 5};
+  const Out out = run(s, 1);
+  expect_valid_unique_faces(out);
+  EXPECT_LE(out.result.triangles, 3u);
+  const Out none = run(uv_sphere(20, 20), 0);
+  EXPECT_EQ(none.result.triangles, 0u);
+}
+
+TEST(ClusterSimplifierRealMesh, DragonToPointEighteenPercent) {
+  LOD_REQUIRE_SHARED_MESH(path, "stanford-dragon.ply");
+  MeshData mesh;
+  ASSERT_TRUE(load_mesh(path, mesh).ok);
+  clean_mesh(mesh);
+  const Soup s{mesh.positions, mesh.indices};
+  const size_t target = size_t(0.0018 * double(s.triangle_count()));
+  const Out out = run(s, target);
+  EXPECT_NEAR(double(out.result.triangles), double(target), 0.05 * double(target));
+  expect_valid_unique_faces(out);
+}
+
+}  // namespace
+}  // namespace lod
