@@ -112,46 +112,32 @@ class FlatImporter final : public OpenMesh::IO::BaseImporter {
   unsigned int reserve_cap = 0;
 };
 
-// Everything OpenMesh says on omerr()/omlog()/omout() (and on std::cerr/std::cout, where
-// some readers write directly) during one read goes into a string. OpenMesh's readers are singletons with
-// per-read state, so reads are serialised anyway; the same lock protects the redirection.
+// Everything OpenMesh says during one read goes into a string. omerr()/omlog()/omout()
+// multiplex into std::cerr/std::clog/std::cout (and some readers write to std::cerr
+// directly), so swapping those streams' buffers catches all of it. Connecting our own
+// stream to the multiplexers instead would leak: mostream::disconnect never frees the
+// target that connect allocated. OpenMesh's readers are singletons with per-read state, so
+// reads are serialised anyway; the same lock protects the swap.
 class OpenMeshOutputCapture {
  public:
   OpenMeshOutputCapture() {
-    err_had_cerr_ = ::omerr().disconnect(std::cerr);
-    log_had_cerr_ = ::omlog().disconnect(std::cerr);
-    log_had_cout_ = ::omlog().disconnect(std::cout);
-    out_had_cout_ = ::omout().disconnect(std::cout);
-    ::omerr().connect(text_);
-    ::omlog().connect(text_);
-    ::omout().connect(text_);
+    flush_openmesh();  // anything pending belongs to someone else
     old_cerr_ = std::cerr.rdbuf(text_.rdbuf());
     old_cout_ = std::cout.rdbuf(text_.rdbuf());
     old_clog_ = std::clog.rdbuf(text_.rdbuf());
   }
   ~OpenMeshOutputCapture() {
+    flush_openmesh();
     std::cerr.rdbuf(old_cerr_);
     std::cout.rdbuf(old_cout_);
     std::clog.rdbuf(old_clog_);
-    ::omerr().flush();
-    ::omlog().flush();
-    ::omout().flush();
-    ::omerr().disconnect(text_);
-    ::omlog().disconnect(text_);
-    ::omout().disconnect(text_);
-    if (out_had_cout_) ::omout().connect(std::cout);
-    if (err_had_cerr_) ::omerr().connect(std::cerr);
-    if (log_had_cerr_) ::omlog().connect(std::cerr);
-    if (log_had_cout_) ::omlog().connect(std::cout);
   }
   OpenMeshOutputCapture(const OpenMeshOutputCapture&) = delete;
   OpenMeshOutputCapture& operator=(const OpenMeshOutputCapture&) = delete;
 
   // One line, trimmed, at most ~300 characters.
   std::string text() {
-    ::omerr().flush();
-    ::omlog().flush();
-    ::omout().flush();
+    flush_openmesh();
     std::string s = text_.str();
     for (char& c : s)
       if (c == '\n' || c == '\r' || c == '\t') c = ' ';
@@ -168,10 +154,13 @@ class OpenMeshOutputCapture {
   std::streambuf* old_cerr_ = nullptr;
   std::streambuf* old_cout_ = nullptr;
   std::streambuf* old_clog_ = nullptr;
-  bool err_had_cerr_ = false;
-  bool log_had_cerr_ = false;
-  bool log_had_cout_ = false;
-  bool out_had_cout_ = false;
+
+  // The multiplexers hold a partial line until '\n'; push it out.
+  static void flush_openmesh() {
+    ::omerr().flush();
+    ::omlog().flush();
+    ::omout().flush();
+  }
 };
 
 std::string lower(std::string s) {

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <thread>
 
 #include "test_support.h"
 
@@ -178,6 +179,30 @@ TEST(BakeModel, CleansTheInputAndReportsIt) {
   EXPECT_EQ(chain.levels[0].vertex_count, 6u);
 }
 
+TEST(BakeModel, GivesTheSameChainWhenBakedConcurrently) {
+  const fs::path a = write_sphere("bake-par-a", 16, 20);
+  const fs::path b = write_sphere("bake-par-b", 12, 30);
+  BakeSettings settings;
+  settings.ratios = {1.0f, 0.5f, 0.25f};
+  LodChain ref_a, ref_b;
+  ASSERT_TRUE(bake_model(a, "a", settings, ref_a, nullptr, nullptr).ok);
+  ASSERT_TRUE(bake_model(b, "b", settings, ref_b, nullptr, nullptr).ok);
+  LodChain par[4];
+  Status st[4];
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 4; ++i)
+    threads.emplace_back([&, i] { st[i] = bake_model(i % 2 ? b : a, i % 2 ? "b" : "a", settings, par[i], nullptr, nullptr); });
+  for (std::thread& t : threads) t.join();
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(st[i].ok) << st[i].message;
+    const LodChain& ref = i % 2 ? ref_b : ref_a;
+    EXPECT_EQ(par[i].indices, ref.indices);
+    EXPECT_EQ(par[i].positions, ref.positions);
+    ASSERT_EQ(par[i].levels.size(), ref.levels.size());
+    for (size_t l = 0; l < ref.levels.size(); ++l) EXPECT_EQ(par[i].levels[l].error, ref.levels[l].error);
+  }
+}
+
 TEST(BakeModel, KeepsEveryFaceOfANonManifoldScan) {
   LOD_REQUIRE_SHARED_MESH(p, "stanford-dragon-res4.ply");
   LodChain chain;
@@ -189,6 +214,29 @@ TEST(BakeModel, KeepsEveryFaceOfANonManifoldScan) {
             11102u - report.cleaned.duplicate_faces - report.cleaned.degenerate_faces);
   expect_chain_invariants(chain);
   for (const std::string& n : report.notes) std::cout << "  note: " << n << "\n";
+}
+
+TEST(BakeModel, CowChainFollowsTheReference) {
+  fs::path cow;
+  if (!test::shared_meshes().empty() && fs::exists(test::shared_meshes() / "cow.obj"))
+    cow = test::shared_meshes() / "cow.obj";
+  else if (!test::data_dir().empty())
+    cow = test::data_dir() / "cow.off";
+  else
+    GTEST_SKIP() << "needs ../shared/data/meshes/cow.obj or the CGAL cow.off (absent on this machine)";
+  LodChain chain;
+  BakeReport report;
+  ASSERT_TRUE(bake_model(cow, "cow", BakeSettings{}, chain, &report, nullptr).ok);
+  EXPECT_EQ(report.input_triangles, 5804u);
+  ASSERT_EQ(chain.levels.size(), 5u);  // R0: 100/50/25/12/6 %
+  const std::vector<float> ratios = default_ratios(5804);
+  for (size_t i = 0; i < chain.levels.size(); ++i) {
+    const double target = ratios[i] * double(chain.levels[0].triangles());
+    EXPECT_NEAR(double(chain.levels[i].triangles()), target, 0.02 * target) << "level " << i;
+  }
+  EXPECT_EQ(chain.levels[0].level, 13);  // round(log2 5804) = 13
+  expect_chain_invariants(chain);
+  EXPECT_GT(chain.levels.back().error, chain.levels[1].error);
 }
 
 TEST(BakeModel, BunnyChainMeetsItsTargets) {

@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <atomic>
 #include <iostream>
+#include <thread>
 
 #include "test_support.h"
 
@@ -43,6 +45,23 @@ std::vector<uint8_t> binary_ply(uint32_t vertices, uint32_t faces, const std::ve
   return bytes;
 }
 
+// Binary STL, one record per triangle (normal left zero), header not starting with "solid".
+std::vector<uint8_t> binary_stl(const std::vector<float>& xyz, const std::vector<uint32_t>& tris) {
+  std::vector<uint8_t> bytes(80, 'x');
+  const uint32_t n = uint32_t(tris.size() / 3);
+  bytes.insert(bytes.end(), reinterpret_cast<const uint8_t*>(&n), reinterpret_cast<const uint8_t*>(&n) + 4);
+  for (uint32_t t = 0; t < n; ++t) {
+    float rec[12] = {};
+    for (int k = 0; k < 3; ++k)
+      for (int d = 0; d < 3; ++d) rec[3 + 3 * k + d] = xyz[3 * tris[3 * t + k] + d];
+    const auto* p = reinterpret_cast<const uint8_t*>(rec);
+    bytes.insert(bytes.end(), p, p + 48);
+    bytes.push_back(0);
+    bytes.push_back(0);
+  }
+  return bytes;
+}
+
 const std::vector<float> kQuadXyz = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
 const std::vector<uint32_t> kQuadTris = {0, 1, 2, 0, 2, 3};
 
@@ -59,7 +78,8 @@ TEST(MeshIo, LoadsEachFormatIntoFlatArrays) {
                    "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\n"
                    "endfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\n"
                    "endfacet\nendsolid q\n");
-  for (const char* name : {"quad.obj", "quad.off", "quad.ply", "quadb.ply", "quad.stl"}) {
+  test::write_bytes(dir / "quadb.stl", binary_stl(kQuadXyz, kQuadTris));
+  for (const char* name : {"quad.obj", "quad.off", "quad.ply", "quadb.ply", "quad.stl", "quadb.stl"}) {
     MeshData m;
     const Status s = load_mesh(dir / name, m);
     ASSERT_TRUE(s.ok) << name << ": " << s.message;
@@ -186,16 +206,20 @@ TEST(MeshIo, RefusesTruncatedAsciiPly) {
   expect_refused(dir / "header.ply", "end_header");
 }
 
-TEST(MeshIo, RefusesTruncatedOffAndStl) {
+TEST(MeshIo, RefusesTruncatedOffAndStlAndNanStl) {
   const fs::path dir = test::temp_dir("io-trunc-off");
   test::write_text(dir / "x.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n");
   expect_refused(dir / "x.off", "truncated");
   test::write_text(dir / "huge.off", "OFF\n353535235358 6 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   expect_refused(dir / "huge.off", "353535235358");
-  std::vector<uint8_t> stl(84 + 50, 0);
-  stl[80] = 2;  // declares two triangles, holds one
+  std::vector<uint8_t> stl = binary_stl(kQuadXyz, kQuadTris);
+  stl.resize(stl.size() - 1);
   test::write_bytes(dir / "x.stl", stl);
   expect_refused(dir / "x.stl", "truncated");
+  std::vector<float> nan_xyz = kQuadXyz;
+  nan_xyz[4] = NAN;
+  test::write_bytes(dir / "nan.stl", binary_stl(nan_xyz, kQuadTris));
+  expect_refused(dir / "nan.stl", "non-finite");
 }
 
 TEST(MeshIo, RefusesPlyTristripsClearly) {
@@ -233,6 +257,31 @@ TEST(MeshIo, SavePlyRoundTrips) {
   EXPECT_NE(s.message.find("references vertex 4 of 4"), std::string::npos) << s.message;
 }
 
+TEST(MeshIo, LoadsConcurrentlyWithTheSameResults) {
+  // OpenMesh's readers are singletons with per-read state: loads from several threads must
+  // still each get their own mesh.
+  const fs::path dir = test::temp_dir("io-threads");
+  test::write_text(dir / "a.off", test::sphere_off(20, 30));
+  test::write_bytes(dir / "b.ply", binary_ply(4, 2, kQuadXyz, kQuadTris));
+  MeshData ref_a, ref_b;
+  ASSERT_TRUE(load_mesh(dir / "a.off", ref_a).ok);
+  ASSERT_TRUE(load_mesh(dir / "b.ply", ref_b).ok);
+  std::vector<std::thread> threads;
+  std::atomic<int> mismatches{0};
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < 10; ++i) {
+        MeshData m;
+        const bool a = (t + i) % 2 == 0;
+        if (!load_mesh(dir / (a ? "a.off" : "b.ply"), m).ok || m.indices != (a ? ref_a : ref_b).indices ||
+            m.positions != (a ? ref_a : ref_b).positions)
+          ++mismatches;
+      }
+    });
+  for (std::thread& th : threads) th.join();
+  EXPECT_EQ(mismatches.load(), 0);
+}
+
 TEST(MeshIo, HandlesEveryEdgeCaseFileWithoutCrashing) {
   if (test::shared_meshes().empty() || !fs::exists(test::shared_meshes() / "edge-cases"))
     GTEST_SKIP() << "needs ../shared/data/meshes/edge-cases (absent on this machine)";
@@ -258,16 +307,22 @@ TEST(MeshIo, HandlesEveryEdgeCaseFileWithoutCrashing) {
 
 struct RealMesh {
   const char* file;
+  size_t vertices;
   size_t triangles;
 };
 
 TEST(MeshIo, LoadsRealMeshesWithTheirPublishedCounts) {
   // Counts from ../shared/data/meshes/STATS.jsonl; the dragons and the buddha contain
   // non-manifold and duplicate faces, which the loader must keep.
-  const RealMesh meshes[] = {{"stanford-bunny.obj", 69451},     {"cow.obj", 5804},
-                             {"stanford-dragon-res3.ply", 47794}, {"stanford-dragon-res4.ply", 11102},
-                             {"stanford-dragon-res2.ply", 202520}, {"happy-buddha-res3.ply", 67240},
-                             {"horse.ply", 96966}};
+  const RealMesh meshes[] = {{"stanford-bunny.obj", 35947, 69451},
+                             {"cow.obj", 2903, 5804},
+                             {"stanford-dragon-res3.ply", 22998, 47794},
+                             {"stanford-dragon-res4.ply", 5205, 11102},
+                             {"stanford-dragon-res2.ply", 100250, 202520},
+                             {"happy-buddha-res3.ply", 32328, 67240},
+                             {"horse.ply", 48485, 96966},
+                             {"teapot.obj", 3644, 6320},
+                             {"spot.obj", 2930, 5856}};
   size_t checked = 0;
   for (const RealMesh& r : meshes) {
     const fs::path p = test::shared_meshes() / r.file;
@@ -276,6 +331,7 @@ TEST(MeshIo, LoadsRealMeshesWithTheirPublishedCounts) {
     const Status s = load_mesh(p, m);
     ASSERT_TRUE(s.ok) << s.message;
     EXPECT_EQ(m.triangle_count(), r.triangles) << r.file;
+    EXPECT_EQ(m.vertex_count(), r.vertices) << r.file;
     ++checked;
   }
   if (checked == 0) GTEST_SKIP() << "needs ../shared/data/meshes (absent on this machine)";
