@@ -115,6 +115,13 @@ struct FrameGraph::Impl {
   std::vector<uint32_t> chunk_offset;   // first compacted slot of each chunk
   std::vector<ViewMinima> chunk_minima;
   std::vector<ChunkTotals> chunk_totals;
+  // Publish counts objects per chain level (index into the ModelTable's per-level arrays),
+  // in kCountLanes interleaved copies so that consecutive increments of one level do not
+  // wait on each other; totals follow from the counts and these per-level tables.
+  static constexpr size_t kCountLanes = 4;
+  size_t level_total = 0;               // levels of all models
+  std::vector<uint32_t> level_counts;   // chunks x kCountLanes x level_total
+  std::vector<uint32_t> full_triangles; // per level: triangles of its model's level 0
   uint32_t visible_total = 0;
 
   // Per frame.
@@ -149,6 +156,13 @@ struct FrameGraph::Impl {
     chunk_offset.resize(chunks);
     chunk_minima.resize(chunks);
     chunk_totals.resize(chunks);
+    const ModelTable& models = scene.models;
+    level_total = models.triangles.size();
+    level_counts.resize(chunks * kCountLanes * level_total);
+    full_triangles.resize(level_total);
+    for (size_t m = 0; m < models.model_count(); ++m)
+      for (size_t k = 0; k < models.level_count[m]; ++k)
+        full_triangles[models.first_level[m] + k] = models.triangles[models.first_level[m]];
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
   }
@@ -282,18 +296,25 @@ struct FrameGraph::Impl {
     for_chunks([&](size_t c, size_t b, size_t e) {
       // Temporal state for the next frame: who was visible, at which level.
       std::copy(state.visible.begin() + b, state.visible.begin() + e, state.was_visible.begin() + b);
-      ChunkTotals t;
+      uint32_t* counts = level_counts.data() + c * kCountLanes * level_total;
+      std::fill(counts, counts + kCountLanes * level_total, 0u);
       const uint32_t first_slot = chunk_offset[c], end_slot = first_slot + chunk_visible[c];
+      const uint32_t* first_level = models.first_level.data();
       for (uint32_t k = first_slot; k < end_slot; ++k) {
         const uint8_t level = f.levels[k];
         state.prev_level[f.objects[k]] = level;
-        const uint32_t first = models.first_level[visible_model[k]];
-        const uint32_t at = first + level;
+        ++counts[(k % kCountLanes) * level_total + first_level[visible_model[k]] + level];
+      }
+      ChunkTotals t;
+      for (size_t at = 0; at < level_total; ++at) {
+        uint64_t n = 0;
+        for (size_t lane = 0; lane < kCountLanes; ++lane) n += counts[lane * level_total + at];
+        if (n == 0) continue;
         const int32_t l = models.level_l[at];
-        t.tris_in_view += models.triangles[first];
-        t.tris_selected += models.triangles[at];
-        t.level_cost += uint64_t{1} << std::clamp(l, 0, 63);
-        ++t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))];
+        t.tris_in_view += n * full_triangles[at];
+        t.tris_selected += n * models.triangles[at];
+        t.level_cost += n << std::clamp(l, 0, 63);
+        t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))] += static_cast<uint32_t>(n);
       }
       // No geomorphing yet: every level is settled.
       std::fill(f.morph.begin() + first_slot, f.morph.begin() + end_slot, 1.0f);
