@@ -207,7 +207,7 @@ int run_interactive(ViewerSession& s) {
       facts.objects = s.loaded.scene.objects.size();
       facts.levels_in_scene = s.max_levels();
       facts.gl = s.window.description();
-      overlay.draw(facts, controls);
+      overlay.draw(facts, controls, /*with_controls=*/true);
     }
     glfwSwapBuffers(window);
     last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - now).count();

@@ -6,7 +6,7 @@
 
 namespace lod::viewer {
 
-inline constexpr std::array<std::array<float, 3>, 8> kLevelPalette = {{
+inline constexpr std::array<std::array<float, 3>, 12> kLevelPalette = {{
     {0.90f, 0.10f, 0.10f},  // 0 red: full detail
     {0.10f, 0.45f, 0.95f},  // 1 blue
     {0.15f, 0.80f, 0.15f},  // 2 green
@@ -14,7 +14,11 @@ inline constexpr std::array<std::array<float, 3>, 8> kLevelPalette = {{
     {0.70f, 0.15f, 0.90f},  // 4 purple
     {0.10f, 0.85f, 0.85f},  // 5 cyan
     {0.95f, 0.50f, 0.05f},  // 6 orange
-    {0.95f, 0.35f, 0.70f},  // 7 pink; deeper levels wrap around
+    {0.95f, 0.35f, 0.70f},  // 7 pink
+    {0.60f, 0.95f, 0.10f},  // 8 lime
+    {0.30f, 0.30f, 0.95f},  // 9 indigo
+    {0.60f, 0.40f, 0.20f},  // 10 brown
+    {0.70f, 0.05f, 0.30f},  // 11 maroon; deeper levels wrap around
 }};
 
 inline const std::array<float, 3>& level_colour(size_t level) { return kLevelPalette[level % kLevelPalette.size()]; }

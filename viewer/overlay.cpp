@@ -55,7 +55,7 @@ void Overlay::record(const OverlayFacts& f) {
   history_.erase(history_.begin(), first_kept);
 }
 
-void Overlay::draw(const OverlayFacts& f, ViewerControls& c) {
+void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls) {
   if (!ready_) return;
   record(f);
   ImGui_ImplOpenGL3_NewFrame();
@@ -117,28 +117,30 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c) {
     plot("selected k", &Sample::selected_k, "k tris");
   }
 
-  ImGui::Separator();
-  int mode = int(c.mode);
-  ImGui::Text("camera");
-  for (int m = 0; m < kCameraModeCount; ++m) {
+  if (with_controls) {
+    ImGui::Separator();
+    int mode = int(c.mode);
+    ImGui::Text("camera");
+    for (int m = 0; m < kCameraModeCount; ++m) {
+      ImGui::SameLine();
+      ImGui::RadioButton(kCameraModeNames[m], &mode, m);
+    }
+    c.mode = CameraMode(mode);
+    ImGui::Checkbox("pause path [P]", &c.paused);
     ImGui::SameLine();
-    ImGui::RadioButton(kCameraModeNames[m], &mode, m);
-  }
-  c.mode = CameraMode(mode);
-  ImGui::Checkbox("pause path [P]", &c.paused);
-  ImGui::SameLine();
-  ImGui::Checkbox("freeze LOD [L]", &c.freeze_lod);
-  ImGui::Checkbox("wireframe [Z]", &c.wireframe);
-  ImGui::SameLine();
-  ImGui::Checkbox("colour by level [C]", &c.colour_by_level);
-  ImGui::SameLine();
-  ImGui::Checkbox("flat [F]", &c.flat_normals);
-  uint64_t budget = c.budget;
-  const uint64_t lo = 1000, hi = 100000000;
-  if (ImGui::SliderScalar("budget M [ ]", ImGuiDataType_U64, &budget, &lo, &hi, "%llu",
-                          ImGuiSliderFlags_Logarithmic)) {
-    c.budget = budget;
-    c.budget_changed = true;
+    ImGui::Checkbox("freeze LOD [L]", &c.freeze_lod);
+    ImGui::Checkbox("wireframe [Z]", &c.wireframe);
+    ImGui::SameLine();
+    ImGui::Checkbox("colour by level [C]", &c.colour_by_level);
+    ImGui::SameLine();
+    ImGui::Checkbox("flat [F]", &c.flat_normals);
+    uint64_t budget = c.budget;
+    const uint64_t lo = 1000, hi = 100000000;
+    if (ImGui::SliderScalar("budget M [ ]", ImGuiDataType_U64, &budget, &lo, &hi, "%llu",
+                            ImGuiSliderFlags_Logarithmic)) {
+      c.budget = budget;
+      c.budget_changed = true;
+    }
   }
   if (c.colour_by_level) {
     ImGui::Text("level");
@@ -148,7 +150,8 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c) {
       ImGui::TextColored(ImVec4(col[0], col[1], col[2], 1), "%zu", l);
     }
   }
-  ImGui::TextDisabled("1/2/3/4 path/fly/orbit/bird's-eye, WASD QE + right mouse, wheel, H hides, Esc quits");
+  if (with_controls)
+    ImGui::TextDisabled("1/2/3/4 path/fly/orbit/bird's-eye, WASD QE + right mouse, wheel, H hides, Esc quits");
   ImGui::End();
 
   ImGui::Render();

@@ -39,8 +39,9 @@ class Overlay {
 
   // Chains GLFW callbacks installed before this call.
   bool init(GLFWwindow* window);
-  // Builds and renders the panel into the bound framebuffer.
-  void draw(const OverlayFacts& facts, ViewerControls& controls);
+  // Builds and renders the panel into the bound framebuffer; `with_controls` adds the
+  // widgets (a screenshot has no use for them).
+  void draw(const OverlayFacts& facts, ViewerControls& controls, bool with_controls);
   bool wants_mouse() const;
   bool wants_keyboard() const;
 

@@ -77,7 +77,7 @@ int run_screenshot(ViewerSession& s) {
       facts.objects = s.loaded.scene.objects.size();
       facts.levels_in_scene = s.max_levels();
       facts.gl = s.window.description();
-      overlay.draw(facts, controls);
+      overlay.draw(facts, controls, /*with_controls=*/false);
     }
     glfwPollEvents();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
