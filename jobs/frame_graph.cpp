@@ -7,8 +7,9 @@
 // parallel_for. Chunk boundaries do not depend on the thread count and every per-chunk
 // result lands in its own slot, merged in chunk order, so 1, 2 or N threads give
 // bit-identical frames. Selection is global (one budget) and runs serially, on the visible
-// objects that importance compacts in object order. vdlod and geomorph are pass-through until view-dependent objects and geomorphing
-// exist: they time themselves (nothing) and forward.
+// objects that importance compacts in object order. vdlod and geomorph are pass-through
+// until view-dependent objects and geomorphing exist: they time themselves (nothing) and
+// forward.
 #include "jobs/frame_graph.h"
 
 #include <algorithm>
