@@ -30,10 +30,6 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
   return instances_.draw(list_, meshes_, view_matrix(viewing), projection_matrix(viewing), settings);
 }
 
-}  // namespace lod::viewer
-
-namespace lod::viewer {
-
 void FrameRenderer::render_culled(const Frame& frame, const View& viewing) {
   const ObjectSet& objects = scene_->objects;
   culled_.objects.clear();

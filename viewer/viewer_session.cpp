@@ -1,8 +1,8 @@
 #include "viewer/viewer_session.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstdio>
-#include <set>
 
 #include "viewer/frame_check.h"
 
@@ -31,9 +31,9 @@ const FrameRow& ViewerSession::record(uint64_t viewer_frame, const Frame& frame,
   row.drawn = drawn.triangles;
   row.gpu_primitives = drawn.gpu_primitives;
   row.draws = drawn.draws;
-  std::set<uint32_t> levels;
-  for (const DrawBatch& b : renderer.draw_list().batches) levels.insert(b.level);
-  row.levels_drawn = uint32_t(levels.size());
+  uint64_t levels = 0;  // bit per chain level (< kMaxLevels)
+  for (const DrawBatch& b : renderer.draw_list().batches) levels |= uint64_t(1) << b.level;
+  row.levels_drawn = uint32_t(std::popcount(levels));
   row.rejected = renderer.draw_list().rejected;
   std::string why;
   row.whole = frame_is_whole(frame, loaded.scene, &why) ? 1 : 0;
