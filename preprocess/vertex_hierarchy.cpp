@@ -1,0 +1,579 @@
+// Vertex hierarchy builder: passes of independent legal edge collapses on flat arrays.
+//
+// R4 (Berkey & Song, "Dynamic view-dependent LOD"): merge tree, region-of-influence marking,
+// dependencies = neighbours at collapse time, tv1/tv2 wings. Hoppe 1997 ("View-dependent
+// refinement of progressive meshes"): normal cones, bounding spheres, error per node.
+// Garland & Heckbert 1997: quadrics. Each pass: vertex->face lists from the current faces,
+// every edge once with its face count (sorted keys), costs, sort, then greedy collapses with
+// both endpoints' one-rings locked for the rest of the pass, so the adjacency built at the
+// start of the pass stays exact wherever a collapse may still happen.
+#include "preprocess/vertex_hierarchy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+namespace lod {
+
+namespace {
+
+struct Quad {
+  double a00 = 0, a11 = 0, a22 = 0, a01 = 0, a02 = 0, a12 = 0;
+  double b0 = 0, b1 = 0, b2 = 0, c = 0;
+  double w = 0;
+
+  void add_plane(double nx, double ny, double nz, double d, double weight) {
+    a00 += weight * nx * nx, a11 += weight * ny * ny, a22 += weight * nz * nz;
+    a01 += weight * nx * ny, a02 += weight * nx * nz, a12 += weight * ny * nz;
+    b0 += weight * nx * d, b1 += weight * ny * d, b2 += weight * nz * d;
+    c += weight * d * d;
+    w += weight;
+  }
+  void add(const Quad& q) {
+    a00 += q.a00, a11 += q.a11, a22 += q.a22, a01 += q.a01, a02 += q.a02, a12 += q.a12;
+    b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c, w += q.w;
+  }
+  double eval(const double* p) const {
+    const double x = p[0], y = p[1], z = p[2];
+    const double e = a00 * x * x + a11 * y * y + a22 * z * z + 2 * (a01 * x * y + a02 * x * z + a12 * y * z) +
+                     2 * (b0 * x + b1 * y + b2 * z) + c;
+    return e > 0 ? e : 0;
+  }
+  // Minimiser of the quadric; false when A is near singular (flat or linear neighbourhoods).
+  bool optimum(double* out) const {
+    const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+    const double det = a00 * c00 + a01 * c01 + a02 * c02;
+    const double scale = std::abs(a00) + std::abs(a11) + std::abs(a22);
+    if (!(std::abs(det) > 1e-10 * scale * scale * scale) || scale == 0) return false;
+    const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+    const double inv = -1.0 / det;
+    out[0] = inv * (c00 * b0 + c01 * b1 + c02 * b2);
+    out[1] = inv * (c01 * b0 + c11 * b1 + c12 * b2);
+    out[2] = inv * (c02 * b0 + c12 * b1 + c22 * b2);
+    return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
+  }
+};
+
+struct Vec {
+  double x = 0, y = 0, z = 0;
+};
+inline Vec sub(const Vec& a, const Vec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec cross(const Vec& a, const Vec& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline double dot(const Vec& a, const Vec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline double length(const Vec& a) { return std::sqrt(dot(a, a)); }
+
+// Normal cone as axis + half-angle (radians); half-angle < 0 marks "no normals yet".
+struct Cone {
+  Vec axis;
+  double half = -1;
+};
+
+Cone merge_cones(const Cone& a, const Cone& b) {
+  if (a.half < 0) return b;
+  if (b.half < 0) return a;
+  const double phi = std::acos(std::clamp(dot(a.axis, b.axis), -1.0, 1.0));
+  if (phi + b.half <= a.half) return a;
+  if (phi + a.half <= b.half) return b;
+  const double half = 0.5 * (phi + a.half + b.half);
+  if (half >= M_PI || phi < 1e-9) return {a.axis, std::min(half, M_PI)};
+  // Rotate a's axis towards b's by (half - a.half) along the great circle.
+  const double t = (half - a.half) / phi;
+  const double s = std::sin(phi);
+  const double wa = std::sin((1 - t) * phi) / s, wb = std::sin(t * phi) / s;
+  Vec axis{wa * a.axis.x + wb * b.axis.x, wa * a.axis.y + wb * b.axis.y, wa * a.axis.z + wb * b.axis.z};
+  const double len = length(axis);
+  if (!(len > 1e-12)) return {a.axis, M_PI};
+  return {{axis.x / len, axis.y / len, axis.z / len}, half};
+}
+
+class Builder {
+ public:
+  Builder(const HierarchyOptions& options) : opt_(options) {}
+
+  Status run(VertexTree& out, const MeshData& mesh);
+
+ private:
+  Vec pos(uint32_t v) const { return {pos_[3 * v], pos_[3 * v + 1], pos_[3 * v + 2]}; }
+  void build_adjacency();
+  void collect_edges();
+  bool try_collapse(uint32_t a, uint32_t b);
+  void finish(VertexTree& out);
+  void mark_split_fans();
+
+  HierarchyOptions opt_;
+  uint32_t leaf_count_ = 0;
+  std::vector<double> pos_;          // per node
+  std::vector<Quad> quad_;           // per node
+  std::vector<Cone> cone_;           // per node
+  std::vector<float> radius_, error_;
+  std::vector<uint32_t> parent_;
+
+  std::vector<uint32_t> leaves_;     // input corners, 3 per kept face
+  std::vector<uint32_t> face_;       // current corners (node ids), 3 per face
+  std::vector<uint8_t> face_alive_;
+  std::vector<uint32_t> face_owner_;
+  std::vector<uint32_t> alive_faces_;  // faces alive at the start of the pass
+
+  // Per pass: vertex -> alive faces (CSR over node ids), flags, locks.
+  std::vector<uint32_t> vf_off_, vf_;
+  std::vector<uint8_t> border_, complex_, locked_;
+  std::vector<uint8_t> nonmanifold_;  // input vertices whose faces form several fans
+  std::vector<uint32_t> stamp_, stamp_b_;
+  uint32_t stamp_now_ = 0;
+
+  struct Edge {
+    uint32_t a, b;
+    double cost;
+  };
+  std::vector<Edge> edges_;
+  std::vector<uint64_t> keys_;
+
+  // Interior node records, appended per collapse.
+  std::vector<uint32_t> children_, split_faces_, wings_;
+  std::vector<uint32_t> dep_off_{0}, deps_, inc_off_{0}, inc_;
+
+  // Scratch per collapse.
+  std::vector<uint32_t> nbr_a_, nbr_b_, faces_ab_;
+};
+
+void Builder::build_adjacency() {
+  const size_t n = parent_.size();
+  vf_off_.assign(n + 1, 0);
+  alive_faces_.clear();
+  for (uint32_t f = 0; f < face_alive_.size(); ++f) {
+    if (!face_alive_[f]) continue;
+    alive_faces_.push_back(f);
+    for (int k = 0; k < 3; ++k) ++vf_off_[face_[3 * f + k] + 1];
+  }
+  for (size_t v = 0; v < n; ++v) vf_off_[v + 1] += vf_off_[v];
+  vf_.resize(vf_off_[n]);
+  std::vector<uint32_t> fill(vf_off_.begin(), vf_off_.end() - 1);
+  for (uint32_t f : alive_faces_)
+    for (int k = 0; k < 3; ++k) vf_[fill[face_[3 * f + k]]++] = f;
+  border_.assign(n, 0);
+  complex_.assign(n, 0);
+  locked_.assign(n, 0);
+  if (stamp_.size() < n) stamp_.resize(n, 0), stamp_b_.resize(n, 0);
+}
+
+// Every edge once (sorted (min, max) keys); its multiplicity is its face count.
+void Builder::collect_edges() {
+  keys_.clear();
+  for (uint32_t f : alive_faces_)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t u = face_[3 * f + k], v = face_[3 * f + (k + 1) % 3];
+      keys_.push_back(u < v ? (uint64_t(u) << 32 | v) : (uint64_t(v) << 32 | u));
+    }
+  std::sort(keys_.begin(), keys_.end());
+  std::vector<uint8_t> border_edges(parent_.size(), 0);
+  edges_.clear();
+  for (size_t i = 0; i < keys_.size();) {
+    size_t j = i + 1;
+    while (j < keys_.size() && keys_[j] == keys_[i]) ++j;
+    const uint32_t a = static_cast<uint32_t>(keys_[i] >> 32), b = static_cast<uint32_t>(keys_[i]);
+    const size_t count = j - i;
+    if (count == 1) {
+      border_[a] = border_[b] = 1;
+      border_edges[a] = static_cast<uint8_t>(std::min(border_edges[a] + 1, 255));
+      border_edges[b] = static_cast<uint8_t>(std::min(border_edges[b] + 1, 255));
+    } else if (count > 2) {
+      complex_[a] = complex_[b] = 1;
+    }
+    edges_.push_back({a, b, 0});
+    i = j;
+  }
+  // A manifold border vertex has exactly two border edges; more is a bow-tie.
+  for (size_t v = 0; v < border_edges.size(); ++v)
+    if ((border_edges[v] != 0 && border_edges[v] != 2) || (v < nonmanifold_.size() && nonmanifold_[v])) complex_[v] = 1;
+
+  size_t kept = 0;
+  for (const Edge& e : edges_) {
+    if (complex_[e.a] || complex_[e.b]) continue;
+    double cost;
+    if (opt_.order == CollapseOrder::shortest) {
+      const Vec d = sub(pos(e.a), pos(e.b));
+      cost = dot(d, d);
+    } else {
+      Quad q = quad_[e.a];
+      q.add(quad_[e.b]);
+      double p[3];
+      if (q.optimum(p)) {
+        cost = q.eval(p);
+      } else {
+        double mid[3] = {0.5 * (pos_[3 * e.a] + pos_[3 * e.b]), 0.5 * (pos_[3 * e.a + 1] + pos_[3 * e.b + 1]),
+                         0.5 * (pos_[3 * e.a + 2] + pos_[3 * e.b + 2])};
+        cost = std::min({q.eval(&pos_[3 * e.a]), q.eval(&pos_[3 * e.b]), q.eval(mid)});
+      }
+    }
+    edges_[kept++] = {e.a, e.b, cost};
+  }
+  edges_.resize(kept);
+  std::sort(edges_.begin(), edges_.end(), [](const Edge& x, const Edge& y) {
+    if (x.cost != y.cost) return x.cost < y.cost;
+    return x.a != y.a ? x.a < y.a : x.b < y.b;  // deterministic ties
+  });
+}
+
+bool Builder::try_collapse(uint32_t a, uint32_t b) {
+  // Neighbours of a (stamped in stamp_) and of b (in stamp_b_), and the faces on the edge.
+  const uint32_t sa = ++stamp_now_;
+  nbr_a_.clear();
+  nbr_b_.clear();
+  faces_ab_.clear();
+  auto gather = [&](uint32_t v, std::vector<uint32_t>& out, std::vector<uint32_t>& stamp) {
+    for (uint32_t k = vf_off_[v]; k < vf_off_[v + 1]; ++k) {
+      const uint32_t f = vf_[k];
+      for (int c = 0; c < 3; ++c) {
+        const uint32_t u = face_[3 * f + c];
+        if (u != v && stamp[u] != sa) stamp[u] = sa, out.push_back(u);
+      }
+    }
+  };
+  gather(a, nbr_a_, stamp_);
+  gather(b, nbr_b_, stamp_b_);
+  for (uint32_t k = vf_off_[a]; k < vf_off_[a + 1]; ++k) {
+    const uint32_t f = vf_[k];
+    const uint32_t* c = &face_[3 * f];
+    if (c[0] == b || c[1] == b || c[2] == b) faces_ab_.push_back(f);
+  }
+  const size_t k_faces = faces_ab_.size();
+  if (k_faces == 0 || k_faces > 2) return false;
+  const bool interior_edge = k_faces == 2;
+  if (interior_edge && border_[a] && border_[b]) return false;  // would pinch two borders together
+
+  // Link condition: the common neighbours are exactly the wings.
+  uint32_t wing[2] = {kNoNode, kNoNode};
+  for (size_t i = 0; i < k_faces; ++i) {
+    const uint32_t* c = &face_[3 * faces_ab_[i]];
+    for (int j = 0; j < 3; ++j)
+      if (c[j] != a && c[j] != b) wing[i] = c[j];
+  }
+  if (interior_edge && wing[0] == wing[1]) return false;
+  size_t common = 0;
+  for (uint32_t u : nbr_b_)
+    if (u != a && stamp_[u] == sa) ++common;
+  if (common != k_faces) return false;
+
+  // Fans stay proper: a wing loses one neighbour, the new vertex keeps a fan of faces.
+  for (size_t i = 0; i < k_faces; ++i) {
+    const uint32_t w = wing[i];
+    uint32_t faces_w = 0;  // alive now: an earlier collapse of this pass may have removed some
+    for (uint32_t k = vf_off_[w]; k < vf_off_[w + 1]; ++k) faces_w += face_alive_[vf_[k]];
+    const uint32_t degree = faces_w + (border_[w] ? 1 : 0);
+    if (degree - 1 < (border_[w] ? 2u : 3u)) return false;
+  }
+  const uint32_t faces_after = (vf_off_[a + 1] - vf_off_[a]) + (vf_off_[b + 1] - vf_off_[b]) - 2 * uint32_t(k_faces);
+  if (faces_after == 0) return false;  // keep at least one triangle of every component
+  if (!border_[a] && !border_[b] && faces_after < 3) return false;
+
+  // Placement: optimal, else the cheapest of the endpoints and the midpoint that folds nothing.
+  Quad q = quad_[a];
+  q.add(quad_[b]);
+  double cand[4][3];
+  int cand_count = 0;
+  const Vec pa = pos(a), pb = pos(b);
+  if (opt_.order == CollapseOrder::shortest) {
+    cand[cand_count][0] = 0.5 * (pa.x + pb.x), cand[cand_count][1] = 0.5 * (pa.y + pb.y);
+    cand[cand_count++][2] = 0.5 * (pa.z + pb.z);
+  } else {
+    if (q.optimum(cand[cand_count])) ++cand_count;
+    cand[cand_count][0] = 0.5 * (pa.x + pb.x), cand[cand_count][1] = 0.5 * (pa.y + pb.y);
+    cand[cand_count++][2] = 0.5 * (pa.z + pb.z);
+    cand[cand_count][0] = pa.x, cand[cand_count][1] = pa.y, cand[cand_count++][2] = pa.z;
+    cand[cand_count][0] = pb.x, cand[cand_count][1] = pb.y, cand[cand_count++][2] = pb.z;
+    // Border vertices stay on the border: prefer the border endpoint when only one is.
+    if (border_[a] != border_[b]) {
+      const Vec keep = border_[a] ? pa : pb;
+      cand[0][0] = keep.x, cand[0][1] = keep.y, cand[0][2] = keep.z;
+      cand_count = 1;
+    }
+  }
+  int best = -1;
+  double best_cost = 0;
+  for (int ci = 0; ci < cand_count; ++ci) {
+    const Vec p{cand[ci][0], cand[ci][1], cand[ci][2]};
+    bool ok = true;
+    for (uint32_t v : {a, b}) {
+      for (uint32_t k = vf_off_[v]; k < vf_off_[v + 1] && ok; ++k) {
+        const uint32_t f = vf_[k];
+        if (std::find(faces_ab_.begin(), faces_ab_.end(), f) != faces_ab_.end()) continue;
+        Vec c[3], d[3];
+        for (int j = 0; j < 3; ++j) {
+          c[j] = pos(face_[3 * f + j]);
+          d[j] = (face_[3 * f + j] == v) ? p : c[j];
+        }
+        const Vec n0 = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+        const Vec n1 = cross(sub(d[1], d[0]), sub(d[2], d[0]));
+        const double l0 = length(n0), l1 = length(n1);
+        if (l0 == 0) continue;  // was degenerate already: nothing to fold
+        if (!(l1 > 0) || dot(n0, n1) < opt_.min_normal_cos * l0 * l1) ok = false;
+      }
+    }
+    if (!ok) continue;
+    const double cost = q.eval(cand[ci]);
+    if (best < 0 || cost < best_cost) best = ci, best_cost = cost;
+  }
+  if (best < 0) return false;
+
+  // Commit: new node p.
+  const uint32_t p = static_cast<uint32_t>(parent_.size());
+  parent_.push_back(kNoNode);
+  parent_[a] = parent_[b] = p;
+  pos_.insert(pos_.end(), cand[best], cand[best] + 3);
+  quad_.push_back(q);
+  cone_.push_back(merge_cones(cone_[a], cone_[b]));
+  const Vec pp = pos(p);
+  radius_.push_back(static_cast<float>(std::max(length(sub(pp, pa)) + radius_[a], length(sub(pp, pb)) + radius_[b])));
+  const double rms = q.w > 0 ? std::sqrt(best_cost / q.w) : 0.0;
+  const double floor = 0.05 * length(sub(pa, pb));  // so that a flat region still refines when close
+  error_.push_back(static_cast<float>(std::max({double(error_[a]), double(error_[b]), rms, floor})));
+
+  children_.push_back(a);
+  children_.push_back(b);
+  for (size_t i = 0; i < 2; ++i) {
+    const uint32_t f = i < k_faces ? faces_ab_[i] : kNoNode;
+    split_faces_.push_back(f);
+    wings_.push_back(i < k_faces ? wing[i] : kNoNode);
+    if (f != kNoNode) {
+      face_alive_[f] = 0;
+      face_owner_[f] = p;
+    }
+  }
+  // Dependencies: p's neighbours (a's and b's but for each other).
+  for (uint32_t u : nbr_a_)
+    if (u != b) deps_.push_back(u);
+  for (uint32_t u : nbr_b_)
+    if (u != a && stamp_[u] != sa) deps_.push_back(u);
+  dep_off_.push_back(static_cast<uint32_t>(deps_.size()));
+  // Incident faces after the collapse: a's and b's surviving faces, corners renamed to p.
+  for (uint32_t v : {a, b})
+    for (uint32_t k = vf_off_[v]; k < vf_off_[v + 1]; ++k) {
+      const uint32_t f = vf_[k];
+      if (!face_alive_[f]) continue;
+      uint32_t* c = &face_[3 * f];
+      if (c[0] != v && c[1] != v && c[2] != v) continue;  // already renamed (shared with the other)
+      for (int j = 0; j < 3; ++j)
+        if (c[j] == v) c[j] = p;
+      inc_.push_back(f);
+    }
+  inc_off_.push_back(static_cast<uint32_t>(inc_.size()));
+
+  // Region of influence: both one-rings stay untouched for the rest of the pass.
+  locked_[a] = locked_[b] = 1;
+  for (uint32_t u : nbr_a_) locked_[u] = 1;
+  for (uint32_t u : nbr_b_) locked_[u] = 1;
+  return true;
+}
+
+// Input vertices whose faces do not form one fan (two cones touching at a vertex) are never
+// collapsed. Legal collapses never make new ones, so the input is checked once.
+void Builder::mark_split_fans() {
+  nonmanifold_.assign(leaf_count_, 0);
+  std::vector<std::pair<uint32_t, uint32_t>> around;  // (other corner, local face)
+  std::vector<uint32_t> root;
+  for (uint32_t v = 0; v < leaf_count_; ++v) {
+    const uint32_t count = vf_off_[v + 1] - vf_off_[v];
+    if (count < 2) continue;
+    around.clear();
+    root.resize(count);
+    std::iota(root.begin(), root.end(), 0u);
+    for (uint32_t k = 0; k < count; ++k) {
+      const uint32_t f = vf_[vf_off_[v] + k];
+      for (int c = 0; c < 3; ++c)
+        if (face_[3 * f + c] != v) around.push_back({face_[3 * f + c], k});
+    }
+    std::sort(around.begin(), around.end());
+    auto find = [&](uint32_t x) {
+      while (root[x] != x) x = root[x] = root[root[x]];
+      return x;
+    };
+    for (size_t k = 1; k < around.size(); ++k)
+      if (around[k].first == around[k - 1].first) root[find(around[k].second)] = find(around[k - 1].second);
+    uint32_t fans = 0;
+    for (uint32_t k = 0; k < count; ++k) fans += find(k) == k;
+    nonmanifold_[v] = fans > 1;
+  }
+}
+
+void Builder::finish(VertexTree& out) {
+  const uint32_t n = static_cast<uint32_t>(parent_.size());
+  out = VertexTree{};
+  out.leaf_count = leaf_count_;
+  out.face_count = static_cast<uint32_t>(face_owner_.size());
+  out.positions.resize(3 * size_t(n));
+  for (size_t i = 0; i < 3 * size_t(n); ++i) out.positions[i] = static_cast<float>(pos_[i]);
+  out.parent = parent_;
+  out.radius = radius_;
+  out.error = error_;
+  out.cone_axis.resize(3 * size_t(n));
+  out.cone_cos.resize(n);
+  for (uint32_t v = 0; v < n; ++v) {
+    const Cone& c = cone_[v];
+    out.cone_axis[3 * v] = static_cast<float>(c.axis.x);
+    out.cone_axis[3 * v + 1] = static_cast<float>(c.axis.y);
+    out.cone_axis[3 * v + 2] = static_cast<float>(c.axis.z);
+    // Half-angles of 90 degrees or more (or unknown) can never be back-facing.
+    out.cone_cos[v] = (c.half < 0 || c.half >= 0.5 * M_PI) ? 0.f : static_cast<float>(std::cos(c.half));
+  }
+  // Depth-first leaf order: sizes bottom-up (children have smaller ids), offsets top-down.
+  std::vector<uint32_t> size(n, 0);
+  for (uint32_t v = 0; v < leaf_count_; ++v) size[v] = 1;
+  const uint32_t inner = n - leaf_count_;
+  for (uint32_t i = 0; i < inner; ++i) size[leaf_count_ + i] = size[children_[2 * i]] + size[children_[2 * i + 1]];
+  out.leaf_lo.assign(n, 0);
+  out.leaf_hi.assign(n, 0);
+  uint32_t next = 0;
+  for (uint32_t v = 0; v < n; ++v)
+    if (parent_[v] == kNoNode) out.leaf_lo[v] = next, next += size[v];
+  for (uint32_t v = n; v-- > leaf_count_;) {
+    const uint32_t i = v - leaf_count_;
+    out.leaf_lo[children_[2 * i]] = out.leaf_lo[v];
+    out.leaf_lo[children_[2 * i + 1]] = out.leaf_lo[v] + size[children_[2 * i]];
+  }
+  for (uint32_t v = 0; v < n; ++v) out.leaf_hi[v] = out.leaf_lo[v] + size[v];
+  out.leaf_rank.assign(out.leaf_lo.begin(), out.leaf_lo.begin() + leaf_count_);
+
+  out.face_leaves = std::move(leaves_);
+  out.face_owner = face_owner_;
+  out.children = std::move(children_);
+  out.split_faces = std::move(split_faces_);
+  out.wings = std::move(wings_);
+  out.dep_offsets = std::move(dep_off_);
+  out.deps = std::move(deps_);
+  out.inc_offsets = std::move(inc_off_);
+  out.inc_faces = std::move(inc_);
+}
+
+Status Builder::run(VertexTree& out, const MeshData& mesh) {
+  const size_t vc = mesh.vertex_count();
+  if (mesh.positions.size() % 3 != 0)
+    return Status::error(mesh.source + ": positions hold " + std::to_string(mesh.positions.size()) +
+                         " floats, not a multiple of 3");
+  if (mesh.indices.size() % 3 != 0)
+    return Status::error(mesh.source + ": " + std::to_string(mesh.indices.size()) + " indices, not a multiple of 3");
+  if (vc >= kNoNode / 2) return Status::error(mesh.source + ": too many vertices for a hierarchy");
+  for (size_t i = 0; i < mesh.positions.size(); ++i)
+    if (!std::isfinite(mesh.positions[i]))
+      return Status::error(mesh.source + ": vertex " + std::to_string(i / 3) + " has a non-finite position");
+  std::vector<uint32_t> leaves;
+  leaves.reserve(mesh.indices.size());
+  for (size_t f = 0; f < mesh.triangle_count(); ++f) {
+    const uint32_t* c = &mesh.indices[3 * f];
+    for (int k = 0; k < 3; ++k)
+      if (c[k] >= vc)
+        return Status::error(mesh.source + ": face " + std::to_string(f) + " references vertex " +
+                             std::to_string(c[k]) + " of " + std::to_string(vc));
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    leaves.insert(leaves.end(), c, c + 3);
+  }
+  leaf_count_ = static_cast<uint32_t>(vc);
+  const size_t fc = leaves.size() / 3;
+
+  pos_.reserve(6 * vc);
+  pos_.assign(mesh.positions.begin(), mesh.positions.end());
+  parent_.reserve(2 * vc);
+  parent_.assign(vc, kNoNode);
+  quad_.reserve(2 * vc);
+  quad_.assign(vc, Quad{});
+  cone_.reserve(2 * vc);
+  cone_.assign(vc, Cone{});
+  radius_.reserve(2 * vc);
+  radius_.assign(vc, 0.f);
+  error_.reserve(2 * vc);
+  error_.assign(vc, 0.f);
+  face_ = leaves;
+  leaves_ = std::move(leaves);
+  face_alive_.assign(fc, 1);
+  face_owner_.assign(fc, kNoNode);
+
+  // Leaf quadrics (area-weighted planes) and normal cones (area-weighted axis, widest normal).
+  std::vector<Vec> normal_sum(vc);
+  std::vector<Vec> face_n(fc);
+  for (size_t f = 0; f < fc; ++f) {
+    const Vec p0 = pos(face_[3 * f]), p1 = pos(face_[3 * f + 1]), p2 = pos(face_[3 * f + 2]);
+    const Vec n = cross(sub(p1, p0), sub(p2, p0));
+    const double len = length(n);
+    if (!(len > 0)) continue;
+    const Vec u{n.x / len, n.y / len, n.z / len};
+    face_n[f] = u;
+    const double area = 0.5 * len;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = face_[3 * f + k];
+      quad_[v].add_plane(u.x, u.y, u.z, -dot(u, p0), area);
+      normal_sum[v].x += n.x, normal_sum[v].y += n.y, normal_sum[v].z += n.z;
+    }
+  }
+  for (size_t v = 0; v < vc; ++v) {
+    const double len = length(normal_sum[v]);
+    if (len > 0) cone_[v] = {{normal_sum[v].x / len, normal_sum[v].y / len, normal_sum[v].z / len}, 0};
+  }
+  for (size_t f = 0; f < fc; ++f) {
+    if (length(face_n[f]) == 0) continue;
+    for (int k = 0; k < 3; ++k) {
+      Cone& c = cone_[face_[3 * f + k]];
+      if (c.half < 0) continue;
+      c.half = std::max(c.half, std::acos(std::clamp(dot(c.axis, face_n[f]), -1.0, 1.0)));
+    }
+  }
+
+  build_adjacency();
+  mark_split_fans();
+  collect_edges();
+  // Border constraint planes (through the border edge, perpendicular to its face) hold the
+  // outline of open meshes in place.
+  if (opt_.order == CollapseOrder::quadric) {
+    for (uint32_t f = 0; f < fc; ++f) {
+      if (length(face_n[f]) == 0) continue;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t u = face_[3 * f + k], v = face_[3 * f + (k + 1) % 3];
+        if (!border_[u] || !border_[v]) continue;
+        // Border edge when no other face has it.
+        bool shared = false;
+        for (uint32_t j = vf_off_[u]; j < vf_off_[u + 1] && !shared; ++j) {
+          const uint32_t g = vf_[j];
+          if (g == f) continue;
+          const uint32_t* c = &face_[3 * g];
+          shared = c[0] == v || c[1] == v || c[2] == v;
+        }
+        if (shared) continue;
+        const Vec e = sub(pos(v), pos(u));
+        const Vec n = cross(e, face_n[f]);
+        const double len = length(n);
+        if (!(len > 0)) continue;
+        const Vec m{n.x / len, n.y / len, n.z / len};
+        const double weight = opt_.border_weight * dot(e, e);
+        quad_[u].add_plane(m.x, m.y, m.z, -dot(m, pos(u)), weight);
+        quad_[v].add_plane(m.x, m.y, m.z, -dot(m, pos(u)), weight);
+      }
+    }
+    collect_edges();  // costs with the border planes
+  }
+
+  for (;;) {
+    size_t collapsed = 0;
+    for (const Edge& e : edges_) {
+      if (locked_[e.a] || locked_[e.b]) continue;
+      if (try_collapse(e.a, e.b)) ++collapsed;
+    }
+    if (collapsed == 0) break;
+    build_adjacency();
+    collect_edges();
+  }
+  finish(out);
+  return Status::success();
+}
+
+}  // namespace
+
+Status build_vertex_hierarchy(VertexTree& out, const MeshData& mesh, const HierarchyOptions& options) {
+  VertexTree tree;
+  Builder builder(options);
+  Status s = builder.run(tree, mesh);
+  if (!s) return s;
+  out = std::move(tree);
+  return s;
+}
+
+}  // namespace lod

@@ -1,0 +1,42 @@
+// Vertex hierarchy builder for view-dependent LOD.
+//
+// R4 (Berkey & Song): a merge forest from repeated legal edge collapses, each pass collapsing
+// an independent set (the region of influence of every collapse, both endpoints' one-rings,
+// is marked until the pass ends) so the forest stays balanced, O(log n) deep. Edges are taken
+// in quadric order (Garland & Heckbert 1997) or, as R4, shortest first. The legality test
+// (link condition, Dey et al. 1999; no pinch of two borders through an interior edge; no
+// fold-over; wings keep a proper fan) keeps every intermediate mesh a manifold, so a front of
+// the forest with El-Sana & Varshney's dependencies is one too. Unlike R4's own build, open
+// meshes (border planes hold the outline) and several components work; a component is never
+// collapsed below one triangle. Non-manifold vertices are kept as they are (never collapsed).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "preprocess/mesh.h"
+#include "runtime/status.h"
+#include "runtime/vertex_tree.h"
+
+namespace lod {
+
+enum class CollapseOrder : uint8_t {
+  quadric,   // QEM cost, optimal placement (fallbacks: endpoints, midpoint)
+  shortest,  // R4: shortest edge first, parent at the midpoint
+};
+
+struct HierarchyOptions {
+  CollapseOrder order = CollapseOrder::quadric;
+  // Weight of border constraint planes relative to the surface's own planes (quadric order).
+  float border_weight = 10;
+  // A collapse is refused when a remaining face's normal would turn by more than this
+  // (cosine of the angle; -1 allows everything but an exact flip).
+  float min_normal_cos = 0.2f;
+};
+
+// Builds the hierarchy of `mesh` (positions and indices; normals are not used). Faces with a
+// repeated corner are dropped first; face ids in `out` count the faces kept, in input order.
+// Fails (out untouched) when an index is out of range or a position is not finite; the
+// message names mesh.source and the element.
+Status build_vertex_hierarchy(VertexTree& out, const MeshData& mesh, const HierarchyOptions& options = {});
+
+}  // namespace lod

@@ -1,0 +1,141 @@
+// Geomorphing: linear blends of positions over time (R3's v(t) = (1 - t) v_i + t v_f).
+#include "runtime/geomorph.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+namespace lod {
+
+namespace {
+
+// Exact at both ends: t = 0 gives a, t = 1 gives b (a + t (b - a) would not, in floats).
+inline float blend(float a, float b, float t) { return (1 - t) * a + t * b; }
+
+}  // namespace
+
+void geomorph_lerp(std::span<float> out, std::span<const float> from, std::span<const float> to, float t) {
+  assert(from.size() == out.size() && to.size() == out.size());
+  t = std::clamp(t, 0.f, 1.f);
+  for (size_t i = 0; i < out.size(); ++i) out[i] = blend(from[i], to[i], t);
+}
+
+float morph_factor(double now, double start, float duration) {
+  if (duration <= 0) return 1;
+  return static_cast<float>(std::clamp((now - start) / duration, 0.0, 1.0));
+}
+
+void vertex_morph_init(VertexMorph& m, const VertexTree& t, float duration) {
+  m.from = t.positions;
+  m.to = t.positions;
+  m.start.assign(t.node_count(), -std::numeric_limits<double>::infinity());
+  m.duration = duration;
+}
+
+void vertex_morph_position(const VertexMorph& m, uint32_t v, double now, float out[3]) {
+  const float t = morph_factor(now, m.start[v], m.duration);
+  for (int k = 0; k < 3; ++k) out[k] = blend(m.from[3 * size_t(v) + k], m.to[3 * size_t(v) + k], t);
+}
+
+void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const FrontEvent> events, double now) {
+  auto retarget = [&](uint32_t v, const float* from, const float* to) {
+    for (int k = 0; k < 3; ++k) m.from[3 * size_t(v) + k] = from[k], m.to[3 * size_t(v) + k] = to[k];
+    m.start[v] = now;
+  };
+  for (const FrontEvent& e : events) {
+    const uint32_t i = e.node - t.leaf_count;
+    const uint32_t c[2] = {t.children[2 * i], t.children[2 * i + 1]};
+    const float* own = &t.positions[3 * size_t(e.node)];
+    float here[3];
+    switch (e.kind) {
+      case FrontEventKind::split:
+        // Both children appear where the parent is shown and move out to their own positions.
+        vertex_morph_position(m, e.node, now, here);
+        for (uint32_t ch : c) retarget(ch, here, &t.positions[3 * size_t(ch)]);
+        break;
+      case FrontEventKind::collapse_begin:
+        for (uint32_t ch : c) {
+          vertex_morph_position(m, ch, now, here);
+          retarget(ch, here, own);
+        }
+        break;
+      case FrontEventKind::collapse_cancel:
+        for (uint32_t ch : c) {
+          vertex_morph_position(m, ch, now, here);
+          retarget(ch, here, &t.positions[3 * size_t(ch)]);
+        }
+        break;
+      case FrontEventKind::collapse:
+        // The children have arrived (deferred) or jump (no delay); the parent is settled.
+        retarget(e.node, own, own);
+        m.start[e.node] = -std::numeric_limits<double>::infinity();
+        break;
+    }
+  }
+}
+
+size_t vertex_morph_positions(std::span<float> out, const VertexMorph& m, std::span<const uint32_t> nodes, double now) {
+  size_t moving = 0;
+  for (uint32_t v : nodes) {
+    assert(3 * size_t(v) + 2 < out.size());
+    const float t = morph_factor(now, m.start[v], m.duration);
+    moving += t < 1;
+    for (int k = 0; k < 3; ++k) out[3 * size_t(v) + k] = blend(m.from[3 * size_t(v) + k], m.to[3 * size_t(v) + k], t);
+  }
+  return moving;
+}
+
+void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine_positions,
+                         std::span<const uint32_t> fine_source, std::span<const float> coarse_positions,
+                         std::span<const uint32_t> coarse_source) {
+  const size_t nf = fine_positions.size() / 3, nc = coarse_positions.size() / 3;
+  assert(target.size() == nf && fine_source.size() == nf && coarse_source.size() == nc);
+  // Sources that survive keep their own coarse vertex (sorted pairs, binary search).
+  std::vector<std::pair<uint32_t, uint32_t>> by_source(nc);
+  for (size_t c = 0; c < nc; ++c) by_source[c] = {coarse_source[c], static_cast<uint32_t>(c)};
+  std::sort(by_source.begin(), by_source.end());
+  for (size_t v = 0; v < nf; ++v) {
+    const auto it = std::lower_bound(by_source.begin(), by_source.end(), std::make_pair(fine_source[v], 0u));
+    if (it != by_source.end() && it->first == fine_source[v]) {
+      target[v] = it->second;
+      continue;
+    }
+    // Merged away: the nearest coarse vertex (a bake-time cost, never per frame).
+    float best = std::numeric_limits<float>::infinity();
+    uint32_t best_c = 0;
+    for (size_t c = 0; c < nc; ++c) {
+      float d2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const float d = fine_positions[3 * v + k] - coarse_positions[3 * c + k];
+        d2 += d * d;
+      }
+      if (d2 < best) best = d2, best_c = static_cast<uint32_t>(c);
+    }
+    target[v] = best_c;
+  }
+}
+
+void level_morph_positions(std::span<float> out, std::span<const float> fine_positions,
+                           std::span<const float> coarse_positions, std::span<const uint32_t> target, float t) {
+  assert(out.size() == fine_positions.size() && target.size() * 3 == fine_positions.size());
+  t = std::clamp(t, 0.f, 1.f);
+  for (size_t v = 0; v < target.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      out[3 * v + k] = blend(fine_positions[3 * v + k], coarse_positions[3 * size_t(target[v]) + k], t);
+}
+
+size_t advance_level_morph(std::span<float> morph, std::span<const uint8_t> level, std::span<const uint8_t> prev_level,
+                           float dt, float duration) {
+  assert(level.size() == morph.size() && prev_level.size() == morph.size());
+  const float step = duration > 0 ? dt / duration : 1.f;
+  size_t moving = 0;
+  for (size_t i = 0; i < morph.size(); ++i) {
+    const float m = level[i] != prev_level[i] ? 0.f : morph[i];
+    morph[i] = std::min(1.f, m + (level[i] != prev_level[i] ? 0.f : step));
+    moving += morph[i] < 1;
+  }
+  return moving;
+}
+
+}  // namespace lod

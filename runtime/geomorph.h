@@ -1,0 +1,71 @@
+// Geomorphing (R3; Hoppe 1996/1997): a change of detail blends vertex positions over time,
+// v(t) = (1 - t) v_i + t v_f, instead of jumping, so no split, collapse or level change pops.
+//
+// View-dependent objects: VertexMorph keeps per hierarchy node where its displayed position
+// started and ends and when. A split starts both children at the parent's displayed position;
+// a deferred collapse (FrontParams::collapse_delay) first moves both children onto the parent,
+// and the topological collapse happens when they have arrived, so the parent appears exactly
+// where they are. Discrete levels: a level change blends the finer level's vertices between
+// their own positions and their morph targets in the coarser level.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "runtime/vertex_front.h"
+#include "runtime/vertex_tree.h"
+
+namespace lod {
+
+// out[i] = (1 - t) * from[i] + t * to[i] for every float; t is clamped to [0, 1], and t = 0
+// and t = 1 give `from` and `to` exactly. Sub-ranges give the same result.
+void geomorph_lerp(std::span<float> out, std::span<const float> from, std::span<const float> to, float t);
+
+// Morph factor after a change made at `start`: (now - start) / duration clamped to [0, 1];
+// 1 when duration <= 0.
+float morph_factor(double now, double start, float duration);
+
+struct VertexMorph {
+  std::vector<float> from;     // xyz per node
+  std::vector<float> to;       // xyz per node
+  std::vector<double> start;   // per node, seconds
+  float duration = 0.25f;      // seconds
+};
+
+// Every node settled at its own position.
+void vertex_morph_init(VertexMorph& morph, const VertexTree& tree, float duration);
+
+// Applies one frame's front events at time `now` (call after front_update with the same time).
+void vertex_morph_apply(VertexMorph& morph, const VertexTree& tree, std::span<const FrontEvent> events, double now);
+
+// Displayed position of one node at `now`.
+void vertex_morph_position(const VertexMorph& morph, uint32_t node, double now, float out[3]);
+
+// Writes displayed positions of `nodes` at `now` into out (xyz per node id, out sized for
+// every node, so the front's triangles index it directly). Returns the number of nodes still
+// moving. Sub-ranges of `nodes` give the same result.
+size_t vertex_morph_positions(std::span<float> out, const VertexMorph& morph, std::span<const uint32_t> nodes,
+                              double now);
+
+// ---- discrete levels --------------------------------------------------------------------------
+
+// Morph targets of a finer level in a coarser one: for each fine vertex the coarse vertex it
+// merged into, from the simplifier's vertex mapping (the input vertex each output vertex
+// descends from). A fine vertex whose source survives in the coarse level maps to that vertex;
+// otherwise to the coarse vertex nearest to it. Writes target[fine] (coarse index).
+void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine_positions,
+                         std::span<const uint32_t> fine_source, std::span<const float> coarse_positions,
+                         std::span<const uint32_t> coarse_source);
+
+// Positions of the finer level blended towards its targets: out = (1 - t) fine + t coarse[target].
+// t = 0 draws the finer level, t = 1 puts every vertex on the coarser level's surface.
+void level_morph_positions(std::span<float> out, std::span<const float> fine_positions,
+                           std::span<const float> coarse_positions, std::span<const uint32_t> target, float t);
+
+// Per object: advance the morph factor towards 1 by dt / duration, restarting it at 0 where the
+// level changed since last frame. Returns the number of objects still morphing.
+size_t advance_level_morph(std::span<float> morph, std::span<const uint8_t> level,
+                           std::span<const uint8_t> prev_level, float dt, float duration);
+
+}  // namespace lod

@@ -1,0 +1,712 @@
+// Active-front update over flat arrays: split/collapse with dependencies, a motion calendar
+// so a frame visits only nodes whose decision may have changed, threshold feedback.
+#include "runtime/vertex_front.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace lod {
+
+namespace {
+
+constexpr uint32_t kBuckets = 4096;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct Decision {
+  bool refine;
+  double slack;  // object units of view motion before `refine` may change
+};
+
+// Hoppe 1997's criteria for one node, with how far the view may move before each could flip.
+Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float threshold, double reach) {
+  const float* c = &t.positions[3 * size_t(v)];
+  const double r = t.radius[v];
+  // Frustum: outside when some plane has the whole sphere behind it.
+  double outside_by = -kInf, inside_by = kInf;
+  for (const auto& pl : view.planes) {
+    const double s = double(pl[0]) * c[0] + double(pl[1]) * c[1] + double(pl[2]) * c[2] + pl[3];
+    outside_by = std::max(outside_by, -r - s);
+    inside_by = std::min(inside_by, s + r);
+  }
+  const bool in_frustum = outside_by <= 0;
+  const double slack_frustum = in_frustum ? inside_by : outside_by;
+
+  const double ax = c[0] - double(view.eye[0]), ay = c[1] - double(view.eye[1]), az = c[2] - double(view.eye[2]);
+  const double d = std::sqrt(ax * ax + ay * ay + az * az);
+  // Normal cone: every normal in the cone points away from every point of the sphere.
+  bool facing = true;
+  double slack_facing = kInf;
+  const double cos_alpha = t.cone_cos[v];
+  if (cos_alpha > 0 && d > r) {
+    const float* n = &t.cone_axis[3 * size_t(v)];
+    const double cos_beta = (ax * n[0] + ay * n[1] + az * n[2]) / d;
+    const double sin_alpha = std::sqrt(std::max(0.0, 1 - cos_alpha * cos_alpha));
+    const double sin_gamma = r / d, cos_gamma = std::sqrt(std::max(0.0, 1 - sin_gamma * sin_gamma));
+    // alpha + gamma < 90 degrees and beta + alpha + gamma < 90 degrees.
+    const double cos_sum = cos_alpha * cos_gamma - sin_alpha * sin_gamma;
+    const double sin_sum = sin_alpha * cos_gamma + cos_alpha * sin_gamma;
+    facing = !(cos_sum > 0 && cos_beta > sin_sum);
+    // An eye move of m turns directions seen from the node by about m / (d - r).
+    slack_facing = 0.5 * std::abs(cos_beta - sin_sum) * std::max(d - r, 0.0);
+  }
+  // Screen-space error: e * focal / distance > threshold while distance < critical.
+  const double dist = std::max(d - r, 1e-6);
+  const double critical = double(t.error[v]) * view.focal_pixels / threshold;
+  const bool coarse = dist < critical;
+  const double slack_error = std::min(std::abs(dist - critical), reach);
+
+  const bool refine = in_frustum && facing && coarse;
+  double slack;
+  if (refine) {
+    slack = std::min({slack_frustum, slack_facing, slack_error});
+  } else {
+    // Stays false while any failing criterion keeps failing.
+    slack = 0;
+    if (!in_frustum) slack = std::max(slack, slack_frustum);
+    if (!facing) slack = std::max(slack, slack_facing);
+    if (!coarse) slack = std::max(slack, slack_error);
+  }
+  return {refine, slack};
+}
+
+class Updater {
+ public:
+  Updater(VertexFront& f, const VertexTree& t, const FrontParams& p) : f_(f), t_(t), p_(p) {}
+
+  FrontStats run(const FrontView& view);
+
+  void split(uint32_t x);
+  void collapse(uint32_t p);
+  void unfile(uint32_t v);
+  void file(uint32_t v, double slack);
+  void stop_waiting(uint32_t v);
+  void wait_for(uint32_t v, uint32_t d);
+  void wake(uint32_t d);
+
+ private:
+  // First dependency of p that is not active, or kNoNode.
+  uint32_t missing_dep(uint32_t p) const {
+    const uint32_t i = p - t_.leaf_count;
+    for (uint32_t k = t_.dep_offsets[i]; k < t_.dep_offsets[i + 1]; ++k)
+      if (f_.state[t_.deps[k]] != VertexFront::kActive) return t_.deps[k];
+    return kNoNode;
+  }
+  bool deps_active(uint32_t p) const { return missing_dep(p) == kNoNode; }
+  bool children_active(uint32_t p) const {
+    const uint32_t i = p - t_.leaf_count;
+    return f_.state[t_.children[2 * i]] == VertexFront::kActive && f_.state[t_.children[2 * i + 1]] == VertexFront::kActive;
+  }
+  uint32_t new_faces(uint32_t x) const {
+    const uint32_t i = x - t_.leaf_count;
+    return (t_.split_faces[2 * i] != kNoNode) + (t_.split_faces[2 * i + 1] != kNoNode);
+  }
+  bool force_split(uint32_t v);
+  void emit(uint32_t node, FrontEventKind kind) {
+    if (f_.event_count < f_.events.size()) f_.events[f_.event_count++] = {node, kind};
+  }
+  void push(uint32_t v) {
+    if (tail_ < limit_) f_.queue[tail_++] = v;
+    else file(v, 0);  // queue full (cannot happen with the sizes front_init picks): next frame
+  }
+  void begin_pending(uint32_t p);
+  void end_pending(uint32_t p);
+  bool consider(uint32_t v, bool phase_two);
+
+  VertexFront& f_;
+  const VertexTree& t_;
+  const FrontParams& p_;
+  FrontView view_;
+  double reach_ = 0;
+  uint32_t head_ = 0, tail_ = 0;
+  bool phase_two_ = false;
+  uint32_t limit_ = 0;
+  uint32_t ops_ = 0;
+  FrontStats stats_;
+};
+
+void Updater::unfile(uint32_t v) {
+  const uint32_t b = f_.bucket_of[v];
+  if (b == kNoNode) return;
+  const uint32_t n = f_.next[v], pr = f_.prev[v];
+  if (pr != kNoNode) f_.next[pr] = n;
+  else f_.bucket_head[b] = n;
+  if (n != kNoNode) f_.prev[n] = pr;
+  f_.bucket_of[v] = kNoNode;
+}
+
+void Updater::file(uint32_t v, double slack) {
+  assert(f_.bucket_of[v] == kNoNode);
+  if (slack <= 0) {
+    // Retry next frame whether or not the view moves (blocked by a limit or a neighbour).
+    f_.prev[v] = kNoNode;
+    f_.next[v] = f_.bucket_head[kBuckets];
+    if (f_.next[v] != kNoNode) f_.prev[f_.next[v]] = v;
+    f_.bucket_head[kBuckets] = v;
+    f_.bucket_of[v] = kBuckets;
+    return;
+  }
+  // Never into a bucket this frame already visited; far deadlines wait in the last bucket.
+  const double at = (f_.motion + slack) / f_.bucket_width;
+  int64_t abs_bucket = at < double(f_.cursor + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : f_.cursor + kBuckets - 1;
+  abs_bucket = std::max(abs_bucket, f_.cursor);
+  const uint32_t b = static_cast<uint32_t>(abs_bucket % kBuckets);
+  f_.prev[v] = kNoNode;
+  f_.next[v] = f_.bucket_head[b];
+  if (f_.next[v] != kNoNode) f_.prev[f_.next[v]] = v;
+  f_.bucket_head[b] = v;
+  f_.bucket_of[v] = b;
+}
+
+void Updater::stop_waiting(uint32_t v) {
+  const uint32_t d = f_.wait_on[v];
+  if (d == kNoNode) return;
+  const uint32_t n = f_.wait_next[v], pr = f_.wait_prev[v];
+  if (pr != kNoNode) f_.wait_next[pr] = n;
+  else f_.wait_head[d] = n;
+  if (n != kNoNode) f_.wait_prev[n] = pr;
+  f_.wait_on[v] = kNoNode;
+}
+
+void Updater::wait_for(uint32_t v, uint32_t d) {
+  stop_waiting(v);
+  f_.wait_on[v] = d;
+  f_.wait_prev[v] = kNoNode;
+  f_.wait_next[v] = f_.wait_head[d];
+  if (f_.wait_next[v] != kNoNode) f_.wait_prev[f_.wait_next[v]] = v;
+  f_.wait_head[d] = v;
+}
+
+// d became active: whoever waited on it is judged again (this frame in phase one).
+void Updater::wake(uint32_t d) {
+  while (f_.wait_head[d] != kNoNode) {
+    const uint32_t v = f_.wait_head[d];
+    stop_waiting(v);
+    if (f_.state[v] != VertexFront::kActive) continue;
+    unfile(v);
+    if (phase_two_) file(v, 0);
+    else push(v);
+  }
+}
+
+void Updater::split(uint32_t x) {
+  const uint32_t i = x - t_.leaf_count;
+  const uint32_t c1 = t_.children[2 * i], c2 = t_.children[2 * i + 1];
+  const uint32_t par = t_.parent[x];
+  if (par != kNoNode && f_.pending_until[par - t_.leaf_count] >= 0) end_pending(par);
+  unfile(x);
+  stop_waiting(x);
+  // Active list: x out (its slot goes to c1), c2 appended.
+  f_.state[x] = VertexFront::kSplit;
+  const uint32_t slot = f_.active_pos[x];
+  f_.active[slot] = c1;
+  f_.active_pos[c1] = slot;
+  f_.active_pos[c2] = f_.active_count;
+  f_.active[f_.active_count++] = c2;
+  f_.state[c1] = f_.state[c2] = VertexFront::kActive;
+  // Faces around x take the child holding their corner's leaf.
+  for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
+    const uint32_t face = t_.inc_faces[k];
+    const uint32_t s = f_.face_slot[face];
+    if (s == kNoNode) continue;
+    uint32_t* tri = &f_.tri_indices[3 * size_t(s)];
+    for (int j = 0; j < 3; ++j)
+      if (tri[j] == x) tri[j] = t_.covers(c1, t_.face_leaves[3 * size_t(face) + j]) ? c1 : c2;
+  }
+  // The split's own faces, appended to the packed triangle array.
+  for (int k = 0; k < 2; ++k) {
+    const uint32_t face = t_.split_faces[2 * i + k];
+    if (face == kNoNode) continue;
+    const uint32_t s = f_.tri_count++;
+    f_.face_slot[face] = s;
+    f_.tri_face[s] = face;
+    for (int j = 0; j < 3; ++j) {
+      const uint32_t leaf = t_.face_leaves[3 * size_t(face) + j];
+      f_.tri_indices[3 * size_t(s) + j] = t_.covers(c1, leaf) ? c1 : t_.covers(c2, leaf) ? c2 : t_.wings[2 * i + k];
+    }
+  }
+  emit(x, FrontEventKind::split);
+  ++stats_.splits;
+  ++ops_;
+  wake(c1);
+  wake(c2);
+}
+
+void Updater::collapse(uint32_t p) {
+  const uint32_t i = p - t_.leaf_count;
+  const uint32_t c1 = t_.children[2 * i], c2 = t_.children[2 * i + 1];
+  if (f_.pending_until[i] >= 0) {
+    f_.pending_until[i] = -1;
+    const uint32_t at = f_.pending_pos[i], last = f_.pending[--f_.pending_count];
+    f_.pending[at] = last;
+    f_.pending_pos[last - t_.leaf_count] = at;
+  }
+  // The split's faces leave; the last triangles fill their slots.
+  for (int k = 0; k < 2; ++k) {
+    const uint32_t face = t_.split_faces[2 * i + k];
+    if (face == kNoNode) continue;
+    const uint32_t s = f_.face_slot[face], last = --f_.tri_count;
+    if (s != last) {
+      const uint32_t moved = f_.tri_face[last];
+      std::copy_n(&f_.tri_indices[3 * size_t(last)], 3, &f_.tri_indices[3 * size_t(s)]);
+      f_.tri_face[s] = moved;
+      f_.face_slot[moved] = s;
+    }
+    f_.face_slot[face] = kNoNode;
+  }
+  for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
+    const uint32_t s = f_.face_slot[t_.inc_faces[k]];
+    if (s == kNoNode) continue;
+    uint32_t* tri = &f_.tri_indices[3 * size_t(s)];
+    for (int j = 0; j < 3; ++j)
+      if (tri[j] == c1 || tri[j] == c2) tri[j] = p;
+  }
+  unfile(c1);
+  unfile(c2);
+  stop_waiting(c1);
+  stop_waiting(c2);
+  f_.state[c1] = f_.state[c2] = VertexFront::kBelow;
+  f_.state[p] = VertexFront::kActive;
+  // Active list: p takes c1's slot, c2's slot is filled by the last entry.
+  const uint32_t s1 = f_.active_pos[c1];
+  f_.active[s1] = p;
+  f_.active_pos[p] = s1;
+  const uint32_t s2 = f_.active_pos[c2], last = f_.active[--f_.active_count];
+  f_.active[s2] = last;
+  f_.active_pos[last] = s2;
+  emit(p, FrontEventKind::collapse);
+  ++stats_.collapses;
+  ++ops_;
+  wake(p);
+}
+
+void Updater::begin_pending(uint32_t p) {
+  const uint32_t i = p - t_.leaf_count;
+  f_.pending_until[i] = p_.time + p_.collapse_delay;
+  f_.pending_pos[i] = f_.pending_count;
+  f_.pending[f_.pending_count++] = p;
+  emit(p, FrontEventKind::collapse_begin);
+}
+
+void Updater::end_pending(uint32_t p) {
+  const uint32_t i = p - t_.leaf_count;
+  f_.pending_until[i] = -1;
+  const uint32_t at = f_.pending_pos[i], last = f_.pending[--f_.pending_count];
+  f_.pending[at] = last;
+  f_.pending_pos[last - t_.leaf_count] = at;
+  emit(p, FrontEventKind::collapse_cancel);
+}
+
+// Splits v after splitting whatever its dependencies need (R4's forced splits), depth first
+// on an explicit stack. Forced splits only go to nodes made later in the build, so it ends.
+bool Updater::force_split(uint32_t v) {
+  uint32_t depth = 0;
+  f_.stack[depth++] = v;
+  while (depth > 0) {
+    const uint32_t x = f_.stack[depth - 1];
+    if (f_.state[x] != VertexFront::kActive) {  // split on the way by an earlier entry
+      --depth;
+      continue;
+    }
+    const uint32_t i = x - t_.leaf_count;
+    uint32_t missing = kNoNode;
+    for (uint32_t k = t_.dep_offsets[i]; k < t_.dep_offsets[i + 1]; ++k)
+      if (f_.state[t_.deps[k]] != VertexFront::kActive) {
+        missing = t_.deps[k];
+        break;
+      }
+    if (missing == kNoNode) {
+      if ((p_.max_triangles && f_.tri_count + new_faces(x) > p_.max_triangles) ||
+          (p_.max_operations && ops_ >= p_.max_operations)) {
+        ++stats_.blocked;
+        return false;
+      }
+      split(x);
+      // New nodes are judged this frame; x itself may have been queued already (harmless).
+      push(t_.children[2 * i]);
+      push(t_.children[2 * i + 1]);
+      --depth;
+      continue;
+    }
+    // A dependency above the front cannot happen while x is active (see vertex_tree.h).
+    assert(f_.state[missing] == VertexFront::kBelow);
+    if (f_.state[missing] != VertexFront::kBelow) return false;
+    uint32_t a = t_.parent[missing];
+    while (f_.state[a] != VertexFront::kActive) a = t_.parent[a];
+    f_.stack[depth++] = a;
+  }
+  return f_.state[v] == VertexFront::kSplit;
+}
+
+// One node's decision. Phase one collapses its parent (now, or deferred for geomorphing) and
+// returns true when the node wants to split instead; phase two splits. Otherwise the node is
+// filed again by its slack.
+bool Updater::consider(uint32_t v, bool phase_two) {
+  if (f_.state[v] != VertexFront::kActive) return false;
+  unfile(v);
+  ++stats_.visited;
+  double slack = kInf;
+  if (!t_.is_leaf(v)) {
+    const Decision d = evaluate(t_, v, view_, f_.threshold, reach_);
+    if (d.refine) {
+      if (!phase_two) return true;
+      if (force_split(v)) return false;
+      if (f_.state[v] == VertexFront::kActive) file(v, 0);  // blocked: try again next frame
+      return false;
+    }
+    slack = d.slack;
+  }
+  const uint32_t p = t_.parent[v];
+  if (p != kNoNode && children_active(p)) {
+    const Decision dp = evaluate(t_, p, view_, f_.threshold, reach_);
+    const uint32_t i = p - t_.leaf_count;
+    const bool pending = f_.pending_until[i] >= 0;
+    if (!dp.refine) {
+      if (phase_two || (p_.max_operations && ops_ >= p_.max_operations)) {
+        file(v, 0);
+        return false;
+      }
+      const uint32_t d = missing_dep(p);
+      if (d != kNoNode) {
+        // A finer neighbour blocks it: wait until that neighbour is active again, and meanwhile
+        // keep watching v's own decision.
+        if (f_.state[d] == VertexFront::kSplit) wait_for(v, d);
+        file(v, f_.state[d] == VertexFront::kSplit ? slack : 0.0);
+        return false;
+      }
+      if (p_.collapse_delay > 0) {
+        if (!pending) begin_pending(p);
+        file(v, kInf);  // the pending list finishes it
+        return false;
+      }
+      collapse(p);
+      push(p);
+      return false;
+    }
+    if (pending) end_pending(p);
+    slack = std::min(slack, dp.slack);
+  }
+  file(v, slack);
+  return false;
+}
+
+FrontStats Updater::run(const FrontView& view) {
+  view_ = view;
+  stats_ = {};
+  f_.event_count = 0;
+  const double ex = view.eye[0] - f_.center[0], ey = view.eye[1] - f_.center[1], ez = view.eye[2] - f_.center[2];
+  reach_ = std::sqrt(ex * ex + ey * ey + ez * ez) + f_.extent;
+
+  // How far may any decision have moved since the last frame (see evaluate's slacks)?
+  double moved = f_.pending_motion;
+  bool full = !f_.has_view;
+  if (!full) {
+    const FrontView& o = f_.last_view;
+    const double dx = view.eye[0] - o.eye[0], dy = view.eye[1] - o.eye[1], dz = view.eye[2] - o.eye[2];
+    moved += std::sqrt(dx * dx + dy * dy + dz * dz);
+    double plane_move = 0;
+    for (int k = 0; k < 6; ++k) {
+      const double nx = view.planes[k][0] - o.planes[k][0], ny = view.planes[k][1] - o.planes[k][1],
+                   nz = view.planes[k][2] - o.planes[k][2];
+      const double at_eye = nx * view.eye[0] + ny * view.eye[1] + nz * view.eye[2] + (view.planes[k][3] - o.planes[k][3]);
+      plane_move = std::max(plane_move, std::sqrt(nx * nx + ny * ny + nz * nz) * reach_ + std::abs(at_eye));
+    }
+    moved = std::max(moved, plane_move + f_.pending_motion);
+    if (view.focal_pixels != o.focal_pixels) {
+      const double k = double(o.focal_pixels) / view.focal_pixels;
+      moved += 2 * reach_ * (std::max(k, 1 / k) - 1);
+    }
+  }
+  f_.pending_motion = 0;
+  f_.has_view = true;
+  f_.last_view = view;
+  f_.motion += moved;
+  head_ = tail_ = 0;
+  ops_ = 0;
+  const uint32_t phase_one_end = static_cast<uint32_t>(f_.queue.size() / 2);
+  limit_ = phase_one_end;
+
+  // Expired buckets, or all of them.
+  const int64_t last = static_cast<int64_t>(std::floor(f_.motion / f_.bucket_width));
+  if (full || last - f_.cursor + 1 >= int64_t(kBuckets)) {
+    full = true;
+    for (uint32_t b = 0; b < kBuckets; ++b)
+      for (uint32_t v = f_.bucket_head[b]; v != kNoNode; v = f_.next[v]) push(v);
+  } else {
+    for (int64_t ab = f_.cursor; ab <= last; ++ab)
+      for (uint32_t v = f_.bucket_head[ab % kBuckets]; v != kNoNode; v = f_.next[v]) push(v);
+  }
+  for (uint32_t v = f_.bucket_head[kBuckets]; v != kNoNode; v = f_.next[v]) push(v);
+  f_.cursor = std::max(f_.cursor, last + 1);
+  for (uint32_t k = 0; k < tail_; ++k) unfile(f_.queue[k]);
+  stats_.full_pass = full;
+
+  // Deferred collapses whose time has come: collapse if still legal and wanted.
+  for (uint32_t k = f_.pending_count; k-- > 0;) {
+    const uint32_t p = f_.pending[k];
+    if (f_.pending_until[p - t_.leaf_count] > p_.time) continue;
+    if (children_active(p) && deps_active(p) && !evaluate(t_, p, view_, f_.threshold, reach_).refine &&
+        !(p_.max_operations && ops_ >= p_.max_operations)) {
+      collapse(p);
+      push(p);
+    } else {
+      end_pending(p);
+      const uint32_t i = p - t_.leaf_count;
+      for (int j = 0; j < 2; ++j) {
+        const uint32_t c = t_.children[2 * i + j];
+        if (f_.state[c] == VertexFront::kActive) {
+          unfile(c);
+          push(c);
+        }
+      }
+    }
+  }
+
+  // Phase one: collapses (they free budget for phase two's splits); wanted splits move on.
+  uint32_t split_tail = phase_one_end;
+  while (head_ < tail_) {
+    const uint32_t v = f_.queue[head_++];
+    if (consider(v, false)) f_.queue[split_tail++] = v;
+  }
+  // Phase two: splits, breadth first so the budget spreads evenly over the view.
+  head_ = phase_one_end;
+  tail_ = split_tail;
+  limit_ = static_cast<uint32_t>(f_.queue.size());
+  phase_two_ = true;
+  while (head_ < tail_) consider(f_.queue[head_++], true);
+
+  // Threshold feedback: triangles grow about as 1 / threshold^2.
+  if (p_.target_triangles > 0) {
+    const double ratio = double(f_.tri_count) / p_.target_triangles;
+    double k = 1;
+    if (ratio > 1.0) k = std::min(1.5, std::sqrt(ratio));
+    else if (ratio < 0.85) k = std::max(0.8, std::sqrt(std::max(ratio, 1e-6)) / std::sqrt(0.92));
+    const float next = std::clamp(static_cast<float>(f_.threshold * k), p_.min_threshold, p_.max_threshold);
+    if (next != f_.threshold) {
+      const double kk = double(next) / f_.threshold;
+      f_.pending_motion += 2 * reach_ * (std::max(kk, 1 / kk) - 1);
+      f_.threshold = next;
+    }
+  }
+  stats_.active_tris = f_.tri_count;
+  stats_.active_vertices = f_.active_count;
+  return stats_;
+}
+
+}  // namespace
+
+FrontView front_view_of(const View& view, const float position[3], float scale, float yaw) {
+  FrontView out;
+  const float c = std::cos(yaw), s = std::sin(yaw);
+  const float inv = scale != 0 ? 1.f / scale : 1.f;
+  // Object = R_y(-yaw) (world - position) / scale; R_y(t) maps (x, z) to (c x + s z, -s x + c z).
+  auto to_object_dir = [&](float x, float y, float z, float* o) {
+    o[0] = c * x - s * z;
+    o[1] = y;
+    o[2] = s * x + c * z;
+  };
+  to_object_dir(view.eye.x - position[0], view.eye.y - position[1], view.eye.z - position[2], out.eye);
+  for (float& e : out.eye) e *= inv;
+  const Frustum fr = frustum_of(view);
+  for (int k = 0; k < 6; ++k) {
+    const glm::vec4& p = fr.planes[k];
+    to_object_dir(p.x, p.y, p.z, out.planes[k]);
+    out.planes[k][3] = (p.x * position[0] + p.y * position[1] + p.z * position[2] + p.w) * inv;
+  }
+  out.focal_pixels = focal_pixels(view) * inv;
+  return out;
+}
+
+void front_init(VertexFront& f, const VertexTree& t, float threshold) {
+  const uint32_t n = t.node_count();
+  const uint32_t inner = t.interior_count();
+  f.state.assign(n, VertexFront::kBelow);
+  f.active.assign(n, 0);
+  f.active_pos.assign(n, kNoNode);
+  f.tri_indices.assign(3 * size_t(t.face_count), 0);
+  f.tri_face.assign(t.face_count, kNoNode);
+  f.face_slot.assign(t.face_count, kNoNode);
+  f.active_count = f.tri_count = 0;
+  f.threshold = threshold;
+  f.next.assign(n, kNoNode);
+  f.prev.assign(n, kNoNode);
+  f.bucket_of.assign(n, kNoNode);
+  f.bucket_head.assign(kBuckets + 1, kNoNode);  // the last one: retry next frame
+  f.motion = 0;
+  f.cursor = 0;
+  f.pending_motion = 0;
+  f.has_view = false;
+  f.wait_on.assign(n, kNoNode);
+  f.wait_next.assign(n, kNoNode);
+  f.wait_prev.assign(n, kNoNode);
+  f.wait_head.assign(n, kNoNode);
+  f.pending_until.assign(inner, -1.0);
+  f.pending.assign(inner, 0);
+  f.pending_pos.assign(inner, 0);
+  f.pending_count = 0;
+  f.queue.assign(8 * size_t(n) + 8, 0);  // phase one, then phase two from the middle
+  f.stack.assign(n + 1, 0);
+  f.events.assign(3 * size_t(inner) + 16, FrontEvent{});
+  f.event_count = 0;
+
+  // Bounds of every node position, for the reach of view changes.
+  float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (uint32_t v = 0; v < n; ++v)
+    for (int k = 0; k < 3; ++k) {
+      const float x = t.positions[3 * size_t(v) + k];
+      lo[k] = v == 0 ? x : std::min(lo[k], x);
+      hi[k] = v == 0 ? x : std::max(hi[k], x);
+    }
+  double extent = 0;
+  for (int k = 0; k < 3; ++k) f.center[k] = 0.5f * (lo[k] + hi[k]);
+  for (uint32_t v = 0; v < n; ++v) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = t.positions[3 * size_t(v) + k] - f.center[k];
+      d2 += d * d;
+    }
+    extent = std::max(extent, std::sqrt(d2) + t.radius[v]);
+  }
+  f.extent = static_cast<float>(extent);
+  f.bucket_width = std::max(extent, 1e-6) * 1e-3;
+
+  // Base mesh: the roots and the faces nobody's split makes, corners mapped to their roots.
+  for (uint32_t v = 0; v < n; ++v)
+    if (t.parent[v] == kNoNode) {
+      f.state[v] = VertexFront::kActive;
+      f.active_pos[v] = f.active_count;
+      f.active[f.active_count++] = v;
+    }
+  for (uint32_t face = 0; face < t.face_count; ++face) {
+    if (t.face_owner[face] != kNoNode) continue;
+    const uint32_t s = f.tri_count++;
+    f.face_slot[face] = s;
+    f.tri_face[s] = face;
+    for (int j = 0; j < 3; ++j) {
+      uint32_t v = t.face_leaves[3 * size_t(face) + j];
+      while (t.parent[v] != kNoNode) v = t.parent[v];
+      f.tri_indices[3 * size_t(s) + j] = v;
+    }
+  }
+  // Every node of the front is judged on the first update.
+  for (uint32_t k = 0; k < f.active_count; ++k) {
+    const uint32_t v = f.active[k];
+    f.next[v] = f.bucket_head[0];
+    if (f.next[v] != kNoNode) f.prev[f.next[v]] = v;
+    f.bucket_head[0] = v;
+    f.bucket_of[v] = 0;
+  }
+}
+
+FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontView& view, const FrontParams& params) {
+  FrontStats s = Updater(front, tree, params).run(view);
+  s.threshold = front.threshold;
+  return s;
+}
+
+void front_refine_all(VertexFront& f, const VertexTree& t) {
+  FrontParams p;
+  Updater u(f, t, p);
+  // Later nodes first: every dependency of a node was made before it, and its parent after
+  // it, so when a node's turn comes its dependencies are active.
+  for (uint32_t v = t.node_count(); v-- > t.leaf_count;)
+    if (f.state[v] == VertexFront::kActive) u.split(v);
+  for (uint32_t k = 0; k < f.active_count; ++k) {
+    u.unfile(f.active[k]);
+    u.file(f.active[k], 0);
+  }
+  f.event_count = 0;
+}
+
+void front_coarsen_all(VertexFront& f, const VertexTree& t) {
+  FrontParams p;
+  Updater u(f, t, p);
+  for (uint32_t v = t.leaf_count; v < t.node_count(); ++v) {
+    const uint32_t i = v - t.leaf_count;
+    if (f.state[v] == VertexFront::kSplit && f.state[t.children[2 * i]] == VertexFront::kActive &&
+        f.state[t.children[2 * i + 1]] == VertexFront::kActive)
+      u.collapse(v);
+  }
+  for (uint32_t k = 0; k < f.active_count; ++k) {
+    u.unfile(f.active[k]);
+    u.file(f.active[k], 0);
+  }
+  f.event_count = 0;
+}
+
+bool check_front(const VertexFront& f, const VertexTree& t, bool closed, std::string* message) {
+  auto fail = [&](std::string text) {
+    if (message) *message = std::move(text);
+    return false;
+  };
+  const uint32_t n = t.node_count();
+  // Active list and states agree.
+  uint32_t active_states = 0;
+  for (uint32_t v = 0; v < n; ++v) active_states += f.state[v] == VertexFront::kActive;
+  if (active_states != f.active_count)
+    return fail(std::to_string(active_states) + " nodes are active but the list holds " + std::to_string(f.active_count));
+  for (uint32_t k = 0; k < f.active_count; ++k) {
+    const uint32_t v = f.active[k];
+    if (v >= n || f.state[v] != VertexFront::kActive || f.active_pos[v] != k)
+      return fail("active list entry " + std::to_string(k) + " (node " + std::to_string(v) + ") is not active there");
+  }
+  // Every leaf has exactly one active ancestor-or-self: a proper front.
+  for (uint32_t l = 0; l < t.leaf_count; ++l) {
+    uint32_t count = 0;
+    for (uint32_t v = l; v != kNoNode; v = t.parent[v]) count += f.state[v] == VertexFront::kActive;
+    if (count != 1) return fail("leaf " + std::to_string(l) + " has " + std::to_string(count) + " active ancestors");
+  }
+  std::vector<uint64_t> directed;
+  directed.reserve(3 * size_t(f.tri_count));
+  for (uint32_t s = 0; s < f.tri_count; ++s) {
+    const uint32_t face = f.tri_face[s];
+    const std::string at = "triangle " + std::to_string(s) + " (face " + std::to_string(face) + ")";
+    if (face >= t.face_count || f.face_slot[face] != s) return fail(at + " is not the face's slot");
+    const uint32_t* tri = &f.tri_indices[3 * size_t(s)];
+    for (int j = 0; j < 3; ++j) {
+      if (tri[j] >= n) return fail(at + " references vertex " + std::to_string(tri[j]) + " of " + std::to_string(n));
+      if (f.state[tri[j]] != VertexFront::kActive)
+        return fail(at + " references inactive vertex " + std::to_string(tri[j]));
+      uint32_t v = t.face_leaves[3 * size_t(face) + j];
+      while (f.state[v] != VertexFront::kActive) v = t.parent[v];
+      if (v != tri[j]) return fail(at + " corner " + std::to_string(j) + " is " + std::to_string(tri[j]) +
+                                   " but its leaf's active ancestor is " + std::to_string(v));
+    }
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) return fail(at + " is degenerate");
+    for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(tri[j]) << 32 | tri[(j + 1) % 3]);
+  }
+  uint32_t face_slots = 0;
+  for (uint32_t face = 0; face < t.face_count; ++face) face_slots += f.face_slot[face] != kNoNode;
+  if (face_slots != f.tri_count) return fail(std::to_string(face_slots) + " faces have slots but " +
+                                             std::to_string(f.tri_count) + " triangles are active");
+  // A face is active exactly when its corners are distinct (no face missing).
+  for (uint32_t face = 0; face < t.face_count; ++face) {
+    if (f.face_slot[face] != kNoNode) continue;
+    uint32_t c[3];
+    for (int j = 0; j < 3; ++j) {
+      uint32_t v = t.face_leaves[3 * size_t(face) + j];
+      while (f.state[v] != VertexFront::kActive) v = t.parent[v];
+      c[j] = v;
+    }
+    if (c[0] != c[1] && c[1] != c[2] && c[0] != c[2])
+      return fail("face " + std::to_string(face) + " has three distinct active corners but is not drawn");
+  }
+  std::sort(directed.begin(), directed.end());
+  for (size_t k = 1; k < directed.size(); ++k)
+    if (directed[k] == directed[k - 1])
+      return fail("edge " + std::to_string(directed[k] >> 32) + "->" + std::to_string(directed[k] & 0xffffffffu) +
+                  " is used twice in one direction (orientation flip or non-manifold edge)");
+  if (closed) {
+    for (uint64_t e : directed) {
+      const uint64_t rev = (e << 32) | (e >> 32);
+      if (!std::binary_search(directed.begin(), directed.end(), rev))
+        return fail("edge " + std::to_string(e >> 32) + "-" + std::to_string(e & 0xffffffffu) +
+                    " has one face on a closed mesh (crack or T-junction)");
+    }
+  }
+  return true;
+}
+
+}  // namespace lod

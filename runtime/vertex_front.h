@@ -1,0 +1,133 @@
+// VertexFront: the active front of a VertexTree for one view-dependent object, and its
+// per-frame refine/coarsen update.
+//
+// Hoppe 1997 ("View-dependent refinement of progressive meshes") for the refinement criteria
+// (frustum, normal cone, screen-space error) and forced splits; R4 (Berkey & Song) and
+// El-Sana & Varshney 1999 for the dependencies that keep every front a valid mesh (a node
+// splits, and a pair merges, only when the neighbours it had at build time are active);
+// R2 (Luebke) for temporal coherence and coherent arrays: active vertices and triangles live
+// in dense arrays kept packed by swaps, so a consumer draws triangles [0, tri_count).
+//
+// Only changed nodes are visited: each active node is filed in a calendar of "camera motion"
+// buckets by how far the view may move before its decision could change (its slack, from
+// frustum plane distances, normal-cone angle and distance to the error's critical distance);
+// a frame visits only the buckets the accumulated motion has passed, plus nodes just made by
+// splits and collapses. A teleport passes every bucket and so re-evaluates the whole front.
+//
+// Everything is allocated by front_init; front_update allocates nothing and owns no threads.
+// Fronts of different objects (or of one tree by different views) are independent.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "runtime/vertex_tree.h"
+#include "runtime/view.h"
+
+namespace lod {
+
+// The camera as seen from the object (object space: transform undone, distances in object units).
+struct FrontView {
+  float eye[3] = {0, 0, 0};
+  float planes[6][4] = {};   // normalized, inside when dot(n, p) + w >= 0
+  float focal_pixels = 1;    // pixels per object unit at distance 1
+};
+
+// `view` seen from an object placed as ObjectSet does: world = R_y(yaw) * (scale * p) + position.
+FrontView front_view_of(const View& view, const float position[3], float scale, float yaw);
+
+enum class FrontEventKind : uint8_t { split, collapse, collapse_begin, collapse_cancel };
+
+struct FrontEvent {
+  uint32_t node;  // the parent: split into / collapsed from its two children
+  FrontEventKind kind;
+};
+
+struct FrontParams {
+  double time = 0;                // seconds, increasing; used by deferred collapses
+  float collapse_delay = 0;       // > 0: collapses wait this long (children morph onto the parent)
+  uint32_t max_triangles = 0;     // hard cap on active triangles; 0 = none
+  uint32_t target_triangles = 0;  // feedback: the pixel threshold moves to meet this; 0 = fixed
+  float min_threshold = 0.05f;    // pixels
+  float max_threshold = 1.0e5f;
+  uint32_t max_operations = 0;    // splits + collapses per frame; 0 = unlimited
+};
+
+struct FrontStats {
+  uint32_t splits = 0;
+  uint32_t collapses = 0;
+  uint32_t visited = 0;         // nodes evaluated this frame
+  uint32_t blocked = 0;         // splits refused by max_triangles or max_operations
+  uint32_t active_tris = 0;
+  uint32_t active_vertices = 0;
+  float threshold = 0;          // pixel threshold used this frame
+  bool full_pass = false;       // every active node was evaluated (teleport / first frame)
+};
+
+struct VertexFront {
+  static constexpr uint8_t kBelow = 0, kActive = 1, kSplit = 2;
+
+  std::vector<uint8_t> state;        // per node
+  std::vector<uint32_t> active;      // active node ids, [0, active_count)
+  std::vector<uint32_t> active_pos;  // per node: index in `active`
+  std::vector<uint32_t> tri_indices; // 3 node ids per active triangle, [0, 3 * tri_count)
+  std::vector<uint32_t> tri_face;    // face id per triangle slot
+  std::vector<uint32_t> face_slot;   // per face: triangle slot or kNoNode
+  uint32_t active_count = 0;
+  uint32_t tri_count = 0;
+  float threshold = 1;               // pixel threshold (tau), moved by feedback
+
+  // Calendar of camera-motion buckets (intrusive doubly linked lists over node ids).
+  std::vector<uint32_t> next, prev, bucket_of;  // per node; bucket_of = kNoNode when unfiled
+  std::vector<uint32_t> bucket_head;
+  double motion = 0;          // accumulated bound on view change, object units
+  int64_t cursor = 0;         // first bucket not yet visited
+  double bucket_width = 1;
+  double pending_motion = 0;  // from last frame's threshold change
+  float center[3] = {0, 0, 0};
+  float extent = 0;           // radius of the sphere at `center` holding every node
+  bool has_view = false;
+  FrontView last_view;
+
+  // Collapses blocked by a finer neighbour wait on it (intrusive lists keyed by the neighbour)
+  // and are woken when it becomes active, so they are not polled every frame.
+  std::vector<uint32_t> wait_on, wait_next, wait_prev, wait_head;  // per node
+
+  // Deferred collapses (geomorphing): per interior node the time it may collapse.
+  std::vector<double> pending_until;  // < 0: not pending
+  std::vector<uint32_t> pending, pending_pos;
+  uint32_t pending_count = 0;
+
+  // Scratch, sized once.
+  std::vector<uint32_t> queue, stack;
+  std::vector<FrontEvent> events;
+  uint32_t event_count = 0;
+
+  std::span<const uint32_t> triangles() const { return {tri_indices.data(), 3 * size_t(tri_count)}; }
+  std::span<const uint32_t> vertices() const { return {active.data(), active_count}; }
+  std::span<const FrontEvent> frame_events() const { return {events.data(), event_count}; }
+};
+
+// Sizes everything for `tree` and sets the front to the base mesh (the roots).
+void front_init(VertexFront& front, const VertexTree& tree, float threshold);
+
+// One frame: visits expired and new nodes, collapses where no refinement is wanted for the
+// parent, then splits (forcing missing dependencies first) where a node is in the frustum,
+// not back-facing and its projected error exceeds the threshold, within max_triangles and
+// max_operations; finally moves the threshold towards target_triangles. The front is a valid
+// mesh after every call. Events of this frame are in front.frame_events().
+FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontView& view, const FrontParams& params);
+
+// Splits everything (the input mesh) / collapses everything (the base mesh); no limits.
+void front_refine_all(VertexFront& front, const VertexTree& tree);
+void front_coarsen_all(VertexFront& front, const VertexTree& tree);
+
+// Checks the active triangles: corners are active nodes and the active ancestors of each
+// face's leaves, no repeated corner, each directed edge used once (consistent orientation,
+// no edge in more than two faces), with `closed` every edge in exactly two faces (no cracks,
+// no T-junctions), and the packed arrays agree with each other. Allocates (a test and
+// `lod run --validate` tool, not a per-frame stage). `message` names the first bad element.
+bool check_front(const VertexFront& front, const VertexTree& tree, bool closed, std::string* message);
+
+}  // namespace lod

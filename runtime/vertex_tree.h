@@ -1,0 +1,70 @@
+// VertexTree: a vertex hierarchy (R4's merge forest, Hoppe 1997's vertex hierarchy) for
+// view-dependent LOD, as flat arrays shared by every instance of a model.
+//
+// Nodes 0..leaf_count-1 are the input vertices (leaves); node leaf_count + k is the parent made
+// by the k-th edge collapse of the build, so a parent always has a larger id than its children
+// and the collapse order is the id order. Roots (parent == kNoNode) are the base mesh's vertices.
+// Faces are the input triangles; a face is created by the split of its `owner` node (or is a
+// base face) and its corners at any front are the active ancestors of its three leaf corners.
+//
+// Per interior node (index i = node - leaf_count): two children, the one or two faces its split
+// creates with their wing vertices (R4's tv1/tv2), the dependency set (its neighbours when it
+// was made by the collapse; R4, El-Sana & Varshney 1999) and the faces incident to it right
+// after the collapse (a superset of its faces at any front on which it is active). Per node:
+// position, a bounding-sphere radius covering its children's, a normal cone and an error.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lod {
+
+inline constexpr uint32_t kNoNode = 0xffffffffu;
+
+struct VertexTree {
+  uint32_t leaf_count = 0;
+  uint32_t face_count = 0;
+
+  // Per node (leaf_count + interior count).
+  std::vector<float> positions;   // xyz; leaves are the input positions bit for bit
+  std::vector<uint32_t> parent;   // kNoNode for roots
+  std::vector<float> radius;      // sphere at the node's position bounding all leaves below
+  std::vector<float> cone_axis;   // xyz unit normal-cone axis (zero when unknown)
+  std::vector<float> cone_cos;    // cos of the cone half-angle; <= 0: never back-facing
+  std::vector<float> error;       // object-space error, never less than a child's
+  std::vector<uint32_t> leaf_lo;  // leaves below are leaf_order[leaf_lo, leaf_hi)
+  std::vector<uint32_t> leaf_hi;
+
+  // Per leaf: its rank in the depth-first leaf order.
+  std::vector<uint32_t> leaf_rank;
+
+  // Per face.
+  std::vector<uint32_t> face_leaves;  // 3 leaf ids per face, input orientation
+  std::vector<uint32_t> face_owner;   // node whose split creates it, kNoNode for base faces
+
+  // Per interior node i.
+  std::vector<uint32_t> children;     // 2 per interior node
+  std::vector<uint32_t> split_faces;  // 2 per interior node, kNoNode when on a border
+  std::vector<uint32_t> wings;        // 2 per interior node: third corner of each split face
+  std::vector<uint32_t> dep_offsets;  // interior count + 1
+  std::vector<uint32_t> deps;         // neighbours at collapse time (node ids)
+  std::vector<uint32_t> inc_offsets;  // interior count + 1
+  std::vector<uint32_t> inc_faces;    // faces incident right after the collapse
+
+  uint32_t node_count() const { return static_cast<uint32_t>(parent.size()); }
+  uint32_t interior_count() const { return node_count() - leaf_count; }
+  bool is_leaf(uint32_t node) const { return node < leaf_count; }
+  // True when `leaf` lies below (or is) `node`.
+  bool covers(uint32_t node, uint32_t leaf) const {
+    const uint32_t r = leaf_rank[leaf];
+    return r >= leaf_lo[node] && r < leaf_hi[node];
+  }
+  bool empty() const { return parent.empty(); }
+};
+
+// Checks sizes, id ranges, parent/child agreement, ids increasing towards the roots, leaf
+// intervals, split faces owned by their node and finite values. On failure `message` names
+// the element ("node 812 child 90211 of 35947"); callers prefix the file.
+bool validate_vertex_tree(const VertexTree& tree, std::string* message);
+
+}  // namespace lod
