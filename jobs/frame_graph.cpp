@@ -31,7 +31,7 @@ namespace lod {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
+using Node = tbb::flow::continue_node<tbb::flow::continue_msg, tbb::flow::lightweight>;
 
 // ThreadSanitizer cannot see the synchronisation inside libtbb (a library not built with
 // it), so it would report every hand-over between a spawning thread and a task. These mark
