@@ -227,14 +227,16 @@ void radix_sort(Work& w, size_t n) {
     w.keys[i] = bits;
     w.order[i] = uint32_t(i);
   }
-  uint32_t hist[3][2048] = {};
+  // The top 22 bits (sign is always 0) order costs to 2^-13 relative: plenty for greedy
+  // collapse order, and one scatter pass fewer.
+  uint32_t hist[2][2048] = {};
   for (size_t i = 0; i < n; ++i) {
-    const uint32_t k = w.keys[i];
+    const uint32_t k = w.keys[i] >> 9;
+    w.keys[i] = k;
     hist[0][k & 2047]++;
     hist[1][(k >> 11) & 2047]++;
-    hist[2][k >> 22]++;
   }
-  for (int pass = 0; pass < 3; ++pass) {
+  for (int pass = 0; pass < 2; ++pass) {
     uint32_t sum = 0;
     for (uint32_t& h : hist[pass]) {
       const uint32_t c = h;
@@ -265,42 +267,42 @@ bool normal_kept(const float* p0, const float* p1, const float* p2, const float*
   return d * d >= kMinNormalCos * kMinNormalCos * l0 * l1;
 }
 
-// Faces of v (other than those also holding `other`) keep their orientation when v moves to p.
-bool faces_kept(const Work& w, const QemMesh& mesh, uint32_t v, uint32_t other, const float* p) {
+// Whether collapsing a into b at p keeps the mesh as it was: the link condition (the common
+// neighbours of a and b are exactly the apexes of the faces on edge a-b), enough faces left
+// around the merged vertex, and no face around a or b flipped or folded. One walk over each
+// vertex's faces. Sets `removed` to the number of faces on the edge.
+bool collapse_allowed(Work& w, const QemMesh& mesh, uint32_t a, uint32_t b, const float* p, bool b_moves,
+                      size_t& removed) {
   const float* pos = mesh.positions.data();
-  for (uint32_t i = w.offset[v]; i < w.offset[v + 1]; ++i) {
-    const uint32_t n = w.remap[w.ring[2 * i]], q = w.remap[w.ring[2 * i + 1]];
-    if (n == q || n == other || q == other || n == v || q == v) continue;  // removed or collapsing
-    if (!normal_kept(pos + 3 * v, pos + 3 * size_t(n), pos + 3 * size_t(q), p)) return false;
-  }
-  return true;
-}
-
-// Link condition (common neighbours of a and b are exactly the apexes of the faces on edge
-// a-b) and enough faces left around the merged vertex. Sets `removed` to those faces' count.
-bool topology_kept(Work& w, uint32_t a, uint32_t b, uint8_t result_kind, size_t& removed) {
+  const float* pa = pos + 3 * size_t(a);
+  const float* pb = pos + 3 * size_t(b);
   w.mark_value += 2;
   const uint32_t na = w.mark_value, counted = w.mark_value + 1;
   size_t faces_a = 0, faces_b = 0, shared = 0, common = 0;
   for (uint32_t i = w.offset[a]; i < w.offset[a + 1]; ++i) {
     const uint32_t y = w.remap[w.ring[2 * i]], z = w.remap[w.ring[2 * i + 1]];
-    if (y == z || y == a || z == a) continue;
+    if (y == z || y == a || z == a) continue;  // collapsed earlier in this pass
     faces_a++;
     w.mark[y] = na;
     w.mark[z] = na;
+    if (y != b && z != b && !normal_kept(pa, pos + 3 * size_t(y), pos + 3 * size_t(z), p)) return false;
   }
   for (uint32_t i = w.offset[b]; i < w.offset[b + 1]; ++i) {
     const uint32_t y = w.remap[w.ring[2 * i]], z = w.remap[w.ring[2 * i + 1]];
     if (y == z || y == b || z == b) continue;
     faces_b++;
-    if (y == a || z == a) shared++;
+    if (y == a || z == a) {
+      shared++;
+    } else if (b_moves && !normal_kept(pb, pos + 3 * size_t(y), pos + 3 * size_t(z), p)) {
+      return false;
+    }
     if (y != a && w.mark[y] == na) w.mark[y] = counted, common++;
     if (z != a && w.mark[z] == na) w.mark[z] = counted, common++;
   }
   removed = shared;
   if (shared == 0 || common != shared) return false;
   const size_t left = faces_a + faces_b - 2 * shared;
-  return result_kind == kManifold ? left >= 3 : left >= 1;
+  return w.kind[b] == kManifold ? left >= 3 : left >= 1;
 }
 
 // Pass over the current mesh: returns the number of faces removed.
@@ -309,41 +311,42 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
   const size_t nv = mesh.positions.size() / 3;
   const size_t nt = mesh.indices.size() / 3;
   if (!lists_current) build_lists(w, mesh);
-  const uint32_t* idx = mesh.indices.data();
   float* pos = mesh.positions.data();
 
   // Every collapsible edge once, with its direction, position and cost.
+  // Walked per vertex (each face's edge a -> next), so a's quadric is read once.
   w.cands.clear();
-  for (size_t t = 0; t < nt; ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t a = idx[3 * t + k], b = idx[3 * t + (k + 1) % 3];
-      const uint8_t ka = w.kind[a], kb = w.kind[b];
-      const bool border = (ka == kBorder && w.next[a] == b) || (kb == kBorder && w.prev[b] == a) ||
-                          (ka == kLocked && kb == kLocked);
-      if (!border && a > b) continue;  // an interior edge is seen from both faces
+  for (uint32_t a = 0; a < nv; ++a) {
+    const uint8_t ka = w.kind[a];
+    const Quadric& qa = mesh.quadrics[a];
+    for (uint32_t i = w.offset[a]; i < w.offset[a + 1]; ++i) {
+      const uint32_t b = w.ring[2 * i];
+      const uint8_t kb = w.kind[b];
       if (ka == kLocked && kb == kLocked) continue;
+      const bool border = (ka == kBorder && w.next[a] == b) || (kb == kBorder && w.prev[b] == a);
+      if (!border && a > b) continue;  // an interior edge is seen from both faces
       Candidate c;
-      const Quadric q = quadric_sum(mesh.quadrics[a], mesh.quadrics[b]);
+      const Quadric q = quadric_sum(qa, mesh.quadrics[b]);
       if (ka == kManifold && kb == kManifold) {
         c.from = a, c.to = b;
-        place_optimal(q, pos + 3 * a, pos + 3 * b, c.p);
+        place_optimal(q, pos + 3 * size_t(a), pos + 3 * size_t(b), c.p);
       } else if (ka == kManifold || kb == kManifold) {
         c.from = ka == kManifold ? a : b;
         c.to = ka == kManifold ? b : a;
-        std::memcpy(c.p, pos + 3 * c.to, sizeof c.p);
-      } else if (!border || (ka == kLocked && kb == kLocked)) {
+        std::memcpy(c.p, pos + 3 * size_t(c.to), sizeof c.p);
+      } else if (!border) {
         continue;  // border vertices only slide along their border; locked ones never move
       } else if (ka == kBorder && kb == kBorder) {
         // Along a border the vertex stays on one end: a point inside the chord would pull
         // both ends off the outline.
-        const float ea = quadric_cost(q, pos + 3 * a), eb = quadric_cost(q, pos + 3 * b);
+        const float ea = quadric_cost(q, pos + 3 * size_t(a)), eb = quadric_cost(q, pos + 3 * size_t(b));
         c.from = ea < eb ? b : a;
         c.to = ea < eb ? a : b;
-        std::memcpy(c.p, pos + 3 * c.to, sizeof c.p);
+        std::memcpy(c.p, pos + 3 * size_t(c.to), sizeof c.p);
       } else {
         c.from = ka == kBorder ? a : b;
         c.to = ka == kBorder ? b : a;
-        std::memcpy(c.p, pos + 3 * c.to, sizeof c.p);
+        std::memcpy(c.p, pos + 3 * size_t(c.to), sizeof c.p);
       }
       c.cost = quadric_cost(q, c.p);
       w.cands.push_back(c);
@@ -380,11 +383,26 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
       const size_t m = std::min(kChunk, n - i);
       for (size_t j = 0; j < m; ++j) chunk[j] = w.cands[w.order[i + j]];
     }
-    if (i % kChunk + kAhead < kChunk && i + kAhead < n) {
-      const Candidate& f = chunk[i % kChunk + kAhead];
+    // Two-stage prefetch: the lists' offsets far ahead, then the lists themselves.
+    if (i % kChunk + 2 * kAhead < kChunk && i + 2 * kAhead < n) {
+      const Candidate& f = chunk[i % kChunk + 2 * kAhead];
       __builtin_prefetch(&w.offset[f.from]);
       __builtin_prefetch(&w.offset[f.to]);
       __builtin_prefetch(&w.pass_lock[f.from]);
+      __builtin_prefetch(&w.pass_lock[f.to]);
+    }
+    if (i % kChunk + kAhead < kChunk && i + kAhead < n) {
+      const Candidate& f = chunk[i % kChunk + kAhead];
+      if (!w.pass_lock[f.from] && !w.pass_lock[f.to]) {
+        const uint32_t* ra = &w.ring[2 * size_t(w.offset[f.from])];
+        const uint32_t* rb = &w.ring[2 * size_t(w.offset[f.to])];
+        __builtin_prefetch(ra);
+        __builtin_prefetch(ra + 16);
+        __builtin_prefetch(rb);
+        __builtin_prefetch(rb + 16);
+        __builtin_prefetch(pos + 3 * size_t(f.from));
+        __builtin_prefetch(pos + 3 * size_t(f.to));
+      }
     }
     const Candidate& c = chunk[i % kChunk];
     if (c.cost > cost_limit) {
@@ -396,10 +414,8 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
     const uint32_t a = c.from, b = c.to;
     if (w.pass_lock[a] || w.pass_lock[b]) continue;
     size_t removed = 0;
-    if (!topology_kept(w, a, b, w.kind[b], removed)) continue;
-    if (!faces_kept(w, mesh, a, b, c.p)) continue;
-    const bool b_moves = std::memcmp(c.p, pos + 3 * b, sizeof c.p) != 0;
-    if (b_moves && !faces_kept(w, mesh, b, a, c.p)) continue;
+    const bool b_moves = std::memcmp(c.p, pos + 3 * size_t(b), sizeof c.p) != 0;
+    if (!collapse_allowed(w, mesh, a, b, c.p, b_moves, removed)) continue;
 
     if (mesh.attribute_count) {
       // Attribute at the new position: interpolated along the edge by the projection.
@@ -559,13 +575,15 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
     out.indices.insert(out.indices.end(), {a, b, c});
   }
 
+  const size_t used_vertices = out.source_vertex.size();
+
   // Vertices sharing a position (attribute seams, unwelded input) are locked: moving one copy
   // alone would tear the surface open.
   {
     size_t cap = 16;
-    while (cap < 2 * vertex_count) cap *= 2;
+    while (cap < 2 * used_vertices) cap *= 2;
     std::vector<uint32_t> table(cap, ~0u);
-    for (size_t v = 0; v < vertex_count; ++v) {
+    for (size_t v = 0; v < used_vertices; ++v) {
       if (!finite[v]) continue;
       const float* p = &out.positions[3 * v];
       uint32_t h[3];
@@ -588,7 +606,7 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
   }
 
   // Area-weighted face planes, plus constraint planes through border edges.
-  out.quadrics.assign(vertex_count, Quadric{});
+  out.quadrics.assign(used_vertices, Quadric{});
   const size_t nt = out.indices.size() / 3;
   for (size_t t = 0; t < nt; ++t) {
     const float* p0 = &out.positions[3 * size_t(out.indices[3 * t])];
@@ -609,9 +627,9 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
   // distance. Against ordinary faces it is negligible.
   double mean_area = 0;
   size_t used = 0;
-  for (size_t v = 0; v < vertex_count; ++v) mean_area += out.quadrics[v].w, used += out.quadrics[v].w > 0;
+  for (size_t v = 0; v < used_vertices; ++v) mean_area += out.quadrics[v].w, used += out.quadrics[v].w > 0;
   mean_area /= std::max<size_t>(used, 1);
-  for (size_t v = 0; v < vertex_count; ++v) {
+  for (size_t v = 0; v < used_vertices; ++v) {
     Quadric& q = out.quadrics[v];
     if (!(q.w > 0)) continue;
     const double wv = kPointWeight * mean_area;
@@ -624,7 +642,7 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
     Work w;
     build_lists(w, out);
     classify(w, out, false);
-    for (size_t v = 0; v < vertex_count; ++v) {
+    for (size_t v = 0; v < used_vertices; ++v) {
       const uint32_t b = w.next[v];
       if (b == ~0u) continue;
       uint32_t c = ~0u;  // apex of the border edge's face
