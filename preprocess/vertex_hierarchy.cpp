@@ -10,6 +10,7 @@
 #include "preprocess/vertex_hierarchy.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -101,6 +102,8 @@ class Builder {
   bool try_collapse(uint32_t a, uint32_t b);
   void finish(VertexTree& out);
   void mark_split_fans();
+  void renumber_passes();
+  std::vector<uint32_t> pass_start_;  // first node id made by each pass
 
   HierarchyOptions opt_;
   uint32_t leaf_count_ = 0;
@@ -128,7 +131,8 @@ class Builder {
     double cost;
   };
   std::vector<Edge> edges_;
-  std::vector<uint64_t> keys_;
+  std::vector<uint64_t> keys_, key_scratch_;
+  std::vector<Edge> sorted_;
 
   // Interior node records, appended per collapse.
   std::vector<uint32_t> children_, split_faces_, wings_;
@@ -158,31 +162,53 @@ void Builder::build_adjacency() {
   if (stamp_.size() < n) stamp_.resize(n, 0), stamp_b_.resize(n, 0);
 }
 
-// Every edge once (sorted (min, max) keys); its multiplicity is its face count.
-void Builder::collect_edges() {
-  keys_.clear();
-  for (uint32_t f : alive_faces_)
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t u = face_[3 * f + k], v = face_[3 * f + (k + 1) % 3];
-      keys_.push_back(u < v ? (uint64_t(u) << 32 | v) : (uint64_t(v) << 32 | u));
+// LSD radix sort of 64-bit keys, 16 bits per pass; passes whose digit never varies are skipped.
+void radix_sort(std::vector<uint64_t>& keys, std::vector<uint64_t>& scratch) {
+  scratch.resize(keys.size());
+  std::vector<uint32_t> count(1 << 16);
+  for (int shift = 0; shift < 64; shift += 16) {
+    std::fill(count.begin(), count.end(), 0u);
+    for (uint64_t k : keys) ++count[(k >> shift) & 0xffff];
+    if (!keys.empty() && count[(keys[0] >> shift) & 0xffff] == keys.size()) continue;
+    uint32_t sum = 0;
+    for (uint32_t& c : count) {
+      const uint32_t n = c;
+      c = sum;
+      sum += n;
     }
-  std::sort(keys_.begin(), keys_.end());
+    for (uint64_t k : keys) scratch[count[(k >> shift) & 0xffff]++] = k;
+    keys.swap(scratch);
+  }
+}
+
+// Every edge once, from each vertex to its larger neighbours, with its face count.
+void Builder::collect_edges() {
   std::vector<uint8_t> border_edges(parent_.size(), 0);
   edges_.clear();
-  for (size_t i = 0; i < keys_.size();) {
-    size_t j = i + 1;
-    while (j < keys_.size() && keys_[j] == keys_[i]) ++j;
-    const uint32_t a = static_cast<uint32_t>(keys_[i] >> 32), b = static_cast<uint32_t>(keys_[i]);
-    const size_t count = j - i;
-    if (count == 1) {
-      border_[a] = border_[b] = 1;
-      border_edges[a] = static_cast<uint8_t>(std::min(border_edges[a] + 1, 255));
-      border_edges[b] = static_cast<uint8_t>(std::min(border_edges[b] + 1, 255));
-    } else if (count > 2) {
-      complex_[a] = complex_[b] = 1;
+  std::vector<std::pair<uint32_t, uint32_t>> around;  // (neighbour, faces on the edge)
+  for (uint32_t a = 0; a < parent_.size(); ++a) {
+    if (vf_off_[a] == vf_off_[a + 1]) continue;
+    around.clear();
+    for (uint32_t k = vf_off_[a]; k < vf_off_[a + 1]; ++k) {
+      const uint32_t* c = &face_[3 * vf_[k]];
+      for (int j = 0; j < 3; ++j) {
+        const uint32_t u = c[j];
+        if (u <= a) continue;
+        auto it = std::find_if(around.begin(), around.end(), [&](const auto& e) { return e.first == u; });
+        if (it == around.end()) around.push_back({u, 1});
+        else ++it->second;
+      }
     }
-    edges_.push_back({a, b, 0});
-    i = j;
+    for (const auto& [b, count] : around) {
+      if (count == 1) {
+        border_[a] = border_[b] = 1;
+        border_edges[a] = static_cast<uint8_t>(std::min(border_edges[a] + 1, 255));
+        border_edges[b] = static_cast<uint8_t>(std::min(border_edges[b] + 1, 255));
+      } else if (count > 2) {
+        complex_[a] = complex_[b] = 1;
+      }
+      edges_.push_back({a, b, 0});
+    }
   }
   // A manifold border vertex has exactly two border edges; more is a bow-tie.
   for (size_t v = 0; v < border_edges.size(); ++v)
@@ -210,10 +236,15 @@ void Builder::collect_edges() {
     edges_[kept++] = {e.a, e.b, cost};
   }
   edges_.resize(kept);
-  std::sort(edges_.begin(), edges_.end(), [](const Edge& x, const Edge& y) {
-    if (x.cost != y.cost) return x.cost < y.cost;
-    return x.a != y.a ? x.a < y.a : x.b < y.b;  // deterministic ties
-  });
+  // Cheapest first; costs are >= 0, so their float bits order like the values, and the edge
+  // index in the low bits breaks ties deterministically.
+  keys_.resize(kept);
+  for (size_t i = 0; i < kept; ++i)
+    keys_[i] = uint64_t(std::bit_cast<uint32_t>(static_cast<float>(edges_[i].cost))) << 32 | i;
+  radix_sort(keys_, key_scratch_);
+  sorted_.resize(kept);
+  for (size_t i = 0; i < kept; ++i) sorted_[i] = edges_[static_cast<uint32_t>(keys_[i])];
+  edges_.swap(sorted_);
 }
 
 bool Builder::try_collapse(uint32_t a, uint32_t b) {
@@ -367,6 +398,89 @@ bool Builder::try_collapse(uint32_t a, uint32_t b) {
   return true;
 }
 
+// Collapses of one pass are independent (their regions never overlap), so their nodes may be
+// numbered in any order without breaking "parents and dependencies come later". Numbering
+// each pass's nodes along a Morton curve puts neighbours in space next to each other in
+// memory, which is what the front's random walks over nodes and dependencies need.
+void Builder::renumber_passes() {
+  const uint32_t n = static_cast<uint32_t>(parent_.size());
+  if (n == leaf_count_) return;
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (uint32_t v = 0; v < n; ++v)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], pos_[3 * v + k]), hi[k] = std::max(hi[k], pos_[3 * v + k]);
+  auto spread = [](uint32_t x) {  // 10 bits -> every third bit
+    x &= 0x3ff;
+    x = (x | (x << 16)) & 0x030000ff;
+    x = (x | (x << 8)) & 0x0300f00f;
+    x = (x | (x << 4)) & 0x030c30c3;
+    x = (x | (x << 2)) & 0x09249249;
+    return x;
+  };
+  auto morton = [&](uint32_t v) {
+    uint32_t code = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double ext = hi[k] - lo[k];
+      const double u = ext > 0 ? (pos_[3 * v + k] - lo[k]) / ext : 0;
+      code |= spread(static_cast<uint32_t>(std::clamp(u, 0.0, 1.0) * 1023)) << k;
+    }
+    return code;
+  };
+  std::vector<uint32_t> old_of(n), new_of(n);
+  std::iota(old_of.begin(), old_of.end(), 0u);
+  std::vector<uint64_t> keys;
+  for (size_t pi = 0; pi + 1 < pass_start_.size(); ++pi) {
+    const uint32_t s = pass_start_[pi], e = pass_start_[pi + 1];
+    keys.clear();
+    for (uint32_t v = s; v < e; ++v) keys.push_back(uint64_t(morton(v)) << 32 | v);
+    std::sort(keys.begin(), keys.end());
+    for (uint32_t k = 0; k < e - s; ++k) old_of[s + k] = static_cast<uint32_t>(keys[k]);
+  }
+  for (uint32_t v = 0; v < n; ++v) new_of[old_of[v]] = v;
+  auto map = [&](uint32_t v) { return v == kNoNode ? kNoNode : new_of[v]; };
+
+  std::vector<double> pos(pos_.size());
+  std::vector<Cone> cone(n);
+  std::vector<float> radius(n), error(n);
+  std::vector<uint32_t> parent(n);
+  const uint32_t inner = n - leaf_count_;
+  std::vector<uint32_t> children(2 * size_t(inner)), split_faces(2 * size_t(inner)), wings(2 * size_t(inner));
+  std::vector<uint32_t> dep_off{0}, deps, inc_off{0}, inc;
+  deps.reserve(deps_.size());
+  inc.reserve(inc_.size());
+  for (uint32_t v = 0; v < n; ++v) {
+    const uint32_t o = old_of[v];
+    for (int k = 0; k < 3; ++k) pos[3 * v + k] = pos_[3 * o + k];
+    cone[v] = cone_[o];
+    radius[v] = radius_[o];
+    error[v] = error_[o];
+    parent[v] = map(parent_[o]);
+    if (v < leaf_count_) continue;
+    const uint32_t i = v - leaf_count_, oi = o - leaf_count_;
+    for (int k = 0; k < 2; ++k) {
+      children[2 * i + k] = map(children_[2 * oi + k]);
+      split_faces[2 * i + k] = split_faces_[2 * oi + k];
+      wings[2 * i + k] = map(wings_[2 * oi + k]);
+    }
+    for (uint32_t k = dep_off_[oi]; k < dep_off_[oi + 1]; ++k) deps.push_back(map(deps_[k]));
+    dep_off.push_back(static_cast<uint32_t>(deps.size()));
+    for (uint32_t k = inc_off_[oi]; k < inc_off_[oi + 1]; ++k) inc.push_back(inc_[k]);
+    inc_off.push_back(static_cast<uint32_t>(inc.size()));
+  }
+  for (uint32_t& owner : face_owner_) owner = map(owner);
+  pos_.swap(pos);
+  cone_.swap(cone);
+  radius_.swap(radius);
+  error_.swap(error);
+  parent_.swap(parent);
+  children_.swap(children);
+  split_faces_.swap(split_faces);
+  wings_.swap(wings);
+  dep_off_.swap(dep_off);
+  deps_.swap(deps);
+  inc_off_.swap(inc_off);
+  inc_.swap(inc);
+}
+
 // Input vertices whose faces do not form one fan (two cones touching at a vertex) are never
 // collapsed. Legal collapses never make new ones, so the input is checked once.
 void Builder::mark_split_fans() {
@@ -444,6 +558,7 @@ void Builder::finish(VertexTree& out) {
   out.deps = std::move(deps_);
   out.inc_offsets = std::move(inc_off_);
   out.inc_faces = std::move(inc_);
+  pack_vertex_bounds(out);
 }
 
 Status Builder::run(VertexTree& out, const MeshData& mesh) {
@@ -552,6 +667,7 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
   }
 
   for (;;) {
+    pass_start_.push_back(static_cast<uint32_t>(parent_.size()));
     size_t collapsed = 0;
     for (const Edge& e : edges_) {
       if (locked_[e.a] || locked_[e.b]) continue;
@@ -561,6 +677,8 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
     build_adjacency();
     collect_edges();
   }
+  pass_start_.push_back(static_cast<uint32_t>(parent_.size()));
+  renumber_passes();
   finish(out);
   return Status::success();
 }

@@ -22,8 +22,9 @@ struct Decision {
 
 // Hoppe 1997's criteria for one node, with how far the view may move before each could flip.
 Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float threshold, double reach) {
-  const float* c = &t.positions[3 * size_t(v)];
-  const double r = t.radius[v];
+  const VertexBounds& nb = t.bounds[v];
+  const float c[3] = {nb.x, nb.y, nb.z};
+  const double r = nb.radius;
   // Frustum: outside when some plane has the whole sphere behind it.
   double outside_by = -kInf, inside_by = kInf;
   for (const auto& pl : view.planes) {
@@ -39,9 +40,9 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
   // Normal cone: every normal in the cone points away from every point of the sphere.
   bool facing = true;
   double slack_facing = kInf;
-  const double cos_alpha = t.cone_cos[v];
+  const double cos_alpha = nb.cone_cos * (1.0 / 32767);
   if (cos_alpha > 0 && d > r) {
-    const float* n = &t.cone_axis[3 * size_t(v)];
+    const double n[3] = {nb.axis[0] * (1.0 / 32767), nb.axis[1] * (1.0 / 32767), nb.axis[2] * (1.0 / 32767)};
     const double cos_beta = (ax * n[0] + ay * n[1] + az * n[2]) / d;
     const double sin_alpha = std::sqrt(std::max(0.0, 1 - cos_alpha * cos_alpha));
     const double sin_gamma = r / d, cos_gamma = std::sqrt(std::max(0.0, 1 - sin_gamma * sin_gamma));
@@ -54,7 +55,7 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
   }
   // Screen-space error: e * focal / distance > threshold while distance < critical.
   const double dist = std::max(d - r, 1e-6);
-  const double critical = double(t.error[v]) * view.focal_pixels / threshold;
+  const double critical = double(nb.error) * view.focal_pixels / threshold;
   const bool coarse = dist < critical;
   const double slack_error = std::min(std::abs(dist - critical), reach);
 
@@ -123,29 +124,30 @@ class Updater {
   uint32_t head_ = 0, tail_ = 0;
   bool phase_two_ = false;
   uint32_t limit_ = 0;
+  float hysteresis_ = 1;
   uint32_t ops_ = 0;
   FrontStats stats_;
 };
 
 void Updater::unfile(uint32_t v) {
-  const uint32_t b = f_.bucket_of[v];
+  const uint32_t b = f_.links[v].bucket;
   if (b == kNoNode) return;
-  const uint32_t n = f_.next[v], pr = f_.prev[v];
-  if (pr != kNoNode) f_.next[pr] = n;
+  const uint32_t n = f_.links[v].next, pr = f_.links[v].prev;
+  if (pr != kNoNode) f_.links[pr].next = n;
   else f_.bucket_head[b] = n;
-  if (n != kNoNode) f_.prev[n] = pr;
-  f_.bucket_of[v] = kNoNode;
+  if (n != kNoNode) f_.links[n].prev = pr;
+  f_.links[v].bucket = kNoNode;
 }
 
 void Updater::file(uint32_t v, double slack) {
-  assert(f_.bucket_of[v] == kNoNode);
+  assert(f_.links[v].bucket == kNoNode);
   if (slack <= 0) {
     // Retry next frame whether or not the view moves (blocked by a limit or a neighbour).
-    f_.prev[v] = kNoNode;
-    f_.next[v] = f_.bucket_head[kBuckets];
-    if (f_.next[v] != kNoNode) f_.prev[f_.next[v]] = v;
+    f_.links[v].prev = kNoNode;
+    f_.links[v].next = f_.bucket_head[kBuckets];
+    if (f_.links[v].next != kNoNode) f_.links[f_.links[v].next].prev = v;
     f_.bucket_head[kBuckets] = v;
-    f_.bucket_of[v] = kBuckets;
+    f_.links[v].bucket = kBuckets;
     return;
   }
   // Never into a bucket this frame already visited; far deadlines wait in the last bucket.
@@ -153,11 +155,11 @@ void Updater::file(uint32_t v, double slack) {
   int64_t abs_bucket = at < double(f_.cursor + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : f_.cursor + kBuckets - 1;
   abs_bucket = std::max(abs_bucket, f_.cursor);
   const uint32_t b = static_cast<uint32_t>(abs_bucket % kBuckets);
-  f_.prev[v] = kNoNode;
-  f_.next[v] = f_.bucket_head[b];
-  if (f_.next[v] != kNoNode) f_.prev[f_.next[v]] = v;
+  f_.links[v].prev = kNoNode;
+  f_.links[v].next = f_.bucket_head[b];
+  if (f_.links[v].next != kNoNode) f_.links[f_.links[v].next].prev = v;
   f_.bucket_head[b] = v;
-  f_.bucket_of[v] = b;
+  f_.links[v].bucket = b;
 }
 
 void Updater::stop_waiting(uint32_t v) {
@@ -360,7 +362,7 @@ bool Updater::consider(uint32_t v, bool phase_two) {
   }
   const uint32_t p = t_.parent[v];
   if (p != kNoNode && children_active(p)) {
-    const Decision dp = evaluate(t_, p, view_, f_.threshold, reach_);
+    const Decision dp = evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_);
     const uint32_t i = p - t_.leaf_count;
     const bool pending = f_.pending_until[i] >= 0;
     if (!dp.refine) {
@@ -394,6 +396,7 @@ bool Updater::consider(uint32_t v, bool phase_two) {
 
 FrontStats Updater::run(const FrontView& view) {
   view_ = view;
+  hysteresis_ = std::max(1.f, p_.hysteresis);
   stats_ = {};
   f_.event_count = 0;
   const double ex = view.eye[0] - f_.center[0], ey = view.eye[1] - f_.center[1], ez = view.eye[2] - f_.center[2];
@@ -433,12 +436,12 @@ FrontStats Updater::run(const FrontView& view) {
   if (full || last - f_.cursor + 1 >= int64_t(kBuckets)) {
     full = true;
     for (uint32_t b = 0; b < kBuckets; ++b)
-      for (uint32_t v = f_.bucket_head[b]; v != kNoNode; v = f_.next[v]) push(v);
+      for (uint32_t v = f_.bucket_head[b]; v != kNoNode; v = f_.links[v].next) push(v);
   } else {
     for (int64_t ab = f_.cursor; ab <= last; ++ab)
-      for (uint32_t v = f_.bucket_head[ab % kBuckets]; v != kNoNode; v = f_.next[v]) push(v);
+      for (uint32_t v = f_.bucket_head[ab % kBuckets]; v != kNoNode; v = f_.links[v].next) push(v);
   }
-  for (uint32_t v = f_.bucket_head[kBuckets]; v != kNoNode; v = f_.next[v]) push(v);
+  for (uint32_t v = f_.bucket_head[kBuckets]; v != kNoNode; v = f_.links[v].next) push(v);
   f_.cursor = std::max(f_.cursor, last + 1);
   for (uint32_t k = 0; k < tail_; ++k) unfile(f_.queue[k]);
   stats_.full_pass = full;
@@ -447,7 +450,7 @@ FrontStats Updater::run(const FrontView& view) {
   for (uint32_t k = f_.pending_count; k-- > 0;) {
     const uint32_t p = f_.pending[k];
     if (f_.pending_until[p - t_.leaf_count] > p_.time) continue;
-    if (children_active(p) && deps_active(p) && !evaluate(t_, p, view_, f_.threshold, reach_).refine &&
+    if (children_active(p) && deps_active(p) && !evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_).refine &&
         !(p_.max_operations && ops_ >= p_.max_operations)) {
       collapse(p);
       push(p);
@@ -521,6 +524,7 @@ FrontView front_view_of(const View& view, const float position[3], float scale, 
 
 void front_init(VertexFront& f, const VertexTree& t, float threshold) {
   const uint32_t n = t.node_count();
+  assert(t.bounds.size() == n && "pack_vertex_bounds(tree) first");
   const uint32_t inner = t.interior_count();
   f.state.assign(n, VertexFront::kBelow);
   f.active.assign(n, 0);
@@ -530,9 +534,7 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
   f.face_slot.assign(t.face_count, kNoNode);
   f.active_count = f.tri_count = 0;
   f.threshold = threshold;
-  f.next.assign(n, kNoNode);
-  f.prev.assign(n, kNoNode);
-  f.bucket_of.assign(n, kNoNode);
+  f.links.assign(n, VertexFront::Link{});
   f.bucket_head.assign(kBuckets + 1, kNoNode);  // the last one: retry next frame
   f.motion = 0;
   f.cursor = 0;
@@ -593,10 +595,10 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
   // Every node of the front is judged on the first update.
   for (uint32_t k = 0; k < f.active_count; ++k) {
     const uint32_t v = f.active[k];
-    f.next[v] = f.bucket_head[0];
-    if (f.next[v] != kNoNode) f.prev[f.next[v]] = v;
+    f.links[v].next = f.bucket_head[0];
+    if (f.links[v].next != kNoNode) f.links[f.links[v].next].prev = v;
     f.bucket_head[0] = v;
-    f.bucket_of[v] = 0;
+    f.links[v].bucket = 0;
   }
 }
 

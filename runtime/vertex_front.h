@@ -52,6 +52,10 @@ struct FrontParams {
   float min_threshold = 0.05f;    // pixels
   float max_threshold = 1.0e5f;
   uint32_t max_operations = 0;    // splits + collapses per frame; 0 = unlimited
+  // Hysteresis: a node splits when its projected error exceeds the threshold, but its children
+  // merge back only when it falls below threshold / hysteresis, so decisions do not flicker
+  // and a moving camera re-judges far fewer nodes. 1 = none.
+  float hysteresis = 1.5f;
 };
 
 struct FrontStats {
@@ -79,7 +83,10 @@ struct VertexFront {
   float threshold = 1;               // pixel threshold (tau), moved by feedback
 
   // Calendar of camera-motion buckets (intrusive doubly linked lists over node ids).
-  std::vector<uint32_t> next, prev, bucket_of;  // per node; bucket_of = kNoNode when unfiled
+  struct Link {
+    uint32_t next = kNoNode, prev = kNoNode, bucket = kNoNode;  // bucket = kNoNode when unfiled
+  };
+  std::vector<Link> links;  // per node, one record so filing touches one cache line
   std::vector<uint32_t> bucket_head;
   double motion = 0;          // accumulated bound on view change, object units
   int64_t cursor = 0;         // first bucket not yet visited

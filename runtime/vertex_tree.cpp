@@ -2,6 +2,7 @@
 // (which only asserts) may walk the arrays.
 #include "runtime/vertex_tree.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -108,6 +109,25 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
     }
   }
   return true;
+}
+
+void pack_vertex_bounds(VertexTree& t) {
+  const uint32_t n = t.node_count();
+  t.bounds.resize(n);
+  for (uint32_t v = 0; v < n; ++v) {
+    VertexBounds& b = t.bounds[v];
+    b.x = t.positions[3 * size_t(v)];
+    b.y = t.positions[3 * size_t(v) + 1];
+    b.z = t.positions[3 * size_t(v) + 2];
+    b.radius = t.radius[v];
+    b.error = t.error[v];
+    for (int k = 0; k < 3; ++k)
+      b.axis[k] = static_cast<int16_t>(std::lround(std::clamp(t.cone_axis[3 * size_t(v) + k], -1.f, 1.f) * 32767));
+    // Rounded down, less a little for the axis rounding: the packed cone holds the real one.
+    const float c = std::clamp(t.cone_cos[v], -1.f, 1.f) - 2e-4f;
+    b.cone_cos = static_cast<int16_t>(std::floor(std::max(c, -1.f) * 32767));
+    b.parent = t.parent[v];
+  }
 }
 
 }  // namespace lod

@@ -1,0 +1,200 @@
+// View-dependent LOD benchmarks (issue 4) on a ~1M-triangle mesh: the Stanford bunny scan
+// subdivided twice (1-to-4 midpoint), or a generated 1M-triangle sphere when the scan is absent.
+//
+//   BM_HierarchyBuild      build time of the vertex hierarchy (quadric order)
+//   BM_FrontSmooth         one frame of front update, camera moving 0.5 % of the model's size
+//                          per frame, threshold feedback holding ~200k active triangles;
+//                          counters: median_ms, changes (splits + collapses) per frame, visited
+//   BM_FrontFullPass       baseline in the same binary: the same frames, every node re-judged
+//                          (no temporal coherence); ratio = smooth / full in BM_FrontSmooth
+//   BM_FrontTeleport       a jump across the model under a triangle cap: frames to settle,
+//                          most triangles seen vs the cap
+//   BM_SplitCollapse       raw splits + collapses per second on one core (refine all, coarsen all)
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "preprocess/mesh_clean.h"
+#include "preprocess/mesh_io.h"
+#include "preprocess/vertex_hierarchy.h"
+#include "runtime/vertex_front.h"
+#include "test_support.h"
+#include "vd_meshes.h"
+
+namespace {
+
+using namespace lod;
+
+struct Fixture {
+  MeshData mesh;
+  VertexTree tree;
+  double build_seconds = 0;
+  float center[3] = {0, 0, 0};
+  float size = 1;  // bounding-box diagonal
+};
+
+const MeshData& big_mesh() {
+  static MeshData mesh = [] {
+    MeshData m;
+    const auto scan = test::shared_meshes() / "stanford-bunny.obj";
+    if (!test::shared_meshes().empty() && std::filesystem::exists(scan) && load_mesh(scan, m).ok) {
+      clean_mesh(m);
+      m = test::vd_subdivide(test::vd_subdivide(m));
+    } else {
+      m = test::vd_sphere(708, 707);
+    }
+    std::fprintf(stderr, "vdlod bench mesh: %s, %zu triangles\n", m.source.c_str(), m.triangle_count());
+    return m;
+  }();
+  return mesh;
+}
+
+Fixture& fixture() {
+  static std::unique_ptr<Fixture> f = [] {
+    auto fx = std::make_unique<Fixture>();
+    fx->mesh = big_mesh();
+    const auto t0 = std::chrono::steady_clock::now();
+    const Status s = build_vertex_hierarchy(fx->tree, fx->mesh);
+    fx->build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!s) std::fprintf(stderr, "hierarchy build failed: %s\n", s.message.c_str());
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    for (size_t v = 0; v < fx->mesh.vertex_count(); ++v)
+      for (int k = 0; k < 3; ++k)
+        lo[k] = std::min(lo[k], fx->mesh.positions[3 * v + k]), hi[k] = std::max(hi[k], fx->mesh.positions[3 * v + k]);
+    for (int k = 0; k < 3; ++k) fx->center[k] = 0.5f * (lo[k] + hi[k]);
+    fx->size = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    return fx;
+  }();
+  return *f;
+}
+
+// Orbit at 0.6 model sizes from the centre; `step` frames along it.
+FrontView orbit_view(const Fixture& fx, double angle, float distance) {
+  View v;
+  v.eye = glm::vec3(fx.center[0] + distance * std::sin(angle), fx.center[1] + 0.2f * distance,
+                    fx.center[2] + distance * std::cos(angle));
+  v.target = glm::vec3(fx.center[0], fx.center[1], fx.center[2]);
+  v.width = 1920;
+  v.height = 1080;
+  v.near_plane = 0.001f * fx.size;
+  v.far_plane = 100 * fx.size;
+  const float origin[3] = {0, 0, 0};
+  return front_view_of(v, origin, 1, 0);
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+void BM_HierarchyBuild(benchmark::State& state) {
+  const MeshData& m = big_mesh();
+  for (auto _ : state) {
+    VertexTree t;
+    const auto t0 = std::chrono::steady_clock::now();
+    build_vertex_hierarchy(t, m);
+    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    benchmark::DoNotOptimize(t.parent.data());
+    state.counters["nodes"] = t.node_count();
+  }
+  state.counters["triangles"] = static_cast<double>(m.triangle_count());
+}
+BENCHMARK(BM_HierarchyBuild)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1);
+
+constexpr uint32_t kTarget = 200000;
+
+// Smooth orbit: an arc step of 0.5 % of the model's size per frame.
+void run_frames(benchmark::State& state, bool full_pass) {
+  Fixture& fx = fixture();
+  VertexFront front;
+  front_init(front, fx.tree, 1.f);
+  FrontParams p;
+  p.target_triangles = kTarget;
+  p.max_triangles = kTarget + kTarget / 10;
+  const float distance = 0.6f * fx.size;
+  const double step = 0.005 * fx.size / distance;
+  double angle = 0;
+  for (int i = 0; i < 60; ++i) front_update(front, fx.tree, orbit_view(fx, angle += step, distance), p);  // settle
+  std::vector<double> ms;
+  uint64_t changes = 0, visited = 0, frames = 0, tris = 0;
+  for (auto _ : state) {
+    const FrontView v = orbit_view(fx, angle += step, distance);
+    if (full_pass) front.has_view = false;  // forget the last view: every node is judged
+    const auto t0 = std::chrono::steady_clock::now();
+    const FrontStats s = front_update(front, fx.tree, v, p);
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(t);
+    ms.push_back(1e3 * t);
+    changes += s.splits + s.collapses;
+    visited += s.visited;
+    tris += s.active_tris;
+    ++frames;
+  }
+  state.counters["median_ms"] = median(ms);
+  state.counters["changes_per_frame"] = double(changes) / frames;
+  state.counters["visited_per_frame"] = double(visited) / frames;
+  state.counters["active_tris"] = double(tris) / frames;
+}
+
+void BM_FrontSmooth(benchmark::State& state) { run_frames(state, false); }
+void BM_FrontFullPass(benchmark::State& state) { run_frames(state, true); }
+BENCHMARK(BM_FrontSmooth)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(300);
+BENCHMARK(BM_FrontFullPass)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(30);
+
+// Teleport: settle at one side, jump to the opposite side and closer. Frames until the front
+// changes by under 1 % of its triangles, the most triangles of any frame vs the cap.
+void BM_FrontTeleport(benchmark::State& state) {
+  Fixture& fx = fixture();
+  FrontParams p;
+  p.target_triangles = kTarget;
+  p.max_triangles = kTarget + kTarget / 10;
+  double settle_frames = 0, worst = 0, first_ms = 0, runs = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    VertexFront front;
+    front_init(front, fx.tree, 1.f);
+    for (int i = 0; i < 60; ++i) front_update(front, fx.tree, orbit_view(fx, 0.0, 0.6f * fx.size), p);
+    state.ResumeTiming();
+    int frames = 0;
+    uint32_t most = 0;
+    for (; frames < 20; ++frames) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const FrontStats s = front_update(front, fx.tree, orbit_view(fx, 3.0, 0.4f * fx.size), p);
+      if (frames == 0) first_ms += 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      most = std::max(most, s.active_tris);
+      if (frames > 0 && s.splits + s.collapses < 0.01 * s.active_tris) break;
+    }
+    settle_frames += frames;
+    worst = std::max<double>(worst, double(most) / p.max_triangles);
+    ++runs;
+  }
+  state.counters["frames_to_settle"] = settle_frames / runs;
+  state.counters["most_tris_over_cap"] = worst;
+  state.counters["first_frame_ms"] = first_ms / runs;
+}
+BENCHMARK(BM_FrontTeleport)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+void BM_SplitCollapse(benchmark::State& state) {
+  Fixture& fx = fixture();
+  VertexFront front;
+  front_init(front, fx.tree, 1.f);
+  uint64_t ops = 0;
+  for (auto _ : state) {
+    front_refine_all(front, fx.tree);
+    front_coarsen_all(front, fx.tree);
+    ops += 2 * uint64_t(fx.tree.interior_count());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(ops));
+  state.counters["hierarchy_build_s"] = fx.build_seconds;
+}
+BENCHMARK(BM_SplitCollapse)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+}  // namespace
+
+BENCHMARK_MAIN();
