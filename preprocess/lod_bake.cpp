@@ -9,8 +9,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "preprocess/cluster_simplifier.h"
 #include "preprocess/decimater_chain.h"
 #include "preprocess/mesh_io.h"
+#include "preprocess/qem_simplifier.h"
 #include "preprocess/surface_error.h"
 #include "runtime/lod_asset.h"
 
@@ -19,7 +21,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 1;
+constexpr uint32_t kBakeFormatVersion = 2;
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
 constexpr size_t kSmallModelTriangles = 20000;
@@ -81,6 +83,58 @@ Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std:
   std::sort(out.begin(), out.end(), std::greater<float>());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return Status::success();
+}
+
+// Levels by lodkit's own simplifiers: level 0 is the cleaned input, then one QEM run makes
+// every coarser level (both halves of the mesh as parts; run one after the other here, the
+// output is the same as in parallel), or the aggressive simplifier does. With method "auto",
+// a QEM level stuck more than 2 % above its target is redone by the aggressive simplifier,
+// and said so in the notes.
+void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, SimplifyMethod method, bool automatic,
+                    std::vector<ChainLevel>& levels, std::vector<std::string>& notes) {
+  const size_t triangles = mesh.triangle_count();
+  levels.assign(ratios.size(), ChainLevel{});
+  ChainLevel& full = levels[0];
+  full.positions = mesh.positions;
+  full.indices = mesh.indices;
+  full.target_triangles = triangles;
+  full.normals.resize(mesh.positions.size());
+  compute_vertex_normals(full.positions.data(), full.vertex_count(), full.indices.data(), full.indices.size(),
+                         full.normals.data());
+  if (ratios.size() < 2) return;
+  std::vector<size_t> targets;
+  for (size_t i = 1; i < ratios.size(); ++i) targets.push_back(size_t(std::llround(double(ratios[i]) * double(triangles))));
+  std::vector<ChainLevelOut> out(targets.size());
+  if (method == SimplifyMethod::qem) {
+    const ParallelFor one_by_one = [](size_t n, const std::function<void(size_t)>& body) {
+      for (size_t i = 0; i < n; ++i) body(i);
+    };
+    qem_simplify_chain_split(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
+                             mesh.indices.size(), targets.data(), targets.size(), QemOptions{}, one_by_one);
+    for (size_t i = 0; i < out.size(); ++i) {
+      if (double(out[i].triangle_count()) <= 1.02 * double(targets[i])) continue;
+      std::string note = "ratio " + std::to_string(ratios[i + 1]) + ": QEM stopped at " +
+                         std::to_string(out[i].triangle_count()) + " triangles for a target of " +
+                         std::to_string(targets[i]) + " (no legal collapse left: topology or locked vertices)";
+      if (automatic) {
+        cluster_simplify_chain(&out[i], mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
+                               mesh.indices.size(), &targets[i], 1, ClusterOptions{});
+        note += "; the aggressive simplifier made this level (" + std::to_string(out[i].triangle_count()) + ")";
+      }
+      notes.push_back(note);
+    }
+  } else {
+    cluster_simplify_chain(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
+                           mesh.indices.size(), targets.data(), targets.size(), ClusterOptions{});
+  }
+  for (size_t i = 0; i < out.size(); ++i) {
+    ChainLevel& l = levels[i + 1];
+    l.positions = std::move(out[i].positions);
+    l.indices = std::move(out[i].indices);
+    l.target_triangles = targets[i];
+    l.normals.resize(l.positions.size());
+    compute_vertex_normals(l.positions.data(), l.vertex_count(), l.indices.data(), l.indices.size(), l.normals.data());
+  }
 }
 
 }  // namespace
@@ -147,28 +201,14 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   SimplifyMethod method = settings.method;
   if (method == SimplifyMethod::automatic)
     method = report.input_triangles > settings.extreme_threshold ? SimplifyMethod::extreme : SimplifyMethod::qem;
-  report.method = std::string("openmesh-decimater-quadric (") + method_name(method) + ")";
+  report.method = std::string(method == SimplifyMethod::qem ? "lodkit-qem" : "lodkit-aggressive") + " (" +
+                  (settings.method == SimplifyMethod::automatic ? "auto -> " : "") + method_name(method) + ")";
   if (method == SimplifyMethod::extreme)
-    report.notes.push_back("method 'extreme' is not implemented yet: OpenMesh's Decimater (QEM) baked this model");
+    report.notes.push_back("method 'extreme': vertex clustering with quadric placement (lodkit aggressive simplifier)");
 
   say(0.06f, "simplify");
   std::vector<ChainLevel> levels;
-  DecimaterChainStats chain_stats;
-  s = bake_decimater_chain(mesh, ratios, levels, &chain_stats,
-                           [&](float f) { say(0.06f + 0.54f * f, "simplify"); });
-  if (!s) return s;
-  for (std::string& note : chain_stats.notes) report.notes.push_back(std::move(note));
-  if (chain_stats.refused_faces)
-    report.notes.push_back(std::to_string(chain_stats.refused_faces) +
-                           " non-manifold faces kept on " + std::to_string(chain_stats.copied_vertices) +
-                           " copied vertices");
-  {
-    std::ostringstream note;
-    note.precision(3);
-    note << chain_stats.collapses << " collapses in " << chain_stats.decimate_seconds << " s";
-    if (chain_stats.decimate_seconds > 0) note << " (" << double(chain_stats.collapses) / chain_stats.decimate_seconds << "/s)";
-    report.notes.push_back(note.str());
-  }
+  simplify_chain(mesh, ratios, method, settings.method == SimplifyMethod::automatic, levels, report.notes);
 
   // A level no smaller than the one before it adds nothing: drop it.
   for (size_t i = 1; i < levels.size();) {
