@@ -1,0 +1,109 @@
+#include "runtime/geomorph.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "vd_fixture.h"
+
+namespace lod {
+namespace {
+
+TEST(Geomorph, LerpEndpointsAreExact) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1e4f, 1e4f);
+  std::vector<float> from(300), to(300), out(300);
+  for (size_t i = 0; i < from.size(); ++i) from[i] = u(rng), to[i] = u(rng) * 1e-3f;
+  geomorph_lerp(out, from, to, 0.f);
+  EXPECT_EQ(out, from);
+  geomorph_lerp(out, from, to, 1.f);
+  EXPECT_EQ(out, to);
+  geomorph_lerp(out, from, to, 7.f);  // clamped
+  EXPECT_EQ(out, to);
+  geomorph_lerp(out, from, to, 0.25f);
+  for (size_t i = 0; i < out.size(); ++i) EXPECT_NEAR(out[i], 0.75f * from[i] + 0.25f * to[i], 1e-2f);
+}
+
+TEST(Geomorph, MorphFactorRisesLinearlyOverTheDuration) {
+  EXPECT_EQ(morph_factor(1.0, 1.0, 0.5f), 0.f);
+  EXPECT_FLOAT_EQ(morph_factor(1.25, 1.0, 0.5f), 0.5f);
+  EXPECT_EQ(morph_factor(2.0, 1.0, 0.5f), 1.f);
+  EXPECT_EQ(morph_factor(0.0, 1.0, 0.5f), 0.f);
+  EXPECT_EQ(morph_factor(0.0, 1.0, 0.f), 1.f);  // no geomorphing
+}
+
+TEST(Geomorph, SplitStartsChildrenWhereTheParentIsShown) {
+  const VertexTree t = test::square_tree();
+  VertexMorph m;
+  vertex_morph_init(m, t, 1.f);
+  const FrontEvent split[] = {{4, FrontEventKind::split}};
+  vertex_morph_apply(m, t, split, 10.0);
+  float p[3];
+  for (uint32_t c : {0u, 1u}) {
+    vertex_morph_position(m, c, 10.0, p);
+    EXPECT_EQ(p[0], 0.5f);  // at the parent
+    vertex_morph_position(m, c, 11.0, p);
+    EXPECT_EQ(p[0], t.positions[3 * c]);  // arrived, exactly
+  }
+  vertex_morph_position(m, 1, 10.5, p);
+  EXPECT_FLOAT_EQ(p[0], 0.75f);  // halfway from 0.5 to 1
+}
+
+TEST(Geomorph, CollapseBeginMovesChildrenOntoTheParentAndCancelBringsThemBack) {
+  const VertexTree t = test::square_tree();
+  VertexMorph m;
+  vertex_morph_init(m, t, 1.f);
+  const FrontEvent begin[] = {{4, FrontEventKind::collapse_begin}};
+  vertex_morph_apply(m, t, begin, 0.0);
+  float p[3];
+  vertex_morph_position(m, 1, 1.0, p);
+  EXPECT_EQ(p[0], 0.5f);
+  EXPECT_EQ(p[1], 0.f);
+  // Cancelled halfway: the child turns back from where it is shown.
+  const FrontEvent cancel[] = {{4, FrontEventKind::collapse_cancel}};
+  vertex_morph_apply(m, t, cancel, 0.5);
+  vertex_morph_position(m, 1, 0.5, p);
+  EXPECT_FLOAT_EQ(p[0], 0.75f);
+  vertex_morph_position(m, 1, 1.5, p);
+  EXPECT_EQ(p[0], 1.f);
+  // A finished collapse settles the parent at its own position.
+  const FrontEvent done[] = {{4, FrontEventKind::collapse}};
+  vertex_morph_apply(m, t, done, 2.0);
+  std::vector<float> shown(3 * t.node_count(), -1);
+  const uint32_t nodes[] = {2, 3, 4};
+  EXPECT_EQ(vertex_morph_positions(shown, m, nodes, 2.0), 0u);
+  EXPECT_EQ(shown[12], 0.5f);
+  EXPECT_EQ(shown[0], -1.f);  // nodes not asked for are left alone
+}
+
+TEST(Geomorph, LevelTargetsFollowTheSourceMapping) {
+  // Fine: 4 vertices from sources 10, 11, 12, 13; coarse kept 10 and 13 (as its 1 and 0).
+  const std::vector<float> fine = {0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0};
+  const std::vector<uint32_t> fine_src = {10, 11, 12, 13};
+  const std::vector<float> coarse = {3.1f, 0, 0, 0.1f, 0, 0};
+  const std::vector<uint32_t> coarse_src = {13, 10};
+  std::vector<uint32_t> target(4);
+  level_morph_targets(target, fine, fine_src, coarse, coarse_src);
+  EXPECT_EQ(target, (std::vector<uint32_t>{1, 1, 0, 0}));  // kept by source, else nearest
+  std::vector<float> out(12);
+  level_morph_positions(out, fine, coarse, target, 0.f);
+  EXPECT_EQ(out, fine);
+  level_morph_positions(out, fine, coarse, target, 1.f);
+  EXPECT_EQ(out[3], 0.1f);
+  EXPECT_EQ(out[9], 3.1f);
+}
+
+TEST(Geomorph, LevelMorphRestartsOnAChangeAndSettles) {
+  std::vector<float> morph = {1, 1, 0.5f};
+  const std::vector<uint8_t> level = {2, 3, 1};
+  const std::vector<uint8_t> prev = {2, 2, 1};
+  EXPECT_EQ(advance_level_morph(morph, level, prev, 0.1f, 0.4f), 2u);
+  EXPECT_EQ(morph[0], 1.f);
+  EXPECT_EQ(morph[1], 0.f);
+  EXPECT_FLOAT_EQ(morph[2], 0.75f);
+  EXPECT_EQ(advance_level_morph(morph, level, level, 0.3f, 0.4f), 1u);
+  EXPECT_EQ(morph[2], 1.f);
+}
+
+}  // namespace
+}  // namespace lod

@@ -1,0 +1,206 @@
+#include "runtime/vertex_front.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "vd_fixture.h"
+
+namespace lod {
+namespace {
+
+std::vector<uint32_t> tri(const VertexFront& f, uint32_t s) {
+  return {f.tri_indices[3 * s], f.tri_indices[3 * s + 1], f.tri_indices[3 * s + 2]};
+}
+
+// Camera on the square's front side (+z), `distance` away from its middle.
+FrontView facing_view(float distance) {
+  View v;
+  v.eye = {0.5f, 0.5f, distance};
+  v.target = {0.5f, 0.5f, 0};
+  v.near_plane = 0.01f;
+  v.far_plane = 1000;
+  const float origin[3] = {0, 0, 0};
+  return front_view_of(v, origin, 1, 0);
+}
+
+TEST(VertexTree, HandBuiltSquareValidatesAndBrokenOnesDoNot) {
+  VertexTree t = test::square_tree();
+  std::string msg;
+  EXPECT_TRUE(validate_vertex_tree(t, &msg)) << msg;
+  VertexTree bad = t;
+  bad.parent[1] = 2;  // a leaf as parent
+  EXPECT_FALSE(validate_vertex_tree(bad, &msg));
+  EXPECT_NE(msg.find("node 1"), std::string::npos) << msg;
+  bad = t;
+  bad.deps[0] = 4;  // depends on itself
+  EXPECT_FALSE(validate_vertex_tree(bad, &msg));
+  bad = t;
+  bad.face_leaves[5] = 17;
+  EXPECT_FALSE(validate_vertex_tree(bad, &msg));
+  EXPECT_NE(msg.find("face 1 references vertex 17 of 4"), std::string::npos) << msg;
+  bad = t;
+  bad.radius[4] = std::nanf("");
+  EXPECT_FALSE(validate_vertex_tree(bad, &msg));
+}
+
+TEST(VertexFront, InitShowsTheBaseMesh) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  ASSERT_EQ(f.tri_count, 1u);
+  EXPECT_EQ(tri(f, 0), (std::vector<uint32_t>{4, 2, 3}));
+  EXPECT_EQ(f.active_count, 3u);
+  std::string msg;
+  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+}
+
+TEST(VertexFront, RefineAllGivesTheInputAndCoarsenAllTheBase) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  front_refine_all(f, t);
+  ASSERT_EQ(f.tri_count, 2u);
+  EXPECT_EQ(tri(f, f.face_slot[0]), (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_EQ(tri(f, f.face_slot[1]), (std::vector<uint32_t>{0, 2, 3}));
+  std::string msg;
+  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  front_coarsen_all(f, t);
+  ASSERT_EQ(f.tri_count, 1u);
+  EXPECT_EQ(tri(f, 0), (std::vector<uint32_t>{4, 2, 3}));
+  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+}
+
+TEST(VertexFront, CheckCatchesBrokenFronts) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  front_refine_all(f, t);
+  std::string msg;
+  // An open square is not closed: its border edges have one face.
+  EXPECT_FALSE(check_front(f, t, true, &msg));
+  EXPECT_NE(msg.find("closed"), std::string::npos) << msg;
+
+  VertexFront g = f;
+  g.tri_indices[3 * g.face_slot[1] + 1] = 3;  // (0, 3, 3): degenerate and wrong corner
+  EXPECT_FALSE(check_front(g, t, false, &msg));
+  g = f;
+  std::swap(g.tri_indices[3 * g.face_slot[1] + 1], g.tri_indices[3 * g.face_slot[1] + 2]);  // flipped
+  EXPECT_FALSE(check_front(g, t, false, &msg));
+  g = f;
+  g.tri_indices[0] = 4;  // an inactive vertex
+  EXPECT_FALSE(check_front(g, t, false, &msg));
+  EXPECT_NE(msg.find("inactive vertex 4"), std::string::npos) << msg;
+  g = f;
+  g.tri_count = 1;  // a face with three distinct corners goes missing
+  EXPECT_FALSE(check_front(g, t, false, &msg));
+  g = f;
+  g.state[4] = VertexFront::kActive;  // two active nodes above one leaf
+  EXPECT_FALSE(check_front(g, t, false, &msg));
+}
+
+TEST(VertexFront, SplitsWhenCloseAndMergesWhenFar) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  // Error 0.1 at distance ~2 is ~30 pixels at 720p: split.
+  FrontStats s = front_update(f, t, facing_view(2), FrontParams{});
+  EXPECT_EQ(s.splits, 1u);
+  EXPECT_EQ(f.tri_count, 2u);
+  ASSERT_EQ(f.frame_events().size(), 1u);
+  EXPECT_EQ(f.frame_events()[0].node, 4u);
+  EXPECT_EQ(f.frame_events()[0].kind, FrontEventKind::split);
+  // At distance 500 it is well under a pixel: merge back.
+  s = front_update(f, t, facing_view(500), FrontParams{});
+  EXPECT_EQ(s.collapses, 1u);
+  EXPECT_EQ(f.tri_count, 1u);
+  std::string msg;
+  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+}
+
+TEST(VertexFront, BackFacingAndOutsideStayCoarse) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  // Behind the square (normals point +z, the eye is at -z): nothing to refine.
+  View v;
+  v.eye = {0.5f, 0.5f, -2};
+  v.target = {0.5f, 0.5f, 0};
+  const float origin[3] = {0, 0, 0};
+  EXPECT_EQ(front_update(f, t, front_view_of(v, origin, 1, 0), FrontParams{}).splits, 0u);
+  // In front but looking away.
+  v.eye = {0.5f, 0.5f, 2};
+  v.target = {0.5f, 0.5f, 4};
+  EXPECT_EQ(front_update(f, t, front_view_of(v, origin, 1, 0), FrontParams{}).splits, 0u);
+  EXPECT_EQ(f.tri_count, 1u);
+}
+
+TEST(VertexFront, TriangleCapBlocksASplit) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  FrontParams p;
+  p.max_triangles = 1;
+  const FrontStats s = front_update(f, t, facing_view(2), p);
+  EXPECT_EQ(s.splits, 0u);
+  EXPECT_EQ(s.blocked, 1u);
+  EXPECT_EQ(f.tri_count, 1u);
+}
+
+TEST(VertexFront, DeferredCollapseWaitsItsDelay) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  FrontParams p;
+  p.collapse_delay = 0.5f;
+  front_update(f, t, facing_view(2), p);
+  ASSERT_EQ(f.tri_count, 2u);
+  p.time = 1;
+  FrontStats s = front_update(f, t, facing_view(500), p);
+  EXPECT_EQ(s.collapses, 0u);
+  ASSERT_EQ(f.frame_events().size(), 1u);
+  EXPECT_EQ(f.frame_events()[0].kind, FrontEventKind::collapse_begin);
+  EXPECT_EQ(f.tri_count, 2u);
+  p.time = 1.3;
+  EXPECT_EQ(front_update(f, t, facing_view(500), p).collapses, 0u);
+  p.time = 1.6;
+  s = front_update(f, t, facing_view(500), p);
+  EXPECT_EQ(s.collapses, 1u);
+  EXPECT_EQ(f.tri_count, 1u);
+}
+
+TEST(VertexFront, DeferredCollapseIsCancelledWhenDetailIsWantedAgain) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  FrontParams p;
+  p.collapse_delay = 0.5f;
+  front_update(f, t, facing_view(2), p);
+  p.time = 1;
+  front_update(f, t, facing_view(500), p);
+  p.time = 1.6;
+  front_update(f, t, facing_view(2), p);  // close again before it merged
+  EXPECT_EQ(f.tri_count, 2u);
+  EXPECT_LT(f.pending_until[0], 0);
+  bool cancelled = false;
+  for (const FrontEvent& e : f.frame_events()) cancelled |= e.kind == FrontEventKind::collapse_cancel;
+  EXPECT_TRUE(cancelled);
+}
+
+TEST(VertexFront, FrontViewUndoesTheObjectTransform) {
+  View v;
+  v.eye = {10, 0, 4};
+  v.target = {10, 0, 0};
+  const float pos[3] = {10, 0, 0};
+  const FrontView fv = front_view_of(v, pos, 2, float(M_PI / 2));
+  // World offset (0, 0, 4) -> R_y(-90 deg) -> (-4, 0, 0) -> / 2.
+  EXPECT_NEAR(fv.eye[0], -2, 1e-5);
+  EXPECT_NEAR(fv.eye[1], 0, 1e-5);
+  EXPECT_NEAR(fv.eye[2], 0, 1e-5);
+  // The object's origin is in front of the camera: inside every plane.
+  for (const auto& pl : fv.planes) EXPECT_GT(pl[3], 0);
+  EXPECT_NEAR(fv.focal_pixels, focal_pixels(v) / 2, 1e-3);
+}
+
+}  // namespace
+}  // namespace lod
