@@ -293,16 +293,30 @@ Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, 
   std::string format;
   std::vector<PlyElement> elements;
   bool ended = false;
+  size_t header_line = 1;
+  // OpenMesh's header parser can loop forever on a malformed header, so anything it might
+  // not understand is refused here, naming the line.
+  auto bad_header = [&](const std::string& why) {
+    return Status::error(what + ": PLY header line " + std::to_string(header_line) + ": " + why);
+  };
   while (next_line(line)) {
+    ++header_line;
     std::istringstream ls(line);
     std::string word;
     ls >> word;
+    if (word.empty() || word == "comment" || word == "obj_info") continue;
     if (word == "format") {
-      ls >> format;
+      std::string version, extra;
+      ls >> format >> version >> extra;
+      char* end = nullptr;
+      std::strtod(version.c_str(), &end);
+      if (version.empty() || *end != 0 || !extra.empty())
+        return bad_header("malformed format line '" + line.substr(0, 80) + "'");
     } else if (word == "element") {
       PlyElement e;
-      std::string count_text;
-      ls >> e.name >> count_text;
+      std::string count_text, extra;
+      ls >> e.name >> count_text >> extra;
+      if (e.name.empty() || !extra.empty()) return bad_header("malformed element line '" + line.substr(0, 80) + "'");
       char* end = nullptr;
       errno = 0;
       const unsigned long long n = std::strtoull(count_text.c_str(), &end, 10);
@@ -315,22 +329,31 @@ Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, 
       PlyProperty p;
       std::string type;
       ls >> type;
+      std::string extra;
       if (type == "list") {
         std::string count_type, value_type;
-        ls >> count_type >> value_type >> p.name;
+        ls >> count_type >> value_type >> p.name >> extra;
         p.is_list = true;
         p.count_size = ply_type_size(count_type);
         p.count_signed = count_type == "char" || count_type == "int8" || count_type == "short" ||
                          count_type == "int16" || count_type == "int" || count_type == "int32";
         p.size = ply_type_size(value_type);
+        if (p.count_size == 0 || p.size == 0 || p.name.empty() || !extra.empty())
+          return bad_header("malformed list property '" + line.substr(0, 80) + "'");
+        if (p.count_size > 4 || p.size > 4)
+          return bad_header("list property '" + p.name + "' has a non-integer type");
       } else {
-        ls >> p.name;
+        ls >> p.name >> extra;
         p.size = ply_type_size(type);
+        if (p.size == 0 || p.name.empty() || !extra.empty())
+          return bad_header("malformed property '" + line.substr(0, 80) + "'");
       }
       elements.back().properties.push_back(p);
     } else if (word == "end_header") {
       ended = true;
       break;
+    } else {
+      return bad_header("unknown keyword '" + word.substr(0, 32) + "'");
     }
   }
   if (!ended) return Status::error(what + ": PLY header has no 'end_header' line (file truncated?)");
@@ -342,6 +365,11 @@ Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, 
     if (e.name == "face") {
       declared.faces = e.count;
       has_face = true;
+      bool has_indices = false;
+      for (const PlyProperty& p : e.properties)
+        has_indices |= p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
+      if (!has_indices)
+        return Status::error(what + ": PLY element 'face' has no 'vertex_indices' list property");
     }
     if (e.name == "tristrips") has_tristrips = true;
   }
@@ -532,7 +560,22 @@ Status precheck_obj(const std::string& what, const std::vector<uint8_t>& bytes) 
     pos = end + 1;
     size_t s = 0;
     while (s < line.size() && (line[s] == ' ' || line[s] == '\t')) ++s;
-    if (line.compare(s, 2, "f ") == 0 || line.compare(s, 2, "f\t") == 0) ++faces;
+    if (line.compare(s, 2, "f ") == 0 || line.compare(s, 2, "f\t") == 0) {
+      // Every corner must start with a vertex index: OpenMesh's reader asserts (aborts the
+      // process) on a corner like "/1/1".
+      std::istringstream corners(line.substr(s + 2));
+      std::string corner;
+      while (corners >> corner) {
+        const size_t slash = corner.find('/');
+        const std::string index = corner.substr(0, slash);
+        char* e = nullptr;
+        const long v = std::strtol(index.c_str(), &e, 10);
+        if (index.empty() || *e != 0 || v == 0)
+          return Status::error(what + ": face " + std::to_string(faces) + " (line " + std::to_string(line_no) +
+                               ") has a corner without a valid vertex index ('" + corner.substr(0, 32) + "')");
+      }
+      ++faces;
+    }
     if (!(line.compare(s, 2, "v ") == 0 || line.compare(s, 2, "v\t") == 0)) continue;
     const char* p = line.c_str() + s + 2;
     float xyz[3];

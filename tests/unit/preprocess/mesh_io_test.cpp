@@ -149,7 +149,7 @@ TEST(MeshIo, RefusesObjIndexOutOfRange) {
   test::write_text(dir / "x.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 9\n");
   expect_refused(dir / "x.obj", "face 1 references vertex 8 of 4");
   test::write_text(dir / "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
-  expect_refused(dir / "zero.obj", "references vertex -1");
+  expect_refused(dir / "zero.obj", "face 0 (line 4) has a corner without a valid vertex index ('0')");
 }
 
 TEST(MeshIo, RefusesOffAndPlyIndexOutOfRange) {
@@ -220,6 +220,39 @@ TEST(MeshIo, RefusesTruncatedOffAndStlAndNanStl) {
   nan_xyz[4] = NAN;
   test::write_bytes(dir / "nan.stl", binary_stl(nan_xyz, kQuadTris));
   expect_refused(dir / "nan.stl", "non-finite");
+}
+
+TEST(MeshIo, RefusesObjCornersWithoutAVertexIndex) {
+  // OpenMesh's OBJ reader asserts (aborting the process) on such a corner.
+  const fs::path dir = test::temp_dir("io-corner");
+  test::write_text(dir / "c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf /1/1 2 3\n");
+  expect_refused(dir / "c.obj", "face 0 (line 5) has a corner without a valid vertex index ('/1/1')");
+  test::write_text(dir / "d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n");
+  expect_refused(dir / "d.obj", "('x')");
+}
+
+TEST(MeshIo, RefusesMalformedPlyHeaders) {
+  // OpenMesh's PLY header parser can spin forever on these; each is refused up front.
+  const fs::path dir = test::temp_dir("io-header");
+  const std::string props = "property float x\nproperty float y\nproperty float z\n";
+  const std::string tail = "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const struct {
+    const char* name;
+    std::string text;
+    const char* needle;
+  } cases[] = {
+      {"version.ply", "ply\nformat ascii ment VCG\nelement vertex 3\n" + props + tail, "line 2: malformed format line"},
+      {"keyword.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperoat x\n" + props + tail, "line 4: unknown keyword 'properoat'"},
+      {"type.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty floot x\nproperty float y\nproperty float z\n" + tail, "line 4: malformed property"},
+      {"list.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + props + "element face 1\nproperty list uchar int1vertex_indices\nend_header\n", "line 8: malformed list property"},
+      {"count.ply", "ply\nformat ascii 1.0\nelement vertex -3\n" + props + tail, "bad count '-3'"},
+      {"noindex.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + props + "element face 1\nproperty list uchar int corners\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "no 'vertex_indices'"},
+      {"magic.ply", "plx\nformat ascii 1.0\n", "not a PLY file"},
+  };
+  for (const auto& c : cases) {
+    test::write_text(dir / c.name, c.text);
+    expect_refused(dir / c.name, c.needle);
+  }
 }
 
 TEST(MeshIo, RefusesPlyTristripsClearly) {
