@@ -5,6 +5,12 @@
 //   sections, each 8-byte aligned: META, LEVL, POSN, NRML, INDX
 //   u64 checksum = hash_bytes(everything before it)
 //
+// VHIE (optional, flag 0; written only when the chain has a vertex hierarchy): u32 leaf
+//       count, u32 face count, u64 nodes, u64 dependencies, u64 incident faces, then 4-byte
+//       words: positions (3n), parent, radius, cone axis (3n), cone cos, error, leaf_lo,
+//       leaf_hi (n each), leaf_rank (leaves), face leaves (3f), face owner (f), children,
+//       split faces, wings (2i each, i = n - leaves), dep offsets (i + 1), deps, incidence
+//       offsets (i + 1), incident faces. Readers that predate it skip it (version stays 1).
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
 //       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
@@ -42,6 +48,8 @@ constexpr uint32_t kLevl = fourcc("LEVL");
 constexpr uint32_t kPosn = fourcc("POSN");
 constexpr uint32_t kNrml = fourcc("NRML");
 constexpr uint32_t kIndx = fourcc("INDX");
+constexpr uint32_t kVhie = fourcc("VHIE");
+constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
 std::string tag_name(uint32_t tag) {
@@ -137,6 +145,42 @@ void get_words(const uint8_t* p, size_t count, std::vector<T>& out) {
   }
 }
 
+template <class T>
+void put_words(Writer& w, const std::vector<T>& v) {
+  static_assert(sizeof(T) == 4);
+  if constexpr (std::endian::native == std::endian::little) {
+    w.raw(v.data(), v.size() * 4);
+  } else {
+    for (T x : v) w.u32(std::bit_cast<uint32_t>(x));
+  }
+}
+
+void put_hierarchy(Writer& w, const VertexTree& t) {
+  w.u32(t.leaf_count);
+  w.u32(t.face_count);
+  w.u64(t.node_count());
+  w.u64(t.deps.size());
+  w.u64(t.inc_faces.size());
+  put_words(w, t.positions);
+  put_words(w, t.parent);
+  put_words(w, t.radius);
+  put_words(w, t.cone_axis);
+  put_words(w, t.cone_cos);
+  put_words(w, t.error);
+  put_words(w, t.leaf_lo);
+  put_words(w, t.leaf_hi);
+  put_words(w, t.leaf_rank);
+  put_words(w, t.face_leaves);
+  put_words(w, t.face_owner);
+  put_words(w, t.children);
+  put_words(w, t.split_faces);
+  put_words(w, t.wings);
+  put_words(w, t.dep_offsets);
+  put_words(w, t.deps);
+  put_words(w, t.inc_offsets);
+  put_words(w, t.inc_faces);
+}
+
 struct SectionRef {
   uint64_t offset = 0;
   uint64_t size = 0;
@@ -144,6 +188,52 @@ struct SectionRef {
 };
 
 Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
+
+Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, VertexTree& out) {
+  if (size < kVhieFixedBytes)
+    return refuse(what, "VHIE section is " + std::to_string(size) + " bytes, needs " + std::to_string(kVhieFixedBytes));
+  VertexTree t;
+  t.leaf_count = load_u32(p);
+  t.face_count = load_u32(p + 4);
+  const uint64_t nodes = load_u64(p + 8), deps = load_u64(p + 16), inc = load_u64(p + 24);
+  const uint64_t words = (size - kVhieFixedBytes) / 4;
+  // Every count is bounded by the section before anything is multiplied or allocated.
+  if (nodes > words || deps > words || inc > words || t.leaf_count > nodes || t.face_count > words)
+    return refuse(what, "VHIE counts do not fit its " + std::to_string(size) + " bytes");
+  const uint64_t inner = nodes - t.leaf_count;
+  const uint64_t need = 12 * nodes + t.leaf_count + 4 * uint64_t(t.face_count) + 6 * inner + 2 * (inner + 1) + deps + inc;
+  if (need != words || (size - kVhieFixedBytes) % 4 != 0)
+    return refuse(what, "VHIE section is " + std::to_string(size) + " bytes but its counts need " +
+                            std::to_string(kVhieFixedBytes + 4 * need));
+  const uint8_t* q = p + kVhieFixedBytes;
+  auto take = [&](auto& v, uint64_t count) {
+    get_words(q, count, v);
+    q += 4 * count;
+  };
+  take(t.positions, 3 * nodes);
+  take(t.parent, nodes);
+  take(t.radius, nodes);
+  take(t.cone_axis, 3 * nodes);
+  take(t.cone_cos, nodes);
+  take(t.error, nodes);
+  take(t.leaf_lo, nodes);
+  take(t.leaf_hi, nodes);
+  take(t.leaf_rank, t.leaf_count);
+  take(t.face_leaves, 3 * uint64_t(t.face_count));
+  take(t.face_owner, t.face_count);
+  take(t.children, 2 * inner);
+  take(t.split_faces, 2 * inner);
+  take(t.wings, 2 * inner);
+  take(t.dep_offsets, inner + 1);
+  take(t.deps, deps);
+  take(t.inc_offsets, inner + 1);
+  take(t.inc_faces, inc);
+  std::string message;
+  if (!validate_vertex_tree(t, &message)) return refuse(what, "hierarchy: " + message);
+  pack_vertex_bounds(t);
+  out = std::move(t);
+  return Status::success();
+}
 
 }  // namespace
 
@@ -186,15 +276,15 @@ uint64_t hash_bytes(const void* data, size_t size, uint64_t seed) {
 
 std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   Writer w;
-  const uint32_t tags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
-  constexpr uint32_t section_count = 5;
+  const uint32_t tags[] = {kMeta, kLevl, kPosn, kNrml, kIndx, kVhie};
+  const uint32_t section_count = chain.hierarchy.empty() ? 5 : 6;
   w.raw(kMagic, sizeof(kMagic));
   w.u32(kLodAssetVersion);
   w.u32(section_count);
   const size_t table = w.bytes.size();
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
-    w.u32(kFlagRequired);
+    w.u32(tags[s] == kVhie ? 0 : kFlagRequired);
     w.u64(0);  // offset, patched below
     w.u64(0);  // size
   }
@@ -226,6 +316,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
       for (uint32_t v : chain.indices) w.u32(v);
     }
   });
+  if (section_count > 5) section(5, [&] { put_hierarchy(w, chain.hierarchy); });
   w.align8();
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -270,6 +361,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     return refuse(what, "checksum mismatch (file is corrupted or truncated)");
 
   SectionRef sec[5];
+  SectionRef vhie;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -279,6 +371,11 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
       return refuse(what, name + " [" + std::to_string(off) + ", +" + std::to_string(sz) +
                               ") lies outside the data area [" + std::to_string(table_end) + ", " +
                               std::to_string(body) + ")");
+    if (tag == kVhie) {
+      if (vhie.present) return refuse(what, name + " appears twice");
+      vhie = {off, sz, true};
+      continue;
+    }
     size_t known = 0;
     while (known < 5 && kKnownTags[known] != tag) ++known;
     if (known == 5) {
@@ -328,6 +425,12 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
 
   std::string message;
   if (!validate_chain(chain, &message)) return refuse(what, message);
+  if (vhie.present) {
+    if (Status st = get_hierarchy(p + vhie.offset, vhie.size, what, chain.hierarchy); !st) return st;
+    if (!chain.levels.empty() && chain.hierarchy.leaf_count != chain.levels[0].vertex_count)
+      return refuse(what, "hierarchy has " + std::to_string(chain.hierarchy.leaf_count) + " leaves but level 0 has " +
+                              std::to_string(chain.levels[0].vertex_count) + " vertices");
+  }
   out = std::move(chain);
   return Status::success();
 }

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "runtime/vertex_tree.h"
+
 namespace lod {
 
 struct Sphere {
@@ -33,6 +35,9 @@ struct LodChain {
   std::vector<float> positions;    // xyz per vertex, all levels back to back
   std::vector<float> normals;      // xyz per vertex, same count as positions
   std::vector<uint32_t> indices;   // level-local vertex indices, all levels back to back
+  // Optional vertex hierarchy of level 0 for view-dependent LOD (empty = none); its leaves are
+  // level 0's vertices. Stored in the asset's optional VHIE section.
+  VertexTree hierarchy;
 };
 
 // R0: l = log2(M) rounded to the nearest integer (5,000 triangles -> 12, 2,000 -> 11).

@@ -15,7 +15,9 @@ inline MeshData vd_sphere(int rings, int segments, float radius = 1, float cx = 
   MeshData m;
   m.source = "sphere";
   auto put = [&](float x, float y, float z) {
-    m.positions.insert(m.positions.end(), {cx + radius * x, cy + radius * y, cz + radius * z});
+    m.positions.push_back(cx + radius * x);
+    m.positions.push_back(cy + radius * y);
+    m.positions.push_back(cz + radius * z);
   };
   put(0, 1, 0);
   for (int r = 1; r < rings; ++r) {
@@ -28,13 +30,18 @@ inline MeshData vd_sphere(int rings, int segments, float radius = 1, float cx = 
   put(0, -1, 0);
   const uint32_t south = static_cast<uint32_t>(m.vertex_count() - 1);
   auto ring = [&](int r, int s) { return uint32_t(1 + (r - 1) * segments + (s % segments)); };
-  for (int s = 0; s < segments; ++s) m.indices.insert(m.indices.end(), {0u, ring(1, s + 1), ring(1, s)});
+  auto face = [&](uint32_t a, uint32_t b, uint32_t c) {
+    m.indices.push_back(a);
+    m.indices.push_back(b);
+    m.indices.push_back(c);
+  };
+  for (int s = 0; s < segments; ++s) face(0u, ring(1, s + 1), ring(1, s));
   for (int r = 1; r + 1 < rings; ++r)
     for (int s = 0; s < segments; ++s) {
-      m.indices.insert(m.indices.end(), {ring(r, s), ring(r, s + 1), ring(r + 1, s + 1)});
-      m.indices.insert(m.indices.end(), {ring(r, s), ring(r + 1, s + 1), ring(r + 1, s)});
+      face(ring(r, s), ring(r, s + 1), ring(r + 1, s + 1));
+      face(ring(r, s), ring(r + 1, s + 1), ring(r + 1, s));
     }
-  for (int s = 0; s < segments; ++s) m.indices.insert(m.indices.end(), {south, ring(rings - 1, s), ring(rings - 1, s + 1)});
+  for (int s = 0; s < segments; ++s) face(south, ring(rings - 1, s), ring(rings - 1, s + 1));
   return m;
 }
 
