@@ -17,7 +17,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct Decision {
   bool refine;
-  double slack;  // object units of view motion before `refine` may change
+  // Object units of view motion before `refine` may change: eye motion (calendar 0) and
+  // frustum-plane motion (calendar 1); infinity when that motion cannot change it.
+  double slack_eye, slack_frustum;
 };
 
 // Hoppe 1997's criteria for one node, with how far the view may move before each could flip.
@@ -60,17 +62,13 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
   const double slack_error = std::min(std::abs(dist - critical), reach);
 
   const bool refine = in_frustum && facing && coarse;
-  double slack;
-  if (refine) {
-    slack = std::min({slack_frustum, slack_facing, slack_error});
-  } else {
-    // Stays false while any failing criterion keeps failing.
-    slack = 0;
-    if (!in_frustum) slack = std::max(slack, slack_frustum);
-    if (!facing) slack = std::max(slack, slack_facing);
-    if (!coarse) slack = std::max(slack, slack_error);
-  }
-  return {refine, slack};
+  if (refine) return {true, std::min(slack_facing, slack_error), slack_frustum};
+  // Stays false while any failing criterion keeps failing: outside the frustum is enough.
+  if (!in_frustum) return {false, kInf, slack_frustum};
+  double slack = 0;
+  if (!facing) slack = std::max(slack, slack_facing);
+  if (!coarse) slack = std::max(slack, slack_error);
+  return {false, slack, kInf};
 }
 
 class Updater {
@@ -82,7 +80,11 @@ class Updater {
   void split(uint32_t x);
   void collapse(uint32_t p);
   void unfile(uint32_t v);
-  void file(uint32_t v, double slack);
+  void unfile(uint32_t v, int c);
+  void file(uint32_t v, double slack_eye, double slack_frustum);
+  void file(uint32_t v, int c, double slack);
+  void file_next_frame(uint32_t v);
+  void drain(uint32_t b, int c);
   void stop_waiting(uint32_t v);
   void wait_for(uint32_t v, uint32_t d);
   void wake(uint32_t d);
@@ -110,7 +112,7 @@ class Updater {
   }
   void push(uint32_t v) {
     if (tail_ < limit_) f_.queue[tail_++] = v;
-    else file(v, 0);  // queue full (cannot happen with the sizes front_init picks): next frame
+    else file_next_frame(v);  // queue full (cannot happen with the sizes front_init picks)
   }
   void begin_pending(uint32_t p);
   void end_pending(uint32_t p);
@@ -129,37 +131,69 @@ class Updater {
   FrontStats stats_;
 };
 
-void Updater::unfile(uint32_t v) {
-  const uint32_t b = f_.links[v].bucket;
-  if (b == kNoNode) return;
-  const uint32_t n = f_.links[v].next, pr = f_.links[v].prev;
-  if (pr != kNoNode) f_.links[pr].next = n;
-  else f_.bucket_head[b] = n;
-  if (n != kNoNode) f_.links[n].prev = pr;
-  f_.links[v].bucket = kNoNode;
+void Updater::unfile(uint32_t v, int c) {
+  VertexFront::Link& l = f_.links[2 * size_t(v) + c];
+  if (l.bucket == kNoNode) return;
+  uint32_t* heads = &f_.bucket_head[size_t(c) * (kBuckets + 1)];
+  if (l.prev != kNoNode) f_.links[2 * size_t(l.prev) + c].next = l.next;
+  else heads[l.bucket] = l.next;
+  if (l.next != kNoNode) f_.links[2 * size_t(l.next) + c].prev = l.prev;
+  l.bucket = kNoNode;
 }
 
-void Updater::file(uint32_t v, double slack) {
-  assert(f_.links[v].bucket == kNoNode);
-  if (slack <= 0) {
-    // Retry next frame whether or not the view moves (blocked by a limit or a neighbour).
-    f_.links[v].prev = kNoNode;
-    f_.links[v].next = f_.bucket_head[kBuckets];
-    if (f_.links[v].next != kNoNode) f_.links[f_.links[v].next].prev = v;
-    f_.bucket_head[kBuckets] = v;
-    f_.links[v].bucket = kBuckets;
-    return;
-  }
+void Updater::unfile(uint32_t v) {
+  unfile(v, 0);
+  unfile(v, 1);
+}
+
+void Updater::file(uint32_t v, int c, double slack) {
+  if (slack == kInf) return;  // that motion can never change the decision
   // Never into a bucket this frame already visited; far deadlines wait in the last bucket.
-  const double at = (f_.motion + slack) / f_.bucket_width;
-  int64_t abs_bucket = at < double(f_.cursor + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : f_.cursor + kBuckets - 1;
-  abs_bucket = std::max(abs_bucket, f_.cursor);
+  const int64_t cur = f_.cursor[c];
+  const double at = (f_.motion[c] + slack) / f_.bucket_width;
+  int64_t abs_bucket = at < double(cur + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : cur + kBuckets - 1;
+  abs_bucket = std::max(abs_bucket, cur);
   const uint32_t b = static_cast<uint32_t>(abs_bucket % kBuckets);
-  f_.links[v].prev = kNoNode;
-  f_.links[v].next = f_.bucket_head[b];
-  if (f_.links[v].next != kNoNode) f_.links[f_.links[v].next].prev = v;
-  f_.bucket_head[b] = v;
-  f_.links[v].bucket = b;
+  uint32_t* heads = &f_.bucket_head[size_t(c) * (kBuckets + 1)];
+  VertexFront::Link& l = f_.links[2 * size_t(v) + c];
+  assert(l.bucket == kNoNode);
+  l.prev = kNoNode;
+  l.next = heads[b];
+  if (l.next != kNoNode) f_.links[2 * size_t(l.next) + c].prev = v;
+  heads[b] = v;
+  l.bucket = b;
+}
+
+void Updater::file(uint32_t v, double slack_eye, double slack_frustum) {
+  unfile(v);
+  if (slack_eye <= 0 || slack_frustum <= 0) return file_next_frame(v);
+  file(v, 0, slack_eye);
+  file(v, 1, slack_frustum);
+}
+
+// Retry next frame whether or not the view moves (blocked by a limit or a neighbour).
+void Updater::file_next_frame(uint32_t v) {
+  unfile(v);
+  VertexFront::Link& l = f_.links[2 * size_t(v)];
+  l.prev = kNoNode;
+  l.next = f_.bucket_head[kBuckets];
+  if (l.next != kNoNode) f_.links[2 * size_t(l.next)].prev = v;
+  f_.bucket_head[kBuckets] = v;
+  l.bucket = kBuckets;
+}
+
+// Every node of bucket b of calendar c into the queue, the bucket emptied without relinking.
+void Updater::drain(uint32_t b, int c) {
+  uint32_t* head = &f_.bucket_head[size_t(c) * (kBuckets + 1) + b];
+  for (uint32_t v = *head; v != kNoNode;) {
+    VertexFront::Link& l = f_.links[2 * size_t(v) + c];
+    const uint32_t next = l.next;
+    l.bucket = kNoNode;
+    unfile(v, 1 - c);  // judged now: out of the other calendar too
+    push(v);
+    v = next;
+  }
+  *head = kNoNode;
 }
 
 void Updater::stop_waiting(uint32_t v) {
@@ -188,7 +222,7 @@ void Updater::wake(uint32_t d) {
     stop_waiting(v);
     if (f_.state[v] != VertexFront::kActive) continue;
     unfile(v);
-    if (phase_two_) file(v, 0);
+    if (phase_two_) file_next_frame(v);
     else push(v);
   }
 }
@@ -299,6 +333,11 @@ void Updater::end_pending(uint32_t p) {
   f_.pending[at] = last;
   f_.pending_pos[last - t_.leaf_count] = at;
   emit(p, FrontEventKind::collapse_cancel);
+  // Its children waited on the pending list, unfiled: judge them again next frame.
+  for (int j = 0; j < 2; ++j) {
+    const uint32_t c = t_.children[2 * i + j];
+    if (f_.state[c] == VertexFront::kActive) file_next_frame(c);
+  }
 }
 
 // Splits v after splitting whatever its dependencies need (R4's forced splits), depth first
@@ -349,16 +388,17 @@ bool Updater::consider(uint32_t v, bool phase_two) {
   if (f_.state[v] != VertexFront::kActive) return false;
   unfile(v);
   ++stats_.visited;
-  double slack = kInf;
+  double se = kInf, sf = kInf;
   if (!t_.is_leaf(v)) {
     const Decision d = evaluate(t_, v, view_, f_.threshold, reach_);
     if (d.refine) {
       if (!phase_two) return true;
       if (force_split(v)) return false;
-      if (f_.state[v] == VertexFront::kActive) file(v, 0);  // blocked: try again next frame
+      if (f_.state[v] == VertexFront::kActive) file_next_frame(v);  // blocked: try again next frame
       return false;
     }
-    slack = d.slack;
+    se = d.slack_eye;
+    sf = d.slack_frustum;
   }
   const uint32_t p = t_.parent[v];
   if (p != kNoNode && children_active(p)) {
@@ -367,30 +407,34 @@ bool Updater::consider(uint32_t v, bool phase_two) {
     const bool pending = f_.pending_until[i] >= 0;
     if (!dp.refine) {
       if (phase_two || (p_.max_operations && ops_ >= p_.max_operations)) {
-        file(v, 0);
+        file_next_frame(v);
         return false;
       }
       const uint32_t d = missing_dep(p);
       if (d != kNoNode) {
         // A finer neighbour blocks it: wait until that neighbour is active again, and meanwhile
         // keep watching v's own decision.
-        if (f_.state[d] == VertexFront::kSplit) wait_for(v, d);
-        file(v, f_.state[d] == VertexFront::kSplit ? slack : 0.0);
+        if (f_.state[d] == VertexFront::kSplit) {
+          wait_for(v, d);
+          file(v, se, sf);
+        } else {
+          file_next_frame(v);
+        }
         return false;
       }
       if (p_.collapse_delay > 0) {
         if (!pending) begin_pending(p);
-        file(v, kInf);  // the pending list finishes it
-        return false;
+        return false;  // the pending list finishes it
       }
       collapse(p);
       push(p);
       return false;
     }
     if (pending) end_pending(p);
-    slack = std::min(slack, dp.slack);
+    se = std::min(se, dp.slack_eye);
+    sf = std::min(sf, dp.slack_frustum);
   }
-  file(v, slack);
+  file(v, se, sf);
   return false;
 }
 
@@ -403,20 +447,18 @@ FrontStats Updater::run(const FrontView& view) {
   reach_ = std::sqrt(ex * ex + ey * ey + ez * ez) + f_.extent;
 
   // How far may any decision have moved since the last frame (see evaluate's slacks)?
-  double moved = f_.pending_motion;
+  double moved = f_.pending_motion, plane_move = 0;
   bool full = !f_.has_view;
   if (!full) {
     const FrontView& o = f_.last_view;
     const double dx = view.eye[0] - o.eye[0], dy = view.eye[1] - o.eye[1], dz = view.eye[2] - o.eye[2];
     moved += std::sqrt(dx * dx + dy * dy + dz * dz);
-    double plane_move = 0;
     for (int k = 0; k < 6; ++k) {
       const double nx = view.planes[k][0] - o.planes[k][0], ny = view.planes[k][1] - o.planes[k][1],
                    nz = view.planes[k][2] - o.planes[k][2];
       const double at_eye = nx * view.eye[0] + ny * view.eye[1] + nz * view.eye[2] + (view.planes[k][3] - o.planes[k][3]);
       plane_move = std::max(plane_move, std::sqrt(nx * nx + ny * ny + nz * nz) * reach_ + std::abs(at_eye));
     }
-    moved = std::max(moved, plane_move + f_.pending_motion);
     if (view.focal_pixels != o.focal_pixels) {
       const double k = double(o.focal_pixels) / view.focal_pixels;
       moved += 2 * reach_ * (std::max(k, 1 / k) - 1);
@@ -425,25 +467,30 @@ FrontStats Updater::run(const FrontView& view) {
   f_.pending_motion = 0;
   f_.has_view = true;
   f_.last_view = view;
-  f_.motion += moved;
+  f_.motion[0] += moved;
+  f_.motion[1] += plane_move;
   head_ = tail_ = 0;
   ops_ = 0;
   const uint32_t phase_one_end = static_cast<uint32_t>(f_.queue.size() / 2);
   limit_ = phase_one_end;
 
-  // Expired buckets, or all of them.
-  const int64_t last = static_cast<int64_t>(std::floor(f_.motion / f_.bucket_width));
-  if (full || last - f_.cursor + 1 >= int64_t(kBuckets)) {
-    full = true;
-    for (uint32_t b = 0; b < kBuckets; ++b)
-      for (uint32_t v = f_.bucket_head[b]; v != kNoNode; v = f_.links[v].next) push(v);
-  } else {
-    for (int64_t ab = f_.cursor; ab <= last; ++ab)
-      for (uint32_t v = f_.bucket_head[ab % kBuckets]; v != kNoNode; v = f_.links[v].next) push(v);
+  // Expired buckets of both calendars, or (first frame, teleport) the whole front.
+  int64_t last[2];
+  for (int c = 0; c < 2; ++c) {
+    last[c] = static_cast<int64_t>(std::floor(f_.motion[c] / f_.bucket_width));
+    if (last[c] - f_.cursor[c] + 1 >= int64_t(kBuckets)) full = true;
   }
-  for (uint32_t v = f_.bucket_head[kBuckets]; v != kNoNode; v = f_.links[v].next) push(v);
-  f_.cursor = std::max(f_.cursor, last + 1);
-  for (uint32_t k = 0; k < tail_; ++k) unfile(f_.queue[k]);
+  if (full) {
+    for (uint32_t k = 0; k < f_.active_count; ++k) {
+      unfile(f_.active[k]);
+      push(f_.active[k]);
+    }
+  } else {
+    for (int c = 0; c < 2; ++c)
+      for (int64_t ab = f_.cursor[c]; ab <= last[c]; ++ab) drain(static_cast<uint32_t>(ab % kBuckets), c);
+  }
+  for (int c = 0; c < 2; ++c) f_.cursor[c] = std::max(f_.cursor[c], last[c] + 1);
+  drain(kBuckets, 0);
   stats_.full_pass = full;
 
   // Deferred collapses whose time has come: collapse if still legal and wanted.
@@ -534,10 +581,10 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
   f.face_slot.assign(t.face_count, kNoNode);
   f.active_count = f.tri_count = 0;
   f.threshold = threshold;
-  f.links.assign(n, VertexFront::Link{});
-  f.bucket_head.assign(kBuckets + 1, kNoNode);  // the last one: retry next frame
-  f.motion = 0;
-  f.cursor = 0;
+  f.links.assign(2 * size_t(n), VertexFront::Link{});
+  f.bucket_head.assign(2 * (kBuckets + 1), kNoNode);
+  f.motion[0] = f.motion[1] = 0;
+  f.cursor[0] = f.cursor[1] = 0;
   f.pending_motion = 0;
   f.has_view = false;
   f.wait_on.assign(n, kNoNode);
@@ -592,14 +639,7 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
       f.tri_indices[3 * size_t(s) + j] = v;
     }
   }
-  // Every node of the front is judged on the first update.
-  for (uint32_t k = 0; k < f.active_count; ++k) {
-    const uint32_t v = f.active[k];
-    f.links[v].next = f.bucket_head[0];
-    if (f.links[v].next != kNoNode) f.links[f.links[v].next].prev = v;
-    f.bucket_head[0] = v;
-    f.links[v].bucket = 0;
-  }
+  // Every node of the front is judged on the first update (a full pass: nothing to file).
 }
 
 FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontView& view, const FrontParams& params) {
@@ -617,7 +657,7 @@ void front_refine_all(VertexFront& f, const VertexTree& t) {
     if (f.state[v] == VertexFront::kActive) u.split(v);
   for (uint32_t k = 0; k < f.active_count; ++k) {
     u.unfile(f.active[k]);
-    u.file(f.active[k], 0);
+    u.file_next_frame(f.active[k]);
   }
   f.event_count = 0;
 }
@@ -633,7 +673,7 @@ void front_coarsen_all(VertexFront& f, const VertexTree& t) {
   }
   for (uint32_t k = 0; k < f.active_count; ++k) {
     u.unfile(f.active[k]);
-    u.file(f.active[k], 0);
+    u.file_next_frame(f.active[k]);
   }
   f.event_count = 0;
 }

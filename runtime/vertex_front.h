@@ -82,16 +82,18 @@ struct VertexFront {
   uint32_t tri_count = 0;
   float threshold = 1;               // pixel threshold (tau), moved by feedback
 
-  // Calendar of camera-motion buckets (intrusive doubly linked lists over node ids).
+  // Two calendars of view-motion buckets (intrusive doubly linked lists over node ids):
+  // calendar 0 by eye movement (and threshold changes): error and normal-cone decisions;
+  // calendar 1 by frustum-plane movement: frustum decisions. A node may sit in both.
   struct Link {
     uint32_t next = kNoNode, prev = kNoNode, bucket = kNoNode;  // bucket = kNoNode when unfiled
   };
-  std::vector<Link> links;  // per node, one record so filing touches one cache line
-  std::vector<uint32_t> bucket_head;
-  double motion = 0;          // accumulated bound on view change, object units
-  int64_t cursor = 0;         // first bucket not yet visited
+  std::vector<Link> links;           // 2 per node (calendar 0, 1), side by side
+  std::vector<uint32_t> bucket_head; // per calendar kBuckets + 1; the last: retry next frame
+  double motion[2] = {0, 0};         // accumulated bound on view change, object units
+  int64_t cursor[2] = {0, 0};        // first bucket not yet visited
   double bucket_width = 1;
-  double pending_motion = 0;  // from last frame's threshold change
+  double pending_motion = 0;         // from last frame's threshold change (calendar 0)
   float center[3] = {0, 0, 0};
   float extent = 0;           // radius of the sphere at `center` holding every node
   bool has_view = false;
