@@ -227,12 +227,23 @@ bool parse_count(std::string_view tok, uint64_t& out) {
 }
 
 // A coordinate token as strtod sees it (accepts nan/inf, which iostreams refuse silently).
+// The whole token must be the number: iostreams would stop inside "2-1" and read the rest
+// as the next value, shifting everything after it.
 bool parse_coordinate(std::string_view tok, float& out) {
   std::string s(tok);
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str()) return false;
+  if (end == s.c_str() || *end != 0) return false;
   out = static_cast<float>(v);
+  return true;
+}
+
+// An integer token, optionally negative, nothing else.
+bool is_integer_token(std::string_view tok) {
+  if (!tok.empty() && tok[0] == '-') tok.remove_prefix(1);
+  if (tok.empty() || tok.size() > 20) return false;
+  for (char c : tok)
+    if (c < '0' || c > '9') return false;
   return true;
 }
 
@@ -252,6 +263,7 @@ struct PlyProperty {
   bool is_list = false;
   int count_size = 0;    // list count type size
   bool count_signed = false;
+  bool is_float = false; // value type
 };
 struct PlyElement {
   std::string name;
@@ -265,6 +277,10 @@ int ply_type_size(const std::string& t) {
   if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
   if (t == "double" || t == "float64") return 8;
   return 0;
+}
+
+bool is_float_type(const std::string& t) {
+  return t == "float" || t == "float32" || t == "double" || t == "float64";
 }
 
 uint64_t read_uint_le(const uint8_t* p, int size, bool big_endian) {
@@ -338,6 +354,7 @@ Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, 
         p.count_signed = count_type == "char" || count_type == "int8" || count_type == "short" ||
                          count_type == "int16" || count_type == "int" || count_type == "int32";
         p.size = ply_type_size(value_type);
+        p.is_float = is_float_type(value_type);
         if (p.count_size == 0 || p.size == 0 || p.name.empty() || !extra.empty())
           return bad_header("malformed list property '" + line.substr(0, 80) + "'");
         if (p.count_size > 4 || p.size > 4)
@@ -345,6 +362,7 @@ Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, 
       } else {
         ls >> p.name >> extra;
         p.size = ply_type_size(type);
+        p.is_float = is_float_type(type);
         if (p.size == 0 || p.name.empty() || !extra.empty())
           return bad_header("malformed property '" + line.substr(0, 80) + "'");
       }
@@ -353,7 +371,12 @@ Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, 
       ended = true;
       break;
     } else {
-      return bad_header("unknown keyword '" + word.substr(0, 32) + "'");
+      // OpenMesh skips unknown words one by one (some exporters write a bare "Created by
+      // ..." line); it would act on a keyword further along the line, so refuse those.
+      std::string rest;
+      while (ls >> rest)
+        if (rest == "element" || rest == "property" || rest == "format" || rest == "end_header")
+          return bad_header("unknown keyword '" + word.substr(0, 32) + "' before '" + rest + "'");
     }
   }
   if (!ended) return Status::error(what + ": PLY header has no 'end_header' line (file truncated?)");
@@ -410,10 +433,14 @@ Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, 
             if (!tokens.next(tok))
               return Status::error(what + ": truncated: the data ends inside " + e.name + " " + std::to_string(i) +
                                    " of " + std::to_string(e.count) + " declared");
-            if (!is_vertex || p.is_list || p.name.size() != 1 || p.name[0] < 'x' || p.name[0] > 'z') continue;
-            if (!parse_coordinate(tok, xyz[p.name[0] - 'x']))
-              return Status::error(what + ": vertex " + std::to_string(i) + " (line " + std::to_string(tokens.line()) +
-                                   ") has a coordinate that is not a number ('" + std::string(tok.substr(0, 32)) + "')");
+            float value = 0;
+            if (p.is_float ? !parse_coordinate(tok, value) : !is_integer_token(tok))
+              return Status::error(what + ": " + e.name + " " + std::to_string(i) + " (line " +
+                                   std::to_string(tokens.line()) + ") has a value that is not " +
+                                   (p.is_float ? "a number" : "an integer") + " ('" +
+                                   std::string(tok.substr(0, 32)) + "')");
+            if (is_vertex && !p.is_list && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z')
+              xyz[p.name[0] - 'x'] = p.is_float ? value : float(std::strtod(std::string(tok).c_str(), nullptr));
           }
         }
         if (is_vertex) {
@@ -533,10 +560,14 @@ Status precheck_off(const std::string& what, const std::vector<uint8_t>& bytes, 
     if (!parse_count(tok, n))
       return Status::error(what + ": face " + std::to_string(f) + " (line " + std::to_string(t2.line()) +
                            ") has a bad corner count '" + std::string(tok.substr(0, 32)) + "'");
-    for (uint64_t k = 0; k < n; ++k)
+    for (uint64_t k = 0; k < n; ++k) {
       if (!t2.next(tok))
         return Status::error(what + ": truncated: the data ends inside face " + std::to_string(f) + " of " +
                              std::to_string(nf) + " declared");
+      if (!is_integer_token(tok))
+        return Status::error(what + ": face " + std::to_string(f) + " (line " + std::to_string(t2.line()) +
+                             ") has a vertex index that is not an integer ('" + std::string(tok.substr(0, 32)) + "')");
+    }
     t2.skip_line();
   }
   return Status::success();

@@ -206,6 +206,21 @@ TEST(MeshIo, RefusesTruncatedAsciiPly) {
   expect_refused(dir / "header.ply", "end_header");
 }
 
+TEST(MeshIo, RefusesValuesThatAreNotWholeNumbers) {
+  // iostreams read "2-1" as 2 and then -1 as the next face's corner count: OpenMesh would
+  // then try to read four billion corners.
+  const fs::path dir = test::temp_dir("io-tokens");
+  test::write_text(dir / "x.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2-1\n3 0 2 3\n");
+  expect_refused(dir / "x.off", "face 0 (line 7) has a vertex index that is not an integer ('2-1')");
+  test::write_text(dir / "y.off", "OFF\n3 1 0\n0 0 0\n1 0x 0\n0 1 0\n3 0 1 2\n");
+  expect_refused(dir / "y.off", "vertex 1 (line 4) has a coordinate that is not a number ('0x')");
+  test::write_text(dir / "z.ply",
+                   "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                   "0 0 0\n1 0 0\n0 1 0\n3 0 1 2-1\n");
+  expect_refused(dir / "z.ply", "face 0 (line 13) has a value that is not an integer ('2-1')");
+}
+
 TEST(MeshIo, RefusesTruncatedOffAndStlAndNanStl) {
   const fs::path dir = test::temp_dir("io-trunc-off");
   test::write_text(dir / "x.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n");
@@ -242,7 +257,7 @@ TEST(MeshIo, RefusesMalformedPlyHeaders) {
     const char* needle;
   } cases[] = {
       {"version.ply", "ply\nformat ascii ment VCG\nelement vertex 3\n" + props + tail, "line 2: malformed format line"},
-      {"keyword.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperoat x\n" + props + tail, "line 4: unknown keyword 'properoat'"},
+      {"keyword.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperoat x property\n" + props + tail, "line 4: unknown keyword 'properoat'"},
       {"type.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty floot x\nproperty float y\nproperty float z\n" + tail, "line 4: malformed property"},
       {"list.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + props + "element face 1\nproperty list uchar int1vertex_indices\nend_header\n", "line 8: malformed list property"},
       {"count.ply", "ply\nformat ascii 1.0\nelement vertex -3\n" + props + tail, "bad count '-3'"},
@@ -313,6 +328,62 @@ TEST(MeshIo, LoadsConcurrentlyWithTheSameResults) {
     });
   for (std::thread& th : threads) th.join();
   EXPECT_EQ(mismatches.load(), 0);
+}
+
+TEST(MeshIo, SurvivesMutatedFiles) {
+  // Seeded mutation of small valid files (byte flips, cuts, inserted tokens such as "nan"
+  // or "/"): every result is either a valid mesh or a refusal naming the file. A crash or
+  // hang here is a loader bug (OpenMesh aborts or spins on some inputs it is never given).
+  const fs::path dir = test::temp_dir("io-mutate");
+  std::vector<std::pair<std::string, std::vector<uint8_t>>> seeds;
+  auto text = [](const std::string& s) { return std::vector<uint8_t>(s.begin(), s.end()); };
+  seeds.emplace_back(".obj", text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 3 4\n"));
+  seeds.emplace_back(".off", text("OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"));
+  seeds.emplace_back(".ply", text("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                  "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                                  "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"));
+  seeds.emplace_back(".ply", binary_ply(4, 2, kQuadXyz, kQuadTris));
+  seeds.emplace_back(".stl", binary_stl(kQuadXyz, kQuadTris));
+  const char* tokens[] = {"nan", "-1", "0", "/", "4294967295", "99999999999", " ", "\n", "inf", "1e39", "//", "f "};
+  uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto next = [&state] {
+    state ^= state << 13, state ^= state >> 7, state ^= state << 17;
+    return state;
+  };
+  size_t loaded = 0, refused = 0;
+  for (const auto& [ext, base] : seeds)
+    for (int i = 0; i < 200; ++i) {
+      std::vector<uint8_t> b = base;
+      const uint64_t kind = next() % 4;
+      for (uint64_t k = 0, n = 1 + next() % 3; k < n && !b.empty(); ++k) {
+        const size_t pos = next() % b.size();
+        if (kind == 0) {
+          b[pos] = uint8_t(next());
+        } else if (kind == 1) {
+          b.resize(pos);
+        } else if (kind == 2) {
+          const std::string t = tokens[next() % std::size(tokens)];
+          b.insert(b.begin() + std::ptrdiff_t(pos), t.begin(), t.end());
+        } else {
+          b.erase(b.begin() + std::ptrdiff_t(pos), b.begin() + std::ptrdiff_t(std::min(b.size(), pos + 1 + next() % 8)));
+        }
+      }
+      const fs::path p = dir / ("m" + ext);
+      test::write_bytes(p, b);
+      MeshData m;
+      const Status s = load_mesh(p, m);
+      if (s.ok) {
+        ++loaded;
+        ASSERT_GT(m.triangle_count(), 0u);
+        for (uint32_t v : m.indices) ASSERT_LT(v, m.vertex_count());
+        for (float c : m.positions) ASSERT_TRUE(std::isfinite(c));
+      } else {
+        ++refused;
+        ASSERT_NE(s.message.find("m" + ext), std::string::npos) << s.message;
+      }
+    }
+  EXPECT_GT(loaded, 0u);
+  EXPECT_GT(refused, 0u);
 }
 
 TEST(MeshIo, HandlesEveryEdgeCaseFileWithoutCrashing) {
