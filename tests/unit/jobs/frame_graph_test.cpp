@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <stdexcept>
@@ -259,6 +260,53 @@ TEST(FrameGraph, ThrowingStagePropagatesAndTheNextFrameStartsFresh) {
     expect_same_frame(f, expected, "after failure");
     EXPECT_EQ(f.index, 4u);
   }
+}
+
+TEST(FrameGraph, ChunkSizeDoesNotChangeTheFrame) {
+  const Scene scene = test::synthetic_scene(3000, 250);
+  const CameraPath path = test::synthetic_config(3000, 250).camera;
+  const uint64_t budget = unbudgeted_triangles(scene, view_at(path, 0)) * 2 / 3;
+  std::vector<std::vector<Frame>> runs;
+  for (uint32_t grain : {1u, 7u, 2048u, 1000000u}) {
+    FrameGraph g(scene, options_with(2, budget, grain));
+    std::vector<Frame> frames(4);
+    for (uint32_t n = 0; n < frames.size(); ++n) g.run(view_at(path, n * 11), frames[n]);
+    runs.push_back(std::move(frames));
+  }
+  ASSERT_GT(runs[0][0].lowered_steps, 0u) << "the budget must bind for this test to mean anything";
+  for (size_t r = 1; r < runs.size(); ++r)
+    for (size_t n = 0; n < runs[0].size(); ++n)
+      expect_same_frame(runs[0][n], runs[r][n], "grain run " + std::to_string(r) + " frame " + std::to_string(n));
+}
+
+TEST(FrameGraph, SingleLevelModelsCannotBeLoweredAndAreFlagged) {
+  SceneConfig c = test::synthetic_config(300, 50);
+  std::vector<LodChain> chains = test::synthetic_chains();
+  for (LodChain& chain : chains) chain.levels.resize(1);  // full detail only
+  const Scene scene = make_scene(c, chains);
+  FrameGraph g(scene, options_with(2, 1000));
+  Frame f;
+  g.run(view_at(c.camera, 0), f);
+  ASSERT_GT(f.visible, 0u);
+  EXPECT_TRUE(f.over_budget);
+  EXPECT_EQ(f.tris_selected, f.tris_in_view);
+  EXPECT_EQ(f.lowered_steps, 0u);
+  for (uint8_t l : f.levels) EXPECT_EQ(l, 0);
+}
+
+TEST(FrameGraph, CameraInsideAnObjectGivesFiniteResults) {
+  const Scene scene = test::synthetic_scene(1000, 100);
+  View inside;
+  inside.eye = {scene.objects.cx[5], scene.objects.cy[5], scene.objects.cz[5]};
+  inside.target = inside.eye + glm::vec3(1, 0, 0);
+  FrameGraph g(scene, options_with(2, 50000));
+  Frame f;
+  g.run(inside, f);
+  ASSERT_GT(f.visible, 0u);
+  EXPECT_NE(std::find(f.objects.begin(), f.objects.end(), 5u), f.objects.end());
+  EXPECT_TRUE(f.over_budget || f.tris_selected <= f.budget);
+  for (size_t k = 0; k < f.objects.size(); ++k)
+    EXPECT_LT(f.levels[k], scene.models.level_count[scene.objects.model[f.objects[k]]]);
 }
 
 TEST(FrameGraph, DotListsEveryStageAsAChain) {
