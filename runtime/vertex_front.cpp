@@ -197,8 +197,10 @@ void Updater::drain(uint32_t b, int c) {
 }
 
 void Updater::stop_waiting(uint32_t v) {
+  if (f_.waiting == 0) return;
   const uint32_t d = f_.wait_on[v];
   if (d == kNoNode) return;
+  --f_.waiting;
   const uint32_t n = f_.wait_next[v], pr = f_.wait_prev[v];
   if (pr != kNoNode) f_.wait_next[pr] = n;
   else f_.wait_head[d] = n;
@@ -208,6 +210,7 @@ void Updater::stop_waiting(uint32_t v) {
 
 void Updater::wait_for(uint32_t v, uint32_t d) {
   stop_waiting(v);
+  ++f_.waiting;
   f_.wait_on[v] = d;
   f_.wait_prev[v] = kNoNode;
   f_.wait_next[v] = f_.wait_head[d];
@@ -217,6 +220,7 @@ void Updater::wait_for(uint32_t v, uint32_t d) {
 
 // d became active: whoever waited on it is judged again (this frame in phase one).
 void Updater::wake(uint32_t d) {
+  if (f_.waiting == 0) return;
   while (f_.wait_head[d] != kNoNode) {
     const uint32_t v = f_.wait_head[d];
     stop_waiting(v);
@@ -230,8 +234,10 @@ void Updater::wake(uint32_t d) {
 void Updater::split(uint32_t x) {
   const uint32_t i = x - t_.leaf_count;
   const uint32_t c1 = t_.children[2 * i], c2 = t_.children[2 * i + 1];
-  const uint32_t par = t_.parent[x];
-  if (par != kNoNode && f_.pending_until[par - t_.leaf_count] >= 0) end_pending(par);
+  if (f_.pending_count) {
+    const uint32_t par = t_.parent[x];
+    if (par != kNoNode && f_.pending_until[par - t_.leaf_count] >= 0) end_pending(par);
+  }
   unfile(x);
   stop_waiting(x);
   // Active list: x out (its slot goes to c1), c2 appended.
@@ -243,13 +249,17 @@ void Updater::split(uint32_t x) {
   f_.active[f_.active_count++] = c2;
   f_.state[c1] = f_.state[c2] = VertexFront::kActive;
   // Faces around x take the child holding their corner's leaf.
+  const uint32_t lo1 = t_.leaf_lo[c1], hi1 = t_.leaf_hi[c1];
   for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
     const uint32_t face = t_.inc_faces[k];
     const uint32_t s = f_.face_slot[face];
     if (s == kNoNode) continue;
     uint32_t* tri = &f_.tri_indices[3 * size_t(s)];
     for (int j = 0; j < 3; ++j)
-      if (tri[j] == x) tri[j] = t_.covers(c1, t_.face_leaves[3 * size_t(face) + j]) ? c1 : c2;
+      if (tri[j] == x) {
+        const uint32_t r = t_.face_ranks[3 * size_t(face) + j];
+        tri[j] = r >= lo1 && r < hi1 ? c1 : c2;
+      }
   }
   // The split's own faces, appended to the packed triangle array.
   for (int k = 0; k < 2; ++k) {
@@ -258,9 +268,10 @@ void Updater::split(uint32_t x) {
     const uint32_t s = f_.tri_count++;
     f_.face_slot[face] = s;
     f_.tri_face[s] = face;
+    const uint32_t lo2 = t_.leaf_lo[c2], hi2 = t_.leaf_hi[c2];
     for (int j = 0; j < 3; ++j) {
-      const uint32_t leaf = t_.face_leaves[3 * size_t(face) + j];
-      f_.tri_indices[3 * size_t(s) + j] = t_.covers(c1, leaf) ? c1 : t_.covers(c2, leaf) ? c2 : t_.wings[2 * i + k];
+      const uint32_t r = t_.face_ranks[3 * size_t(face) + j];
+      f_.tri_indices[3 * size_t(s) + j] = r >= lo1 && r < hi1 ? c1 : r >= lo2 && r < hi2 ? c2 : t_.wings[2 * i + k];
     }
   }
   emit(x, FrontEventKind::split);
@@ -591,6 +602,7 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
   f.wait_next.assign(n, kNoNode);
   f.wait_prev.assign(n, kNoNode);
   f.wait_head.assign(n, kNoNode);
+  f.waiting = 0;
   f.pending_until.assign(inner, -1.0);
   f.pending.assign(inner, 0);
   f.pending_pos.assign(inner, 0);

@@ -102,6 +102,7 @@ struct VertexFront {
   // Collapses blocked by a finer neighbour wait on it (intrusive lists keyed by the neighbour)
   // and are woken when it becomes active, so they are not polled every frame.
   std::vector<uint32_t> wait_on, wait_next, wait_prev, wait_head;  // per node
+  uint32_t waiting = 0;  // nodes on some wait list
 
   // Deferred collapses (geomorphing): per interior node the time it may collapse.
   std::vector<double> pending_until;  // < 0: not pending

@@ -128,6 +128,8 @@ void pack_vertex_bounds(VertexTree& t) {
     b.cone_cos = static_cast<int16_t>(std::floor(std::max(c, -1.f) * 32767));
     b.parent = t.parent[v];
   }
+  t.face_ranks.resize(t.face_leaves.size());
+  for (size_t k = 0; k < t.face_leaves.size(); ++k) t.face_ranks[k] = t.leaf_rank[t.face_leaves[k]];
 }
 
 }  // namespace lod

@@ -62,8 +62,10 @@ struct VertexTree {
   std::vector<uint32_t> inc_offsets;  // interior count + 1
   std::vector<uint32_t> inc_faces;    // faces incident right after the collapse
 
-  // Derived (pack_vertex_bounds): per node, what refinement tests read.
+  // Derived (pack_vertex_bounds): per node, what refinement tests read; per face corner, the
+  // leaf's depth-first rank (so a split finds a corner's child without a leaf lookup).
   std::vector<VertexBounds> bounds;
+  std::vector<uint32_t> face_ranks;
 
   uint32_t node_count() const { return static_cast<uint32_t>(parent.size()); }
   uint32_t interior_count() const { return node_count() - leaf_count; }
