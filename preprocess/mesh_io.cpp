@@ -664,6 +664,9 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   if (!fs::exists(path, ec)) return Status::error(what + ": no such file");
   if (!fs::is_regular_file(path, ec)) return Status::error(what + ": not a regular file");
   const std::string ext = lower(path.extension().string());
+  if (ext == ".gz" || ext == ".zip" || ext == ".bz2" || ext == ".xz")
+    return Status::error(what + ": is compressed ('" + path.extension().string() +
+                         "'); decompress it first (.obj, .ply, .off or .stl)");
   if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl")
     return Status::error(what + ": unknown mesh format '" + path.extension().string() +
                          "' (expected .obj, .ply, .off or .stl)");

@@ -122,6 +122,8 @@ TEST(MeshIo, RefusesUnknownExtension) {
   expect_refused(dir / "mesh.xyz", "unknown mesh format");
   test::write_text(dir / "noext", "v 0 0 0\n");
   expect_refused(dir / "noext", "unknown mesh format");
+  test::write_text(dir / "mesh.ply.gz", "\x1f\x8b");
+  expect_refused(dir / "mesh.ply.gz", "decompress it first");
 }
 
 TEST(MeshIo, RefusesEmptyFiles) {
@@ -426,7 +428,12 @@ TEST(MeshIo, LoadsRealMeshesWithTheirPublishedCounts) {
                              {"happy-buddha-res3.ply", 32328, 67240},
                              {"horse.ply", 48485, 96966},
                              {"teapot.obj", 3644, 6320},
-                             {"spot.obj", 2930, 5856}};
+                             {"spot.obj", 2930, 5856},
+                             {"fandisk.obj", 6475, 12946},
+                             {"mountain.obj", 25600, 50562},
+                             {"rocker-arm.obj", 10044, 20088},
+                             {"stanford-armadillo-100k.obj", 49990, 99976},
+                             {"stanford-dragon.ply", 437645, 871414}};
   size_t checked = 0;
   for (const RealMesh& r : meshes) {
     const fs::path p = test::shared_meshes() / r.file;
