@@ -763,4 +763,57 @@ bool check_front(const VertexFront& f, const VertexTree& t, bool closed, std::st
   return true;
 }
 
+uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indices, const VertexFront& f,
+                            const VertexTree& t, std::span<const float> shown) {
+  assert(positions.size() >= 3 * size_t(f.active_count) && indices.size() >= 3 * size_t(f.tri_count));
+  const float* src = shown.empty() ? t.positions.data() : shown.data();
+  for (uint32_t k = 0; k < f.active_count; ++k)
+    std::copy_n(src + 3 * size_t(f.active[k]), 3, positions.data() + 3 * size_t(k));
+  // active_pos maps a node id to its slot in the active list: the compact vertex index.
+  for (size_t k = 0; k < 3 * size_t(f.tri_count); ++k) indices[k] = f.active_pos[f.tri_indices[k]];
+  return f.tri_count;
+}
+
+bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, bool closed, std::string* message) {
+  auto fail = [&](std::string text) {
+    if (message) *message = std::move(text);
+    return false;
+  };
+  if (indices.size() % 3 != 0) return fail(std::to_string(indices.size()) + " indices, not a multiple of 3");
+  std::vector<uint64_t> directed;
+  directed.reserve(indices.size());
+  for (size_t s = 0; s < indices.size() / 3; ++s) {
+    const uint32_t* tri = &indices[3 * s];
+    for (int j = 0; j < 3; ++j)
+      if (tri[j] >= vertex_count)
+        return fail("triangle " + std::to_string(s) + " references vertex " + std::to_string(tri[j]) + " of " +
+                    std::to_string(vertex_count));
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+      return fail("triangle " + std::to_string(s) + " is degenerate");
+    for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(tri[j]) << 32 | tri[(j + 1) % 3]);
+  }
+  std::sort(directed.begin(), directed.end());
+  for (size_t k = 1; k < directed.size(); ++k)
+    if (directed[k] == directed[k - 1])
+      return fail("edge " + std::to_string(directed[k] >> 32) + "->" + std::to_string(directed[k] & 0xffffffffu) +
+                  " is used twice in one direction (orientation flip or non-manifold edge)");
+  if (closed)
+    for (uint64_t e : directed)
+      if (!std::binary_search(directed.begin(), directed.end(), (e << 32) | (e >> 32)))
+        return fail("edge " + std::to_string(e >> 32) + "-" + std::to_string(e & 0xffffffffu) +
+                    " has one face on a closed mesh (crack or T-junction)");
+  return true;
+}
+
+bool triangles_closed(std::span<const uint32_t> indices) {
+  std::vector<uint64_t> directed;
+  directed.reserve(indices.size());
+  for (size_t s = 0; s + 2 < indices.size(); s += 3)
+    for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(indices[s + j]) << 32 | indices[s + (j + 1) % 3]);
+  std::sort(directed.begin(), directed.end());
+  for (uint64_t e : directed)
+    if (!std::binary_search(directed.begin(), directed.end(), (e << 32) | (e >> 32))) return false;
+  return !directed.empty();
+}
+
 }  // namespace lod

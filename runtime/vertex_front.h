@@ -140,4 +140,19 @@ void front_coarsen_all(VertexFront& front, const VertexTree& tree);
 // `lod run --validate` tool, not a per-frame stage). `message` names the first bad element.
 bool check_front(const VertexFront& front, const VertexTree& tree, bool closed, std::string* message);
 
+// The front as a compact mesh for a consumer: positions of the active vertices in active-list
+// order (taken from `shown`, xyz per node id, e.g. geomorphed positions; the tree's own
+// positions when `shown` is empty) and triangles [0, tri_count) indexing them. `positions`
+// holds at least 3 * active_count floats, `indices` 3 * tri_count. Returns tri_count.
+uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indices, const VertexFront& front,
+                            const VertexTree& tree, std::span<const float> shown);
+
+// Checks a plain indexed triangle list: indices < vertex_count, no repeated corner, each
+// directed edge at most once; with `closed` every edge also used the other way round.
+// Allocates. `message` names the first bad triangle or edge.
+bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, bool closed, std::string* message);
+
+// True when every directed edge of the list has its reverse (a closed, oriented surface).
+bool triangles_closed(std::span<const uint32_t> indices);
+
 }  // namespace lod

@@ -204,3 +204,45 @@ TEST(VertexFront, FrontViewUndoesTheObjectTransform) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+TEST(VertexFront, CompactMeshIndexesActiveVerticesOnly) {
+  const VertexTree t = test::square_tree();
+  VertexFront f;
+  front_init(f, t, 1);
+  std::vector<float> pos(3 * 5);
+  std::vector<uint32_t> idx(3 * 2);
+  ASSERT_EQ(front_compact_mesh(pos, idx, f, t, {}), 1u);
+  std::string msg;
+  EXPECT_TRUE(check_triangles(std::span(idx.data(), 3), f.active_count, false, &msg)) << msg;
+  // The base triangle (4, 2, 3) through the compact vertex list gives the node positions.
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(pos[3 * idx[j] + k], t.positions[3 * f.tri_indices[j] + k]);
+  front_refine_all(f, t);
+  ASSERT_EQ(front_compact_mesh(pos, idx, f, t, {}), 2u);
+  EXPECT_TRUE(check_triangles(idx, 4, false, &msg)) << msg;
+  EXPECT_FALSE(triangles_closed(idx));
+}
+
+TEST(VertexFront, CheckTrianglesCatchesBadLists) {
+  std::string msg;
+  const std::vector<uint32_t> tetra = {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0};
+  EXPECT_TRUE(check_triangles(tetra, 4, true, &msg)) << msg;
+  EXPECT_TRUE(triangles_closed(tetra));
+  EXPECT_FALSE(check_triangles(tetra, 3, true, &msg));  // index 3 out of range
+  EXPECT_NE(msg.find("references vertex 3 of 3"), std::string::npos) << msg;
+  std::vector<uint32_t> open(tetra.begin(), tetra.end() - 3);
+  EXPECT_FALSE(check_triangles(open, 4, true, &msg));  // a hole: crack
+  EXPECT_TRUE(check_triangles(open, 4, false, &msg));
+  std::vector<uint32_t> flipped = tetra;
+  std::swap(flipped[1], flipped[2]);
+  EXPECT_FALSE(check_triangles(flipped, 4, false, &msg));
+  const std::vector<uint32_t> degenerate = {0, 1, 1};
+  EXPECT_FALSE(check_triangles(degenerate, 4, false, &msg));
+}
+
+}  // namespace
+}  // namespace lod
