@@ -21,7 +21,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 2;
+constexpr uint32_t kBakeFormatVersion = 3;  // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
 constexpr size_t kSmallModelTriangles = 20000;
