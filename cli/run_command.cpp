@@ -13,9 +13,46 @@
 #include "jobs/scene_config.h"
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
+#include "runtime/vertex_front.h"
 
 namespace lod::cli {
 namespace {
+
+// --validate for view-dependent objects: every active mesh is a valid triangulation (indices in
+// range, no degenerate triangle, each directed edge once; closed inputs: every edge twice, so
+// no crack or T-junction), ranges inside the frame's arrays, totals adding up.
+bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
+  char buf[256];
+  uint64_t tris = 0, splits = 0, collapses = 0;
+  for (size_t k = 0; k < f.vd_objects.size(); ++k) {
+    const VdObjectFrame& o = f.vd_objects[k];
+    if (o.object >= scene.objects.size() || scene.chains[scene.objects.model[o.object]].hierarchy.empty()) {
+      std::snprintf(buf, sizeof buf, "vd entry %zu: object %u is not view-dependent", k, o.object);
+      *why = buf;
+      return false;
+    }
+    if (uint64_t(o.first_vertex + o.vertex_count) * 3 > f.vd_positions.size() ||
+        uint64_t(o.first_index) + o.index_count > f.vd_indices.size() || o.index_count % 3 != 0) {
+      std::snprintf(buf, sizeof buf, "vd object %u: vertex or index range outside the frame's arrays", o.object);
+      *why = buf;
+      return false;
+    }
+    std::string bad;
+    if (!check_triangles(std::span(f.vd_indices.data() + o.first_index, o.index_count), o.vertex_count, o.closed,
+                         &bad)) {
+      *why = "vd object " + std::to_string(o.object) + ": " + bad;
+      return false;
+    }
+    tris += o.index_count / 3;
+    splits += o.splits;
+    collapses += o.collapses;
+  }
+  if (tris != f.vd_active_tris || splits != f.vd_splits || collapses != f.vd_collapses) {
+    *why = "vd totals do not add up over the vd objects";
+    return false;
+  }
+  return true;
+}
 
 // --validate: the invariants every published frame must hold.
 bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index, std::string* why) {
@@ -52,7 +89,7 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
     *why = buf;
     return false;
   }
-  return true;
+  return validate_vd_objects(f, scene, why);
 }
 
 }  // namespace

@@ -52,6 +52,9 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"over_budget", r.over_budget},
           {"lowered_steps", r.lowered_steps},
           {"levels", levels},
+          {"vd_active_tris", r.vd_active_tris},
+          {"vd_splits", r.vd_splits},
+          {"vd_collapses", r.vd_collapses},
           {"ms", ms}};
 }
 
@@ -98,6 +101,9 @@ FrameRecord record_of(const Frame& f) {
   r.levels = f.level_histogram;
   r.stage_ms = f.stage_ms;
   r.total_ms = f.total_ms;
+  r.vd_active_tris = f.vd_active_tris;
+  r.vd_splits = f.vd_splits;
+  r.vd_collapses = f.vd_collapses;
   return r;
 }
 

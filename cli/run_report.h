@@ -21,6 +21,7 @@ struct FrameRecord {
   std::array<uint32_t, kHistogramLevels> levels{};
   std::array<double, kStageCount> stage_ms{};
   double total_ms = 0;
+  uint64_t vd_active_tris = 0, vd_splits = 0, vd_collapses = 0;  // view-dependent objects
 };
 
 FrameRecord record_of(const Frame& frame);

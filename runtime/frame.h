@@ -14,6 +14,21 @@ inline constexpr const char* kStageNames[] = {"view",     "visibility", "importa
 inline constexpr size_t kStageCount = static_cast<size_t>(Stage::count);
 inline constexpr size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 
+// One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
+// draws instead of a discrete level. Positions are object space and already geomorphed.
+struct VdObjectFrame {
+  uint32_t object = 0;        // object id
+  uint32_t first_vertex = 0;  // into Frame::vd_positions, in vertices
+  uint32_t vertex_count = 0;
+  uint32_t first_index = 0;   // into Frame::vd_indices; indices are local to this object's vertices
+  uint32_t index_count = 0;   // 3 per triangle
+  uint32_t splits = 0;        // this frame
+  uint32_t collapses = 0;
+  uint32_t moving = 0;        // vertices still geomorphing
+  float threshold = 0;        // pixel threshold after this frame's feedback
+  bool closed = false;        // the object's full mesh is closed (every edge in two faces)
+};
+
 struct Frame {
   uint64_t index = 0;  // frame number, increasing
   View view;
@@ -33,6 +48,15 @@ struct Frame {
   bool over_budget = false;     // even the coarsest levels exceed M
   uint32_t lowered_steps = 0;   // heap pops in selection
   std::array<uint32_t, kHistogramLevels> level_histogram{};  // objects per l
+
+  // View-dependent objects (models with view_dependent = true), visible ones only, in object
+  // order; their discrete level above still says the share of the budget they were given.
+  std::vector<VdObjectFrame> vd_objects;
+  std::vector<float> vd_positions;   // xyz per vertex, all vd objects back to back
+  std::vector<uint32_t> vd_indices;  // all vd objects back to back
+  uint64_t vd_active_tris = 0;
+  uint64_t vd_splits = 0;
+  uint64_t vd_collapses = 0;
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds
   double total_ms = 0;
