@@ -26,6 +26,11 @@ constexpr float kMinNormalCos = 0.2f;
 // Optimal placement is regularised towards the edge midpoint by this fraction of trace(A), so
 // flat and crease regions (rank-deficient A) still get a well-defined, nearby optimum.
 constexpr double kRegularisation = 1e-3;
+// Edges at vertices with more faces than this are left alone: checking a collapse walks the
+// faces of both ends, and a hub of a huge fan would make every pass quadratic.
+constexpr uint32_t kMaxValence = 256;
+// Passes per level before giving up (each removes at least one face); real meshes need ~10.
+constexpr int kMaxPassesPerLevel = 100;
 // Weight of each vertex's point quadric, relative to the mean vertex area.
 constexpr double kPointWeight = 1e-3;
 // An optimum farther than this many edge lengths from the midpoint is distrusted.
@@ -319,10 +324,12 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
   for (uint32_t a = 0; a < nv; ++a) {
     const uint8_t ka = w.kind[a];
     const Quadric& qa = mesh.quadrics[a];
+    if (w.offset[a + 1] - w.offset[a] > kMaxValence) continue;
     for (uint32_t i = w.offset[a]; i < w.offset[a + 1]; ++i) {
       const uint32_t b = w.ring[2 * i];
       const uint8_t kb = w.kind[b];
       if (ka == kLocked && kb == kLocked) continue;
+      if (w.offset[b + 1] - w.offset[b] > kMaxValence) continue;
       const bool border = (ka == kBorder && w.next[a] == b) || (kb == kBorder && w.prev[b] == a);
       if (!border && a > b) continue;  // an interior edge is seen from both faces
       Candidate c;
@@ -686,7 +693,7 @@ size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* tar
   for (size_t l = 0; l < level_count; ++l) {
     const size_t target = std::min(target_triangles[l], previous_target);
     previous_target = target;
-    while (mesh.triangle_count() > target && !hit_limit) {
+    for (int pass = 0; pass < kMaxPassesPerLevel && mesh.triangle_count() > target && !hit_limit; ++pass) {
       if (2 * mesh.triangle_count() < compacted_at) {
         compact_vertices(w, mesh);
         compacted_at = mesh.triangle_count();

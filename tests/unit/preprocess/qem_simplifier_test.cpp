@@ -366,6 +366,29 @@ TEST(QemSimplifier, BowTieNonManifoldAndDegenerateInputsNeverCrash) {
   EXPECT_FALSE(levels[2].reached);  // zero faces is not reachable without tearing shapes apart
 }
 
+TEST(QemSimplifier, HugeFanFinishesAndSimplifiesAroundItsHub) {
+  // A disk of 20 rings around one centre vertex shared by 4,000 faces.
+  Soup s;
+  const int spokes = 4000, rings = 20;
+  s.positions.insert(s.positions.end(), {0, 0, 0});
+  for (int r = 1; r <= rings; ++r)
+    for (int k = 0; k < spokes; ++k) {
+      const double a = 2 * M_PI * k / spokes;
+      s.positions.insert(s.positions.end(), {float(r * std::cos(a)), float(r * std::sin(a)), 0.01f * float(k % 7)});
+    }
+  auto id = [&](int r, int k) { return uint32_t(1 + (r - 1) * spokes + (k % spokes)); };
+  for (int k = 0; k < spokes; ++k) s.indices.insert(s.indices.end(), {0, id(1, k), id(1, k + 1)});
+  for (int r = 1; r < rings; ++r)
+    for (int k = 0; k < spokes; ++k) {
+      s.indices.insert(s.indices.end(), {id(r, k), id(r + 1, k), id(r + 1, k + 1)});
+      s.indices.insert(s.indices.end(), {id(r, k), id(r + 1, k + 1), id(r, k + 1)});
+    }
+  const auto levels = run_chain(s, targets_for(s.triangle_count(), {0.5, 0.1}));
+  EXPECT_LT(levels[0].triangle_count(), s.triangle_count() * 6 / 10);
+  EXPECT_LT(levels[1].triangle_count(), levels[0].triangle_count());
+  for (const auto& [edge, count] : directed_edges(levels[1].indices)) ASSERT_EQ(count, 1);
+}
+
 TEST(QemSimplifier, EmptyAndTinyInputs) {
   std::vector<ChainLevelOut> levels(1);
   const size_t target = 0;
