@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <thread>
 
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
@@ -103,6 +104,33 @@ TEST(DecimaterChain, RefusesBadRatiosAndEmptyInput) {
   MeshData empty;
   const std::vector<float> one = {1.0f};
   EXPECT_FALSE(bake_decimater_chain(empty, one, levels, nullptr, nullptr).ok);
+}
+
+TEST(DecimaterChain, GivesTheSameChainWhenRunConcurrently) {
+  // Non-manifold input makes OpenMesh complain on omerr(), which is silenced under the
+  // shared OpenMesh lock; several threads must still get identical, complete chains.
+  MeshData m = sphere(16, 20);
+  const size_t n = m.vertex_count();
+  m.positions.insert(m.positions.end(), {0, 0, 2});
+  m.indices.insert(m.indices.end(), {m.indices[0], m.indices[1], uint32_t(n)});  // a fin on edge 0
+  const std::vector<float> ratios = {1.0f, 0.5f, 0.25f};
+  std::vector<ChainLevel> ref;
+  ASSERT_TRUE(bake_decimater_chain(m, ratios, ref, nullptr, nullptr).ok);
+  std::vector<ChainLevel> out[4];
+  Status st[4];
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 4; ++i)
+    threads.emplace_back([&, i] { st[i] = bake_decimater_chain(m, ratios, out[i], nullptr, nullptr); });
+  for (std::thread& t : threads) t.join();
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(st[i].ok);
+    ASSERT_EQ(out[i].size(), ref.size());
+    for (size_t l = 0; l < ref.size(); ++l) {
+      EXPECT_EQ(out[i][l].indices, ref[l].indices);
+      EXPECT_EQ(out[i][l].positions, ref[l].positions);
+    }
+  }
+  EXPECT_EQ(ref[0].triangle_count(), m.triangle_count());
 }
 
 TEST(DecimaterChain, CowChainHitsTheReferenceRatios) {
