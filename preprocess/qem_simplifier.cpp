@@ -31,6 +31,8 @@ constexpr double kRegularisation = 1e-3;
 constexpr uint32_t kMaxValence = 256;
 // Passes per level before giving up (each removes at least one face); real meshes need ~10.
 constexpr int kMaxPassesPerLevel = 100;
+// Below this many faces a split costs more than it saves.
+constexpr size_t kMinSplitTriangles = 20000;
 // Weight of each vertex's point quadric, relative to the mean vertex area.
 constexpr double kPointWeight = 1e-3;
 // An optimum farther than this many edge lengths from the midpoint is distrusted.
@@ -542,57 +544,55 @@ void snapshot(ChainLevelOut& level, Work& w, const QemMesh& mesh) {
 
 }  // namespace
 
-void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, const uint32_t* indices,
-                 size_t index_count, const QemOptions& options) {
-  out = QemMesh{};
-  out.input_vertex_count = vertex_count;
-  out.attribute_count = options.attributes ? options.attribute_count : 0;
-  const size_t ac = out.attribute_count;
+namespace {
 
-  // Frame: a power-of-two scale and no offset, so normalising is exact and vertices that
-  // never move come out bit-identical.
-  std::vector<uint8_t> finite(vertex_count);
+// What every part of one input shares: the frame, the valid faces, vertex locks and the
+// weight of the point quadrics.
+struct Frame {
+  float scale = 1;
+  double point_weight = 0;
+  std::vector<uint8_t> finite;
+  std::vector<uint8_t> lock;    // per input vertex
+  std::vector<uint32_t> faces;  // valid input faces, input ids
+};
+
+void make_frame(Frame& f, const float* positions, size_t vertex_count, const uint32_t* indices, size_t index_count,
+                const QemOptions& options) {
+  // A power-of-two scale and no offset, so normalising is exact and vertices that never move
+  // come out bit-identical.
+  f.finite.resize(vertex_count);
   float max_abs = 0;
   for (size_t v = 0; v < vertex_count; ++v) {
     const float* p = positions + 3 * v;
-    finite[v] = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
-    if (!finite[v]) continue;
+    f.finite[v] = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+    if (!f.finite[v]) continue;
     for (int k = 0; k < 3; ++k) max_abs = std::max(max_abs, std::fabs(p[k]));
   }
-  out.scale = max_abs > 0 ? std::exp2(std::ceil(std::log2(max_abs))) : 1.f;
-  const float inv = 1 / out.scale;
-
-  out.positions.resize(3 * vertex_count);
-  for (size_t v = 0; v < vertex_count; ++v)
-    for (int k = 0; k < 3; ++k)
-      out.positions[3 * v + k] = finite[v] ? positions[3 * v + k] * inv : 0;
-  if (ac) out.attributes.assign(options.attributes, options.attributes + ac * vertex_count);
-  out.source_vertex.resize(vertex_count);
-  for (size_t v = 0; v < vertex_count; ++v) out.source_vertex[v] = uint32_t(v);
-  out.lock.assign(vertex_count, 0);
-  if (options.vertex_lock)
-    for (size_t v = 0; v < vertex_count; ++v) out.lock[v] = options.vertex_lock[v] ? QemMesh::kLockUser : 0;
+  f.scale = max_abs > 0 ? std::exp2(std::ceil(std::log2(max_abs))) : 1.f;
+  const float inv = 1 / f.scale;
 
   // Faces that cannot be simplified meaningfully are dropped: bad indices, repeats, NaNs.
-  out.indices.reserve(index_count);
+  f.faces.clear();
+  f.faces.reserve(index_count);
   for (size_t t = 0; t + 2 < index_count; t += 3) {
     const uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];
     if (a >= vertex_count || b >= vertex_count || c >= vertex_count) continue;
-    if (a == b || b == c || a == c || !finite[a] || !finite[b] || !finite[c]) continue;
-    out.indices.insert(out.indices.end(), {a, b, c});
+    if (a == b || b == c || a == c || !f.finite[a] || !f.finite[b] || !f.finite[c]) continue;
+    f.faces.insert(f.faces.end(), {a, b, c});
   }
 
-  const size_t used_vertices = out.source_vertex.size();
-
+  f.lock.assign(vertex_count, 0);
+  if (options.vertex_lock)
+    for (size_t v = 0; v < vertex_count; ++v) f.lock[v] = options.vertex_lock[v] ? QemMesh::kLockUser : 0;
   // Vertices sharing a position (attribute seams, unwelded input) are locked: moving one copy
   // alone would tear the surface open.
   {
     size_t cap = 16;
-    while (cap < 2 * used_vertices) cap *= 2;
+    while (cap < 2 * vertex_count) cap *= 2;
     std::vector<uint32_t> table(cap, ~0u);
-    for (size_t v = 0; v < used_vertices; ++v) {
-      if (!finite[v]) continue;
-      const float* p = &out.positions[3 * v];
+    for (size_t v = 0; v < vertex_count; ++v) {
+      if (!f.finite[v]) continue;
+      const float* p = positions + 3 * v;
       uint32_t h[3];
       std::memcpy(h, p, 12);
       size_t slot = (h[0] * 73856093u ^ h[1] * 19349663u ^ h[2] * 83492791u) & (cap - 1);
@@ -602,9 +602,9 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
           table[slot] = uint32_t(v);
           break;
         }
-        if (std::memcmp(&out.positions[3 * size_t(o)], p, 12) == 0) {
-          out.lock[v] |= QemMesh::kLockUser;
-          out.lock[o] |= QemMesh::kLockUser;
+        if (std::memcmp(positions + 3 * size_t(o), p, 12) == 0) {
+          f.lock[v] |= QemMesh::kLockUser;
+          f.lock[o] |= QemMesh::kLockUser;
           break;
         }
         slot = (slot + 1) & (cap - 1);
@@ -612,8 +612,60 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
     }
   }
 
-  // Area-weighted face planes, plus constraint planes through border edges.
-  out.quadrics.assign(used_vertices, Quadric{});
+  // A weak point quadric at every vertex, the same for all: plane quadrics alone see no error
+  // when a needle or fin of tiny faces (scan spikes) folds back along its own planes, and a
+  // mean-area-normalised cost would remove such features first and cost a large Hausdorff
+  // distance. Against ordinary faces it is negligible. Weight: kPointWeight x the mean area
+  // per vertex (each face counted at its three corners).
+  double area = 0;
+  std::vector<uint8_t> has_area(vertex_count, 0);
+  for (size_t t = 0; t < f.faces.size(); t += 3) {
+    const uint32_t* c = &f.faces[t];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+      const float p0 = positions[3 * size_t(c[0]) + k] * inv;
+      e1[k] = double(positions[3 * size_t(c[1]) + k] * inv) - p0;
+      e2[k] = double(positions[3 * size_t(c[2]) + k] * inv) - p0;
+    }
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0)) continue;
+    area += 3 * 0.5 * len;
+    has_area[c[0]] = has_area[c[1]] = has_area[c[2]] = 1;
+  }
+  size_t with_area = 0;
+  for (uint8_t h : has_area) with_area += h;
+  f.point_weight = kPointWeight * area / double(std::max<size_t>(with_area, 1));
+}
+
+// The working mesh of `vertices` (input ids, in the order they get) and `faces` (ids into
+// `vertices`). `seam` (optional, per part vertex) marks vertices shared with another part:
+// they are locked, get no boundary planes along the cut, and their point quadric only where
+// `point_terms_on_seam` (so that merging the parts adds it once).
+void build_part(QemMesh& out, const float* positions, size_t vertex_count, const Frame& f,
+                const std::vector<uint32_t>& vertices, std::vector<uint32_t>&& faces, const std::vector<uint8_t>* seam,
+                bool point_terms_on_seam, const QemOptions& options) {
+  out = QemMesh{};
+  out.input_vertex_count = vertex_count;
+  out.attribute_count = options.attributes ? options.attribute_count : 0;
+  out.scale = f.scale;
+  const size_t ac = out.attribute_count;
+  const size_t nv = vertices.size();
+  const float inv = 1 / f.scale;
+  out.positions.resize(3 * nv);
+  out.attributes.resize(ac * nv);
+  out.source_vertex = vertices;
+  out.lock.resize(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    const uint32_t v = vertices[i];
+    for (int k = 0; k < 3; ++k) out.positions[3 * i + k] = f.finite[v] ? positions[3 * size_t(v) + k] * inv : 0;
+    if (ac) std::memcpy(&out.attributes[ac * i], options.attributes + ac * v, ac * sizeof(float));
+    out.lock[i] = uint8_t(f.lock[v] | (seam && (*seam)[i] ? QemMesh::kLockSeam : 0));
+  }
+  out.indices = std::move(faces);
+
+  // Area-weighted face planes.
+  out.quadrics.assign(nv, Quadric{});
   const size_t nt = out.indices.size() / 3;
   for (size_t t = 0; t < nt; ++t) {
     const float* p0 = &out.positions[3 * size_t(out.indices[3 * t])];
@@ -623,35 +675,29 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
     const double e2[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
     double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (len <= 0) continue;  // zero-area faces carry no plane
+    if (!(len > 0)) continue;  // zero-area faces carry no plane
     for (double& x : n) x /= len;
     const double d = -(n[0] * p0[0] + n[1] * p0[1] + n[2] * p0[2]);
     for (int k = 0; k < 3; ++k) quadric_add_plane(out.quadrics[out.indices[3 * t + k]], n[0], n[1], n[2], d, 0.5 * len);
   }
-  // A weak point quadric at every vertex, the same for all: plane quadrics alone see no error
-  // when a needle or fin of tiny faces (scan spikes) folds back along its own planes, and a
-  // mean-area-normalised cost would remove such features first and cost a large Hausdorff
-  // distance. Against ordinary faces it is negligible.
-  double mean_area = 0;
-  size_t used = 0;
-  for (size_t v = 0; v < used_vertices; ++v) mean_area += out.quadrics[v].w, used += out.quadrics[v].w > 0;
-  mean_area /= std::max<size_t>(used, 1);
-  for (size_t v = 0; v < used_vertices; ++v) {
+  for (size_t v = 0; v < nv; ++v) {
     Quadric& q = out.quadrics[v];
-    if (!(q.w > 0)) continue;
-    const double wv = kPointWeight * mean_area;
+    if (!(q.w > 0) || (seam && (*seam)[v] && !point_terms_on_seam)) continue;
+    const double wv = f.point_weight;
     const double x = out.positions[3 * v], y = out.positions[3 * v + 1], z = out.positions[3 * v + 2];
     q.a00 += wv, q.a11 += wv, q.a22 += wv;
     q.b0 -= wv * x, q.b1 -= wv * y, q.b2 -= wv * z;
     q.c += wv * (x * x + y * y + z * z);
   }
+  // Constraint planes through border edges (not through the cut between parts).
   if (nt > 0 && options.border_weight > 0) {
     Work w;
     build_lists(w, out);
     classify(w, out, false);
-    for (size_t v = 0; v < used_vertices; ++v) {
+    for (size_t v = 0; v < nv; ++v) {
       const uint32_t b = w.next[v];
       if (b == ~0u) continue;
+      if (seam && (*seam)[v] && (*seam)[b]) continue;
       uint32_t c = ~0u;  // apex of the border edge's face
       for (uint32_t i = w.offset[v]; i < w.offset[v + 1]; ++i)
         if (w.ring[2 * i] == b) c = w.ring[2 * i + 1];
@@ -659,8 +705,8 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
       const float* pb = &out.positions[3 * size_t(b)];
       const float* pc = &out.positions[3 * size_t(c)];
       const double e[3] = {double(pb[0]) - pa[0], double(pb[1]) - pa[1], double(pb[2]) - pa[2]};
-      const double f[3] = {double(pc[0]) - pa[0], double(pc[1]) - pa[1], double(pc[2]) - pa[2]};
-      const double n[3] = {e[1] * f[2] - e[2] * f[1], e[2] * f[0] - e[0] * f[2], e[0] * f[1] - e[1] * f[0]};
+      const double g[3] = {double(pc[0]) - pa[0], double(pc[1]) - pa[1], double(pc[2]) - pa[2]};
+      const double n[3] = {e[1] * g[2] - e[2] * g[1], e[2] * g[0] - e[0] * g[2], e[0] * g[1] - e[1] * g[0]};
       // The constraint plane contains the edge and is perpendicular to the face.
       double m[3] = {e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2], e[0] * n[1] - e[1] * n[0]};
       const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
@@ -676,6 +722,17 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
       }
     }
   }
+}
+
+}  // namespace
+
+void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, const uint32_t* indices,
+                 size_t index_count, const QemOptions& options) {
+  Frame f;
+  make_frame(f, positions, vertex_count, indices, index_count, options);
+  std::vector<uint32_t> all(vertex_count);
+  for (size_t v = 0; v < vertex_count; ++v) all[v] = uint32_t(v);
+  build_part(out, positions, vertex_count, f, all, std::move(f.faces), nullptr, true, options);
 }
 
 size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* target_triangles,
@@ -722,7 +779,6 @@ size_t qem_simplify_chain(ChainLevelOut* levels, const float* positions, size_t 
 size_t qem_split(QemMesh* parts, const QemMesh& whole) {
   const size_t nt = whole.triangle_count();
   const size_t nv = whole.positions.size() / 3;
-  constexpr size_t kMinSplitTriangles = 20000;  // below this a split costs more than it saves
   if (nt < kMinSplitTriangles) {
     parts[0] = whole;
     return 1;
@@ -851,24 +907,72 @@ size_t qem_simplify_chain_split(ChainLevelOut* levels, const float* positions, s
                                 const uint32_t* indices, size_t index_count,
                                 const size_t* target_triangles, size_t level_count,
                                 const QemOptions& options, const ParallelFor& parallel_for) {
-  QemMesh whole;
-  qem_prepare(whole, positions, vertex_count, indices, index_count, options);
-  QemMesh parts[2];
-  if (qem_split(parts, whole) < 2)
-    return qem_simplify_mesh(levels, parts[0], target_triangles, level_count, options);
+  Frame f;
+  make_frame(f, positions, vertex_count, indices, index_count, options);
+  const size_t nt = f.faces.size() / 3;
+  if (nt < kMinSplitTriangles) {
+    QemMesh whole;
+    std::vector<uint32_t> all(vertex_count);
+    for (size_t v = 0; v < vertex_count; ++v) all[v] = uint32_t(v);
+    build_part(whole, positions, vertex_count, f, all, std::move(f.faces), nullptr, true, options);
+    return qem_simplify_mesh(levels, whole, target_triangles, level_count, options);
+  }
+
+  // Halves at the median face centre along the longest axis; every part is then built and
+  // simplified on its own thread, so only this split is serial.
+  const float inv = 1 / f.scale;
+  float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+  for (uint32_t v : f.faces)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min(lo[k], positions[3 * size_t(v) + k] * inv), hi[k] = std::max(hi[k], positions[3 * size_t(v) + k] * inv);
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  std::vector<float> centre(nt);
+  for (size_t t = 0; t < nt; ++t) {
+    float c = 0;
+    for (int k = 0; k < 3; ++k) c += positions[3 * size_t(f.faces[3 * t + k]) + axis] * inv;
+    centre[t] = c;
+  }
+  std::vector<float> sorted = centre;
+  std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(nt / 2), sorted.end());
+  const float median = sorted[nt / 2];
+  std::vector<uint8_t> side(nt), used(vertex_count, 0);
+  size_t faces_in[2] = {0, 0};
+  for (size_t t = 0; t < nt; ++t) {
+    side[t] = centre[t] < median ? 0 : 1;
+    faces_in[side[t]]++;
+    for (int k = 0; k < 3; ++k) used[f.faces[3 * t + k]] |= uint8_t(1u << side[t]);
+  }
+  size_t seam = 0;
+  for (uint8_t u : used) seam += u == 3;
 
   // The halves run alone while their locked shared border is small next to the target.
   constexpr size_t kSeamFactor = 12;
-  size_t seam = 0;
-  for (uint8_t l : parts[0].lock) seam += (l & QemMesh::kLockSeam) != 0;
-  const size_t nt = whole.triangle_count();
   const size_t handoff = std::min(nt, kSeamFactor * seam);
   size_t parallel_levels = 0;
   while (parallel_levels < level_count && target_triangles[parallel_levels] >= handoff) parallel_levels++;
 
+  QemMesh parts[2];
   std::vector<ChainLevelOut> part_levels[2];
   parallel_for(2, [&](size_t p) {
-    const double share = double(parts[p].triangle_count()) / double(nt);
+    std::vector<uint32_t> local(vertex_count, ~0u), vertices, faces;
+    std::vector<uint8_t> on_seam;
+    faces.reserve(3 * faces_in[p]);
+    for (size_t t = 0; t < nt; ++t) {
+      if (side[t] != p) continue;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = f.faces[3 * t + k];
+        if (local[v] == ~0u) {
+          local[v] = uint32_t(vertices.size());
+          vertices.push_back(v);
+          on_seam.push_back(used[v] == 3);
+        }
+        faces.push_back(local[v]);
+      }
+    }
+    build_part(parts[p], positions, vertex_count, f, vertices, std::move(faces), &on_seam, p == 0, options);
+    const double share = double(faces_in[p]) / double(nt);
     std::vector<size_t> targets;
     for (size_t l = 0; l < parallel_levels; ++l) targets.push_back(size_t(std::llround(target_triangles[l] * share)));
     const size_t last = parallel_levels ? target_triangles[parallel_levels - 1] : nt;
@@ -881,7 +985,8 @@ size_t qem_simplify_chain_split(ChainLevelOut* levels, const float* positions, s
     chain_level_merge(levels[l], pair, 2);
     levels[l].target_triangles = target_triangles[l];
   }
-  whole = QemMesh{};
+  if (parallel_levels == level_count) return level_count;
+  QemMesh whole;
   qem_merge(whole, parts, 2);
   parts[0] = parts[1] = QemMesh{};
   qem_simplify_mesh(levels + parallel_levels, whole, target_triangles + parallel_levels,

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -41,13 +42,24 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+double process_cpu_seconds() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// CPU seconds (all threads) of the last timed run, next to its wall time.
+double g_last_cpu = 0;
+
 // Best of `repeats` wall-clock runs.
 double time_best(int repeats, const std::function<void()>& fn) {
   double best = 1e30;
   for (int i = 0; i < repeats; ++i) {
+    const double c0 = process_cpu_seconds();
     const auto t0 = std::chrono::steady_clock::now();
     fn();
-    best = std::min(best, seconds_since(t0));
+    const double wall = seconds_since(t0);
+    if (wall < best) best = wall, g_last_cpu = process_cpu_seconds() - c0;
   }
   return best;
 }
@@ -95,6 +107,7 @@ struct Row {
   double ratio = 0;
   size_t target = 0, achieved = 0;
   double seconds = 0;
+  double cpu_seconds = 0;  // all threads
   double max_rel = 0, rms_rel = 0;  // fractions of the bounding-box diagonal
   double mtris_per_s() const { return seconds > 0 ? double(input) / seconds / 1e6 : 0; }
 };
@@ -110,13 +123,13 @@ struct Bench {
            size_t vertex_count, const uint32_t* indices, size_t index_count) {
     Row r;
     r.mesh = mesh, r.method = method, r.input = input, r.ratio = ratio, r.target = target;
-    r.achieved = index_count / 3, r.seconds = seconds;
+    r.achieved = index_count / 3, r.seconds = seconds, r.cpu_seconds = g_last_cpu;
     lod::SurfaceError e;
     const lod::Status s = meter.measure({positions, vertex_count, indices, index_count}, e);
     if (s.ok) r.max_rel = e.max / diag, r.rms_rel = e.rms / diag;
     else std::fprintf(stderr, "measure failed: %s\n", s.message.c_str());
-    std::printf("%-10s %-16s %7.4f%% target %8zu got %8zu  %8.3f s %7.2f Mtri/s  max %.5f%%  rms %.6f%%\n",
-                mesh.c_str(), method.c_str(), 100 * ratio, target, r.achieved, seconds, r.mtris_per_s(),
+    std::printf("%-10s %-17s %7.4f%% target %8zu got %8zu  %7.3f s (cpu %7.3f s) %6.2f Mtri/s  max %.5f%%  rms %.6f%%\n",
+                mesh.c_str(), method.c_str(), 100 * ratio, target, r.achieved, seconds, r.cpu_seconds, r.mtris_per_s(),
                 100 * r.max_rel, 100 * r.rms_rel);
     std::fflush(stdout);
     rows.push_back(r);
@@ -305,16 +318,17 @@ int main(int argc, char** argv) {
   }
 
   std::ofstream out(csv);
-  out << "mesh,method,input_triangles,ratio,target,achieved,seconds,input_mtris_per_s,max_rel_diag,rms_rel_diag\n";
+  out << "mesh,method,input_triangles,ratio,target,achieved,seconds,cpu_seconds,input_mtris_per_s,max_rel_diag,"
+         "rms_rel_diag\n";
   for (const Row& r : b.rows)
     out << r.mesh << ',' << r.method << ',' << r.input << ',' << r.ratio << ',' << r.target << ',' << r.achieved << ','
-        << r.seconds << ',' << r.mtris_per_s() << ',' << r.max_rel << ',' << r.rms_rel << '\n';
+        << r.seconds << ',' << r.cpu_seconds << ',' << r.mtris_per_s() << ',' << r.max_rel << ',' << r.rms_rel << '\n';
   std::printf("\nwrote %s\n", csv.c_str());
 
 #ifdef LOD_HAVE_MESHOPTIMIZER
   // The figures, as ratios of the same run.
-  std::printf("\n%-10s %8s | %9s %9s %9s | %9s %9s %9s\n", "mesh", "ratio", "qem/mo t", "rms/mo", "max/mo",
-              "aggr/sl t", "rms/sl@n", "count%");
+  std::printf("\n%-10s %8s | %9s %9s %9s %9s | %9s %9s %9s\n", "mesh", "ratio", "qem/mo t", "cpu/cpu", "rms/mo",
+              "max/mo", "aggr/sl t", "rms/sl@n", "count%");
   for (const Row& q : b.rows) {
     if (q.method != "lodkit-qem-2t") continue;
     const Row* mo = b.find(q.mesh, "meshopt", q.ratio);
@@ -322,8 +336,9 @@ int main(int argc, char** argv) {
     const Row* sl = b.find(q.mesh, "meshopt-sloppy", q.ratio);
     const Row* sn = b.find(q.mesh, "sloppy@aggr-count", q.ratio);
     if (!mo || !ag || !sl || !sn) continue;
-    std::printf("%-10s %7.3f%% | %9.2f %9.2f %9.2f | %9.2f %9.2f %+8.1f%%\n", q.mesh.c_str(), 100 * q.ratio,
-                mo->seconds / q.seconds, mo->rms_rel > 0 ? q.rms_rel / mo->rms_rel : 0,
+    std::printf("%-10s %7.3f%% | %9.2f %9.2f %9.2f %9.2f | %9.2f %9.2f %+8.1f%%\n", q.mesh.c_str(), 100 * q.ratio,
+                mo->seconds / q.seconds, q.cpu_seconds > 0 ? mo->cpu_seconds / q.cpu_seconds : 0,
+                mo->rms_rel > 0 ? q.rms_rel / mo->rms_rel : 0,
                 mo->max_rel > 0 ? q.max_rel / mo->max_rel : 0, sl->seconds / ag->seconds,
                 sn->rms_rel > 0 ? ag->rms_rel / sn->rms_rel : 0,
                 100.0 * (double(q.achieved) - double(q.target)) / double(std::max<size_t>(q.target, 1)));
@@ -335,7 +350,8 @@ int main(int argc, char** argv) {
         std::printf("%-10s chain: lodkit QEM %.3f s vs OpenMesh Decimater %.3f s = %.1fx\n", c.mesh.c_str(), q.seconds,
                     c.seconds, c.seconds / q.seconds);
   }
-  std::printf("(qem/mo t: meshopt_simplify time / lodkit QEM time, >= 1 is faster; rms/mo, max/mo: error ratios,\n"
+  std::printf("(qem/mo t: meshopt_simplify wall time / lodkit QEM (2 threads) wall time, >= 1 is faster; cpu/cpu:\n"
+              " the same with CPU seconds summed over threads, i.e. per-core efficiency; rms/mo, max/mo: error ratios,\n"
               " <= 1 is better; aggr/sl t: sloppy time / aggressive time; rms/sl@n: aggressive RMS / sloppy RMS at\n"
               " the aggressive count; count%%: QEM achieved vs target)\n");
 #endif
