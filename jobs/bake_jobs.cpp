@@ -10,6 +10,7 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include "preprocess/vertex_hierarchy.h"
 #include "runtime/lod_asset.h"
 
 namespace lod {
@@ -46,6 +47,29 @@ struct BakeTask {
   Status status;
 };
 
+// View-dependent models need level 0's vertex hierarchy (built once, then kept in the cached
+// asset); other models drop one a shared cache file may carry.
+Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* rewrite, LogLines& log, LodChain& chain) {
+  if (!model.view_dependent) {
+    chain.hierarchy = VertexTree{};
+    return Status::success();
+  }
+  if (!chain.hierarchy.empty()) return Status::success();
+  const LodLevel& l0 = chain.levels.at(0);
+  MeshData mesh;
+  mesh.source = model.file.string();
+  mesh.positions.assign(chain.positions.begin() + 3 * size_t(l0.first_vertex),
+                        chain.positions.begin() + 3 * size_t(l0.first_vertex + l0.vertex_count));
+  mesh.indices.assign(chain.indices.begin() + l0.first_index, chain.indices.begin() + l0.first_index + l0.index_count);
+  const auto t0 = std::chrono::steady_clock::now();
+  if (Status s = build_vertex_hierarchy(chain.hierarchy, mesh); !s) return s;
+  char ms[32];
+  std::snprintf(ms, sizeof ms, "%.0f", ms_since(t0));
+  log.line("bake " + model.name + ": vertex hierarchy of " + std::to_string(chain.hierarchy.node_count()) +
+           " nodes in " + ms + " ms");
+  return rewrite ? write_lod_asset(*rewrite, chain) : Status::success();
+}
+
 void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, LogLines& log, BakeTask& task) {
   const auto t0 = std::chrono::steady_clock::now();
   task.result.model = model.name;
@@ -64,6 +88,10 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
     LodChain cached;
     const Status read = read_lod_asset(asset, cached);
     if (read && cached.source_hash == key) {
+      if (Status h = ensure_hierarchy(model, &asset, log, cached); !h) {
+        task.status = Status::error(where + ": " + h.message);
+        return;
+      }
       task.chain = std::move(cached);
       task.result.from_cache = true;
       task.result.levels = task.chain.levels.size();
@@ -91,6 +119,10 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
   const Status baked = bake_model(model.file, model.name, model.bake, chain, &report, progress);
   if (!baked) {
     task.status = Status::error(where + ": " + baked.message);
+    return;
+  }
+  if (Status h = ensure_hierarchy(model, nullptr, log, chain); !h) {
+    task.status = Status::error(where + ": " + h.message);
     return;
   }
   const Status written = write_lod_asset(asset, chain);

@@ -7,9 +7,11 @@
 // parallel_for. Chunk boundaries do not depend on the thread count and every per-chunk
 // result lands in its own slot, merged in chunk order, so 1, 2 or N threads give
 // bit-identical frames. Selection is global (one budget) and runs serially, on the visible
-// objects that importance compacts in object order. vdlod and geomorph are pass-through
-// until view-dependent objects and geomorphing exist: they time themselves (nothing) and
-// forward.
+// objects that importance compacts in object order. vdlod updates the vertex front of every
+// visible view-dependent object (a model with a vertex hierarchy), one task per object, its
+// triangle target being the level selection gave it (its share of M); geomorph advances the
+// morph factor of level changes and the per-vertex morphs of splits and collapses, and writes
+// each view-dependent object's compact, geomorphed mesh into the frame.
 #include "jobs/frame_graph.h"
 
 #include <algorithm>
@@ -24,7 +26,9 @@
 #include <optional>
 #include <span>
 
+#include "runtime/geomorph.h"
 #include "runtime/importance.h"
+#include "runtime/vertex_front.h"
 #include "runtime/visibility.h"
 
 namespace lod {
@@ -91,8 +95,8 @@ constexpr StageEntry kStageTable[kStageCount] = {
     {"visibility", "cull_spheres, parallel over chunks"},
     {"importance", "measure_objects + minima, importance_weights + choose_initial_levels, compaction, parallel"},
     {"selection", "select_under_budget, serial over the visible set"},
-    {"vdlod", "pass-through (no view-dependent objects yet)"},
-    {"geomorph", "pass-through (morph = 1)"},
+    {"vdlod", "front_update per visible view-dependent object, parallel over objects"},
+    {"geomorph", "level morph factors; vertex morphs + compact meshes of vd objects, parallel"},
     {"publish", "totals, levels -> prev_level, parallel"},
 };
 
@@ -124,6 +128,23 @@ struct FrameGraph::Impl {
   std::vector<uint32_t> level_counts;   // chunks x kCountLanes x level_total
   std::vector<uint32_t> full_triangles; // per level: triangles of its model's level 0
   uint32_t visible_total = 0;
+
+  // View-dependent objects: one front and one morph state per object of a model with a
+  // vertex hierarchy, in object order.
+  struct VdObject {
+    uint32_t object = 0;
+    uint32_t model = 0;
+    bool closed = false;
+    VertexFront front;
+    VertexMorph morph;
+    std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
+    FrontStats stats;
+    uint32_t moving = 0;
+    int32_t slot = -1;         // this frame: index in Frame::objects, -1 = not visible
+  };
+  std::vector<VdObject> vd;
+  std::vector<uint32_t> vd_visible;     // this frame: indices into vd
+  std::vector<double> morph_start;      // per object: when its level last changed (seconds)
 
   // Per frame.
   View view;
@@ -164,6 +185,27 @@ struct FrameGraph::Impl {
     for (size_t m = 0; m < models.model_count(); ++m)
       for (size_t k = 0; k < models.level_count[m]; ++k)
         full_triangles[models.first_level[m] + k] = models.triangles[models.first_level[m]];
+    morph_start.assign(count, -1e300);
+    std::vector<uint8_t> closed(models.model_count(), 0);
+    for (size_t m = 0; m < models.model_count(); ++m) {
+      const LodChain& chain = scene.chains[m];
+      if (chain.hierarchy.empty()) continue;
+      const LodLevel& l0 = chain.levels[0];
+      closed[m] = triangles_closed(std::span(chain.indices.data() + l0.first_index, l0.index_count));
+    }
+    for (uint32_t id = 0; id < count; ++id) {
+      const uint32_t m = scene.objects.model[id];
+      const VertexTree& tree = scene.chains[m].hierarchy;
+      if (tree.empty()) continue;
+      VdObject& obj = vd.emplace_back();
+      obj.object = id;
+      obj.model = m;
+      obj.closed = closed[m];
+      front_init(obj.front, tree, std::max(o_pixel_error(), 0.05f));
+      vertex_morph_init(obj.morph, tree, options.geomorph_seconds);
+      obj.shown = tree.positions;
+    }
+    vd_visible.reserve(vd.size());
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
   }
@@ -196,8 +238,8 @@ struct FrameGraph::Impl {
       case Stage::visibility: return stage_visibility();
       case Stage::importance: return stage_importance();
       case Stage::selection: return stage_selection();
-      case Stage::vdlod: return;     // later issue: vertex-front updates of view-dependent objects
-      case Stage::geomorph: return;  // later issue: morph factors; publish writes settled (1)
+      case Stage::vdlod: return stage_vdlod();
+      case Stage::geomorph: return stage_geomorph();
       case Stage::publish: return stage_publish();
       case Stage::count: break;
     }
@@ -290,9 +332,103 @@ struct FrameGraph::Impl {
                                    std::span<HeapEntry>(heap.data(), v));
   }
 
-  void stage_publish() {
+  float o_pixel_error() const { return options.pixel_error; }
+  double now() const { return double(frame_index) * options.frame_seconds; }
+
+  // One task per visible view-dependent object; fronts are independent, so the result does
+  // not depend on the thread count.
+  void stage_vdlod() {
+    const Frame& f = *out;
+    vd_visible.clear();
+    // Both lists are in object order: one merge finds each vd object's visible slot.
+    size_t k = 0;
+    for (uint32_t i = 0; i < vd.size(); ++i) {
+      VdObject& o = vd[i];
+      while (k < visible_total && f.objects[k] < o.object) ++k;
+      o.slot = (k < visible_total && f.objects[k] == o.object) ? static_cast<int32_t>(k) : -1;
+      if (o.slot >= 0) vd_visible.push_back(i);
+    }
+    if (vd_visible.empty()) return;
+    const ObjectSet& objs = scene.objects;
+    const ModelTable& models = scene.models;
+    before_spawn();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+      task_begins();
+      for (size_t j = r.begin(); j != r.end(); ++j) {
+        VdObject& o = vd[vd_visible[j]];
+        const float pos[3] = {objs.x[o.object], objs.y[o.object], objs.z[o.object]};
+        const FrontView fv = front_view_of(view, pos, objs.scale[o.object], objs.yaw[o.object]);
+        // Its share of the budget: the triangles of the level selection gave it.
+        const uint32_t share = models.triangles[models.first_level[o.model] + f.levels[o.slot]];
+        FrontParams p;
+        p.time = now();
+        p.collapse_delay = options.geomorph_seconds;
+        p.target_triangles = std::max<uint32_t>(share, 1);
+        p.max_triangles = share + share / 10 + 16;
+        p.hysteresis = options.vd_hysteresis;
+        const VertexTree& tree = scene.chains[o.model].hierarchy;
+        o.stats = front_update(o.front, tree, fv, p);
+        vertex_morph_apply(o.morph, tree, o.front.frame_events(), p.time);
+      }
+      task_ends();
+    });
+    after_join();
+  }
+
+  // Level changes restart a per-object morph factor (newly visible objects appear settled);
+  // view-dependent objects get their geomorphed vertices and compact mesh into the frame.
+  void stage_geomorph() {
     Frame& f = *out;
     f.morph.resize(visible_total);
+    const double t = now();
+    for (uint32_t k = 0; k < visible_total; ++k) {
+      const uint32_t id = f.objects[k];
+      if (state.was_visible[id] && state.prev_level[id] != f.levels[k]) morph_start[id] = t;
+      if (!state.was_visible[id]) morph_start[id] = -1e300;
+      f.morph[k] = morph_factor(t, morph_start[id], options.geomorph_seconds);
+    }
+    f.vd_objects.resize(vd_visible.size());
+    uint32_t vertices = 0, indices = 0;
+    f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;
+    for (size_t j = 0; j < vd_visible.size(); ++j) {
+      const VdObject& o = vd[vd_visible[j]];
+      VdObjectFrame& e = f.vd_objects[j];
+      e.object = o.object;
+      e.first_vertex = vertices;
+      e.vertex_count = o.front.active_count;
+      e.first_index = indices;
+      e.index_count = 3 * o.front.tri_count;
+      e.splits = o.stats.splits;
+      e.collapses = o.stats.collapses;
+      e.threshold = o.stats.threshold;
+      e.closed = o.closed;
+      vertices += e.vertex_count;
+      indices += e.index_count;
+      f.vd_active_tris += o.front.tri_count;
+      f.vd_splits += o.stats.splits;
+      f.vd_collapses += o.stats.collapses;
+    }
+    f.vd_positions.resize(3 * size_t(vertices));
+    f.vd_indices.resize(indices);
+    if (vd_visible.empty()) return;
+    before_spawn();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+      task_begins();
+      for (size_t j = r.begin(); j != r.end(); ++j) {
+        VdObject& o = vd[vd_visible[j]];
+        VdObjectFrame& e = f.vd_objects[j];
+        e.moving = static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, o.front.vertices(), t));
+        front_compact_mesh(std::span(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
+                           std::span(f.vd_indices.data() + e.first_index, e.index_count), o.front,
+                           scene.chains[o.model].hierarchy, o.shown);
+      }
+      task_ends();
+    });
+    after_join();
+  }
+
+  void stage_publish() {
+    Frame& f = *out;
     const ModelTable& models = scene.models;
     for_chunks([&](size_t c, size_t b, size_t e) {
       // Temporal state for the next frame: who was visible, at which level.
@@ -317,8 +453,6 @@ struct FrameGraph::Impl {
         t.level_cost += n << std::clamp(l, 0, 63);
         t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))] += static_cast<uint32_t>(n);
       }
-      // No geomorphing yet: every level is settled.
-      std::fill(f.morph.begin() + first_slot, f.morph.begin() + end_slot, 1.0f);
       chunk_totals[c] = t;
     });
 

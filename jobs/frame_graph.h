@@ -23,6 +23,11 @@ struct FrameGraphOptions {
   float pixel_error = 1.0f;
   float hysteresis = 0.25f;
   uint32_t grain = 2048;           // objects per parallel chunk
+  // View-dependent objects and geomorphing: a level change, split or collapse blends over
+  // geomorph_seconds (0 = none); frames are frame_seconds apart on the geomorph clock.
+  float geomorph_seconds = 0.25f;
+  float frame_seconds = 1.0f / 60;
+  float vd_hysteresis = 1.5f;      // FrontParams::hysteresis
   // Called at the start of every stage, on the thread running it (tracing; tests inject
   // failures by throwing from it). Empty = no call.
   std::function<void(Stage)> stage_hook;

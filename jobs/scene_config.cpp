@@ -280,7 +280,7 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
   for (size_t i = 0; i < models.size(); ++i) {
     const toml::table& t = *models[i];
     const std::string key = indexed("model", i);
-    r.only_keys(t, key, {"name", "file", "ratios", "method", "extreme_threshold"});
+    r.only_keys(t, key, {"name", "file", "ratios", "method", "extreme_threshold", "view_dependent"});
     ModelConfig m;
     auto name = r.string(t, "name", key + ".name");
     if (!name) r.fail(key + ".name", "missing");
@@ -317,6 +317,11 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
         r.fail(key + ".method", "must be \"qem\", \"extreme\" or \"auto\", got \"" + *v + "\"");
     }
     r.integer_in(t, "extreme_threshold", key + ".extreme_threshold", 1, INT64_MAX, m.bake.extreme_threshold);
+    if (const toml::node* n = t.get("view_dependent")) {
+      const auto* b = n->as_boolean();
+      if (!b) r.fail(key + ".view_dependent", "must be true or false");
+      m.view_dependent = b->get();
+    }
     c.models.push_back(std::move(m));
   }
 }

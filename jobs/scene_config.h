@@ -16,6 +16,7 @@ struct ModelConfig {
   std::string name;
   std::filesystem::path file;   // resolved: config folder first, then the data directory
   BakeSettings bake;
+  bool view_dependent = false;  // view_dependent = true: a vertex hierarchy, refined per frame
 };
 
 struct InstanceConfig {

@@ -576,7 +576,8 @@ FrontView front_view_of(const View& view, const float position[3], float scale, 
     to_object_dir(p.x, p.y, p.z, out.planes[k]);
     out.planes[k][3] = (p.x * position[0] + p.y * position[1] + p.z * position[2] + p.w) * inv;
   }
-  out.focal_pixels = focal_pixels(view) * inv;
+  // Error and distance scale alike, so projected error needs no scale here.
+  out.focal_pixels = focal_pixels(view);
   return out;
 }
 

@@ -31,7 +31,7 @@ namespace lod {
 struct FrontView {
   float eye[3] = {0, 0, 0};
   float planes[6][4] = {};   // normalized, inside when dot(n, p) + w >= 0
-  float focal_pixels = 1;    // pixels per object unit at distance 1
+  float focal_pixels = 1;    // pixels per unit of size at distance 1 (scale free)
 };
 
 // `view` seen from an object placed as ObjectSet does: world = R_y(yaw) * (scale * p) + position.

@@ -1,0 +1,122 @@
+// View-dependent objects in the frame graph: every published active mesh is a valid, closed
+// triangulation, within its share of the budget, identical at 1 and 2 threads.
+#include <gtest/gtest.h>
+
+#include "jobs/frame_graph.h"
+#include "preprocess/vertex_hierarchy.h"
+#include "runtime/vertex_front.h"
+#include "synthetic_scene.h"
+#include "vd_meshes.h"
+
+namespace lod {
+namespace {
+
+LodChain ball_chain() {
+  const MeshData fine = test::vd_sphere(40, 60), coarse = test::vd_sphere(12, 16);
+  LodChain c;
+  c.name = "ball";
+  for (const MeshData* m : {&fine, &coarse}) {
+    LodLevel l;
+    l.first_index = static_cast<uint32_t>(c.indices.size());
+    l.index_count = static_cast<uint32_t>(m->indices.size());
+    l.first_vertex = static_cast<uint32_t>(c.positions.size() / 3);
+    l.vertex_count = static_cast<uint32_t>(m->vertex_count());
+    l.level = level_of_triangles(m->triangle_count());
+    l.error = m == &fine ? 0.f : 0.05f;
+    l.bounds.radius = 1;
+    c.levels.push_back(l);
+    c.positions.insert(c.positions.end(), m->positions.begin(), m->positions.end());
+    c.indices.insert(c.indices.end(), m->indices.begin(), m->indices.end());
+  }
+  EXPECT_TRUE(build_vertex_hierarchy(c.hierarchy, fine).ok);
+  return c;
+}
+
+Scene ball_scene() {
+  SceneConfig c = test::synthetic_config(300, 200);
+  c.models.resize(1);  // cowlike
+  c.instances.resize(1);
+  c.instances[0].model = 0;
+  c.models.push_back(ModelConfig{"ball", {}, {}});
+  c.models.back().view_dependent = true;
+  InstanceConfig i;
+  i.model = 1;
+  i.count = 1;
+  i.grid = true;
+  i.box_min[0] = i.box_min[1] = i.box_min[2] = 0;
+  i.box_max[0] = i.box_max[1] = i.box_max[2] = 0;
+  i.scale_min = i.scale_max = 40;
+  c.instances.push_back(i);
+  std::vector<LodChain> chains = {test::synthetic_chains()[0], ball_chain()};
+  return make_scene(c, std::move(chains));
+}
+
+View orbit(uint32_t n) {
+  View v;
+  const float a = 0.02f * n;
+  v.eye = {120 * std::sin(a), 30, 120 * std::cos(a)};
+  v.target = {0, 0, 0};
+  v.far_plane = 2000;
+  return v;
+}
+
+FrameGraphOptions options(uint32_t threads) {
+  FrameGraphOptions o;
+  o.threads = threads;
+  o.selection.budget = 60000;
+  return o;
+}
+
+TEST(FrameGraphVd, PublishesValidClosedMeshesWithinTheirShare) {
+  const Scene scene = ball_scene();
+  FrameGraph g(scene, options(2));
+  Frame f;
+  uint64_t changes = 0;
+  for (uint32_t n = 0; n < 90; ++n) {
+    g.run(orbit(n), f);
+    ASSERT_EQ(f.vd_objects.size(), 1u) << "frame " << n;
+    const VdObjectFrame& o = f.vd_objects[0];
+    EXPECT_TRUE(o.closed);
+    std::string msg;
+    ASSERT_TRUE(check_triangles(std::span(f.vd_indices.data() + o.first_index, o.index_count), o.vertex_count, true,
+                                &msg))
+        << "frame " << n << ": " << msg;
+    // Its share: the triangles of the level selection picked for it, plus the cap's margin.
+    size_t slot = 0;
+    while (f.objects[slot] != o.object) ++slot;
+    const uint32_t m = scene.objects.model[o.object];
+    const uint32_t share = scene.models.triangles[scene.models.first_level[m] + f.levels[slot]];
+    EXPECT_LE(o.index_count / 3, share + share / 10 + 16) << "frame " << n;
+    EXPECT_EQ(f.vd_active_tris, o.index_count / 3);
+    changes += o.splits + o.collapses;
+    for (float mf : f.morph) ASSERT_TRUE(mf >= 0 && mf <= 1);
+  }
+  EXPECT_GT(changes, 0u);
+  EXPECT_GT(f.vd_active_tris, 50u);
+}
+
+TEST(FrameGraphVd, OneAndTwoThreadsGiveIdenticalFrames) {
+  const Scene scene = ball_scene();
+  FrameGraph one(scene, options(1)), two(scene, options(2));
+  Frame a, b;
+  for (uint32_t n = 0; n < 40; ++n) {
+    one.run(orbit(3 * n), a);
+    two.run(orbit(3 * n), b);
+    ASSERT_EQ(a.vd_indices, b.vd_indices) << "frame " << n;
+    ASSERT_EQ(a.vd_positions, b.vd_positions) << "frame " << n;
+    ASSERT_EQ(a.morph, b.morph);
+  }
+}
+
+TEST(FrameGraphVd, ObjectsWithoutAHierarchyPublishNoVdMesh) {
+  const Scene scene = test::synthetic_scene(500, 200);
+  FrameGraph g(scene, options(2));
+  Frame f;
+  g.run(orbit(0), f);
+  EXPECT_TRUE(f.vd_objects.empty());
+  EXPECT_EQ(f.vd_active_tris, 0u);
+  EXPECT_TRUE(f.vd_indices.empty());
+}
+
+}  // namespace
+}  // namespace lod
