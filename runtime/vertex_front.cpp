@@ -52,8 +52,10 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
     const double cos_sum = cos_alpha * cos_gamma - sin_alpha * sin_gamma;
     const double sin_sum = sin_alpha * cos_gamma + cos_alpha * sin_gamma;
     facing = !(cos_sum > 0 && cos_beta > sin_sum);
-    // An eye move of m turns directions seen from the node by about m / (d - r).
-    slack_facing = 0.5 * std::abs(cos_beta - sin_sum) * std::max(d - r, 0.0);
+    // An eye move of m turns the direction to the centre by at most m / d and widens the
+    // sphere's angle by at most m r / (d (d - r)): together m / (d - r) radians, and the
+    // margin in angle is at least the margin in cosine.
+    slack_facing = std::abs(cos_beta - sin_sum) * std::max(d - r, 0.0);
   }
   // Screen-space error: e * focal / distance > threshold while distance < critical.
   const double dist = std::max(d - r, 1e-6);
@@ -501,6 +503,9 @@ FrontStats Updater::run(const FrontView& view) {
       for (int64_t ab = f_.cursor[c]; ab <= last[c]; ++ab) drain(static_cast<uint32_t>(ab % kBuckets), c);
   }
   for (int c = 0; c < 2; ++c) f_.cursor[c] = std::max(f_.cursor[c], last[c] + 1);
+  // Node ids follow space (Morton order per pass): judging them in id order walks memory
+  // far more coherently than bucket order.
+  std::sort(f_.queue.begin(), f_.queue.begin() + tail_);
   drain(kBuckets, 0);
   stats_.full_pass = full;
 
