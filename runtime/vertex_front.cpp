@@ -253,15 +253,11 @@ void Updater::split(uint32_t x) {
   // Faces around x take the child holding their corner's leaf.
   const uint32_t lo1 = t_.leaf_lo[c1], hi1 = t_.leaf_hi[c1];
   for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
-    const uint32_t face = t_.inc_faces[k];
-    const uint32_t s = f_.face_slot[face];
+    const uint32_t s = f_.face_slot[t_.inc_faces[k]];
     if (s == kNoNode) continue;
-    uint32_t* tri = &f_.tri_indices[3 * size_t(s)];
-    for (int j = 0; j < 3; ++j)
-      if (tri[j] == x) {
-        const uint32_t r = t_.face_ranks[3 * size_t(face) + j];
-        tri[j] = r >= lo1 && r < hi1 ? c1 : c2;
-      }
+    const uint32_t r = t_.inc_corner[k] >> 2, j = t_.inc_corner[k] & 3;
+    assert(f_.tri_indices[3 * size_t(s) + j] == x);
+    f_.tri_indices[3 * size_t(s) + j] = r >= lo1 && r < hi1 ? c1 : c2;
   }
   // The split's own faces, appended to the packed triangle array.
   for (int k = 0; k < 2; ++k) {
@@ -308,9 +304,9 @@ void Updater::collapse(uint32_t p) {
   for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
     const uint32_t s = f_.face_slot[t_.inc_faces[k]];
     if (s == kNoNode) continue;
-    uint32_t* tri = &f_.tri_indices[3 * size_t(s)];
-    for (int j = 0; j < 3; ++j)
-      if (tri[j] == c1 || tri[j] == c2) tri[j] = p;
+    const uint32_t j = t_.inc_corner[k] & 3;
+    assert(f_.tri_indices[3 * size_t(s) + j] == c1 || f_.tri_indices[3 * size_t(s) + j] == c2);
+    f_.tri_indices[3 * size_t(s) + j] = p;
   }
   unfile(c1);
   unfile(c2);

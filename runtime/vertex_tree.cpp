@@ -130,6 +130,20 @@ void pack_vertex_bounds(VertexTree& t) {
   }
   t.face_ranks.resize(t.face_leaves.size());
   for (size_t k = 0; k < t.face_leaves.size(); ++k) t.face_ranks[k] = t.leaf_rank[t.face_leaves[k]];
+  t.inc_corner.assign(t.inc_faces.size(), 0);
+  for (uint32_t i = 0; i < t.interior_count(); ++i) {
+    const uint32_t v = t.leaf_count + i;
+    for (uint32_t k = t.inc_offsets[i]; k < t.inc_offsets[i + 1]; ++k) {
+      const uint32_t f = t.inc_faces[k];
+      for (uint32_t j = 0; j < 3; ++j) {
+        const uint32_t r = t.face_ranks[3 * size_t(f) + j];
+        if (r >= t.leaf_lo[v] && r < t.leaf_hi[v]) {
+          t.inc_corner[k] = r * 4 + j;
+          break;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace lod

@@ -66,6 +66,9 @@ struct VertexTree {
   // leaf's depth-first rank (so a split finds a corner's child without a leaf lookup).
   std::vector<VertexBounds> bounds;
   std::vector<uint32_t> face_ranks;
+  // Per incidence entry (inc_faces[k]): the leaf rank of the face's corner below its node,
+  // times 4, plus that corner's index (0..2): a split or collapse touches only that corner.
+  std::vector<uint32_t> inc_corner;
 
   uint32_t node_count() const { return static_cast<uint32_t>(parent.size()); }
   uint32_t interior_count() const { return node_count() - leaf_count; }
