@@ -132,7 +132,7 @@ struct CellTable {
 };
 
 // Faces left after clustering, canonically rotated (smallest cluster first, orientation
-// kept), each once. Returns their count; writes them to `out` when given.
+// kept), each set of three cells once. Returns their count; writes them to `out` when given.
 size_t unique_faces(std::vector<uint32_t>& faces, std::vector<uint32_t>& table, const std::vector<uint32_t>& cluster,
                     const Prepared& p, std::vector<uint32_t>* out) {
   faces.resize(p.triangles.size());
@@ -151,12 +151,14 @@ size_t unique_faces(std::vector<uint32_t>& faces, std::vector<uint32_t>& table, 
   table.assign(cap, ~0u);
   size_t kept = 0;
   for (size_t f = 0; f < n; ++f) {
+    // Same three cells in either orientation is one face (a two-sided sliver otherwise).
     const uint32_t* x = &faces[3 * f];
-    size_t slot = mix(uint64_t(x[0]) * 0x9e3779b97f4a7c15ull ^ (uint64_t(x[1]) << 32 | x[2])) & (cap - 1);
+    const uint32_t xl = std::min(x[1], x[2]), xh = std::max(x[1], x[2]);
+    size_t slot = mix(uint64_t(x[0]) * 0x9e3779b97f4a7c15ull ^ (uint64_t(xl) << 32 | xh)) & (cap - 1);
     bool duplicate = false;
     while (table[slot] != ~0u) {
       const uint32_t* y = &faces[3 * size_t(table[slot])];
-      if (y[0] == x[0] && y[1] == x[1] && y[2] == x[2]) {
+      if (y[0] == x[0] && std::min(y[1], y[2]) == xl && std::max(y[1], y[2]) == xh) {
         duplicate = true;
         break;
       }
@@ -379,6 +381,7 @@ size_t cluster_run(std::vector<uint32_t>& out_indices, std::vector<float>& out_p
   if (grid_target != target) {
     ChainLevelOut level;
     QemOptions qo;
+    qo.move_nonmanifold = false;  // clustering leaves many; moving them costs accuracy here
     qo.attributes = out_attributes && ac ? out_attributes->data() : nullptr;
     qo.attribute_count = ac;
     qem_simplify_chain(&level, out_positions.data(), out_positions.size() / 3, out_indices.data(), out_indices.size(),

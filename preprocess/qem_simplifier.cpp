@@ -150,6 +150,7 @@ struct Work {
   std::vector<Candidate> cands;
   std::vector<uint32_t> keys, order, order_tmp;
   std::vector<uint32_t> vmap;
+  bool dedupe_faces = false;  // the mesh has non-manifold edges: collapses may double faces
 
   void reserve(size_t v, size_t t) {
     offset.reserve(v + 1);
@@ -189,7 +190,7 @@ void build_lists(Work& w, const QemMesh& mesh) {
 
 // Vertex kinds and border loops, once per call: collapses that pass the link condition keep
 // every vertex's kind, and border collapses update the loops as they go.
-void classify(Work& w, const QemMesh& mesh, bool lock_border) {
+void classify(Work& w, const QemMesh& mesh, bool lock_border, bool move_nonmanifold) {
   const size_t nv = mesh.positions.size() / 3;
   w.kind.assign(nv, kLocked);
   w.next.assign(nv, ~0u);
@@ -197,6 +198,7 @@ void classify(Work& w, const QemMesh& mesh, bool lock_border) {
   w.stamp.assign(nv, 0);
   w.out_count.assign(nv, 0);
   w.in_count.assign(nv, 0);
+  w.dedupe_faces = false;
   for (size_t v = 0; v < nv; ++v) {
     const uint32_t begin = w.offset[v], end = w.offset[v + 1];
     if (begin == end) continue;
@@ -216,8 +218,12 @@ void classify(Work& w, const QemMesh& mesh, bool lock_border) {
       if (w.in_count[p] == 1 && w.out_count[p] == 0) border_in++, w.prev[v] = p;
       complex |= w.out_count[n] > 1 || w.in_count[n] > 1 || w.out_count[p] > 1 || w.in_count[p] > 1;
     }
+    // A vertex on non-manifold edges (more than two faces) but on no border moves like a
+    // manifold one, as in meshoptimizer: locking every such vertex leaves dirty scans stuck
+    // far above their targets. The link condition and the face checks still apply to it.
     uint8_t kind = kLocked;
-    if (!complex && border_out == 0 && border_in == 0) kind = kManifold;
+    if (border_out == 0 && border_in == 0 && (move_nonmanifold || !complex)) kind = kManifold;
+    if (complex && kind == kManifold && !mesh.lock[v]) w.dedupe_faces = true;
     if (!complex && border_out == 1 && border_in == 1) kind = lock_border ? kLocked : kBorder;
     if (mesh.lock[v]) kind = kLocked;
     w.kind[v] = kind;
@@ -310,6 +316,40 @@ bool collapse_allowed(Work& w, const QemMesh& mesh, uint32_t a, uint32_t b, cons
   if (shared == 0 || common != shared) return false;
   const size_t left = faces_a + faces_b - 2 * shared;
   return w.kind[b] == kManifold ? left >= 3 : left >= 1;
+}
+
+// Removes faces on the same three vertices as an earlier face; returns the faces left.
+size_t drop_duplicate_faces(Work& w, std::vector<uint32_t>& indices) {
+  const size_t nf = indices.size() / 3;
+  size_t cap = 16;
+  while (cap < 2 * nf) cap *= 2;
+  std::vector<uint32_t>& table = w.order_tmp;  // reuse: face id per slot
+  table.assign(cap, ~0u);
+  uint32_t* idx = indices.data();
+  size_t kept = 0;
+  for (size_t t = 0; t < nf; ++t) {
+    uint32_t k[3] = {idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]};
+    std::sort(k, k + 3);
+    size_t slot = size_t(((uint64_t(k[0]) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k[1]) * 0xc2b2ae3d27d4eb4full) ^
+                          (uint64_t(k[2]) * 0x165667b19e3779f9ull)) >> 7) & (cap - 1);
+    bool duplicate = false;
+    while (table[slot] != ~0u) {
+      uint32_t o[3] = {idx[3 * size_t(table[slot])], idx[3 * size_t(table[slot]) + 1], idx[3 * size_t(table[slot]) + 2]};
+      std::sort(o, o + 3);
+      if (o[0] == k[0] && o[1] == k[1] && o[2] == k[2]) {
+        duplicate = true;
+        break;
+      }
+      slot = (slot + 1) & (cap - 1);
+    }
+    if (duplicate) continue;
+    // Kept faces move down in place; the table refers to their new slots.
+    for (int c = 0; c < 3; ++c) idx[3 * kept + c] = idx[3 * t + c];
+    table[slot] = uint32_t(kept);
+    kept++;
+  }
+  indices.resize(3 * kept);
+  return kept;
 }
 
 // Pass over the current mesh: returns the number of faces removed.
@@ -470,6 +510,7 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
     kept++;
   }
   mesh.indices.resize(3 * kept);
+  if (w.dedupe_faces) kept = drop_duplicate_faces(w, mesh.indices);
   return nt - kept;
 }
 
@@ -520,24 +561,50 @@ void compact_vertices(Work& w, QemMesh& mesh) {
   mesh.lock.swap(tmp.lock);
 }
 
+// Copies the live mesh out in object space, each face once: collapses around non-manifold
+// input can leave two faces on the same three vertices, and a level should not draw both.
 void snapshot(ChainLevelOut& level, Work& w, const QemMesh& mesh) {
   const size_t nv = mesh.positions.size() / 3;
   const size_t ac = mesh.attribute_count;
+  const size_t nf = mesh.indices.size() / 3;
+  size_t cap = 16;
+  while (cap < 2 * nf) cap *= 2;
+  std::vector<uint32_t>& table = w.keys;  // reuse: face id per slot
+  table.assign(cap, ~0u);
   w.vmap.assign(nv, ~0u);
-  level.indices.resize(mesh.indices.size());
+  level.indices.clear();
   level.positions.clear();
   level.attributes.clear();
   level.source_vertex.clear();
   uint32_t next = 0;
-  for (size_t i = 0; i < mesh.indices.size(); ++i) {
-    const uint32_t v = mesh.indices[i];
-    if (w.vmap[v] == ~0u) {
-      w.vmap[v] = next++;
-      for (int k = 0; k < 3; ++k) level.positions.push_back(mesh.positions[3 * v + k] * mesh.scale + mesh.offset[k]);
-      for (size_t k = 0; k < ac; ++k) level.attributes.push_back(mesh.attributes[v * ac + k]);
-      level.source_vertex.push_back(mesh.source_vertex[v]);
+  const uint32_t* idx = mesh.indices.data();
+  for (size_t t = 0; t < nf; ++t) {
+    uint32_t k[3] = {idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]};
+    std::sort(k, k + 3);
+    size_t slot = size_t((uint64_t(k[0]) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k[1]) * 0xc2b2ae3d27d4eb4full) ^
+                         (uint64_t(k[2]) * 0x165667b19e3779f9ull)) >> 7 & (cap - 1);
+    bool duplicate = false;
+    while (table[slot] != ~0u) {
+      uint32_t o[3] = {idx[3 * size_t(table[slot])], idx[3 * size_t(table[slot]) + 1], idx[3 * size_t(table[slot]) + 2]};
+      std::sort(o, o + 3);
+      if (o[0] == k[0] && o[1] == k[1] && o[2] == k[2]) {
+        duplicate = true;
+        break;
+      }
+      slot = (slot + 1) & (cap - 1);
     }
-    level.indices[i] = w.vmap[v];
+    if (duplicate) continue;
+    table[slot] = uint32_t(t);
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t v = idx[3 * t + c];
+      if (w.vmap[v] == ~0u) {
+        w.vmap[v] = next++;
+        for (int j = 0; j < 3; ++j) level.positions.push_back(mesh.positions[3 * size_t(v) + j] * mesh.scale);
+        for (size_t j = 0; j < ac; ++j) level.attributes.push_back(mesh.attributes[v * ac + j]);
+        level.source_vertex.push_back(mesh.source_vertex[v]);
+      }
+      level.indices.push_back(w.vmap[v]);
+    }
   }
   level.error = float(std::sqrt(mesh.error) * mesh.scale);
 }
@@ -693,7 +760,7 @@ void build_part(QemMesh& out, const float* positions, size_t vertex_count, const
   if (nt > 0 && options.border_weight > 0) {
     Work w;
     build_lists(w, out);
-    classify(w, out, false);
+    classify(w, out, false, true);
     for (size_t v = 0; v < nv; ++v) {
       const uint32_t b = w.next[v];
       if (b == ~0u) continue;
@@ -745,7 +812,7 @@ size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* tar
   bool hit_limit = false;
   size_t previous_target = mesh.triangle_count();
   build_lists(w, mesh);
-  classify(w, mesh, options.lock_border);
+  classify(w, mesh, options.lock_border, options.move_nonmanifold);
   bool lists_current = true;
   for (size_t l = 0; l < level_count; ++l) {
     const size_t target = std::min(target_triangles[l], previous_target);
@@ -812,7 +879,6 @@ size_t qem_split(QemMesh* parts, const QemMesh& whole) {
     part = QemMesh{};
     part.attribute_count = ac;
     part.input_vertex_count = whole.input_vertex_count;
-    std::memcpy(part.offset, whole.offset, sizeof part.offset);
     part.scale = whole.scale;
     part.error = whole.error;
     std::vector<uint32_t> local(nv, ~0u);
@@ -841,7 +907,6 @@ void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
   const size_t ac = parts[0].attribute_count;
   out.attribute_count = ac;
   out.input_vertex_count = parts[0].input_vertex_count;
-  std::memcpy(out.offset, parts[0].offset, sizeof out.offset);
   out.scale = parts[0].scale;
   std::vector<uint32_t> merged(out.input_vertex_count, ~0u);
   for (size_t p = 0; p < part_count; ++p) {

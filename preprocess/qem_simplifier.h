@@ -27,6 +27,10 @@ struct QemOptions {
   float max_error = 0;
   // Weight of the boundary constraint planes relative to the surface's own planes.
   float border_weight = 10;
+  // Vertices on non-manifold edges (three or more faces) but on no border move like manifold
+  // ones (as in meshoptimizer); dirty scans otherwise stop far above their targets. Faces
+  // such collapses double are dropped. false locks those vertices instead.
+  bool move_nonmanifold = true;
   // Optional: nonzero = that input vertex never moves (others may collapse onto it).
   const uint8_t* vertex_lock = nullptr;
   // Optional per-vertex attributes (normals, uv, ...): attribute_count floats per vertex,
@@ -68,8 +72,8 @@ struct Quadric {
   double w = 0;                                                 // summed area weight
 };
 
-// A mesh being simplified, with its quadrics. Positions are normalised into the unit cube of
-// the whole input (object = normalised * scale + offset), so parts of one input share a frame.
+// A mesh being simplified, with its quadrics. Positions are divided by a power-of-two scale of
+// the whole input (object = normalised * scale, exactly), so parts of one input share a frame.
 struct QemMesh {
   std::vector<float> positions;
   std::vector<float> attributes;
@@ -79,7 +83,6 @@ struct QemMesh {
   std::vector<uint8_t> lock;            // kLockUser | kLockSeam bits per vertex
   size_t attribute_count = 0;
   size_t input_vertex_count = 0;
-  float offset[3] = {0, 0, 0};
   float scale = 1;
   double error = 0;  // largest normalised collapse error so far
 
