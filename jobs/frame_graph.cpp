@@ -381,12 +381,16 @@ struct FrameGraph::Impl {
     Frame& f = *out;
     f.morph.resize(visible_total);
     const double t = now();
-    for (uint32_t k = 0; k < visible_total; ++k) {
-      const uint32_t id = f.objects[k];
-      if (state.was_visible[id] && state.prev_level[id] != f.levels[k]) morph_start[id] = t;
-      if (!state.was_visible[id]) morph_start[id] = -1e300;
-      f.morph[k] = morph_factor(t, morph_start[id], options.geomorph_seconds);
-    }
+    // Per object and independent: parallel over each chunk's visible slots.
+    for_chunks([&](size_t c, size_t, size_t) {
+      const uint32_t end_slot = chunk_offset[c] + chunk_visible[c];
+      for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) {
+        const uint32_t id = f.objects[k];
+        if (state.was_visible[id] && state.prev_level[id] != f.levels[k]) morph_start[id] = t;
+        if (!state.was_visible[id]) morph_start[id] = -1e300;
+        f.morph[k] = morph_factor(t, morph_start[id], options.geomorph_seconds);
+      }
+    });
     f.vd_objects.resize(vd_visible.size());
     uint32_t vertices = 0, indices = 0;
     f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;
