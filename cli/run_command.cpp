@@ -38,7 +38,8 @@ bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
       return false;
     }
     std::string bad;
-    if (!check_triangles(std::span(f.vd_indices.data() + o.first_index, o.index_count), o.vertex_count, o.closed,
+    if (!check_triangles(std::span(f.vd_indices.data() + o.first_index, o.index_count), o.vertex_count,
+                         o.closed ? EdgeCheck::closed : o.oriented ? EdgeCheck::oriented : EdgeCheck::corners,
                          &bad)) {
       *why = "vd object " + std::to_string(o.object) + ": " + bad;
       return false;

@@ -134,7 +134,7 @@ struct FrameGraph::Impl {
   struct VdObject {
     uint32_t object = 0;
     uint32_t model = 0;
-    bool closed = false;
+    EdgeCheck edges = EdgeCheck::corners;  // what its full mesh passes, so every front must
     VertexFront front;
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
@@ -186,12 +186,12 @@ struct FrameGraph::Impl {
       for (size_t k = 0; k < models.level_count[m]; ++k)
         full_triangles[models.first_level[m] + k] = models.triangles[models.first_level[m]];
     morph_start.assign(count, -1e300);
-    std::vector<uint8_t> closed(models.model_count(), 0);
+    std::vector<EdgeCheck> edges(models.model_count(), EdgeCheck::corners);
     for (size_t m = 0; m < models.model_count(); ++m) {
       const LodChain& chain = scene.chains[m];
       if (chain.hierarchy.empty()) continue;
       const LodLevel& l0 = chain.levels[0];
-      closed[m] = triangles_closed(std::span(chain.indices.data() + l0.first_index, l0.index_count));
+      edges[m] = edge_check_of(std::span(chain.indices.data() + l0.first_index, l0.index_count));
     }
     for (uint32_t id = 0; id < count; ++id) {
       const uint32_t m = scene.objects.model[id];
@@ -200,7 +200,7 @@ struct FrameGraph::Impl {
       VdObject& obj = vd.emplace_back();
       obj.object = id;
       obj.model = m;
-      obj.closed = closed[m];
+      obj.edges = edges[m];
       front_init(obj.front, tree, std::max(o_pixel_error(), 0.05f));
       vertex_morph_init(obj.morph, tree, options.geomorph_seconds);
       obj.shown = tree.positions;
@@ -405,7 +405,8 @@ struct FrameGraph::Impl {
       e.splits = o.stats.splits;
       e.collapses = o.stats.collapses;
       e.threshold = o.stats.threshold;
-      e.closed = o.closed;
+      e.closed = o.edges == EdgeCheck::closed;
+      e.oriented = o.edges != EdgeCheck::corners;
       vertices += e.vertex_count;
       indices += e.index_count;
       f.vd_active_tris += o.front.tri_count;

@@ -27,6 +27,7 @@ struct VdObjectFrame {
   uint32_t moving = 0;        // vertices still geomorphing
   float threshold = 0;        // pixel threshold after this frame's feedback
   bool closed = false;        // the object's full mesh is closed (every edge in two faces)
+  bool oriented = false;      // ... consistently oriented (each directed edge once)
 };
 
 struct Frame {

@@ -692,7 +692,7 @@ void front_coarsen_all(VertexFront& f, const VertexTree& t) {
   f.event_count = 0;
 }
 
-bool check_front(const VertexFront& f, const VertexTree& t, bool closed, std::string* message) {
+bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std::string* message) {
   auto fail = [&](std::string text) {
     if (message) *message = std::move(text);
     return false;
@@ -749,12 +749,13 @@ bool check_front(const VertexFront& f, const VertexTree& t, bool closed, std::st
     if (c[0] != c[1] && c[1] != c[2] && c[0] != c[2])
       return fail("face " + std::to_string(face) + " has three distinct active corners but is not drawn");
   }
+  if (edges == EdgeCheck::corners) return true;
   std::sort(directed.begin(), directed.end());
   for (size_t k = 1; k < directed.size(); ++k)
     if (directed[k] == directed[k - 1])
       return fail("edge " + std::to_string(directed[k] >> 32) + "->" + std::to_string(directed[k] & 0xffffffffu) +
                   " is used twice in one direction (orientation flip or non-manifold edge)");
-  if (closed) {
+  if (edges == EdgeCheck::closed) {
     for (uint64_t e : directed) {
       const uint64_t rev = (e << 32) | (e >> 32);
       if (!std::binary_search(directed.begin(), directed.end(), rev))
@@ -776,7 +777,7 @@ uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indi
   return f.tri_count;
 }
 
-bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, bool closed, std::string* message) {
+bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges, std::string* message) {
   auto fail = [&](std::string text) {
     if (message) *message = std::move(text);
     return false;
@@ -794,12 +795,13 @@ bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, b
       return fail("triangle " + std::to_string(s) + " is degenerate");
     for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(tri[j]) << 32 | tri[(j + 1) % 3]);
   }
+  if (edges == EdgeCheck::corners) return true;
   std::sort(directed.begin(), directed.end());
   for (size_t k = 1; k < directed.size(); ++k)
     if (directed[k] == directed[k - 1])
       return fail("edge " + std::to_string(directed[k] >> 32) + "->" + std::to_string(directed[k] & 0xffffffffu) +
                   " is used twice in one direction (orientation flip or non-manifold edge)");
-  if (closed)
+  if (edges == EdgeCheck::closed)
     for (uint64_t e : directed)
       if (!std::binary_search(directed.begin(), directed.end(), (e << 32) | (e >> 32)))
         return fail("edge " + std::to_string(e >> 32) + "-" + std::to_string(e & 0xffffffffu) +
@@ -816,6 +818,18 @@ bool triangles_closed(std::span<const uint32_t> indices) {
   for (uint64_t e : directed)
     if (!std::binary_search(directed.begin(), directed.end(), (e << 32) | (e >> 32))) return false;
   return !directed.empty();
+}
+
+EdgeCheck edge_check_of(std::span<const uint32_t> indices) {
+  std::vector<uint64_t> directed;
+  directed.reserve(indices.size());
+  for (size_t s = 0; s + 2 < indices.size(); s += 3)
+    for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(indices[s + j]) << 32 | indices[s + (j + 1) % 3]);
+  std::sort(directed.begin(), directed.end());
+  if (std::adjacent_find(directed.begin(), directed.end()) != directed.end()) return EdgeCheck::corners;
+  for (uint64_t e : directed)
+    if (!std::binary_search(directed.begin(), directed.end(), (e << 32) | (e >> 32))) return EdgeCheck::oriented;
+  return directed.empty() ? EdgeCheck::oriented : EdgeCheck::closed;
 }
 
 }  // namespace lod

@@ -133,12 +133,17 @@ FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontV
 void front_refine_all(VertexFront& front, const VertexTree& tree);
 void front_coarsen_all(VertexFront& front, const VertexTree& tree);
 
+// How much of a triangulation check applies: inputs with orientation flips or edges in three
+// faces can only be checked for valid corners; consistently oriented ones also for each
+// directed edge being used once; closed ones also for every edge having two faces.
+enum class EdgeCheck : uint8_t { corners, oriented, closed };
+
 // Checks the active triangles: corners are active nodes and the active ancestors of each
-// face's leaves, no repeated corner, each directed edge used once (consistent orientation,
-// no edge in more than two faces), with `closed` every edge in exactly two faces (no cracks,
-// no T-junctions), and the packed arrays agree with each other. Allocates (a test and
+// face's leaves, no repeated corner, the packed arrays agree with each other; from `oriented`
+// on each directed edge used once (consistent orientation, no edge in more than two faces);
+// with `closed` every edge in exactly two faces (no cracks, no T-junctions). Allocates (a test and
 // `lod run --validate` tool, not a per-frame stage). `message` names the first bad element.
-bool check_front(const VertexFront& front, const VertexTree& tree, bool closed, std::string* message);
+bool check_front(const VertexFront& front, const VertexTree& tree, EdgeCheck edges, std::string* message);
 
 // The front as a compact mesh for a consumer: positions of the active vertices in active-list
 // order (taken from `shown`, xyz per node id, e.g. geomorphed positions; the tree's own
@@ -147,12 +152,16 @@ bool check_front(const VertexFront& front, const VertexTree& tree, bool closed, 
 uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indices, const VertexFront& front,
                             const VertexTree& tree, std::span<const float> shown);
 
-// Checks a plain indexed triangle list: indices < vertex_count, no repeated corner, each
-// directed edge at most once; with `closed` every edge also used the other way round.
+// Checks a plain indexed triangle list: indices < vertex_count, no repeated corner; from
+// `oriented` on each directed edge at most once; with `closed` every edge also used the other
+// way round.
 // Allocates. `message` names the first bad triangle or edge.
-bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, bool closed, std::string* message);
+bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges, std::string* message);
 
 // True when every directed edge of the list has its reverse (a closed, oriented surface).
 bool triangles_closed(std::span<const uint32_t> indices);
+
+// The strongest check a full-detail mesh passes itself (what its fronts are held to).
+EdgeCheck edge_check_of(std::span<const uint32_t> indices);
 
 }  // namespace lod

@@ -78,7 +78,7 @@ TEST(FrameGraphVd, PublishesValidClosedMeshesWithinTheirShare) {
     const VdObjectFrame& o = f.vd_objects[0];
     EXPECT_TRUE(o.closed);
     std::string msg;
-    ASSERT_TRUE(check_triangles(std::span(f.vd_indices.data() + o.first_index, o.index_count), o.vertex_count, true,
+    ASSERT_TRUE(check_triangles(std::span(f.vd_indices.data() + o.first_index, o.index_count), o.vertex_count, EdgeCheck::closed,
                                 &msg))
         << "frame " << n << ": " << msg;
     // Its share: the triangles of the level selection picked for it, plus the cap's margin.

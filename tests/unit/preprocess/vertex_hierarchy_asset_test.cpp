@@ -62,7 +62,7 @@ TEST(VertexHierarchyAsset, RoundTripsEveryArray) {
   front_init(f, b, 1);
   front_refine_all(f, b);
   std::string msg;
-  EXPECT_TRUE(check_front(f, b, true, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, b, EdgeCheck::closed, &msg)) << msg;
 }
 
 TEST(VertexHierarchyAsset, ChainsWithoutAHierarchyStayAsTheyWere) {

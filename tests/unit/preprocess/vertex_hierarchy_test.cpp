@@ -55,7 +55,7 @@ TEST(VertexHierarchy, ClosedSphereCollapsesToASmallBalancedBase) {
   VertexFront f;
   front_init(f, t, 1);
   std::string msg;
-  EXPECT_TRUE(check_front(f, t, true, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::closed, &msg)) << msg;
   EXPECT_LT(f.tri_count, m.triangle_count() / 20);
   EXPECT_GE(f.tri_count, 4u);  // never below a tetrahedron
   // Independent-set passes keep the forest O(log n) deep, not a chain.
@@ -69,7 +69,7 @@ TEST(VertexHierarchy, RefiningEverythingGivesTheInputExactly) {
   front_init(f, t, 1);
   front_refine_all(f, t);
   std::string msg;
-  ASSERT_TRUE(check_front(f, t, true, &msg)) << msg;
+  ASSERT_TRUE(check_front(f, t, EdgeCheck::closed, &msg)) << msg;
   EXPECT_EQ(f.active_count, m.vertex_count());
   EXPECT_EQ(canonical(f.tri_indices.data(), f.tri_count), canonical(m.indices.data(), m.triangle_count()));
   for (size_t i = 0; i < m.positions.size(); ++i) ASSERT_EQ(t.positions[i], m.positions[i]);
@@ -85,7 +85,7 @@ TEST(VertexHierarchy, CoarseningEverythingGivesTheBaseMesh) {
   front_refine_all(f, t);
   front_coarsen_all(f, t);
   std::string msg;
-  ASSERT_TRUE(check_front(f, t, false, &msg)) << msg;
+  ASSERT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   EXPECT_EQ(canonical(f.tri_indices.data(), f.tri_count), canonical(base.tri_indices.data(), base.tri_count));
   std::vector<uint32_t> a(f.active.begin(), f.active.begin() + f.active_count);
   std::vector<uint32_t> b(base.active.begin(), base.active.begin() + base.active_count);
@@ -100,7 +100,7 @@ TEST(VertexHierarchy, OpenGridKeepsItsOutlineAndStaysValid) {
   VertexFront f;
   front_init(f, t, 1);
   std::string msg;
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   EXPECT_LT(f.tri_count, m.triangle_count() / 4);
   // Border planes hold the outline: the base mesh still spans the grid's square.
   float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
@@ -125,7 +125,7 @@ TEST(VertexHierarchy, EveryComponentKeepsAtLeastOneTriangle) {
   VertexFront f;
   front_init(f, t, 1);
   std::string msg;
-  ASSERT_TRUE(check_front(f, t, false, &msg)) << msg;
+  ASSERT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   // The lone triangle survives whole; each component shows up in the base mesh.
   bool lone = false;
   for (uint32_t s = 0; s < f.tri_count; ++s) lone |= f.tri_face[s] == m.triangle_count() - 3;
@@ -144,7 +144,7 @@ TEST(VertexHierarchy, ShortestEdgeOrderBuildsAValidForestToo) {
   VertexFront f;
   front_init(f, t, 1);
   std::string msg;
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   EXPECT_LT(f.tri_count, m.triangle_count() / 4);
   front_refine_all(f, t);
   EXPECT_EQ(canonical(f.tri_indices.data(), f.tri_count), canonical(m.indices.data(), m.triangle_count()));
@@ -208,10 +208,10 @@ TEST(VertexHierarchy, BowTieVertexStaysValidAtEveryFront) {
   VertexFront f;
   front_init(f, t, 1);
   std::string msg;
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   EXPECT_EQ(t.parent[24], kNoNode);  // a non-manifold vertex is never collapsed
   front_refine_all(f, t);
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   EXPECT_EQ(f.tri_count, m.triangle_count());
 }
 
@@ -252,9 +252,9 @@ TEST(VertexHierarchy, RealCowRoundTripsThroughRefineAndCoarsen) {
   VertexFront f;
   front_init(f, t, 1);
   std::string msg;
-  ASSERT_TRUE(check_front(f, t, false, &msg)) << msg;
+  ASSERT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   front_refine_all(f, t);
-  ASSERT_TRUE(check_front(f, t, false, &msg)) << msg;
+  ASSERT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   EXPECT_EQ(canonical(f.tri_indices.data(), f.tri_count), canonical(m.indices.data(), m.triangle_count()));
 }
 

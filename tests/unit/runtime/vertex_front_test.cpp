@@ -52,7 +52,7 @@ TEST(VertexFront, InitShowsTheBaseMesh) {
   EXPECT_EQ(tri(f, 0), (std::vector<uint32_t>{4, 2, 3}));
   EXPECT_EQ(f.active_count, 3u);
   std::string msg;
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
 }
 
 TEST(VertexFront, RefineAllGivesTheInputAndCoarsenAllTheBase) {
@@ -64,11 +64,11 @@ TEST(VertexFront, RefineAllGivesTheInputAndCoarsenAllTheBase) {
   EXPECT_EQ(tri(f, f.face_slot[0]), (std::vector<uint32_t>{0, 1, 2}));
   EXPECT_EQ(tri(f, f.face_slot[1]), (std::vector<uint32_t>{0, 2, 3}));
   std::string msg;
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
   front_coarsen_all(f, t);
   ASSERT_EQ(f.tri_count, 1u);
   EXPECT_EQ(tri(f, 0), (std::vector<uint32_t>{4, 2, 3}));
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
 }
 
 TEST(VertexFront, CheckCatchesBrokenFronts) {
@@ -78,25 +78,25 @@ TEST(VertexFront, CheckCatchesBrokenFronts) {
   front_refine_all(f, t);
   std::string msg;
   // An open square is not closed: its border edges have one face.
-  EXPECT_FALSE(check_front(f, t, true, &msg));
+  EXPECT_FALSE(check_front(f, t, EdgeCheck::closed, &msg));
   EXPECT_NE(msg.find("closed"), std::string::npos) << msg;
 
   VertexFront g = f;
   g.tri_indices[3 * g.face_slot[1] + 1] = 3;  // (0, 3, 3): degenerate and wrong corner
-  EXPECT_FALSE(check_front(g, t, false, &msg));
+  EXPECT_FALSE(check_front(g, t, EdgeCheck::oriented, &msg));
   g = f;
   std::swap(g.tri_indices[3 * g.face_slot[1] + 1], g.tri_indices[3 * g.face_slot[1] + 2]);  // flipped
-  EXPECT_FALSE(check_front(g, t, false, &msg));
+  EXPECT_FALSE(check_front(g, t, EdgeCheck::oriented, &msg));
   g = f;
   g.tri_indices[0] = 4;  // an inactive vertex
-  EXPECT_FALSE(check_front(g, t, false, &msg));
+  EXPECT_FALSE(check_front(g, t, EdgeCheck::oriented, &msg));
   EXPECT_NE(msg.find("inactive vertex 4"), std::string::npos) << msg;
   g = f;
   g.tri_count = 1;  // a face with three distinct corners goes missing
-  EXPECT_FALSE(check_front(g, t, false, &msg));
+  EXPECT_FALSE(check_front(g, t, EdgeCheck::oriented, &msg));
   g = f;
   g.state[4] = VertexFront::kActive;  // two active nodes above one leaf
-  EXPECT_FALSE(check_front(g, t, false, &msg));
+  EXPECT_FALSE(check_front(g, t, EdgeCheck::oriented, &msg));
 }
 
 TEST(VertexFront, SplitsWhenCloseAndMergesWhenFar) {
@@ -115,7 +115,7 @@ TEST(VertexFront, SplitsWhenCloseAndMergesWhenFar) {
   EXPECT_EQ(s.collapses, 1u);
   EXPECT_EQ(f.tri_count, 1u);
   std::string msg;
-  EXPECT_TRUE(check_front(f, t, false, &msg)) << msg;
+  EXPECT_TRUE(check_front(f, t, EdgeCheck::oriented, &msg)) << msg;
 }
 
 TEST(VertexFront, BackFacingAndOutsideStayCoarse) {
@@ -217,32 +217,36 @@ TEST(VertexFront, CompactMeshIndexesActiveVerticesOnly) {
   std::vector<uint32_t> idx(3 * 2);
   ASSERT_EQ(front_compact_mesh(pos, idx, f, t, {}), 1u);
   std::string msg;
-  EXPECT_TRUE(check_triangles(std::span(idx.data(), 3), f.active_count, false, &msg)) << msg;
+  EXPECT_TRUE(check_triangles(std::span(idx.data(), 3), f.active_count, EdgeCheck::oriented, &msg)) << msg;
   // The base triangle (4, 2, 3) through the compact vertex list gives the node positions.
   for (int j = 0; j < 3; ++j)
     for (int k = 0; k < 3; ++k)
       EXPECT_EQ(pos[3 * idx[j] + k], t.positions[3 * f.tri_indices[j] + k]);
   front_refine_all(f, t);
   ASSERT_EQ(front_compact_mesh(pos, idx, f, t, {}), 2u);
-  EXPECT_TRUE(check_triangles(idx, 4, false, &msg)) << msg;
+  EXPECT_TRUE(check_triangles(idx, 4, EdgeCheck::oriented, &msg)) << msg;
   EXPECT_FALSE(triangles_closed(idx));
+  EXPECT_EQ(edge_check_of(idx), EdgeCheck::oriented);
 }
 
 TEST(VertexFront, CheckTrianglesCatchesBadLists) {
   std::string msg;
   const std::vector<uint32_t> tetra = {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0};
-  EXPECT_TRUE(check_triangles(tetra, 4, true, &msg)) << msg;
+  EXPECT_TRUE(check_triangles(tetra, 4, EdgeCheck::closed, &msg)) << msg;
   EXPECT_TRUE(triangles_closed(tetra));
-  EXPECT_FALSE(check_triangles(tetra, 3, true, &msg));  // index 3 out of range
+  EXPECT_EQ(edge_check_of(tetra), EdgeCheck::closed);
+  EXPECT_FALSE(check_triangles(tetra, 3, EdgeCheck::closed, &msg));  // index 3 out of range
   EXPECT_NE(msg.find("references vertex 3 of 3"), std::string::npos) << msg;
   std::vector<uint32_t> open(tetra.begin(), tetra.end() - 3);
-  EXPECT_FALSE(check_triangles(open, 4, true, &msg));  // a hole: crack
-  EXPECT_TRUE(check_triangles(open, 4, false, &msg));
+  EXPECT_FALSE(check_triangles(open, 4, EdgeCheck::closed, &msg));  // a hole: crack
+  EXPECT_TRUE(check_triangles(open, 4, EdgeCheck::oriented, &msg));
   std::vector<uint32_t> flipped = tetra;
   std::swap(flipped[1], flipped[2]);
-  EXPECT_FALSE(check_triangles(flipped, 4, false, &msg));
+  EXPECT_FALSE(check_triangles(flipped, 4, EdgeCheck::oriented, &msg));
+  EXPECT_TRUE(check_triangles(flipped, 4, EdgeCheck::corners, &msg)) << msg;  // only corners checked
+  EXPECT_EQ(edge_check_of(flipped), EdgeCheck::corners);
   const std::vector<uint32_t> degenerate = {0, 1, 1};
-  EXPECT_FALSE(check_triangles(degenerate, 4, false, &msg));
+  EXPECT_FALSE(check_triangles(degenerate, 4, EdgeCheck::oriented, &msg));
 }
 
 }  // namespace
