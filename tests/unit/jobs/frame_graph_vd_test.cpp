@@ -32,7 +32,7 @@ LodChain ball_chain() {
   return c;
 }
 
-Scene ball_scene() {
+Scene ball_scene(uint32_t balls = 1) {
   SceneConfig c = test::synthetic_config(300, 200);
   c.models.resize(1);  // cowlike
   c.instances.resize(1);
@@ -41,10 +41,11 @@ Scene ball_scene() {
   c.models.back().view_dependent = true;
   InstanceConfig i;
   i.model = 1;
-  i.count = 1;
+  i.count = balls;
   i.grid = true;
   i.box_min[0] = i.box_min[1] = i.box_min[2] = 0;
   i.box_max[0] = i.box_max[1] = i.box_max[2] = 0;
+  if (balls > 1) i.box_min[0] = -60, i.box_max[0] = 60;
   i.scale_min = i.scale_max = 40;
   c.instances.push_back(i);
   std::vector<LodChain> chains = {test::synthetic_chains()[0], ball_chain()};
@@ -96,16 +97,20 @@ TEST(FrameGraphVd, PublishesValidClosedMeshesWithinTheirShare) {
 }
 
 TEST(FrameGraphVd, OneAndTwoThreadsGiveIdenticalFrames) {
-  const Scene scene = ball_scene();
+  const Scene scene = ball_scene(3);  // three view-dependent objects update in parallel
   FrameGraph one(scene, options(1)), two(scene, options(2));
   Frame a, b;
+  size_t seen = 0;
   for (uint32_t n = 0; n < 40; ++n) {
     one.run(orbit(3 * n), a);
     two.run(orbit(3 * n), b);
+    ASSERT_EQ(a.vd_objects.size(), b.vd_objects.size());
     ASSERT_EQ(a.vd_indices, b.vd_indices) << "frame " << n;
     ASSERT_EQ(a.vd_positions, b.vd_positions) << "frame " << n;
     ASSERT_EQ(a.morph, b.morph);
+    seen = std::max(seen, a.vd_objects.size());
   }
+  EXPECT_GE(seen, 2u);
 }
 
 TEST(FrameGraphVd, ObjectsWithoutAHierarchyPublishNoVdMesh) {
