@@ -29,7 +29,7 @@ struct HierarchyOptions {
   // Weight of border constraint planes relative to the surface's own planes (quadric order).
   float border_weight = 10;
   // A collapse is refused when a remaining face's normal would turn by more than this
-  // (cosine of the angle; -1 allows everything but an exact flip).
+  // (cosine of the angle; -1 refuses nothing but faces that would become degenerate).
   float min_normal_cos = 0.2f;
 };
 

@@ -1,9 +1,11 @@
 // VertexTree: a vertex hierarchy (R4's merge forest, Hoppe 1997's vertex hierarchy) for
 // view-dependent LOD, as flat arrays shared by every instance of a model.
 //
-// Nodes 0..leaf_count-1 are the input vertices (leaves); node leaf_count + k is the parent made
-// by the k-th edge collapse of the build, so a parent always has a larger id than its children
-// and the collapse order is the id order. Roots (parent == kNoNode) are the base mesh's vertices.
+// Nodes 0..leaf_count-1 are the input vertices (leaves); nodes from leaf_count on are parents
+// made by edge collapses, numbered in an order the build could have collapsed them in (pass by
+// pass; within a pass, whose collapses are independent, along a Morton curve so that nodes
+// near in space are near in memory). So a parent, and every node depending on another, has
+// the larger id. Roots (parent == kNoNode) are the base mesh's vertices.
 // Faces are the input triangles; a face is created by the split of its `owner` node (or is a
 // base face) and its corners at any front are the active ancestors of its three leaf corners.
 //
