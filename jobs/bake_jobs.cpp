@@ -1,14 +1,15 @@
 // Bake jobs: one task per model on oneTBB; an asset named by the bake key is a cache hit.
 #include "jobs/bake_jobs.h"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <mutex>
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
 
 #include "preprocess/vertex_hierarchy.h"
 #include "runtime/lod_asset.h"
@@ -49,7 +50,8 @@ struct BakeTask {
 
 // View-dependent models need level 0's vertex hierarchy (built once, then kept in the cached
 // asset); other models drop one a shared cache file may carry.
-Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* rewrite, LogLines& log, LodChain& chain) {
+Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* rewrite, LogLines& log,
+                        LodChain& chain) {
   if (!model.view_dependent) {
     chain.hierarchy = VertexTree{};
     return Status::success();
@@ -60,7 +62,8 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   mesh.source = model.file.string();
   mesh.positions.assign(chain.positions.begin() + 3 * size_t(l0.first_vertex),
                         chain.positions.begin() + 3 * size_t(l0.first_vertex + l0.vertex_count));
-  mesh.indices.assign(chain.indices.begin() + l0.first_index, chain.indices.begin() + l0.first_index + l0.index_count);
+  mesh.indices.assign(chain.indices.begin() + l0.first_index,
+                      chain.indices.begin() + l0.first_index + l0.index_count);
   const auto t0 = std::chrono::steady_clock::now();
   if (Status s = build_vertex_hierarchy(chain.hierarchy, mesh); !s) return s;
   char ms[32];
@@ -70,7 +73,8 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   return rewrite ? write_lod_asset(*rewrite, chain) : Status::success();
 }
 
-void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, LogLines& log, BakeTask& task) {
+void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, LogLines& log,
+              BakeTask& task) {
   const auto t0 = std::chrono::steady_clock::now();
   task.result.model = model.name;
   const std::string where = "model " + model.name + " (" + model.file.string() + ")";
@@ -149,21 +153,24 @@ Status bake_scene_models(const std::vector<ModelConfig>& models, const std::file
   const auto t0 = std::chrono::steady_clock::now();
   std::error_code ec;
   std::filesystem::create_directories(cache_dir, ec);
-  if (ec) return Status::error(cache_dir.string() + ": cannot create the bake cache directory: " + ec.message());
+  if (ec)
+    return Status::error(cache_dir.string() + ": cannot create the bake cache directory: " + ec.message());
 
   std::vector<BakeTask> tasks(models.size());
   LogLines lines(log);
   tbb::task_arena arena(threads == 0 ? tbb::task_arena::automatic : static_cast<int>(threads));
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, models.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) {
-        try {
-          bake_one(models[i], cache_dir, lines, tasks[i]);
-        } catch (const std::exception& e) {  // e.g. bad_alloc on a huge mesh: a status, not a crash
-          tasks[i].status = Status::error("model " + models[i].name + " (" + models[i].file.string() + "): " + e.what());
-        }
-      }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, models.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t i = r.begin(); i != r.end(); ++i) {
+            try {
+              bake_one(models[i], cache_dir, lines, tasks[i]);
+            } catch (const std::exception& e) {  // e.g. bad_alloc on a huge mesh: a status, not a crash
+              tasks[i].status = Status::error("model " + models[i].name + " (" + models[i].file.string() +
+                                              "): " + e.what());
+            }
+          }
+        });
   });
 
   BakeSummary s;

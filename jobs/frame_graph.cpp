@@ -14,14 +14,15 @@
 // each view-dependent object's compact, geomorphed mesh into the frame.
 #include "jobs/frame_graph.h"
 
-#include <algorithm>
-#include <cassert>
-#include <chrono>
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/flow_graph.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <span>
@@ -93,7 +94,8 @@ struct StageEntry {
 constexpr StageEntry kStageTable[kStageCount] = {
     {"view", "frustum planes, focal length, budget"},
     {"visibility", "cull_spheres, parallel over chunks"},
-    {"importance", "measure_objects + minima, importance_weights + choose_initial_levels, compaction, parallel"},
+    {"importance",
+     "measure_objects + minima, importance_weights + choose_initial_levels, compaction, parallel"},
     {"selection", "select_under_budget, serial over the visible set"},
     {"vdlod", "front_update per visible view-dependent object, parallel over objects"},
     {"geomorph", "level morph factors; vertex morphs + compact meshes of vd objects, parallel"},
@@ -105,7 +107,7 @@ constexpr StageEntry kStageTable[kStageCount] = {
 struct FrameGraph::Impl {
   const Scene& scene;
   FrameGraphOptions options;
-  size_t count = 0;   // objects
+  size_t count = 0;  // objects
   size_t grain = 1;
   size_t chunks = 0;
 
@@ -114,7 +116,7 @@ struct FrameGraph::Impl {
   // serial selection streams over the visible set only, without a branch per object.
   std::vector<float> visible_weight;
   std::vector<uint32_t> visible_model;
-  std::vector<uint8_t> all_ones;        // the `visible` column of the compacted set
+  std::vector<uint8_t> all_ones;  // the `visible` column of the compacted set
   std::vector<HeapEntry> heap;
   std::vector<uint32_t> chunk_visible;  // visibility: visible objects per chunk
   std::vector<uint32_t> chunk_offset;   // first compacted slot of each chunk
@@ -124,9 +126,9 @@ struct FrameGraph::Impl {
   // in kCountLanes interleaved copies so that consecutive increments of one level do not
   // wait on each other; totals follow from the counts and these per-level tables.
   static constexpr size_t kCountLanes = 4;
-  size_t level_total = 0;               // levels of all models
-  std::vector<uint32_t> level_counts;   // chunks x kCountLanes x level_total
-  std::vector<uint32_t> full_triangles; // per level: triangles of its model's level 0
+  size_t level_total = 0;                // levels of all models
+  std::vector<uint32_t> level_counts;    // chunks x kCountLanes x level_total
+  std::vector<uint32_t> full_triangles;  // per level: triangles of its model's level 0
   uint32_t visible_total = 0;
 
   // View-dependent objects: one front and one morph state per object of a model with a
@@ -140,11 +142,11 @@ struct FrameGraph::Impl {
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
     FrontStats stats;
     uint32_t moving = 0;
-    int32_t slot = -1;         // this frame: index in Frame::objects, -1 = not visible
+    int32_t slot = -1;  // this frame: index in Frame::objects, -1 = not visible
   };
   std::vector<VdObject> vd;
-  std::vector<uint32_t> vd_visible;     // this frame: indices into vd
-  std::vector<double> morph_start;      // per object: when its level last changed (seconds)
+  std::vector<uint32_t> vd_visible;  // this frame: indices into vd
+  std::vector<double> morph_start;   // per object: when its level last changed (seconds)
 
   // Per frame.
   View view;
@@ -234,14 +236,22 @@ struct FrameGraph::Impl {
 
   void run_stage(Stage stage) {
     switch (stage) {
-      case Stage::view: return stage_view();
-      case Stage::visibility: return stage_visibility();
-      case Stage::importance: return stage_importance();
-      case Stage::selection: return stage_selection();
-      case Stage::vdlod: return stage_vdlod();
-      case Stage::geomorph: return stage_geomorph();
-      case Stage::publish: return stage_publish();
-      case Stage::count: break;
+      case Stage::view:
+        return stage_view();
+      case Stage::visibility:
+        return stage_visibility();
+      case Stage::importance:
+        return stage_importance();
+      case Stage::selection:
+        return stage_selection();
+      case Stage::vdlod:
+        return stage_vdlod();
+      case Stage::geomorph:
+        return stage_geomorph();
+      case Stage::publish:
+        return stage_publish();
+      case Stage::count:
+        break;
     }
     assert(false);
   }
@@ -269,8 +279,9 @@ struct FrameGraph::Impl {
   void stage_visibility() {
     const ObjectSet& o = scene.objects;
     for_chunks([&](size_t c, size_t b, size_t e) {
-      chunk_visible[c] = static_cast<uint32_t>(cull_spheres(sub(state.visible, b, e), sub(o.cx, b, e), sub(o.cy, b, e),
-                                                            sub(o.cz, b, e), sub(o.radius, b, e), frustum));
+      chunk_visible[c] =
+          static_cast<uint32_t>(cull_spheres(sub(state.visible, b, e), sub(o.cx, b, e), sub(o.cy, b, e),
+                                             sub(o.cz, b, e), sub(o.radius, b, e), frustum));
     });
     // Exclusive prefix sum over the chunks: where each chunk's visible objects go.
     visible_total = 0;
@@ -283,9 +294,9 @@ struct FrameGraph::Impl {
   void stage_importance() {
     const ObjectSet& o = scene.objects;
     for_chunks([&](size_t c, size_t b, size_t e) {
-      chunk_minima[c] =
-          measure_objects(sub(state.distance, b, e), sub(state.area, b, e), sub(state.visible, b, e), sub(o.cx, b, e),
-                          sub(o.cy, b, e), sub(o.cz, b, e), sub(o.radius, b, e), view.eye, focal);
+      chunk_minima[c] = measure_objects(sub(state.distance, b, e), sub(state.area, b, e),
+                                        sub(state.visible, b, e), sub(o.cx, b, e), sub(o.cy, b, e),
+                                        sub(o.cz, b, e), sub(o.radius, b, e), view.eye, focal);
     });
     // min() is order-free, but merging in chunk order keeps even that obvious.
     minima = empty_minima();
@@ -326,10 +337,10 @@ struct FrameGraph::Impl {
   // ties by position, and compaction keeps object order), with less to stream through.
   void stage_selection() {
     const size_t v = visible_total;
-    selected = select_under_budget(std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
-                                   std::span<const float>(visible_weight.data(), v),
-                                   std::span<const uint32_t>(visible_model.data(), v), scene.models, options.selection,
-                                   std::span<HeapEntry>(heap.data(), v));
+    selected = select_under_budget(
+        std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
+        std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_model.data(), v),
+        scene.models, options.selection, std::span<HeapEntry>(heap.data(), v));
   }
 
   float o_pixel_error() const { return options.pixel_error; }
@@ -352,26 +363,27 @@ struct FrameGraph::Impl {
     const ObjectSet& objs = scene.objects;
     const ModelTable& models = scene.models;
     before_spawn();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-      task_begins();
-      for (size_t j = r.begin(); j != r.end(); ++j) {
-        VdObject& o = vd[vd_visible[j]];
-        const float pos[3] = {objs.x[o.object], objs.y[o.object], objs.z[o.object]};
-        const FrontView fv = front_view_of(view, pos, objs.scale[o.object], objs.yaw[o.object]);
-        // Its share of the budget: the triangles of the level selection gave it.
-        const uint32_t share = models.triangles[models.first_level[o.model] + f.levels[o.slot]];
-        FrontParams p;
-        p.time = now();
-        p.collapse_delay = options.geomorph_seconds;
-        p.target_triangles = std::max<uint32_t>(share, 1);
-        p.max_triangles = share + share / 10 + 16;
-        p.hysteresis = options.vd_hysteresis;
-        const VertexTree& tree = scene.chains[o.model].hierarchy;
-        o.stats = front_update(o.front, tree, fv, p);
-        vertex_morph_apply(o.morph, tree, o.front.frame_events(), p.time);
-      }
-      task_ends();
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+          task_begins();
+          for (size_t j = r.begin(); j != r.end(); ++j) {
+            VdObject& o = vd[vd_visible[j]];
+            const float pos[3] = {objs.x[o.object], objs.y[o.object], objs.z[o.object]};
+            const FrontView fv = front_view_of(view, pos, objs.scale[o.object], objs.yaw[o.object]);
+            // Its share of the budget: the triangles of the level selection gave it.
+            const uint32_t share = models.triangles[models.first_level[o.model] + f.levels[o.slot]];
+            FrontParams p;
+            p.time = now();
+            p.collapse_delay = options.geomorph_seconds;
+            p.target_triangles = std::max<uint32_t>(share, 1);
+            p.max_triangles = share + share / 10 + 16;
+            p.hysteresis = options.vd_hysteresis;
+            const VertexTree& tree = scene.chains[o.model].hierarchy;
+            o.stats = front_update(o.front, tree, fv, p);
+            vertex_morph_apply(o.morph, tree, o.front.frame_events(), p.time);
+          }
+          task_ends();
+        });
     after_join();
   }
 
@@ -417,18 +429,20 @@ struct FrameGraph::Impl {
     f.vd_indices.resize(indices);
     if (vd_visible.empty()) return;
     before_spawn();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-      task_begins();
-      for (size_t j = r.begin(); j != r.end(); ++j) {
-        VdObject& o = vd[vd_visible[j]];
-        VdObjectFrame& e = f.vd_objects[j];
-        e.moving = static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, o.front.vertices(), t));
-        front_compact_mesh(std::span(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
-                           std::span(f.vd_indices.data() + e.first_index, e.index_count), o.front,
-                           scene.chains[o.model].hierarchy, o.shown);
-      }
-      task_ends();
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+          task_begins();
+          for (size_t j = r.begin(); j != r.end(); ++j) {
+            VdObject& o = vd[vd_visible[j]];
+            VdObjectFrame& e = f.vd_objects[j];
+            e.moving = static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, o.front.vertices(), t));
+            front_compact_mesh(
+                std::span(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
+                std::span(f.vd_indices.data() + e.first_index, e.index_count), o.front,
+                scene.chains[o.model].hierarchy, o.shown);
+          }
+          task_ends();
+        });
     after_join();
   }
 
@@ -456,7 +470,8 @@ struct FrameGraph::Impl {
         t.tris_in_view += n * full_triangles[at];
         t.tris_selected += n * models.triangles[at];
         t.level_cost += n << std::clamp(l, 0, 63);
-        t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))] += static_cast<uint32_t>(n);
+        t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))] +=
+            static_cast<uint32_t>(n);
       }
       chunk_totals[c] = t;
     });

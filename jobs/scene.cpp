@@ -45,7 +45,8 @@ ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>
     std::mt19937_64 rng(inst.seed);
     // Grid: ceil(sqrt(n)) columns along x, as many rows along z as needed, one object per
     // cell centre; y at the middle of the box.
-    const uint32_t cols = std::max<uint32_t>(1, static_cast<uint32_t>(std::ceil(std::sqrt(double(inst.count)))));
+    const uint32_t cols =
+        std::max<uint32_t>(1, static_cast<uint32_t>(std::ceil(std::sqrt(double(inst.count)))));
     const uint32_t rows = std::max<uint32_t>(1, (inst.count + cols - 1) / cols);
     for (uint32_t i = 0; i < inst.count; ++i, ++o) {
       float p[3];

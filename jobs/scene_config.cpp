@@ -3,6 +3,8 @@
 // written only when the whole file is good.
 #include "jobs/scene_config.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,12 +12,11 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
-#include <toml++/toml.h>
 
 namespace lod {
 namespace {
 
-inline constexpr int kMaxWindowPixels = 16384;    // per side
+inline constexpr int kMaxWindowPixels = 16384;  // per side
 inline constexpr uint32_t kMaxThreads = 1024;
 inline constexpr uint64_t kMaxObjects = 10000000;  // all [[instances]] together
 
@@ -39,7 +40,8 @@ class Reader {
   }
 
   // Refuses keys a table does not know: a typo must not silently fall back to a default.
-  void only_keys(const toml::table& t, const std::string& where, std::initializer_list<std::string_view> known) const {
+  void only_keys(const toml::table& t, const std::string& where,
+                 std::initializer_list<std::string_view> known) const {
     for (auto&& [k, v] : t) {
       if (std::find(known.begin(), known.end(), k.str()) != known.end()) continue;
       std::string list;
@@ -69,7 +71,8 @@ class Reader {
                   T& value) const {
     if (auto v = integer(t, name, key)) {
       if (*v < lo || *v > hi)
-        fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(*v));
+        fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                      std::to_string(*v));
       value = static_cast<T>(*v);
     }
   }
@@ -91,7 +94,8 @@ class Reader {
     return number(*n, key);
   }
 
-  std::optional<std::string> string(const toml::table& t, std::string_view name, const std::string& key) const {
+  std::optional<std::string> string(const toml::table& t, std::string_view name,
+                                    const std::string& key) const {
     const toml::node* n = t.get(name);
     if (!n) return std::nullopt;
     if (!n->is_string()) fail(key, "expected a string");
@@ -110,7 +114,8 @@ class Reader {
     const toml::array* a = array(t, name, key);
     if (!a) return false;
     if (a->size() != 3) fail(key, "expected 3 numbers [x, y, z], got " + std::to_string(a->size()));
-    for (size_t i = 0; i < 3; ++i) out[i] = static_cast<float>(*number(*a->get(i), key + "[" + std::to_string(i) + "]"));
+    for (size_t i = 0; i < 3; ++i)
+      out[i] = static_cast<float>(*number(*a->get(i), key + "[" + std::to_string(i) + "]"));
     return true;
   }
   bool vec3(const toml::table& t, std::string_view name, const std::string& key, glm::vec3& out) const {
@@ -121,13 +126,15 @@ class Reader {
   }
 
   // Array of tables ([[name]]); an empty vector when absent.
-  std::vector<const toml::table*> tables(const toml::table& t, std::string_view name, const std::string& key) const {
+  std::vector<const toml::table*> tables(const toml::table& t, std::string_view name,
+                                         const std::string& key) const {
     std::vector<const toml::table*> out;
     const toml::array* a = array(t, name, key);
     if (!a) return out;
     for (size_t i = 0; i < a->size(); ++i) {
       const toml::node* n = a->get(i);
-      if (!n->is_table()) fail(key + "[" + std::to_string(i) + "]", "expected a table (write [[" + key + "]])");
+      if (!n->is_table())
+        fail(key + "[" + std::to_string(i) + "]", "expected a table (write [[" + key + "]])");
       out.push_back(n->as_table());
     }
     return out;
@@ -142,8 +149,8 @@ std::string indexed(const std::string& base, size_t i) { return base + "[" + std
 bool valid_model_name(const std::string& name) {
   if (name.empty() || name.size() > 64) return false;
   return std::all_of(name.begin(), name.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
-           c == '.';
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-' || c == '.';
   });
 }
 
@@ -154,7 +161,8 @@ void read_run(const Reader& r, const toml::table& root, SceneConfig& c) {
   r.integer_in(*t, "frames", "run.frames", 1, 100000000, c.frames);
   r.integer_in(*t, "threads", "run.threads", 0, kMaxThreads, c.threads);
   if (auto v = r.number(*t, "rate_hz", "run.rate_hz")) {
-    if (*v <= 0 || *v > 10000) r.fail("run.rate_hz", "must be in (0, 10000] frames per second, got " + number_text(*v));
+    if (*v <= 0 || *v > 10000)
+      r.fail("run.rate_hz", "must be in (0, 10000] frames per second, got " + number_text(*v));
     c.rate_hz = *v;
   }
 }
@@ -182,7 +190,8 @@ void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {
   if (!t) return;
   r.only_keys(*t, "lod", {"pixel_error", "hysteresis"});
   if (auto v = r.number(*t, "pixel_error", "lod.pixel_error")) {
-    if (*v <= 0 || *v > 10000) r.fail("lod.pixel_error", "must be in (0, 10000] pixels, got " + number_text(*v));
+    if (*v <= 0 || *v > 10000)
+      r.fail("lod.pixel_error", "must be in (0, 10000] pixels, got " + number_text(*v));
     c.pixel_error = static_cast<float>(*v);
   }
   if (auto v = r.number(*t, "hysteresis", "lod.hysteresis")) {
@@ -195,8 +204,8 @@ void read_camera(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "camera", "camera");
   if (!t) return;
   r.only_keys(*t, "camera",
-              {"fov_deg", "width", "height", "path", "center", "radius", "height_above", "period_frames", "near", "far",
-               "keyframe"});
+              {"fov_deg", "width", "height", "path", "center", "radius", "height_above", "period_frames",
+               "near", "far", "keyframe"});
   CameraPath& cam = c.camera;
   if (auto v = r.number(*t, "fov_deg", "camera.fov_deg")) {
     if (*v <= 1 || *v >= 179) r.fail("camera.fov_deg", "must be in (1, 179) degrees, got " + number_text(*v));
@@ -242,10 +251,12 @@ void read_camera(const Reader& r, const toml::table& root, SceneConfig& c) {
     if (!r.vec3(*keys[i], "look_at", key + ".look_at", k.look_at)) r.fail(key + ".look_at", "missing");
     if (k.position == k.look_at) r.fail(key + ".look_at", "equals position: no view direction");
     for (const CameraKeyframe& other : frames)
-      if (other.frame == k.frame) r.fail(key + ".frame", "frame " + std::to_string(k.frame) + " appears twice");
+      if (other.frame == k.frame)
+        r.fail(key + ".frame", "frame " + std::to_string(k.frame) + " appears twice");
     frames.push_back(k);
   }
-  std::stable_sort(frames.begin(), frames.end(), [](const auto& a, const auto& b) { return a.frame < b.frame; });
+  std::stable_sort(frames.begin(), frames.end(),
+                   [](const auto& a, const auto& b) { return a.frame < b.frame; });
   if (cam.kind == PathKind::keyframes && frames.empty())
     r.fail("camera.keyframe", "path = \"keyframes\" needs at least one [[camera.keyframe]]");
   cam.keyframes = std::move(frames);
@@ -253,7 +264,8 @@ void read_camera(const Reader& r, const toml::table& root, SceneConfig& c) {
 
 // Config folder first, then the data directory; absolute paths are taken as they are.
 std::filesystem::path resolve_mesh(const Reader& r, const std::string& key, const std::string& file,
-                                   const std::filesystem::path& config_dir, const std::filesystem::path& data_dir) {
+                                   const std::filesystem::path& config_dir,
+                                   const std::filesystem::path& data_dir) {
   std::error_code ec;
   const std::filesystem::path p(file);
   if (p.is_absolute()) {
@@ -285,7 +297,8 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
     auto name = r.string(t, "name", key + ".name");
     if (!name) r.fail(key + ".name", "missing");
     if (!valid_model_name(*name))
-      r.fail(key + ".name", "\"" + *name + "\" must be 1-64 characters of A-Z a-z 0-9 _ - . (it names cache files)");
+      r.fail(key + ".name",
+             "\"" + *name + "\" must be 1-64 characters of A-Z a-z 0-9 _ - . (it names cache files)");
     for (const ModelConfig& other : c.models)
       if (other.name == *name) r.fail(key + ".name", "model \"" + *name + "\" is defined twice");
     m.name = *name;
@@ -302,7 +315,8 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
         if (!(v > 0 && v <= 1)) r.fail(rk, "must be in (0, 1], got " + number_text(v));
         if (j == 0 && v != 1) r.fail(rk, "must be 1.0: level 0 is the full mesh, got " + number_text(v));
         if (j > 0 && !(v < m.bake.ratios.back()))
-          r.fail(rk, "ratios must decrease, but " + number_text(v) + " follows " + number_text(m.bake.ratios.back()));
+          r.fail(rk, "ratios must decrease, but " + number_text(v) + " follows " +
+                         number_text(m.bake.ratios.back()));
         m.bake.ratios.push_back(static_cast<float>(v));
       }
     }
@@ -333,12 +347,15 @@ void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
   for (size_t i = 0; i < blocks.size(); ++i) {
     const toml::table& t = *blocks[i];
     const std::string key = indexed("instances", i);
-    r.only_keys(t, key, {"model", "count", "placement", "box_min", "box_max", "scale", "scale_range", "seed"});
+    r.only_keys(t, key,
+                {"model", "count", "placement", "box_min", "box_max", "scale", "scale_range", "seed"});
     InstanceConfig inst;
     auto model = r.string(t, "model", key + ".model");
     if (!model) r.fail(key + ".model", "missing");
-    auto it = std::find_if(c.models.begin(), c.models.end(), [&](const ModelConfig& m) { return m.name == *model; });
-    if (it == c.models.end()) r.fail(key + ".model", "unknown model \"" + *model + "\" (no [[model]] has that name)");
+    auto it = std::find_if(c.models.begin(), c.models.end(),
+                           [&](const ModelConfig& m) { return m.name == *model; });
+    if (it == c.models.end())
+      r.fail(key + ".model", "unknown model \"" + *model + "\" (no [[model]] has that name)");
     inst.model = static_cast<uint32_t>(it - c.models.begin());
 
     if (!r.integer(t, "count", key + ".count")) r.fail(key + ".count", "missing");
@@ -358,8 +375,9 @@ void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
     r.vec3(t, "box_max", key + ".box_max", inst.box_max);
     for (int a = 0; a < 3; ++a)
       if (inst.box_min[a] > inst.box_max[a])
-        r.fail(key + ".box_max", std::string("is below box_min on ") + "xyz"[a] + " (" + number_text(inst.box_max[a]) +
-                                     " < " + number_text(inst.box_min[a]) + ")");
+        r.fail(key + ".box_max", std::string("is below box_min on ") + "xyz"[a] + " (" +
+                                     number_text(inst.box_max[a]) + " < " + number_text(inst.box_min[a]) +
+                                     ")");
 
     const bool has_scale = t.contains("scale");
     if (has_scale && t.contains("scale_range"))
@@ -369,7 +387,8 @@ void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
       inst.scale_min = inst.scale_max = static_cast<float>(*v);
     }
     if (const toml::array* a = r.array(t, "scale_range", key + ".scale_range")) {
-      if (a->size() != 2) r.fail(key + ".scale_range", "expected [min, max], got " + std::to_string(a->size()) + " values");
+      if (a->size() != 2)
+        r.fail(key + ".scale_range", "expected [min, max], got " + std::to_string(a->size()) + " values");
       const double lo = *r.number(*a->get(0), key + ".scale_range[0]");
       const double hi = *r.number(*a->get(1), key + ".scale_range[1]");
       if (lo <= 0) r.fail(key + ".scale_range[0]", "must be > 0, got " + number_text(lo));
@@ -406,7 +425,8 @@ Status load_scene_config(const std::filesystem::path& file, const std::filesyste
     read_budget(r, root, c);
     read_lod(r, root, c);
     read_camera(r, root, c);
-    const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+    const std::filesystem::path dir =
+        file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
     read_models(r, root, dir, data_dir, c);
     read_instances(r, root, c);
   } catch (const ConfigError& e) {

@@ -53,8 +53,9 @@ struct Service::Impl {
     using Clock = std::chrono::steady_clock;
     // rate_hz <= 0 means free-running as fast as frames complete.
     const Clock::duration period =
-        rate_hz > 0 ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz))
-                    : Clock::duration::zero();
+        rate_hz > 0
+            ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz))
+            : Clock::duration::zero();
     Clock::time_point next = Clock::now();
     for (;;) {
       View v;

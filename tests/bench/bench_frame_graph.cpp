@@ -125,8 +125,10 @@ class RatioReporter : public benchmark::ConsoleReporter {
       if (one == times_.end() || two == times_.end()) continue;
       const Times& a = one->second;
       const Times& b = two->second;
-      std::printf("speed-up %6u objects, 2 vs 1 thread: mean %.2fx, median %.2fx (%.3f -> %.3f ms), min %.2fx (%.3f -> %.3f ms)\n",
-                  objects, a.mean / b.mean, a.median / b.median, a.median, b.median, a.min / b.min, a.min, b.min);
+      std::printf(
+          "speed-up %6u objects, 2 vs 1 thread: mean %.2fx, median %.2fx (%.3f -> %.3f ms), min %.2fx (%.3f "
+          "-> %.3f ms)\n",
+          objects, a.mean / b.mean, a.median / b.median, a.median, b.median, a.min / b.min, a.min, b.min);
     }
   }
 

@@ -96,7 +96,8 @@ TEST(Stress, TenThousandObjectsTwoHundredFramesMovingCamera) {
       ASSERT_LT(i, kObjects);
       ASSERT_EQ(selected[i], 0) << "object " << i << " published twice";
       selected[i] = 1;
-      EXPECT_LE(outside_by(planes, scene.objects, i), 1e-3f * (1 + scene.objects.radius[i])) << "object " << i;
+      EXPECT_LE(outside_by(planes, scene.objects, i), 1e-3f * (1 + scene.objects.radius[i]))
+          << "object " << i;
       EXPECT_LT(f.levels[k], scene.models.level_count[scene.objects.model[i]]);
     }
     for (uint32_t i = 0; i < kObjects; ++i) {

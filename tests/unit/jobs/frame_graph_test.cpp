@@ -67,7 +67,8 @@ TEST(FrameGraph, BudgetMetOrFlaggedAtEveryBudget) {
   const Scene scene = test::synthetic_scene(3000, 250);
   const View view = view_at(test::synthetic_config(3000, 250).camera, 30);
   const uint64_t unbudgeted = unbudgeted_triangles(scene, view);
-  for (uint64_t budget : {uint64_t{0}, uint64_t{1000}, unbudgeted / 50, unbudgeted / 4, unbudgeted, unbudgeted * 2}) {
+  for (uint64_t budget :
+       {uint64_t{0}, uint64_t{1000}, unbudgeted / 50, unbudgeted / 4, unbudgeted, unbudgeted * 2}) {
     FrameGraph g(scene, options_with(2, budget));
     Frame f;
     g.run(view, f);
@@ -276,7 +277,8 @@ TEST(FrameGraph, ChunkSizeDoesNotChangeTheFrame) {
   ASSERT_GT(runs[0][0].lowered_steps, 0u) << "the budget must bind for this test to mean anything";
   for (size_t r = 1; r < runs.size(); ++r)
     for (size_t n = 0; n < runs[0].size(); ++n)
-      expect_same_frame(runs[0][n], runs[r][n], "grain run " + std::to_string(r) + " frame " + std::to_string(n));
+      expect_same_frame(runs[0][n], runs[r][n],
+                        "grain run " + std::to_string(r) + " frame " + std::to_string(n));
 }
 
 TEST(FrameGraph, SingleLevelModelsCannotBeLoweredAndAreFlagged) {

@@ -183,7 +183,8 @@ TEST(SceneConfig, MinimalConfigTakesTheDefaults) {
 TEST(SceneConfig, ShippedConfigsLoad) {
   // The repository's own configs must stay loadable (their meshes come from the build's data).
   const fs::path configs = fs::path(LOD_SOURCE_DIR) / "configs";
-  if (!fs::is_directory(configs) || test::data_dir().empty()) GTEST_SKIP() << "no configs/ or no extracted meshes";
+  if (!fs::is_directory(configs) || test::data_dir().empty())
+    GTEST_SKIP() << "no configs/ or no extracted meshes";
   size_t loaded = 0;
   for (const auto& e : fs::directory_iterator(configs)) {
     if (e.path().extension() != ".toml") continue;
@@ -231,30 +232,78 @@ TEST(SceneConfig, MeshPathRelativeToTheConfigFolder) {
   EXPECT_EQ(c.models[0].file, d.dir / "meshes" / "sub.off");
 }
 
-TEST(SceneConfig, RefusesUnknownTopLevelKey) { expect_refused("[render]\nx = 1\n" + kModel + kInstances, "render", "unknown key"); }
-TEST(SceneConfig, RefusesUnknownKeyInsideATable) { expect_refused("[run]\nframs = 10\n" + kModel + kInstances, "run.frams", "unknown key"); }
-TEST(SceneConfig, RefusesZeroFrames) { expect_refused("[run]\nframes = 0\n" + kModel + kInstances, "run.frames"); }
-TEST(SceneConfig, RefusesNegativeFrames) { expect_refused("[run]\nframes = -5\n" + kModel + kInstances, "run.frames"); }
-TEST(SceneConfig, RefusesFramesOfTheWrongType) { expect_refused("[run]\nframes = \"ten\"\n" + kModel + kInstances, "run.frames", "integer"); }
-TEST(SceneConfig, RefusesTooManyThreads) { expect_refused("[run]\nthreads = 1025\n" + kModel + kInstances, "run.threads"); }
-TEST(SceneConfig, RefusesNegativeThreads) { expect_refused("[run]\nthreads = -1\n" + kModel + kInstances, "run.threads"); }
-TEST(SceneConfig, RefusesZeroRate) { expect_refused("[run]\nrate_hz = 0\n" + kModel + kInstances, "run.rate_hz"); }
-TEST(SceneConfig, RefusesZeroBudget) { expect_refused("[budget]\ntriangles = 0\n" + kModel + kInstances, "budget.triangles"); }
-TEST(SceneConfig, RefusesNegativeBudget) { expect_refused("[budget]\ntriangles = -100\n" + kModel + kInstances, "budget.triangles"); }
-TEST(SceneConfig, RefusesUnknownBudgetCount) { expect_refused("[budget]\ncount = \"vertices\"\n" + kModel + kInstances, "budget.count"); }
-TEST(SceneConfig, RefusesZeroPixelError) { expect_refused("[lod]\npixel_error = 0\n" + kModel + kInstances, "lod.pixel_error"); }
-TEST(SceneConfig, RefusesNegativeHysteresis) { expect_refused("[lod]\nhysteresis = -0.1\n" + kModel + kInstances, "lod.hysteresis"); }
-TEST(SceneConfig, RefusesZeroWidth) { expect_refused("[camera]\nwidth = 0\n" + kModel + kInstances, "camera.width"); }
-TEST(SceneConfig, RefusesNegativeHeight) { expect_refused("[camera]\nheight = -720\n" + kModel + kInstances, "camera.height"); }
-TEST(SceneConfig, RefusesHugeWidth) { expect_refused("[camera]\nwidth = 16385\n" + kModel + kInstances, "camera.width"); }
-TEST(SceneConfig, RefusesFovOfOneDegree) { expect_refused("[camera]\nfov_deg = 1\n" + kModel + kInstances, "camera.fov_deg"); }
-TEST(SceneConfig, RefusesFovOf179Degrees) { expect_refused("[camera]\nfov_deg = 179\n" + kModel + kInstances, "camera.fov_deg"); }
-TEST(SceneConfig, RefusesNonFiniteFov) { expect_refused("[camera]\nfov_deg = nan\n" + kModel + kInstances, "camera.fov_deg", "finite"); }
-TEST(SceneConfig, RefusesUnknownCameraPath) { expect_refused("[camera]\npath = \"spiral\"\n" + kModel + kInstances, "camera.path"); }
-TEST(SceneConfig, RefusesFarBeforeNear) { expect_refused("[camera]\nnear = 10\nfar = 5\n" + kModel + kInstances, "camera.far"); }
-TEST(SceneConfig, RefusesZeroNear) { expect_refused("[camera]\nnear = 0\n" + kModel + kInstances, "camera.near"); }
-TEST(SceneConfig, RefusesZeroPeriod) { expect_refused("[camera]\nperiod_frames = 0\n" + kModel + kInstances, "camera.period_frames"); }
-TEST(SceneConfig, RefusesCenterWithTwoNumbers) { expect_refused("[camera]\ncenter = [1, 2]\n" + kModel + kInstances, "camera.center"); }
+TEST(SceneConfig, RefusesUnknownTopLevelKey) {
+  expect_refused("[render]\nx = 1\n" + kModel + kInstances, "render", "unknown key");
+}
+TEST(SceneConfig, RefusesUnknownKeyInsideATable) {
+  expect_refused("[run]\nframs = 10\n" + kModel + kInstances, "run.frams", "unknown key");
+}
+TEST(SceneConfig, RefusesZeroFrames) {
+  expect_refused("[run]\nframes = 0\n" + kModel + kInstances, "run.frames");
+}
+TEST(SceneConfig, RefusesNegativeFrames) {
+  expect_refused("[run]\nframes = -5\n" + kModel + kInstances, "run.frames");
+}
+TEST(SceneConfig, RefusesFramesOfTheWrongType) {
+  expect_refused("[run]\nframes = \"ten\"\n" + kModel + kInstances, "run.frames", "integer");
+}
+TEST(SceneConfig, RefusesTooManyThreads) {
+  expect_refused("[run]\nthreads = 1025\n" + kModel + kInstances, "run.threads");
+}
+TEST(SceneConfig, RefusesNegativeThreads) {
+  expect_refused("[run]\nthreads = -1\n" + kModel + kInstances, "run.threads");
+}
+TEST(SceneConfig, RefusesZeroRate) {
+  expect_refused("[run]\nrate_hz = 0\n" + kModel + kInstances, "run.rate_hz");
+}
+TEST(SceneConfig, RefusesZeroBudget) {
+  expect_refused("[budget]\ntriangles = 0\n" + kModel + kInstances, "budget.triangles");
+}
+TEST(SceneConfig, RefusesNegativeBudget) {
+  expect_refused("[budget]\ntriangles = -100\n" + kModel + kInstances, "budget.triangles");
+}
+TEST(SceneConfig, RefusesUnknownBudgetCount) {
+  expect_refused("[budget]\ncount = \"vertices\"\n" + kModel + kInstances, "budget.count");
+}
+TEST(SceneConfig, RefusesZeroPixelError) {
+  expect_refused("[lod]\npixel_error = 0\n" + kModel + kInstances, "lod.pixel_error");
+}
+TEST(SceneConfig, RefusesNegativeHysteresis) {
+  expect_refused("[lod]\nhysteresis = -0.1\n" + kModel + kInstances, "lod.hysteresis");
+}
+TEST(SceneConfig, RefusesZeroWidth) {
+  expect_refused("[camera]\nwidth = 0\n" + kModel + kInstances, "camera.width");
+}
+TEST(SceneConfig, RefusesNegativeHeight) {
+  expect_refused("[camera]\nheight = -720\n" + kModel + kInstances, "camera.height");
+}
+TEST(SceneConfig, RefusesHugeWidth) {
+  expect_refused("[camera]\nwidth = 16385\n" + kModel + kInstances, "camera.width");
+}
+TEST(SceneConfig, RefusesFovOfOneDegree) {
+  expect_refused("[camera]\nfov_deg = 1\n" + kModel + kInstances, "camera.fov_deg");
+}
+TEST(SceneConfig, RefusesFovOf179Degrees) {
+  expect_refused("[camera]\nfov_deg = 179\n" + kModel + kInstances, "camera.fov_deg");
+}
+TEST(SceneConfig, RefusesNonFiniteFov) {
+  expect_refused("[camera]\nfov_deg = nan\n" + kModel + kInstances, "camera.fov_deg", "finite");
+}
+TEST(SceneConfig, RefusesUnknownCameraPath) {
+  expect_refused("[camera]\npath = \"spiral\"\n" + kModel + kInstances, "camera.path");
+}
+TEST(SceneConfig, RefusesFarBeforeNear) {
+  expect_refused("[camera]\nnear = 10\nfar = 5\n" + kModel + kInstances, "camera.far");
+}
+TEST(SceneConfig, RefusesZeroNear) {
+  expect_refused("[camera]\nnear = 0\n" + kModel + kInstances, "camera.near");
+}
+TEST(SceneConfig, RefusesZeroPeriod) {
+  expect_refused("[camera]\nperiod_frames = 0\n" + kModel + kInstances, "camera.period_frames");
+}
+TEST(SceneConfig, RefusesCenterWithTwoNumbers) {
+  expect_refused("[camera]\ncenter = [1, 2]\n" + kModel + kInstances, "camera.center");
+}
 TEST(SceneConfig, RefusesKeyframePathWithoutKeyframes) {
   expect_refused("[camera]\npath = \"keyframes\"\n" + kModel + kInstances, "camera.keyframe");
 }
@@ -263,37 +312,65 @@ TEST(SceneConfig, RefusesKeyframeWithoutPosition) {
                  "camera.keyframe[0].position", "missing");
 }
 TEST(SceneConfig, RefusesKeyframeLookingAtItself) {
-  expect_refused("[[camera.keyframe]]\nframe = 0\nposition = [1, 1, 1]\nlook_at = [1, 1, 1]\n" + kModel + kInstances,
-                 "camera.keyframe[0].look_at");
+  expect_refused(
+      "[[camera.keyframe]]\nframe = 0\nposition = [1, 1, 1]\nlook_at = [1, 1, 1]\n" + kModel + kInstances,
+      "camera.keyframe[0].look_at");
 }
 TEST(SceneConfig, RefusesTwoKeyframesOnOneFrame) {
   const std::string k = "[[camera.keyframe]]\nframe = 5\nposition = [1, 1, 1]\nlook_at = [0, 0, 0]\n";
   expect_refused(k + k + kModel + kInstances, "camera.keyframe[1].frame", "twice");
 }
 TEST(SceneConfig, RefusesNoModels) { expect_refused(kInstances, "model"); }
-TEST(SceneConfig, RefusesModelWithoutName) { expect_refused("[[model]]\nfile = \"ball.off\"\n" + kInstances, "model[0].name"); }
+TEST(SceneConfig, RefusesModelWithoutName) {
+  expect_refused("[[model]]\nfile = \"ball.off\"\n" + kInstances, "model[0].name");
+}
 TEST(SceneConfig, RefusesModelNameWithASlash) {
   expect_refused("[[model]]\nname = \"a/b\"\nfile = \"ball.off\"\n" + kInstances, "model[0].name");
 }
-TEST(SceneConfig, RefusesDuplicateModelNames) { expect_refused(kModel + kModel + kInstances, "model[1].name", "twice"); }
-TEST(SceneConfig, RefusesRatioAboveOne) { expect_refused(kModel + "ratios = [1.0, 1.5]\n" + kInstances, "model[0].ratios[1]"); }
-TEST(SceneConfig, RefusesZeroRatio) { expect_refused(kModel + "ratios = [1.0, 0.5, 0.0]\n" + kInstances, "model[0].ratios[2]"); }
-TEST(SceneConfig, RefusesNegativeRatio) { expect_refused(kModel + "ratios = [1.0, -0.5]\n" + kInstances, "model[0].ratios[1]"); }
+TEST(SceneConfig, RefusesDuplicateModelNames) {
+  expect_refused(kModel + kModel + kInstances, "model[1].name", "twice");
+}
+TEST(SceneConfig, RefusesRatioAboveOne) {
+  expect_refused(kModel + "ratios = [1.0, 1.5]\n" + kInstances, "model[0].ratios[1]");
+}
+TEST(SceneConfig, RefusesZeroRatio) {
+  expect_refused(kModel + "ratios = [1.0, 0.5, 0.0]\n" + kInstances, "model[0].ratios[2]");
+}
+TEST(SceneConfig, RefusesNegativeRatio) {
+  expect_refused(kModel + "ratios = [1.0, -0.5]\n" + kInstances, "model[0].ratios[1]");
+}
 TEST(SceneConfig, RefusesIncreasingRatios) {
   expect_refused(kModel + "ratios = [1.0, 0.25, 0.5]\n" + kInstances, "model[0].ratios[2]", "decrease");
 }
-TEST(SceneConfig, RefusesRepeatedRatio) { expect_refused(kModel + "ratios = [1.0, 0.5, 0.5]\n" + kInstances, "model[0].ratios[2]"); }
-TEST(SceneConfig, RefusesRatiosNotStartingAtOne) { expect_refused(kModel + "ratios = [0.5, 0.25]\n" + kInstances, "model[0].ratios[0]"); }
-TEST(SceneConfig, RefusesEmptyRatios) { expect_refused(kModel + "ratios = []\n" + kInstances, "model[0].ratios"); }
-TEST(SceneConfig, RefusesUnknownMethod) { expect_refused(kModel + "method = \"magic\"\n" + kInstances, "model[0].method"); }
-TEST(SceneConfig, RefusesZeroExtremeThreshold) { expect_refused(kModel + "extreme_threshold = 0\n" + kInstances, "model[0].extreme_threshold"); }
+TEST(SceneConfig, RefusesRepeatedRatio) {
+  expect_refused(kModel + "ratios = [1.0, 0.5, 0.5]\n" + kInstances, "model[0].ratios[2]");
+}
+TEST(SceneConfig, RefusesRatiosNotStartingAtOne) {
+  expect_refused(kModel + "ratios = [0.5, 0.25]\n" + kInstances, "model[0].ratios[0]");
+}
+TEST(SceneConfig, RefusesEmptyRatios) {
+  expect_refused(kModel + "ratios = []\n" + kInstances, "model[0].ratios");
+}
+TEST(SceneConfig, RefusesUnknownMethod) {
+  expect_refused(kModel + "method = \"magic\"\n" + kInstances, "model[0].method");
+}
+TEST(SceneConfig, RefusesZeroExtremeThreshold) {
+  expect_refused(kModel + "extreme_threshold = 0\n" + kInstances, "model[0].extreme_threshold");
+}
 TEST(SceneConfig, RefusesNoInstances) { expect_refused(kModel, "instances"); }
 TEST(SceneConfig, RefusesUnknownModelName) {
-  expect_refused(kModel + "[[instances]]\nmodel = \"cow\"\ncount = 1\n", "instances[0].model", "unknown model \"cow\"");
+  expect_refused(kModel + "[[instances]]\nmodel = \"cow\"\ncount = 1\n", "instances[0].model",
+                 "unknown model \"cow\"");
 }
-TEST(SceneConfig, RefusesZeroCount) { expect_refused(kModel + "[[instances]]\nmodel = \"ball\"\ncount = 0\n", "instances[0].count"); }
-TEST(SceneConfig, RefusesNegativeCount) { expect_refused(kModel + "[[instances]]\nmodel = \"ball\"\ncount = -3\n", "instances[0].count"); }
-TEST(SceneConfig, RefusesMissingCount) { expect_refused(kModel + "[[instances]]\nmodel = \"ball\"\n", "instances[0].count", "missing"); }
+TEST(SceneConfig, RefusesZeroCount) {
+  expect_refused(kModel + "[[instances]]\nmodel = \"ball\"\ncount = 0\n", "instances[0].count");
+}
+TEST(SceneConfig, RefusesNegativeCount) {
+  expect_refused(kModel + "[[instances]]\nmodel = \"ball\"\ncount = -3\n", "instances[0].count");
+}
+TEST(SceneConfig, RefusesMissingCount) {
+  expect_refused(kModel + "[[instances]]\nmodel = \"ball\"\n", "instances[0].count", "missing");
+}
 TEST(SceneConfig, RefusesMoreThanTenMillionObjects) {
   const std::string block = "[[instances]]\nmodel = \"ball\"\ncount = 6000000\n";
   expect_refused(kModel + block + block, "instances[1].count", "10000000");
@@ -302,10 +379,15 @@ TEST(SceneConfig, RefusesUnknownPlacement) {
   expect_refused(kModel + kInstances + "placement = \"spiral\"\n", "instances[0].placement");
 }
 TEST(SceneConfig, RefusesInvertedBox) {
-  expect_refused(kModel + kInstances + "box_min = [0, 0, 0]\nbox_max = [10, -1, 10]\n", "instances[0].box_max", "on y");
+  expect_refused(kModel + kInstances + "box_min = [0, 0, 0]\nbox_max = [10, -1, 10]\n",
+                 "instances[0].box_max", "on y");
 }
-TEST(SceneConfig, RefusesZeroScale) { expect_refused(kModel + kInstances + "scale = 0\n", "instances[0].scale"); }
-TEST(SceneConfig, RefusesNegativeScale) { expect_refused(kModel + kInstances + "scale = -2\n", "instances[0].scale"); }
+TEST(SceneConfig, RefusesZeroScale) {
+  expect_refused(kModel + kInstances + "scale = 0\n", "instances[0].scale");
+}
+TEST(SceneConfig, RefusesNegativeScale) {
+  expect_refused(kModel + kInstances + "scale = -2\n", "instances[0].scale");
+}
 TEST(SceneConfig, RefusesScaleRangeStartingAtZero) {
   expect_refused(kModel + kInstances + "scale_range = [0.0, 2.0]\n", "instances[0].scale_range[0]");
 }
@@ -315,11 +397,11 @@ TEST(SceneConfig, RefusesInvertedScaleRange) {
 TEST(SceneConfig, RefusesScaleAndScaleRangeTogether) {
   expect_refused(kModel + kInstances + "scale = 1\nscale_range = [1.0, 2.0]\n", "instances[0].scale_range");
 }
-TEST(SceneConfig, RefusesNegativeSeed) { expect_refused(kModel + kInstances + "seed = -1\n", "instances[0].seed"); }
-
-TEST(SceneConfig, DefaultDataDirIsTheCompiledInOne) {
-  EXPECT_EQ(default_data_dir(), fs::path(LOD_DATA_DIR));
+TEST(SceneConfig, RefusesNegativeSeed) {
+  expect_refused(kModel + kInstances + "seed = -1\n", "instances[0].seed");
 }
+
+TEST(SceneConfig, DefaultDataDirIsTheCompiledInOne) { EXPECT_EQ(default_data_dir(), fs::path(LOD_DATA_DIR)); }
 
 }  // namespace
 }  // namespace lod

@@ -16,8 +16,8 @@ namespace lod::test {
 
 // Level k has triangles[k]; error doubles per level from `base_error`; sphere of `radius`
 // centred a little off the origin so that the world-sphere transform matters.
-inline LodChain synthetic_chain(const std::string& name, const std::vector<uint32_t>& triangles, float base_error,
-                                float radius) {
+inline LodChain synthetic_chain(const std::string& name, const std::vector<uint32_t>& triangles,
+                                float base_error, float radius) {
   LodChain c;
   c.name = name;
   uint32_t first_index = 0;
@@ -89,6 +89,8 @@ inline Scene synthetic_scene(uint32_t count, float extent, uint64_t seed = 1) {
 }
 
 // Field size that keeps object density the same at every count (about 10k objects per 1 km^2).
-inline float extent_for(uint32_t count) { return 500.f * std::sqrt(static_cast<float>(count) / 10000.f) + 50.f; }
+inline float extent_for(uint32_t count) {
+  return 500.f * std::sqrt(static_cast<float>(count) / 10000.f) + 50.f;
+}
 
 }  // namespace lod::test
