@@ -253,6 +253,60 @@ void run_mesh(Bench& b, const std::string& name, const MeshData& mesh, const std
   }
 }
 
+// One panel per mesh: RMS error (log, % of the diagonal) against ratio (log), one line per
+// method, so the CSV has a picture next to it.
+void write_plot(const std::string& path, const std::vector<Row>& rows) {
+  const char* methods[] = {"lodkit-qem-2t", "lodkit-aggressive", "meshopt", "meshopt-sloppy"};
+  const char* colours[] = {"#1f77b4", "#2ca02c", "#d62728", "#ff7f0e"};
+  std::vector<std::string> meshes;
+  for (const Row& r : rows)
+    if (r.ratio > 0 && std::find(meshes.begin(), meshes.end(), r.mesh) == meshes.end()) meshes.push_back(r.mesh);
+  const double w = 520, h = 260, left = 60, top = 30;
+  std::ofstream out(path);
+  out << "<svg xmlns='http://www.w3.org/2000/svg' width='" << w << "' height='" << h * double(meshes.size()) + 40
+      << "' font-family='sans-serif' font-size='11'>\n<rect width='100%' height='100%' fill='white'/>\n";
+  for (size_t i = 0; i < 4; ++i)
+    out << "<text x='" << left + 110 * double(i) << "' y='16' fill='" << colours[i] << "'>" << methods[i] << "</text>\n";
+  for (size_t m = 0; m < meshes.size(); ++m) {
+    double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+    for (const Row& r : rows) {
+      if (r.mesh != meshes[m] || r.ratio <= 0 || r.rms_rel <= 0) continue;
+      x0 = std::min(x0, std::log10(r.ratio)), x1 = std::max(x1, std::log10(r.ratio));
+      y0 = std::min(y0, std::log10(r.rms_rel)), y1 = std::max(y1, std::log10(r.rms_rel));
+    }
+    if (x1 <= x0) x1 = x0 + 1;
+    if (y1 <= y0) y1 = y0 + 1;
+    const double oy = top + h * double(m), pw = w - left - 20, ph = h - 60;
+    auto px = [&](double r) { return left + (std::log10(r) - x0) / (x1 - x0) * pw; };
+    auto py = [&](double e) { return oy + 10 + (y1 - std::log10(e)) / (y1 - y0) * ph; };
+    out << "<text x='" << left << "' y='" << oy + 5 << "'>" << meshes[m]
+        << ": RMS distance (% of diagonal, log) vs ratio (log)</text>\n";
+    out << "<rect x='" << left << "' y='" << oy + 10 << "' width='" << pw << "' height='" << ph
+        << "' fill='none' stroke='#999'/>\n";
+    for (size_t k = 0; k < 4; ++k) {
+      std::string pts;
+      for (const Row& r : rows)
+        if (r.mesh == meshes[m] && r.method == methods[k] && r.ratio > 0 && r.rms_rel > 0) {
+          pts += std::to_string(px(r.ratio)) + "," + std::to_string(py(r.rms_rel)) + " ";
+          out << "<circle cx='" << px(r.ratio) << "' cy='" << py(r.rms_rel) << "' r='2.5' fill='" << colours[k] << "'/>\n";
+        }
+      out << "<polyline points='" << pts << "' fill='none' stroke='" << colours[k] << "'/>\n";
+    }
+    for (const Row& r : rows)
+      if (r.mesh == meshes[m] && r.method == methods[0] && r.ratio > 0) {
+        char label[32];
+        std::snprintf(label, sizeof label, "%g%%", 100 * r.ratio);
+        out << "<text x='" << px(r.ratio) - 10 << "' y='" << oy + 25 + ph << "'>" << label << "</text>\n";
+      }
+    char lo[32], hi[32];
+    std::snprintf(lo, sizeof lo, "%.2g", 100 * std::pow(10.0, y0));
+    std::snprintf(hi, sizeof hi, "%.2g", 100 * std::pow(10.0, y1));
+    out << "<text x='4' y='" << oy + 20 << "'>" << hi << "</text><text x='4' y='" << oy + 10 + ph << "'>" << lo
+        << "</text>\n";
+  }
+  out << "</svg>\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -323,7 +377,10 @@ int main(int argc, char** argv) {
   for (const Row& r : b.rows)
     out << r.mesh << ',' << r.method << ',' << r.input << ',' << r.ratio << ',' << r.target << ',' << r.achieved << ','
         << r.seconds << ',' << r.cpu_seconds << ',' << r.mtris_per_s() << ',' << r.max_rel << ',' << r.rms_rel << '\n';
-  std::printf("\nwrote %s\n", csv.c_str());
+  const std::string svg = csv.size() > 4 && csv.substr(csv.size() - 4) == ".csv" ? csv.substr(0, csv.size() - 4) + ".svg"
+                                                                                 : csv + ".svg";
+  write_plot(svg, b.rows);
+  std::printf("\nwrote %s and %s\n", csv.c_str(), svg.c_str());
 
 #ifdef LOD_HAVE_MESHOPTIMIZER
   // The figures, as ratios of the same run.
