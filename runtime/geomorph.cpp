@@ -91,26 +91,67 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
                          std::span<const uint32_t> coarse_source) {
   const size_t nf = fine_positions.size() / 3, nc = coarse_positions.size() / 3;
   assert(target.size() == nf && fine_source.size() == nf && coarse_source.size() == nc);
+  if (nc == 0) return;
   // Sources that survive keep their own coarse vertex (sorted pairs, binary search).
   std::vector<std::pair<uint32_t, uint32_t>> by_source(nc);
   for (size_t c = 0; c < nc; ++c) by_source[c] = {coarse_source[c], static_cast<uint32_t>(c)};
   std::sort(by_source.begin(), by_source.end());
+  // Merged-away vertices take the nearest coarse vertex: a uniform grid of about one coarse
+  // vertex per cell, searched in growing shells (a bake-time cost, never per frame).
+  float lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = coarse_positions[k];
+  for (size_t c = 0; c < nc; ++c)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min(lo[k], coarse_positions[3 * c + k]), hi[k] = std::max(hi[k], coarse_positions[3 * c + k]);
+  const int res = std::clamp(static_cast<int>(std::cbrt(double(nc))), 1, 256);
+  float cell = 0;
+  for (int k = 0; k < 3; ++k) cell = std::max(cell, (hi[k] - lo[k]) / res);
+  if (!(cell > 0)) cell = 1;
+  auto cell_of = [&](const float* p, int k) {
+    return std::clamp(static_cast<int>((p[k] - lo[k]) / cell), 0, res - 1);
+  };
+  const size_t cells = size_t(res) * res * res;
+  std::vector<uint32_t> start(cells + 1, 0), items(nc);
+  auto index = [&](int x, int y, int z) { return (size_t(z) * res + y) * res + x; };
+  for (size_t c = 0; c < nc; ++c) {
+    const float* p = &coarse_positions[3 * c];
+    ++start[index(cell_of(p, 0), cell_of(p, 1), cell_of(p, 2)) + 1];
+  }
+  for (size_t i = 0; i < cells; ++i) start[i + 1] += start[i];
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t c = 0; c < nc; ++c) {
+    const float* p = &coarse_positions[3 * c];
+    items[fill[index(cell_of(p, 0), cell_of(p, 1), cell_of(p, 2))]++] = static_cast<uint32_t>(c);
+  }
   for (size_t v = 0; v < nf; ++v) {
     const auto it = std::lower_bound(by_source.begin(), by_source.end(), std::make_pair(fine_source[v], 0u));
     if (it != by_source.end() && it->first == fine_source[v]) {
       target[v] = it->second;
       continue;
     }
-    // Merged away: the nearest coarse vertex (a bake-time cost, never per frame).
+    const float* p = &fine_positions[3 * v];
+    const int cx = cell_of(p, 0), cy = cell_of(p, 1), cz = cell_of(p, 2);
     float best = std::numeric_limits<float>::infinity();
     uint32_t best_c = 0;
-    for (size_t c = 0; c < nc; ++c) {
-      float d2 = 0;
-      for (int k = 0; k < 3; ++k) {
-        const float d = fine_positions[3 * v + k] - coarse_positions[3 * c + k];
-        d2 += d * d;
-      }
-      if (d2 < best) best = d2, best_c = static_cast<uint32_t>(c);
+    // Shell r holds every cell at Chebyshev distance r; once a hit is closer than the inner
+    // edge of the next shell, nothing farther can beat it.
+    for (int r = 0; r < res; ++r) {
+      for (int z = std::max(cz - r, 0); z <= std::min(cz + r, res - 1); ++z)
+        for (int y = std::max(cy - r, 0); y <= std::min(cy + r, res - 1); ++y)
+          for (int x = std::max(cx - r, 0); x <= std::min(cx + r, res - 1); ++x) {
+            if (std::max({std::abs(x - cx), std::abs(y - cy), std::abs(z - cz)}) != r) continue;
+            const size_t i = index(x, y, z);
+            for (uint32_t k = start[i]; k < start[i + 1]; ++k) {
+              const uint32_t c = items[k];
+              float d2 = 0;
+              for (int a = 0; a < 3; ++a) {
+                const float d = p[a] - coarse_positions[3 * size_t(c) + a];
+                d2 += d * d;
+              }
+              if (d2 < best || (d2 == best && c < best_c)) best = d2, best_c = c;
+            }
+          }
+      if (best <= (r * cell) * (r * cell)) break;
     }
     target[v] = best_c;
   }

@@ -107,3 +107,32 @@ TEST(Geomorph, LevelMorphRestartsOnAChangeAndSettles) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+TEST(Geomorph, LevelTargetsMatchABruteForceNearestSearch) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-5, 5);
+  std::vector<float> fine(3 * 500), coarse(3 * 60);
+  for (float& x : fine) x = u(rng);
+  for (float& x : coarse) x = u(rng) * 0.5f;  // a tighter cloud: many fine vertices lie outside its grid
+  std::vector<uint32_t> fine_src(500), coarse_src(60);
+  for (uint32_t i = 0; i < 500; ++i) fine_src[i] = 1000 + i;  // nothing survives
+  for (uint32_t i = 0; i < 60; ++i) coarse_src[i] = i;
+  std::vector<uint32_t> target(500);
+  level_morph_targets(target, fine, fine_src, coarse, coarse_src);
+  for (size_t v = 0; v < 500; ++v) {
+    float best = 1e30f;
+    uint32_t best_c = 0;
+    for (uint32_t c = 0; c < 60; ++c) {
+      float d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += (fine[3 * v + k] - coarse[3 * c + k]) * (fine[3 * v + k] - coarse[3 * c + k]);
+      if (d2 < best) best = d2, best_c = c;
+    }
+    ASSERT_EQ(target[v], best_c) << "fine vertex " << v;
+  }
+}
+
+}  // namespace
+}  // namespace lod
