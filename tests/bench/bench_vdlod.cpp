@@ -109,7 +109,7 @@ BENCHMARK(BM_HierarchyBuild)->Unit(benchmark::kMillisecond)->UseManualTime()->It
 
 constexpr uint32_t kTarget = 200000;
 
-// Smooth orbit: an arc step of 0.5 % of the model's size per frame.
+// Smooth orbit: an arc step of 0.5 % of the model's size per frame. Arg: hysteresis x 100.
 void run_frames(benchmark::State& state, bool full_pass) {
   Fixture& fx = fixture();
   VertexFront front;
@@ -117,6 +117,7 @@ void run_frames(benchmark::State& state, bool full_pass) {
   FrontParams p;
   p.target_triangles = kTarget;
   p.max_triangles = kTarget + kTarget / 10;
+  p.hysteresis = static_cast<float>(state.range(0)) / 100;
   const float distance = 0.6f * fx.size;
   const double step = 0.005 * fx.size / distance;
   double angle = 0;
@@ -144,8 +145,8 @@ void run_frames(benchmark::State& state, bool full_pass) {
 
 void BM_FrontSmooth(benchmark::State& state) { run_frames(state, false); }
 void BM_FrontFullPass(benchmark::State& state) { run_frames(state, true); }
-BENCHMARK(BM_FrontSmooth)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(300);
-BENCHMARK(BM_FrontFullPass)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(30);
+BENCHMARK(BM_FrontSmooth)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(300)->Arg(150)->Arg(100);
+BENCHMARK(BM_FrontFullPass)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(30)->Arg(150);
 
 // Teleport: settle at one side, jump to the opposite side and closer. Frames until the front
 // changes by under 1 % of its triangles, the most triangles of any frame vs the cap.
