@@ -5,9 +5,12 @@
 #include <cmath>
 #include <random>
 
+#include "preprocess/mesh_clean.h"
+#include "preprocess/mesh_io.h"
 #include "preprocess/vertex_hierarchy.h"
 #include "runtime/geomorph.h"
 #include "runtime/vertex_front.h"
+#include "test_support.h"
 #include "vd_meshes.h"
 
 namespace lod {
@@ -260,15 +263,11 @@ TEST(VertexFrontWalk, GeomorphMovesEachVertexAtMostItsShareOfTheDistancePerFrame
 }  // namespace
 }  // namespace lod
 
-// Real scans: open borders, several components, orientation flips (the res3 reconstructions):
-// every front passes whatever check the full mesh itself passes.
-#include "preprocess/mesh_clean.h"
-#include "preprocess/mesh_io.h"
-#include "test_support.h"
-
 namespace lod {
 namespace {
 
+// Real scans: open borders, several components, orientation flips (the res3 reconstructions):
+// every front passes whatever check the full mesh itself passes.
 void walk_scan(const std::filesystem::path& file) {
   MeshData m;
   ASSERT_TRUE(load_mesh(file, m).ok);
