@@ -707,8 +707,8 @@ void make_frame(Frame& f, const float* positions, size_t vertex_count, const uin
 
 // The working mesh of `vertices` (input ids, in the order they get) and `faces` (ids into
 // `vertices`). `seam` (optional, per part vertex) marks vertices shared with another part:
-// they are locked, get no boundary planes along the cut, and their point quadric only where
-// `point_terms_on_seam` (so that merging the parts adds it once).
+// they are locked, and get their point quadric only where `point_terms_on_seam` (so that
+// merging the parts adds it once). Boundary planes come with the first simplification.
 void build_part(QemMesh& out, const float* positions, size_t vertex_count, const Frame& f,
                 const std::vector<uint32_t>& vertices, std::vector<uint32_t>&& faces, const std::vector<uint8_t>* seam,
                 bool point_terms_on_seam, const QemOptions& options) {
@@ -756,39 +756,6 @@ void build_part(QemMesh& out, const float* positions, size_t vertex_count, const
     q.b0 -= wv * x, q.b1 -= wv * y, q.b2 -= wv * z;
     q.c += wv * (x * x + y * y + z * z);
   }
-  // Constraint planes through border edges (not through the cut between parts).
-  if (nt > 0 && options.border_weight > 0) {
-    Work w;
-    build_lists(w, out);
-    classify(w, out, false, true);
-    for (size_t v = 0; v < nv; ++v) {
-      const uint32_t b = w.next[v];
-      if (b == ~0u) continue;
-      if (seam && (*seam)[v] && (*seam)[b]) continue;
-      uint32_t c = ~0u;  // apex of the border edge's face
-      for (uint32_t i = w.offset[v]; i < w.offset[v + 1]; ++i)
-        if (w.ring[2 * i] == b) c = w.ring[2 * i + 1];
-      const float* pa = &out.positions[3 * v];
-      const float* pb = &out.positions[3 * size_t(b)];
-      const float* pc = &out.positions[3 * size_t(c)];
-      const double e[3] = {double(pb[0]) - pa[0], double(pb[1]) - pa[1], double(pb[2]) - pa[2]};
-      const double g[3] = {double(pc[0]) - pa[0], double(pc[1]) - pa[1], double(pc[2]) - pa[2]};
-      const double n[3] = {e[1] * g[2] - e[2] * g[1], e[2] * g[0] - e[0] * g[2], e[0] * g[1] - e[1] * g[0]};
-      // The constraint plane contains the edge and is perpendicular to the face.
-      double m[3] = {e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2], e[0] * n[1] - e[1] * n[0]};
-      const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-      if (!(len > 0)) continue;
-      for (double& x : m) x /= len;
-      const double d = -(m[0] * pa[0] + m[1] * pa[1] + m[2] * pa[2]);
-      const double wgt = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) * options.border_weight;
-      // Constraint planes add error but no area: the cost stays a mean over the surface.
-      for (uint32_t x : {uint32_t(v), b}) {
-        const double keep = out.quadrics[x].w;
-        quadric_add_plane(out.quadrics[x], m[0], m[1], m[2], d, wgt);
-        out.quadrics[x].w = keep;
-      }
-    }
-  }
 }
 
 }  // namespace
@@ -802,6 +769,45 @@ void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, cons
   build_part(out, positions, vertex_count, f, all, std::move(f.faces), nullptr, true, options);
 }
 
+namespace {
+
+// Constraint planes through border edges, once per mesh, from the classification the first
+// simplification makes anyway; edges between two vertices shared with another part are the
+// cut, not a border.
+void add_border_planes(const Work& w, QemMesh& mesh, float border_weight) {
+  const size_t nv = mesh.positions.size() / 3;
+  for (size_t v = 0; v < nv; ++v) {
+    const uint32_t b = w.next[v];
+    if (b == ~0u) continue;
+    if ((mesh.lock[v] & QemMesh::kLockSeam) && (mesh.lock[b] & QemMesh::kLockSeam)) continue;
+    uint32_t c = ~0u;  // apex of the border edge's face
+    for (uint32_t i = w.offset[v]; i < w.offset[v + 1]; ++i)
+      if (w.ring[2 * i] == b) c = w.ring[2 * i + 1];
+    if (c == ~0u) continue;
+    const float* pa = &mesh.positions[3 * v];
+    const float* pb = &mesh.positions[3 * size_t(b)];
+    const float* pc = &mesh.positions[3 * size_t(c)];
+    const double e[3] = {double(pb[0]) - pa[0], double(pb[1]) - pa[1], double(pb[2]) - pa[2]};
+    const double g[3] = {double(pc[0]) - pa[0], double(pc[1]) - pa[1], double(pc[2]) - pa[2]};
+    const double n[3] = {e[1] * g[2] - e[2] * g[1], e[2] * g[0] - e[0] * g[2], e[0] * g[1] - e[1] * g[0]};
+    // The constraint plane contains the edge and is perpendicular to the face.
+    double m[3] = {e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2], e[0] * n[1] - e[1] * n[0]};
+    const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    if (!(len > 0)) continue;
+    for (double& x : m) x /= len;
+    const double d = -(m[0] * pa[0] + m[1] * pa[1] + m[2] * pa[2]);
+    const double wgt = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) * border_weight;
+    // Constraint planes add error but no area: the cost stays a mean over the surface.
+    for (uint32_t x : {uint32_t(v), b}) {
+      const double keep = mesh.quadrics[x].w;
+      quadric_add_plane(mesh.quadrics[x], m[0], m[1], m[2], d, wgt);
+      mesh.quadrics[x].w = keep;
+    }
+  }
+}
+
+}  // namespace
+
 size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* target_triangles,
                          size_t level_count, const QemOptions& options) {
   Work w;
@@ -813,6 +819,10 @@ size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* tar
   size_t previous_target = mesh.triangle_count();
   build_lists(w, mesh);
   classify(w, mesh, options.lock_border, options.move_nonmanifold);
+  if (!mesh.border_planes) {
+    if (options.border_weight > 0) add_border_planes(w, mesh, options.border_weight);
+    mesh.border_planes = true;
+  }
   bool lists_current = true;
   for (size_t l = 0; l < level_count; ++l) {
     const size_t target = std::min(target_triangles[l], previous_target);
@@ -881,6 +891,7 @@ size_t qem_split(QemMesh* parts, const QemMesh& whole) {
     part.input_vertex_count = whole.input_vertex_count;
     part.scale = whole.scale;
     part.error = whole.error;
+    part.border_planes = whole.border_planes;
     std::vector<uint32_t> local(nv, ~0u);
     for (size_t v = 0; v < nv; ++v) {
       if (!(used[v] & (1u << p))) continue;
@@ -912,6 +923,7 @@ void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
   for (size_t p = 0; p < part_count; ++p) {
     const QemMesh& part = parts[p];
     out.error = std::max(out.error, part.error);
+    out.border_planes = out.border_planes || part.border_planes;
     const size_t nv = part.source_vertex.size();
     std::vector<uint32_t> local(nv, ~0u);
     // Only live vertices survive the merge.

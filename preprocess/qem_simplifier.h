@@ -85,13 +85,15 @@ struct QemMesh {
   size_t input_vertex_count = 0;
   float scale = 1;
   double error = 0;  // largest normalised collapse error so far
+  bool border_planes = false;  // boundary constraint planes added (by the first simplification)
 
   static constexpr uint8_t kLockUser = 1;  // options.vertex_lock, attribute seams, locked borders
   static constexpr uint8_t kLockSeam = 2;  // shared between parts of a split; cleared by merge
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
-// Builds the working mesh (quadrics from the whole input, including boundary planes).
+// Builds the working mesh (face and point quadrics of the whole input; boundary planes are
+// added by the first qem_simplify_mesh, which classifies the vertices anyway).
 void qem_prepare(QemMesh& out, const float* positions, size_t vertex_count, const uint32_t* indices,
                  size_t index_count, const QemOptions& options);
 
@@ -106,7 +108,8 @@ size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* tar
                          size_t level_count, const QemOptions& options);
 
 // Joins parts made by qem_split (after any simplification) back into one mesh; shared
-// vertices are welded by source_vertex and unlocked again.
+// vertices are welded by source_vertex and unlocked again. Simplify every part at least once
+// before merging, so that each has its boundary planes (the merged mesh gets none of its own).
 void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count);
 
 // Joins the same level of several parts into one (shared vertices welded by source_vertex).
