@@ -61,7 +61,9 @@ struct Vec {
   double x = 0, y = 0, z = 0;
 };
 inline Vec sub(const Vec& a, const Vec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec cross(const Vec& a, const Vec& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline Vec cross(const Vec& a, const Vec& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 inline double dot(const Vec& a, const Vec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline double length(const Vec& a) { return std::sqrt(dot(a, a)); }
 
@@ -107,14 +109,14 @@ class Builder {
 
   HierarchyOptions opt_;
   uint32_t leaf_count_ = 0;
-  std::vector<double> pos_;          // per node
-  std::vector<Quad> quad_;           // per node
-  std::vector<Cone> cone_;           // per node
+  std::vector<double> pos_;  // per node
+  std::vector<Quad> quad_;   // per node
+  std::vector<Cone> cone_;   // per node
   std::vector<float> radius_, error_;
   std::vector<uint32_t> parent_;
 
-  std::vector<uint32_t> leaves_;     // input corners, 3 per kept face
-  std::vector<uint32_t> face_;       // current corners (node ids), 3 per face
+  std::vector<uint32_t> leaves_;  // input corners, 3 per kept face
+  std::vector<uint32_t> face_;    // current corners (node ids), 3 per face
   std::vector<uint8_t> face_alive_;
   std::vector<uint32_t> face_owner_;
   std::vector<uint32_t> alive_faces_;  // faces alive at the start of the pass
@@ -195,8 +197,10 @@ void Builder::collect_edges() {
         const uint32_t u = c[j];
         if (u <= a) continue;
         auto it = std::find_if(around.begin(), around.end(), [&](const auto& e) { return e.first == u; });
-        if (it == around.end()) around.push_back({u, 1});
-        else ++it->second;
+        if (it == around.end())
+          around.push_back({u, 1});
+        else
+          ++it->second;
       }
     }
     for (const auto& [b, count] : around) {
@@ -212,7 +216,8 @@ void Builder::collect_edges() {
   }
   // A manifold border vertex has exactly two border edges; more is a bow-tie.
   for (size_t v = 0; v < border_edges.size(); ++v)
-    if ((border_edges[v] != 0 && border_edges[v] != 2) || (v < nonmanifold_.size() && nonmanifold_[v])) complex_[v] = 1;
+    if ((border_edges[v] != 0 && border_edges[v] != 2) || (v < nonmanifold_.size() && nonmanifold_[v]))
+      complex_[v] = 1;
 
   size_t kept = 0;
   for (const Edge& e : edges_) {
@@ -295,7 +300,8 @@ bool Builder::try_collapse(uint32_t a, uint32_t b) {
     const uint32_t degree = faces_w + (border_[w] ? 1 : 0);
     if (degree - 1 < (border_[w] ? 2u : 3u)) return false;
   }
-  const uint32_t faces_after = (vf_off_[a + 1] - vf_off_[a]) + (vf_off_[b + 1] - vf_off_[b]) - 2 * uint32_t(k_faces);
+  const uint32_t faces_after =
+      (vf_off_[a + 1] - vf_off_[a]) + (vf_off_[b + 1] - vf_off_[b]) - 2 * uint32_t(k_faces);
   if (faces_after == 0) return false;  // keep at least one triangle of every component
   if (!border_[a] && !border_[b] && faces_after < 3) return false;
 
@@ -356,7 +362,8 @@ bool Builder::try_collapse(uint32_t a, uint32_t b) {
   quad_.push_back(q);
   cone_.push_back(merge_cones(cone_[a], cone_[b]));
   const Vec pp = pos(p);
-  radius_.push_back(static_cast<float>(std::max(length(sub(pp, pa)) + radius_[a], length(sub(pp, pb)) + radius_[b])));
+  radius_.push_back(
+      static_cast<float>(std::max(length(sub(pp, pa)) + radius_[a], length(sub(pp, pb)) + radius_[b])));
   const double rms = q.w > 0 ? std::sqrt(best_cost / q.w) : 0.0;
   const double floor = 0.05 * length(sub(pa, pb));  // so that a flat region still refines when close
   error_.push_back(static_cast<float>(std::max({double(error_[a]), double(error_[b]), rms, floor})));
@@ -407,7 +414,8 @@ void Builder::renumber_passes() {
   if (n == leaf_count_) return;
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
   for (uint32_t v = 0; v < n; ++v)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], pos_[3 * v + k]), hi[k] = std::max(hi[k], pos_[3 * v + k]);
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min(lo[k], pos_[3 * v + k]), hi[k] = std::max(hi[k], pos_[3 * v + k]);
   auto spread = [](uint32_t x) {  // 10 bits -> every third bit
     x &= 0x3ff;
     x = (x | (x << 16)) & 0x030000ff;
@@ -535,7 +543,8 @@ void Builder::finish(VertexTree& out) {
   std::vector<uint32_t> size(n, 0);
   for (uint32_t v = 0; v < leaf_count_; ++v) size[v] = 1;
   const uint32_t inner = n - leaf_count_;
-  for (uint32_t i = 0; i < inner; ++i) size[leaf_count_ + i] = size[children_[2 * i]] + size[children_[2 * i + 1]];
+  for (uint32_t i = 0; i < inner; ++i)
+    size[leaf_count_ + i] = size[children_[2 * i]] + size[children_[2 * i + 1]];
   out.leaf_lo.assign(n, 0);
   out.leaf_hi.assign(n, 0);
   uint32_t next = 0;
@@ -567,7 +576,8 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
     return Status::error(mesh.source + ": positions hold " + std::to_string(mesh.positions.size()) +
                          " floats, not a multiple of 3");
   if (mesh.indices.size() % 3 != 0)
-    return Status::error(mesh.source + ": " + std::to_string(mesh.indices.size()) + " indices, not a multiple of 3");
+    return Status::error(mesh.source + ": " + std::to_string(mesh.indices.size()) +
+                         " indices, not a multiple of 3");
   if (vc >= kNoNode / 2) return Status::error(mesh.source + ": too many vertices for a hierarchy");
   for (size_t i = 0; i < mesh.positions.size(); ++i)
     if (!std::isfinite(mesh.positions[i]))

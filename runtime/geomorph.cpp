@@ -75,13 +75,15 @@ void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const Fro
   }
 }
 
-size_t vertex_morph_positions(std::span<float> out, const VertexMorph& m, std::span<const uint32_t> nodes, double now) {
+size_t vertex_morph_positions(std::span<float> out, const VertexMorph& m, std::span<const uint32_t> nodes,
+                              double now) {
   size_t moving = 0;
   for (uint32_t v : nodes) {
     assert(3 * size_t(v) + 2 < out.size());
     const float t = morph_factor(now, m.start[v], m.duration);
     moving += t < 1;
-    for (int k = 0; k < 3; ++k) out[3 * size_t(v) + k] = blend(m.from[3 * size_t(v) + k], m.to[3 * size_t(v) + k], t);
+    for (int k = 0; k < 3; ++k)
+      out[3 * size_t(v) + k] = blend(m.from[3 * size_t(v) + k], m.to[3 * size_t(v) + k], t);
   }
   return moving;
 }
@@ -102,7 +104,8 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
   for (int k = 0; k < 3; ++k) lo[k] = hi[k] = coarse_positions[k];
   for (size_t c = 0; c < nc; ++c)
     for (int k = 0; k < 3; ++k)
-      lo[k] = std::min(lo[k], coarse_positions[3 * c + k]), hi[k] = std::max(hi[k], coarse_positions[3 * c + k]);
+      lo[k] = std::min(lo[k], coarse_positions[3 * c + k]),
+      hi[k] = std::max(hi[k], coarse_positions[3 * c + k]);
   const int res = std::clamp(static_cast<int>(std::cbrt(double(nc))), 1, 256);
   float cell = 0;
   for (int k = 0; k < 3; ++k) cell = std::max(cell, (hi[k] - lo[k]) / res);
@@ -158,7 +161,8 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
 }
 
 void level_morph_positions(std::span<float> out, std::span<const float> fine_positions,
-                           std::span<const float> coarse_positions, std::span<const uint32_t> target, float t) {
+                           std::span<const float> coarse_positions, std::span<const uint32_t> target,
+                           float t) {
   assert(out.size() == fine_positions.size() && target.size() * 3 == fine_positions.size());
   t = std::clamp(t, 0.f, 1.f);
   for (size_t v = 0; v < target.size(); ++v)
@@ -166,8 +170,8 @@ void level_morph_positions(std::span<float> out, std::span<const float> fine_pos
       out[3 * v + k] = blend(fine_positions[3 * v + k], coarse_positions[3 * size_t(target[v]) + k], t);
 }
 
-size_t advance_level_morph(std::span<float> morph, std::span<const uint8_t> level, std::span<const uint8_t> prev_level,
-                           float dt, float duration) {
+size_t advance_level_morph(std::span<float> morph, std::span<const uint8_t> level,
+                           std::span<const uint8_t> prev_level, float dt, float duration) {
   assert(level.size() == morph.size() && prev_level.size() == morph.size());
   const float step = duration > 0 ? dt / duration : 1.f;
   size_t moving = 0;

@@ -27,17 +27,18 @@ void geomorph_lerp(std::span<float> out, std::span<const float> from, std::span<
 float morph_factor(double now, double start, float duration);
 
 struct VertexMorph {
-  std::vector<float> from;     // xyz per node
-  std::vector<float> to;       // xyz per node
-  std::vector<double> start;   // per node, seconds
-  float duration = 0.25f;      // seconds
+  std::vector<float> from;    // xyz per node
+  std::vector<float> to;      // xyz per node
+  std::vector<double> start;  // per node, seconds
+  float duration = 0.25f;     // seconds
 };
 
 // Every node settled at its own position.
 void vertex_morph_init(VertexMorph& morph, const VertexTree& tree, float duration);
 
 // Applies one frame's front events at time `now` (call after front_update with the same time).
-void vertex_morph_apply(VertexMorph& morph, const VertexTree& tree, std::span<const FrontEvent> events, double now);
+void vertex_morph_apply(VertexMorph& morph, const VertexTree& tree, std::span<const FrontEvent> events,
+                        double now);
 
 // Displayed position of one node at `now`.
 void vertex_morph_position(const VertexMorph& morph, uint32_t node, double now, float out[3]);
@@ -61,7 +62,8 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
 // Positions of the finer level blended towards its targets: out = (1 - t) fine + t coarse[target].
 // t = 0 draws the finer level, t = 1 puts every vertex on the coarser level's surface.
 void level_morph_positions(std::span<float> out, std::span<const float> fine_positions,
-                           std::span<const float> coarse_positions, std::span<const uint32_t> target, float t);
+                           std::span<const float> coarse_positions, std::span<const uint32_t> target,
+                           float t);
 
 // Per object: advance the morph factor towards 1 by dt / duration, restarting it at 0 where the
 // level changed since last frame. Returns the number of objects still morphing.

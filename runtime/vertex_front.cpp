@@ -37,7 +37,8 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
   const bool in_frustum = outside_by <= 0;
   const double slack_frustum = in_frustum ? inside_by : outside_by;
 
-  const double ax = c[0] - double(view.eye[0]), ay = c[1] - double(view.eye[1]), az = c[2] - double(view.eye[2]);
+  const double ax = c[0] - double(view.eye[0]), ay = c[1] - double(view.eye[1]),
+               az = c[2] - double(view.eye[2]);
   const double d = std::sqrt(ax * ax + ay * ay + az * az);
   // Normal cone: every normal in the cone points away from every point of the sphere.
   bool facing = true;
@@ -102,7 +103,8 @@ class Updater {
   bool deps_active(uint32_t p) const { return missing_dep(p) == kNoNode; }
   bool children_active(uint32_t p) const {
     const uint32_t i = p - t_.leaf_count;
-    return f_.state[t_.children[2 * i]] == VertexFront::kActive && f_.state[t_.children[2 * i + 1]] == VertexFront::kActive;
+    return f_.state[t_.children[2 * i]] == VertexFront::kActive &&
+           f_.state[t_.children[2 * i + 1]] == VertexFront::kActive;
   }
   uint32_t new_faces(uint32_t x) const {
     const uint32_t i = x - t_.leaf_count;
@@ -113,8 +115,10 @@ class Updater {
     if (f_.event_count < f_.events.size()) f_.events[f_.event_count++] = {node, kind};
   }
   void push(uint32_t v) {
-    if (tail_ < limit_) f_.queue[tail_++] = v;
-    else file_next_frame(v);  // queue full (cannot happen with the sizes front_init picks)
+    if (tail_ < limit_)
+      f_.queue[tail_++] = v;
+    else
+      file_next_frame(v);  // queue full (cannot happen with the sizes front_init picks)
   }
   void begin_pending(uint32_t p);
   void end_pending(uint32_t p);
@@ -137,8 +141,10 @@ void Updater::unfile(uint32_t v, int c) {
   VertexFront::Link& l = f_.links[2 * size_t(v) + c];
   if (l.bucket == kNoNode) return;
   uint32_t* heads = &f_.bucket_head[size_t(c) * (kBuckets + 1)];
-  if (l.prev != kNoNode) f_.links[2 * size_t(l.prev) + c].next = l.next;
-  else heads[l.bucket] = l.next;
+  if (l.prev != kNoNode)
+    f_.links[2 * size_t(l.prev) + c].next = l.next;
+  else
+    heads[l.bucket] = l.next;
   if (l.next != kNoNode) f_.links[2 * size_t(l.next) + c].prev = l.prev;
   l.bucket = kNoNode;
 }
@@ -153,7 +159,8 @@ void Updater::file(uint32_t v, int c, double slack) {
   // Never into a bucket this frame already visited; far deadlines wait in the last bucket.
   const int64_t cur = f_.cursor[c];
   const double at = (f_.motion[c] + slack) / f_.bucket_width;
-  int64_t abs_bucket = at < double(cur + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : cur + kBuckets - 1;
+  int64_t abs_bucket =
+      at < double(cur + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : cur + kBuckets - 1;
   abs_bucket = std::max(abs_bucket, cur);
   const uint32_t b = static_cast<uint32_t>(abs_bucket % kBuckets);
   uint32_t* heads = &f_.bucket_head[size_t(c) * (kBuckets + 1)];
@@ -204,8 +211,10 @@ void Updater::stop_waiting(uint32_t v) {
   if (d == kNoNode) return;
   --f_.waiting;
   const uint32_t n = f_.wait_next[v], pr = f_.wait_prev[v];
-  if (pr != kNoNode) f_.wait_next[pr] = n;
-  else f_.wait_head[d] = n;
+  if (pr != kNoNode)
+    f_.wait_next[pr] = n;
+  else
+    f_.wait_head[d] = n;
   if (n != kNoNode) f_.wait_prev[n] = pr;
   f_.wait_on[v] = kNoNode;
 }
@@ -228,8 +237,10 @@ void Updater::wake(uint32_t d) {
     stop_waiting(v);
     if (f_.state[v] != VertexFront::kActive) continue;
     unfile(v);
-    if (phase_two_) file_next_frame(v);
-    else push(v);
+    if (phase_two_)
+      file_next_frame(v);
+    else
+      push(v);
   }
 }
 
@@ -269,7 +280,9 @@ void Updater::split(uint32_t x) {
     const uint32_t lo2 = t_.leaf_lo[c2], hi2 = t_.leaf_hi[c2];
     for (int j = 0; j < 3; ++j) {
       const uint32_t r = t_.face_ranks[3 * size_t(face) + j];
-      f_.tri_indices[3 * size_t(s) + j] = r >= lo1 && r < hi1 ? c1 : r >= lo2 && r < hi2 ? c2 : t_.wings[2 * i + k];
+      f_.tri_indices[3 * size_t(s) + j] = r >= lo1 && r < hi1   ? c1
+                                          : r >= lo2 && r < hi2 ? c2
+                                                                : t_.wings[2 * i + k];
     }
   }
   emit(x, FrontEventKind::split);
@@ -452,7 +465,8 @@ FrontStats Updater::run(const FrontView& view) {
   hysteresis_ = std::max(1.f, p_.hysteresis);
   stats_ = {};
   f_.event_count = 0;
-  const double ex = view.eye[0] - f_.center[0], ey = view.eye[1] - f_.center[1], ez = view.eye[2] - f_.center[2];
+  const double ex = view.eye[0] - f_.center[0], ey = view.eye[1] - f_.center[1],
+               ez = view.eye[2] - f_.center[2];
   reach_ = std::sqrt(ex * ex + ey * ey + ez * ez) + f_.extent;
 
   // How far may any decision have moved since the last frame (see evaluate's slacks)?
@@ -465,7 +479,8 @@ FrontStats Updater::run(const FrontView& view) {
     for (int k = 0; k < 6; ++k) {
       const double nx = view.planes[k][0] - o.planes[k][0], ny = view.planes[k][1] - o.planes[k][1],
                    nz = view.planes[k][2] - o.planes[k][2];
-      const double at_eye = nx * view.eye[0] + ny * view.eye[1] + nz * view.eye[2] + (view.planes[k][3] - o.planes[k][3]);
+      const double at_eye =
+          nx * view.eye[0] + ny * view.eye[1] + nz * view.eye[2] + (view.planes[k][3] - o.planes[k][3]);
       plane_move = std::max(plane_move, std::sqrt(nx * nx + ny * ny + nz * nz) * reach_ + std::abs(at_eye));
     }
     if (view.focal_pixels != o.focal_pixels) {
@@ -509,7 +524,8 @@ FrontStats Updater::run(const FrontView& view) {
   for (uint32_t k = f_.pending_count; k-- > 0;) {
     const uint32_t p = f_.pending[k];
     if (f_.pending_until[p - t_.leaf_count] > p_.time) continue;
-    if (children_active(p) && deps_active(p) && !evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_).refine &&
+    if (children_active(p) && deps_active(p) &&
+        !evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_).refine &&
         !(p_.max_operations && ops_ >= p_.max_operations)) {
       collapse(p);
       push(p);
@@ -543,8 +559,10 @@ FrontStats Updater::run(const FrontView& view) {
   if (p_.target_triangles > 0) {
     const double ratio = double(f_.tri_count) / p_.target_triangles;
     double k = 1;
-    if (ratio > 1.0) k = std::min(1.5, std::sqrt(ratio));
-    else if (ratio < 0.85) k = std::max(0.8, std::sqrt(std::max(ratio, 1e-6)) / std::sqrt(0.92));
+    if (ratio > 1.0)
+      k = std::min(1.5, std::sqrt(ratio));
+    else if (ratio < 0.85)
+      k = std::max(0.8, std::sqrt(std::max(ratio, 1e-6)) / std::sqrt(0.92));
     const float next = std::clamp(static_cast<float>(f_.threshold * k), p_.min_threshold, p_.max_threshold);
     if (next != f_.threshold) {
       const double kk = double(next) / f_.threshold;
@@ -656,7 +674,8 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
   // Every node of the front is judged on the first update (a full pass: nothing to file).
 }
 
-FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontView& view, const FrontParams& params) {
+FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontView& view,
+                        const FrontParams& params) {
   FrontStats s = Updater(front, tree, params).run(view);
   s.threshold = front.threshold;
   return s;
@@ -702,17 +721,20 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
   uint32_t active_states = 0;
   for (uint32_t v = 0; v < n; ++v) active_states += f.state[v] == VertexFront::kActive;
   if (active_states != f.active_count)
-    return fail(std::to_string(active_states) + " nodes are active but the list holds " + std::to_string(f.active_count));
+    return fail(std::to_string(active_states) + " nodes are active but the list holds " +
+                std::to_string(f.active_count));
   for (uint32_t k = 0; k < f.active_count; ++k) {
     const uint32_t v = f.active[k];
     if (v >= n || f.state[v] != VertexFront::kActive || f.active_pos[v] != k)
-      return fail("active list entry " + std::to_string(k) + " (node " + std::to_string(v) + ") is not active there");
+      return fail("active list entry " + std::to_string(k) + " (node " + std::to_string(v) +
+                  ") is not active there");
   }
   // Every leaf has exactly one active ancestor-or-self: a proper front.
   for (uint32_t l = 0; l < t.leaf_count; ++l) {
     uint32_t count = 0;
     for (uint32_t v = l; v != kNoNode; v = t.parent[v]) count += f.state[v] == VertexFront::kActive;
-    if (count != 1) return fail("leaf " + std::to_string(l) + " has " + std::to_string(count) + " active ancestors");
+    if (count != 1)
+      return fail("leaf " + std::to_string(l) + " has " + std::to_string(count) + " active ancestors");
   }
   std::vector<uint64_t> directed;
   directed.reserve(3 * size_t(f.tri_count));
@@ -722,21 +744,24 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
     if (face >= t.face_count || f.face_slot[face] != s) return fail(at + " is not the face's slot");
     const uint32_t* tri = &f.tri_indices[3 * size_t(s)];
     for (int j = 0; j < 3; ++j) {
-      if (tri[j] >= n) return fail(at + " references vertex " + std::to_string(tri[j]) + " of " + std::to_string(n));
+      if (tri[j] >= n)
+        return fail(at + " references vertex " + std::to_string(tri[j]) + " of " + std::to_string(n));
       if (f.state[tri[j]] != VertexFront::kActive)
         return fail(at + " references inactive vertex " + std::to_string(tri[j]));
       uint32_t v = t.face_leaves[3 * size_t(face) + j];
       while (f.state[v] != VertexFront::kActive) v = t.parent[v];
-      if (v != tri[j]) return fail(at + " corner " + std::to_string(j) + " is " + std::to_string(tri[j]) +
-                                   " but its leaf's active ancestor is " + std::to_string(v));
+      if (v != tri[j])
+        return fail(at + " corner " + std::to_string(j) + " is " + std::to_string(tri[j]) +
+                    " but its leaf's active ancestor is " + std::to_string(v));
     }
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) return fail(at + " is degenerate");
     for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(tri[j]) << 32 | tri[(j + 1) % 3]);
   }
   uint32_t face_slots = 0;
   for (uint32_t face = 0; face < t.face_count; ++face) face_slots += f.face_slot[face] != kNoNode;
-  if (face_slots != f.tri_count) return fail(std::to_string(face_slots) + " faces have slots but " +
-                                             std::to_string(f.tri_count) + " triangles are active");
+  if (face_slots != f.tri_count)
+    return fail(std::to_string(face_slots) + " faces have slots but " + std::to_string(f.tri_count) +
+                " triangles are active");
   // A face is active exactly when its corners are distinct (no face missing).
   for (uint32_t face = 0; face < t.face_count; ++face) {
     if (f.face_slot[face] != kNoNode) continue;
@@ -753,7 +778,8 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
   std::sort(directed.begin(), directed.end());
   for (size_t k = 1; k < directed.size(); ++k)
     if (directed[k] == directed[k - 1])
-      return fail("edge " + std::to_string(directed[k] >> 32) + "->" + std::to_string(directed[k] & 0xffffffffu) +
+      return fail("edge " + std::to_string(directed[k] >> 32) + "->" +
+                  std::to_string(directed[k] & 0xffffffffu) +
                   " is used twice in one direction (orientation flip or non-manifold edge)");
   if (edges == EdgeCheck::closed) {
     for (uint64_t e : directed) {
@@ -777,7 +803,8 @@ uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indi
   return f.tri_count;
 }
 
-bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges, std::string* message) {
+bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges,
+                     std::string* message) {
   auto fail = [&](std::string text) {
     if (message) *message = std::move(text);
     return false;
@@ -789,8 +816,8 @@ bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, E
     const uint32_t* tri = &indices[3 * s];
     for (int j = 0; j < 3; ++j)
       if (tri[j] >= vertex_count)
-        return fail("triangle " + std::to_string(s) + " references vertex " + std::to_string(tri[j]) + " of " +
-                    std::to_string(vertex_count));
+        return fail("triangle " + std::to_string(s) + " references vertex " + std::to_string(tri[j]) +
+                    " of " + std::to_string(vertex_count));
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
       return fail("triangle " + std::to_string(s) + " is degenerate");
     for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(tri[j]) << 32 | tri[(j + 1) % 3]);
@@ -799,7 +826,8 @@ bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, E
   std::sort(directed.begin(), directed.end());
   for (size_t k = 1; k < directed.size(); ++k)
     if (directed[k] == directed[k - 1])
-      return fail("edge " + std::to_string(directed[k] >> 32) + "->" + std::to_string(directed[k] & 0xffffffffu) +
+      return fail("edge " + std::to_string(directed[k] >> 32) + "->" +
+                  std::to_string(directed[k] & 0xffffffffu) +
                   " is used twice in one direction (orientation flip or non-manifold edge)");
   if (edges == EdgeCheck::closed)
     for (uint64_t e : directed)
@@ -828,7 +856,8 @@ EdgeCheck edge_check_of(std::span<const uint32_t> indices) {
   std::sort(directed.begin(), directed.end());
   if (std::adjacent_find(directed.begin(), directed.end()) != directed.end()) return EdgeCheck::corners;
   for (uint64_t e : directed)
-    if (!std::binary_search(directed.begin(), directed.end(), (e << 32) | (e >> 32))) return EdgeCheck::oriented;
+    if (!std::binary_search(directed.begin(), directed.end(), (e << 32) | (e >> 32)))
+      return EdgeCheck::oriented;
   return directed.empty() ? EdgeCheck::oriented : EdgeCheck::closed;
 }
 

@@ -30,8 +30,8 @@ namespace lod {
 // The camera as seen from the object (object space: transform undone, distances in object units).
 struct FrontView {
   float eye[3] = {0, 0, 0};
-  float planes[6][4] = {};   // normalized, inside when dot(n, p) + w >= 0
-  float focal_pixels = 1;    // pixels per unit of size at distance 1 (scale free)
+  float planes[6][4] = {};  // normalized, inside when dot(n, p) + w >= 0
+  float focal_pixels = 1;   // pixels per unit of size at distance 1 (scale free)
 };
 
 // `view` seen from an object placed as ObjectSet does: world = R_y(yaw) * (scale * p) + position.
@@ -51,7 +51,7 @@ struct FrontParams {
   uint32_t target_triangles = 0;  // feedback: the pixel threshold moves to meet this; 0 = fixed
   float min_threshold = 0.05f;    // pixels
   float max_threshold = 1.0e5f;
-  uint32_t max_operations = 0;    // splits + collapses per frame; 0 = unlimited
+  uint32_t max_operations = 0;  // splits + collapses per frame; 0 = unlimited
   // Hysteresis: a node splits when its projected error exceeds the threshold, but its children
   // merge back only when it falls below threshold / hysteresis, so decisions do not flicker
   // and a moving camera re-judges far fewer nodes. 1 = none.
@@ -61,26 +61,26 @@ struct FrontParams {
 struct FrontStats {
   uint32_t splits = 0;
   uint32_t collapses = 0;
-  uint32_t visited = 0;         // nodes evaluated this frame
-  uint32_t blocked = 0;         // splits refused by max_triangles or max_operations
+  uint32_t visited = 0;  // nodes evaluated this frame
+  uint32_t blocked = 0;  // splits refused by max_triangles or max_operations
   uint32_t active_tris = 0;
   uint32_t active_vertices = 0;
-  float threshold = 0;          // pixel threshold used this frame
-  bool full_pass = false;       // every active node was evaluated (teleport / first frame)
+  float threshold = 0;     // pixel threshold used this frame
+  bool full_pass = false;  // every active node was evaluated (teleport / first frame)
 };
 
 struct VertexFront {
   static constexpr uint8_t kBelow = 0, kActive = 1, kSplit = 2;
 
-  std::vector<uint8_t> state;        // per node
-  std::vector<uint32_t> active;      // active node ids, [0, active_count)
-  std::vector<uint32_t> active_pos;  // per node: index in `active`
-  std::vector<uint32_t> tri_indices; // 3 node ids per active triangle, [0, 3 * tri_count)
-  std::vector<uint32_t> tri_face;    // face id per triangle slot
-  std::vector<uint32_t> face_slot;   // per face: triangle slot or kNoNode
+  std::vector<uint8_t> state;         // per node
+  std::vector<uint32_t> active;       // active node ids, [0, active_count)
+  std::vector<uint32_t> active_pos;   // per node: index in `active`
+  std::vector<uint32_t> tri_indices;  // 3 node ids per active triangle, [0, 3 * tri_count)
+  std::vector<uint32_t> tri_face;     // face id per triangle slot
+  std::vector<uint32_t> face_slot;    // per face: triangle slot or kNoNode
   uint32_t active_count = 0;
   uint32_t tri_count = 0;
-  float threshold = 1;               // pixel threshold (tau), moved by feedback
+  float threshold = 1;  // pixel threshold (tau), moved by feedback
 
   // Two calendars of view-motion buckets (intrusive doubly linked lists over node ids):
   // calendar 0 by eye movement (and threshold changes): error and normal-cone decisions;
@@ -88,21 +88,21 @@ struct VertexFront {
   struct Link {
     uint32_t next = kNoNode, prev = kNoNode, bucket = kNoNode;  // bucket = kNoNode when unfiled
   };
-  std::vector<Link> links;           // 2 per node (calendar 0, 1), side by side
-  std::vector<uint32_t> bucket_head; // per calendar kBuckets + 1; the last: retry next frame
-  double motion[2] = {0, 0};         // accumulated bound on view change, object units
-  int64_t cursor[2] = {0, 0};        // first bucket not yet visited
+  std::vector<Link> links;            // 2 per node (calendar 0, 1), side by side
+  std::vector<uint32_t> bucket_head;  // per calendar kBuckets + 1; the last: retry next frame
+  double motion[2] = {0, 0};          // accumulated bound on view change, object units
+  int64_t cursor[2] = {0, 0};         // first bucket not yet visited
   double bucket_width = 1;
-  double pending_motion = 0;         // from last frame's threshold change (calendar 0)
+  double pending_motion = 0;  // from last frame's threshold change (calendar 0)
   float center[3] = {0, 0, 0};
-  float extent = 0;           // radius of the sphere at `center` holding every node
+  float extent = 0;  // radius of the sphere at `center` holding every node
   bool has_view = false;
   FrontView last_view;
 
   // Collapses blocked by a finer neighbour wait on it (intrusive lists keyed by the neighbour)
   // and are woken when it becomes active, so they are not polled every frame.
   std::vector<uint32_t> wait_on, wait_next, wait_prev, wait_head;  // per node
-  uint32_t waiting = 0;  // nodes on some wait list
+  uint32_t waiting = 0;                                            // nodes on some wait list
 
   // Deferred collapses (geomorphing): per interior node the time it may collapse.
   std::vector<double> pending_until;  // < 0: not pending
@@ -127,7 +127,8 @@ void front_init(VertexFront& front, const VertexTree& tree, float threshold);
 // not back-facing and its projected error exceeds the threshold, within max_triangles and
 // max_operations; finally moves the threshold towards target_triangles. The front is a valid
 // mesh after every call. Events of this frame are in front.frame_events().
-FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontView& view, const FrontParams& params);
+FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontView& view,
+                        const FrontParams& params);
 
 // Splits everything (the input mesh) / collapses everything (the base mesh); no limits.
 void front_refine_all(VertexFront& front, const VertexTree& tree);
@@ -156,7 +157,8 @@ uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indi
 // `oriented` on each directed edge at most once; with `closed` every edge also used the other
 // way round.
 // Allocates. `message` names the first bad triangle or edge.
-bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges, std::string* message);
+bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges,
+                     std::string* message);
 
 // True when every directed edge of the list has its reverse (a closed, oriented surface).
 bool triangles_closed(std::span<const uint32_t> indices);

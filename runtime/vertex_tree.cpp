@@ -27,7 +27,8 @@ bool check_csr(const std::vector<uint32_t>& offsets, size_t rows, size_t values,
     if (offsets[i + 1] < offsets[i] || offsets[i + 1] > values)
       return fail(message, std::string(what) + " offsets of interior node " + num(i) + " are out of order");
   if (offsets[rows] != values)
-    return fail(message, std::string(what) + " offsets end at " + num(offsets[rows]) + " but hold " + num(values));
+    return fail(message,
+                std::string(what) + " offsets end at " + num(offsets[rows]) + " but hold " + num(values));
   return true;
 }
 
@@ -40,12 +41,14 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
   const size_t inner = n - t.leaf_count;
   auto sized = [&](const auto& v, size_t want, const char* what) {
     if (v.size() == want) return true;
-    return fail(message, std::string("hierarchy ") + what + " holds " + num(v.size()) + " values, expected " + num(want));
+    return fail(message, std::string("hierarchy ") + what + " holds " + num(v.size()) + " values, expected " +
+                             num(want));
   };
   if (!sized(t.positions, 3 * n, "positions") || !sized(t.radius, n, "radius") ||
       !sized(t.cone_axis, 3 * n, "cone axes") || !sized(t.cone_cos, n, "cone angles") ||
-      !sized(t.error, n, "errors") || !sized(t.leaf_lo, n, "leaf ranges") || !sized(t.leaf_hi, n, "leaf ranges") ||
-      !sized(t.leaf_rank, t.leaf_count, "leaf ranks") || !sized(t.face_leaves, 3 * size_t(t.face_count), "faces") ||
+      !sized(t.error, n, "errors") || !sized(t.leaf_lo, n, "leaf ranges") ||
+      !sized(t.leaf_hi, n, "leaf ranges") || !sized(t.leaf_rank, t.leaf_count, "leaf ranks") ||
+      !sized(t.face_leaves, 3 * size_t(t.face_count), "faces") ||
       !sized(t.face_owner, t.face_count, "face owners") || !sized(t.children, 2 * inner, "children") ||
       !sized(t.split_faces, 2 * inner, "split faces") || !sized(t.wings, 2 * inner, "wings"))
     return false;
@@ -56,14 +59,15 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
     if (!std::isfinite(t.positions[i]) || !std::isfinite(t.cone_axis[i]))
       return fail(message, "node " + num(i / 3) + " has a non-finite position or cone");
   for (size_t v = 0; v < n; ++v) {
-    if (!std::isfinite(t.radius[v]) || !(t.radius[v] >= 0) || !std::isfinite(t.error[v]) || !(t.error[v] >= 0) ||
-        !std::isfinite(t.cone_cos[v]))
+    if (!std::isfinite(t.radius[v]) || !(t.radius[v] >= 0) || !std::isfinite(t.error[v]) ||
+        !(t.error[v] >= 0) || !std::isfinite(t.cone_cos[v]))
       return fail(message, "node " + num(v) + " has a bad radius, error or cone angle");
     const uint32_t p = t.parent[v];
     if (p != kNoNode && (p >= n || p <= v || p < t.leaf_count))
       return fail(message, "node " + num(v) + " has parent " + num(p) + " of " + num(n));
     if (t.leaf_lo[v] > t.leaf_hi[v] || t.leaf_hi[v] > t.leaf_count)
-      return fail(message, "node " + num(v) + " has leaf range [" + num(t.leaf_lo[v]) + ", " + num(t.leaf_hi[v]) + ")");
+      return fail(message, "node " + num(v) + " has leaf range [" + num(t.leaf_lo[v]) + ", " +
+                               num(t.leaf_hi[v]) + ")");
   }
   for (uint32_t l = 0; l < t.leaf_count; ++l) {
     if (t.leaf_rank[l] >= t.leaf_count) return fail(message, "leaf " + num(l) + " has rank out of range");
@@ -75,30 +79,35 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
     for (int k = 0; k < 2; ++k) {
       const uint32_t c = t.children[2 * i + k];
       if (c >= v || t.parent[c] != v)
-        return fail(message, "node " + num(v) + " child " + num(c) + " of " + num(n) + " does not name it as parent");
+        return fail(message,
+                    "node " + num(v) + " child " + num(c) + " of " + num(n) + " does not name it as parent");
       const uint32_t f = t.split_faces[2 * i + k];
       if (f != kNoNode && (f >= t.face_count || t.face_owner[f] != v))
-        return fail(message, "node " + num(v) + " split face " + num(f) + " of " + num(t.face_count) + " is not owned by it");
+        return fail(message, "node " + num(v) + " split face " + num(f) + " of " + num(t.face_count) +
+                                 " is not owned by it");
       const uint32_t w = t.wings[2 * i + k];
       if ((f == kNoNode) != (w == kNoNode) || (w != kNoNode && w >= v))
         return fail(message, "node " + num(v) + " wing " + num(w) + " of " + num(n) + " is out of range");
     }
     if (t.split_faces[2 * i] == kNoNode) return fail(message, "node " + num(v) + " creates no face");
     const uint32_t a = t.children[2 * i], b = t.children[2 * i + 1];
-    if (t.leaf_lo[v] != std::min(t.leaf_lo[a], t.leaf_lo[b]) || t.leaf_hi[v] != std::max(t.leaf_hi[a], t.leaf_hi[b]) ||
+    if (t.leaf_lo[v] != std::min(t.leaf_lo[a], t.leaf_lo[b]) ||
+        t.leaf_hi[v] != std::max(t.leaf_hi[a], t.leaf_hi[b]) ||
         t.leaf_hi[v] - t.leaf_lo[v] != (t.leaf_hi[a] - t.leaf_lo[a]) + (t.leaf_hi[b] - t.leaf_lo[b]))
       return fail(message, "node " + num(v) + " leaf range is not its children's");
     for (uint32_t k = t.dep_offsets[i]; k < t.dep_offsets[i + 1]; ++k)
-      if (t.deps[k] >= v) return fail(message, "node " + num(v) + " depends on node " + num(t.deps[k]) + " made after it");
+      if (t.deps[k] >= v)
+        return fail(message, "node " + num(v) + " depends on node " + num(t.deps[k]) + " made after it");
     for (uint32_t k = t.inc_offsets[i]; k < t.inc_offsets[i + 1]; ++k)
       if (t.inc_faces[k] >= t.face_count)
-        return fail(message, "node " + num(v) + " incident face " + num(t.inc_faces[k]) + " of " + num(t.face_count));
+        return fail(message,
+                    "node " + num(v) + " incident face " + num(t.inc_faces[k]) + " of " + num(t.face_count));
   }
   for (size_t f = 0; f < t.face_count; ++f) {
     for (int k = 0; k < 3; ++k)
       if (t.face_leaves[3 * f + k] >= t.leaf_count)
-        return fail(message, "face " + num(f) + " references vertex " + num(t.face_leaves[3 * f + k]) + " of " +
-                                 num(t.leaf_count));
+        return fail(message, "face " + num(f) + " references vertex " + num(t.face_leaves[3 * f + k]) +
+                                 " of " + num(t.leaf_count));
     const uint32_t o = t.face_owner[f];
     if (o != kNoNode && (o < t.leaf_count || o >= n))
       return fail(message, "face " + num(f) + " owner " + num(o) + " is not an interior node");
@@ -122,7 +131,8 @@ void pack_vertex_bounds(VertexTree& t) {
     b.radius = t.radius[v];
     b.error = t.error[v];
     for (int k = 0; k < 3; ++k)
-      b.axis[k] = static_cast<int16_t>(std::lround(std::clamp(t.cone_axis[3 * size_t(v) + k], -1.f, 1.f) * 32767));
+      b.axis[k] =
+          static_cast<int16_t>(std::lround(std::clamp(t.cone_axis[3 * size_t(v) + k], -1.f, 1.f) * 32767));
     // Rounded down, less a little for the axis rounding: the packed cone holds the real one.
     const float c = std::clamp(t.cone_cos[v], -1.f, 1.f) - 2e-4f;
     b.cone_cos = static_cast<int16_t>(std::floor(std::max(c, -1.f) * 32767));

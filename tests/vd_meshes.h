@@ -11,7 +11,8 @@
 namespace lod::test {
 
 // Closed UV sphere with one vertex per pole; `rings` >= 2, `segments` >= 3.
-inline MeshData vd_sphere(int rings, int segments, float radius = 1, float cx = 0, float cy = 0, float cz = 0) {
+inline MeshData vd_sphere(int rings, int segments, float radius = 1, float cx = 0, float cy = 0,
+                          float cz = 0) {
   MeshData m;
   m.source = "sphere";
   auto put = [&](float x, float y, float z) {
@@ -52,7 +53,8 @@ inline MeshData vd_grid(int nx, int ny, float size = 1, float ox = 0, float oz =
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i) {
       const float x = size * i / nx, z = size * j / ny;
-      m.positions.insert(m.positions.end(), {ox + x, 0.05f * size * std::sin(7 * x / size) * std::cos(5 * z / size), oz + z});
+      m.positions.insert(m.positions.end(),
+                         {ox + x, 0.05f * size * std::sin(7 * x / size) * std::cos(5 * z / size), oz + z});
     }
   auto id = [&](int i, int j) { return uint32_t(j * (nx + 1) + i); };
   for (int j = 0; j < ny; ++j)
@@ -83,7 +85,8 @@ inline MeshData vd_subdivide(const MeshData& in) {
     auto it = mid.find(key);
     if (it != mid.end()) return it->second;
     const uint32_t id = static_cast<uint32_t>(m.vertex_count());
-    for (int k = 0; k < 3; ++k) m.positions.push_back(0.5f * (in.positions[3 * a + k] + in.positions[3 * b + k]));
+    for (int k = 0; k < 3; ++k)
+      m.positions.push_back(0.5f * (in.positions[3 * a + k] + in.positions[3 * b + k]));
     mid.emplace(key, id);
     return id;
   };

@@ -65,9 +65,11 @@ Fixture& fixture() {
     float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
     for (size_t v = 0; v < fx->mesh.vertex_count(); ++v)
       for (int k = 0; k < 3; ++k)
-        lo[k] = std::min(lo[k], fx->mesh.positions[3 * v + k]), hi[k] = std::max(hi[k], fx->mesh.positions[3 * v + k]);
+        lo[k] = std::min(lo[k], fx->mesh.positions[3 * v + k]),
+        hi[k] = std::max(hi[k], fx->mesh.positions[3 * v + k]);
     for (int k = 0; k < 3; ++k) fx->center[k] = 0.5f * (lo[k] + hi[k]);
-    fx->size = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    fx->size = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
     return fx;
   }();
   return *f;
@@ -121,7 +123,8 @@ void run_frames(benchmark::State& state, bool full_pass) {
   const float distance = 0.6f * fx.size;
   const double step = 0.005 * fx.size / distance;
   double angle = 0;
-  for (int i = 0; i < 60; ++i) front_update(front, fx.tree, orbit_view(fx, angle += step, distance), p);  // settle
+  for (int i = 0; i < 60; ++i)
+    front_update(front, fx.tree, orbit_view(fx, angle += step, distance), p);  // settle
   std::vector<double> ms;
   uint64_t changes = 0, visited = 0, frames = 0, tris = 0;
   for (auto _ : state) {
@@ -145,7 +148,12 @@ void run_frames(benchmark::State& state, bool full_pass) {
 
 void BM_FrontSmooth(benchmark::State& state) { run_frames(state, false); }
 void BM_FrontFullPass(benchmark::State& state) { run_frames(state, true); }
-BENCHMARK(BM_FrontSmooth)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(300)->Arg(150)->Arg(100);
+BENCHMARK(BM_FrontSmooth)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseManualTime()
+    ->Iterations(300)
+    ->Arg(150)
+    ->Arg(100);
 BENCHMARK(BM_FrontFullPass)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(30)->Arg(150);
 
 // Teleport: settle at one side, jump to the opposite side and closer. Frames until the front
@@ -157,7 +165,8 @@ void BM_FrontTeleport(benchmark::State& state) {
   p.target_triangles = kTarget;
   p.max_triangles = kTarget + kTarget / 10;
   p.max_operations = static_cast<uint32_t>(state.range(0));
-  double settle_frames = 0, worst = 0, first_ms = 0, runs = 0, slowest_ms = 0, first_ops = 0, first_visits = 0;
+  double settle_frames = 0, worst = 0, first_ms = 0, runs = 0, slowest_ms = 0, first_ops = 0,
+         first_visits = 0;
   for (auto _ : state) {
     state.PauseTiming();
     VertexFront front;

@@ -23,7 +23,7 @@ int run_lod_vd(const std::string& args, std::string* out) {
 }
 
 std::filesystem::path write_vd_scene(const std::filesystem::path& dir, const std::string& flag) {
-  lod::test::write_text(dir / "ball.off", lod::test::sphere_off(60, 120));   // 14,160 triangles
+  lod::test::write_text(dir / "ball.off", lod::test::sphere_off(60, 120));  // 14,160 triangles
   lod::test::write_text(dir / "pebble.off", lod::test::sphere_off(12, 24));
   const auto cfg = dir / "scene.toml";
   lod::test::write_text(cfg, R"([run]
@@ -94,7 +94,9 @@ TEST(LodRunVd, ValidatesEveryViewDependentFrameAndReportsItsFigures) {
   EXPECT_GT(splits, 0u);
   // A second run takes the hierarchy from the cache.
   out.clear();
-  ASSERT_EQ(run_lod_vd("run --config " + cfg.string() + " --cache " + (dir / "cache").string() + " --quiet", &out), 0)
+  ASSERT_EQ(
+      run_lod_vd("run --config " + cfg.string() + " --cache " + (dir / "cache").string() + " --quiet", &out),
+      0)
       << out;
   EXPECT_EQ(out.find("vertex hierarchy"), std::string::npos) << out;
 }
@@ -103,7 +105,9 @@ TEST(LodRunVd, RefusesANonBooleanViewDependentKey) {
   const auto dir = lod::test::temp_dir("run_vd_bad");
   const auto cfg = write_vd_scene(dir, "\"yes\"");
   std::string out;
-  EXPECT_EQ(run_lod_vd("run --config " + cfg.string() + " --cache " + (dir / "cache").string() + " --quiet", &out), 1);
+  EXPECT_EQ(
+      run_lod_vd("run --config " + cfg.string() + " --cache " + (dir / "cache").string() + " --quiet", &out),
+      1);
   EXPECT_NE(out.find("model[0].view_dependent: must be true or false"), std::string::npos) << out;
 }
 

@@ -56,7 +56,8 @@ void walk(const MeshData& mesh, bool closed, int frames, const FrontParams& base
     p.time = i / 60.0;
     const FrontStats s = front_update(f, t, view_at(eye, look), p);
     std::string msg;
-    ASSERT_TRUE(check_front(f, t, closed ? EdgeCheck::closed : EdgeCheck::oriented, &msg)) << "frame " << i << ": " << msg;
+    ASSERT_TRUE(check_front(f, t, closed ? EdgeCheck::closed : EdgeCheck::oriented, &msg))
+        << "frame " << i << ": " << msg;
     if (p.max_triangles) {
       ASSERT_LE(s.active_tris, p.max_triangles) << "frame " << i;
     }
@@ -73,8 +74,9 @@ TEST(VertexFrontWalk, OpenGridStaysValidOnARandomWalk) {
 }
 
 TEST(VertexFrontWalk, SeveralComponentsStayValidUnderABudgetAndFeedback) {
-  const MeshData m = test::vd_concat(test::vd_concat(test::vd_sphere(20, 24, 0.5f, -0.8f), test::vd_sphere(12, 16, 0.3f, 0.8f)),
-                                     test::vd_grid(16, 16, 1, -0.5f, 0.8f));
+  const MeshData m = test::vd_concat(
+      test::vd_concat(test::vd_sphere(20, 24, 0.5f, -0.8f), test::vd_sphere(12, 16, 0.3f, 0.8f)),
+      test::vd_grid(16, 16, 1, -0.5f, 0.8f));
   FrontParams p;
   p.max_triangles = 1200;
   p.target_triangles = 1000;
@@ -213,7 +215,8 @@ TEST(VertexFrontWalk, GeomorphMovesEachVertexAtMostItsShareOfTheDistancePerFrame
   size_t checked = 0;
   for (int i = 0; i < 240; ++i) {
     p.time = i * dt;
-    eye = glm::vec3(2.5f * std::sin(i * 0.02f), 0.4f, 2.5f * std::cos(i * 0.02f)) * (1.f + 0.5f * std::sin(i * 0.05f));
+    eye = glm::vec3(2.5f * std::sin(i * 0.02f), 0.4f, 2.5f * std::cos(i * 0.02f)) *
+          (1.f + 0.5f * std::sin(i * 0.05f));
     front_update(f, t, view_at(eye, {0, 0, 0}), p);
     vertex_morph_apply(morph, t, f.frame_events(), p.time);
     std::string msg;
@@ -226,7 +229,8 @@ TEST(VertexFrontWalk, GeomorphMovesEachVertexAtMostItsShareOfTheDistancePerFrame
       const uint32_t i_e = e.node - t.leaf_count;
       for (int c = 0; c < 2; ++c)
         for (int k = 0; k < 3; ++k)
-          ASSERT_EQ(before[3 * t.children[2 * i_e + c] + k], t.positions[3 * e.node + k]) << "node " << e.node;
+          ASSERT_EQ(before[3 * t.children[2 * i_e + c] + k], t.positions[3 * e.node + k])
+              << "node " << e.node;
     }
     for (uint32_t v : f.vertices()) {
       if (!was_active[v] || morph.start[v] >= p.time - 1e-9) continue;  // new, or (re)started now
@@ -292,8 +296,10 @@ void walk_scan(const std::filesystem::path& file) {
   p.max_triangles = p.target_triangles + p.target_triangles / 10;
   p.collapse_delay = 0.05f;
   for (int i = 0; i < 60; ++i) {
-    if (i % 20 == 19) eye = c + glm::vec3(u(rng), u(rng), u(rng)) * size;
-    else eye += glm::vec3(u(rng), u(rng), u(rng)) * 0.02f * size;
+    if (i % 20 == 19)
+      eye = c + glm::vec3(u(rng), u(rng), u(rng)) * size;
+    else
+      eye += glm::vec3(u(rng), u(rng), u(rng)) * 0.02f * size;
     View v;
     v.eye = eye;
     v.target = c + glm::vec3(u(rng), u(rng), u(rng)) * 0.1f * size;

@@ -119,8 +119,10 @@ TEST(VertexHierarchy, EveryComponentKeepsAtLeastOneTriangle) {
   MeshData m = test::vd_concat(test::vd_sphere(6, 8), test::vd_grid(4, 4, 1, 3, 0));
   // A lone triangle and a lone quad as components of their own.
   const uint32_t base = static_cast<uint32_t>(m.vertex_count());
-  m.positions.insert(m.positions.end(), {10, 0, 0, 11, 0, 0, 10, 1, 0, 20, 0, 0, 21, 0, 0, 21, 1, 0, 20, 1, 0});
-  m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base + 3, base + 4, base + 5, base + 3, base + 5, base + 6});
+  m.positions.insert(m.positions.end(),
+                     {10, 0, 0, 11, 0, 0, 10, 1, 0, 20, 0, 0, 21, 0, 0, 21, 1, 0, 20, 1, 0});
+  m.indices.insert(m.indices.end(),
+                   {base, base + 1, base + 2, base + 3, base + 4, base + 5, base + 3, base + 5, base + 6});
   const VertexTree t = build(m);
   VertexFront f;
   front_init(f, t, 1);
@@ -156,13 +158,15 @@ TEST(VertexHierarchy, NodesBoundTheirChildrenAndNeverHaveLessError) {
     const uint32_t i = v - t.leaf_count;
     for (int k = 0; k < 2; ++k) {
       const uint32_t c = t.children[2 * i + k];
-      const float d = std::hypot(t.positions[3 * v] - t.positions[3 * c], t.positions[3 * v + 1] - t.positions[3 * c + 1],
-                                 t.positions[3 * v + 2] - t.positions[3 * c + 2]);
+      const float d =
+          std::hypot(t.positions[3 * v] - t.positions[3 * c], t.positions[3 * v + 1] - t.positions[3 * c + 1],
+                     t.positions[3 * v + 2] - t.positions[3 * c + 2]);
       EXPECT_LE(d + t.radius[c], t.radius[v] * 1.0001f + 1e-6f) << "node " << v;
       EXPECT_GE(t.error[v], t.error[c]) << "node " << v;
       // The child's cone axis lies inside the parent's cone whenever the parent's is narrow.
       if (t.cone_cos[v] > 0 && t.cone_cos[c] > 0) {
-        const float dot = t.cone_axis[3 * v] * t.cone_axis[3 * c] + t.cone_axis[3 * v + 1] * t.cone_axis[3 * c + 1] +
+        const float dot = t.cone_axis[3 * v] * t.cone_axis[3 * c] +
+                          t.cone_axis[3 * v + 1] * t.cone_axis[3 * c + 1] +
                           t.cone_axis[3 * v + 2] * t.cone_axis[3 * c + 2];
         EXPECT_GE(dot, t.cone_cos[v] - 1e-4f) << "node " << v;
       }
@@ -244,7 +248,8 @@ TEST(VertexHierarchy, EmptyMeshGivesAnEmptyForest) {
 
 TEST(VertexHierarchy, RealCowRoundTripsThroughRefineAndCoarsen) {
   const std::filesystem::path dir = test::data_dir();
-  if (dir.empty() || !std::filesystem::exists(dir / "cow.off")) GTEST_SKIP() << "needs cow.off in the data dir";
+  if (dir.empty() || !std::filesystem::exists(dir / "cow.off"))
+    GTEST_SKIP() << "needs cow.off in the data dir";
   MeshData m;
   ASSERT_TRUE(load_mesh(dir / "cow.off", m).ok);
   clean_mesh(m);

@@ -127,7 +127,8 @@ TEST(Geomorph, LevelTargetsMatchABruteForceNearestSearch) {
     uint32_t best_c = 0;
     for (uint32_t c = 0; c < 60; ++c) {
       float d2 = 0;
-      for (int k = 0; k < 3; ++k) d2 += (fine[3 * v + k] - coarse[3 * c + k]) * (fine[3 * v + k] - coarse[3 * c + k]);
+      for (int k = 0; k < 3; ++k)
+        d2 += (fine[3 * v + k] - coarse[3 * c + k]) * (fine[3 * v + k] - coarse[3 * c + k]);
       if (d2 < best) best = d2, best_c = c;
     }
     ASSERT_EQ(target[v], best_c) << "fine vertex " << v;

@@ -220,8 +220,7 @@ TEST(VertexFront, CompactMeshIndexesActiveVerticesOnly) {
   EXPECT_TRUE(check_triangles(std::span(idx.data(), 3), f.active_count, EdgeCheck::oriented, &msg)) << msg;
   // The base triangle (4, 2, 3) through the compact vertex list gives the node positions.
   for (int j = 0; j < 3; ++j)
-    for (int k = 0; k < 3; ++k)
-      EXPECT_EQ(pos[3 * idx[j] + k], t.positions[3 * f.tri_indices[j] + k]);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(pos[3 * idx[j] + k], t.positions[3 * f.tri_indices[j] + k]);
   front_refine_all(f, t);
   ASSERT_EQ(front_compact_mesh(pos, idx, f, t, {}), 2u);
   EXPECT_TRUE(check_triangles(idx, 4, EdgeCheck::oriented, &msg)) << msg;
