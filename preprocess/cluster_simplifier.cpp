@@ -202,7 +202,7 @@ size_t count_unique(Scratch& s, const Prepared& p, const Grid& g) {
 Grid search_grid(Scratch& s, const Prepared& p, size_t target, const ClusterOptions& options, bool& current) {
   const size_t faces = p.triangles.size() / 3;
   Grid best = make_grid(p, 1);
-  double best_miss = std::numeric_limits<double>::max();
+  double best_miss = std::numeric_limits<double>::max(), best_unique = -1;
   double aim = double(target);
   int probes = 0;
   double cells = std::sqrt(aim / std::max<double>(1, double(faces))) * std::sqrt(double(p.vertex_count)) + 1;
@@ -212,11 +212,15 @@ Grid search_grid(Scratch& s, const Prepared& p, size_t target, const ClusterOpti
     double lo_n = 0, hi_n = double(faces);
     cells = std::clamp(cells, 1.0, kMaxGrid);
     Grid g = make_grid(p, cells);
+    double g_miss = std::numeric_limits<double>::max(), g_n = -1;
     for (int i = 0; i < 12 && probes < options.max_probes; ++i, ++probes) {
-      g = make_grid(p, cells);
-      cell_ids(s.ids, p, g);
+      const Grid probe = make_grid(p, cells);
+      cell_ids(s.ids, p, probe);
       const double n = double(count_spanning(s.ids, p));
-      if (std::fabs(n - aim) <= 0.5 * options.tolerance * aim) break;
+      // The closest probe so far (equally close: the one with more faces) is the candidate.
+      const double m = std::fabs(n - aim);
+      if (m < g_miss || (m == g_miss && n > g_n)) g = probe, g_miss = m, g_n = n;
+      if (m <= 0.5 * options.tolerance * aim) break;
       if (n < aim) lo = cells, lo_n = n;
       else hi = cells, hi_n = n;
       double next;
@@ -233,8 +237,9 @@ Grid search_grid(Scratch& s, const Prepared& p, size_t target, const ClusterOpti
     const double unique = double(count_unique(s, p, g));
     probes++;
     const double miss = std::fabs(unique - double(target));
-    current = miss < best_miss;
-    if (current) best_miss = miss, best = g;
+    // Equally far: keep more faces (a tiny mesh may offer only "all" or "none").
+    current = miss < best_miss || (miss == best_miss && unique > best_unique);
+    if (current) best_miss = miss, best_unique = unique, best = g;
     if (miss <= options.tolerance * double(target) || unique <= 0) break;
     aim *= double(target) / unique;
     cells = g.cells * std::sqrt(double(target) / std::max(unique, 1.0));

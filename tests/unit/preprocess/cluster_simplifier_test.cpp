@@ -158,6 +158,17 @@ TEST(ClusterSimplifier, DegenerateAndEmptyInputsNeverCrash) {
   EXPECT_EQ(none.result.triangles, 0u);
 }
 
+TEST(ClusterSimplifier, TinyMeshKeepsFacesRatherThanVanishing) {
+  // A cube offers only "all 12 faces" or "none" to a grid: asked for 6, it keeps them all.
+  Soup cube;
+  cube.positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+  cube.indices = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                  1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  const Out out = run(cube, 6);
+  EXPECT_EQ(out.result.triangles, 12u);
+  expect_valid_unique_faces(out);
+}
+
 TEST(ClusterSimplifierRealMesh, DragonToPointEighteenPercent) {
   LOD_REQUIRE_SHARED_MESH(path, "stanford-dragon.ply");
   MeshData mesh;
