@@ -1,11 +1,13 @@
 // QEM edge collapse in sorted passes (see qem_simplifier.h for the papers).
 //
-// Each pass: build vertex->triangle lists (CSR) and classify vertices (manifold / border /
-// locked) from the current index buffer; give every collapsible edge its optimal position and
-// quadric cost; radix-sort the costs; collapse in order, skipping an edge when either end was
-// already touched this pass (its cost is stale) or when the collapse would break the link
-// condition or flip/fold a face; then rewrite the index buffer through the remap table. Every
-// array is sized once per call and reused by every pass.
+// Once per call: vertex kinds (manifold / border / locked) and border loops; both stay valid
+// because every allowed collapse keeps the kinds. Each pass: build vertex -> face lists (CSR,
+// each entry the face's other two corners) from the current index buffer; give every
+// collapsible edge its position and quadric cost; radix-sort the costs; collapse in order,
+// skipping an edge when either end was already touched this pass (its cost is stale) or when
+// the collapse would break the link condition or flip/fold a face; then rewrite the index
+// buffer through the remap table. Scratch arrays are sized once per call and reused by every
+// pass; the only other allocations are vertex compactions, each after the face count halves.
 #include "preprocess/qem_simplifier.h"
 
 #include <algorithm>
