@@ -413,7 +413,7 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
   const size_t edge_goal = face_goal / 2;
   // Close to the target the remaining few collapses go in one pass, not in a long tail of them.
   const bool last_stretch = face_goal * 50 < nt;
-  const float error_goal = edge_goal < n && !last_stretch ? 2.0f * w.cands[w.order[edge_goal]].cost
+  const float error_goal = edge_goal < n && !last_stretch ? 1.5f * w.cands[w.order[edge_goal]].cost
                                                           : std::numeric_limits<float>::max();
   const size_t collapse_floor = edge_goal / 6;
 
