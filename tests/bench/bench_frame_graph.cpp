@@ -84,10 +84,7 @@ void BM_FrameGraph(benchmark::State& state) {
   state.counters["min_ms"] = percentile(totals, 0.0);  // robust to other processes on a shared machine
   state.counters["median_ms"] = percentile(totals, 0.5);
   state.counters["p99_ms"] = percentile(totals, 0.99);
-  for (size_t s = 0; s < kStageCount; ++s) {
-    if (static_cast<Stage>(s) == Stage::vdlod || static_cast<Stage>(s) == Stage::geomorph) continue;
-    state.counters[std::string("st_") + kStageNames[s]] = stage_sum[s] / frames;
-  }
+  for (size_t s = 0; s < kStageCount; ++s) state.counters[std::string("st_") + kStageNames[s]] = stage_sum[s] / frames;
   double sum = 0;
   for (double t : totals) sum += t;
   state.counters["sel_share"] = stage_sum[static_cast<size_t>(Stage::selection)] / sum;
