@@ -120,7 +120,13 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
   };
   LodChain chain;
   BakeReport report;
-  const Status baked = bake_model(model.file, model.name, model.bake, chain, &report, progress);
+  // Inside one model too, idle cores help (QEM halves, level measurements); results are the
+  // same as serially. Runs in the caller's arena, so the configured thread count holds.
+  BakeSettings settings = model.bake;
+  settings.parallel_for = [](size_t count, const std::function<void(size_t)>& body) {
+    tbb::parallel_for(size_t(0), count, [&](size_t i) { body(i); });
+  };
+  const Status baked = bake_model(model.file, model.name, settings, chain, &report, progress);
   if (!baked) {
     task.status = Status::error(where + ": " + baked.message);
     return;

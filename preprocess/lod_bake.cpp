@@ -4,6 +4,7 @@
 #include "preprocess/lod_bake.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -91,7 +92,8 @@ Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std:
 // a QEM level stuck more than 2 % above its target is redone by the aggressive simplifier,
 // and said so in the notes.
 void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, SimplifyMethod method, bool automatic,
-                    std::vector<ChainLevel>& levels, std::vector<std::string>& notes) {
+                    const BakeParallelFor& parallel_for, std::vector<ChainLevel>& levels,
+                    std::vector<std::string>& notes) {
   const size_t triangles = mesh.triangle_count();
   levels.assign(ratios.size(), ChainLevel{});
   ChainLevel& full = levels[0];
@@ -110,7 +112,8 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
       for (size_t i = 0; i < n; ++i) body(i);
     };
     qem_simplify_chain_split(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
-                             mesh.indices.size(), targets.data(), targets.size(), QemOptions{}, one_by_one);
+                             mesh.indices.size(), targets.data(), targets.size(), QemOptions{},
+                             parallel_for ? ParallelFor(parallel_for) : one_by_one);
     for (size_t i = 0; i < out.size(); ++i) {
       if (double(out[i].triangle_count()) <= 1.02 * double(targets[i])) continue;
       std::string note = "ratio " + std::to_string(ratios[i + 1]) + ": QEM stopped at " +
@@ -208,7 +211,8 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
 
   say(0.06f, "simplify");
   std::vector<ChainLevel> levels;
-  simplify_chain(mesh, ratios, method, settings.method == SimplifyMethod::automatic, levels, report.notes);
+  simplify_chain(mesh, ratios, method, settings.method == SimplifyMethod::automatic, settings.parallel_for, levels,
+                 report.notes);
 
   // A level no smaller than the one before it adds nothing: drop it.
   for (size_t i = 1; i < levels.size();) {
@@ -230,12 +234,22 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
     s = meter.set_reference({l0.positions.data(), l0.vertex_count(), l0.indices.data(), l0.indices.size()},
                             SurfaceErrorSettings{}, what);
     if (!s) return s;
-    for (size_t i = 1; i < levels.size(); ++i) {
-      const ChainLevel& l = levels[i];
-      s = meter.measure({l.positions.data(), l.vertex_count(), l.indices.data(), l.indices.size()}, errors[i]);
-      if (!s) return s;
-      say(0.6f + 0.38f * float(i) / float(levels.size() - 1), "measure");
+    // Levels are measured independently against the same reference, so they may run in parallel.
+    std::vector<Status> measured(levels.size());
+    std::atomic<size_t> done{0};
+    auto measure_level = [&](size_t k) {
+      const ChainLevel& l = levels[k + 1];
+      measured[k + 1] =
+          meter.measure({l.positions.data(), l.vertex_count(), l.indices.data(), l.indices.size()}, errors[k + 1]);
+      say(0.6f + 0.38f * float(++done) / float(levels.size() - 1), "measure");
+    };
+    if (settings.parallel_for) {
+      settings.parallel_for(levels.size() - 1, measure_level);
+    } else {
+      for (size_t k = 0; k + 1 < levels.size(); ++k) measure_level(k);
     }
+    for (size_t i = 1; i < levels.size(); ++i)
+      if (!measured[i]) return measured[i];
   }
   // A coarser level never reports less error than a finer one: selection relies on it.
   for (size_t i = 1; i < errors.size(); ++i) {

@@ -14,10 +14,17 @@ namespace lod {
 
 enum class SimplifyMethod : uint8_t { qem, extreme, automatic };
 
+// Runs body(0..count-1), possibly in parallel. preprocess/ owns no threads: jobs/ passes one in.
+using BakeParallelFor = std::function<void(size_t count, const std::function<void(size_t)>& body)>;
+
 struct BakeSettings {
   std::vector<float> ratios;  // fractions of the input triangles, 1.0 first; empty = defaults by size
   SimplifyMethod method = SimplifyMethod::automatic;
   uint64_t extreme_threshold = 1000000;  // auto: triangles above which the aggressive method is used
+  // Optional: lets one model use several cores (the two halves of a QEM run, the levels'
+  // error measurements). The output is byte-identical with or without it, so it is not
+  // part of the cache key.
+  BakeParallelFor parallel_for;
 };
 
 // progress(fraction in [0,1], what) is called from the baking thread.

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <thread>
 
@@ -201,6 +202,34 @@ TEST(BakeModel, GivesTheSameChainWhenBakedConcurrently) {
     ASSERT_EQ(par[i].levels.size(), ref.levels.size());
     for (size_t l = 0; l < ref.levels.size(); ++l) EXPECT_EQ(par[i].levels[l].error, ref.levels[l].error);
   }
+}
+
+TEST(BakeModel, ParallelForInsideOneModelGivesTheSameBytes) {
+  const fs::path p = write_sphere("bake-inner-par", 40, 60);
+  BakeSettings serial;
+  serial.ratios = {1.0f, 0.5f, 0.25f, 0.12f, 0.06f};
+  BakeSettings parallel = serial;
+  size_t calls = 0;
+  parallel.parallel_for = [&calls](size_t count, const std::function<void(size_t)>& body) {
+    ++calls;
+    std::vector<std::thread> threads;
+    for (size_t i = 0; i < count; ++i) threads.emplace_back(body, i);
+    for (std::thread& t : threads) t.join();
+  };
+  LodChain a, b;
+  BakeReport ra, rb;
+  ASSERT_TRUE(bake_model(p, "s", serial, a, &ra, nullptr).ok);
+  ASSERT_TRUE(bake_model(p, "s", parallel, b, &rb, nullptr).ok);
+  EXPECT_GE(calls, 1u) << "the level measurements go through parallel_for (small meshes are not split)";
+  EXPECT_EQ(a.indices, b.indices);
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.normals, b.normals);
+  ASSERT_EQ(a.levels.size(), b.levels.size());
+  for (size_t l = 0; l < a.levels.size(); ++l) {
+    EXPECT_EQ(a.levels[l].error, b.levels[l].error) << "level " << l;
+    EXPECT_EQ(a.levels[l].error_rms, b.levels[l].error_rms) << "level " << l;
+  }
+  EXPECT_EQ(a.source_hash, b.source_hash) << "the hook is not part of the cache key";
 }
 
 TEST(BakeModel, KeepsEveryFaceOfANonManifoldScan) {
