@@ -62,6 +62,10 @@ void make_heap(HeapEntry* heap, size_t size) {
 
 inline uint64_t pow2(int32_t l) { return uint64_t{1} << l; }
 
+// gather_selection's entry for an object that cannot be lowered: rank 0, below every real
+// entry (a real one has ~object > 0), so it sinks to the bottom and is never popped.
+constexpr uint32_t kPlaceholder = 0xffffffffu;
+
 struct Gathered {
   uint64_t tri_sum = 0, lev_sum = 0;        // initial levels
   uint64_t tri_coarse = 0, lev_coarse = 0;  // coarsest levels
@@ -170,6 +174,42 @@ Gathered gather_direct(const Columns& c, const ModelTable& models, HeapEntry* he
   return g;
 }
 
+
+// Pass 3: lower the top one level at a time until the budget holds. The coarsest levels fit,
+// so the heap cannot run dry first (and placeholders, ranked below every real entry, are
+// never reached). Returns the steps taken.
+uint32_t lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std::span<const float> weight,
+                         std::span<const uint32_t> model, const ModelTable& models, bool by_triangles,
+                         uint64_t budget, uint64_t& cost, uint64_t& tri_sum, uint64_t& lev_sum) {
+  const uint32_t* first = models.first_level.data();
+  const uint8_t* counts = models.level_count.data();
+  const uint32_t* tris = models.triangles.data();
+  const int32_t* ls = models.level_l.data();
+  uint32_t steps = 0;
+  while (cost > budget) {
+    assert(size > 0 && h[0].object != kPlaceholder);
+    const uint32_t obj = h[0].object;
+    const uint32_t m = model[obj];
+    const uint32_t cur = level[obj];
+    const uint32_t at = first[m] + cur;
+    const uint64_t tri_drop = tris[at] - tris[at + 1];
+    const uint64_t lev_drop = pow2(ls[at]) - pow2(ls[at + 1]);
+    tri_sum -= tri_drop;
+    lev_sum -= lev_drop;
+    cost -= by_triangles ? tri_drop : lev_drop;
+    level[obj] = static_cast<uint8_t>(cur + 1u);
+    ++steps;
+    if (cur + 2u < counts[m]) {
+      const HeapEntry next{weight[obj] * static_cast<float>(span_of_level_changed(ls[at + 1], ls[at + 2])), obj};
+      sift_down(h, size, 0, next);
+    } else {
+      --size;
+      if (size > 0) sift_down(h, size, 0, h[size]);
+    }
+  }
+  return steps;
+}
+
 }  // namespace
 
 uint64_t level_cost(const ModelTable& models, uint32_t model, uint32_t level, BudgetCount count) {
@@ -184,10 +224,7 @@ SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const ui
                                     std::span<HeapEntry> heap) {
   const size_t n = visible.size();
   assert(level.size() == n && weight.size() == n && model.size() == n);
-  const uint32_t* first = models.first_level.data();
   const uint8_t* counts = models.level_count.data();
-  const uint32_t* tris = models.triangles.data();
-  const int32_t* ls = models.level_l.data();
   const bool by_triangles = params.count == BudgetCount::triangles;
 
   // Pass 1: totals, and every lowerable visible object's key. Keys are written even when
@@ -217,35 +254,97 @@ SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const ui
   if (cost > params.budget) {
     // Pass 2: heapify, O(m).
     assert(g.heap_size <= heap.size() && "heap scratch needs room for every visible object");
-    size_t size = g.heap_size;
-    make_heap(h, size);
+    make_heap(h, g.heap_size);
+    r.lowered_steps = lower_from_heap(h, g.heap_size, level, weight, model, models, by_triangles, params.budget,
+                                      cost, tri_sum, lev_sum);
+  }
+  r.cost = cost;
+  r.triangles = tri_sum;
+  r.level_cost = lev_sum;
+  return r;
+}
 
-    // Pass 3: lower the top one level at a time until the budget holds. The coarsest levels
-    // fit, so the heap cannot run dry first.
-    uint32_t steps = 0;
-    while (cost > params.budget) {
-      assert(size > 0);
-      const uint32_t obj = h[0].object;
-      const uint32_t m = model[obj];
-      const uint32_t cur = level[obj];
-      const uint32_t at = first[m] + cur;
-      const uint64_t tri_drop = tris[at] - tris[at + 1];
-      const uint64_t lev_drop = pow2(ls[at]) - pow2(ls[at + 1]);
-      tri_sum -= tri_drop;
-      lev_sum -= lev_drop;
-      cost -= by_triangles ? tri_drop : lev_drop;
-      level[obj] = static_cast<uint8_t>(cur + 1u);
-      ++steps;
-      if (cur + 2u < counts[m]) {
-        const HeapEntry next{weight[obj] * static_cast<float>(span_of_level_changed(ls[at + 1], ls[at + 2])),
-                             obj};
-        sift_down(h, size, 0, next);
-      } else {
-        --size;
-        if (size > 0) sift_down(h, size, 0, h[size]);
-      }
+SelectionTables build_selection_tables(const ModelTable& models) {
+  SelectionTables t;
+  // Room past the end: an invisible object's stale level may index past its chain.
+  const size_t size = models.triangles.size() + kStaleLevelRoom;
+  t.slc_next.assign(size, 0.f);
+  t.lowerable.assign(size, 0);
+  for (size_t m = 0; m < models.model_count(); ++m) {
+    const uint32_t first = models.first_level[m];
+    for (uint32_t k = first; k + 1 < first + models.level_count[m]; ++k) {
+      t.slc_next[k] = static_cast<float>(span_of_level_changed(models.level_l[k], models.level_l[k + 1]));
+      t.lowerable[k] = 1;
     }
-    r.lowered_steps = steps;
+  }
+  return t;
+}
+
+void gather_selection(std::span<HeapEntry> heap, std::span<uint32_t> level_counts, std::span<const uint8_t> level,
+                      std::span<const uint8_t> visible, std::span<const float> weight,
+                      std::span<const uint32_t> model, uint32_t first_id, const ModelTable& models,
+                      const SelectionTables& tables) {
+  const size_t n = visible.size();
+  assert(heap.size() == n && level.size() == n && weight.size() == n && model.size() == n);
+  assert(level_counts.size() == models.triangles.size());
+  assert(tables.slc_next.size() == models.triangles.size() + kStaleLevelRoom);
+  const uint32_t* first = models.first_level.data();
+  const float* slc_next = tables.slc_next.data();
+  const uint8_t* lowerable = tables.lowerable.data();
+  uint32_t* counts = level_counts.data();
+  HeapEntry* __restrict out = heap.data();
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t v = visible[i] != 0;
+    assert(!v || level[i] < models.level_count[model[i]]);
+    const uint32_t at = first[model[i]] + level[i];
+    counts[v ? at : 0] += v;  // an invisible object adds 0 at a valid index
+    const bool keep = v & lowerable[at];
+    const HeapEntry real{weight[i] * slc_next[at], first_id + static_cast<uint32_t>(i)};
+    assert(!keep || real.key >= 0.f);
+    out[i] = keep ? real : HeapEntry{0.f, kPlaceholder};
+  }
+}
+
+SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
+                                   std::span<const float> weight, std::span<const uint32_t> model,
+                                   const ModelTable& models, const SelectionParams& params,
+                                   std::span<const uint32_t> level_counts, std::span<HeapEntry> heap) {
+  const size_t n = visible.size();
+  assert(level.size() == n && weight.size() == n && model.size() == n && heap.size() == n);
+  assert(level_counts.size() == models.triangles.size());
+  const uint32_t* tris = models.triangles.data();
+  const int32_t* ls = models.level_l.data();
+  uint64_t tri_sum = 0, lev_sum = 0, tri_coarse = 0, lev_coarse = 0;
+  for (size_t m = 0; m < models.model_count(); ++m) {
+    const uint32_t begin = models.first_level[m], last = begin + models.level_count[m] - 1u;
+    uint64_t count = 0;
+    for (uint32_t k = begin; k <= last; ++k) {
+      count += level_counts[k];
+      tri_sum += uint64_t{level_counts[k]} * tris[k];
+      lev_sum += uint64_t{level_counts[k]} * pow2(ls[k]);
+    }
+    tri_coarse += count * tris[last];
+    lev_coarse += count * pow2(ls[last]);
+  }
+  const bool by_triangles = params.count == BudgetCount::triangles;
+  SelectionResult r;
+  r.coarsest_cost = by_triangles ? tri_coarse : lev_coarse;
+  if (r.coarsest_cost > params.budget) {
+    for (size_t i = 0; i < n; ++i) {
+      const uint8_t last = static_cast<uint8_t>(models.level_count[model[i]] - 1u);
+      level[i] = visible[i] ? last : level[i];
+    }
+    r.cost = r.coarsest_cost;
+    r.triangles = tri_coarse;
+    r.level_cost = lev_coarse;
+    r.over_budget = true;
+    return r;
+  }
+  uint64_t cost = by_triangles ? tri_sum : lev_sum;
+  if (cost > params.budget) {
+    make_heap(heap.data(), n);
+    r.lowered_steps = lower_from_heap(heap.data(), n, level, weight, model, models, by_triangles, params.budget, cost,
+                                      tri_sum, lev_sum);
   }
   r.cost = cost;
   r.triangles = tri_sum;

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "runtime/model_table.h"
 
@@ -42,6 +43,34 @@ uint64_t level_cost(const ModelTable& models, uint32_t model, uint32_t level, Bu
 // exit. `heap` is caller-owned scratch with room for every visible object (room for every
 // object saves a bound check per object). Invisible objects' levels are left as they are.
 // Deterministic: equal keys are taken in increasing object id.
+// The same selection in two parts, so that its streaming pass runs in parallel:
+//
+//   gather_selection    sub-range safe: writes one heap entry per object of its range (a
+//                       placeholder that is never popped when the object is invisible or at
+//                       its coarsest level) and adds its visible objects per chain level into
+//                       `level_counts` (one counter per ModelTable level). Run it on chunks.
+//   lower_under_budget  serial: from the summed counts and the whole heap array, the same
+//                       result as select_under_budget on the same inputs.
+//
+// `tables` comes from build_selection_tables(models), once per ModelTable.
+struct SelectionTables {
+  std::vector<float> slc_next;     // per level: SLC of lowering one step from it (0 at coarsest)
+  std::vector<uint8_t> lowerable;  // per level: 1 unless it is its chain's coarsest
+};
+SelectionTables build_selection_tables(const ModelTable& models);
+
+// `first_id` is the id of the range's first object in the array lower_under_budget gets.
+void gather_selection(std::span<HeapEntry> heap, std::span<uint32_t> level_counts, std::span<const uint8_t> level,
+                      std::span<const uint8_t> visible, std::span<const float> weight,
+                      std::span<const uint32_t> model, uint32_t first_id, const ModelTable& models,
+                      const SelectionTables& tables);
+
+// `heap` holds one entry per object (from gather_selection); it is reordered in place.
+SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
+                                   std::span<const float> weight, std::span<const uint32_t> model,
+                                   const ModelTable& models, const SelectionParams& params,
+                                   std::span<const uint32_t> level_counts, std::span<HeapEntry> heap);
+
 SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
                                     std::span<const float> weight, std::span<const uint32_t> model,
                                     const ModelTable& models, const SelectionParams& params,

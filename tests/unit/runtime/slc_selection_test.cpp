@@ -125,6 +125,54 @@ TEST(Selection, MeetsBudgetWheneverCoarsestLevelsFitInBothUnits) {
   EXPECT_GT(binding, 300);  // the budget really bound in most trials
 }
 
+// The two-part form (gather on chunks, then lower) gives exactly what the one-call form
+// gives, whatever the chunking, in both units, binding or over budget.
+TEST(Selection, GatherOnChunksThenLowerEqualsOneCall) {
+  const ModelTable t = paper_table();
+  const SelectionTables tables = build_selection_tables(t);
+  std::mt19937 rng(77);
+  int binding = 0, over = 0;
+  for (BudgetCount unit : {BudgetCount::triangles, BudgetCount::levels}) {
+    for (int trial = 0; trial < 150; ++trial) {
+      Scene one = random_scene(t, 1 + rng() % 400, rng);
+      Scene two = one;
+      const Scene initial = one;
+      SelectionParams p;
+      p.count = unit;
+      const uint64_t start = cost_of(one, t, unit);
+      p.budget = trial % 10 == 0 ? 1 : 1 + rng() % (start + 1);
+      const SelectionResult a = select_under_budget(one.level, one.visible, one.weight, one.model, t, p, one.heap);
+
+      const size_t n = two.level.size();
+      const size_t chunk = 1 + rng() % 64;
+      std::vector<uint32_t> counts(t.triangles.size(), 0);
+      for (size_t b = 0; b < n; b += chunk) {
+        const size_t e = std::min(n, b + chunk);
+        std::vector<uint32_t> part(t.triangles.size(), 0);
+        gather_selection(std::span(two.heap).subspan(b, e - b), part, std::span(two.level).subspan(b, e - b),
+                         std::span(two.visible).subspan(b, e - b), std::span(two.weight).subspan(b, e - b),
+                         std::span(two.model).subspan(b, e - b), static_cast<uint32_t>(b), t, tables);
+        for (size_t k = 0; k < counts.size(); ++k) counts[k] += part[k];
+      }
+      const SelectionResult b = lower_under_budget(two.level, two.visible, two.weight, two.model, t, p, counts, two.heap);
+      ASSERT_EQ(two.level, one.level) << "trial " << trial << " chunk " << chunk;
+      EXPECT_EQ(b.cost, a.cost);
+      EXPECT_EQ(b.triangles, a.triangles);
+      EXPECT_EQ(b.level_cost, a.level_cost);
+      EXPECT_EQ(b.coarsest_cost, a.coarsest_cost);
+      EXPECT_EQ(b.lowered_steps, a.lowered_steps);
+      EXPECT_EQ(b.over_budget, a.over_budget);
+      if (!a.over_budget) {
+        EXPECT_EQ(two.level, reference_select(initial, t, p));
+      }
+      binding += a.lowered_steps > 0;
+      over += a.over_budget;
+    }
+  }
+  EXPECT_GT(binding, 100);
+  EXPECT_GT(over, 10);
+}
+
 TEST(Selection, MatchesReferenceWithManyModelsAndTightScratch) {
   // 400 chains of 2 to 9 levels: more levels than selection's stack tables hold, so the
   // table-free path runs; and scratch with room for exactly the visible objects.
