@@ -95,8 +95,9 @@ constexpr StageEntry kStageTable[kStageCount] = {
     {"view", "frustum planes, focal length, budget"},
     {"visibility", "cull_spheres, parallel over chunks"},
     {"importance",
-     "measure_objects + minima, importance_weights + choose_initial_levels, compaction, parallel"},
-    {"selection", "select_under_budget, serial over the visible set"},
+     "measure_objects + minima, importance_weights + choose_initial_levels, compaction, gather_selection, "
+     "parallel"},
+    {"selection", "lower_under_budget: heap over the visible set, serial (its gather pass runs in importance)"},
     {"vdlod", "front_update per visible view-dependent object, parallel over objects"},
     {"geomorph", "level morph factors; vertex morphs + compact meshes of vd objects, parallel"},
     {"publish", "totals, levels -> prev_level, parallel"},
@@ -117,7 +118,10 @@ struct FrameGraph::Impl {
   std::vector<float> visible_weight;
   std::vector<uint32_t> visible_model;
   std::vector<uint8_t> all_ones;  // the `visible` column of the compacted set
-  std::vector<HeapEntry> heap;
+  std::vector<HeapEntry> heap;           // selection: one entry per visible slot
+  SelectionTables selection_tables;      // per level: SLC of the next step, lowerable
+  std::vector<uint32_t> selection_counts;  // chunks x level_total: visible objects per level
+  std::vector<uint32_t> selection_total;   // level_total: the chunks' counts summed
   std::vector<uint32_t> chunk_visible;  // visibility: visible objects per chunk
   std::vector<uint32_t> chunk_offset;   // first compacted slot of each chunk
   std::vector<ViewMinima> chunk_minima;
@@ -183,6 +187,9 @@ struct FrameGraph::Impl {
     const ModelTable& models = scene.models;
     level_total = models.triangles.size();
     level_counts.resize(chunks * kCountLanes * level_total);
+    selection_tables = build_selection_tables(models);
+    selection_counts.resize(chunks * level_total);
+    selection_total.resize(level_total);
     full_triangles.resize(level_total);
     for (size_t m = 0; m < models.model_count(); ++m)
       for (size_t k = 0; k < models.level_count[m]; ++k)
@@ -330,6 +337,17 @@ struct FrameGraph::Impl {
         slot += state.visible[i];
       }
       assert(slot == end_slot);
+      // Selection's streaming pass on this chunk's slots (heap keys, visible per level), so
+      // that only the heap work stays serial.
+      const size_t b0 = chunk_offset[c], n0 = chunk_visible[c];
+      const std::span<uint32_t> counts(selection_counts.data() + c * level_total, level_total);
+      std::fill(counts.begin(), counts.end(), 0u);
+      gather_selection(std::span<HeapEntry>(heap.data() + b0, n0), counts,
+                       std::span<const uint8_t>(f.levels.data() + b0, n0),
+                       std::span<const uint8_t>(all_ones.data() + b0, n0),
+                       std::span<const float>(visible_weight.data() + b0, n0),
+                       std::span<const uint32_t>(visible_model.data() + b0, n0), static_cast<uint32_t>(b0),
+                       scene.models, selection_tables);
     });
   }
 
@@ -337,10 +355,15 @@ struct FrameGraph::Impl {
   // ties by position, and compaction keeps object order), with less to stream through.
   void stage_selection() {
     const size_t v = visible_total;
-    selected = select_under_budget(
+    std::fill(selection_total.begin(), selection_total.end(), 0u);
+    for (size_t c = 0; c < chunks; ++c) {
+      const uint32_t* counts = selection_counts.data() + c * level_total;
+      for (size_t k = 0; k < level_total; ++k) selection_total[k] += counts[k];
+    }
+    selected = lower_under_budget(
         std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
         std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_model.data(), v),
-        scene.models, options.selection, std::span<HeapEntry>(heap.data(), v));
+        scene.models, options.selection, selection_total, std::span<HeapEntry>(heap.data(), v));
   }
 
   float o_pixel_error() const { return options.pixel_error; }
