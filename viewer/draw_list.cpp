@@ -11,11 +11,51 @@ void build_draw_list(const Frame& frame, const ObjectSet& objects, const MeshLay
   out.triangles = 0;
   out.indices = 0;
   out.rejected = 0;
+  out.vd.clear();
+  out.vd_triangles = 0;
+  out.vd_level_triangles = 0;
   std::vector<uint32_t>& slot = out.per_batch_slot;
   slot.assign(layout.ranges.size() + 1, 0);
 
   // A torn frame could have arrays of different lengths; draw only the common prefix.
   const size_t n = std::min({frame.objects.size(), frame.levels.size(), frame.morph.size()});
+  auto transform_of = [&](uint32_t id, float morph) {
+    InstanceData d;
+    d.position_scale[0] = objects.x[id];
+    d.position_scale[1] = objects.y[id];
+    d.position_scale[2] = objects.z[id];
+    d.position_scale[3] = objects.scale[id];
+    d.yaw = objects.yaw[id];
+    d.morph = morph;
+    return d;
+  };
+
+  // View-dependent objects: both lists are in object order, so one merge marks their entries.
+  // Their entry is not an instance; its level's triangles are what tris_selected counted.
+  out.is_vd.assign(n, 0);
+  size_t k = 0;
+  for (const VdObjectFrame& v : frame.vd_objects) {
+    while (k < n && frame.objects[k] < v.object) ++k;
+    const bool listed = k < n && frame.objects[k] == v.object;
+    const bool in_range = uint64_t(v.first_vertex) + v.vertex_count <= frame.vd_positions.size() / 3 &&
+                          uint64_t(v.first_index) + v.index_count <= frame.vd_indices.size() &&
+                          v.index_count % 3 == 0 && v.object < objects.size();
+    bool indices_ok = in_range;
+    for (uint32_t i = 0; indices_ok && i < v.index_count; ++i)
+      indices_ok = frame.vd_indices[v.first_index + i] < v.vertex_count;
+    if (!listed || !indices_ok) {
+      ++out.rejected;
+      continue;
+    }
+    out.is_vd[k] = 1;
+    const uint32_t model = objects.model[v.object];
+    if (model < layout.level_count.size() && frame.levels[k] < layout.level_count[model])
+      out.vd_level_triangles += layout.ranges[layout.range_of(model, frame.levels[k])].index_count / 3;
+    out.vd.push_back({v.object, v.first_vertex, v.vertex_count, v.first_index, v.index_count,
+                      transform_of(v.object, 1.f)});
+    out.vd_triangles += v.index_count / 3;
+  }
+
   auto range_of = [&](size_t i, uint32_t* range) {
     const uint32_t id = frame.objects[i];
     if (id >= objects.size()) return false;
@@ -27,6 +67,7 @@ void build_draw_list(const Frame& frame, const ObjectSet& objects, const MeshLay
 
   uint32_t drawn = 0;
   for (size_t i = 0; i < n; ++i) {
+    if (out.is_vd[i]) continue;
     uint32_t r;
     if (range_of(i, &r)) {
       ++slot[r + 1];
@@ -52,15 +93,8 @@ void build_draw_list(const Frame& frame, const ObjectSet& objects, const MeshLay
   out.instances.resize(drawn);
   for (size_t i = 0; i < n; ++i) {
     uint32_t r;
-    if (!range_of(i, &r)) continue;
-    const uint32_t id = frame.objects[i];
-    InstanceData& d = out.instances[slot[r]++];
-    d.position_scale[0] = objects.x[id];
-    d.position_scale[1] = objects.y[id];
-    d.position_scale[2] = objects.z[id];
-    d.position_scale[3] = objects.scale[id];
-    d.yaw = objects.yaw[id];
-    d.morph = frame.morph[i];
+    if (out.is_vd[i] || !range_of(i, &r)) continue;
+    out.instances[slot[r]++] = transform_of(frame.objects[i], frame.morph[i]);
   }
 }
 

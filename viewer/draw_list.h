@@ -27,17 +27,40 @@ struct DrawBatch {
   uint32_t instance_count = 0;
 };
 
+// One view-dependent object's active mesh (Frame::vd_objects): drawn from the frame's own
+// vd_positions / vd_indices with the object's transform, never at its discrete level.
+struct VdDraw {
+  uint32_t object = 0;
+  uint32_t first_vertex = 0;  // into Frame::vd_positions, in vertices
+  uint32_t vertex_count = 0;
+  uint32_t first_index = 0;   // into Frame::vd_indices; local to this object's vertices
+  uint32_t index_count = 0;
+  InstanceData transform;     // the same per-object transform the instances use, morph = 1
+};
+
 struct DrawList {
   std::vector<DrawBatch> batches;         // non-empty groups, in (model, level) order
   std::vector<InstanceData> instances;    // grouped by batch
-  uint64_t triangles = 0;                 // sum of index_count / 3 * instance_count
-  uint64_t indices = 0;                   // indices submitted
-  uint32_t rejected = 0;                  // frame entries naming an unknown object or level
+  uint64_t triangles = 0;                 // sum of index_count / 3 * instance_count (instanced only)
+  uint64_t indices = 0;                   // indices submitted (instanced only)
+  uint32_t rejected = 0;                  // frame entries naming an unknown object or level, bad vd meshes
+  std::vector<VdDraw> vd;                 // view-dependent objects, in frame order
+  uint64_t vd_triangles = 0;              // sum of vd index_count / 3
+  uint64_t vd_level_triangles = 0;        // what Frame::tris_selected counts for those objects (their level)
   std::vector<uint32_t> per_batch_slot;   // scratch: instances per range (counting sort)
+  std::vector<uint8_t> is_vd;             // scratch: per frame entry, drawn from its active mesh
 };
 
 // Rebuilds `out` from `frame` (reusing its capacity). Entries whose object id or level is out
 // of range are not drawn and are counted in `rejected`: a well-formed frame has none.
+// Objects listed in frame.vd_objects are drawn from their active mesh (out.vd) instead of an
+// instance; a vd entry whose ranges or indices fall outside the frame's arrays is rejected.
 void build_draw_list(const Frame& frame, const ObjectSet& objects, const MeshLayout& layout, DrawList& out);
+
+// The frame's selected triangles as a renderer draws them: Frame::tris_selected counts a
+// view-dependent object at its discrete level, but what is drawn is its active mesh.
+inline uint64_t selected_as_drawn(const Frame& frame, const DrawList& list) {
+  return frame.tris_selected - list.vd_level_triangles + frame.vd_active_tris;
+}
 
 }  // namespace lod::viewer

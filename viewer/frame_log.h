@@ -14,8 +14,12 @@ struct FrameRow {
   uint64_t viewer_frame = 0;
   uint64_t lod_frame = 0;        // Frame::index drawn
   uint32_t visible = 0;
-  uint64_t tris_selected = 0;    // Frame::tris_selected
+  // Frame::tris_selected with view-dependent objects counted at their active mesh (what is
+  // drawn for them) instead of their discrete level: selected_as_drawn().
+  uint64_t tris_selected = 0;
   uint64_t drawn = 0;            // triangles submitted
+  uint32_t vd_objects = 0;       // view-dependent objects drawn from their active mesh
+  uint64_t vd_drawn = 0;         // their triangles (part of `drawn`)
   int64_t gpu_primitives = -1;   // GL_PRIMITIVES_GENERATED, -1 when not queried
   uint32_t draws = 0;
   uint32_t levels_drawn = 0;     // distinct chain levels among the draws

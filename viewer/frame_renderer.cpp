@@ -8,6 +8,7 @@ bool FrameRenderer::init(const Scene& scene, std::string* message) {
   scene_ = &scene;
   if (!instances_.init(message)) return false;
   meshes_.upload(scene.chains);
+  vd_meshes_.init();
   if (const GLenum err = glGetError(); err != GL_NO_ERROR) {
     *message = "uploading " + std::to_string(meshes_.layout().index_count / 3) + " triangles failed (GL error " +
                std::to_string(err) + ")";
@@ -27,7 +28,8 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
   glDisable(GL_SCISSOR_TEST);
 
   build_draw_list(frame, scene_->objects, meshes_.layout(), list_);
-  return instances_.draw(list_, meshes_, view_matrix(viewing), projection_matrix(viewing), settings);
+  vd_meshes_.upload(frame);
+  return instances_.draw(list_, meshes_, &vd_meshes_, view_matrix(viewing), projection_matrix(viewing), settings);
 }
 
 void FrameRenderer::render_culled(const Frame& frame, const View& viewing) {
@@ -47,7 +49,7 @@ void FrameRenderer::render_culled(const Frame& frame, const View& viewing) {
   RenderSettings dark;
   dark.colour_override = true;
   dark.colour = kCulledColour;
-  instances_.draw(culled_list_, meshes_, view_matrix(viewing), projection_matrix(viewing), dark);
+  instances_.draw(culled_list_, meshes_, nullptr, view_matrix(viewing), projection_matrix(viewing), dark);
 }
 
 }  // namespace lod::viewer

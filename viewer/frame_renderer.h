@@ -1,5 +1,6 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
-// clear, build the draw list, one instanced draw per (model, level).
+// clear, build the draw list, one instanced draw per (model, level), then one draw per
+// view-dependent object from the active mesh the frame carries.
 #pragma once
 #include <span>
 #include <string>
@@ -10,6 +11,7 @@
 #include "viewer/draw_list.h"
 #include "viewer/instance_renderer.h"
 #include "viewer/mesh_buffers.h"
+#include "viewer/vd_mesh_buffers.h"
 
 namespace lod::viewer {
 
@@ -30,6 +32,7 @@ class FrameRenderer {
  private:
   const Scene* scene_ = nullptr;
   MeshBuffers meshes_;
+  VdMeshBuffers vd_meshes_;
   InstanceRenderer instances_;
   DrawList list_;
   Frame culled_;        // scratch: the culled objects as a frame

@@ -74,8 +74,8 @@ bool InstanceRenderer::init(std::string* message) {
   return true;
 }
 
-DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, const glm::mat4& view,
-                                 const glm::mat4& projection, const RenderSettings& settings) {
+DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, const VdMeshBuffers* vd,
+                                 const glm::mat4& view, const glm::mat4& projection, const RenderSettings& settings) {
   DrawStats stats;
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_, 1, GL_FALSE, glm::value_ptr(view));
@@ -116,6 +116,28 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
     ++stats.draws;
     stats.instances += b.instance_count;
     stats.triangles += uint64_t(r.index_count / 3) * b.instance_count;
+  }
+
+  if (vd && !list.vd.empty()) {
+    // Same shader: the per-object attributes are disabled in this VAO, so the constant values
+    // set below are the transform; a zero normal makes the shader use face normals.
+    glBindVertexArray(vd->vao());
+    glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);
+    const auto& c = settings.colour_override ? settings.colour
+                    : settings.colour_by_level ? kViewDependentColour
+                                               : kModelColour;
+    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    for (const VdDraw& d : list.vd) {
+      glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
+      glVertexAttrib2f(kAttribInstanceYawMorph, d.transform.yaw, d.transform.morph);
+      glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(d.index_count), GL_UNSIGNED_INT,
+                               reinterpret_cast<const void*>(size_t(d.first_index) * sizeof(uint32_t)),
+                               GLint(d.first_vertex));
+      ++stats.draws;
+      ++stats.vd_draws;
+      stats.vd_triangles += d.index_count / 3;
+      stats.triangles += d.index_count / 3;
+    }
   }
 
   if (settings.count_primitives) {

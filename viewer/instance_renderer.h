@@ -11,6 +11,7 @@
 
 #include "viewer/draw_list.h"
 #include "viewer/mesh_buffers.h"
+#include "viewer/vd_mesh_buffers.h"
 
 namespace lod::viewer {
 
@@ -26,7 +27,9 @@ struct RenderSettings {
 struct DrawStats {
   uint32_t draws = 0;
   uint64_t instances = 0;
-  uint64_t triangles = 0;        // submitted: sum of index_count / 3 * instances
+  uint64_t triangles = 0;        // submitted: sum of index_count / 3 * instances, vd meshes included
+  uint32_t vd_draws = 0;         // view-dependent objects drawn from their active mesh
+  uint64_t vd_triangles = 0;     // their triangles (part of `triangles`)
   int64_t gpu_primitives = -1;   // what the GL counted, when count_primitives; else -1
 };
 
@@ -39,8 +42,10 @@ class InstanceRenderer {
 
   // Compiles the shaders; false with the driver's log in `message`.
   bool init(std::string* message);
-  DrawStats draw(const DrawList& list, const MeshBuffers& meshes, const glm::mat4& view, const glm::mat4& projection,
-                 const RenderSettings& settings);
+  // Draws the list's instances from `meshes` and its view-dependent objects (list.vd) from
+  // `vd`, which holds the same frame's vd meshes; `vd` may be null when list.vd is empty.
+  DrawStats draw(const DrawList& list, const MeshBuffers& meshes, const VdMeshBuffers* vd, const glm::mat4& view,
+                 const glm::mat4& projection, const RenderSettings& settings);
 
  private:
   GLuint program_ = 0;

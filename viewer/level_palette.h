@@ -23,6 +23,9 @@ inline constexpr std::array<std::array<float, 3>, 12> kLevelPalette = {{
 
 inline const std::array<float, 3>& level_colour(size_t level) { return kLevelPalette[level % kLevelPalette.size()]; }
 
+// View-dependent objects in colour-by-level mode: they have no single level; white is no
+// palette entry.
+inline constexpr std::array<float, 3> kViewDependentColour = {0.97f, 0.97f, 0.97f};
 // Neutral grey-blue for the normal (not colour-by-level) mode.
 inline constexpr std::array<float, 3> kModelColour = {0.72f, 0.74f, 0.78f};
 // Objects the LOD frame culled, seen from outside (bird's-eye, frozen LOD).

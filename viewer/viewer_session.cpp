@@ -27,8 +27,10 @@ const FrameRow& ViewerSession::record(uint64_t viewer_frame, const Frame& frame,
   row.viewer_frame = viewer_frame;
   row.lod_frame = frame.index;
   row.visible = frame.visible;
-  row.tris_selected = frame.tris_selected;
+  row.tris_selected = selected_as_drawn(frame, renderer.draw_list());
   row.drawn = drawn.triangles;
+  row.vd_objects = drawn.vd_draws;
+  row.vd_drawn = drawn.vd_triangles;
   row.gpu_primitives = drawn.gpu_primitives;
   row.draws = drawn.draws;
   uint64_t levels = 0;  // bit per chain level (< kMaxLevels)

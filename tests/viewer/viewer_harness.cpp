@@ -55,7 +55,7 @@ std::string box_off(int n) {
 }
 
 ViewerScene write_viewer_scene(const std::string& tag, const std::string& budget_and_run, const std::string& camera,
-                               const std::string& instances) {
+                               const std::string& instances, const std::string& extra_models) {
   ViewerScene scene;
   scene.dir = temp_dir("viewer-" + tag);
   write_text(scene.dir / "sphere.off", sphere_off(25, 48));
@@ -65,6 +65,7 @@ ViewerScene write_viewer_scene(const std::string& tag, const std::string& budget
     << camera << "\n"
     << "[[model]]\nname = \"sphere\"\nfile = \"sphere.off\"\nratios = [1.0, 0.5, 0.25, 0.12, 0.06]\n\n"
     << "[[model]]\nname = \"box\"\nfile = \"box.off\"\nratios = [1.0, 0.5, 0.25, 0.12, 0.06]\n\n"
+    << extra_models << "\n"
     << instances << "\n";
   scene.config = scene.dir / "config.toml";
   write_text(scene.config, c.str());

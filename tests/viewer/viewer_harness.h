@@ -17,9 +17,10 @@ struct ViewerScene {
 };
 
 // A scene of one generated sphere (2,304 triangles) and one generated box (3,072 triangles).
-// `instances` and `camera` are TOML text appended after the [[model]] blocks.
+// `instances` and `camera` are TOML text appended after the [[model]] blocks; `extra_models`
+// is more [[model]] blocks (they may use sphere.off / box.off).
 ViewerScene write_viewer_scene(const std::string& tag, const std::string& budget_and_run, const std::string& camera,
-                               const std::string& instances);
+                               const std::string& instances, const std::string& extra_models = "");
 
 struct RunResult {
   int exit_code = -1;

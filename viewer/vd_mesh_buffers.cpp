@@ -1,0 +1,50 @@
+#include "viewer/vd_mesh_buffers.h"
+
+#include "viewer/mesh_buffers.h"
+
+namespace lod::viewer {
+
+namespace {
+
+// Orphans `target`'s storage (growing it geometrically when `bytes` do not fit) and copies in.
+void stream(GLenum target, size_t bytes, const void* data, size_t& capacity) {
+  if (bytes > capacity) capacity = bytes + bytes / 2;
+  if (capacity == 0) return;
+  glBufferData(target, GLsizeiptr(capacity), nullptr, GL_STREAM_DRAW);
+  if (bytes) glBufferSubData(target, 0, GLsizeiptr(bytes), data);
+}
+
+}  // namespace
+
+VdMeshBuffers::~VdMeshBuffers() {
+  if (ibo_) glDeleteBuffers(1, &ibo_);
+  if (vbo_) glDeleteBuffers(1, &vbo_);
+  if (vao_) glDeleteVertexArrays(1, &vao_);
+}
+
+void VdMeshBuffers::init() {
+  glGenVertexArrays(1, &vao_);
+  glGenBuffers(1, &vbo_);
+  glGenBuffers(1, &ibo_);
+  glBindVertexArray(vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
+  glEnableVertexAttribArray(kAttribPosition);
+  glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  // Normal and per-object attributes stay disabled: their current (constant) values are used.
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+void VdMeshBuffers::upload(const Frame& frame) {
+  if (frame.vd_objects.empty()) return;  // nothing drawn from the buffers this frame
+  glBindVertexArray(vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
+  stream(GL_ARRAY_BUFFER, frame.vd_positions.size() * sizeof(float), frame.vd_positions.data(), vbo_capacity_);
+  stream(GL_ELEMENT_ARRAY_BUFFER, frame.vd_indices.size() * sizeof(uint32_t), frame.vd_indices.data(),
+         ibo_capacity_);
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+}  // namespace lod::viewer
