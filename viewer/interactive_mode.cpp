@@ -201,6 +201,7 @@ int run_interactive(ViewerSession& s) {
       facts.time_s = std::chrono::duration<double>(now - start).count();
       facts.viewer_ms = last_ms;
       facts.frame = &frame;
+      facts.selected = selected_as_drawn(frame, s.renderer.draw_list());
       facts.drawn = drawn;
       facts.service = service_stats;
       facts.threads = s.threads;

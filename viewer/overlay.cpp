@@ -54,7 +54,7 @@ bool Overlay::wants_keyboard() const { return ready_ && ImGui::GetIO().WantCaptu
 
 void Overlay::record(const OverlayFacts& f) {
   Sample s{f.time_s, float(f.viewer_ms), f.frame ? float(f.frame->total_ms) : 0.f,
-           f.frame ? float(f.frame->tris_selected) / 1000.f : 0.f, float(f.drawn.triangles) / 1000.f};
+           f.frame ? float(f.selected) / 1000.f : 0.f, float(f.drawn.triangles) / 1000.f};
   history_.push_back(s);
   const auto first_kept = std::find_if(history_.begin(), history_.end(),
                                        [&](const Sample& x) { return x.t >= f.time_s - kHistorySeconds; });
@@ -90,8 +90,12 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
     }
     ImGui::Text("visible      %s / %s objects", thousands(fr->visible).c_str(), thousands(f.objects).c_str());
     ImGui::Text("tris in view %s", thousands(fr->tris_in_view).c_str());
-    ImGui::Text("selected     %s", thousands(fr->tris_selected).c_str());
+    ImGui::Text("selected     %s", thousands(f.selected).c_str());
     ImGui::Text("drawn        %s  (%u draws)", thousands(f.drawn.triangles).c_str(), f.drawn.draws);
+    // Both figures count view-dependent objects at their active mesh, not their level.
+    if (!fr->vd_objects.empty())
+      ImGui::Text("view-dep.    %u objects, %s active tris drawn", f.drawn.vd_draws,
+                  thousands(f.drawn.vd_triangles).c_str());
     ImGui::Text("budget M     %s%s", thousands(fr->budget).c_str(), fr->over_budget ? "  (over: coarsest levels)" : "");
 
     // Level histogram over R0's l = round(log2 tris): only the occupied span.

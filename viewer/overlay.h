@@ -23,6 +23,7 @@ struct OverlayFacts {
   double viewer_ms = 0;       // last viewer frame, CPU wall time
   const Frame* frame = nullptr;
   DrawStats drawn;
+  uint64_t selected = 0;      // selected_as_drawn(): vd objects at their active mesh
   ServiceStats service;
   uint32_t threads = 0;       // LOD thread pool size
   size_t objects = 0;

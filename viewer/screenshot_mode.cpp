@@ -71,6 +71,7 @@ int run_screenshot(ViewerSession& s) {
       facts.time_s = std::chrono::duration<double>(t0 - start).count();
       facts.viewer_ms = s.log.rows().empty() ? 0 : s.log.rows().back().viewer_ms;
       facts.frame = &frame;
+      facts.selected = selected_as_drawn(frame, s.renderer.draw_list());
       facts.drawn = last;
       facts.service = service.stats();
       facts.threads = s.threads;

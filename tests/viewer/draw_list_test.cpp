@@ -163,4 +163,70 @@ TEST(DrawList, EmptyFrameDrawsNothingAndReusesTheList) {
   EXPECT_EQ(list.triangles, 0u);
 }
 
+// A vd entry for `object` with `vertices` vertices and the given local indices, appended to
+// the frame's vd arrays.
+void add_vd(Frame& f, uint32_t object, uint32_t vertices, std::vector<uint32_t> indices) {
+  VdObjectFrame v;
+  v.object = object;
+  v.first_vertex = uint32_t(f.vd_positions.size() / 3);
+  v.vertex_count = vertices;
+  v.first_index = uint32_t(f.vd_indices.size());
+  v.index_count = uint32_t(indices.size());
+  for (uint32_t i = 0; i < 3 * vertices; ++i) f.vd_positions.push_back(float(i));
+  f.vd_indices.insert(f.vd_indices.end(), indices.begin(), indices.end());
+  f.vd_active_tris += indices.size() / 3;
+  f.vd_objects.push_back(v);
+}
+
+TEST(DrawList, VdObjectsDrawFromTheirActiveMeshNotAnInstance) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2}), chain_with_levels({5, 3, 1})};
+  const MeshLayout m = layout_meshes(chains);
+  const ObjectSet objects = objects_of_models({0, 1, 0, 1});
+  Frame f = frame_of({0, 1, 2, 3}, {0, 1, 1, 2});
+  f.morph = {1, 0.25f, 1, 1};
+  f.tris_selected = 4 + 3 + 2 + 1;
+  add_vd(f, 1, 4, {0, 1, 2, 0, 2, 3});        // 2 triangles instead of level 1's 3
+  add_vd(f, 3, 3, {0, 1, 2, 2, 1, 0, 0, 2, 1});  // 3 triangles instead of level 2's 1
+  DrawList list;
+  build_draw_list(f, objects, m, list);
+  EXPECT_EQ(list.rejected, 0u);
+  EXPECT_EQ(list.instances.size(), 2u) << "objects 0 and 2 only";
+  EXPECT_EQ(list.triangles, 4u + 2u);
+  ASSERT_EQ(list.vd.size(), 2u);
+  EXPECT_EQ(list.vd_triangles, 5u);
+  EXPECT_EQ(list.vd_level_triangles, 3u + 1u);
+  EXPECT_EQ(selected_as_drawn(f, list), list.triangles + list.vd_triangles);
+  const VdDraw& a = list.vd[0];
+  EXPECT_EQ(a.object, 1u);
+  EXPECT_EQ(a.first_vertex, 0u);
+  EXPECT_EQ(a.index_count, 6u);
+  EXPECT_EQ(a.transform.position_scale[0], 1.f);  // object 1's transform
+  EXPECT_EQ(a.transform.position_scale[3], 2.f);
+  EXPECT_EQ(a.transform.yaw, 0.5f);
+  EXPECT_EQ(a.transform.morph, 1.f) << "the vd mesh is already geomorphed";
+  EXPECT_EQ(list.vd[1].first_vertex, 4u);
+  EXPECT_EQ(list.vd[1].first_index, 6u);
+  for (const DrawBatch& b : list.batches) EXPECT_EQ(b.model, 0u) << "no model-1 instance is drawn";
+}
+
+TEST(DrawList, VdEntriesOutsideTheFrameAreRejectedAndDrawnAtTheirLevel) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2})};
+  const MeshLayout m = layout_meshes(chains);
+  const ObjectSet objects = objects_of_models({0, 0, 0, 0});
+  Frame f = frame_of({0, 1, 2}, {1, 1, 1});
+  add_vd(f, 0, 3, {0, 1, 3});  // index 3 of 3 vertices
+  add_vd(f, 1, 3, {0, 1});     // not whole triangles
+  add_vd(f, 3, 3, {0, 1, 2});  // object 3 is not visible in this frame
+  add_vd(f, 2, 3, {0, 1, 2});
+  f.vd_objects.back().first_index = 100;  // past vd_indices
+  DrawList list;
+  build_draw_list(f, objects, m, list);
+  EXPECT_EQ(list.rejected, 4u);
+  EXPECT_TRUE(list.vd.empty());
+  EXPECT_EQ(list.vd_triangles, 0u);
+  EXPECT_EQ(list.vd_level_triangles, 0u);
+  EXPECT_EQ(list.instances.size(), 3u) << "a refused vd mesh falls back to the object's level";
+  EXPECT_EQ(list.triangles, 3u * 2u);
+}
+
 }  // namespace
