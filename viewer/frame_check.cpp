@@ -35,6 +35,32 @@ bool frame_is_whole(const Frame& f, const Scene& scene, std::string* why) {
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     return fail(buf);
   }
+  // View-dependent meshes: in object order, each a visible object, packed back to back.
+  uint64_t vertices = 0, indices = 0, vd_tris = 0;
+  size_t k = 0;
+  for (size_t j = 0; j < f.vd_objects.size(); ++j) {
+    const VdObjectFrame& v = f.vd_objects[j];
+    while (k < f.objects.size() && f.objects[k] < v.object) ++k;
+    if (k == f.objects.size() || f.objects[k] != v.object) {
+      std::snprintf(buf, sizeof buf, "vd entry %zu: object %u is not a visible object (or out of order)", j,
+                    v.object);
+      return fail(buf);
+    }
+    if (v.first_vertex != vertices || v.first_index != indices || v.index_count % 3 != 0) {
+      std::snprintf(buf, sizeof buf, "vd entry %zu (object %u): ranges not packed back to back", j, v.object);
+      return fail(buf);
+    }
+    vertices += v.vertex_count;
+    indices += v.index_count;
+    vd_tris += v.index_count / 3;
+  }
+  if (3 * vertices != f.vd_positions.size() || indices != f.vd_indices.size())
+    return fail("vd positions / indices do not match the vd entries");
+  if (vd_tris != f.vd_active_tris) {
+    std::snprintf(buf, sizeof buf, "vd_active_tris %llu but the vd meshes add up to %llu",
+                  (unsigned long long)f.vd_active_tris, (unsigned long long)vd_tris);
+    return fail(buf);
+  }
   return true;
 }
 
