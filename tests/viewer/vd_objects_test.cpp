@@ -9,6 +9,7 @@
 
 #include "runtime/view.h"
 #include "viewer/level_palette.h"
+#include "viewer/picture_checks.h"
 #include "viewer/viewer_harness.h"
 
 namespace {
@@ -63,23 +64,8 @@ box_max = [8.0, 0.0, 0.0]
 scale = 3.0
 )";
 
-std::array<int, 2> project(glm::vec3 p, int width, int height) {
-  lod::View v;
-  v.eye = {0, 0, 30};
-  v.target = {0, 0, 0};
-  v.fov_y_deg = 60;
-  v.width = width;
-  v.height = height;
-  const glm::vec4 clip = lod::projection_matrix(v) * lod::view_matrix(v) * glm::vec4(p, 1);
-  const float nx = clip.x / clip.w, ny = clip.y / clip.w;
-  return {int((nx * 0.5f + 0.5f) * float(width)), int((0.5f - ny * 0.5f) * float(height))};
-}
-
-bool is_background(const uint8_t* px) {
-  for (int c = 0; c < 3; ++c)
-    if (std::abs(int(px[c]) - int(std::lround(lod::viewer::kBackground[size_t(c)] * 255))) > 1) return false;
-  return true;
-}
+using lod::test::is_background;
+using lod::test::project;
 
 // A lit shade of the view-dependent colour (near-white grey): channels equal and bright.
 bool is_vd_colour(const uint8_t* px) {
