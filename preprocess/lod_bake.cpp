@@ -15,6 +15,7 @@
 #include "preprocess/mesh_io.h"
 #include "preprocess/qem_simplifier.h"
 #include "preprocess/surface_error.h"
+#include "runtime/geomorph.h"
 #include "runtime/lod_asset.h"
 
 namespace lod {
@@ -22,7 +23,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 3;  // 3: surface error samples in mesh order
+constexpr uint32_t kBakeFormatVersion = 4;  // 4: morph targets (MRPH); 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
 constexpr size_t kSmallModelTriangles = 20000;
@@ -93,7 +94,7 @@ Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std:
 // and said so in the notes.
 void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, SimplifyMethod method, bool automatic,
                     const BakeParallelFor& parallel_for, std::vector<ChainLevel>& levels,
-                    std::vector<std::string>& notes) {
+                    std::vector<std::vector<uint32_t>>& sources, std::vector<std::string>& notes) {
   const size_t triangles = mesh.triangle_count();
   levels.assign(ratios.size(), ChainLevel{});
   ChainLevel& full = levels[0];
@@ -103,6 +104,10 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
   full.normals.resize(mesh.positions.size());
   compute_vertex_normals(full.positions.data(), full.vertex_count(), full.indices.data(), full.indices.size(),
                          full.normals.data());
+  // Input vertex each level's vertex descends from (level 0 is the input itself).
+  sources.assign(ratios.size(), {});
+  sources[0].resize(full.vertex_count());
+  for (uint32_t v = 0; v < sources[0].size(); ++v) sources[0][v] = v;
   if (ratios.size() < 2) return;
   std::vector<size_t> targets;
   for (size_t i = 1; i < ratios.size(); ++i) targets.push_back(size_t(std::llround(double(ratios[i]) * double(triangles))));
@@ -134,6 +139,7 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
     ChainLevel& l = levels[i + 1];
     l.positions = std::move(out[i].positions);
     l.indices = std::move(out[i].indices);
+    sources[i + 1] = std::move(out[i].source_vertex);
     l.target_triangles = targets[i];
     l.normals.resize(l.positions.size());
     compute_vertex_normals(l.positions.data(), l.vertex_count(), l.indices.data(), l.indices.size(), l.normals.data());
@@ -211,8 +217,9 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
 
   say(0.06f, "simplify");
   std::vector<ChainLevel> levels;
+  std::vector<std::vector<uint32_t>> sources;
   simplify_chain(mesh, ratios, method, settings.method == SimplifyMethod::automatic, settings.parallel_for, levels,
-                 report.notes);
+                 sources, report.notes);
 
   // A level no smaller than the one before it adds nothing: drop it.
   for (size_t i = 1; i < levels.size();) {
@@ -220,6 +227,7 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
       report.notes.push_back("dropped the level for ratio " + std::to_string(ratios[i]) + ": no fewer triangles (" +
                              std::to_string(levels[i].triangle_count()) + ") than the level before");
       levels.erase(levels.begin() + std::ptrdiff_t(i));
+      sources.erase(sources.begin() + std::ptrdiff_t(i));
       ratios.erase(ratios.begin() + std::ptrdiff_t(i));
     } else {
       ++i;
@@ -284,6 +292,32 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
     chain.normals.insert(chain.normals.end(), l.normals.begin(), l.normals.end());
     chain.indices.insert(chain.indices.end(), l.indices.begin(), l.indices.end());
     chain.levels.push_back(level);
+  }
+  // Morph targets of each level into the next, from the simplifier's vertex mapping; levels
+  // are independent, so they may run in parallel.
+  if (levels.size() > 1) {
+    say(0.98f, "morph targets");
+    chain.morph_targets.resize(morph_target_count(chain));
+    std::vector<size_t> misses(levels.size() - 1, 0);
+    auto targets_of = [&](size_t k) {
+      const ChainLevel& fine = levels[k];
+      const ChainLevel& coarse = levels[k + 1];
+      const LodLevel& lv = chain.levels[k];
+      misses[k] = level_morph_targets_by_collapse(
+          std::span(chain.morph_targets.data() + lv.first_vertex, lv.vertex_count), fine.positions, fine.indices,
+          sources[k], coarse.positions, coarse.indices, sources[k + 1]);
+    };
+    if (settings.parallel_for) {
+      settings.parallel_for(levels.size() - 1, targets_of);
+    } else {
+      for (size_t k = 0; k + 1 < levels.size(); ++k) targets_of(k);
+    }
+    for (size_t k = 0; k < misses.size(); ++k)
+      if (misses[k] > 0)
+        report.notes.push_back("morph targets: " + std::to_string(misses[k]) + " of level " + std::to_string(k) +
+                               "'s " + std::to_string(levels[k].triangle_count()) +
+                               " triangles do not collapse onto level " + std::to_string(k + 1) +
+                               " (not an edge-collapse pair; nearest vertices used)");
   }
   std::string problem;
   if (!validate_chain(chain, &problem)) return Status::error(what + ": baked chain is invalid: " + problem);

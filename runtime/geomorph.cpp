@@ -2,6 +2,7 @@
 #include "runtime/geomorph.h"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -158,6 +159,114 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
     }
     target[v] = best_c;
   }
+}
+
+namespace {
+
+using Tri = std::array<uint32_t, 3>;
+
+Tri sorted_tri(uint32_t a, uint32_t b, uint32_t c) {
+  Tri t{a, b, c};
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+// The coarse triangles as sorted vertex sets, sorted, for binary search.
+std::vector<Tri> triangle_sets(std::span<const uint32_t> indices) {
+  std::vector<Tri> tris(indices.size() / 3);
+  for (size_t f = 0; f < tris.size(); ++f) tris[f] = sorted_tri(indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]);
+  std::sort(tris.begin(), tris.end());
+  return tris;
+}
+
+// A fine triangle whose corners go to a, b, c: fine if they coincide, else a coarse triangle.
+bool lands(const std::vector<Tri>& coarse, uint32_t a, uint32_t b, uint32_t c) {
+  if (a == b || b == c || a == c) return true;
+  return std::binary_search(coarse.begin(), coarse.end(), sorted_tri(a, b, c));
+}
+
+}  // namespace
+
+size_t level_morph_misses(std::span<const uint32_t> target, std::span<const uint32_t> fine_indices,
+                          std::span<const uint32_t> coarse_indices) {
+  const std::vector<Tri> coarse = triangle_sets(coarse_indices);
+  size_t misses = 0;
+  for (size_t f = 0; f + 2 < fine_indices.size(); f += 3)
+    misses += !lands(coarse, target[fine_indices[f]], target[fine_indices[f + 1]], target[fine_indices[f + 2]]);
+  return misses;
+}
+
+size_t level_morph_targets_by_collapse(std::span<uint32_t> target, std::span<const float> fine_positions,
+                                       std::span<const uint32_t> fine_indices,
+                                       std::span<const uint32_t> fine_source,
+                                       std::span<const float> coarse_positions,
+                                       std::span<const uint32_t> coarse_indices,
+                                       std::span<const uint32_t> coarse_source) {
+  level_morph_targets(target, fine_positions, fine_source, coarse_positions, coarse_source);
+  const size_t nf = fine_positions.size() / 3, nc = coarse_positions.size() / 3;
+  if (nc == 0 || nf == 0) return level_morph_misses(target, fine_indices, coarse_indices);
+  // Which fine vertices may move: those whose source did not survive.
+  std::vector<uint32_t> kept(coarse_source.begin(), coarse_source.end());
+  std::sort(kept.begin(), kept.end());
+  std::vector<uint8_t> free(nf);
+  for (size_t v = 0; v < nf; ++v) free[v] = !std::binary_search(kept.begin(), kept.end(), fine_source[v]);
+  // Fine vertex -> incident triangles (CSR).
+  const size_t nt = fine_indices.size() / 3;
+  std::vector<uint32_t> first(nf + 1, 0), faces(3 * nt);
+  for (size_t i = 0; i < 3 * nt; ++i) ++first[fine_indices[i] + 1];
+  for (size_t v = 0; v < nf; ++v) first[v + 1] += first[v];
+  {
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (size_t i = 0; i < 3 * nt; ++i) faces[fill[fine_indices[i]]++] = static_cast<uint32_t>(i / 3);
+  }
+  const std::vector<Tri> coarse = triangle_sets(coarse_indices);
+  auto dist2 = [&](size_t v, uint32_t c) {
+    float d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const float d = fine_positions[3 * v + k] - coarse_positions[3 * size_t(c) + k];
+      d2 += d * d;
+    }
+    return d2;
+  };
+  // Misses among v's triangles if v went to c (the other corners where they are now).
+  auto misses_if = [&](size_t v, uint32_t c) {
+    uint32_t n = 0;
+    for (uint32_t i = first[v]; i < first[v + 1]; ++i) {
+      const uint32_t* f = &fine_indices[3 * size_t(faces[i])];
+      uint32_t t[3];
+      for (int k = 0; k < 3; ++k) t[k] = f[k] == v ? c : target[f[k]];
+      n += !lands(coarse, t[0], t[1], t[2]);
+    }
+    return n;
+  };
+  std::vector<uint32_t> candidates;
+  // Local search, one vertex at a time in index order (deterministic); each round can only
+  // keep or lower a vertex's own misses, and a few rounds settle real chains.
+  for (int round = 0; round < 16; ++round) {
+    bool changed = false;
+    for (size_t v = 0; v < nf; ++v) {
+      if (!free[v] || first[v] == first[v + 1]) continue;
+      candidates.clear();
+      for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t u = fine_indices[3 * size_t(faces[i]) + k];
+          if (u != v) candidates.push_back(target[u]);
+        }
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+      uint32_t best = target[v], best_misses = misses_if(v, best);
+      float best_d2 = dist2(v, best);
+      if (best_misses == 0) continue;
+      for (uint32_t c : candidates) {
+        const uint32_t m = misses_if(v, c);
+        const float d2 = dist2(v, c);
+        if (m < best_misses || (m == best_misses && d2 < best_d2)) best = c, best_misses = m, best_d2 = d2;
+      }
+      if (best != target[v]) target[v] = best, changed = true;
+    }
+    if (!changed) break;
+  }
+  return level_morph_misses(target, fine_indices, coarse_indices);
 }
 
 void level_morph_positions(std::span<float> out, std::span<const float> fine_positions,

@@ -59,6 +59,26 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
                          std::span<const uint32_t> fine_source, std::span<const float> coarse_positions,
                          std::span<const uint32_t> coarse_source);
 
+// level_morph_targets, then made to follow the collapses: a fine vertex whose source did not
+// survive merged (through a chain of edge collapses) into a coarse vertex one of its fine
+// neighbours also reaches, so among its own target and its neighbours' targets it takes the one
+// under which most of its fine triangles land on a coarse triangle or collapse to a line or
+// point (ties: the nearest), repeated until nothing changes. Where every fine triangle does,
+// the finer mesh morphed to t = 1 is the coarser mesh plus degenerate triangles. Returns the
+// number of fine triangles that still land on no coarse triangle (0 for clean edge-collapse
+// chains; clustering levels may leave some). Indices are level-local, 3 per triangle.
+size_t level_morph_targets_by_collapse(std::span<uint32_t> target, std::span<const float> fine_positions,
+                                       std::span<const uint32_t> fine_indices,
+                                       std::span<const uint32_t> fine_source,
+                                       std::span<const float> coarse_positions,
+                                       std::span<const uint32_t> coarse_indices,
+                                       std::span<const uint32_t> coarse_source);
+
+// Fine triangles that land on neither a coarse triangle (as a vertex set) nor a line or point
+// once every vertex moves to its target.
+size_t level_morph_misses(std::span<const uint32_t> target, std::span<const uint32_t> fine_indices,
+                          std::span<const uint32_t> coarse_indices);
+
 // Positions of the finer level blended towards its targets: out = (1 - t) fine + t coarse[target].
 // t = 0 draws the finer level, t = 1 puts every vertex on the coarser level's surface.
 void level_morph_positions(std::span<float> out, std::span<const float> fine_positions,

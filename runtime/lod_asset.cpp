@@ -11,6 +11,8 @@
 //       leaf_hi (n each), leaf_rank (leaves), face leaves (3f), face owner (f), children,
 //       split faces, wings (2i each, i = n - leaves), dep offsets (i + 1), deps, incidence
 //       offsets (i + 1), incident faces. Readers that predate it skip it (version stays 1).
+// MRPH (optional, flag 0; written only when the chain has morph targets): u32 per vertex of
+//       every level but the last (LodChain::morph_targets), checked like the levels' indices.
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
 //       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
@@ -49,6 +51,7 @@ constexpr uint32_t kPosn = fourcc("POSN");
 constexpr uint32_t kNrml = fourcc("NRML");
 constexpr uint32_t kIndx = fourcc("INDX");
 constexpr uint32_t kVhie = fourcc("VHIE");
+constexpr uint32_t kMrph = fourcc("MRPH");
 constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
@@ -276,15 +279,17 @@ uint64_t hash_bytes(const void* data, size_t size, uint64_t seed) {
 
 std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   Writer w;
-  const uint32_t tags[] = {kMeta, kLevl, kPosn, kNrml, kIndx, kVhie};
-  const uint32_t section_count = chain.hierarchy.empty() ? 5 : 6;
+  std::vector<uint32_t> tags = {kMeta, kLevl, kPosn, kNrml, kIndx};
+  if (!chain.hierarchy.empty()) tags.push_back(kVhie);
+  if (!chain.morph_targets.empty()) tags.push_back(kMrph);
+  const uint32_t section_count = static_cast<uint32_t>(tags.size());
   w.raw(kMagic, sizeof(kMagic));
   w.u32(kLodAssetVersion);
   w.u32(section_count);
   const size_t table = w.bytes.size();
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
-    w.u32(tags[s] == kVhie ? 0 : kFlagRequired);
+    w.u32(tags[s] == kVhie || tags[s] == kMrph ? 0 : kFlagRequired);
     w.u64(0);  // offset, patched below
     w.u64(0);  // size
   }
@@ -316,7 +321,10 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
       for (uint32_t v : chain.indices) w.u32(v);
     }
   });
-  if (section_count > 5) section(5, [&] { put_hierarchy(w, chain.hierarchy); });
+  for (uint32_t s = 5; s < section_count; ++s) {
+    if (tags[s] == kVhie) section(s, [&] { put_hierarchy(w, chain.hierarchy); });
+    if (tags[s] == kMrph) section(s, [&] { put_words(w, chain.morph_targets); });
+  }
   w.align8();
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -361,7 +369,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     return refuse(what, "checksum mismatch (file is corrupted or truncated)");
 
   SectionRef sec[5];
-  SectionRef vhie;
+  SectionRef vhie, mrph;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -374,6 +382,11 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     if (tag == kVhie) {
       if (vhie.present) return refuse(what, name + " appears twice");
       vhie = {off, sz, true};
+      continue;
+    }
+    if (tag == kMrph) {
+      if (mrph.present) return refuse(what, name + " appears twice");
+      mrph = {off, sz, true};
       continue;
     }
     size_t known = 0;
@@ -423,6 +436,13 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
   get_words(p + sec[3].offset, normal_vertices * 3, chain.normals);
   get_words(p + sec[4].offset, indices, chain.indices);
 
+  if (mrph.present) {
+    const uint64_t want = morph_target_count(chain);
+    if (mrph.size != 4 * want)
+      return refuse(what, "MRPH section is " + std::to_string(mrph.size) + " bytes but the levels but the last have " +
+                              std::to_string(want) + " vertices (4 bytes each)");
+    get_words(p + mrph.offset, want, chain.morph_targets);
+  }
   std::string message;
   if (!validate_chain(chain, &message)) return refuse(what, message);
   if (vhie.present) {

@@ -2,6 +2,8 @@
 // chain passes before the runtime trusts it (asset decode, bake output).
 #include "runtime/lod_chain.h"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <string>
 
@@ -93,7 +95,42 @@ bool validate_chain(const LodChain& chain, std::string* message) {
                                  std::to_string(k - 1) + "'s " + std::to_string(finer.error));
     }
   }
+  if (!chain.morph_targets.empty()) {
+    const uint64_t want = morph_target_count(chain);
+    if (chain.morph_targets.size() != want)
+      return fail(message, "morph targets hold " + std::to_string(chain.morph_targets.size()) +
+                               " entries, the levels but the last have " + std::to_string(want) + " vertices");
+    for (size_t k = 0; k + 1 < chain.levels.size(); ++k) {
+      const LodLevel& lv = chain.levels[k];
+      const uint32_t next = chain.levels[k + 1].vertex_count;
+      // Ranges were checked above; targets of level k start where its vertices do.
+      const uint32_t* t = chain.morph_targets.data() + lv.first_vertex;
+      for (uint32_t v = 0; v < lv.vertex_count; ++v)
+        if (t[v] >= next)
+          return fail(message, "level " + std::to_string(k) + " vertex " + std::to_string(v) +
+                                   " morphs into vertex " + std::to_string(t[v]) + " of level " +
+                                   std::to_string(k + 1) + "'s " + std::to_string(next));
+    }
+  }
   return true;
+}
+
+uint64_t morph_target_count(const LodChain& chain) {
+  uint64_t end = 0;
+  for (size_t k = 0; k + 1 < chain.levels.size(); ++k)
+    end = std::max(end, uint64_t{chain.levels[k].first_vertex} + chain.levels[k].vertex_count);
+  return end;
+}
+
+void compose_morph_targets(std::span<uint32_t> out, const LodChain& chain, uint32_t fine, uint32_t coarse) {
+  assert(fine <= coarse && coarse < chain.levels.size());
+  assert(out.size() == chain.levels[fine].vertex_count);
+  assert(fine == coarse || chain.morph_targets.size() == morph_target_count(chain));
+  for (uint32_t v = 0; v < out.size(); ++v) {
+    uint32_t at = v;
+    for (uint32_t k = fine; k < coarse; ++k) at = chain.morph_targets[chain.levels[k].first_vertex + at];
+    out[v] = at;
+  }
 }
 
 }  // namespace lod

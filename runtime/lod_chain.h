@@ -3,6 +3,7 @@
 // with an object-space error each, so per-frame selection is one comparison per level.
 #pragma once
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ struct LodChain {
   std::vector<float> positions;    // xyz per vertex, all levels back to back
   std::vector<float> normals;      // xyz per vertex, same count as positions
   std::vector<uint32_t> indices;   // level-local vertex indices, all levels back to back
+  // Optional geomorph targets (empty = none): per vertex of every level but the last, laid out
+  // like positions (level k's at levels[k].first_vertex), the level-local index of the vertex
+  // of level k + 1 it merges into. Stored in the asset's optional MRPH section.
+  std::vector<uint32_t> morph_targets;
   // Optional vertex hierarchy of level 0 for view-dependent LOD (empty = none); its leaves are
   // level 0's vertices. Stored in the asset's optional VHIE section.
   VertexTree hierarchy;
@@ -48,6 +53,17 @@ int32_t level_of_triangles(uint64_t triangles);
 // non-increasing, errors non-decreasing, l = level_of_triangles, finite values, at most
 // kMaxLevels levels. On failure `message` names the element ("level 3 index 812 references
 // vertex 90211 of 35947"); callers prefix the file.
+// With morph targets: one per vertex of every level but the last, each < the next level's
+// vertex_count ("level 2 vertex 17 morphs into vertex 900 of level 3's 812").
 bool validate_chain(const LodChain& chain, std::string* message);
+
+// Number of morph targets a chain with these levels stores: up to the end of the last
+// vertex range of the levels but the last (their vertex total when levels are back to back).
+uint64_t morph_target_count(const LodChain& chain);
+
+// Composed morph targets of level `fine` into the coarser level `coarse` (fine < coarse):
+// out[v] = t_{coarse-1}(...t_fine(v)), level-local indices of `coarse`, out sized for the fine
+// level's vertices. `fine == coarse` gives the identity. The chain must have morph targets.
+void compose_morph_targets(std::span<uint32_t> out, const LodChain& chain, uint32_t fine, uint32_t coarse);
 
 }  // namespace lod

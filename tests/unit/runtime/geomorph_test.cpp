@@ -137,3 +137,45 @@ TEST(Geomorph, LevelTargetsMatchABruteForceNearestSearch) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+// C (fine vertex 1) collapsed into B, but QEM's placement left B far from C and D near it:
+// the nearest coarse vertex is the wrong one, the collapse-following one is right.
+//   T1 --- T2          fine: B=0 C=1 D=2 T1=3 T2=4 U=5
+//   | \  / |  \        coarse (C gone): B=0 D=1 T1=2 T2=3 U=4
+//   B -- C -- D
+//     \  |  /
+//        U
+TEST(Geomorph, LevelTargetsFollowCollapsesWhereNearestWouldTearTheMesh) {
+  const std::vector<float> fine = {0, 0, 0, 1.4f, 0, 0, 2, 0, 0, 0.5f, 1, 0, 1.5f, 1, 0, 1, -1, 0};
+  const std::vector<uint32_t> fine_idx = {0, 1, 3, 1, 4, 3, 1, 2, 4, 0, 5, 1, 1, 5, 2};
+  const std::vector<uint32_t> fine_src = {0, 1, 2, 3, 4, 5};
+  const std::vector<float> coarse = {0, 0, 0, 2, 0, 0, 0.5f, 1, 0, 1.5f, 1, 0, 1, -1, 0};
+  const std::vector<uint32_t> coarse_idx = {0, 3, 2, 0, 1, 3, 0, 4, 1};
+  const std::vector<uint32_t> coarse_src = {0, 2, 3, 4, 5};
+  std::vector<uint32_t> nearest(6), collapse(6);
+  level_morph_targets(nearest, fine, fine_src, coarse, coarse_src);
+  EXPECT_EQ(nearest[1], 1u);  // D: nearer, but wrong
+  EXPECT_EQ(level_morph_misses(nearest, fine_idx, coarse_idx), 2u);  // B-D-T1 and D-T2-T1
+  EXPECT_EQ(level_morph_targets_by_collapse(collapse, fine, fine_idx, fine_src, coarse, coarse_idx, coarse_src), 0u);
+  EXPECT_EQ(collapse, (std::vector<uint32_t>{0, 0, 1, 2, 3, 4}));
+}
+
+TEST(Geomorph, LevelTargetsByCollapseKeepSurvivorsAndHandleAnEmptyCoarseLevel) {
+  const std::vector<float> fine = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const std::vector<uint32_t> idx = {0, 1, 2};
+  const std::vector<uint32_t> src = {7, 8, 9};
+  std::vector<uint32_t> target(3, 99);
+  // Everything survives (same sources): identity, whatever the positions.
+  EXPECT_EQ(level_morph_targets_by_collapse(target, fine, idx, src, fine, idx, src), 0u);
+  EXPECT_EQ(target, (std::vector<uint32_t>{0, 1, 2}));
+  // Nothing to map into: targets untouched, the triangle lands nowhere.
+  target = {5, 6, 7};
+  EXPECT_EQ(level_morph_targets_by_collapse(target, fine, idx, src, {}, {}, {}), 1u);
+  EXPECT_EQ(target, (std::vector<uint32_t>{5, 6, 7}));
+}
+
+}  // namespace
+}  // namespace lod

@@ -171,3 +171,60 @@ TEST(HashBytes, SwappedWordsDoNotCollide) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+LodChain chain_with_targets() {
+  LodChain c = sample_chain();
+  for (size_t k = 0; k + 1 < c.levels.size(); ++k)
+    for (uint32_t v = 0; v < c.levels[k].vertex_count; ++v)
+      c.morph_targets.push_back((v * 7) % c.levels[k + 1].vertex_count);
+  return c;
+}
+
+TEST(LodAsset, RoundTripsMorphTargetsInTheirOwnSection) {
+  const LodChain c = chain_with_targets();
+  const std::vector<uint8_t> bytes = encode_lod_asset(c);
+  EXPECT_GT(bytes.size(), encode_lod_asset(sample_chain()).size());
+  LodChain back;
+  const Status st = decode_lod_asset(bytes, "bunny.lod", back);
+  ASSERT_TRUE(st) << st.message;
+  expect_same_chain(c, back);
+  EXPECT_EQ(back.morph_targets, c.morph_targets);
+  EXPECT_EQ(encode_lod_asset(back), bytes);
+  // Without them, the section is absent and the chain reads back with none.
+  ASSERT_TRUE(decode_lod_asset(encode_lod_asset(sample_chain()), "bunny.lod", back));
+  EXPECT_TRUE(back.morph_targets.empty());
+}
+
+TEST(LodAsset, RefusesTruncatedOrFlippedMorphTargets) {
+  const std::vector<uint8_t> bytes = encode_lod_asset(chain_with_targets());
+  for (size_t len = 0; len < bytes.size(); ++len) {
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(std::span(bytes).first(len), "bunny.lod", out);
+    ASSERT_FALSE(st) << "accepted a file cut to " << len << " of " << bytes.size() << " bytes";
+    EXPECT_EQ(st.message.rfind("bunny.lod: ", 0), 0u) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+  for (size_t at = 0; at < bytes.size(); ++at) {
+    std::vector<uint8_t> bad = bytes;
+    bad[at] ^= 0x10;
+    LodChain out = sentinel();
+    ASSERT_FALSE(decode_lod_asset(bad, "bunny.lod", out)) << "byte " << at;
+    EXPECT_EQ(out.name, "untouched");
+  }
+}
+
+TEST(LodAsset, RefusesMorphTargetOutOfRangeNamingLevelAndVertex) {
+  LodChain c = chain_with_targets();
+  c.morph_targets[c.levels[1].first_vertex + 3] = 40;  // level 2 has 4 vertices
+  LodChain out = sentinel();
+  const Status st = decode_lod_asset(encode_lod_asset(c), "bunny.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.message, "bunny.lod: level 1 vertex 3 morphs into vertex 40 of level 2's 4");
+  EXPECT_EQ(out.name, "untouched");
+}
+
+}  // namespace
+}  // namespace lod

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -162,6 +163,55 @@ TEST(ObjectColumns, ResizeKeepsEveryColumnTheSameLength) {
   for (size_t s : {st.visible.size(), st.distance.size(), st.area.size(), st.weight.size(), st.level.size(),
                    st.prev_level.size(), st.was_visible.size()})
     EXPECT_EQ(s, 5u);
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+// Fan chains: vertex v of level k morphs into vertex min(v, last) of level k + 1.
+LodChain fan_with_targets(const std::vector<uint32_t>& triangles) {
+  LodChain c = test::fan_chain("fan", triangles);
+  for (size_t k = 0; k + 1 < c.levels.size(); ++k)
+    for (uint32_t v = 0; v < c.levels[k].vertex_count; ++v)
+      c.morph_targets.push_back(std::min(v, c.levels[k + 1].vertex_count - 1));
+  return c;
+}
+
+TEST(ValidateChain, AcceptsMorphTargetsOnePerVertexButTheLastLevel) {
+  const LodChain c = fan_with_targets({6, 3, 1});
+  EXPECT_EQ(c.morph_targets.size(), 8u + 5u);
+  EXPECT_EQ(morph_target_count(c), 13u);
+  std::string msg;
+  EXPECT_TRUE(validate_chain(c, &msg)) << msg;
+}
+
+TEST(ValidateChain, RefusesMorphTargetsOfTheWrongSizeOrRange) {
+  LodChain c = fan_with_targets({6, 3, 1});
+  c.morph_targets.pop_back();
+  std::string msg;
+  EXPECT_FALSE(validate_chain(c, &msg));
+  EXPECT_EQ(msg, "morph targets hold 12 entries, the levels but the last have 13 vertices");
+  c = fan_with_targets({6, 3, 1});
+  c.morph_targets[8 + 4] = 3;  // level 2 has 3 vertices
+  EXPECT_FALSE(validate_chain(c, &msg));
+  EXPECT_EQ(msg, "level 1 vertex 4 morphs into vertex 3 of level 2's 3");
+}
+
+TEST(ComposeMorphTargets, FollowsEveryLevelInBetween) {
+  LodChain c = fan_with_targets({6, 3, 1});
+  c.morph_targets[0 + 7] = 2;  // level 0 vertex 7 -> level 1 vertex 2
+  c.morph_targets[8 + 2] = 0;  // level 1 vertex 2 -> level 2 vertex 0
+  std::vector<uint32_t> out(8);
+  compose_morph_targets(out, c, 0, 2);
+  EXPECT_EQ(out, (std::vector<uint32_t>{0, 1, 0, 2, 2, 2, 2, 0}));
+  compose_morph_targets(out, c, 0, 0);
+  EXPECT_EQ(out, (std::vector<uint32_t>{0, 1, 2, 3, 4, 5, 6, 7}));
+  std::vector<uint32_t> one(5);
+  compose_morph_targets(one, c, 1, 2);
+  EXPECT_EQ(one, (std::vector<uint32_t>{0, 1, 0, 2, 2}));
 }
 
 }  // namespace
