@@ -1,13 +1,15 @@
 // QEM edge collapse in sorted passes (see qem_simplifier.h for the papers).
 //
-// Once per call: vertex kinds (manifold / border / locked) and border loops; both stay valid
-// because every allowed collapse keeps the kinds. Each pass: build vertex -> face lists (CSR,
-// each entry the face's other two corners) from the current index buffer; give every
-// collapsible edge its position and quadric cost; radix-sort the costs; collapse in order,
-// skipping an edge when either end was already touched this pass (its cost is stale) or when
-// the collapse would break the link condition or flip/fold a face; then rewrite the index
-// buffer through the remap table. Scratch arrays are sized once per call and reused by every
-// pass; the only other allocations are vertex compactions, each after the face count halves.
+// Once per call: vertex kinds (manifold / border / locked) and border loops; on manifold input
+// both stay valid because every allowed collapse keeps the kinds (next to a non-manifold vertex
+// a loop may point at a vertex gone since, which only leaves that border edge uncollapsed).
+// Each pass: build vertex -> face lists (CSR, each entry the face's other two corners) from
+// the current index buffer; give every collapsible edge its position and quadric cost;
+// radix-sort the costs; collapse in order, skipping an edge when either end was already
+// touched this pass (its cost is stale) or when the collapse would break the link condition
+// or flip/fold a face; then rewrite the index buffer through the remap table. Scratch arrays
+// are sized once per call and reused by every pass; the only other allocations are vertex
+// compactions, each after the face count halves.
 #include "preprocess/qem_simplifier.h"
 
 #include <algorithm>
@@ -220,13 +222,18 @@ void classify(Work& w, const QemMesh& mesh, bool lock_border, bool move_nonmanif
       if (w.in_count[p] == 1 && w.out_count[p] == 0) border_in++, w.prev[v] = p;
       complex |= w.out_count[n] > 1 || w.in_count[n] > 1 || w.out_count[p] > 1 || w.in_count[p] > 1;
     }
-    // A vertex on non-manifold edges (more than two faces) but on no border moves like a
-    // manifold one, as in meshoptimizer: locking every such vertex leaves dirty scans stuck
-    // far above their targets. The link condition and the face checks still apply to it.
+    // One open edge out and one in: a border loop passes through v, and v slides along it
+    // (whatever else meets there). A non-manifold vertex (edges with more than two faces or
+    // faces of both orientations) moves like a manifold one otherwise, as in meshoptimizer,
+    // even at the open end of a fin or a flipped patch: Stanford's own decimated scans have
+    // thousands of those, and locking them leaves the chain stuck far above its targets with
+    // every remaining collapse costly. The link condition and the face checks still apply.
+    // A plain bow-tie (two border loops through one vertex) stays locked.
     uint8_t kind = kLocked;
-    if (border_out == 0 && border_in == 0 && (move_nonmanifold || !complex)) kind = kManifold;
+    if (border_out == 0 && border_in == 0 && !complex) kind = kManifold;
+    if (complex && move_nonmanifold) kind = kManifold;
     if (complex && kind == kManifold && !mesh.lock[v]) w.dedupe_faces = true;
-    if (!complex && border_out == 1 && border_in == 1) kind = lock_border ? kLocked : kBorder;
+    if (border_out == 1 && border_in == 1 && (!complex || move_nonmanifold)) kind = lock_border ? kLocked : kBorder;
     if (mesh.lock[v]) kind = kLocked;
     w.kind[v] = kind;
   }
@@ -486,10 +493,10 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
       // a leaves its border loop
       const uint32_t pa = w.prev[a], na = w.next[a];
       if (na == b) {
-        w.next[pa] = b;
+        if (pa != ~0u) w.next[pa] = b;
         w.prev[b] = pa;
       } else {
-        w.prev[na] = b;
+        if (na != ~0u) w.prev[na] = b;
         w.next[b] = na;
       }
     }
