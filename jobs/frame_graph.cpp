@@ -151,6 +151,13 @@ struct FrameGraph::Impl {
   std::vector<VdObject> vd;
   std::vector<uint32_t> vd_visible;  // this frame: indices into vd
   std::vector<double> morph_start;   // per object: when its level last changed (seconds)
+  std::vector<uint8_t> morph_from;   // per object: the level it morphs from
+  std::vector<uint8_t> model_has_tree;  // per model: drawn from the vd front, never blended
+  struct MorphTotals {
+    uint32_t morphing = 0;
+    uint64_t extra_tris = 0;
+  };
+  std::vector<MorphTotals> chunk_morph;  // geomorph: per chunk
 
   // Per frame.
   View view;
@@ -195,6 +202,10 @@ struct FrameGraph::Impl {
       for (size_t k = 0; k < models.level_count[m]; ++k)
         full_triangles[models.first_level[m] + k] = models.triangles[models.first_level[m]];
     morph_start.assign(count, -1e300);
+    morph_from.assign(count, 0);
+    chunk_morph.resize(chunks);
+    model_has_tree.resize(models.model_count());
+    for (size_t m = 0; m < models.model_count(); ++m) model_has_tree[m] = !scene.chains[m].hierarchy.empty();
     std::vector<EdgeCheck> edges(models.model_count(), EdgeCheck::corners);
     for (size_t m = 0; m < models.model_count(); ++m) {
       const LodChain& chain = scene.chains[m];
@@ -410,22 +421,42 @@ struct FrameGraph::Impl {
     after_join();
   }
 
-  // Level changes restart a per-object morph factor (newly visible objects appear settled);
-  // view-dependent objects get their geomorphed vertices and compact mesh into the frame.
+  // Level changes restart a per-object morph factor from the level last shown (newly visible
+  // objects appear settled); view-dependent objects get their geomorphed vertices and compact
+  // mesh into the frame.
   void stage_geomorph() {
     Frame& f = *out;
     f.morph.resize(visible_total);
+    f.from_levels.resize(visible_total);
     const double t = now();
+    const ModelTable& models = scene.models;
     // Per object and independent: parallel over each chunk's visible slots.
     for_chunks([&](size_t c, size_t, size_t) {
       const uint32_t end_slot = chunk_offset[c] + chunk_visible[c];
+      MorphTotals totals;
       for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) {
         const uint32_t id = f.objects[k];
-        if (state.was_visible[id] && state.prev_level[id] != f.levels[k]) morph_start[id] = t;
+        const uint8_t level = f.levels[k];
+        if (state.was_visible[id] && state.prev_level[id] != level) {
+          morph_start[id] = t;
+          morph_from[id] = state.prev_level[id];
+        }
         if (!state.was_visible[id]) morph_start[id] = -1e300;
         f.morph[k] = morph_factor(t, morph_start[id], options.geomorph_seconds);
+        const uint32_t model = visible_model[k];
+        const bool blends = f.morph[k] < 1 && !model_has_tree[model] && morph_from[id] != level;
+        f.from_levels[k] = blends ? morph_from[id] : level;
+        if (blends) {
+          const uint32_t first = models.first_level[model];
+          ++totals.morphing;
+          totals.extra_tris += models.triangles[first + std::min(level, morph_from[id])] - models.triangles[first + level];
+        }
       }
+      chunk_morph[c] = totals;
     });
+    f.morphing = 0;
+    f.tris_morph_extra = 0;
+    for (const MorphTotals& m : chunk_morph) f.morphing += m.morphing, f.tris_morph_extra += m.extra_tris;
     f.vd_objects.resize(vd_visible.size());
     uint32_t vertices = 0, indices = 0;
     f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;

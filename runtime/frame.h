@@ -38,11 +38,21 @@ struct Frame {
   std::vector<uint32_t> objects;  // object ids
   std::vector<uint8_t> levels;    // chain level index (0 = full detail)
   std::vector<float> morph;       // geomorph factor in [0, 1] towards `levels` (1 = settled)
+  // Level each object morphs FROM (equal to `levels` once settled, and always for view-dependent
+  // objects, which draw their active mesh). To blend, a renderer draws the FINER of (from, to)
+  // with every vertex at mix(own, target in the coarser level, w), the targets composed through
+  // the levels in between (i -> i+1 -> ... -> j, LodChain::morph_targets); w = morph when the
+  // object coarsens (from < to) and 1 - morph when it refines, so morph 0 looks exactly like
+  // the old level and morph 1 exactly like the new one. A change in mid-morph starts from the
+  // level the object was heading to.
+  std::vector<uint8_t> from_levels;
 
   uint32_t object_count = 0;
   uint32_t visible = 0;
   uint64_t tris_in_view = 0;    // visible objects at full detail
   uint64_t tris_selected = 0;
+  uint32_t morphing = 0;         // visible objects blending two levels (from_levels != levels)
+  uint64_t tris_morph_extra = 0; // what drawing their finer level adds to tris_selected
   uint64_t level_cost = 0;      // sum of 2^l over visible objects
   uint64_t budget = 0;          // M
   uint64_t coarsest_cost = 0;   // cost with all visible objects at their coarsest level

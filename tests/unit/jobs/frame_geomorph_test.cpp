@@ -1,0 +1,109 @@
+// FrameGraph's geomorph stage for discrete levels: the level each object morphs from follows a
+// level change and settles back to the selected level after geomorph_seconds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "jobs/frame_graph.h"
+#include "unit/jobs/synthetic_scene.h"
+
+namespace lod {
+namespace {
+
+// The extra triangles a renderer draws for the frame's morphing objects (their finer level).
+uint64_t extra_of(const Scene& scene, const Frame& f, uint32_t* morphing) {
+  uint64_t extra = 0;
+  *morphing = 0;
+  for (size_t k = 0; k < f.objects.size(); ++k) {
+    if (f.from_levels[k] == f.levels[k]) continue;
+    const uint32_t first = scene.models.first_level[scene.objects.model[f.objects[k]]];
+    ++*morphing;
+    extra += scene.models.triangles[first + std::min(f.from_levels[k], f.levels[k])] -
+             scene.models.triangles[first + f.levels[k]];
+  }
+  return extra;
+}
+
+TEST(FrameGeomorph, FromLevelsFollowALevelChangeAndSettle) {
+  const Scene scene = test::synthetic_scene(3000, 250);
+  const View view = view_at(test::synthetic_config(3000, 250).camera, 0);
+  FrameGraphOptions o;
+  o.threads = 2;
+  o.grain = 64;
+  o.selection.budget = UINT64_MAX;
+  o.geomorph_seconds = 0.25f;
+  o.frame_seconds = 1.0f / 60;
+  FrameGraph g(scene, o);
+  Frame f;
+  g.run(view, f);
+  ASSERT_GT(f.visible, 0u);
+  ASSERT_EQ(f.from_levels.size(), f.visible);
+  EXPECT_EQ(f.from_levels, f.levels) << "newly visible objects appear settled";
+  EXPECT_EQ(f.morphing, 0u);
+  EXPECT_EQ(f.tris_morph_extra, 0u);
+  const std::vector<uint32_t> objects = f.objects;
+  const std::vector<uint8_t> before = f.levels;
+
+  g.set_budget(f.tris_selected / 3);  // forces many objects coarser
+  g.run(view, f);
+  ASSERT_EQ(f.objects, objects);
+  const std::vector<uint8_t> after = f.levels;
+  uint32_t changed = 0;
+  for (size_t k = 0; k < f.objects.size(); ++k) {
+    if (after[k] == before[k]) {
+      EXPECT_EQ(f.from_levels[k], f.levels[k]);
+      EXPECT_EQ(f.morph[k], 1.f);
+      continue;
+    }
+    ++changed;
+    EXPECT_EQ(f.from_levels[k], before[k]) << "object " << f.objects[k] << " morphs from the level it showed";
+    EXPECT_EQ(f.morph[k], 0.f) << "a change starts looking like the old level";
+  }
+  ASSERT_GT(changed, 0u) << "the lower budget changed no level";
+  uint32_t morphing = 0;
+  EXPECT_EQ(f.tris_morph_extra, extra_of(scene, f, &morphing));
+  EXPECT_EQ(f.morphing, changed);
+  EXPECT_EQ(morphing, changed);
+  EXPECT_GT(f.tris_morph_extra, 0u) << "coarsening objects draw their finer level while morphing";
+
+  // 0.25 s at 60 Hz: still blending after 14 more frames, settled on the 15th.
+  float last_morph = 0;
+  for (int frame = 1; frame <= 15; ++frame) {
+    g.run(view, f);
+    ASSERT_EQ(f.levels, after) << "the levels must hold still for this test (frame " << frame << ")";
+    float m = 1;
+    for (size_t k = 0; k < f.objects.size(); ++k)
+      if (after[k] != before[k]) m = std::min(m, f.morph[k]);
+    EXPECT_GT(m, last_morph) << "frame " << frame;
+    last_morph = m;
+    EXPECT_EQ(f.tris_morph_extra, extra_of(scene, f, &morphing)) << "frame " << frame;
+    EXPECT_EQ(f.morphing, morphing);
+    if (frame < 15) {
+      EXPECT_EQ(f.morphing, changed) << "frame " << frame;
+    }
+  }
+  EXPECT_EQ(last_morph, 1.f);
+  EXPECT_EQ(f.from_levels, f.levels);
+  EXPECT_EQ(f.morphing, 0u);
+  EXPECT_EQ(f.tris_morph_extra, 0u);
+}
+
+TEST(FrameGeomorph, NoGeomorphTimeMeansNothingBlends) {
+  const Scene scene = test::synthetic_scene(2000, 250);
+  const View view = view_at(test::synthetic_config(2000, 250).camera, 0);
+  FrameGraphOptions o;
+  o.threads = 1;
+  o.selection.budget = UINT64_MAX;
+  o.geomorph_seconds = 0;
+  FrameGraph g(scene, o);
+  Frame f;
+  g.run(view, f);
+  g.set_budget(f.tris_selected / 3);
+  g.run(view, f);
+  EXPECT_EQ(f.from_levels, f.levels);
+  EXPECT_EQ(f.morphing, 0u);
+  EXPECT_EQ(f.tris_morph_extra, 0u);
+}
+
+}  // namespace
+}  // namespace lod
