@@ -152,7 +152,7 @@ struct FrameGraph::Impl {
   std::vector<uint32_t> vd_visible;  // this frame: indices into vd
   std::vector<double> morph_start;   // per object: when its level last changed (seconds)
   std::vector<uint8_t> morph_from;   // per object: the level it morphs from
-  std::vector<uint8_t> model_has_tree;  // per model: drawn from the vd front, never blended
+  std::vector<uint8_t> model_blends;  // per model: discrete levels with morph targets (not vd)
   struct MorphTotals {
     uint32_t morphing = 0;
     uint64_t extra_tris = 0;
@@ -204,8 +204,9 @@ struct FrameGraph::Impl {
     morph_start.assign(count, -1e300);
     morph_from.assign(count, 0);
     chunk_morph.resize(chunks);
-    model_has_tree.resize(models.model_count());
-    for (size_t m = 0; m < models.model_count(); ++m) model_has_tree[m] = !scene.chains[m].hierarchy.empty();
+    model_blends.resize(models.model_count());
+    for (size_t m = 0; m < models.model_count(); ++m)
+      model_blends[m] = scene.chains[m].hierarchy.empty() && can_morph_levels(scene.chains[m]);
     std::vector<EdgeCheck> edges(models.model_count(), EdgeCheck::corners);
     for (size_t m = 0; m < models.model_count(); ++m) {
       const LodChain& chain = scene.chains[m];
@@ -444,7 +445,7 @@ struct FrameGraph::Impl {
         if (!state.was_visible[id]) morph_start[id] = -1e300;
         f.morph[k] = morph_factor(t, morph_start[id], options.geomorph_seconds);
         const uint32_t model = visible_model[k];
-        const bool blends = f.morph[k] < 1 && !model_has_tree[model] && morph_from[id] != level;
+        const bool blends = f.morph[k] < 1 && model_blends[model] && morph_from[id] != level;
         f.from_levels[k] = blends ? morph_from[id] : level;
         if (blends) {
           const uint32_t first = models.first_level[model];

@@ -39,7 +39,7 @@ struct Frame {
   std::vector<uint8_t> levels;    // chain level index (0 = full detail)
   std::vector<float> morph;       // geomorph factor in [0, 1] towards `levels` (1 = settled)
   // Level each object morphs FROM (equal to `levels` once settled, and always for view-dependent
-  // objects, which draw their active mesh). To blend, a renderer draws the FINER of (from, to)
+  // objects, which draw their active mesh, and for chains without morph targets). To blend, a renderer draws the FINER of (from, to)
   // with every vertex at mix(own, target in the coarser level, w), the targets composed through
   // the levels in between (i -> i+1 -> ... -> j, LodChain::morph_targets); w = morph when the
   // object coarsens (from < to) and 1 - morph when it refines, so morph 0 looks exactly like

@@ -122,6 +122,10 @@ uint64_t morph_target_count(const LodChain& chain) {
   return end;
 }
 
+bool can_morph_levels(const LodChain& chain) {
+  return chain.levels.size() > 1 && chain.morph_targets.size() == morph_target_count(chain);
+}
+
 void compose_morph_targets(std::span<uint32_t> out, const LodChain& chain, uint32_t fine, uint32_t coarse) {
   assert(fine <= coarse && coarse < chain.levels.size());
   assert(out.size() == chain.levels[fine].vertex_count);

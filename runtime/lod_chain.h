@@ -61,6 +61,10 @@ bool validate_chain(const LodChain& chain, std::string* message);
 // vertex range of the levels but the last (their vertex total when levels are back to back).
 uint64_t morph_target_count(const LodChain& chain);
 
+// True when level changes can blend: every vertex of every level but the last has a morph
+// target (vacuously so for chains without vertices).
+bool can_morph_levels(const LodChain& chain);
+
 // Composed morph targets of level `fine` into the coarser level `coarse` (fine < coarse):
 // out[v] = t_{coarse-1}(...t_fine(v)), level-local indices of `coarse`, out sized for the fine
 // level's vertices. `fine == coarse` gives the identity. The chain must have morph targets.

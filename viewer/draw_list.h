@@ -1,6 +1,8 @@
-// DrawList: one published Frame turned into GPU work: instances grouped by (model, level), so
-// the renderer issues exactly one instanced draw per group. Pure CPU, so tests can count what
-// would be submitted without a GL context.
+// DrawList: one published Frame turned into GPU work: instances grouped by (model, drawn level,
+// target level), so the renderer issues exactly one instanced draw per group. An object blending
+// between two levels (Frame::from_levels) is drawn at the finer one with its vertices pulled
+// towards their morph targets in the coarser one by a per-instance weight. Pure CPU, so tests
+// can count what would be submitted without a GL context.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -16,13 +18,30 @@ struct InstanceData {
   float position_scale[4];  // world position of the model origin, uniform scale
   float yaw = 0;            // radians about +y
   float morph = 1;          // geomorph factor towards the selected level (1 = settled)
+  // Position = mix(own, morph target in the batch's target level, weight): 0 draws the batch's
+  // level as it is, 1 puts every vertex on the target level's surface.
+  float weight = 0;
 };
-static_assert(sizeof(InstanceData) == 24, "instance attributes are tightly packed");
+static_assert(sizeof(InstanceData) == 28, "instance attributes are tightly packed");
+
+// How an object with level `to`, morphing from `from` with factor `morph`, is drawn: the finer
+// level, blended towards the coarser by `weight` (morph when coarsening, 1 - morph when refining).
+struct MorphDraw {
+  uint32_t level = 0;   // drawn (the finer of from, to)
+  uint32_t target = 0;  // the coarser; == level when nothing blends
+  float weight = 0;
+};
+inline MorphDraw morph_draw(uint32_t from, uint32_t to, float morph) {
+  if (from == to || !(morph < 1)) return {to, to, 0.f};
+  if (from < to) return {from, to, morph};
+  return {to, from, 1.f - morph};
+}
 
 struct DrawBatch {
   uint32_t range = 0;           // index into MeshLayout::ranges
   uint32_t model = 0;
-  uint32_t level = 0;           // chain level index (0 = full detail)
+  uint32_t level = 0;           // chain level index drawn (0 = full detail)
+  uint32_t target_level = 0;    // level the vertices blend towards; == level when none blends
   uint32_t first_instance = 0;  // into DrawList::instances
   uint32_t instance_count = 0;
 };
@@ -39,20 +58,25 @@ struct VdDraw {
 };
 
 struct DrawList {
-  std::vector<DrawBatch> batches;         // non-empty groups, in (model, level) order
+  std::vector<DrawBatch> batches;         // non-empty groups, in (model, level, target level) order
   std::vector<InstanceData> instances;    // grouped by batch
   uint64_t triangles = 0;                 // sum of index_count / 3 * instance_count (instanced only)
   uint64_t indices = 0;                   // indices submitted (instanced only)
+  uint32_t morphing = 0;                  // instances blending two levels
+  uint64_t morph_triangles = 0;           // what drawing their finer level adds (vs their frame level)
   uint32_t rejected = 0;                  // frame entries naming an unknown object or level, bad vd meshes
   std::vector<VdDraw> vd;                 // view-dependent objects, in frame order
   uint64_t vd_triangles = 0;              // sum of vd index_count / 3
   uint64_t vd_level_triangles = 0;        // what Frame::tris_selected counts for those objects (their level)
-  std::vector<uint32_t> per_batch_slot;   // scratch: instances per range (counting sort)
+  std::vector<uint32_t> per_batch_slot;   // scratch: instances per (model, level, target) (counting sort)
+  std::vector<uint32_t> first_key;        // scratch: per model, its first key (level_count^2 each)
   std::vector<uint8_t> is_vd;             // scratch: per frame entry, drawn from its active mesh
 };
 
-// Rebuilds `out` from `frame` (reusing its capacity). Entries whose object id or level is out
-// of range are not drawn and are counted in `rejected`: a well-formed frame has none.
+// Rebuilds `out` from `frame` (reusing its capacity). Entries whose object id, level or from
+// level is out of range are not drawn and are counted in `rejected`: a well-formed frame has
+// none. A frame without from_levels (hand-built) is settled; models without morph targets never
+// blend.
 // Objects listed in frame.vd_objects are drawn from their active mesh (out.vd) instead of an
 // instance; a vd entry whose ranges or indices fall outside the frame's arrays is rejected.
 void build_draw_list(const Frame& frame, const ObjectSet& objects, const MeshLayout& layout, DrawList& out);

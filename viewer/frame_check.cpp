@@ -1,5 +1,6 @@
 #include "viewer/frame_check.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace lod::viewer {
@@ -10,12 +11,14 @@ bool frame_is_whole(const Frame& f, const Scene& scene, std::string* why) {
     *why = text;
     return false;
   };
-  if (f.objects.size() != f.visible || f.levels.size() != f.visible || f.morph.size() != f.visible)
+  if (f.objects.size() != f.visible || f.levels.size() != f.visible || f.morph.size() != f.visible ||
+      f.from_levels.size() != f.visible)
     return fail("per-object arrays do not match the visible count");
   uint64_t histogram = 0;
   for (uint32_t n : f.level_histogram) histogram += n;
   if (histogram != f.visible) return fail("level histogram does not count the visible objects");
-  uint64_t tris = 0;
+  uint64_t tris = 0, extra = 0;
+  uint32_t morphing = 0;
   for (size_t i = 0; i < f.objects.size(); ++i) {
     const uint32_t id = f.objects[i];
     if (id >= scene.objects.size() || (i > 0 && f.objects[i - 1] >= id)) {
@@ -28,7 +31,23 @@ bool frame_is_whole(const Frame& f, const Scene& scene, std::string* why) {
                     unsigned(scene.models.level_count[m]));
       return fail(buf);
     }
-    tris += scene.models.triangles[scene.models.first_level[m] + f.levels[i]];
+    if (f.from_levels[i] >= scene.models.level_count[m]) {
+      std::snprintf(buf, sizeof buf, "object %u: morphs from level %u of %u", id, unsigned(f.from_levels[i]),
+                    unsigned(scene.models.level_count[m]));
+      return fail(buf);
+    }
+    const uint32_t first = scene.models.first_level[m];
+    tris += scene.models.triangles[first + f.levels[i]];
+    if (f.from_levels[i] != f.levels[i]) {
+      ++morphing;
+      extra += scene.models.triangles[first + std::min(f.from_levels[i], f.levels[i])] -
+               scene.models.triangles[first + f.levels[i]];
+    }
+  }
+  if (morphing != f.morphing || extra != f.tris_morph_extra) {
+    std::snprintf(buf, sizeof buf, "%u objects morph adding %llu triangles but the frame says %u adding %llu",
+                  morphing, (unsigned long long)extra, f.morphing, (unsigned long long)f.tris_morph_extra);
+    return fail(buf);
   }
   if (tris != f.tris_selected) {
     std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels add up to %llu",

@@ -17,6 +17,11 @@ struct FrameRow {
   // Frame::tris_selected with view-dependent objects counted at their active mesh (what is
   // drawn for them) instead of their discrete level: selected_as_drawn().
   uint64_t tris_selected = 0;
+  // Objects blending two levels are drawn at the finer one: Frame::tris_morph_extra says what
+  // that adds, so drawn == tris_selected + morph_extra (== tris_selected when none morphs).
+  uint32_t morphing = 0;         // Frame::morphing
+  uint64_t morph_extra = 0;      // Frame::tris_morph_extra
+  uint32_t morph_draws = 0;      // blended batches drawn
   uint64_t drawn = 0;            // triangles submitted
   uint32_t vd_objects = 0;       // view-dependent objects drawn from their active mesh
   uint64_t vd_drawn = 0;         // their triangles (part of `drawn`)

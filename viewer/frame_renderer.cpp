@@ -8,6 +8,7 @@ bool FrameRenderer::init(const Scene& scene, std::string* message) {
   scene_ = &scene;
   if (!instances_.init(message)) return false;
   meshes_.upload(scene.chains);
+  morphs_.init(scene.chains);
   vd_meshes_.init();
   if (const GLenum err = glGetError(); err != GL_NO_ERROR) {
     *message = "uploading " + std::to_string(meshes_.layout().index_count / 3) + " triangles failed (GL error " +
@@ -29,7 +30,8 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
 
   build_draw_list(frame, scene_->objects, meshes_.layout(), list_);
   vd_meshes_.upload(frame);
-  return instances_.draw(list_, meshes_, &vd_meshes_, view_matrix(viewing), projection_matrix(viewing), settings);
+  return instances_.draw(list_, meshes_, &morphs_, &vd_meshes_, view_matrix(viewing), projection_matrix(viewing),
+                         settings);
 }
 
 void FrameRenderer::render_culled(const Frame& frame, const View& viewing) {
@@ -49,7 +51,7 @@ void FrameRenderer::render_culled(const Frame& frame, const View& viewing) {
   RenderSettings dark;
   dark.colour_override = true;
   dark.colour = kCulledColour;
-  instances_.draw(culled_list_, meshes_, nullptr, view_matrix(viewing), projection_matrix(viewing), dark);
+  instances_.draw(culled_list_, meshes_, nullptr, nullptr, view_matrix(viewing), projection_matrix(viewing), dark);
 }
 
 }  // namespace lod::viewer

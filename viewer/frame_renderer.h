@@ -1,5 +1,5 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
-// clear, build the draw list, one instanced draw per (model, level), then one draw per
+// clear, build the draw list, one instanced draw per (model, level, target level), then one draw per
 // view-dependent object from the active mesh the frame carries.
 #pragma once
 #include <span>
@@ -11,6 +11,7 @@
 #include "viewer/draw_list.h"
 #include "viewer/instance_renderer.h"
 #include "viewer/mesh_buffers.h"
+#include "viewer/morph_buffers.h"
 #include "viewer/vd_mesh_buffers.h"
 
 namespace lod::viewer {
@@ -28,10 +29,12 @@ class FrameRenderer {
 
   const DrawList& draw_list() const { return list_; }
   const MeshBuffers& meshes() const { return meshes_; }
+  const MorphBuffers& morphs() const { return morphs_; }
 
  private:
   const Scene* scene_ = nullptr;
   MeshBuffers meshes_;
+  MorphBuffers morphs_;
   VdMeshBuffers vd_meshes_;
   InstanceRenderer instances_;
   DrawList list_;

@@ -10,26 +10,32 @@ namespace lod::viewer {
 namespace {
 
 // world = R_y(yaw) * (scale * p) + position, the transform place_instances gives objects.
+// Blended draws (u_blend = 1): p = mix(own, morph target, weight), exact at weight 0 and 1;
+// other draws have no target stream bound and use the vertex's own position.
 const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 i_position_scale;
-layout(location = 3) in vec2 i_yaw_morph;
+layout(location = 3) in vec3 i_yaw_morph_weight;
+layout(location = 4) in vec3 a_target_position;
+layout(location = 5) in vec3 a_target_normal;
 uniform mat4 u_view;
 uniform mat4 u_projection;
+uniform int u_blend;
 out vec3 v_position_view;
 out vec3 v_normal_view;
 out float v_morph;
 vec3 rotate_y(vec3 p, float c, float s) { return vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z); }
 void main() {
-  float c = cos(i_yaw_morph.x), s = sin(i_yaw_morph.x);
-  vec3 world = rotate_y(a_position * i_position_scale.w, c, s) + i_position_scale.xyz;
+  float c = cos(i_yaw_morph_weight.x), s = sin(i_yaw_morph_weight.x);
+  float w = i_yaw_morph_weight.z;
+  vec3 p = u_blend != 0 ? mix(a_position, a_target_position, w) : a_position;
+  vec3 n = u_blend != 0 ? mix(a_normal, a_target_normal, w) : a_normal;
+  vec3 world = rotate_y(p * i_position_scale.w, c, s) + i_position_scale.xyz;
   vec4 view_pos = u_view * vec4(world, 1.0);
   v_position_view = view_pos.xyz;
-  v_normal_view = mat3(u_view) * rotate_y(a_normal, c, s);
-  // Geomorph factor towards the selected level: the morph target stream plugs in here,
-  // position = mix(from, to, morph); until then only the colour shows it.
-  v_morph = i_yaw_morph.y;
+  v_normal_view = mat3(u_view) * rotate_y(n, c, s);
+  v_morph = i_yaw_morph_weight.y;
   gl_Position = u_projection * view_pos;
 }
 )";
@@ -69,19 +75,22 @@ bool InstanceRenderer::init(std::string* message) {
   u_colour_ = glGetUniformLocation(program_, "u_colour");
   u_flat_ = glGetUniformLocation(program_, "u_flat");
   u_show_morph_ = glGetUniformLocation(program_, "u_show_morph");
+  u_blend_ = glGetUniformLocation(program_, "u_blend");
   glGenBuffers(1, &instance_vbo_);
   glGenQueries(1, &query_);
   return true;
 }
 
-DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, const VdMeshBuffers* vd,
-                                 const glm::mat4& view, const glm::mat4& projection, const RenderSettings& settings) {
+DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, MorphBuffers* morphs,
+                                 const VdMeshBuffers* vd, const glm::mat4& view, const glm::mat4& projection,
+                                 const RenderSettings& settings) {
   DrawStats stats;
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_, 1, GL_FALSE, glm::value_ptr(view));
   glUniformMatrix4fv(u_projection_, 1, GL_FALSE, glm::value_ptr(projection));
   glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
   glUniform1i(u_show_morph_, settings.colour_by_level ? 1 : 0);
+  glUniform1i(u_blend_, 0);
 
   glBindVertexArray(meshes.vao());
   glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
@@ -94,6 +103,8 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   glEnableVertexAttribArray(kAttribInstanceYawMorph);
   glVertexAttribDivisor(kAttribInstancePositionScale, 1);
   glVertexAttribDivisor(kAttribInstanceYawMorph, 1);
+  glDisableVertexAttribArray(kAttribTargetPosition);
+  glDisableVertexAttribArray(kAttribTargetNormal);
 
   glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
@@ -103,16 +114,48 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
     const size_t offset = size_t(b.first_instance) * sizeof(InstanceData);
     glVertexAttribPointer(kAttribInstancePositionScale, 4, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
                           reinterpret_cast<const void*>(offset));
-    glVertexAttribPointer(kAttribInstanceYawMorph, 2, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
+    glVertexAttribPointer(kAttribInstanceYawMorph, 3, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
                           reinterpret_cast<const void*>(offset + 4 * sizeof(float)));
     const auto& c = settings.colour_override ? settings.colour
                     : settings.colour_by_level ? level_colour(b.level)
                                                : kModelColour;
     glUniform3f(u_colour_, c[0], c[1], c[2]);
     const LevelRange& r = meshes.layout().ranges[b.range];
-    glDrawElementsInstancedBaseVertex(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,
-                                      reinterpret_cast<const void*>(size_t(r.first_index) * sizeof(uint32_t)),
-                                      GLsizei(b.instance_count), r.base_vertex);
+    const int64_t stream = b.target_level != b.level && morphs ? morphs->stream(b.model, b.level, b.target_level) : -1;
+    if (stream >= 0) {
+      // Both streams start at the level's first vertex (the target stream has no room before
+      // it for a base vertex), so the level's own attributes are re-pointed there too.
+      glBindBuffer(GL_ARRAY_BUFFER, meshes.vbo());
+      const size_t own = size_t(r.base_vertex) * 6 * sizeof(float);
+      glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<const void*>(own));
+      glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                            reinterpret_cast<const void*>(own + 3 * sizeof(float)));
+      glBindBuffer(GL_ARRAY_BUFFER, morphs->buffer());
+      const size_t target = size_t(stream) * 6 * sizeof(float);
+      glEnableVertexAttribArray(kAttribTargetPosition);
+      glEnableVertexAttribArray(kAttribTargetNormal);
+      glVertexAttribPointer(kAttribTargetPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                            reinterpret_cast<const void*>(target));
+      glVertexAttribPointer(kAttribTargetNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                            reinterpret_cast<const void*>(target + 3 * sizeof(float)));
+      glUniform1i(u_blend_, 1);
+      glDrawElementsInstanced(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,
+                              reinterpret_cast<const void*>(size_t(r.first_index) * sizeof(uint32_t)),
+                              GLsizei(b.instance_count));
+      glUniform1i(u_blend_, 0);
+      glDisableVertexAttribArray(kAttribTargetPosition);
+      glDisableVertexAttribArray(kAttribTargetNormal);
+      glBindBuffer(GL_ARRAY_BUFFER, meshes.vbo());
+      glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+      glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                            reinterpret_cast<const void*>(3 * sizeof(float)));
+      glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
+      ++stats.morph_draws;
+    } else {
+      glDrawElementsInstancedBaseVertex(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,
+                                        reinterpret_cast<const void*>(size_t(r.first_index) * sizeof(uint32_t)),
+                                        GLsizei(b.instance_count), r.base_vertex);
+    }
     ++stats.draws;
     stats.instances += b.instance_count;
     stats.triangles += uint64_t(r.index_count / 3) * b.instance_count;
@@ -129,7 +172,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
     glUniform3f(u_colour_, c[0], c[1], c[2]);
     for (const VdDraw& d : list.vd) {
       glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
-      glVertexAttrib2f(kAttribInstanceYawMorph, d.transform.yaw, d.transform.morph);
+      glVertexAttrib3f(kAttribInstanceYawMorph, d.transform.yaw, d.transform.morph, 0.f);
       glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(d.index_count), GL_UNSIGNED_INT,
                                reinterpret_cast<const void*>(size_t(d.first_index) * sizeof(uint32_t)),
                                GLint(d.first_vertex));

@@ -1,6 +1,7 @@
-// InstanceRenderer: draws a DrawList with one glDrawElementsInstancedBaseVertex per
-// (model, level) batch; per-instance position, scale, yaw and geomorph factor are vertex
-// attributes with divisor 1. Lighting is a headlight Lambert term.
+// InstanceRenderer: draws a DrawList with one instanced draw per (model, level, target level)
+// batch; per-instance position, scale, yaw, geomorph factor and blend weight are vertex
+// attributes with divisor 1. A blended batch adds the composed morph-target stream of its
+// (level, target level) pair as a second vertex stream. Lighting is a headlight Lambert term.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -11,6 +12,7 @@
 
 #include "viewer/draw_list.h"
 #include "viewer/mesh_buffers.h"
+#include "viewer/morph_buffers.h"
 #include "viewer/vd_mesh_buffers.h"
 
 namespace lod::viewer {
@@ -30,6 +32,7 @@ struct DrawStats {
   uint64_t triangles = 0;        // submitted: sum of index_count / 3 * instances, vd meshes included
   uint32_t vd_draws = 0;         // view-dependent objects drawn from their active mesh
   uint64_t vd_triangles = 0;     // their triangles (part of `triangles`)
+  uint32_t morph_draws = 0;      // batches drawn blending towards a coarser level
   int64_t gpu_primitives = -1;   // what the GL counted, when count_primitives; else -1
 };
 
@@ -42,17 +45,19 @@ class InstanceRenderer {
 
   // Compiles the shaders; false with the driver's log in `message`.
   bool init(std::string* message);
-  // Draws the list's instances from `meshes` and its view-dependent objects (list.vd) from
-  // `vd`, which holds the same frame's vd meshes; `vd` may be null when list.vd is empty.
-  DrawStats draw(const DrawList& list, const MeshBuffers& meshes, const VdMeshBuffers* vd, const glm::mat4& view,
-                 const glm::mat4& projection, const RenderSettings& settings);
+  // Draws the list's instances from `meshes` (blended batches with target streams from
+  // `morphs`; null draws every batch unblended at its level) and its view-dependent objects
+  // (list.vd) from `vd`, which holds the same frame's vd meshes; `vd` may be null when list.vd
+  // is empty.
+  DrawStats draw(const DrawList& list, const MeshBuffers& meshes, MorphBuffers* morphs, const VdMeshBuffers* vd,
+                 const glm::mat4& view, const glm::mat4& projection, const RenderSettings& settings);
 
  private:
   GLuint program_ = 0;
   GLuint instance_vbo_ = 0;
   GLuint query_ = 0;
   size_t instance_capacity_ = 0;
-  GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1;
+  GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1, u_blend_ = -1;
 };
 
 }  // namespace lod::viewer

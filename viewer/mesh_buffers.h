@@ -14,7 +14,9 @@ namespace lod::viewer {
 inline constexpr GLuint kAttribPosition = 0;
 inline constexpr GLuint kAttribNormal = 1;
 inline constexpr GLuint kAttribInstancePositionScale = 2;
-inline constexpr GLuint kAttribInstanceYawMorph = 3;
+inline constexpr GLuint kAttribInstanceYawMorph = 3;  // yaw, morph, blend weight
+inline constexpr GLuint kAttribTargetPosition = 4;    // morph target stream (MorphBuffers)
+inline constexpr GLuint kAttribTargetNormal = 5;
 
 class MeshBuffers {
  public:
@@ -27,6 +29,7 @@ class MeshBuffers {
 
   const MeshLayout& layout() const { return layout_; }
   GLuint vao() const { return vao_; }
+  GLuint vbo() const { return vbo_; }  // position + normal, 6 floats per vertex
   size_t bytes() const { return bytes_; }
 
  private:

@@ -12,6 +12,7 @@ MeshLayout layout_meshes(std::span<const LodChain> chains) {
   for (const LodChain& chain : chains) {
     layout.first_range.push_back(static_cast<uint32_t>(layout.ranges.size()));
     layout.level_count.push_back(static_cast<uint32_t>(chain.levels.size()));
+    layout.morphable.push_back(can_morph_levels(chain) ? 1 : 0);
     for (const LodLevel& level : chain.levels) {
       LevelRange r;
       r.first_index = static_cast<uint32_t>(index_base + level.first_index);

@@ -19,6 +19,7 @@ struct LevelRange {
 struct MeshLayout {
   std::vector<uint32_t> first_range;  // per model: offset into `ranges`
   std::vector<uint32_t> level_count;  // per model
+  std::vector<uint8_t> morphable;     // per model: level changes blend (can_morph_levels)
   std::vector<LevelRange> ranges;     // per (model, level), models back to back
   uint64_t vertex_count = 0;
   uint64_t index_count = 0;

@@ -96,6 +96,9 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
     if (!fr->vd_objects.empty())
       ImGui::Text("view-dep.    %u objects, %s active tris drawn", f.drawn.vd_draws,
                   thousands(f.drawn.vd_triangles).c_str());
+    // Objects blending between two levels are drawn at the finer one until they settle.
+    if (fr->morphing)
+      ImGui::Text("morphing     %u objects, +%s tris drawn", fr->morphing, thousands(fr->tris_morph_extra).c_str());
     ImGui::Text("budget M     %s%s", thousands(fr->budget).c_str(), fr->over_budget ? "  (over: coarsest levels)" : "");
 
     // Level histogram over R0's l = round(log2 tris): only the occupied span.

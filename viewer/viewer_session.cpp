@@ -29,6 +29,9 @@ const FrameRow& ViewerSession::record(uint64_t viewer_frame, const Frame& frame,
   row.visible = frame.visible;
   row.tris_selected = selected_as_drawn(frame, renderer.draw_list());
   row.drawn = drawn.triangles;
+  row.morphing = frame.morphing;
+  row.morph_extra = frame.tris_morph_extra;
+  row.morph_draws = drawn.morph_draws;
   row.vd_objects = drawn.vd_draws;
   row.vd_drawn = drawn.vd_triangles;
   row.gpu_primitives = drawn.gpu_primitives;

@@ -3,6 +3,7 @@
 // GL_PRIMITIVES_GENERATED query; in driven (screenshot) and free-running (live) modes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 #include "viewer/viewer_harness.h"
@@ -42,15 +43,29 @@ scale_range = [1.0, 2.0]
 seed = 4
 )";
 
-// Every row: a whole frame, nothing refused, and selected == submitted == GL-counted.
-void expect_rows_consistent(const CsvTable& t) {
+// Every row: a whole frame, nothing refused, and what the frame says is drawn == submitted ==
+// GL-counted: the selected triangles plus, for objects blending two levels, what drawing their
+// finer level adds (exactly the selected triangles on frames where nothing morphs). Returns the
+// rows where something morphed.
+size_t expect_rows_consistent(const CsvTable& t) {
+  size_t morphing_rows = 0;
   for (size_t i = 0; i < t.rows.size(); ++i) {
     SCOPED_TRACE("viewer frame " + std::to_string(i));
     EXPECT_EQ(t.get(i, "whole"), 1);
     EXPECT_EQ(t.get(i, "rejected"), 0);
-    EXPECT_EQ(t.get(i, "drawn"), t.get(i, "tris_selected"));
-    EXPECT_EQ(t.get(i, "gpu_primitives"), t.get(i, "tris_selected"));
+    const double expected = t.get(i, "tris_selected") + t.get(i, "morph_extra");
+    EXPECT_EQ(t.get(i, "drawn"), expected);
+    EXPECT_EQ(t.get(i, "gpu_primitives"), expected);
+    if (t.get(i, "morphing") == 0) {
+      EXPECT_EQ(t.get(i, "morph_extra"), 0);
+      EXPECT_EQ(t.get(i, "morph_draws"), 0);
+      EXPECT_EQ(t.get(i, "drawn"), t.get(i, "tris_selected"));
+    } else {
+      ++morphing_rows;
+      EXPECT_GT(t.get(i, "morph_draws"), 0) << "objects morph but no batch blended";
+    }
   }
+  return morphing_rows;
 }
 
 TEST(ViewerDrawnTriangles, EqualSelectedInEveryDrivenFrame) {
@@ -72,6 +87,54 @@ TEST(ViewerDrawnTriangles, EqualSelectedInEveryDrivenFrame) {
   }
   EXPECT_GT(most, 0) << "the orbit never saw an object";
   EXPECT_LE(most, 40000) << "selection kept the budget";
+}
+
+// The camera backs out of a field of spheres: levels coarsen on the way, and each change blends
+// over geomorph_seconds (0.25 s = 15 driven frames), drawn at the finer level (the old one).
+const char* kApproach = R"([camera]
+fov_deg = 60
+width = 1280
+height = 720
+path = "keyframes"
+near = 0.5
+far = 1000.0
+[[camera.keyframe]]
+frame = 0
+position = [0.0, 2.0, 4.0]
+look_at = [0.0, 0.0, -20.0]
+[[camera.keyframe]]
+frame = 40
+position = [0.0, 10.0, 120.0]
+look_at = [0.0, 0.0, 0.0]
+)";
+
+const char* kSpheres = R"([[instances]]
+model = "sphere"
+count = 30
+box_min = [-20.0, 0.0, -20.0]
+box_max = [20.0, 0.0, 20.0]
+scale_range = [1.0, 2.0]
+seed = 5
+)";
+
+TEST(ViewerDrawnTriangles, MorphingObjectsDrawTheirFinerLevelAndSayWhatItAdds) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("approach", "[run]\nframes = 40\nthreads = 2\nrate_hz = 60\n"
+                                                               "[budget]\ntriangles = 10000000\n",
+                                                   kApproach, kSpheres);
+  const auto stats = scene.dir / "approach.csv";
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + (scene.dir / "approach.png").string() +
+                                                  "' --frames 40 --width 320 --height 180 --stats '" +
+                                                  stats.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  CsvTable t;
+  ASSERT_TRUE(lod::test::load_csv(stats, t));
+  ASSERT_EQ(t.rows.size(), 40u);
+  const size_t morphing_rows = expect_rows_consistent(t);
+  EXPECT_GT(morphing_rows, 0u) << "no level change blended on the way out";
+  double extra = 0;
+  for (size_t i = 0; i < t.rows.size(); ++i) extra = std::max(extra, t.get(i, "morph_extra"));
+  EXPECT_GT(extra, 0) << "coarsening objects are drawn at the finer level they leave";
 }
 
 // The LOD thread publishes at up to 1 kHz while the viewer draws as fast as it can: every

@@ -1,7 +1,7 @@
 // The viewer sees only whole frames: a reader loop doing what the viewer's frame loop does
 // (set the view, take latest_frame(), build the draw list) while the service publishes on its
 // own thread as fast as it can. Every frame read must be self-consistent, and what would be
-// submitted must equal its tris_selected.
+// submitted must equal its tris_selected plus what its morphing objects add.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -70,7 +70,9 @@ TEST(ViewerFrames, ReaderNeverSeesATornFrameWhileTheServicePublishes) {
     std::string why;
     const bool whole = viewer::frame_is_whole(f, scene, &why);
     viewer::build_draw_list(f, scene.objects, layout, list);
-    if (!whole || list.rejected != 0 || list.triangles != f.tris_selected || f.index < last_index) {
+    // Objects blending two levels are drawn at the finer one: the frame says what that adds.
+    if (!whole || list.rejected != 0 || list.triangles != f.tris_selected + f.tris_morph_extra ||
+        list.morphing != f.morphing || f.index < last_index) {
       if (torn++ == 0)
         first_problem = "frame " + std::to_string(f.index) + ": " + (whole ? "draw list disagrees" : why);
     }
