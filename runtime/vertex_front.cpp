@@ -9,7 +9,6 @@
 #include <string>
 
 namespace lod {
-
 namespace {
 
 constexpr uint32_t kBuckets = 4096;
@@ -17,17 +16,27 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct Decision {
   bool refine;
-  // Object units of view motion before `refine` may change: eye motion (calendar 0) and
-  // frustum-plane motion (calendar 1); infinity when that motion cannot change it.
-  double slack_eye, slack_frustum;
+  // How much view motion `refine` survives: eye travel plus plane offset change in object
+  // units (calendar 0) and plane turning in radians (calendar 1); infinity when that motion
+  // cannot change it.
+  double slack_eye, slack_turn;
 };
 
 // Hoppe 1997's criteria for one node, with how far the view may move before each could flip.
-Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float threshold, double reach) {
+// A plane's signed distance at the node's centre c changes between views by at most
+// |dn| |c - eye'| + |d eye| + |d offset| (offset: the eye's own signed distance to the plane),
+// and |c - eye'| <= d + eye travel. So a frustum margin S holds while the eye part stays under
+// `split` * S and the summed turning under (1 - split) S / (d + split S); `split` only trades
+// one calendar against the other and any value in (0, 1) is safe.
+Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float threshold, double reach,
+                  double split) {
   const VertexBounds& nb = t.bounds[v];
   const float c[3] = {nb.x, nb.y, nb.z};
-  const double r = nb.radius;
+  const double ax = c[0] - double(view.eye[0]), ay = c[1] - double(view.eye[1]),
+               az = c[2] - double(view.eye[2]);
+  const double d = std::sqrt(ax * ax + ay * ay + az * az);
   // Frustum: outside when some plane has the whole sphere behind it.
+  const double r = nb.radius;
   double outside_by = -kInf, inside_by = kInf;
   for (const auto& pl : view.planes) {
     const double s = double(pl[0]) * c[0] + double(pl[1]) * c[1] + double(pl[2]) * c[2] + pl[3];
@@ -37,9 +46,6 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
   const bool in_frustum = outside_by <= 0;
   const double slack_frustum = in_frustum ? inside_by : outside_by;
 
-  const double ax = c[0] - double(view.eye[0]), ay = c[1] - double(view.eye[1]),
-               az = c[2] - double(view.eye[2]);
-  const double d = std::sqrt(ax * ax + ay * ay + az * az);
   // Normal cone: every normal in the cone points away from every point of the sphere.
   bool facing = true;
   double slack_facing = kInf;
@@ -64,10 +70,12 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
   const bool coarse = dist < critical;
   const double slack_error = std::min(std::abs(dist - critical), reach);
 
+  const double frustum_eye = split * slack_frustum;
+  const double frustum_turn = (1 - split) * slack_frustum / (d + frustum_eye);
   const bool refine = in_frustum && facing && coarse;
-  if (refine) return {true, std::min(slack_facing, slack_error), slack_frustum};
+  if (refine) return {true, std::min({slack_facing, slack_error, frustum_eye}), frustum_turn};
   // Stays false while any failing criterion keeps failing: outside the frustum is enough.
-  if (!in_frustum) return {false, kInf, slack_frustum};
+  if (!in_frustum) return {false, frustum_eye, frustum_turn};
   double slack = 0;
   if (!facing) slack = std::max(slack, slack_facing);
   if (!coarse) slack = std::max(slack, slack_error);
@@ -101,11 +109,8 @@ class Updater {
     return kNoNode;
   }
   bool deps_active(uint32_t p) const { return missing_dep(p) == kNoNode; }
-  bool children_active(uint32_t p) const {
-    const uint32_t i = p - t_.leaf_count;
-    return f_.state[t_.children[2 * i]] == VertexFront::kActive &&
-           f_.state[t_.children[2 * i + 1]] == VertexFront::kActive;
-  }
+  bool children_active(uint32_t p) const { return f_.kids[p] == 2; }
+  bool is_pending(uint32_t p) const { return f_.pending_count && f_.pending_until[p - t_.leaf_count] >= 0; }
   uint32_t new_faces(uint32_t x) const {
     const uint32_t i = x - t_.leaf_count;
     return (t_.split_faces[2 * i] != kNoNode) + (t_.split_faces[2 * i + 1] != kNoNode);
@@ -120,6 +125,25 @@ class Updater {
     else
       file_next_frame(v);  // queue full (cannot happen with the sizes front_init picks)
   }
+  // A visit reads scattered records of the node and of its parent; fetching them a few queue
+  // entries ahead overlaps those misses instead of paying them one after another.
+  void prefetch_ahead() {
+    constexpr uint32_t kNear = 6, kFar = 12;
+    if (head_ + kFar < tail_) {
+      const uint32_t v = f_.queue[head_ + kFar];
+      __builtin_prefetch(&t_.bounds[v]);
+      __builtin_prefetch(&f_.state[v]);
+      __builtin_prefetch(&f_.links[2 * size_t(v)]);
+      if (f_.waiting) __builtin_prefetch(&f_.wait_on[v]);
+    }
+    if (head_ + kNear < tail_) {
+      const uint32_t p = t_.bounds[f_.queue[head_ + kNear]].parent;
+      if (p != kNoNode) {
+        __builtin_prefetch(&t_.bounds[p]);
+        __builtin_prefetch(&f_.kids[p]);
+      }
+    }
+  }
   void begin_pending(uint32_t p);
   void end_pending(uint32_t p);
   bool consider(uint32_t v, bool phase_two);
@@ -129,6 +153,7 @@ class Updater {
   const FrontParams& p_;
   FrontView view_;
   double reach_ = 0;
+  double split_ = 0.5;
   uint32_t head_ = 0, tail_ = 0;
   bool phase_two_ = false;
   uint32_t limit_ = 0;
@@ -158,7 +183,7 @@ void Updater::file(uint32_t v, int c, double slack) {
   if (slack == kInf) return;  // that motion can never change the decision
   // Never into a bucket this frame already visited; far deadlines wait in the last bucket.
   const int64_t cur = f_.cursor[c];
-  const double at = (f_.motion[c] + slack) / f_.bucket_width;
+  const double at = (f_.motion[c] + slack) / f_.bucket_width[c];
   int64_t abs_bucket =
       at < double(cur + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : cur + kBuckets - 1;
   abs_bucket = std::max(abs_bucket, cur);
@@ -261,6 +286,8 @@ void Updater::split(uint32_t x) {
   f_.active_pos[c2] = f_.active_count;
   f_.active[f_.active_count++] = c2;
   f_.state[c1] = f_.state[c2] = VertexFront::kActive;
+  f_.kids[x] = 2;
+  if (const uint32_t par = t_.bounds[x].parent; par != kNoNode) --f_.kids[par];
   // Faces around x take the child holding their corner's leaf.
   const uint32_t lo1 = t_.leaf_lo[c1], hi1 = t_.leaf_hi[c1];
   for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
@@ -327,6 +354,8 @@ void Updater::collapse(uint32_t p) {
   stop_waiting(c2);
   f_.state[c1] = f_.state[c2] = VertexFront::kBelow;
   f_.state[p] = VertexFront::kActive;
+  f_.kids[p] = 0;
+  if (const uint32_t par = t_.bounds[p].parent; par != kNoNode) ++f_.kids[par];
   // Active list: p takes c1's slot, c2's slot is filled by the last entry.
   const uint32_t s1 = f_.active_pos[c1];
   f_.active[s1] = p;
@@ -412,7 +441,7 @@ bool Updater::consider(uint32_t v, bool phase_two) {
   ++stats_.visited;
   double se = kInf, sf = kInf;
   if (!t_.is_leaf(v)) {
-    const Decision d = evaluate(t_, v, view_, f_.threshold, reach_);
+    const Decision d = evaluate(t_, v, view_, f_.threshold, reach_, split_);
     if (d.refine) {
       if (!phase_two) return true;
       if (force_split(v)) return false;
@@ -420,16 +449,21 @@ bool Updater::consider(uint32_t v, bool phase_two) {
       return false;
     }
     se = d.slack_eye;
-    sf = d.slack_frustum;
+    sf = d.slack_turn;
   }
-  const uint32_t p = t_.parent[v];
+  const uint32_t p = t_.bounds[v].parent;
   if (p != kNoNode && children_active(p)) {
-    const Decision dp = evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_);
-    const uint32_t i = p - t_.leaf_count;
-    const bool pending = f_.pending_until[i] >= 0;
+    const Decision dp = evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_, split_);
+    const bool pending = is_pending(p);
     if (!dp.refine) {
       if (phase_two || (p_.max_operations && ops_ >= p_.max_operations)) {
         file_next_frame(v);
+        return false;
+      }
+      // Still waiting on the same finer neighbour: the collapse stays blocked, and the wait
+      // list entry stands (no dependency scan, no relinking).
+      if (f_.waiting && f_.wait_on[v] != kNoNode && f_.state[f_.wait_on[v]] == VertexFront::kSplit) {
+        file(v, se, sf);
         return false;
       }
       const uint32_t d = missing_dep(p);
@@ -454,7 +488,7 @@ bool Updater::consider(uint32_t v, bool phase_two) {
     }
     if (pending) end_pending(p);
     se = std::min(se, dp.slack_eye);
-    sf = std::min(sf, dp.slack_frustum);
+    sf = std::min(sf, dp.slack_turn);
   }
   file(v, se, sf);
   return false;
@@ -470,29 +504,38 @@ FrontStats Updater::run(const FrontView& view) {
   reach_ = std::sqrt(ex * ex + ey * ey + ez * ez) + f_.extent;
 
   // How far may any decision have moved since the last frame (see evaluate's slacks)?
-  double moved = f_.pending_motion, plane_move = 0;
+  double moved = f_.pending_motion, turned = 0;
   bool full = !f_.has_view;
   if (!full) {
     const FrontView& o = f_.last_view;
     const double dx = view.eye[0] - o.eye[0], dy = view.eye[1] - o.eye[1], dz = view.eye[2] - o.eye[2];
-    moved += std::sqrt(dx * dx + dy * dy + dz * dz);
+    double offset_change = 0;
     for (int k = 0; k < 6; ++k) {
-      const double nx = view.planes[k][0] - o.planes[k][0], ny = view.planes[k][1] - o.planes[k][1],
-                   nz = view.planes[k][2] - o.planes[k][2];
-      const double at_eye =
-          nx * view.eye[0] + ny * view.eye[1] + nz * view.eye[2] + (view.planes[k][3] - o.planes[k][3]);
-      plane_move = std::max(plane_move, std::sqrt(nx * nx + ny * ny + nz * nz) * reach_ + std::abs(at_eye));
+      const float* a = view.planes[k];
+      const float* b = o.planes[k];
+      const double nx = double(a[0]) - b[0], ny = double(a[1]) - b[1], nz = double(a[2]) - b[2];
+      turned = std::max(turned, std::sqrt(nx * nx + ny * ny + nz * nz));
+      const double off_a = double(a[0]) * view.eye[0] + double(a[1]) * view.eye[1] + double(a[2]) * view.eye[2] + a[3];
+      const double off_b = double(b[0]) * o.eye[0] + double(b[1]) * o.eye[1] + double(b[2]) * o.eye[2] + b[3];
+      offset_change = std::max(offset_change, std::abs(off_a - off_b));
     }
+    const double travel = std::sqrt(dx * dx + dy * dy + dz * dz);
+    moved += travel + offset_change;
     if (view.focal_pixels != o.focal_pixels) {
       const double k = double(o.focal_pixels) / view.focal_pixels;
       moved += 2 * reach_ * (std::max(k, 1 / k) - 1);
     }
+    // Share frustum margins between the calendars as this frame's motion does (travel vs
+    // turning at the object's distance), so neither expires much before the other.
+    const double ec = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double sweep = turned * std::max(ec, 0.1 * double(f_.extent));
+    if (travel + sweep > 0) split_ = std::clamp(travel / (travel + sweep), 0.1, 0.9);
   }
   f_.pending_motion = 0;
   f_.has_view = true;
   f_.last_view = view;
   f_.motion[0] += moved;
-  f_.motion[1] += plane_move;
+  f_.motion[1] += turned;
   head_ = tail_ = 0;
   ops_ = 0;
   const uint32_t phase_one_end = static_cast<uint32_t>(f_.queue.size() / 2);
@@ -501,7 +544,7 @@ FrontStats Updater::run(const FrontView& view) {
   // Expired buckets of both calendars, or (first frame, teleport) the whole front.
   int64_t last[2];
   for (int c = 0; c < 2; ++c) {
-    last[c] = static_cast<int64_t>(std::floor(f_.motion[c] / f_.bucket_width));
+    last[c] = static_cast<int64_t>(std::floor(f_.motion[c] / f_.bucket_width[c]));
     if (last[c] - f_.cursor[c] + 1 >= int64_t(kBuckets)) full = true;
   }
   if (full) {
@@ -518,6 +561,7 @@ FrontStats Updater::run(const FrontView& view) {
   // far more coherently than bucket order.
   std::sort(f_.queue.begin(), f_.queue.begin() + tail_);
   drain(kBuckets, 0);
+
   stats_.full_pass = full;
 
   // Deferred collapses whose time has come: collapse if still legal and wanted.
@@ -525,7 +569,7 @@ FrontStats Updater::run(const FrontView& view) {
     const uint32_t p = f_.pending[k];
     if (f_.pending_until[p - t_.leaf_count] > p_.time) continue;
     if (children_active(p) && deps_active(p) &&
-        !evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_).refine &&
+        !evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_, split_).refine &&
         !(p_.max_operations && ops_ >= p_.max_operations)) {
       collapse(p);
       push(p);
@@ -545,6 +589,7 @@ FrontStats Updater::run(const FrontView& view) {
   // Phase one: collapses (they free budget for phase two's splits); wanted splits move on.
   uint32_t split_tail = phase_one_end;
   while (head_ < tail_) {
+    prefetch_ahead();
     const uint32_t v = f_.queue[head_++];
     if (consider(v, false)) f_.queue[split_tail++] = v;
   }
@@ -578,22 +623,39 @@ FrontStats Updater::run(const FrontView& view) {
 }  // namespace
 
 FrontView front_view_of(const View& view, const float position[3], float scale, float yaw) {
+  // The planes are built from the camera's basis in double rather than extracted from the
+  // float clip matrix: extraction leaves the far plane (far / near ~ 1e5) noisy by ~1e-3 of
+  // its distance, and front_update reads frame-to-frame plane motion as view motion.
+  using V = glm::dvec3;
+  const V eye(view.eye), pos(position[0], position[1], position[2]);
+  V fwd = V(view.target) - eye;
+  fwd = glm::length(fwd) > 0 ? glm::normalize(fwd) : V(0, 0, -1);
+  V right = glm::cross(fwd, V(view.up));
+  if (glm::length(right) < 1e-12) right = glm::cross(fwd, std::abs(fwd.y) < 0.9 ? V(0, 1, 0) : V(1, 0, 0));
+  right = glm::normalize(right);
+  const V up = glm::cross(right, fwd);
+  const double ty = std::tan(0.5 * glm::radians(double(view.fov_y_deg)));
+  const double aspect = double(view.width) / double(view.height > 0 ? view.height : 1);
+  const double hy = std::atan(ty), hx = std::atan(aspect * ty);
+  // World planes n . (p - eye) + c >= 0: left, right, bottom, top, near, far (as frustum_of).
+  const V normals[6] = {std::cos(hx) * right + std::sin(hx) * fwd, -std::cos(hx) * right + std::sin(hx) * fwd,
+                        std::cos(hy) * up + std::sin(hy) * fwd,    -std::cos(hy) * up + std::sin(hy) * fwd,
+                        fwd,                                       -fwd};
+  const double offsets[6] = {0, 0, 0, 0, -double(view.near_plane), double(view.far_plane)};
+
   FrontView out;
-  const float c = std::cos(yaw), s = std::sin(yaw);
-  const float inv = scale != 0 ? 1.f / scale : 1.f;
+  const double c = std::cos(double(yaw)), s = std::sin(double(yaw));
+  const double inv = scale != 0 ? 1.0 / scale : 1.0;
   // Object = R_y(-yaw) (world - position) / scale; R_y(t) maps (x, z) to (c x + s z, -s x + c z).
-  auto to_object_dir = [&](float x, float y, float z, float* o) {
-    o[0] = c * x - s * z;
-    o[1] = y;
-    o[2] = s * x + c * z;
-  };
-  to_object_dir(view.eye.x - position[0], view.eye.y - position[1], view.eye.z - position[2], out.eye);
-  for (float& e : out.eye) e *= inv;
-  const Frustum fr = frustum_of(view);
+  auto to_object_dir = [&](const V& d) { return V(c * d.x - s * d.z, d.y, s * d.x + c * d.z); };
+  const V eye_o = to_object_dir(eye - pos) * inv;
+  for (int k = 0; k < 3; ++k) out.eye[k] = static_cast<float>(eye_o[k]);
   for (int k = 0; k < 6; ++k) {
-    const glm::vec4& p = fr.planes[k];
-    to_object_dir(p.x, p.y, p.z, out.planes[k]);
-    out.planes[k][3] = (p.x * position[0] + p.y * position[1] + p.z * position[2] + p.w) * inv;
+    const V n = glm::normalize(to_object_dir(normals[k]));
+    // n_w . (R s p + pos - eye) + c = s (n_o . p) + n_w . (pos - eye) + c, divided by s.
+    const double w = (glm::dot(normals[k], pos - eye) + offsets[k]) * inv;
+    for (int j = 0; j < 3; ++j) out.planes[k][j] = static_cast<float>(n[j]);
+    out.planes[k][3] = static_cast<float>(w);
   }
   // Error and distance scale alike, so projected error needs no scale here.
   out.focal_pixels = focal_pixels(view);
@@ -605,6 +667,7 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
   assert(t.bounds.size() == n && "pack_vertex_bounds(tree) first");
   const uint32_t inner = t.interior_count();
   f.state.assign(n, VertexFront::kBelow);
+  f.kids.assign(n, 0);
   f.active.assign(n, 0);
   f.active_pos.assign(n, kNoNode);
   f.tri_indices.assign(3 * size_t(t.face_count), 0);
@@ -651,7 +714,8 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
     extent = std::max(extent, std::sqrt(d2) + t.radius[v]);
   }
   f.extent = static_cast<float>(extent);
-  f.bucket_width = std::max(extent, 1e-6) * 1e-3;
+  f.bucket_width[0] = std::max(extent, 1e-6) * 1e-3;
+  f.bucket_width[1] = 1.5e-4;  // radians: a horizon of 0.6 rad of turning
 
   // Base mesh: the roots and the faces nobody's split makes, corners mapped to their roots.
   for (uint32_t v = 0; v < n; ++v)
@@ -790,6 +854,35 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
     }
   }
   return true;
+}
+
+uint32_t front_stale_decisions(const VertexFront& f, const VertexTree& t, const FrontView& view,
+                               const FrontParams& params, std::string* message) {
+  const float hysteresis = std::max(1.f, params.hysteresis);
+  auto retrying = [&](uint32_t v) { return f.links[2 * size_t(v)].bucket == kBuckets; };
+  uint32_t stale = 0;
+  auto note = [&](std::string text) {
+    if (stale++ == 0 && message) *message = std::move(text);
+  };
+  for (uint32_t k = 0; k < f.active_count; ++k) {
+    const uint32_t v = f.active[k];
+    if (t.is_leaf(v) || retrying(v)) continue;
+    if (evaluate(t, v, view, f.threshold, kInf, 0.5).refine)
+      note("active node " + std::to_string(v) + " wants to split");
+  }
+  for (uint32_t p = t.leaf_count; p < t.node_count(); ++p) {
+    const uint32_t i = p - t.leaf_count;
+    const uint32_t c1 = t.children[2 * i], c2 = t.children[2 * i + 1];
+    if (f.state[p] != VertexFront::kSplit || f.state[c1] != VertexFront::kActive ||
+        f.state[c2] != VertexFront::kActive || retrying(c1) || retrying(c2) || f.pending_until[i] >= 0)
+      continue;
+    bool deps = true;
+    for (uint32_t k = t.dep_offsets[i]; k < t.dep_offsets[i + 1]; ++k)
+      deps = deps && f.state[t.deps[k]] == VertexFront::kActive;
+    if (deps && !evaluate(t, p, view, f.threshold / hysteresis, kInf, 0.5).refine)
+      note("split node " + std::to_string(p) + " wants to merge");
+  }
+  return stale;
 }
 
 uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indices, const VertexFront& f,

@@ -73,6 +73,7 @@ struct VertexFront {
   static constexpr uint8_t kBelow = 0, kActive = 1, kSplit = 2;
 
   std::vector<uint8_t> state;         // per node
+  std::vector<uint8_t> kids;          // per node: how many of its children are active (0..2)
   std::vector<uint32_t> active;       // active node ids, [0, active_count)
   std::vector<uint32_t> active_pos;   // per node: index in `active`
   std::vector<uint32_t> tri_indices;  // 3 node ids per active triangle, [0, 3 * tri_count)
@@ -83,16 +84,17 @@ struct VertexFront {
   float threshold = 1;  // pixel threshold (tau), moved by feedback
 
   // Two calendars of view-motion buckets (intrusive doubly linked lists over node ids):
-  // calendar 0 by eye movement (and threshold changes): error and normal-cone decisions;
-  // calendar 1 by frustum-plane movement: frustum decisions. A node may sit in both.
+  // calendar 0 by eye travel, plane offset and threshold changes (object units); calendar 1
+  // by frustum-plane turning (radians), which moves a plane less near the eye than far away.
+  // A node may sit in both.
   struct Link {
     uint32_t next = kNoNode, prev = kNoNode, bucket = kNoNode;  // bucket = kNoNode when unfiled
   };
   std::vector<Link> links;            // 2 per node (calendar 0, 1), side by side
   std::vector<uint32_t> bucket_head;  // per calendar kBuckets + 1; the last: retry next frame
-  double motion[2] = {0, 0};          // accumulated bound on view change, object units
+  double motion[2] = {0, 0};          // accumulated bound on view change per calendar
   int64_t cursor[2] = {0, 0};         // first bucket not yet visited
-  double bucket_width = 1;
+  double bucket_width[2] = {1, 1};
   double pending_motion = 0;  // from last frame's threshold change (calendar 0)
   float center[3] = {0, 0, 0};
   float extent = 0;  // radius of the sphere at `center` holding every node
@@ -145,6 +147,14 @@ enum class EdgeCheck : uint8_t { corners, oriented, closed };
 // with `closed` every edge in exactly two faces (no cracks, no T-junctions). Allocates (a test and
 // `lod run --validate` tool, not a per-frame stage). `message` names the first bad element.
 bool check_front(const VertexFront& front, const VertexTree& tree, EdgeCheck edges, std::string* message);
+
+// Checks temporal coherence against a full re-evaluation: counts the decisions of `front` that
+// disagree with `view` at the front's threshold (active nodes that want to split; split nodes
+// whose children are active, which want to merge and whose dependencies are active). Nodes
+// left for a retry next frame (a limit, a split made late in the frame) and deferred merges are
+// not counted. A test and `--validate` tool; `message` names the first.
+uint32_t front_stale_decisions(const VertexFront& front, const VertexTree& tree, const FrontView& view,
+                               const FrontParams& params, std::string* message);
 
 // The front as a compact mesh for a consumer: positions of the active vertices in active-list
 // order (taken from `shown`, xyz per node id, e.g. geomorphed positions; the tree's own

@@ -165,6 +165,33 @@ TEST(VertexFrontWalk, SmallMovesVisitFewNodesAndMatchAFullPass) {
   EXPECT_LT(ratio, 1.03);
 }
 
+// Temporal coherence must never leave a decision stale: after every frame of smooth motion
+// (orbiting, turning, moving in and out) the front agrees with judging every node afresh.
+TEST(VertexFrontWalk, CoherentFramesAgreeWithAFullReevaluation) {
+  const MeshData m = test::vd_sphere(60, 80);
+  const VertexTree t = build(m);
+  for (float hysteresis : {1.f, 1.5f}) {
+    VertexFront f;
+    front_init(f, t, 1.f);
+    FrontParams p;
+    p.hysteresis = hysteresis;
+    uint64_t visited = 0, changes = 0;
+    for (int i = 0; i < 240; ++i) {
+      const float a = 0.01f * i, r = 1.6f + 0.6f * std::sin(0.02f * i);
+      const glm::vec3 eye(r * std::sin(a), 0.3f, r * std::cos(a));
+      const glm::vec3 look(0.4f * std::sin(0.03f * i), 0.2f * std::cos(0.05f * i), 0);  // the view turns too
+      const FrontView v = view_at(eye, look);
+      const FrontStats s = front_update(f, t, v, p);
+      if (i > 0) visited += s.visited, changes += s.splits + s.collapses;
+      std::string msg;
+      ASSERT_EQ(front_stale_decisions(f, t, v, p, &msg), 0u) << "hysteresis " << hysteresis << " frame " << i
+                                                             << ": " << msg;
+    }
+    EXPECT_GT(changes, 0u) << "the walk should change the front";
+    EXPECT_LT(visited / 239, f.active_count) << "coherent frames should not re-judge everything";
+  }
+}
+
 TEST(VertexFrontWalk, FeedbackBringsTrianglesToTheTarget) {
   const MeshData m = test::vd_sphere(80, 100);
   const VertexTree t = build(m);

@@ -203,6 +203,37 @@ TEST(VertexFront, FrontViewUndoesTheObjectTransform) {
   EXPECT_NEAR(fv.focal_pixels, focal_pixels(v), 1e-3);
 }
 
+// The object-space planes are built from the camera's basis, not extracted from the clip
+// matrix: they must still be the culling frustum's planes, scaled into object units.
+TEST(VertexFront, FrontViewPlanesAreTheFrustumPlanesInObjectSpace) {
+  View v;
+  v.eye = {3, 2, 9};
+  v.target = {-1, 0.5f, 1};
+  v.width = 1600;
+  v.height = 900;
+  v.fov_y_deg = 50;
+  v.near_plane = 0.1f;
+  v.far_plane = 400;
+  const Frustum world = frustum_of(v);
+  const float pos[3] = {1, -2, 0.5f};
+  const float scale = 2.5f, yaw = 0.7f;
+  const FrontView fv = front_view_of(v, pos, scale, yaw);
+  const float c = std::cos(yaw), s = std::sin(yaw);
+  for (int i = 0; i < 50; ++i) {
+    const glm::vec3 po(std::sin(1.3f * i) * 3, std::cos(0.7f * i) * 2, std::sin(0.31f * i + 1) * 4);
+    // world = R_y(yaw) (scale p) + position; R_y(t) maps (x, z) to (c x + s z, -s x + c z).
+    const glm::vec3 ps = scale * po;
+    const glm::vec3 pw(c * ps.x + s * ps.z + pos[0], ps.y + pos[1], -s * ps.x + c * ps.z + pos[2]);
+    for (int k = 0; k < 6; ++k) {
+      const glm::vec4& pl = world.planes[k];
+      const float dw = pl.x * pw.x + pl.y * pw.y + pl.z * pw.z + pl.w;
+      const float* q = fv.planes[k];
+      const float dobj = q[0] * po.x + q[1] * po.y + q[2] * po.z + q[3];
+      EXPECT_NEAR(dobj * scale, dw, 2e-3f * (1 + std::abs(dw))) << "plane " << k << " point " << i;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace lod
 
