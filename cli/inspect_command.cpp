@@ -26,6 +26,8 @@ int inspect_command(const InspectArgs& args) {
     char hash[32];
     std::snprintf(hash, sizeof hash, "%016llx", (unsigned long long)chain.source_hash);
     j["source_hash"] = hash;
+    j["morph_targets"] = chain.morph_targets.size();  // 0 = level changes cannot blend
+    j["hierarchy_nodes"] = chain.hierarchy.node_count();
     j["levels"] = nlohmann::json::array();
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
@@ -51,6 +53,12 @@ int inspect_command(const InspectArgs& args) {
                   100.0 * l.triangles() / full, l.level, l.error, l.error_rms, l.bounds.radius,
                   (unsigned long long)(l.vertex_count * 24ull + l.index_count * 4ull));
     }
+    if (can_morph_levels(chain))
+      std::printf("morph targets: %zu (level changes blend; %llu bytes)\n", chain.morph_targets.size(),
+                  (unsigned long long)(chain.morph_targets.size() * 4ull));
+    else if (chain.levels.size() > 1)
+      std::printf("morph targets: none (level changes pop; re-bake to add them)\n");
+    if (!chain.hierarchy.empty()) std::printf("vertex hierarchy: %zu nodes\n", size_t(chain.hierarchy.node_count()));
   }
   if (!args.export_dir.empty()) {
     std::error_code ec;

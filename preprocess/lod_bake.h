@@ -34,6 +34,7 @@ struct BakeReport {
   CleanReport cleaned;
   size_t input_triangles = 0;
   double seconds = 0;
+  double morph_seconds = 0;  // of which: morph targets between consecutive levels
   std::string method;  // what actually ran
   std::vector<std::string> notes;  // e.g. a level that stopped above its target, and why
 };

@@ -89,18 +89,50 @@ size_t vertex_morph_positions(std::span<float> out, const VertexMorph& m, std::s
   return moving;
 }
 
-void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine_positions,
-                         std::span<const uint32_t> fine_source, std::span<const float> coarse_positions,
-                         std::span<const uint32_t> coarse_source) {
-  const size_t nf = fine_positions.size() / 3, nc = coarse_positions.size() / 3;
-  assert(target.size() == nf && fine_source.size() == nf && coarse_source.size() == nc);
-  if (nc == 0) return;
-  // Sources that survive keep their own coarse vertex (sorted pairs, binary search).
-  std::vector<std::pair<uint32_t, uint32_t>> by_source(nc);
-  for (size_t c = 0; c < nc; ++c) by_source[c] = {coarse_source[c], static_cast<uint32_t>(c)};
+namespace {
+
+using Tri = std::array<uint32_t, 3>;
+
+Tri sorted_tri(uint32_t a, uint32_t b, uint32_t c) {
+  Tri t{a, b, c};
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+// The coarse triangles as sorted vertex sets, sorted, for binary search.
+std::vector<Tri> triangle_sets(std::span<const uint32_t> indices) {
+  std::vector<Tri> tris(indices.size() / 3);
+  for (size_t f = 0; f < tris.size(); ++f) tris[f] = sorted_tri(indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]);
+  std::sort(tris.begin(), tris.end());
+  return tris;
+}
+
+// A fine triangle whose corners go to a, b, c: fine if they coincide, else a coarse triangle.
+bool lands(const std::vector<Tri>& coarse, uint32_t a, uint32_t b, uint32_t c) {
+  if (a == b || b == c || a == c) return true;
+  return std::binary_search(coarse.begin(), coarse.end(), sorted_tri(a, b, c));
+}
+
+constexpr uint32_t kUnset = UINT32_MAX;
+
+// Coarse vertex index per fine vertex whose source survives, kUnset elsewhere.
+void surviving_targets(std::span<uint32_t> target, std::span<const uint32_t> fine_source,
+                       std::span<const uint32_t> coarse_source) {
+  std::vector<std::pair<uint32_t, uint32_t>> by_source(coarse_source.size());
+  for (size_t c = 0; c < coarse_source.size(); ++c) by_source[c] = {coarse_source[c], static_cast<uint32_t>(c)};
   std::sort(by_source.begin(), by_source.end());
-  // Merged-away vertices take the nearest coarse vertex: a uniform grid of about one coarse
-  // vertex per cell, searched in growing shells (a bake-time cost, never per frame).
+  for (size_t v = 0; v < target.size(); ++v) {
+    const auto it = std::lower_bound(by_source.begin(), by_source.end(), std::make_pair(fine_source[v], 0u));
+    target[v] = it != by_source.end() && it->first == fine_source[v] ? it->second : kUnset;
+  }
+}
+
+// Every target still kUnset becomes the coarse vertex nearest to its fine vertex: a uniform
+// grid of about one coarse vertex per cell, searched in growing shells (bake time, not per frame).
+void nearest_targets(std::span<uint32_t> target, std::span<const float> fine_positions,
+                     std::span<const float> coarse_positions) {
+  const size_t nf = target.size(), nc = coarse_positions.size() / 3;
+  if (nc == 0 || std::find(target.begin(), target.end(), kUnset) == target.end()) return;
   float lo[3], hi[3];
   for (int k = 0; k < 3; ++k) lo[k] = hi[k] = coarse_positions[k];
   for (size_t c = 0; c < nc; ++c)
@@ -128,11 +160,7 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
     items[fill[index(cell_of(p, 0), cell_of(p, 1), cell_of(p, 2))]++] = static_cast<uint32_t>(c);
   }
   for (size_t v = 0; v < nf; ++v) {
-    const auto it = std::lower_bound(by_source.begin(), by_source.end(), std::make_pair(fine_source[v], 0u));
-    if (it != by_source.end() && it->first == fine_source[v]) {
-      target[v] = it->second;
-      continue;
-    }
+    if (target[v] != kUnset) continue;
     const float* p = &fine_positions[3 * v];
     const int cx = cell_of(p, 0), cy = cell_of(p, 1), cz = cell_of(p, 2);
     float best = std::numeric_limits<float>::infinity();
@@ -161,31 +189,18 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
   }
 }
 
-namespace {
-
-using Tri = std::array<uint32_t, 3>;
-
-Tri sorted_tri(uint32_t a, uint32_t b, uint32_t c) {
-  Tri t{a, b, c};
-  std::sort(t.begin(), t.end());
-  return t;
-}
-
-// The coarse triangles as sorted vertex sets, sorted, for binary search.
-std::vector<Tri> triangle_sets(std::span<const uint32_t> indices) {
-  std::vector<Tri> tris(indices.size() / 3);
-  for (size_t f = 0; f < tris.size(); ++f) tris[f] = sorted_tri(indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]);
-  std::sort(tris.begin(), tris.end());
-  return tris;
-}
-
-// A fine triangle whose corners go to a, b, c: fine if they coincide, else a coarse triangle.
-bool lands(const std::vector<Tri>& coarse, uint32_t a, uint32_t b, uint32_t c) {
-  if (a == b || b == c || a == c) return true;
-  return std::binary_search(coarse.begin(), coarse.end(), sorted_tri(a, b, c));
-}
-
 }  // namespace
+
+void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine_positions,
+                         std::span<const uint32_t> fine_source, std::span<const float> coarse_positions,
+                         std::span<const uint32_t> coarse_source) {
+  const size_t nf = fine_positions.size() / 3, nc = coarse_positions.size() / 3;
+  assert(target.size() == nf && fine_source.size() == nf && coarse_source.size() == nc);
+  (void)nf;
+  if (nc == 0) return;
+  surviving_targets(target, fine_source, coarse_source);
+  nearest_targets(target, fine_positions, coarse_positions);
+}
 
 size_t level_morph_misses(std::span<const uint32_t> target, std::span<const uint32_t> fine_indices,
                           std::span<const uint32_t> coarse_indices) {
@@ -202,14 +217,13 @@ size_t level_morph_targets_by_collapse(std::span<uint32_t> target, std::span<con
                                        std::span<const float> coarse_positions,
                                        std::span<const uint32_t> coarse_indices,
                                        std::span<const uint32_t> coarse_source) {
-  level_morph_targets(target, fine_positions, fine_source, coarse_positions, coarse_source);
   const size_t nf = fine_positions.size() / 3, nc = coarse_positions.size() / 3;
+  assert(target.size() == nf && fine_source.size() == nf && coarse_source.size() == nc);
   if (nc == 0 || nf == 0) return level_morph_misses(target, fine_indices, coarse_indices);
+  surviving_targets(target, fine_source, coarse_source);
   // Which fine vertices may move: those whose source did not survive.
-  std::vector<uint32_t> kept(coarse_source.begin(), coarse_source.end());
-  std::sort(kept.begin(), kept.end());
   std::vector<uint8_t> free(nf);
-  for (size_t v = 0; v < nf; ++v) free[v] = !std::binary_search(kept.begin(), kept.end(), fine_source[v]);
+  for (size_t v = 0; v < nf; ++v) free[v] = target[v] == kUnset;
   // Fine vertex -> incident triangles (CSR).
   const size_t nt = fine_indices.size() / 3;
   std::vector<uint32_t> first(nf + 1, 0), faces(3 * nt);
@@ -228,7 +242,7 @@ size_t level_morph_targets_by_collapse(std::span<uint32_t> target, std::span<con
     }
     return d2;
   };
-  // Misses among v's triangles if v went to c (the other corners where they are now).
+  // Misses among v's triangles if v went to c.
   auto misses_if = [&](size_t v, uint32_t c) {
     uint32_t n = 0;
     for (uint32_t i = first[v]; i < first[v + 1]; ++i) {
@@ -239,32 +253,52 @@ size_t level_morph_targets_by_collapse(std::span<uint32_t> target, std::span<con
     }
     return n;
   };
+  // Best of v's own and its neighbours' targets (fewest misses, then nearest).
   std::vector<uint32_t> candidates;
-  // Local search, one vertex at a time in index order (deterministic); each round can only
-  // keep or lower a vertex's own misses, and a few rounds settle real chains.
-  for (int round = 0; round < 16; ++round) {
-    bool changed = false;
-    for (size_t v = 0; v < nf; ++v) {
-      if (!free[v] || first[v] == first[v + 1]) continue;
-      candidates.clear();
+  auto choose = [&](size_t v) {
+    candidates.clear();
+    for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t u = fine_indices[3 * size_t(faces[i]) + k];
+        if (u != v) candidates.push_back(target[u]);
+      }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    uint32_t best = target[v], best_misses = misses_if(v, best);
+    float best_d2 = dist2(v, best);
+    if (best_misses == 0) return best;
+    for (uint32_t c : candidates) {
+      const uint32_t m = misses_if(v, c);
+      const float d2 = dist2(v, c);
+      if (m < best_misses || (m == best_misses && d2 < best_d2)) best = c, best_misses = m, best_d2 = d2;
+    }
+    return best;
+  };
+  // Start from the nearest coarse vertex (right for most merged vertices), then repair: a
+  // vertex with a triangle that lands nowhere takes the best of its neighbours' targets, and
+  // when it changes, its free neighbours are looked at again. Each change lowers that vertex's
+  // misses (or keeps them and gets nearer); the work is bounded, and index order keeps it
+  // deterministic.
+  nearest_targets(target, fine_positions, coarse_positions);
+  std::vector<uint32_t> work, next;
+  std::vector<uint8_t> queued(nf, 0);
+  for (size_t v = 0; v < nf; ++v)
+    if (free[v] && misses_if(v, target[v]) > 0) work.push_back(static_cast<uint32_t>(v)), queued[v] = 1;
+  for (int round = 0; round < 16 && !work.empty(); ++round) {
+    next.clear();
+    for (uint32_t v : work) queued[v] = 0;
+    for (uint32_t v : work) {
+      const uint32_t best = choose(v);
+      if (best == target[v]) continue;
+      target[v] = best;
       for (uint32_t i = first[v]; i < first[v + 1]; ++i)
         for (int k = 0; k < 3; ++k) {
           const uint32_t u = fine_indices[3 * size_t(faces[i]) + k];
-          if (u != v) candidates.push_back(target[u]);
+          if (free[u] && !queued[u]) queued[u] = 1, next.push_back(u);
         }
-      std::sort(candidates.begin(), candidates.end());
-      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-      uint32_t best = target[v], best_misses = misses_if(v, best);
-      float best_d2 = dist2(v, best);
-      if (best_misses == 0) continue;
-      for (uint32_t c : candidates) {
-        const uint32_t m = misses_if(v, c);
-        const float d2 = dist2(v, c);
-        if (m < best_misses || (m == best_misses && d2 < best_d2)) best = c, best_misses = m, best_d2 = d2;
-      }
-      if (best != target[v]) target[v] = best, changed = true;
     }
-    if (!changed) break;
+    std::sort(next.begin(), next.end());
+    work.swap(next);
   }
   return level_morph_misses(target, fine_indices, coarse_indices);
 }
