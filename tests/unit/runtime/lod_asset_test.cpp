@@ -216,6 +216,16 @@ TEST(LodAsset, RefusesTruncatedOrFlippedMorphTargets) {
   }
 }
 
+// Assets baked before morph targets carry no MRPH section: they still load, and their level
+// changes cannot blend (the bake cache key changed with them, so `lod run` re-bakes anyway).
+TEST(LodAsset, AssetWithoutMorphTargetsLoadsAndCannotBlend) {
+  LodChain back;
+  ASSERT_TRUE(decode_lod_asset(encode_lod_asset(sample_chain()), "old.lod", back));
+  EXPECT_FALSE(can_morph_levels(back));
+  ASSERT_TRUE(decode_lod_asset(encode_lod_asset(chain_with_targets()), "new.lod", back));
+  EXPECT_TRUE(can_morph_levels(back));
+}
+
 TEST(LodAsset, RefusesMorphTargetOutOfRangeNamingLevelAndVertex) {
   LodChain c = chain_with_targets();
   c.morph_targets[c.levels[1].first_vertex + 3] = 40;  // level 2 has 4 vertices
