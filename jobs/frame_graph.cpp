@@ -422,9 +422,9 @@ struct FrameGraph::Impl {
     after_join();
   }
 
-  // Level changes restart a per-object morph factor from the level last shown (newly visible
-  // objects appear settled); view-dependent objects get their geomorphed vertices and compact
-  // mesh into the frame.
+  // Level changes restart a per-object morph factor from the level last selected (newly
+  // visible objects appear settled; a reversal mid-blend continues backwards); view-dependent
+  // objects get their geomorphed vertices and compact mesh into the frame.
   void stage_geomorph() {
     Frame& f = *out;
     f.morph.resize(visible_total);
@@ -439,7 +439,11 @@ struct FrameGraph::Impl {
         const uint32_t id = f.objects[k];
         const uint8_t level = f.levels[k];
         if (state.was_visible[id] && state.prev_level[id] != level) {
-          morph_start[id] = t;
+          // Going back to the level it was leaving, mid-blend, runs the same blend backwards
+          // from where it is (no jump); any other change starts from the level last selected.
+          const float m = morph_factor(t, morph_start[id], options.geomorph_seconds);
+          const bool reverses = m < 1 && morph_from[id] == level;
+          morph_start[id] = reverses ? t - double(1 - m) * options.geomorph_seconds : t;
           morph_from[id] = state.prev_level[id];
         }
         if (!state.was_visible[id]) morph_start[id] = -1e300;

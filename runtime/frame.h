@@ -43,8 +43,9 @@ struct Frame {
   // with every vertex at mix(own, target in the coarser level, w), the targets composed through
   // the levels in between (i -> i+1 -> ... -> j, LodChain::morph_targets); w = morph when the
   // object coarsens (from < to) and 1 - morph when it refines, so morph 0 looks exactly like
-  // the old level and morph 1 exactly like the new one. A change in mid-morph starts from the
-  // level the object was heading to.
+  // the old level and morph 1 exactly like the new one. Going back mid-morph to the level it
+  // came from continues from the same shape (morph restarts at 1 - morph); any other change in
+  // mid-morph starts from the level the object was heading to.
   std::vector<uint8_t> from_levels;
 
   uint32_t object_count = 0;

@@ -88,6 +88,45 @@ TEST(FrameGeomorph, FromLevelsFollowALevelChangeAndSettle) {
   EXPECT_EQ(f.tris_morph_extra, 0u);
 }
 
+// A blend that reverses mid-way (the level goes back to where it came from) keeps its shape:
+// the renderer's weight is continuous, only its direction flips.
+TEST(FrameGeomorph, GoingBackMidBlendContinuesFromTheSameShape) {
+  const Scene scene = test::synthetic_scene(3000, 250);
+  const View view = view_at(test::synthetic_config(3000, 250).camera, 0);
+  FrameGraphOptions o;
+  o.threads = 2;
+  o.grain = 64;
+  o.selection.budget = UINT64_MAX;
+  o.geomorph_seconds = 0.25f;
+  o.frame_seconds = 1.0f / 60;
+  FrameGraph g(scene, o);
+  Frame f;
+  g.run(view, f);
+  const std::vector<uint8_t> before = f.levels;
+  const uint64_t free_tris = f.tris_selected;
+  g.set_budget(free_tris / 3);
+  for (int i = 0; i < 6; ++i) g.run(view, f);  // 5 frames into a 15-frame blend
+  const std::vector<uint8_t> coarse = f.levels;
+  const std::vector<float> morph = f.morph;
+  ASSERT_EQ(f.from_levels, before);
+  g.set_budget(UINT64_MAX);
+  g.run(view, f);
+  uint32_t reversed = 0;
+  for (size_t k = 0; k < f.objects.size(); ++k) {
+    if (coarse[k] == before[k] || f.levels[k] == coarse[k]) continue;
+    SCOPED_TRACE("object " + std::to_string(f.objects[k]));
+    EXPECT_EQ(f.from_levels[k], coarse[k]);
+    if (f.levels[k] != before[k]) {
+      EXPECT_EQ(f.morph[k], 0.f);
+      continue;
+    }
+    ++reversed;
+    // Before: coarsening, weight = morph. Now: refining, weight = 1 - morph' = morph + one frame.
+    EXPECT_NEAR(1 - f.morph[k], morph[k] + 4.f / 60, 1e-4f);  // one frame = 1/15 of the blend
+  }
+  EXPECT_GT(reversed, 0u) << "no object went back to its level when the budget came back";
+}
+
 TEST(FrameGeomorph, NoGeomorphTimeMeansNothingBlends) {
   const Scene scene = test::synthetic_scene(2000, 250);
   const View view = view_at(test::synthetic_config(2000, 250).camera, 0);
