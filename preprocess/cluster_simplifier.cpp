@@ -27,9 +27,11 @@ constexpr double kMaxGrid = 1 << 20;  // cells along the longest axis
 struct Prepared {
   std::vector<float> unit;          // positions in [0,1] of the longest axis
   std::vector<uint32_t> triangles;  // valid faces only
+  std::vector<float> planes;        // per valid face: unit normal, offset, area (0s when degenerate)
   float origin[3] = {0, 0, 0};
   float extent = 1;                 // longest side of the bounding box
   float span[3] = {1, 1, 1};        // each side / extent
+  double area = 0;                  // surface area in those units
   size_t vertex_count = 0;
 };
 
@@ -56,14 +58,35 @@ void prepare(Prepared& p, const float* positions, size_t vertex_count, const uin
   p.unit.resize(3 * vertex_count);
   for (size_t v = 0; v < vertex_count; ++v)
     for (int k = 0; k < 3; ++k) p.unit[3 * v + k] = finite[v] ? (positions[3 * v + k] - p.origin[k]) * inv : 0;
-  p.triangles.clear();
-  p.triangles.reserve(index_count);
+  p.triangles.resize(index_count - index_count % 3);
+  p.planes.resize(5 * (index_count / 3));
+  size_t kept = 0;
+  double area = 0;
+  const float* u = p.unit.data();
   for (size_t t = 0; t + 2 < index_count; t += 3) {
     const uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];
     if (a >= vertex_count || b >= vertex_count || c >= vertex_count) continue;
     if (a == b || b == c || a == c || !finite[a] || !finite[b] || !finite[c]) continue;
-    p.triangles.insert(p.triangles.end(), {a, b, c});
+    const float e1[3] = {u[3 * b] - u[3 * a], u[3 * b + 1] - u[3 * a + 1], u[3 * b + 2] - u[3 * a + 2]};
+    const float e2[3] = {u[3 * c] - u[3 * a], u[3 * c + 1] - u[3 * a + 1], u[3 * c + 2] - u[3 * a + 2]};
+    float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    float* plane = &p.planes[5 * (kept / 3)];
+    if (len > 0) {
+      const float r = 1 / len;
+      for (float& x : n) x *= r;
+      plane[0] = n[0], plane[1] = n[1], plane[2] = n[2];
+      plane[3] = -(n[0] * u[3 * a] + n[1] * u[3 * a + 1] + n[2] * u[3 * a + 2]);
+      plane[4] = 0.5f * len;
+      area += plane[4];
+    } else {
+      plane[0] = plane[1] = plane[2] = plane[3] = plane[4] = 0;  // zero-area faces carry no plane
+    }
+    p.triangles[kept++] = a, p.triangles[kept++] = b, p.triangles[kept++] = c;
   }
+  p.triangles.resize(kept);
+  p.planes.resize(5 * (kept / 3));
+  p.area = area;
 }
 
 struct Grid {
@@ -78,8 +101,11 @@ Grid make_grid(const Prepared& p, double cells) {
   return g;
 }
 
-void cell_ids(std::vector<uint64_t>& ids, const Prepared& p, const Grid& g) {
-  ids.resize(p.vertex_count);
+// Whether every cell id of the grid fits 32 bits (halves the probes' memory traffic).
+bool narrow_ids(const Grid& g) { return double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]) < 4294967295.0; }
+
+template <typename Id>
+void cell_ids(Id* ids, const Prepared& p, const Grid& g) {
   const float s = float(g.cells);
   const int64_t d0 = int64_t(g.dims[0]), d1 = int64_t(g.dims[1]), d2 = int64_t(g.dims[2]);
   const float* u = p.unit.data();
@@ -87,16 +113,17 @@ void cell_ids(std::vector<uint64_t>& ids, const Prepared& p, const Grid& g) {
     const int64_t x = std::min(int64_t(u[3 * v] * s), d0 - 1);
     const int64_t y = std::min(int64_t(u[3 * v + 1] * s), d1 - 1);
     const int64_t z = std::min(int64_t(u[3 * v + 2] * s), d2 - 1);
-    ids[v] = uint64_t(x) + uint64_t(d0) * (uint64_t(y) + uint64_t(d1) * uint64_t(z));
+    ids[v] = Id(uint64_t(x) + uint64_t(d0) * (uint64_t(y) + uint64_t(d1) * uint64_t(z)));
   }
 }
 
 // Faces whose corners lie in three different cells (duplicates included).
-size_t count_spanning(const std::vector<uint64_t>& ids, const Prepared& p) {
+template <typename Id>
+size_t count_spanning(const Id* ids, const Prepared& p) {
   size_t n = 0;
   const uint32_t* t = p.triangles.data();
   for (size_t i = 0; i < p.triangles.size(); i += 3) {
-    const uint64_t a = ids[t[i]], b = ids[t[i + 1]], c = ids[t[i + 2]];
+    const Id a = ids[t[i]], b = ids[t[i + 1]], c = ids[t[i + 2]];
     n += (a != b) & (b != c) & (a != c);
   }
   return n;
@@ -111,30 +138,50 @@ inline uint64_t mix(uint64_t h) {
   return h;
 }
 
-// Open-addressing table from 64-bit cell id to dense cluster number.
+// Open-addressing table from 64-bit cell id to dense cluster number; grows as it fills, so
+// it can start at the size the search expects rather than one slot pair per vertex.
 struct CellTable {
-  std::vector<uint64_t> keys;
-  std::vector<uint32_t> values;
-  size_t mask = 0;
+  struct Entry {
+    uint64_t key;
+    uint32_t value, unused;
+  };
+  std::vector<Entry> entries, old;
+  size_t mask = 0, count = 0;
   void reset(size_t expected) {
     size_t cap = 64;
     while (cap < 2 * expected) cap *= 2;
-    keys.assign(cap, ~0ull);
-    values.resize(cap);
+    entries.assign(cap, Entry{~0ull, 0, 0});
     mask = cap - 1;
+    count = 0;
   }
   uint32_t insert(uint64_t key, uint32_t next) {
+    if (2 * (count + 1) > entries.size()) grow();
     size_t slot = mix(key) & mask;
-    while (keys[slot] != ~0ull && keys[slot] != key) slot = (slot + 1) & mask;
-    if (keys[slot] == ~0ull) keys[slot] = key, values[slot] = next;
-    return values[slot];
+    while (entries[slot].key != ~0ull && entries[slot].key != key) slot = (slot + 1) & mask;
+    if (entries[slot].key == ~0ull) entries[slot] = Entry{key, next, 0}, count++;
+    return entries[slot].value;
+  }
+  void grow() {
+    old.swap(entries);
+    entries.assign(2 * old.size(), Entry{~0ull, 0, 0});
+    mask = entries.size() - 1;
+    for (const Entry& e : old) {
+      if (e.key == ~0ull) continue;
+      size_t slot = mix(e.key) & mask;
+      while (entries[slot].key != ~0ull) slot = (slot + 1) & mask;
+      entries[slot] = e;
+    }
   }
 };
 
+// Hash lookups go in batches: the slots of a batch are fetched together, then used in order
+// (same result as one at a time, without waiting on each miss).
+constexpr size_t kBatch = 16;
+
 // Faces left after clustering, canonically rotated (smallest cluster first, orientation
 // kept), each set of three cells once. Returns their count; writes them to `out` when given.
-size_t unique_faces(std::vector<uint32_t>& faces, std::vector<uint32_t>& table, const std::vector<uint32_t>& cluster,
-                    const Prepared& p, std::vector<uint32_t>* out) {
+size_t unique_faces(std::vector<uint32_t>& faces, std::vector<uint64_t>& table, const std::vector<uint32_t>& cluster,
+                    size_t clusters, const Prepared& p, std::vector<uint32_t>* out) {
   faces.resize(p.triangles.size());
   const uint32_t* t = p.triangles.data();
   size_t n = 0;
@@ -148,98 +195,160 @@ size_t unique_faces(std::vector<uint32_t>& faces, std::vector<uint32_t>& table, 
   }
   size_t cap = 64;
   while (cap < 2 * n) cap *= 2;
-  table.assign(cap, ~0u);
-  size_t kept = 0;
-  for (size_t f = 0; f < n; ++f) {
-    // Same three cells in either orientation is one face (a two-sided sliver otherwise).
+  const size_t mask = cap - 1;
+  // Same three cells in either orientation is one face (a two-sided sliver otherwise). The
+  // key packs the three cluster numbers when they fit 21 bits each, else it is the first
+  // face's index (the faces are compared then).
+  const bool packed = clusters < (size_t(1) << 21);
+  table.assign(cap, ~0ull);
+  auto key_of = [&](size_t f) {
     const uint32_t* x = &faces[3 * f];
-    const uint32_t xl = std::min(x[1], x[2]), xh = std::max(x[1], x[2]);
-    size_t slot = mix(uint64_t(x[0]) * 0x9e3779b97f4a7c15ull ^ (uint64_t(xl) << 32 | xh)) & (cap - 1);
-    bool duplicate = false;
-    while (table[slot] != ~0u) {
-      const uint32_t* y = &faces[3 * size_t(table[slot])];
-      if (y[0] == x[0] && std::min(y[1], y[2]) == xl && std::max(y[1], y[2]) == xh) {
-        duplicate = true;
-        break;
-      }
-      slot = (slot + 1) & (cap - 1);
+    const uint64_t xl = std::min(x[1], x[2]), xh = std::max(x[1], x[2]);
+    return packed ? uint64_t(x[0]) << 42 | xl << 21 | xh : mix(uint64_t(x[0]) * 0x9e3779b97f4a7c15ull ^ (xl << 32 | xh));
+  };
+  auto same = [&](size_t f, uint64_t stored, uint64_t key) {
+    if (packed) return stored == key;
+    const uint32_t* x = &faces[3 * f];
+    const uint32_t* y = &faces[3 * stored];
+    return y[0] == x[0] && std::min(y[1], y[2]) == std::min(x[1], x[2]) && std::max(y[1], y[2]) == std::max(x[1], x[2]);
+  };
+  size_t kept = 0;
+  uint64_t keys[kBatch];
+  for (size_t f0 = 0; f0 < n; f0 += kBatch) {
+    const size_t m = std::min(kBatch, n - f0);
+    for (size_t j = 0; j < m; ++j) {
+      keys[j] = key_of(f0 + j);
+      __builtin_prefetch(&table[(packed ? mix(keys[j]) : keys[j]) & mask]);
     }
-    if (duplicate) continue;
-    table[slot] = uint32_t(f);
-    if (out) out->push_back(x[0]), out->push_back(x[1]), out->push_back(x[2]);
-    kept++;
+    for (size_t j = 0; j < m; ++j) {
+      const size_t f = f0 + j;
+      size_t slot = (packed ? mix(keys[j]) : keys[j]) & mask;
+      bool duplicate = false;
+      while (table[slot] != ~0ull) {
+        if (same(f, table[slot], keys[j])) {
+          duplicate = true;
+          break;
+        }
+        slot = (slot + 1) & mask;
+      }
+      if (duplicate) continue;
+      table[slot] = packed ? keys[j] : uint64_t(f);
+      if (out) out->insert(out->end(), &faces[3 * f], &faces[3 * f] + 3);
+      kept++;
+    }
   }
   return kept;
 }
 
 struct Scratch {
   std::vector<uint64_t> ids;
-  std::vector<uint32_t> cluster, faces, table, out_faces;
+  std::vector<uint32_t> ids32;
+  std::vector<uint32_t> cluster, faces, out_faces;
+  std::vector<uint64_t> table;
+  std::vector<uint32_t> best_cluster, best_faces;
   CellTable cells;
 };
 
-size_t number_cells(Scratch& s, const Prepared& p) {
-  s.cells.reset(std::min<size_t>(p.vertex_count, 1u << 24));
+// Spanning-face count of one grid.
+size_t probe(Scratch& s, const Prepared& p, const Grid& g) {
+  if (narrow_ids(g)) {
+    s.ids32.resize(p.vertex_count);
+    cell_ids(s.ids32.data(), p, g);
+    return count_spanning(s.ids32.data(), p);
+  }
+  s.ids.resize(p.vertex_count);
+  cell_ids(s.ids.data(), p, g);
+  return count_spanning(s.ids.data(), p);
+}
+
+// Dense cluster number per vertex (s.cluster); returns the number of clusters.
+// `expected`: about how many cells (the table grows past it).
+size_t number_cells(Scratch& s, const Prepared& p, const Grid& g, size_t expected) {
+  s.ids.resize(p.vertex_count);
+  cell_ids(s.ids.data(), p, g);
+  s.cells.reset(std::min(expected, p.vertex_count));
   s.cluster.resize(p.vertex_count);
   uint32_t next = 0;
+  uint64_t last_id = ~0ull;
+  uint32_t last = 0;
   for (size_t v = 0; v < p.vertex_count; ++v) {
-    const uint32_t c = s.cells.insert(s.ids[v], next);
-    if (c == next) next++;
-    s.cluster[v] = c;
+    // Neighbouring vertices often share a cell: skip the table then.
+    const uint64_t id = s.ids[v];
+    if (id != last_id) {
+      last = s.cells.insert(id, next);
+      last_id = id;
+      if (last == next) next++;
+    }
+    s.cluster[v] = last;
   }
   return next;
 }
 
-size_t count_unique(Scratch& s, const Prepared& p, const Grid& g) {
-  cell_ids(s.ids, p, g);
-  number_cells(s, p);
-  return unique_faces(s.faces, s.table, s.cluster, p, nullptr);
-}
-
-// Grid whose unique face count is close to `target`: log-space interpolation on the cheap
-// spanning count, re-aimed by the spanning/unique ratio of the last candidate.
-// `current` tells whether s.ids and s.cluster already hold the returned grid's cells.
-Grid search_grid(Scratch& s, const Prepared& p, size_t target, const ClusterOptions& options, bool& current) {
+// Grid whose unique face count is close to `target`. Probes count only the faces spanning
+// three cells (a pass over vertices and one over faces) and interpolate the grid size in log
+// space; the closest probe is then clustered for real, its unique faces being what the output
+// holds. When those miss the tolerance, the aim is corrected by the observed unique/spanning
+// ratio and the search goes on. The best grid's clusters and faces are left in
+// s.best_cluster and s.best_faces.
+Grid search_grid(Scratch& s, const Prepared& p, size_t target, const ClusterOptions& options) {
   const size_t faces = p.triangles.size() / 3;
   Grid best = make_grid(p, 1);
   double best_miss = std::numeric_limits<double>::max(), best_unique = -1;
   double aim = double(target);
   int probes = 0;
-  double cells = std::sqrt(aim / std::max<double>(1, double(faces))) * std::sqrt(double(p.vertex_count)) + 1;
+  // Counts are searched as t(n) = -ln(1 - n / faces), which grows about as cells^2 on every
+  // grid: a surface of area A meets about kCellsPerArea * A * cells^2 cells, each spanning
+  // face is one more, and on fine grids the count saturates at the face count.
+  const double all = double(std::max<size_t>(faces, 1));
+  auto linear = [all](double n) { return -std::log(1 - std::min(n, 0.999 * all) / all); };
+  constexpr double kCellsPerArea = 2.5;
+  double cells = std::sqrt(linear(aim) * all / (kCellsPerArea * std::max(p.area, 1e-12)));
   for (int round = 0; round < 4 && probes < options.max_probes; ++round) {
-    // Bracket and interpolate on the spanning count (grows about as cells^2).
     double lo = 1, hi = kMaxGrid;
-    double lo_n = 0, hi_n = double(faces);
+    double lo_n = 0;
     cells = std::clamp(cells, 1.0, kMaxGrid);
     Grid g = make_grid(p, cells);
     double g_miss = std::numeric_limits<double>::max(), g_n = -1;
+    double last_cells = 0, last_t = 0;
+    const double aim_t = linear(aim);
     for (int i = 0; i < 12 && probes < options.max_probes; ++i, ++probes) {
-      const Grid probe = make_grid(p, cells);
-      cell_ids(s.ids, p, probe);
-      const double n = double(count_spanning(s.ids, p));
+      const Grid candidate = make_grid(p, cells);
+      const double n = double(probe(s, p, candidate));
       // The closest probe so far (equally close: the one with more faces) is the candidate.
       const double m = std::fabs(n - aim);
-      if (m < g_miss || (m == g_miss && n > g_n)) g = probe, g_miss = m, g_n = n;
+      if (m < g_miss || (m == g_miss && n > g_n)) g = candidate, g_miss = m, g_n = n;
       if (m <= 0.5 * options.tolerance * aim) break;
       if (n < aim) lo = cells, lo_n = n;
-      else hi = cells, hi_n = n;
-      double next;
+      else hi = cells;
+      // Secant on log t(count) against log cells through the last two probes (slope 2 at first).
+      const double t = linear(std::max(n, 1.0));
+      double slope = 2;
+      if (last_t > 0 && t != last_t && cells != last_cells)
+        slope = std::clamp((std::log(t) - std::log(last_t)) / (std::log(cells) - std::log(last_cells)), 0.5, 4.0);
+      double next = cells * std::exp(std::clamp((std::log(aim_t) - std::log(t)) / slope, -1.5, 1.5));
       if (lo_n > 0 && hi < kMaxGrid) {
-        const double t = (std::log(aim) - std::log(lo_n)) / (std::log(hi_n) - std::log(lo_n));
-        next = std::exp(std::log(lo) + std::clamp(t, 0.1, 0.9) * (std::log(hi) - std::log(lo)));
+        // Bracketed: stay strictly inside, so the bracket shrinks even when the secant overshoots.
+        const double l = std::log(lo), h = std::log(hi);
+        next = std::exp(std::clamp(std::log(next), l + 0.1 * (h - l), h - 0.1 * (h - l)));
       } else {
-        next = cells * std::clamp(std::sqrt(aim / std::max(n, 1.0)), 0.25, 4.0);
         next = std::clamp(next, lo, hi);
       }
       if (hi - lo < 1e-3 * lo) break;
+      last_cells = cells, last_t = t;
       cells = next;
     }
-    const double unique = double(count_unique(s, p, g));
+    // A closed surface has about half as many vertices as faces.
+    const size_t clusters = number_cells(s, p, g, size_t(g_n / 2) + 64);
+    s.out_faces.clear();
+    const double unique = double(unique_faces(s.faces, s.table, s.cluster, clusters, p, &s.out_faces));
     probes++;
     const double miss = std::fabs(unique - double(target));
     // Equally far: keep more faces (a tiny mesh may offer only "all" or "none").
-    current = miss < best_miss || (miss == best_miss && unique > best_unique);
-    if (current) best_miss = miss, best_unique = unique, best = g;
+    if (miss < best_miss || (miss == best_miss && unique > best_unique)) {
+      best_miss = miss, best_unique = unique, best = g;
+      s.best_cluster.swap(s.cluster);
+      s.best_faces.swap(s.out_faces);
+    }
     if (miss <= options.tolerance * double(target) || unique <= 0) break;
     aim *= double(target) / unique;
     cells = g.cells * std::sqrt(double(target) / std::max(unique, 1.0));
@@ -283,50 +392,54 @@ size_t cluster_run(std::vector<uint32_t>& out_indices, std::vector<float>& out_p
   // Small targets: cluster to a few times the target, then let QEM edge collapse (cheap at that
   // size) choose which detail goes; clustering alone spends faces evenly over the grid.
   const size_t grid_target = target * kRefine * kRefineLimit <= faces ? target * kRefine : target;
-  bool current = false;
-  const Grid g = target == 0 ? make_grid(p, 1) : search_grid(s, p, grid_target, options, current);
-  size_t clusters = 0;
-  if (current) {
-    for (uint32_t c : s.cluster) clusters = std::max<size_t>(clusters, c + 1);
+  Grid g = make_grid(p, 1);
+  if (target == 0) {
+    const size_t clusters = number_cells(s, p, g, 64);
+    s.best_cluster.swap(s.cluster);
+    s.best_faces.clear();
+    unique_faces(s.faces, s.table, s.best_cluster, clusters, p, &s.best_faces);
   } else {
-    cell_ids(s.ids, p, g);
-    clusters = number_cells(s, p);
+    g = search_grid(s, p, grid_target, options);
   }
+  s.cluster.swap(s.best_cluster);
+  size_t clusters = 0;
+  for (uint32_t c : s.cluster) clusters = std::max<size_t>(clusters, c + 1);
 
-  // Lindstrom: every face's plane quadric goes to the cells of its corners.
+  // Lindstrom: every face's plane quadric goes to the cells of its corners. Floats, relative to
+  // each cell's first vertex so that nothing cancels: half the memory traffic of doubles.
   struct CellQuadric {
-    double a00, a11, a22, a01, a02, a12, b0, b1, b2, c, w;
-    double sx, sy, sz;
+    float a00, a11, a22, a01, a02, a12, b0, b1, b2, c, w;
+    float ox, oy, oz;  // origin: the cell's first vertex
+    float sx, sy, sz;  // vertex sum, relative to the origin
     uint32_t n;
   };
   std::vector<CellQuadric> q(clusters, CellQuadric{});
+  std::vector<uint32_t> first_vertex(clusters);  // also each output vertex's source
+  const float* unit = p.unit.data();
   for (size_t v = 0; v < p.vertex_count; ++v) {
     CellQuadric& c = q[s.cluster[v]];
-    c.sx += p.unit[3 * v], c.sy += p.unit[3 * v + 1], c.sz += p.unit[3 * v + 2];
+    if (c.n == 0) c.ox = unit[3 * v], c.oy = unit[3 * v + 1], c.oz = unit[3 * v + 2], first_vertex[s.cluster[v]] = uint32_t(v);
+    c.sx += unit[3 * v] - c.ox, c.sy += unit[3 * v + 1] - c.oy, c.sz += unit[3 * v + 2] - c.oz;
     c.n++;
   }
   for (size_t i = 0; i < p.triangles.size(); i += 3) {
-    const float* p0 = &p.unit[3 * size_t(p.triangles[i])];
-    const float* p1 = &p.unit[3 * size_t(p.triangles[i + 1])];
-    const float* p2 = &p.unit[3 * size_t(p.triangles[i + 2])];
-    const double e1[3] = {double(p1[0]) - p0[0], double(p1[1]) - p0[1], double(p1[2]) - p0[2]};
-    const double e2[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
-    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 0)) continue;
-    for (double& x : n) x /= len;
-    const double d = -(n[0] * p0[0] + n[1] * p0[1] + n[2] * p0[2]);
-    const double w = 0.5 * len;
+    const float* plane = &p.planes[5 * (i / 3)];
+    const float w = plane[4];
+    if (!(w > 0)) continue;
+    const float n[3] = {plane[0], plane[1], plane[2]};
+    const float wn[3] = {w * n[0], w * n[1], w * n[2]};
     const uint32_t c0 = s.cluster[p.triangles[i]], c1 = s.cluster[p.triangles[i + 1]], c2 = s.cluster[p.triangles[i + 2]];
-    auto add = [&](CellQuadric& r) {
-      r.a00 += w * n[0] * n[0], r.a11 += w * n[1] * n[1], r.a22 += w * n[2] * n[2];
-      r.a01 += w * n[0] * n[1], r.a02 += w * n[0] * n[2], r.a12 += w * n[1] * n[2];
-      r.b0 += w * n[0] * d, r.b1 += w * n[1] * d, r.b2 += w * n[2] * d;
+    auto add = [&](uint32_t k) {
+      CellQuadric& r = q[k];
+      const float d = plane[3] + n[0] * r.ox + n[1] * r.oy + n[2] * r.oz;  // offset from the cell's origin
+      r.a00 += wn[0] * n[0], r.a11 += wn[1] * n[1], r.a22 += wn[2] * n[2];
+      r.a01 += wn[0] * n[1], r.a02 += wn[0] * n[2], r.a12 += wn[1] * n[2];
+      r.b0 += wn[0] * d, r.b1 += wn[1] * d, r.b2 += wn[2] * d;
       r.c += w * d * d, r.w += w;
     };
-    add(q[c0]);  // once per distinct cell
-    if (c1 != c0) add(q[c1]);
-    if (c2 != c0 && c2 != c1) add(q[c2]);
+    add(c0);  // once per distinct cell
+    if (c1 != c0) add(c1);
+    if (c2 != c0 && c2 != c1) add(c2);
   }
 
   // Each cell's vertex: the regularised quadric minimum, kept inside the cell.
@@ -335,35 +448,36 @@ size_t cluster_run(std::vector<uint32_t>& out_indices, std::vector<float>& out_p
   double worst = 0;
   for (size_t k = 0; k < clusters; ++k) {
     const CellQuadric& c = q[k];
-    const double m[3] = {c.sx / c.n, c.sy / c.n, c.sz / c.n};
-    const double lambda = kRegularisation * (c.a00 + c.a11 + c.a22) + 1e-30;
+    const float o[3] = {c.ox, c.oy, c.oz};
+    const double m[3] = {double(c.sx) / c.n, double(c.sy) / c.n, double(c.sz) / c.n};  // local centroid
+    const double lambda = kRegularisation * (double(c.a00) + c.a11 + c.a22) + 1e-30;
     const double a00 = c.a00 + lambda, a11 = c.a11 + lambda, a22 = c.a22 + lambda;
+    const double a01 = c.a01, a02 = c.a02, a12 = c.a12;
     const double r0 = -c.b0 + lambda * m[0], r1 = -c.b1 + lambda * m[1], r2 = -c.b2 + lambda * m[2];
-    const double c00 = a11 * a22 - c.a12 * c.a12, c01 = c.a02 * c.a12 - c.a01 * a22, c02 = c.a01 * c.a12 - c.a02 * a11;
-    const double det = a00 * c00 + c.a01 * c01 + c.a02 * c02;
+    const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+    const double det = a00 * c00 + a01 * c01 + a02 * c02;
     double x[3] = {m[0], m[1], m[2]};
     if (det > 1e-300) {
-      const double c11 = a00 * a22 - c.a02 * c.a02, c12 = c.a01 * c.a02 - a00 * c.a12, c22 = a00 * a11 - c.a01 * c.a01;
+      const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
       const double sol[3] = {(c00 * r0 + c01 * r1 + c02 * r2) / det, (c01 * r0 + c11 * r1 + c12 * r2) / det,
                              (c02 * r0 + c12 * r1 + c22 * r2) / det};
       // Cell bounds from the centroid's cell; a solution outside is pulled back in.
       for (int d = 0; d < 3; ++d) {
-        const double lo = std::floor(m[d] * g.cells) * cell;
+        const double lo = std::floor((o[d] + m[d]) * g.cells) * cell - o[d];
         x[d] = std::isfinite(sol[d]) ? std::clamp(sol[d], lo, lo + cell) : m[d];
       }
     }
-    const double e = x[0] * (c.a00 * x[0] + c.a01 * x[1] + c.a02 * x[2]) + x[1] * (c.a01 * x[0] + c.a11 * x[1] + c.a12 * x[2]) +
-                     x[2] * (c.a02 * x[0] + c.a12 * x[1] + c.a22 * x[2]) + 2 * (c.b0 * x[0] + c.b1 * x[1] + c.b2 * x[2]) + c.c;
+    const double e = x[0] * (c.a00 * x[0] + a01 * x[1] + a02 * x[2]) + x[1] * (a01 * x[0] + c.a11 * x[1] + a12 * x[2]) +
+                     x[2] * (a02 * x[0] + a12 * x[1] + c.a22 * x[2]) + 2 * (c.b0 * x[0] + c.b1 * x[1] + c.b2 * x[2]) + c.c;
     if (c.w > 0) worst = std::max(worst, std::max(e, 0.0) / c.w);
-    for (int d = 0; d < 3; ++d) rep[3 * k + d] = float(x[d]);
+    for (int d = 0; d < 3; ++d) rep[3 * k + d] = float(o[d] + x[d]);
   }
   // Only cells some face still uses become vertices.
-  s.out_faces.clear();
-  unique_faces(s.faces, s.table, s.cluster, p, &s.out_faces);
+  s.out_faces.swap(s.best_faces);
   std::vector<uint32_t> used(clusters, ~0u);
-  std::vector<uint32_t> first_vertex(clusters, ~0u);
-  for (size_t v = 0; v < p.vertex_count; ++v)
-    if (first_vertex[s.cluster[v]] == ~0u) first_vertex[s.cluster[v]] = uint32_t(v);
+  out_positions.reserve(3 * clusters);
+  out_indices.reserve(s.out_faces.size());
+  if (out_source) out_source->reserve(clusters);
   for (uint32_t c : s.out_faces) {
     if (used[c] == ~0u) {
       used[c] = uint32_t(out_positions.size() / 3);
