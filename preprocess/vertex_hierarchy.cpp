@@ -104,6 +104,7 @@ class Builder {
   bool try_collapse(uint32_t a, uint32_t b);
   void finish(VertexTree& out);
   void mark_split_fans();
+  void pin_part_seams();
   void renumber_passes();
   std::vector<uint32_t> pass_start_;  // first node id made by each pass
 
@@ -124,7 +125,7 @@ class Builder {
   // Per pass: vertex -> alive faces (CSR over node ids), flags, locks.
   std::vector<uint32_t> vf_off_, vf_;
   std::vector<uint8_t> border_, complex_, locked_;
-  std::vector<uint8_t> nonmanifold_;  // input vertices whose faces form several fans
+  std::vector<uint8_t> nonmanifold_;  // input vertices never collapsed: split fans, part seams
   std::vector<uint32_t> stamp_, stamp_b_;
   uint32_t stamp_now_ = 0;
 
@@ -519,6 +520,56 @@ void Builder::mark_split_fans() {
   }
 }
 
+// Cuts the faces into opt_.parts spatial parts and pins the vertices two parts share.
+void Builder::pin_part_seams() {
+  const uint32_t fc = static_cast<uint32_t>(leaves_.size() / 3);
+  if (opt_.parts <= 1 || fc < 2) return;
+  std::vector<float> centre(3 * size_t(fc));
+  for (uint32_t f = 0; f < fc; ++f)
+    for (int k = 0; k < 3; ++k)
+      centre[3 * size_t(f) + k] = static_cast<float>(
+          (pos_[3 * size_t(leaves_[3 * f]) + k] + pos_[3 * size_t(leaves_[3 * f + 1]) + k] +
+           pos_[3 * size_t(leaves_[3 * f + 2]) + k]) / 3);
+  std::vector<uint32_t> order(fc);
+  std::iota(order.begin(), order.end(), 0u);
+  std::vector<uint32_t> part(fc, 0);
+  // Recursive median cuts: [lo, hi) of `order` becomes `parts` parts numbered from first_part.
+  auto cut = [&](auto&& self, uint32_t lo, uint32_t hi, uint32_t parts, uint32_t first_part) -> void {
+    if (parts <= 1 || hi - lo < 2) {
+      for (uint32_t k = lo; k < hi; ++k) part[order[k]] = first_part;
+      return;
+    }
+    float bmin[3] = {1e30f, 1e30f, 1e30f}, bmax[3] = {-1e30f, -1e30f, -1e30f};
+    for (uint32_t k = lo; k < hi; ++k)
+      for (int a = 0; a < 3; ++a) {
+        bmin[a] = std::min(bmin[a], centre[3 * size_t(order[k]) + a]);
+        bmax[a] = std::max(bmax[a], centre[3 * size_t(order[k]) + a]);
+      }
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (bmax[a] - bmin[a] > bmax[axis] - bmin[axis]) axis = a;
+    const uint32_t left = parts / 2;
+    const uint32_t mid = lo + static_cast<uint32_t>(uint64_t(hi - lo) * left / parts);
+    // Ties broken by face id so the cut does not depend on the sort's implementation.
+    std::nth_element(order.begin() + lo, order.begin() + mid, order.begin() + hi, [&](uint32_t x, uint32_t y) {
+      const float cx = centre[3 * size_t(x) + axis], cy = centre[3 * size_t(y) + axis];
+      return cx < cy || (cx == cy && x < y);
+    });
+    self(self, lo, mid, left, first_part);
+    self(self, mid, hi, parts - left, first_part + left);
+  };
+  cut(cut, 0, fc, opt_.parts, 0);
+  std::vector<uint32_t> seen(leaf_count_, kNoNode);
+  for (uint32_t f = 0; f < fc; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = leaves_[3 * f + k];
+      if (seen[v] == kNoNode)
+        seen[v] = part[f];
+      else if (seen[v] != part[f])
+        nonmanifold_[v] = 1;
+    }
+}
+
 void Builder::finish(VertexTree& out) {
   const uint32_t n = static_cast<uint32_t>(parent_.size());
   out = VertexTree{};
@@ -645,6 +696,7 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
 
   build_adjacency();
   mark_split_fans();
+  pin_part_seams();
   collect_edges();
   // Border constraint planes (through the border edge, perpendicular to its face) hold the
   // outline of open meshes in place.

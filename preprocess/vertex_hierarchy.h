@@ -31,6 +31,11 @@ struct HierarchyOptions {
   // A collapse is refused when a remaining face's normal would turn by more than this
   // (cosine of the angle; -1 refuses nothing but faces that would become degenerate).
   float min_normal_cos = 0.2f;
+  // > 1: the faces are cut into this many spatial parts (median splits of face centres along
+  // the longest axis) and the vertices the parts share are never collapsed. Then no collapse,
+  // dependency or face crosses a part, so the parts' fronts can be updated on separate threads
+  // (vertex_tree_regions); the price is the seam kept at full resolution.
+  uint32_t parts = 1;
 };
 
 // Builds the hierarchy of `mesh` (positions and indices; normals are not used). Faces with a

@@ -109,7 +109,8 @@ class Updater {
     return kNoNode;
   }
   bool deps_active(uint32_t p) const { return missing_dep(p) == kNoNode; }
-  bool children_active(uint32_t p) const { return f_.kids[p] == 2; }
+  bool children_active(uint32_t p) const { return (f_.kids[p] & VertexFront::kKidsMask) == 2; }
+  bool watches_parent(uint32_t v) const { return f_.kids[v] & VertexFront::kFirstChild; }
   bool is_pending(uint32_t p) const { return f_.pending_count && f_.pending_until[p - t_.leaf_count] >= 0; }
   uint32_t new_faces(uint32_t x) const {
     const uint32_t i = x - t_.leaf_count;
@@ -133,6 +134,7 @@ class Updater {
       const uint32_t v = f_.queue[head_ + kFar];
       __builtin_prefetch(&t_.bounds[v]);
       __builtin_prefetch(&f_.state[v]);
+      __builtin_prefetch(&f_.kids[v]);
       __builtin_prefetch(&f_.links[2 * size_t(v)]);
       if (f_.waiting) __builtin_prefetch(&f_.wait_on[v]);
     }
@@ -286,7 +288,7 @@ void Updater::split(uint32_t x) {
   f_.active_pos[c2] = f_.active_count;
   f_.active[f_.active_count++] = c2;
   f_.state[c1] = f_.state[c2] = VertexFront::kActive;
-  f_.kids[x] = 2;
+  f_.kids[x] = (f_.kids[x] & ~VertexFront::kKidsMask) | 2;
   if (const uint32_t par = t_.bounds[x].parent; par != kNoNode) --f_.kids[par];
   // Faces around x take the child holding their corner's leaf.
   const uint32_t lo1 = t_.leaf_lo[c1], hi1 = t_.leaf_hi[c1];
@@ -354,8 +356,15 @@ void Updater::collapse(uint32_t p) {
   stop_waiting(c2);
   f_.state[c1] = f_.state[c2] = VertexFront::kBelow;
   f_.state[p] = VertexFront::kActive;
-  f_.kids[p] = 0;
-  if (const uint32_t par = t_.bounds[p].parent; par != kNoNode) ++f_.kids[par];
+  f_.kids[p] &= ~VertexFront::kKidsMask;
+  if (const uint32_t par = t_.bounds[p].parent; par != kNoNode && (++f_.kids[par], children_active(par))) {
+    // par may merge now: its watching child (maybe p's sibling) judges it again.
+    const uint32_t w = t_.children[2 * (par - t_.leaf_count)];
+    if (w != p) {
+      unfile(w);
+      push(w);
+    }
+  }
   // Active list: p takes c1's slot, c2's slot is filled by the last entry.
   const uint32_t s1 = f_.active_pos[c1];
   f_.active[s1] = p;
@@ -451,8 +460,9 @@ bool Updater::consider(uint32_t v, bool phase_two) {
     se = d.slack_eye;
     sf = d.slack_turn;
   }
+  // Only the first child watches the parent's merge: one judgement per pair, not two.
   const uint32_t p = t_.bounds[v].parent;
-  if (p != kNoNode && children_active(p)) {
+  if (p != kNoNode && watches_parent(v) && children_active(p)) {
     const Decision dp = evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_, split_);
     const bool pending = is_pending(p);
     if (!dp.refine) {
@@ -600,21 +610,8 @@ FrontStats Updater::run(const FrontView& view) {
   phase_two_ = true;
   while (head_ < tail_) consider(f_.queue[head_++], true);
 
-  // Threshold feedback: triangles grow about as 1 / threshold^2.
-  if (p_.target_triangles > 0) {
-    const double ratio = double(f_.tri_count) / p_.target_triangles;
-    double k = 1;
-    if (ratio > 1.0)
-      k = std::min(1.5, std::sqrt(ratio));
-    else if (ratio < 0.85)
-      k = std::max(0.8, std::sqrt(std::max(ratio, 1e-6)) / std::sqrt(0.92));
-    const float next = std::clamp(static_cast<float>(f_.threshold * k), p_.min_threshold, p_.max_threshold);
-    if (next != f_.threshold) {
-      const double kk = double(next) / f_.threshold;
-      f_.pending_motion += 2 * reach_ * (std::max(kk, 1 / kk) - 1);
-      f_.threshold = next;
-    }
-  }
+  if (p_.target_triangles > 0)
+    front_set_threshold(f_, front_next_threshold(f_.threshold, f_.tri_count, p_.target_triangles, p_));
   stats_.active_tris = f_.tri_count;
   stats_.active_vertices = f_.active_count;
   return stats_;
@@ -662,12 +659,44 @@ FrontView front_view_of(const View& view, const float position[3], float scale, 
   return out;
 }
 
-void front_init(VertexFront& f, const VertexTree& t, float threshold) {
+float front_next_threshold(float threshold, uint64_t triangles, uint64_t target, const FrontParams& p) {
+  if (target == 0) return threshold;
+  const double ratio = double(triangles) / double(target);
+  double k = 1;
+  if (ratio > 1.0)
+    k = std::min(1.5, std::sqrt(ratio));
+  else if (ratio < 0.85)
+    k = std::max(0.8, std::sqrt(std::max(ratio, 1e-6)) / std::sqrt(0.92));
+  return std::clamp(static_cast<float>(threshold * k), p.min_threshold, p.max_threshold);
+}
+
+void front_set_threshold(VertexFront& f, float threshold) {
+  if (threshold == f.threshold || !(threshold > 0)) return;
+  if (f.has_view) {
+    // A critical distance e * focal / tau scales with 1 / tau and is at most the view's reach.
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) d2 += double(f.last_view.eye[k] - f.center[k]) * (f.last_view.eye[k] - f.center[k]);
+    const double reach = std::sqrt(d2) + f.extent;
+    const double kk = double(threshold) / f.threshold;
+    f.pending_motion += 2 * reach * (std::max(kk, 1 / kk) - 1);
+  }
+  f.threshold = threshold;
+}
+
+void front_init(VertexFront& f, const VertexTree& t, float threshold) { front_init(f, t, threshold, {}, kSharedRegion); }
+
+void front_init(VertexFront& f, const VertexTree& t, float threshold, std::span<const uint8_t> regions,
+                uint8_t region) {
   const uint32_t n = t.node_count();
+  assert(regions.empty() || regions.size() == n);
+  f.region = regions.empty() ? kSharedRegion : region;
+  f.node_region.assign(regions.begin(), regions.end());
+  auto mine = [&](uint32_t v) { return regions.empty() || regions[v] == region || regions[v] == kSharedRegion; };
   assert(t.bounds.size() == n && "pack_vertex_bounds(tree) first");
   const uint32_t inner = t.interior_count();
   f.state.assign(n, VertexFront::kBelow);
   f.kids.assign(n, 0);
+  for (uint32_t i = 0; i < inner; ++i) f.kids[t.children[2 * size_t(i)]] = VertexFront::kFirstChild;
   f.active.assign(n, 0);
   f.active_pos.assign(n, kNoNode);
   f.tri_indices.assign(3 * size_t(t.face_count), 0);
@@ -719,13 +748,14 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold) {
 
   // Base mesh: the roots and the faces nobody's split makes, corners mapped to their roots.
   for (uint32_t v = 0; v < n; ++v)
-    if (t.parent[v] == kNoNode) {
+    if (t.parent[v] == kNoNode && mine(v)) {
       f.state[v] = VertexFront::kActive;
       f.active_pos[v] = f.active_count;
       f.active[f.active_count++] = v;
     }
   for (uint32_t face = 0; face < t.face_count; ++face) {
     if (t.face_owner[face] != kNoNode) continue;
+    if (!regions.empty() && face_region(t, regions, face) != region) continue;
     const uint32_t s = f.tri_count++;
     f.face_slot[face] = s;
     f.tri_face[s] = face;
@@ -793,8 +823,15 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
       return fail("active list entry " + std::to_string(k) + " (node " + std::to_string(v) +
                   ") is not active there");
   }
+  const bool all = f.region == kSharedRegion || f.node_region.size() != n;
+  auto leaf_mine = [&](uint32_t l) {
+    return all || f.node_region[l] == f.region || f.node_region[l] == kSharedRegion;
+  };
+  auto face_mine = [&](uint32_t face) { return all || face_region(t, f.node_region, face) == f.region; };
+  if (!all && edges == EdgeCheck::closed) edges = EdgeCheck::oriented;  // a region is open at its seam
   // Every leaf has exactly one active ancestor-or-self: a proper front.
   for (uint32_t l = 0; l < t.leaf_count; ++l) {
+    if (!leaf_mine(l)) continue;
     uint32_t count = 0;
     for (uint32_t v = l; v != kNoNode; v = t.parent[v]) count += f.state[v] == VertexFront::kActive;
     if (count != 1)
@@ -823,12 +860,13 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
   }
   uint32_t face_slots = 0;
   for (uint32_t face = 0; face < t.face_count; ++face) face_slots += f.face_slot[face] != kNoNode;
+
   if (face_slots != f.tri_count)
     return fail(std::to_string(face_slots) + " faces have slots but " + std::to_string(f.tri_count) +
                 " triangles are active");
   // A face is active exactly when its corners are distinct (no face missing).
   for (uint32_t face = 0; face < t.face_count; ++face) {
-    if (f.face_slot[face] != kNoNode) continue;
+    if (f.face_slot[face] != kNoNode || !face_mine(face)) continue;
     uint32_t c[3];
     for (int j = 0; j < 3; ++j) {
       uint32_t v = t.face_leaves[3 * size_t(face) + j];
@@ -894,6 +932,30 @@ uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indi
   // active_pos maps a node id to its slot in the active list: the compact vertex index.
   for (size_t k = 0; k < 3 * size_t(f.tri_count); ++k) indices[k] = f.active_pos[f.tri_indices[k]];
   return f.tri_count;
+}
+
+uint32_t fronts_compact_mesh(std::span<float> positions, std::span<uint32_t> indices, std::span<uint32_t> node_index,
+                             std::span<const VertexFront* const> fronts, const VertexTree& t,
+                             std::span<const float> shown, uint32_t* vertex_count) {
+  const float* src = shown.empty() ? t.positions.data() : shown.data();
+  uint32_t nv = 0, nt = 0;
+  for (size_t r = 0; r < fronts.size(); ++r) {
+    const VertexFront& f = *fronts[r];
+    for (uint32_t k = 0; k < f.active_count; ++k) {
+      const uint32_t v = f.active[k];
+      if (r > 0 && !f.node_region.empty() && f.node_region[v] == kSharedRegion) continue;
+      assert(positions.size() >= 3 * size_t(nv + 1));
+      std::copy_n(src + 3 * size_t(v), 3, positions.data() + 3 * size_t(nv));
+      node_index[v] = nv++;
+    }
+  }
+  for (const VertexFront* f : fronts) {
+    assert(indices.size() >= 3 * size_t(nt + f->tri_count));
+    for (size_t k = 0; k < 3 * size_t(f->tri_count); ++k) indices[3 * size_t(nt) + k] = node_index[f->tri_indices[k]];
+    nt += f->tri_count;
+  }
+  if (vertex_count) *vertex_count = nv;
+  return nt;
 }
 
 bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges,

@@ -73,7 +73,10 @@ struct VertexFront {
   static constexpr uint8_t kBelow = 0, kActive = 1, kSplit = 2;
 
   std::vector<uint8_t> state;         // per node
-  std::vector<uint8_t> kids;          // per node: how many of its children are active (0..2)
+  // Per node: how many of its children are active (kKidsMask bits), and kFirstChild when it is
+  // its parent's first child, the one that judges whether the parent should merge.
+  static constexpr uint8_t kKidsMask = 3, kFirstChild = 0x80;
+  std::vector<uint8_t> kids;
   std::vector<uint32_t> active;       // active node ids, [0, active_count)
   std::vector<uint32_t> active_pos;   // per node: index in `active`
   std::vector<uint32_t> tri_indices;  // 3 node ids per active triangle, [0, 3 * tri_count)
@@ -82,6 +85,10 @@ struct VertexFront {
   uint32_t active_count = 0;
   uint32_t tri_count = 0;
   float threshold = 1;  // pixel threshold (tau), moved by feedback
+  // The region of the tree this front covers (vertex_tree_regions), or kSharedRegion for all of
+  // it; node_region is the tree's region per node (empty for the whole tree).
+  uint8_t region = kSharedRegion;
+  std::vector<uint8_t> node_region;
 
   // Two calendars of view-motion buckets (intrusive doubly linked lists over node ids):
   // calendar 0 by eye travel, plane offset and threshold changes (object units); calendar 1
@@ -124,6 +131,21 @@ struct VertexFront {
 // Sizes everything for `tree` and sets the front to the base mesh (the roots).
 void front_init(VertexFront& front, const VertexTree& tree, float threshold);
 
+// The same for one region of vertex_tree_regions: the region's roots, every fixed leaf and the
+// region's base faces. Fronts of different regions of one tree touch disjoint nodes, faces and
+// per-node arrays, so they may be updated on different threads at once, each result the same
+// as alone; together their triangles are the whole mesh (fronts_compact_mesh).
+void front_init(VertexFront& front, const VertexTree& tree, float threshold, std::span<const uint8_t> regions,
+                uint8_t region);
+
+// Threshold feedback (front_update does it when target_triangles > 0): the next pixel threshold
+// for `triangles` active against `target` (triangles grow about as 1 / threshold^2), clamped
+// to the params' range. Fronts sharing one threshold (regions of one object) use it on their
+// summed triangles and then front_set_threshold on each.
+float front_next_threshold(float threshold, uint64_t triangles, uint64_t target, const FrontParams& params);
+// Moves the threshold, telling the motion calendar how far decisions may have moved.
+void front_set_threshold(VertexFront& front, float threshold);
+
 // One frame: visits expired and new nodes, collapses where no refinement is wanted for the
 // parent, then splits (forcing missing dependencies first) where a node is in the frustum,
 // not back-facing and its projected error exceeds the threshold, within max_triangles and
@@ -141,7 +163,8 @@ void front_coarsen_all(VertexFront& front, const VertexTree& tree);
 // directed edge being used once; closed ones also for every edge having two faces.
 enum class EdgeCheck : uint8_t { corners, oriented, closed };
 
-// Checks the active triangles: corners are active nodes and the active ancestors of each
+// Checks the active triangles (of the front's region only: its leaves and faces; a region is
+// open along its seam, so `closed` is checked as `oriented` there): corners are active nodes and the active ancestors of each
 // face's leaves, no repeated corner, the packed arrays agree with each other; from `oriented`
 // on each directed edge used once (consistent orientation, no edge in more than two faces);
 // with `closed` every edge in exactly two faces (no cracks, no T-junctions). Allocates (a test and
@@ -162,6 +185,15 @@ uint32_t front_stale_decisions(const VertexFront& front, const VertexTree& tree,
 // holds at least 3 * active_count floats, `indices` 3 * tri_count. Returns tri_count.
 uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indices, const VertexFront& front,
                             const VertexTree& tree, std::span<const float> shown);
+
+// The fronts of all regions of one tree as one compact mesh: vertices of fronts[0] in its
+// active order, then each other front's active nodes outside kSharedRegion (fixed leaves are
+// active in every region and written once), so seams share vertices. `node_index` is scratch
+// of node_count entries. Writes *vertex_count and returns the triangle count; positions and
+// indices need room for the summed active vertices and triangles.
+uint32_t fronts_compact_mesh(std::span<float> positions, std::span<uint32_t> indices, std::span<uint32_t> node_index,
+                             std::span<const VertexFront* const> fronts, const VertexTree& tree,
+                             std::span<const float> shown, uint32_t* vertex_count);
 
 // Checks a plain indexed triangle list: indices < vertex_count, no repeated corner; from
 // `oriented` on each directed edge at most once; with `closed` every edge also used the other

@@ -156,4 +156,65 @@ void pack_vertex_bounds(VertexTree& t) {
   }
 }
 
+uint32_t vertex_tree_regions(std::vector<uint8_t>& region, const VertexTree& t, uint32_t max_regions) {
+  const uint32_t n = t.node_count();
+  max_regions = std::clamp(max_regions, 1u, 254u);
+  region.assign(n, 0);
+  std::vector<uint32_t> root(n);
+  for (uint32_t v = 0; v < n; ++v) root[v] = v;
+  auto find = [&](uint32_t x) {
+    while (root[x] != x) x = root[x] = root[root[x]];
+    return x;
+  };
+  auto fixed = [&](uint32_t v) { return t.is_leaf(v) && t.parent[v] == kNoNode; };
+  auto join = [&](uint32_t a, uint32_t b) {
+    a = find(a), b = find(b);
+    if (a != b) root[std::max(a, b)] = std::min(a, b);  // smallest id represents: deterministic
+  };
+  for (uint32_t i = 0; i < t.interior_count(); ++i) {
+    const uint32_t x = t.leaf_count + i;
+    join(x, t.children[2 * i]);
+    join(x, t.children[2 * i + 1]);
+    for (uint32_t k = t.dep_offsets[i]; k < t.dep_offsets[i + 1]; ++k)
+      if (!fixed(t.deps[k])) join(x, t.deps[k]);
+  }
+  for (uint32_t f = 0; f < t.face_count; ++f) {
+    uint32_t first = kNoNode;
+    for (int j = 0; j < 3; ++j) {
+      const uint32_t l = t.face_leaves[3 * size_t(f) + j];
+      if (fixed(l)) continue;
+      if (first == kNoNode)
+        first = l;
+      else
+        join(first, l);
+    }
+  }
+  // Components by leaf count, largest first (ties: smaller representative first).
+  std::vector<uint32_t> leaves(n, 0);
+  for (uint32_t l = 0; l < t.leaf_count; ++l)
+    if (!fixed(l)) ++leaves[find(l)];
+  std::vector<uint32_t> comps;
+  for (uint32_t v = 0; v < n; ++v)
+    if (!fixed(v) && find(v) == v) comps.push_back(v);
+  std::stable_sort(comps.begin(), comps.end(), [&](uint32_t a, uint32_t b) { return leaves[a] > leaves[b]; });
+  const uint32_t used = std::max<uint32_t>(1, std::min<uint32_t>(max_regions, static_cast<uint32_t>(comps.size())));
+  std::vector<uint64_t> load(used, 0);
+  std::vector<uint8_t> of_comp(n, 0);
+  for (uint32_t c : comps) {
+    const auto least = std::min_element(load.begin(), load.end()) - load.begin();
+    of_comp[c] = static_cast<uint8_t>(least);
+    load[least] += std::max<uint32_t>(leaves[c], 1);
+  }
+  for (uint32_t v = 0; v < n; ++v) region[v] = fixed(v) ? kSharedRegion : of_comp[find(v)];
+  return used;
+}
+
+uint8_t face_region(const VertexTree& t, std::span<const uint8_t> region, uint32_t face) {
+  for (int j = 0; j < 3; ++j) {
+    const uint8_t r = region[t.face_leaves[3 * size_t(face) + j]];
+    if (r != kSharedRegion) return r;
+  }
+  return 0;
+}
+
 }  // namespace lod

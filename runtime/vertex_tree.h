@@ -16,6 +16,7 @@
 // position, a bounding-sphere radius covering its children's, a normal cone and an error.
 #pragma once
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -90,5 +91,20 @@ bool validate_vertex_tree(const VertexTree& tree, std::string* message);
 
 // Fills tree.bounds from the per-node arrays. Builders and readers call it; fronts need it.
 void pack_vertex_bounds(VertexTree& tree);
+
+// Leaves that are roots never split or merge; they sit in every region.
+inline constexpr uint8_t kSharedRegion = 0xff;
+
+// Cuts the tree into at most max_regions (1..254) regions whose fronts never touch each
+// other's nodes or faces: nodes linked by a parent, a dependency or a face (through their
+// leaves) share a region; fixed leaves (roots) are kSharedRegion. Components are dealt to the
+// least loaded region by leaf count, largest first, so the cut is deterministic. A hierarchy
+// built with HierarchyOptions::parts > 1 has at least that many components; any other has
+// one per mesh component. Writes region per node; returns the number of regions used (>= 1).
+// Allocates: call once per tree, not per frame.
+uint32_t vertex_tree_regions(std::vector<uint8_t>& region, const VertexTree& tree, uint32_t max_regions);
+
+// Region of a face: that of its first corner leaf outside kSharedRegion; 0 when all are fixed.
+uint8_t face_region(const VertexTree& tree, std::span<const uint8_t> region, uint32_t face);
 
 }  // namespace lod

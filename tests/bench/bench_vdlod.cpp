@@ -7,10 +7,15 @@
 //                          counters: median_ms, changes (splits + collapses) per frame, visited
 //   BM_FrontFullPass       baseline in the same binary: the same frames, every node re-judged
 //                          (no temporal coherence); ratio = smooth / full in BM_FrontSmooth
+//   BM_FrontSmoothRegions  the same motion on the mesh's hierarchy built in 2 parts (seam kept),
+//                          its 2 region fronts updated one after the other (Arg 1) or on 2
+//                          threads (Arg 2); one shared threshold; ratio = 1 thread / 2 threads
 //   BM_FrontTeleport       a jump across the model under a triangle cap: frames to settle,
 //                          most triangles seen vs the cap
 //   BM_SplitCollapse       raw splits + collapses per second on one core (refine all, coarsen all)
 #include <benchmark/benchmark.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -54,12 +59,16 @@ const MeshData& big_mesh() {
   return mesh;
 }
 
-Fixture& fixture() {
-  static std::unique_ptr<Fixture> f = [] {
+Fixture& fixture(uint32_t parts = 1) {
+  static std::unique_ptr<Fixture> cache[17];
+  std::unique_ptr<Fixture>& f = cache[std::min(parts, 16u)];
+  if (!f) f = [parts] {
     auto fx = std::make_unique<Fixture>();
     fx->mesh = big_mesh();
     const auto t0 = std::chrono::steady_clock::now();
-    const Status s = build_vertex_hierarchy(fx->tree, fx->mesh);
+    HierarchyOptions options;
+    options.parts = parts;
+    const Status s = build_vertex_hierarchy(fx->tree, fx->mesh, options);
     fx->build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!s) std::fprintf(stderr, "hierarchy build failed: %s\n", s.message.c_str());
     float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
@@ -155,6 +164,63 @@ BENCHMARK(BM_FrontSmooth)
     ->Arg(150)
     ->Arg(100);
 BENCHMARK(BM_FrontFullPass)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(30)->Arg(150);
+
+// One object in kParts regions: the whole frame (every region's front and the shared threshold
+// feedback), regions dealt to the threads by TBB's work stealing.
+constexpr uint32_t kParts = 8;
+void BM_FrontSmoothRegions(benchmark::State& state) {
+  Fixture& fx = fixture(kParts);
+  std::vector<uint8_t> region;
+  const uint32_t regions = vertex_tree_regions(region, fx.tree, kParts);
+  std::vector<VertexFront> fronts(regions);
+  for (uint32_t r = 0; r < regions; ++r) front_init(fronts[r], fx.tree, 1.f, region, static_cast<uint8_t>(r));
+  FrontParams p;
+  // No per-region cap: the shared feedback holds the target; a cap split by region would
+  // block the regions in view while the others have room.
+  p.hysteresis = 1.5f;
+  const int threads = static_cast<int>(state.range(0));
+  tbb::task_arena arena(threads);
+  const float distance = 0.6f * fx.size;
+  const double step = 0.005 * fx.size / distance;
+  double angle = 0;
+  uint64_t changes = 0, visited = 0, frames = 0, tris = 0;
+  double balance = 0;
+  auto frame = [&](const FrontView& v) {
+    uint64_t total = 0;
+    std::vector<FrontStats> st(regions);
+    arena.execute([&] {
+      tbb::parallel_for(0u, regions, [&](uint32_t r) { st[r] = front_update(fronts[r], fx.tree, v, p); });
+    });
+    for (uint32_t r = 0; r < regions; ++r) total += st[r].active_tris;
+    const float next = front_next_threshold(fronts[0].threshold, total, kTarget, p);
+    for (auto& f : fronts) front_set_threshold(f, next);
+    uint64_t ch = 0, vis = 0;
+    for (uint32_t r = 0; r < regions; ++r) ch += st[r].splits + st[r].collapses, vis += st[r].visited;
+    uint32_t most = 1;
+    for (const FrontStats& x : st) most = std::max(most, x.visited);
+    balance += double(vis) / most / regions;
+    return std::array<uint64_t, 3>{total, ch, vis};
+  };
+  for (int i = 0; i < 60; ++i) frame(orbit_view(fx, angle += step, distance));  // settle
+  std::vector<double> ms;
+  for (auto _ : state) {
+    const FrontView v = orbit_view(fx, angle += step, distance);
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = frame(v);
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(t);
+    ms.push_back(1e3 * t);
+    tris += r[0], changes += r[1], visited += r[2];
+    ++frames;
+  }
+  state.counters["regions"] = regions;
+  state.counters["visit_balance"] = balance / (frames + 60);  // mean / largest region's visits
+  state.counters["median_ms"] = median(ms);
+  state.counters["changes_per_frame"] = double(changes) / frames;
+  state.counters["visited_per_frame"] = double(visited) / frames;
+  state.counters["active_tris"] = double(tris) / frames;
+}
+BENCHMARK(BM_FrontSmoothRegions)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(300)->Arg(1)->Arg(2);
 
 // Teleport: settle at one side, jump to the opposite side and closer. Frames until the front
 // changes by under 1 % of its triangles, the most triangles of any frame vs the cap.
