@@ -460,6 +460,13 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
         __builtin_prefetch(rb + 16);
         __builtin_prefetch(pos + 3 * size_t(f.from));
         __builtin_prefetch(pos + 3 * size_t(f.to));
+        // A successful collapse adds the quadrics (88 bytes each, two lines).
+        const char* qa = reinterpret_cast<const char*>(&mesh.quadrics[f.from]);
+        const char* qb = reinterpret_cast<const char*>(&mesh.quadrics[f.to]);
+        __builtin_prefetch(qa);
+        __builtin_prefetch(qa + 64);
+        __builtin_prefetch(qb);
+        __builtin_prefetch(qb + 64);
       }
     }
     const Candidate& c = chunk[i % kChunk];
