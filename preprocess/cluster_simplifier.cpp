@@ -1,10 +1,12 @@
 // Grid vertex clustering with quadric representatives (see cluster_simplifier.h for the papers).
 //
-// Passes: normalise positions once; search the grid resolution (each probe: cell id per vertex,
-// then count the faces whose corners fall in three different cells); for the chosen grid,
-// number the occupied cells, sum each cell's face quadrics, solve for its vertex, and emit the
-// surviving faces once each. The face count that matters is after duplicates are removed,
-// which the cheap probe cannot see, so the search is re-aimed by the observed ratio.
+// Passes: normalise positions and compute face planes and vertex normals once; search the grid
+// resolution (each probe: cell id per vertex, then count the faces whose corners fall in three
+// different cells); for the chosen grid, number the occupied cells, split the cells whose
+// vertices face opposite ways, sum each cell's face quadrics, solve for its vertex, and emit
+// the surviving faces once each. The face count that matters is after the split and after
+// duplicates are removed, which the cheap probe cannot see, so the search is re-aimed by the
+// observed ratio.
 #include "preprocess/cluster_simplifier.h"
 
 #include <algorithm>
@@ -28,6 +30,7 @@ struct Prepared {
   std::vector<float> unit;          // positions in [0,1] of the longest axis
   std::vector<uint32_t> triangles;  // valid faces only
   std::vector<float> planes;        // per valid face: unit normal, offset, area (0s when degenerate)
+  std::vector<float> normals;       // per vertex, area-weighted
   float origin[3] = {0, 0, 0};
   float extent = 1;                 // longest side of the bounding box
   float span[3] = {1, 1, 1};        // each side / extent
@@ -87,6 +90,15 @@ void prepare(Prepared& p, const float* positions, size_t vertex_count, const uin
   p.triangles.resize(kept);
   p.planes.resize(5 * (kept / 3));
   p.area = area;
+  // Area-weighted vertex normals (unnormalised: only their directions are compared).
+  p.normals.assign(3 * vertex_count, 0.f);
+  for (size_t f = 0; f < kept / 3; ++f) {
+    const float* plane = &p.planes[5 * f];
+    for (int k = 0; k < 3; ++k) {
+      float* n = &p.normals[3 * size_t(p.triangles[3 * f + k])];
+      n[0] += plane[4] * plane[0], n[1] += plane[4] * plane[1], n[2] += plane[4] * plane[2];
+    }
+  }
 }
 
 struct Grid {
@@ -246,6 +258,7 @@ struct Scratch {
   std::vector<uint32_t> cluster, faces, out_faces;
   std::vector<uint64_t> table;
   std::vector<uint32_t> best_cluster, best_faces;
+  std::vector<uint32_t> reference, twin;
   CellTable cells;
 };
 
@@ -280,6 +293,25 @@ size_t number_cells(Scratch& s, const Prepared& p, const Grid& g, size_t expecte
       if (last == next) next++;
     }
     s.cluster[v] = last;
+  }
+  // A cell holding both sides of a thin part (a tube or sheet thinner than the cell) would
+  // fold them into one vertex, and the faces between them would vanish with the part: its
+  // vertices facing away from the cell's first vertex get a cluster of their own.
+  const size_t cells = next;
+  s.reference.assign(cells, ~0u);
+  s.twin.assign(cells, ~0u);
+  const float* nrm = p.normals.data();
+  for (size_t v = 0; v < p.vertex_count; ++v) {
+    const uint32_t c = s.cluster[v];
+    if (s.reference[c] == ~0u) {
+      s.reference[c] = uint32_t(v);
+      continue;
+    }
+    const float* r = nrm + 3 * size_t(s.reference[c]);
+    const float* n = nrm + 3 * v;
+    if (r[0] * n[0] + r[1] * n[1] + r[2] * n[2] >= 0) continue;
+    if (s.twin[c] == ~0u) s.twin[c] = next++;
+    s.cluster[v] = s.twin[c];
   }
   return next;
 }
@@ -392,15 +424,12 @@ size_t cluster_run(std::vector<uint32_t>& out_indices, std::vector<float>& out_p
   // Small targets: cluster to a few times the target, then let QEM edge collapse (cheap at that
   // size) choose which detail goes; clustering alone spends faces evenly over the grid.
   const size_t grid_target = target * kRefine * kRefineLimit <= faces ? target * kRefine : target;
-  Grid g = make_grid(p, 1);
   if (target == 0) {
-    const size_t clusters = number_cells(s, p, g, 64);
-    s.best_cluster.swap(s.cluster);
-    s.best_faces.clear();
-    unique_faces(s.faces, s.table, s.best_cluster, clusters, p, &s.best_faces);
-  } else {
-    g = search_grid(s, p, grid_target, options);
+    // Nothing asked for: no faces (one cell would still split by facing).
+    result.cell_size = p.extent;
+    return 0;
   }
+  const Grid g = search_grid(s, p, grid_target, options);
   s.cluster.swap(s.best_cluster);
   size_t clusters = 0;
   for (uint32_t c : s.cluster) clusters = std::max<size_t>(clusters, c + 1);
@@ -500,7 +529,9 @@ size_t cluster_run(std::vector<uint32_t>& out_indices, std::vector<float>& out_p
   if (grid_target != target) {
     ChainLevelOut level;
     QemOptions qo;
-    qo.move_nonmanifold = false;  // clustering leaves many; moving them costs accuracy here
+    // Split cells leave fins and doubled edges behind; locking their vertices would stall
+    // the finish above its target.
+    qo.move_nonmanifold = true;
     qo.attributes = out_attributes && ac ? out_attributes->data() : nullptr;
     qo.attribute_count = ac;
     qem_simplify_chain(&level, out_positions.data(), out_positions.size() / 3, out_indices.data(), out_indices.size(),

@@ -1,8 +1,11 @@
 // Aggressive simplifier for meshes with very many triangles: vertex clustering on a uniform
 // grid (Rossignac & Borrel 1993) with each cell's vertex placed by its summed face quadrics
 // (Lindstrom 2000, "Out-of-core simplification of large polygonal models"). The grid size is
-// searched so the result lands on a target triangle count. Topology may change (small parts
-// vanish, holes close, thin parts merge); every output face is non-degenerate and unique.
+// searched so the result lands on a target triangle count. A cell's vertices that face away
+// from its first vertex form a second cluster, so parts thinner than a cell (tubes, sheets)
+// keep both sides instead of vanishing with the faces between them. Topology may change
+// (small parts vanish, holes close, nearby parts merge); every output face is non-degenerate
+// and unique.
 //
 // Style follows meshoptimizer: output first, const inputs with counts, options last, return
 // the count written; scratch memory is owned by the call.

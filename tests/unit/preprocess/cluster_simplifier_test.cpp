@@ -169,6 +169,71 @@ TEST(ClusterSimplifier, TinyMeshKeepsFacesRatherThanVanishing) {
   expect_valid_unique_faces(out);
 }
 
+// A closed tube along x (faces outwards), far thinner than the cells a coarse target needs.
+Soup thin_tube(int rings, int segments, float radius) {
+  Soup s;
+  for (int r = 0; r <= rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      const double th = 2 * M_PI * k / segments;
+      s.positions.insert(s.positions.end(), {float(r) / float(rings), float(radius * std::cos(th)), float(radius * std::sin(th))});
+    }
+  const uint32_t first_cap = uint32_t(s.vertex_count());
+  s.positions.insert(s.positions.end(), {0, 0, 0, 1, 0, 0});
+  auto id = [&](int r, int k) { return uint32_t(r * segments + (k % segments)); };
+  for (int r = 0; r < rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      s.indices.insert(s.indices.end(), {id(r, k), id(r + 1, k + 1), id(r + 1, k)});
+      s.indices.insert(s.indices.end(), {id(r, k), id(r, k + 1), id(r + 1, k + 1)});
+    }
+  for (int k = 0; k < segments; ++k) {  // outward-facing caps
+    s.indices.insert(s.indices.end(), {first_cap, id(0, k + 1), id(0, k)});
+    s.indices.insert(s.indices.end(), {first_cap + 1, id(rings, k), id(rings, k + 1)});
+  }
+  return s;
+}
+
+TEST(ClusterSimplifier, TubeThinnerThanACellKeepsItsLength) {
+  // Both sides of the tube share every cell; folded into one vertex per cell, all its faces
+  // would degenerate and the tube would vanish. Split by facing, it survives as a ribbon.
+  const Soup tube = thin_tube(200, 8, 0.004f);
+  const Out out = run(tube, tube.triangle_count() / 10);
+  expect_valid_unique_faces(out);
+  ASSERT_GT(out.result.triangles, 0u);
+  EXPECT_GT(out.result.cell_size, 0.008f);  // the grid is coarser than the tube
+  float lo = 1e30f, hi = -1e30f;
+  for (size_t v = 0; v < out.positions.size() / 3; ++v) lo = std::min(lo, out.positions[3 * v]), hi = std::max(hi, out.positions[3 * v]);
+  EXPECT_GT(hi - lo, 0.9f);
+  // The faces cover the tube's length, not just its ends.
+  std::set<int> covered;
+  for (uint32_t i : out.indices) covered.insert(int(out.positions[3 * size_t(i)] * 10));
+  EXPECT_GE(covered.size(), 9u);
+}
+
+TEST(ClusterSimplifier, ThinSlabKeepsItsThickness) {
+  // A flat closed slab, 0.6 wide and 0.02 thick (a four-sided tube squashed along z): one
+  // vertex per cell would fold top and bottom into one sheet at mid-thickness; split by
+  // facing, the upward faces stay on top and the downward ones below.
+  Soup slab = thin_tube(40, 4, 0.01f);
+  for (size_t v = 0; v < slab.vertex_count(); ++v) slab.positions[3 * v + 1] *= 30;
+  const Out out = run(slab, slab.triangle_count() / 8);
+  expect_valid_unique_faces(out);
+  EXPECT_GT(out.result.cell_size, 0.02f);
+  double up = 0, down = 0, up_z = 0, down_z = 0;
+  for (size_t t = 0; t < out.indices.size() / 3; ++t) {
+    const float* a = &out.positions[3 * size_t(out.indices[3 * t])];
+    const float* b = &out.positions[3 * size_t(out.indices[3 * t + 1])];
+    const float* c = &out.positions[3 * size_t(out.indices[3 * t + 2])];
+    const double nz = double(b[0] - a[0]) * (c[1] - a[1]) - double(b[1] - a[1]) * (c[0] - a[0]);
+    const double z = (double(a[2]) + b[2] + c[2]) / 3, area = 0.5 * std::fabs(nz);
+    if (nz > 0) up += area, up_z += area * z;
+    else down += area, down_z += area * z;
+  }
+  ASSERT_GT(up, 0.3);  // each side is about 1 x 0.6
+  ASSERT_GT(down, 0.3);
+  EXPECT_GT(up_z / up, 0.004);  // 0 when folded
+  EXPECT_LT(down_z / down, -0.004);
+}
+
 TEST(ClusterSimplifierRealMesh, DragonToPointEighteenPercent) {
   LOD_REQUIRE_SHARED_MESH(path, "stanford-dragon.ply");
   MeshData mesh;
