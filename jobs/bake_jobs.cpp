@@ -65,7 +65,9 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   mesh.indices.assign(chain.indices.begin() + l0.first_index,
                       chain.indices.begin() + l0.first_index + l0.index_count);
   const auto t0 = std::chrono::steady_clock::now();
-  if (Status s = build_vertex_hierarchy(chain.hierarchy, mesh); !s) return s;
+  HierarchyOptions options;
+  options.parts = model.vd_parts;
+  if (Status s = build_vertex_hierarchy(chain.hierarchy, mesh, options); !s) return s;
   char ms[32];
   std::snprintf(ms, sizeof ms, "%.0f", ms_since(t0));
   log.line("bake " + model.name + ": vertex hierarchy of " + std::to_string(chain.hierarchy.node_count()) +
@@ -85,7 +87,9 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
     task.status = Status::error(where + ": " + key_status.message);
     return;
   }
-  const std::filesystem::path asset = cache_dir / (model.name + "-" + hex64(key) + ".lod");
+  // A hierarchy cut into parts is another asset (the levels are the same; the tree is not).
+  const std::string parts = model.view_dependent && model.vd_parts > 1 ? "-p" + std::to_string(model.vd_parts) : "";
+  const std::filesystem::path asset = cache_dir / (model.name + "-" + hex64(key) + parts + ".lod");
 
   std::error_code ec;
   if (std::filesystem::exists(asset, ec)) {

@@ -105,6 +105,10 @@ constexpr StageEntry kStageTable[kStageCount] = {
 
 }  // namespace
 
+// Regions of one view-dependent object updated as separate tasks (more than threads, so work
+// stealing evens out regions in and out of view).
+constexpr uint32_t kMaxVdRegions = 8;
+
 struct FrameGraph::Impl {
   const Scene& scene;
   FrameGraphOptions options;
@@ -141,15 +145,26 @@ struct FrameGraph::Impl {
     uint32_t object = 0;
     uint32_t model = 0;
     EdgeCheck edges = EdgeCheck::corners;  // what its full mesh passes, so every front must
-    VertexFront front;
+    // One front per region of its model's hierarchy (vertex_tree_regions): regions update as
+    // separate tasks and share one pixel threshold.
+    std::vector<VertexFront> fronts;
+    std::vector<FrontStats> region_stats;
+    std::vector<uint32_t> node_index;  // fronts_compact_mesh scratch (several regions only)
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
-    FrontStats stats;
+    FrontStats stats;          // summed over the regions
     uint32_t moving = 0;
     int32_t slot = -1;  // this frame: index in Frame::objects, -1 = not visible
   };
   std::vector<VdObject> vd;
   std::vector<uint32_t> vd_visible;  // this frame: indices into vd
+  struct VdTask {
+    uint32_t vd_index, region;
+    uint32_t cap;  // max_triangles of this front this frame
+  };
+  std::vector<VdTask> vd_tasks;                   // this frame: one per (visible vd object, region)
+  std::vector<std::vector<uint8_t>> vd_regions;   // per model: region per hierarchy node
+  std::vector<uint32_t> vd_shared;                // per model: nodes active in every region
   std::vector<double> morph_start;   // per object: when its level last changed (seconds)
   std::vector<uint8_t> morph_from;   // per object: the level it morphs from
   std::vector<uint8_t> model_blends;  // per model: discrete levels with morph targets (not vd)
@@ -214,6 +229,19 @@ struct FrameGraph::Impl {
       const LodLevel& l0 = chain.levels[0];
       edges[m] = edge_check_of(std::span(chain.indices.data() + l0.first_index, l0.index_count));
     }
+    vd_regions.resize(models.model_count());
+    vd_shared.assign(models.model_count(), 0);
+    for (size_t m = 0; m < models.model_count(); ++m) {
+      const VertexTree& tree = scene.chains[m].hierarchy;
+      if (tree.empty()) continue;
+      // Regions only pay off when the hierarchy was built in parts: a one-part tree's extra
+      // regions are tiny components, kept together in one front.
+      if (vertex_tree_regions(vd_regions[m], tree, kMaxVdRegions) < 2) {
+        vd_regions[m].clear();
+        continue;
+      }
+      for (uint8_t r : vd_regions[m]) vd_shared[m] += r == kSharedRegion;
+    }
     for (uint32_t id = 0; id < count; ++id) {
       const uint32_t m = scene.objects.model[id];
       const VertexTree& tree = scene.chains[m].hierarchy;
@@ -222,7 +250,18 @@ struct FrameGraph::Impl {
       obj.object = id;
       obj.model = m;
       obj.edges = edges[m];
-      front_init(obj.front, tree, std::max(o_pixel_error(), 0.05f));
+      const float tau = std::max(o_pixel_error(), 0.05f);
+      if (vd_regions[m].empty()) {
+        front_init(obj.fronts.emplace_back(), tree, tau);
+      } else {
+        uint32_t regions = 0;
+        for (uint8_t r : vd_regions[m])
+          if (r != kSharedRegion) regions = std::max<uint32_t>(regions, r + 1u);
+        obj.fronts.resize(regions);
+        for (uint32_t r = 0; r < regions; ++r) front_init(obj.fronts[r], tree, tau, vd_regions[m], uint8_t(r));
+        obj.node_index.assign(tree.node_count(), 0);
+      }
+      obj.region_stats.resize(obj.fronts.size());
       vertex_morph_init(obj.morph, tree, options.geomorph_seconds);
       obj.shown = tree.positions;
     }
@@ -394,32 +433,69 @@ struct FrameGraph::Impl {
       o.slot = (k < visible_total && f.objects[k] == o.object) ? static_cast<int32_t>(k) : -1;
       if (o.slot >= 0) vd_visible.push_back(i);
     }
-    if (vd_visible.empty()) return;
     const ObjectSet& objs = scene.objects;
     const ModelTable& models = scene.models;
+    auto share_of = [&](const VdObject& o) {
+      // Its share of the budget: the triangles of the level selection gave it.
+      return std::max<uint32_t>(models.triangles[models.first_level[o.model] + f.levels[o.slot]], 1);
+    };
+    vd_tasks.clear();
+    for (uint32_t j : vd_visible) {
+      const VdObject& o = vd[j];
+      const uint32_t share = share_of(o);
+      const uint64_t cap = share + share / 10 + 16;
+      // Regions share the cap: each keeps what it had and may grow by an equal part of the
+      // room left, so their sum never passes it.
+      uint64_t used = 0;
+      for (const VertexFront& fr : o.fronts) used += fr.tri_count;
+      const uint64_t room = used < cap ? (cap - used) / o.fronts.size() : 0;
+      for (uint32_t r = 0; r < o.fronts.size(); ++r) {
+        const uint64_t c = o.fronts.size() == 1 ? cap : std::max<uint64_t>(o.fronts[r].tri_count + room, 1);
+        vd_tasks.push_back({j, r, static_cast<uint32_t>(std::min<uint64_t>(c, UINT32_MAX))});
+      }
+    }
+    if (vd_tasks.empty()) return;
     before_spawn();
     tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+        tbb::blocked_range<size_t>(0, vd_tasks.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
           task_begins();
-          for (size_t j = r.begin(); j != r.end(); ++j) {
-            VdObject& o = vd[vd_visible[j]];
+          for (size_t j = range.begin(); j != range.end(); ++j) {
+            VdObject& o = vd[vd_tasks[j].vd_index];
+            const uint32_t r = vd_tasks[j].region;
             const float pos[3] = {objs.x[o.object], objs.y[o.object], objs.z[o.object]};
             const FrontView fv = front_view_of(view, pos, objs.scale[o.object], objs.yaw[o.object]);
-            // Its share of the budget: the triangles of the level selection gave it.
-            const uint32_t share = models.triangles[models.first_level[o.model] + f.levels[o.slot]];
             FrontParams p;
             p.time = now();
             p.collapse_delay = options.geomorph_seconds;
-            p.target_triangles = std::max<uint32_t>(share, 1);
-            p.max_triangles = share + share / 10 + 16;
             p.hysteresis = options.vd_hysteresis;
+            p.max_triangles = vd_tasks[j].cap;
+            // One front: its own feedback; regions: feedback once per object after the join.
+            if (o.fronts.size() == 1) p.target_triangles = share_of(o);
             const VertexTree& tree = scene.chains[o.model].hierarchy;
-            o.stats = front_update(o.front, tree, fv, p);
-            vertex_morph_apply(o.morph, tree, o.front.frame_events(), p.time);
+            o.region_stats[r] = front_update(o.fronts[r], tree, fv, p);
+            vertex_morph_apply(o.morph, tree, o.fronts[r].frame_events(), p.time);
           }
           task_ends();
         });
     after_join();
+    for (uint32_t j : vd_visible) {
+      VdObject& o = vd[j];
+      if (o.fronts.size() == 1) {
+        o.stats = o.region_stats[0];
+        continue;
+      }
+      FrontStats sum;
+      for (const FrontStats& st : o.region_stats) {
+        sum.splits += st.splits, sum.collapses += st.collapses, sum.visited += st.visited;
+        sum.blocked += st.blocked, sum.active_tris += st.active_tris;
+        sum.full_pass = sum.full_pass || st.full_pass;
+      }
+      FrontParams p;
+      const float next = front_next_threshold(o.fronts[0].threshold, sum.active_tris, share_of(o), p);
+      for (VertexFront& fr : o.fronts) front_set_threshold(fr, next);
+      sum.threshold = next;
+      o.stats = sum;
+    }
   }
 
   // Level changes restart a per-object morph factor from the level last selected (newly
@@ -469,10 +545,13 @@ struct FrameGraph::Impl {
       const VdObject& o = vd[vd_visible[j]];
       VdObjectFrame& e = f.vd_objects[j];
       e.object = o.object;
+      // Fixed seam vertices are active in every region but written once.
+      uint32_t active = 0, tris = 0;
+      for (const VertexFront& fr : o.fronts) active += fr.active_count, tris += fr.tri_count;
       e.first_vertex = vertices;
-      e.vertex_count = o.front.active_count;
+      e.vertex_count = active - uint32_t(o.fronts.size() - 1) * vd_shared[o.model];
       e.first_index = indices;
-      e.index_count = 3 * o.front.tri_count;
+      e.index_count = 3 * tris;
       e.splits = o.stats.splits;
       e.collapses = o.stats.collapses;
       e.threshold = o.stats.threshold;
@@ -480,7 +559,7 @@ struct FrameGraph::Impl {
       e.oriented = o.edges != EdgeCheck::corners;
       vertices += e.vertex_count;
       indices += e.index_count;
-      f.vd_active_tris += o.front.tri_count;
+      f.vd_active_tris += tris;
       f.vd_splits += o.stats.splits;
       f.vd_collapses += o.stats.collapses;
     }
@@ -494,11 +573,22 @@ struct FrameGraph::Impl {
           for (size_t j = r.begin(); j != r.end(); ++j) {
             VdObject& o = vd[vd_visible[j]];
             VdObjectFrame& e = f.vd_objects[j];
-            e.moving = static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, o.front.vertices(), t));
-            front_compact_mesh(
-                std::span(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
-                std::span(f.vd_indices.data() + e.first_index, e.index_count), o.front,
-                scene.chains[o.model].hierarchy, o.shown);
+            const VertexTree& tree = scene.chains[o.model].hierarchy;
+            const std::span positions(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count));
+            const std::span tris(f.vd_indices.data() + e.first_index, e.index_count);
+            e.moving = 0;
+            for (const VertexFront& fr : o.fronts)
+              e.moving += static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, fr.vertices(), t));
+            if (o.fronts.size() == 1) {
+              front_compact_mesh(positions, tris, o.fronts[0], tree, o.shown);
+            } else {
+              const VertexFront* fronts[kMaxVdRegions];
+              for (size_t k = 0; k < o.fronts.size(); ++k) fronts[k] = &o.fronts[k];
+              uint32_t written = 0;
+              fronts_compact_mesh(positions, tris, o.node_index, std::span(fronts, o.fronts.size()), tree,
+                                  o.shown, &written);
+              assert(written == e.vertex_count);
+            }
           }
           task_ends();
         });

@@ -292,7 +292,7 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
   for (size_t i = 0; i < models.size(); ++i) {
     const toml::table& t = *models[i];
     const std::string key = indexed("model", i);
-    r.only_keys(t, key, {"name", "file", "ratios", "method", "extreme_threshold", "view_dependent"});
+    r.only_keys(t, key, {"name", "file", "ratios", "method", "extreme_threshold", "view_dependent", "vd_parts"});
     ModelConfig m;
     auto name = r.string(t, "name", key + ".name");
     if (!name) r.fail(key + ".name", "missing");
@@ -336,6 +336,8 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
       if (!b) r.fail(key + ".view_dependent", "must be true or false");
       m.view_dependent = b->get();
     }
+    r.integer_in(t, "vd_parts", key + ".vd_parts", 1, 64, m.vd_parts);
+    if (m.vd_parts > 1 && !m.view_dependent) r.fail(key + ".vd_parts", "needs view_dependent = true");
     c.models.push_back(std::move(m));
   }
 }

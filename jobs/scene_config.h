@@ -17,6 +17,9 @@ struct ModelConfig {
   std::filesystem::path file;   // resolved: config folder first, then the data directory
   BakeSettings bake;
   bool view_dependent = false;  // view_dependent = true: a vertex hierarchy, refined per frame
+  // vd_parts = N: the hierarchy is cut into N spatial parts (seams kept at full detail) whose
+  // fronts update on separate threads; 1 = one front per object.
+  uint32_t vd_parts = 1;
 };
 
 struct InstanceConfig {

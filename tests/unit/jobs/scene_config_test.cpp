@@ -92,6 +92,8 @@ file = "ball.off"
 ratios = [1.0, 0.5, 0.25]
 method = "extreme"
 extreme_threshold = 5000
+view_dependent = true
+vd_parts = 4
 
 [[model]]
 name = "other"
@@ -145,6 +147,10 @@ scale = 4
   EXPECT_EQ(c.models[0].bake.ratios, (std::vector<float>{1.0f, 0.5f, 0.25f}));
   EXPECT_EQ(c.models[0].bake.method, SimplifyMethod::extreme);
   EXPECT_EQ(c.models[0].bake.extreme_threshold, 5000u);
+  EXPECT_TRUE(c.models[0].view_dependent);
+  EXPECT_EQ(c.models[0].vd_parts, 4u);
+  EXPECT_FALSE(c.models[1].view_dependent);
+  EXPECT_EQ(c.models[1].vd_parts, 1u);
   EXPECT_EQ(c.models[1].file, d.data / "datamesh.off") << "then the data directory";
   EXPECT_TRUE(c.models[1].bake.ratios.empty()) << "absent ratios = defaults by size";
   EXPECT_EQ(c.models[1].bake.method, SimplifyMethod::qem);
@@ -294,6 +300,12 @@ TEST(SceneConfig, RefusesUnknownCameraPath) {
 }
 TEST(SceneConfig, RefusesFarBeforeNear) {
   expect_refused("[camera]\nnear = 10\nfar = 5\n" + kModel + kInstances, "camera.far");
+}
+TEST(SceneConfig, RefusesZeroVdParts) {
+  expect_refused(kModel + "view_dependent = true\nvd_parts = 0\n" + kInstances, "model[0].vd_parts", "[1, 64]");
+}
+TEST(SceneConfig, RefusesVdPartsWithoutViewDependence) {
+  expect_refused(kModel + "vd_parts = 4\n" + kInstances, "model[0].vd_parts", "view_dependent");
 }
 TEST(SceneConfig, RefusesZeroNear) {
   expect_refused("[camera]\nnear = 0\n" + kModel + kInstances, "camera.near");
