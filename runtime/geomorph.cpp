@@ -282,23 +282,74 @@ size_t level_morph_targets_by_collapse(std::span<uint32_t> target, std::span<con
   nearest_targets(target, fine_positions, coarse_positions);
   std::vector<uint32_t> work, next;
   std::vector<uint8_t> queued(nf, 0);
+  auto repair = [&] {
+    for (int round = 0; round < 16 && !work.empty(); ++round) {
+      next.clear();
+      for (uint32_t v : work) queued[v] = 0;
+      for (uint32_t v : work) {
+        const uint32_t best = choose(v);
+        if (best == target[v]) continue;
+        target[v] = best;
+        for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+          for (int k = 0; k < 3; ++k) {
+            const uint32_t u = fine_indices[3 * size_t(faces[i]) + k];
+            if (free[u] && !queued[u]) queued[u] = 1, next.push_back(u);
+          }
+      }
+      std::sort(next.begin(), next.end());
+      work.swap(next);
+    }
+    for (uint32_t v : work) queued[v] = 0;
+    work.clear();
+  };
   for (size_t v = 0; v < nf; ++v)
     if (free[v] && misses_if(v, target[v]) > 0) work.push_back(static_cast<uint32_t>(v)), queued[v] = 1;
-  for (int round = 0; round < 16 && !work.empty(); ++round) {
-    next.clear();
-    for (uint32_t v : work) queued[v] = 0;
-    for (uint32_t v : work) {
-      const uint32_t best = choose(v);
-      if (best == target[v]) continue;
-      target[v] = best;
-      for (uint32_t i = first[v]; i < first[v + 1]; ++i)
-        for (int k = 0; k < 3; ++k) {
-          const uint32_t u = fine_indices[3 * size_t(faces[i]) + k];
-          if (free[u] && !queued[u]) queued[u] = 1, next.push_back(u);
+  repair();
+  // What one vertex at a time cannot fix, two free corners of a missing triangle moving
+  // together often can (a chain of collapses through both): try every pair of their own and
+  // neighbours' targets, keep a pair that lowers the misses around both, then repair again.
+  std::vector<uint32_t> ca, cb;
+  auto candidates_of = [&](uint32_t v, std::vector<uint32_t>& out) {
+    out.assign(1, target[v]);
+    for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k) out.push_back(target[fine_indices[3 * size_t(faces[i]) + k]]);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  };
+  auto misses_around = [&](uint32_t a, uint32_t b) { return misses_if(a, target[a]) + misses_if(b, target[b]); };
+  for (int pass = 0; pass < 4; ++pass) {
+    bool improved = false;
+    for (size_t f = 0; f + 2 < fine_indices.size(); f += 3) {
+      const uint32_t* t = &fine_indices[f];
+      if (lands(coarse, target[t[0]], target[t[1]], target[t[2]])) continue;
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = t[e], b = t[(e + 1) % 3];
+        if (!free[a] || !free[b]) continue;
+        candidates_of(a, ca);
+        candidates_of(b, cb);
+        const uint32_t keep_a = target[a], keep_b = target[b];
+        uint32_t best = misses_around(a, b), best_a = keep_a, best_b = keep_b;
+        for (uint32_t x : ca)
+          for (uint32_t y : cb) {
+            target[a] = x, target[b] = y;
+            if (const uint32_t m = misses_around(a, b); m < best) best = m, best_a = x, best_b = y;
+          }
+        target[a] = best_a, target[b] = best_b;
+        if (best_a != keep_a || best_b != keep_b) {
+          improved = true;
+          for (uint32_t v : {a, b})
+            for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+              for (int k = 0; k < 3; ++k) {
+                const uint32_t u = fine_indices[3 * size_t(faces[i]) + k];
+                if (free[u] && u != a && u != b && !queued[u]) queued[u] = 1, work.push_back(u);
+              }
+          break;
         }
+      }
     }
-    std::sort(next.begin(), next.end());
-    work.swap(next);
+    std::sort(work.begin(), work.end());
+    repair();
+    if (!improved) break;
   }
   return level_morph_misses(target, fine_indices, coarse_indices);
 }

@@ -63,7 +63,8 @@ void level_morph_targets(std::span<uint32_t> target, std::span<const float> fine
 // survive merged (through a chain of edge collapses) into a coarse vertex one of its fine
 // neighbours also reaches, so among its own target and its neighbours' targets it takes the one
 // under which most of its fine triangles land on a coarse triangle or collapse to a line or
-// point (ties: the nearest), repeated until nothing changes. Where every fine triangle does,
+// point (ties: the nearest), repeated while that changes anything; then two free corners of a
+// triangle still missing try every pair of their candidates together. Where every fine triangle does,
 // the finer mesh morphed to t = 1 is the coarser mesh plus degenerate triangles. Returns the
 // number of fine triangles that still land on no coarse triangle (0 for clean edge-collapse
 // chains; clustering levels may leave some). Indices are level-local, 3 per triangle.
