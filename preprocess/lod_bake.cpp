@@ -23,7 +23,8 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 4;  // 4: morph targets (MRPH); 3: surface error samples in mesh order
+constexpr uint32_t kBakeFormatVersion = 5;  // 5: morph targets repaired in pairs; 4: morph targets (MRPH);
+                                             // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
 constexpr size_t kSmallModelTriangles = 20000;
