@@ -7,6 +7,8 @@
 //                          counters: median_ms, changes (splits + collapses) per frame, visited
 //   BM_FrontFullPass       baseline in the same binary: the same frames, every node re-judged
 //                          (no temporal coherence); ratio = smooth / full in BM_FrontSmooth
+//   BM_FrontScaling        cost vs changes and vs active size: camera speed (Arg 0, per mille of
+//                          the model's size per frame) x target active triangles (Arg 1, k)
 //   BM_FrontSmoothRegions  the same motion on the mesh's hierarchy built in 2 parts (seam kept),
 //                          its 2 region fronts updated one after the other (Arg 1) or on 2
 //                          threads (Arg 2); one shared threshold; ratio = 1 thread / 2 threads
@@ -22,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <numeric>
 #include <vector>
 
 #include "preprocess/mesh_clean.h"
@@ -164,6 +167,46 @@ BENCHMARK(BM_FrontSmooth)
     ->Arg(150)
     ->Arg(100);
 BENCHMARK(BM_FrontFullPass)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(30)->Arg(150);
+
+// Cost follows the changes (camera speed), not the active size (target triangles).
+void BM_FrontScaling(benchmark::State& state) {
+  Fixture& fx = fixture();
+  VertexFront front;
+  front_init(front, fx.tree, 1.f);
+  FrontParams p;
+  p.target_triangles = static_cast<uint32_t>(state.range(1)) * 1000;
+  p.hysteresis = 1.5f;
+  const float distance = 0.6f * fx.size;
+  const double step = 0.001 * double(state.range(0)) * fx.size / distance;
+  double angle = 0;
+  for (int i = 0; i < 80; ++i) front_update(front, fx.tree, orbit_view(fx, angle += step, distance), p);
+  std::vector<double> ms;
+  uint64_t changes = 0, visited = 0, frames = 0, tris = 0;
+  for (auto _ : state) {
+    const FrontView v = orbit_view(fx, angle += step, distance);
+    const auto t0 = std::chrono::steady_clock::now();
+    const FrontStats s = front_update(front, fx.tree, v, p);
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(t);
+    ms.push_back(1e3 * t);
+    changes += s.splits + s.collapses, visited += s.visited, tris += s.active_tris;
+    ++frames;
+  }
+  state.counters["median_ms"] = median(ms);
+  state.counters["changes_per_frame"] = double(changes) / frames;
+  state.counters["visited_per_frame"] = double(visited) / frames;
+  state.counters["active_tris"] = double(tris) / frames;
+  state.counters["us_per_change"] = 1e3 * std::accumulate(ms.begin(), ms.end(), 0.0) / std::max<uint64_t>(changes, 1);
+}
+BENCHMARK(BM_FrontScaling)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseManualTime()
+    ->Iterations(150)
+    ->Args({1, 200})
+    ->Args({5, 200})
+    ->Args({20, 200})
+    ->Args({5, 50})
+    ->Args({5, 400});
 
 // One object in kParts regions: the whole frame (every region's front and the shared threshold
 // feedback), regions dealt to the threads by TBB's work stealing.
