@@ -22,7 +22,7 @@ namespace {
 constexpr double kRegularisation = 1e-2;
 // Targets below faces / kRefineLimit are clustered to kRefine times the target and finished by
 // QEM edge collapse, which is cheap at that size and places the last faces where they matter.
-constexpr size_t kRefine = 2;
+constexpr double kRefine = 2;
 constexpr size_t kRefineLimit = 30;
 constexpr double kMaxGrid = 1 << 20;  // cells along the longest axis
 
@@ -63,6 +63,7 @@ void prepare(Prepared& p, const float* positions, size_t vertex_count, const uin
     for (int k = 0; k < 3; ++k) p.unit[3 * v + k] = finite[v] ? (positions[3 * v + k] - p.origin[k]) * inv : 0;
   p.triangles.resize(index_count - index_count % 3);
   p.planes.resize(5 * (index_count / 3));
+  p.normals.assign(3 * vertex_count, 0.f);
   size_t kept = 0;
   double area = 0;
   const float* u = p.unit.data();
@@ -82,6 +83,11 @@ void prepare(Prepared& p, const float* positions, size_t vertex_count, const uin
       plane[3] = -(n[0] * u[3 * a] + n[1] * u[3 * a + 1] + n[2] * u[3 * a + 2]);
       plane[4] = 0.5f * len;
       area += plane[4];
+      // Area-weighted vertex normals (unnormalised: only their directions are compared).
+      for (const uint32_t v : {a, b, c}) {
+        float* vn = &p.normals[3 * size_t(v)];
+        vn[0] += plane[4] * n[0], vn[1] += plane[4] * n[1], vn[2] += plane[4] * n[2];
+      }
     } else {
       plane[0] = plane[1] = plane[2] = plane[3] = plane[4] = 0;  // zero-area faces carry no plane
     }
@@ -90,15 +96,6 @@ void prepare(Prepared& p, const float* positions, size_t vertex_count, const uin
   p.triangles.resize(kept);
   p.planes.resize(5 * (kept / 3));
   p.area = area;
-  // Area-weighted vertex normals (unnormalised: only their directions are compared).
-  p.normals.assign(3 * vertex_count, 0.f);
-  for (size_t f = 0; f < kept / 3; ++f) {
-    const float* plane = &p.planes[5 * f];
-    for (int k = 0; k < 3; ++k) {
-      float* n = &p.normals[3 * size_t(p.triangles[3 * f + k])];
-      n[0] += plane[4] * plane[0], n[1] += plane[4] * plane[1], n[2] += plane[4] * plane[2];
-    }
-  }
 }
 
 struct Grid {
@@ -322,68 +319,88 @@ size_t number_cells(Scratch& s, const Prepared& p, const Grid& g, size_t expecte
 // holds. When those miss the tolerance, the aim is corrected by the observed unique/spanning
 // ratio and the search goes on. The best grid's clusters and faces are left in
 // s.best_cluster and s.best_faces.
-Grid search_grid(Scratch& s, const Prepared& p, size_t target, const ClusterOptions& options) {
+Grid search_grid(Scratch& s, const Prepared& p, size_t target, double tolerance, int max_probes) {
   const size_t faces = p.triangles.size() / 3;
   Grid best = make_grid(p, 1);
   double best_miss = std::numeric_limits<double>::max(), best_unique = -1;
-  double aim = double(target);
-  int probes = 0;
   // Counts are searched as t(n) = -ln(1 - n / faces), which grows about as cells^2 on every
   // grid: a surface of area A meets about kCellsPerArea * A * cells^2 cells, each spanning
   // face is one more, and on fine grids the count saturates at the face count.
   const double all = double(std::max<size_t>(faces, 1));
-  auto linear = [all](double n) { return -std::log(1 - std::min(n, 0.999 * all) / all); };
+  auto linear = [all](double n) { return -std::log(1 - std::min(std::max(n, 1.0), 0.999 * all) / all); };
   constexpr double kCellsPerArea = 2.5;
-  double cells = std::sqrt(linear(aim) * all / (kCellsPerArea * std::max(p.area, 1e-12)));
-  for (int round = 0; round < 4 && probes < options.max_probes; ++round) {
-    double lo = 1, hi = kMaxGrid;
-    double lo_n = 0;
-    cells = std::clamp(cells, 1.0, kMaxGrid);
-    Grid g = make_grid(p, cells);
-    double g_miss = std::numeric_limits<double>::max(), g_n = -1;
-    double last_cells = 0, last_t = 0;
+  // Every probe is kept: a later round (aiming elsewhere) brackets and interpolates with them.
+  struct Probe {
+    double cells, n;
+  };
+  std::vector<Probe> history;
+  // Next grid for `aim`: between the closest probes below and above it (log t against log
+  // cells), else a step from the closest probe with the local slope (2 when unknown).
+  auto predict = [&](double aim) {
     const double aim_t = linear(aim);
-    for (int i = 0; i < 12 && probes < options.max_probes; ++i, ++probes) {
-      const Grid candidate = make_grid(p, cells);
-      const double n = double(probe(s, p, candidate));
-      // The closest probe so far (equally close: the one with more faces) is the candidate.
-      const double m = std::fabs(n - aim);
-      if (m < g_miss || (m == g_miss && n > g_n)) g = candidate, g_miss = m, g_n = n;
-      if (m <= 0.5 * options.tolerance * aim) break;
-      if (n < aim) lo = cells, lo_n = n;
-      else hi = cells;
-      // Secant on log t(count) against log cells through the last two probes (slope 2 at first).
-      const double t = linear(std::max(n, 1.0));
-      double slope = 2;
-      if (last_t > 0 && t != last_t && cells != last_cells)
-        slope = std::clamp((std::log(t) - std::log(last_t)) / (std::log(cells) - std::log(last_cells)), 0.5, 4.0);
-      double next = cells * std::exp(std::clamp((std::log(aim_t) - std::log(t)) / slope, -1.5, 1.5));
-      if (lo_n > 0 && hi < kMaxGrid) {
-        // Bracketed: stay strictly inside, so the bracket shrinks even when the secant overshoots.
-        const double l = std::log(lo), h = std::log(hi);
-        next = std::exp(std::clamp(std::log(next), l + 0.1 * (h - l), h - 0.1 * (h - l)));
-      } else {
-        next = std::clamp(next, lo, hi);
+    const Probe* below = nullptr;
+    const Probe* above = nullptr;
+    for (const Probe& h : history) {
+      if (h.n < aim && (!below || h.n > below->n || (h.n == below->n && h.cells > below->cells))) below = &h;
+      if (h.n >= aim && (!above || h.n < above->n || (h.n == above->n && h.cells < above->cells))) above = &h;
+    }
+    if (below && above && below->n > 0 && above->cells > below->cells) {
+      const double l = std::log(below->cells), h = std::log(above->cells);
+      const double tl = std::log(linear(below->n)), th = std::log(linear(above->n));
+      const double f = th > tl ? (std::log(aim_t) - tl) / (th - tl) : 0.5;
+      // Strictly inside, so the bracket shrinks even when the interpolation overshoots.
+      return std::exp(l + std::clamp(f, 0.1, 0.9) * (h - l));
+    }
+    const Probe* near = below ? below : above;
+    double slope = 2;
+    for (const Probe& h : history)
+      if (&h != near && h.cells != near->cells && h.n > 0 && near->n > 0 && linear(h.n) != linear(near->n)) {
+        slope = std::clamp((std::log(linear(h.n)) - std::log(linear(near->n))) / (std::log(h.cells) - std::log(near->cells)),
+                           0.5, 4.0);
+        break;
       }
-      if (hi - lo < 1e-3 * lo) break;
-      last_cells = cells, last_t = t;
+    return near->cells * std::exp(std::clamp((std::log(aim_t) - std::log(linear(near->n))) / slope, -1.5, 1.5));
+  };
+  double aim = double(target);
+  double cells = std::sqrt(linear(aim) * all / (kCellsPerArea * std::max(p.area, 1e-12)));
+  int probes = 0;
+  double numbered = -1;  // grid last clustered for real
+  for (int round = 0; round < 4 && probes < max_probes; ++round) {
+    for (int i = 0; i < 12 && probes < max_probes; ++i, ++probes) {
+      cells = std::clamp(cells, 1.0, kMaxGrid);
+      const double n = double(probe(s, p, make_grid(p, cells)));
+      history.push_back({cells, n});
+      if (std::fabs(n - aim) <= 0.5 * tolerance * aim) break;
+      const double next = predict(aim);
+      if (std::fabs(next - cells) < 1e-3 * cells) break;
       cells = next;
     }
+    // The closest probe to the aim (equally close: the one with more faces) is clustered.
+    const Probe* g = &history.front();
+    for (const Probe& h : history) {
+      const double m = std::fabs(h.n - aim), gm = std::fabs(g->n - aim);
+      if (m < gm || (m == gm && h.n > g->n)) g = &h;
+    }
+    if (g->cells == numbered) break;  // nothing new to try
+    numbered = g->cells;
+    const Grid grid = make_grid(p, g->cells);
     // A closed surface has about half as many vertices as faces.
-    const size_t clusters = number_cells(s, p, g, size_t(g_n / 2) + 64);
+    const size_t clusters = number_cells(s, p, grid, size_t(g->n / 2) + 64);
     s.out_faces.clear();
     const double unique = double(unique_faces(s.faces, s.table, s.cluster, clusters, p, &s.out_faces));
     probes++;
     const double miss = std::fabs(unique - double(target));
     // Equally far: keep more faces (a tiny mesh may offer only "all" or "none").
     if (miss < best_miss || (miss == best_miss && unique > best_unique)) {
-      best_miss = miss, best_unique = unique, best = g;
+      best_miss = miss, best_unique = unique, best = grid;
       s.best_cluster.swap(s.cluster);
       s.best_faces.swap(s.out_faces);
     }
-    if (miss <= options.tolerance * double(target) || unique <= 0) break;
-    aim *= double(target) / unique;
-    cells = g.cells * std::sqrt(double(target) / std::max(unique, 1.0));
+    if (miss <= tolerance * double(target) || unique <= 0) break;
+    // Unique faces (after the facing split and duplicates) track the spanning count closely:
+    // aim the spanning count at what gives the target.
+    aim = std::max(1.0, g->n * double(target) / unique);
+    cells = predict(aim);
   }
   return best;
 }
@@ -423,13 +440,16 @@ size_t cluster_run(std::vector<uint32_t>& out_indices, std::vector<float>& out_p
 
   // Small targets: cluster to a few times the target, then let QEM edge collapse (cheap at that
   // size) choose which detail goes; clustering alone spends faces evenly over the grid.
-  const size_t grid_target = target * kRefine * kRefineLimit <= faces ? target * kRefine : target;
+  const size_t grid_target = double(target) * kRefine * kRefineLimit <= double(faces) ? size_t(double(target) * kRefine) : target;
   if (target == 0) {
     // Nothing asked for: no faces (one cell would still split by facing).
     result.cell_size = p.extent;
     return 0;
   }
-  const Grid g = search_grid(s, p, grid_target, options);
+  // The finish lands on the target exactly, so the grid it starts from need not.
+  constexpr double kRefineTolerance = 0.25;
+  const Grid g = search_grid(s, p, grid_target, grid_target != target ? kRefineTolerance : options.tolerance,
+                             options.max_probes);
   s.cluster.swap(s.best_cluster);
   size_t clusters = 0;
   for (uint32_t c : s.cluster) clusters = std::max<size_t>(clusters, c + 1);
