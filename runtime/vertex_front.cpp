@@ -12,6 +12,7 @@ namespace lod {
 namespace {
 
 constexpr uint32_t kBuckets = 4096;
+constexpr uint16_t kUnfiled = 0xffff;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct Decision {
@@ -91,11 +92,14 @@ class Updater {
   void split(uint32_t x);
   void collapse(uint32_t p);
   void unfile(uint32_t v);
-  void unfile(uint32_t v, int c);
   void file(uint32_t v, double slack_eye, double slack_frustum);
   void file(uint32_t v, int c, double slack);
   void file_next_frame(uint32_t v);
   void drain(uint32_t b, int c);
+  VertexFront::Bucket& bucket(int c, uint32_t b);
+  void append(int c, uint32_t b, uint32_t v);
+  void compact(int c, uint32_t b);
+  void release_chunks(uint32_t chunk);
   void stop_waiting(uint32_t v);
   void wait_for(uint32_t v, uint32_t d);
   void wake(uint32_t d);
@@ -135,7 +139,7 @@ class Updater {
       __builtin_prefetch(&t_.bounds[v]);
       __builtin_prefetch(&f_.state[v]);
       __builtin_prefetch(&f_.kids[v]);
-      __builtin_prefetch(&f_.links[2 * size_t(v)]);
+      __builtin_prefetch(&f_.filing[v]);
       if (f_.waiting) __builtin_prefetch(&f_.wait_on[v]);
     }
     if (head_ + kNear < tail_) {
@@ -164,21 +168,80 @@ class Updater {
   FrontStats stats_;
 };
 
-void Updater::unfile(uint32_t v, int c) {
-  VertexFront::Link& l = f_.links[2 * size_t(v) + c];
-  if (l.bucket == kNoNode) return;
-  uint32_t* heads = &f_.bucket_head[size_t(c) * (kBuckets + 1)];
-  if (l.prev != kNoNode)
-    f_.links[2 * size_t(l.prev) + c].next = l.next;
-  else
-    heads[l.bucket] = l.next;
-  if (l.next != kNoNode) f_.links[2 * size_t(l.next) + c].prev = l.prev;
-  l.bucket = kNoNode;
+VertexFront::Bucket& Updater::bucket(int c, uint32_t b) { return f_.buckets[size_t(c) * (kBuckets + 1) + b]; }
+
+// Takes v out of every bucket: its entries die with the old stamp.
+void Updater::unfile(uint32_t v) {
+  VertexFront::Filing& fl = f_.filing[v];
+  for (int c = 0; c < 2; ++c) {
+    if (fl.bucket[c] == kUnfiled) continue;
+    const uint32_t b = fl.bucket[c];
+    fl.bucket[c] = kUnfiled;
+    VertexFront::Bucket& bk = bucket(c, b);
+    --bk.live;
+    if (bk.total > 4 * bk.live + 4 * VertexFront::kChunkEntries) compact(c, b);
+  }
+  ++fl.stamp;
 }
 
-void Updater::unfile(uint32_t v) {
-  unfile(v, 0);
-  unfile(v, 1);
+// Drops the dead entries of a bucket in place (the live ones keep their order) and returns the
+// emptied chunks to the pool. Amortised: it runs when at least three quarters are dead.
+void Updater::compact(int c, uint32_t b) {
+  VertexFront::Bucket& bk = bucket(c, b);
+  uint32_t w_chunk = bk.head, w = 0, kept = 0;
+  for (uint32_t r_chunk = bk.head; r_chunk != kNoNode;) {
+    VertexFront::Chunk& rc = f_.chunks[r_chunk];
+    for (uint32_t i = 0; i < rc.count; ++i) {
+      const uint32_t v = rc.node[i];
+      if (f_.filing[v].stamp != rc.stamp[i]) continue;
+      if (w == VertexFront::kChunkEntries) {
+        f_.chunks[w_chunk].count = w;
+        w_chunk = f_.chunks[w_chunk].next;
+        w = 0;
+      }
+      f_.chunks[w_chunk].node[w] = v;
+      f_.chunks[w_chunk].stamp[w] = rc.stamp[i];
+      ++w, ++kept;
+    }
+    r_chunk = rc.next;
+  }
+  if (kept == 0) {
+    release_chunks(bk.head);
+    bk.head = kNoNode;
+  } else {
+    f_.chunks[w_chunk].count = w;
+    release_chunks(f_.chunks[w_chunk].next);
+    f_.chunks[w_chunk].next = kNoNode;
+  }
+  bk.total = bk.live = kept;
+}
+
+void Updater::release_chunks(uint32_t chunk) {
+  while (chunk != kNoNode) {
+    const uint32_t next = f_.chunks[chunk].next;
+    f_.chunks[chunk].next = f_.free_chunk;
+    f_.free_chunk = chunk;
+    chunk = next;
+  }
+}
+
+void Updater::append(int c, uint32_t b, uint32_t v) {
+  VertexFront::Bucket& bk = bucket(c, b);
+  if (bk.head == kNoNode || f_.chunks[bk.head].count == VertexFront::kChunkEntries) {
+    // front_init sizes the pool for the worst case the compaction rule allows.
+    assert(f_.free_chunk != kNoNode);
+    const uint32_t k = f_.free_chunk;
+    f_.free_chunk = f_.chunks[k].next;
+    f_.chunks[k].next = bk.head;
+    f_.chunks[k].count = 0;
+    bk.head = k;
+  }
+  VertexFront::Chunk& ch = f_.chunks[bk.head];
+  ch.node[ch.count] = v;
+  ch.stamp[ch.count] = f_.filing[v].stamp;
+  ++ch.count;
+  ++bk.live, ++bk.total;
+  f_.filing[v].bucket[c] = static_cast<uint16_t>(b);
 }
 
 void Updater::file(uint32_t v, int c, double slack) {
@@ -189,15 +252,7 @@ void Updater::file(uint32_t v, int c, double slack) {
   int64_t abs_bucket =
       at < double(cur + kBuckets - 1) ? static_cast<int64_t>(std::floor(at)) : cur + kBuckets - 1;
   abs_bucket = std::max(abs_bucket, cur);
-  const uint32_t b = static_cast<uint32_t>(abs_bucket % kBuckets);
-  uint32_t* heads = &f_.bucket_head[size_t(c) * (kBuckets + 1)];
-  VertexFront::Link& l = f_.links[2 * size_t(v) + c];
-  assert(l.bucket == kNoNode);
-  l.prev = kNoNode;
-  l.next = heads[b];
-  if (l.next != kNoNode) f_.links[2 * size_t(l.next) + c].prev = v;
-  heads[b] = v;
-  l.bucket = b;
+  append(c, static_cast<uint32_t>(abs_bucket % kBuckets), v);
 }
 
 void Updater::file(uint32_t v, double slack_eye, double slack_frustum) {
@@ -210,26 +265,25 @@ void Updater::file(uint32_t v, double slack_eye, double slack_frustum) {
 // Retry next frame whether or not the view moves (blocked by a limit or a neighbour).
 void Updater::file_next_frame(uint32_t v) {
   unfile(v);
-  VertexFront::Link& l = f_.links[2 * size_t(v)];
-  l.prev = kNoNode;
-  l.next = f_.bucket_head[kBuckets];
-  if (l.next != kNoNode) f_.links[2 * size_t(l.next)].prev = v;
-  f_.bucket_head[kBuckets] = v;
-  l.bucket = kBuckets;
+  append(0, kBuckets, v);
 }
 
-// Every node of bucket b of calendar c into the queue, the bucket emptied without relinking.
+// Every live node of bucket b of calendar c into the queue; the bucket's chunks go back.
 void Updater::drain(uint32_t b, int c) {
-  uint32_t* head = &f_.bucket_head[size_t(c) * (kBuckets + 1) + b];
-  for (uint32_t v = *head; v != kNoNode;) {
-    VertexFront::Link& l = f_.links[2 * size_t(v) + c];
-    const uint32_t next = l.next;
-    l.bucket = kNoNode;
-    unfile(v, 1 - c);  // judged now: out of the other calendar too
-    push(v);
-    v = next;
+  VertexFront::Bucket& bk = bucket(c, b);
+  for (uint32_t k = bk.head; k != kNoNode; k = f_.chunks[k].next) {
+    const VertexFront::Chunk& ch = f_.chunks[k];
+    for (uint32_t i = 0; i < ch.count; ++i) {
+      const uint32_t v = ch.node[i];
+      VertexFront::Filing& fl = f_.filing[v];
+      if (fl.stamp != ch.stamp[i]) continue;  // unfiled or filed again since
+      fl.bucket[c] = kUnfiled;                 // this bucket is going away
+      unfile(v);                               // judged now: out of the other calendar too
+      push(v);
+    }
   }
-  *head = kNoNode;
+  release_chunks(bk.head);
+  bk = VertexFront::Bucket{};
 }
 
 void Updater::stop_waiting(uint32_t v) {
@@ -694,6 +748,13 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold, std::span<
   auto mine = [&](uint32_t v) { return regions.empty() || regions[v] == region || regions[v] == kSharedRegion; };
   assert(t.bounds.size() == n && "pack_vertex_bounds(tree) first");
   const uint32_t inner = t.interior_count();
+  // Work arrays are sized for what this front can hold: its region's nodes and leaves.
+  size_t my_nodes = n, my_leaves = t.leaf_count, my_inner = inner;
+  if (!regions.empty()) {
+    my_nodes = my_leaves = my_inner = 0;
+    for (uint32_t v = 0; v < n; ++v)
+      if (mine(v)) ++my_nodes, t.is_leaf(v) ? ++my_leaves : ++my_inner;
+  }
   f.state.assign(n, VertexFront::kBelow);
   f.kids.assign(n, 0);
   for (uint32_t i = 0; i < inner; ++i) f.kids[t.children[2 * size_t(i)]] = VertexFront::kFirstChild;
@@ -704,8 +765,17 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold, std::span<
   f.face_slot.assign(t.face_count, kNoNode);
   f.active_count = f.tri_count = 0;
   f.threshold = threshold;
-  f.links.assign(2 * size_t(n), VertexFront::Link{});
-  f.bucket_head.assign(2 * (kBuckets + 1), kNoNode);
+  f.filing.assign(n, VertexFront::Filing{});
+  f.buckets.assign(2 * (kBuckets + 1), VertexFront::Bucket{});
+  // Live entries: at most two per active node (no more active nodes than leaves); a bucket is
+  // compacted before its entries pass 4 x live + 4 chunks; each bucket wastes under a chunk.
+  {
+    const size_t entries = 4 * 2 * my_leaves + 4 * size_t(VertexFront::kChunkEntries) * f.buckets.size();
+    const size_t count = entries / VertexFront::kChunkEntries + 2 * f.buckets.size() + 16;
+    f.chunks.resize(count);
+    for (size_t k = 0; k < count; ++k) f.chunks[k].next = k + 1 < count ? static_cast<uint32_t>(k + 1) : kNoNode;
+    f.free_chunk = 0;
+  }
   f.motion[0] = f.motion[1] = 0;
   f.cursor[0] = f.cursor[1] = 0;
   f.pending_motion = 0;
@@ -719,9 +789,9 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold, std::span<
   f.pending.assign(inner, 0);
   f.pending_pos.assign(inner, 0);
   f.pending_count = 0;
-  f.queue.assign(8 * size_t(n) + 8, 0);  // phase one, then phase two from the middle
-  f.stack.assign(n + 1, 0);
-  f.events.assign(3 * size_t(inner) + 16, FrontEvent{});
+  f.queue.assign(8 * my_nodes + 8, 0);  // phase one, then phase two from the middle
+  f.stack.assign(my_nodes + 1, 0);
+  f.events.assign(3 * my_inner + 16, FrontEvent{});
   f.event_count = 0;
 
   // Bounds of every node position, for the reach of view changes.
@@ -897,7 +967,7 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
 uint32_t front_stale_decisions(const VertexFront& f, const VertexTree& t, const FrontView& view,
                                const FrontParams& params, std::string* message) {
   const float hysteresis = std::max(1.f, params.hysteresis);
-  auto retrying = [&](uint32_t v) { return f.links[2 * size_t(v)].bucket == kBuckets; };
+  auto retrying = [&](uint32_t v) { return f.filing[v].bucket[0] == kBuckets; };
   uint32_t stale = 0;
   auto note = [&](std::string text) {
     if (stale++ == 0 && message) *message = std::move(text);

@@ -90,15 +90,30 @@ struct VertexFront {
   uint8_t region = kSharedRegion;
   std::vector<uint8_t> node_region;
 
-  // Two calendars of view-motion buckets (intrusive doubly linked lists over node ids):
-  // calendar 0 by eye travel, plane offset and threshold changes (object units); calendar 1
-  // by frustum-plane turning (radians), which moves a plane less near the eye than far away.
-  // A node may sit in both.
-  struct Link {
-    uint32_t next = kNoNode, prev = kNoNode, bucket = kNoNode;  // bucket = kNoNode when unfiled
+  // Two calendars of view-motion buckets: calendar 0 by eye travel, plane offset and threshold
+  // changes (object units); calendar 1 by frustum-plane turning (radians), which moves a plane
+  // less near the eye than far away. A node may sit in both, plus a retry-next-frame bucket.
+  // Buckets are lists of fixed chunks of (node, stamp) entries from one pool, appended and
+  // drained as arrays; unfiling a node only bumps its stamp, so its old entries read as dead
+  // (no neighbours to relink), and a bucket is compacted once mostly dead.
+  static constexpr uint32_t kChunkEntries = 63;
+  struct Chunk {
+    uint32_t next, count;
+    uint32_t node[kChunkEntries];
+    uint32_t stamp[kChunkEntries];
   };
-  std::vector<Link> links;            // 2 per node (calendar 0, 1), side by side
-  std::vector<uint32_t> bucket_head;  // per calendar kBuckets + 1; the last: retry next frame
+  struct Bucket {
+    uint32_t head = kNoNode;  // newest chunk
+    uint32_t live = 0, total = 0;
+  };
+  struct Filing {
+    uint32_t stamp = 0;
+    uint16_t bucket[2] = {0xffff, 0xffff};  // per calendar; 0xffff = not filed there
+  };
+  std::vector<Filing> filing;   // per node
+  std::vector<Bucket> buckets;  // per calendar kBuckets + 1; the last of calendar 0: retry
+  std::vector<Chunk> chunks;
+  uint32_t free_chunk = kNoNode;
   double motion[2] = {0, 0};          // accumulated bound on view change per calendar
   int64_t cursor[2] = {0, 0};         // first bucket not yet visited
   double bucket_width[2] = {1, 1};
