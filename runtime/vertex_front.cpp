@@ -83,6 +83,30 @@ Decision evaluate(const VertexTree& t, uint32_t v, const FrontView& view, float 
   return {false, slack, kInf};
 }
 
+// LSD radix sort of node ids, 11 bits per pass, only as many passes as the ids need;
+// `scratch` holds `count` ids.
+void sort_ids(uint32_t* ids, uint32_t count, uint32_t* scratch, uint32_t id_limit) {
+  if (count < 64) return std::sort(ids, ids + count);
+  constexpr uint32_t kBits = 11, kBins = 1u << kBits;
+  uint32_t histogram[kBins];
+  uint32_t* from = ids;
+  uint32_t* to = scratch;
+  int passes = 0;
+  for (uint32_t shift = 0; shift < 32 && (id_limit >> shift) > 0; shift += kBits, ++passes) {
+    std::fill(histogram, histogram + kBins, 0u);
+    for (uint32_t k = 0; k < count; ++k) ++histogram[(from[k] >> shift) & (kBins - 1)];
+    uint32_t sum = 0;
+    for (uint32_t& h : histogram) {
+      const uint32_t c = h;
+      h = sum;
+      sum += c;
+    }
+    for (uint32_t k = 0; k < count; ++k) to[histogram[(from[k] >> shift) & (kBins - 1)]++] = from[k];
+    std::swap(from, to);
+  }
+  if (passes % 2 == 1) std::copy_n(from, count, ids);
+}
+
 class Updater {
  public:
   Updater(VertexFront& f, const VertexTree& t, const FrontParams& p) : f_(f), t_(t), p_(p) {}
@@ -623,7 +647,7 @@ FrontStats Updater::run(const FrontView& view) {
   for (int c = 0; c < 2; ++c) f_.cursor[c] = std::max(f_.cursor[c], last[c] + 1);
   // Node ids follow space (Morton order per pass): judging them in id order walks memory
   // far more coherently than bucket order.
-  std::sort(f_.queue.begin(), f_.queue.begin() + tail_);
+  sort_ids(f_.queue.data(), tail_, f_.queue.data() + phase_one_end, t_.node_count());
   drain(kBuckets, 0);
 
   stats_.full_pass = full;
