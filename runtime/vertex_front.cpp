@@ -184,6 +184,11 @@ class Updater {
   FrontView view_;
   double reach_ = 0;
   double split_ = 0.5;
+
+ public:
+  bool bulk_ = false;  // refine_all / coarsen_all: everything is judged again next frame anyway
+
+ private:
   uint32_t head_ = 0, tail_ = 0;
   bool phase_two_ = false;
   uint32_t limit_ = 0;
@@ -367,7 +372,7 @@ void Updater::split(uint32_t x) {
   f_.active[f_.active_count++] = c2;
   f_.state[c1] = f_.state[c2] = VertexFront::kActive;
   f_.kids[x] = (f_.kids[x] & ~VertexFront::kKidsMask) | 2;
-  if (const uint32_t par = t_.bounds[x].parent; par != kNoNode) --f_.kids[par];
+  if (const uint32_t par = t_.parent[x]; par != kNoNode) --f_.kids[par];
   // Faces around x take the child holding their corner's leaf.
   const uint32_t lo1 = t_.leaf_lo[c1], hi1 = t_.leaf_hi[c1];
   for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
@@ -435,10 +440,10 @@ void Updater::collapse(uint32_t p) {
   f_.state[c1] = f_.state[c2] = VertexFront::kBelow;
   f_.state[p] = VertexFront::kActive;
   f_.kids[p] &= ~VertexFront::kKidsMask;
-  if (const uint32_t par = t_.bounds[p].parent; par != kNoNode && (++f_.kids[par], children_active(par))) {
+  if (const uint32_t par = t_.parent[p]; par != kNoNode && (++f_.kids[par], children_active(par))) {
     // par may merge now: its watching child (maybe p's sibling) judges it again.
     const uint32_t w = t_.children[2 * (par - t_.leaf_count)];
-    if (w != p) {
+    if (w != p && !bulk_) {
       unfile(w);
       push(w);
     }
@@ -872,6 +877,7 @@ FrontStats front_update(VertexFront& front, const VertexTree& tree, const FrontV
 void front_refine_all(VertexFront& f, const VertexTree& t) {
   FrontParams p;
   Updater u(f, t, p);
+  u.bulk_ = true;
   // Later nodes first: every dependency of a node was made before it, and its parent after
   // it, so when a node's turn comes its dependencies are active.
   for (uint32_t v = t.node_count(); v-- > t.leaf_count;)
@@ -886,6 +892,7 @@ void front_refine_all(VertexFront& f, const VertexTree& t) {
 void front_coarsen_all(VertexFront& f, const VertexTree& t) {
   FrontParams p;
   Updater u(f, t, p);
+  u.bulk_ = true;
   for (uint32_t v = t.leaf_count; v < t.node_count(); ++v) {
     const uint32_t i = v - t.leaf_count;
     if (f.state[v] == VertexFront::kSplit && f.state[t.children[2 * i]] == VertexFront::kActive &&
