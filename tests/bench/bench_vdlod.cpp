@@ -217,6 +217,14 @@ void BM_FrontSmoothRegions(benchmark::State& state) {
   const uint32_t regions = vertex_tree_regions(region, fx.tree, kParts);
   std::vector<VertexFront> fronts(regions);
   for (uint32_t r = 0; r < regions; ++r) front_init(fronts[r], fx.tree, 1.f, region, static_cast<uint8_t>(r));
+  // What the seam costs: its fixed vertices, and the base mesh (coarsest front) they hold up.
+  uint64_t base_tris = 0;
+  for (const VertexFront& f : fronts) base_tris += f.tri_count;
+  VertexFront whole;
+  front_init(whole, fixture().tree, 1.f);
+  state.counters["seam_vertices"] = static_cast<double>(std::count(region.begin(), region.end(), kSharedRegion));
+  state.counters["base_tris"] = static_cast<double>(base_tris);
+  state.counters["base_tris_one_part"] = whole.tri_count;
   FrontParams p;
   // No per-region cap: the shared feedback holds the target; a cap split by region would
   // block the regions in view while the others have room.
