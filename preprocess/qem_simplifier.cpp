@@ -371,7 +371,9 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
 
   // Every collapsible edge once, with its direction, position and cost.
   // Walked per vertex (each face's edge a -> next), so a's quadric is read once.
-  w.cands.clear();
+  // Written in place (a candidate built on the stack and pushed stalls on its own stores).
+  if (w.cands.size() < 3 * nt) w.cands.resize(3 * nt);
+  size_t n = 0;
   for (uint32_t a = 0; a < nv; ++a) {
     const uint8_t ka = w.kind[a];
     const Quadric& qa = mesh.quadrics[a];
@@ -383,7 +385,7 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
       if (w.offset[b + 1] - w.offset[b] > kMaxValence) continue;
       const bool border = (ka == kBorder && w.next[a] == b) || (kb == kBorder && w.prev[b] == a);
       if (!border && a > b) continue;  // an interior edge is seen from both faces
-      Candidate c;
+      Candidate& c = w.cands[n];
       const Quadric q = quadric_sum(qa, mesh.quadrics[b]);
       if (ka == kManifold && kb == kManifold) {
         c.from = a, c.to = b;
@@ -407,10 +409,9 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
         std::memcpy(c.p, pos + 3 * size_t(c.to), sizeof c.p);
       }
       c.cost = quadric_cost(q, c.p);
-      w.cands.push_back(c);
+      n++;
     }
   }
-  const size_t n = w.cands.size();
   if (n == 0) return 0;
   radix_sort(w, n);
 
