@@ -273,9 +273,13 @@ size_t probe(Scratch& s, const Prepared& p, const Grid& g) {
 
 // Dense cluster number per vertex (s.cluster); returns the number of clusters.
 // `expected`: about how many cells (the table grows past it).
-size_t number_cells(Scratch& s, const Prepared& p, const Grid& g, size_t expected) {
-  s.ids.resize(p.vertex_count);
-  cell_ids(s.ids.data(), p, g);
+// `probed`: s.ids32 already holds this grid's ids (it was the last probe).
+size_t number_cells(Scratch& s, const Prepared& p, const Grid& g, size_t expected, bool probed) {
+  const bool narrow = probed && narrow_ids(g);
+  if (!narrow) {
+    s.ids.resize(p.vertex_count);
+    cell_ids(s.ids.data(), p, g);
+  }
   s.cells.reset(std::min(expected, p.vertex_count));
   s.cluster.resize(p.vertex_count);
   uint32_t next = 0;
@@ -283,7 +287,7 @@ size_t number_cells(Scratch& s, const Prepared& p, const Grid& g, size_t expecte
   uint32_t last = 0;
   for (size_t v = 0; v < p.vertex_count; ++v) {
     // Neighbouring vertices often share a cell: skip the table then.
-    const uint64_t id = s.ids[v];
+    const uint64_t id = narrow ? uint64_t(s.ids32[v]) : s.ids[v];
     if (id != last_id) {
       last = s.cells.insert(id, next);
       last_id = id;
@@ -365,12 +369,15 @@ Grid search_grid(Scratch& s, const Prepared& p, size_t target, double tolerance,
   double cells = std::sqrt(linear(aim) * all / (kCellsPerArea * std::max(p.area, 1e-12)));
   int probes = 0;
   double numbered = -1;  // grid last clustered for real
+  double probed = -1;    // grid whose ids the last probe left
   for (int round = 0; round < 4 && probes < max_probes; ++round) {
     for (int i = 0; i < 12 && probes < max_probes; ++i, ++probes) {
       cells = std::clamp(cells, 1.0, kMaxGrid);
       const double n = double(probe(s, p, make_grid(p, cells)));
+      probed = cells;
       history.push_back({cells, n});
-      if (std::fabs(n - aim) <= 0.5 * tolerance * aim) break;
+      // Later rounds know the unique/spanning ratio: aim closer, a probe costs less than a round.
+      if (std::fabs(n - aim) <= (round == 0 ? 0.5 : 0.25) * tolerance * aim) break;
       const double next = predict(aim);
       if (std::fabs(next - cells) < 1e-3 * cells) break;
       cells = next;
@@ -385,7 +392,7 @@ Grid search_grid(Scratch& s, const Prepared& p, size_t target, double tolerance,
     numbered = g->cells;
     const Grid grid = make_grid(p, g->cells);
     // A closed surface has about half as many vertices as faces.
-    const size_t clusters = number_cells(s, p, grid, size_t(g->n / 2) + 64);
+    const size_t clusters = number_cells(s, p, grid, size_t(g->n / 2) + 64, g->cells == probed);
     s.out_faces.clear();
     const double unique = double(unique_faces(s.faces, s.table, s.cluster, clusters, p, &s.out_faces));
     probes++;
