@@ -359,7 +359,8 @@ Grid search_grid(Scratch& s, const Prepared& p, size_t target, double tolerance,
     double slope = 2;
     for (const Probe& h : history)
       if (&h != near && h.cells != near->cells && h.n > 0 && near->n > 0 && linear(h.n) != linear(near->n)) {
-        slope = std::clamp((std::log(linear(h.n)) - std::log(linear(near->n))) / (std::log(h.cells) - std::log(near->cells)),
+        slope = std::clamp((std::log(linear(h.n)) - std::log(linear(near->n))) /
+                               (std::log(h.cells) - std::log(near->cells)),
                            0.5, 4.0);
         break;
       }
@@ -445,14 +446,15 @@ size_t cluster_run(std::vector<uint32_t>& out_indices, std::vector<float>& out_p
     return result.triangles;
   }
 
-  // Small targets: cluster to a few times the target, then let QEM edge collapse (cheap at that
-  // size) choose which detail goes; clustering alone spends faces evenly over the grid.
-  const size_t grid_target = double(target) * kRefine * kRefineLimit <= double(faces) ? size_t(double(target) * kRefine) : target;
   if (target == 0) {
     // Nothing asked for: no faces (one cell would still split by facing).
     result.cell_size = p.extent;
     return 0;
   }
+  // Small targets: cluster to a few times the target, then let QEM edge collapse (cheap at that
+  // size) choose which detail goes; clustering alone spends faces evenly over the grid.
+  const bool refine = double(target) * kRefine * kRefineLimit <= double(faces);
+  const size_t grid_target = refine ? size_t(double(target) * kRefine) : target;
   // The finish lands on the target exactly, so the grid it starts from need not.
   constexpr double kRefineTolerance = 0.25;
   const Grid g = search_grid(s, p, grid_target, grid_target != target ? kRefineTolerance : options.tolerance,

@@ -175,7 +175,8 @@ Soup thin_tube(int rings, int segments, float radius) {
   for (int r = 0; r <= rings; ++r)
     for (int k = 0; k < segments; ++k) {
       const double th = 2 * M_PI * k / segments;
-      s.positions.insert(s.positions.end(), {float(r) / float(rings), float(radius * std::cos(th)), float(radius * std::sin(th))});
+      s.positions.insert(s.positions.end(),
+                         {float(r) / float(rings), float(radius * std::cos(th)), float(radius * std::sin(th))});
     }
   const uint32_t first_cap = uint32_t(s.vertex_count());
   s.positions.insert(s.positions.end(), {0, 0, 0, 1, 0, 0});
@@ -201,7 +202,8 @@ TEST(ClusterSimplifier, TubeThinnerThanACellKeepsItsLength) {
   ASSERT_GT(out.result.triangles, 0u);
   EXPECT_GT(out.result.cell_size, 0.008f);  // the grid is coarser than the tube
   float lo = 1e30f, hi = -1e30f;
-  for (size_t v = 0; v < out.positions.size() / 3; ++v) lo = std::min(lo, out.positions[3 * v]), hi = std::max(hi, out.positions[3 * v]);
+  for (size_t v = 0; v < out.positions.size() / 3; ++v)
+    lo = std::min(lo, out.positions[3 * v]), hi = std::max(hi, out.positions[3 * v]);
   EXPECT_GT(hi - lo, 0.9f);
   // The faces cover the tube's length, not just its ends.
   std::set<int> covered;
