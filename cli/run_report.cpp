@@ -55,6 +55,9 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"vd_active_tris", r.vd_active_tris},
           {"vd_splits", r.vd_splits},
           {"vd_collapses", r.vd_collapses},
+          {"morphing", r.morphing},
+          {"tris_morph_extra", r.tris_morph_extra},
+          {"budget_morph_reserve", r.budget_morph_reserve},
           {"ms", ms}};
 }
 
@@ -78,6 +81,8 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"mean_visible", s.mean_visible},
           {"mean_tris_in_view", s.mean_tris_in_view},
           {"mean_tris_selected", s.mean_tris_selected},
+          {"mean_tris_drawn", s.mean_tris_drawn},
+          {"max_drawn_over_budget", s.max_drawn_over_budget},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
           {"cached_models", s.cached_models},
@@ -104,6 +109,9 @@ FrameRecord record_of(const Frame& f) {
   r.vd_active_tris = f.vd_active_tris;
   r.vd_splits = f.vd_splits;
   r.vd_collapses = f.vd_collapses;
+  r.morphing = f.morphing;
+  r.tris_morph_extra = f.tris_morph_extra;
+  r.budget_morph_reserve = f.budget_morph_reserve;
   return r;
 }
 
@@ -113,7 +121,8 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.binding_frames = 0;
   std::vector<double> total;
   std::array<std::vector<double>, kStageCount> stage;
-  double vis = 0, inview = 0, sel = 0;
+  double vis = 0, inview = 0, sel = 0, drawn = 0;
+  s.max_drawn_over_budget = 0;
   for (const auto& r : records) {
     s.over_budget_frames += r.over_budget;
     s.binding_frames += (r.lowered_steps > 0 || r.over_budget);
@@ -122,6 +131,9 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     vis += r.visible;
     inview += double(r.tris_in_view);
     sel += double(r.tris_selected);
+    const double d = double(r.tris_selected + r.tris_morph_extra);
+    drawn += d;
+    if (r.budget > 0) s.max_drawn_over_budget = std::max(s.max_drawn_over_budget, d / double(r.budget));
   }
   const double n = std::max<double>(1, double(records.size()));
   s.median_ms = percentile(total, 0.5);
@@ -134,6 +146,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.mean_visible = vis / n;
   s.mean_tris_in_view = inview / n;
   s.mean_tris_selected = sel / n;
+  s.mean_tris_drawn = drawn / n;
 }
 
 std::string table_header() {
@@ -169,10 +182,11 @@ std::string summary_text(const RunSummary& s) {
   std::snprintf(buf, sizeof buf,
                 " ms\n  budget bound on %zu of %zu frames; over budget (coarsest levels exceed M) on %zu frames\n"
                 "  mean visible %.0f, mean triangles in view %.0f at full detail, %.0f selected (%.1fx fewer)\n"
+                "  drawn with level blends: mean %.0f, worst frame %.3f x M\n"
                 "  bake: %.0f ms, %zu models baked, %zu from cache; wall %.1f s\n",
                 s.binding_frames, s.frames, s.over_budget_frames, s.mean_visible, s.mean_tris_in_view,
                 s.mean_tris_selected, s.mean_tris_selected > 0 ? s.mean_tris_in_view / s.mean_tris_selected : 0.0,
-                s.bake_ms, s.baked_models, s.cached_models, s.wall_s);
+                s.mean_tris_drawn, s.max_drawn_over_budget, s.bake_ms, s.baked_models, s.cached_models, s.wall_s);
   o << buf;
   return o.str();
 }

@@ -22,6 +22,9 @@ struct FrameRecord {
   std::array<double, kStageCount> stage_ms{};
   double total_ms = 0;
   uint64_t vd_active_tris = 0, vd_splits = 0, vd_collapses = 0;  // view-dependent objects
+  uint32_t morphing = 0;             // objects blending two levels (drawn at the finer one)
+  uint64_t tris_morph_extra = 0;     // what that adds to tris_selected
+  uint64_t budget_morph_reserve = 0; // held back from M for last frame's blends
 };
 
 FrameRecord record_of(const Frame& frame);
@@ -36,6 +39,8 @@ struct RunSummary {
   double median_ms = 0, p99_ms = 0, mean_ms = 0, max_ms = 0;
   std::array<double, kStageCount> median_stage_ms{};
   double mean_visible = 0, mean_tris_in_view = 0, mean_tris_selected = 0;
+  // Drawn = selected + what blends add (triangle budgets): the mean and the worst frame vs M.
+  double mean_tris_drawn = 0, max_drawn_over_budget = 0;
   double bake_ms = 0;
   size_t baked_models = 0, cached_models = 0;
   double wall_s = 0;

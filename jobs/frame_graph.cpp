@@ -173,6 +173,8 @@ struct FrameGraph::Impl {
     uint64_t extra_tris = 0;
   };
   std::vector<MorphTotals> chunk_morph;  // geomorph: per chunk
+  uint64_t last_morph_extra = 0;         // last frame's Frame::tris_morph_extra
+  uint64_t morph_reserve = 0;            // this frame: held back from M for blends
 
   // Per frame.
   View view;
@@ -411,10 +413,19 @@ struct FrameGraph::Impl {
       const uint32_t* counts = selection_counts.data() + c * level_total;
       for (size_t k = 0; k < level_total; ++k) selection_total[k] += counts[k];
     }
+    // Blending objects draw their finer level: what last frame's blends added is held back
+    // from M (at most half of it, so blends never starve the selection), so that what is
+    // drawn, not only what is selected, stays near M.
+    SelectionParams so = options.selection;
+    morph_reserve = 0;
+    if (so.count == BudgetCount::triangles && so.reserve_blends) {
+      morph_reserve = std::min(last_morph_extra, so.budget / 2);
+      so.budget -= morph_reserve;
+    }
     selected = lower_under_budget(
         std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
         std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_model.data(), v),
-        scene.models, options.selection, selection_total, std::span<HeapEntry>(heap.data(), v));
+        scene.models, so, selection_total, std::span<HeapEntry>(heap.data(), v));
   }
 
   float o_pixel_error() const { return options.pixel_error; }
@@ -538,6 +549,7 @@ struct FrameGraph::Impl {
     f.morphing = 0;
     f.tris_morph_extra = 0;
     for (const MorphTotals& m : chunk_morph) f.morphing += m.morphing, f.tris_morph_extra += m.extra_tris;
+    last_morph_extra = f.tris_morph_extra;
     f.vd_objects.resize(vd_visible.size());
     uint32_t vertices = 0, indices = 0;
     f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;
@@ -636,6 +648,7 @@ struct FrameGraph::Impl {
       for (size_t l = 0; l < kHistogramLevels; ++l) f.level_histogram[l] += t.histogram[l];
     }
     f.budget = options.selection.budget;
+    f.budget_morph_reserve = morph_reserve;
     f.coarsest_cost = selected.coarsest_cost;
     f.over_budget = selected.over_budget;
     f.lowered_steps = selected.lowered_steps;
@@ -643,6 +656,7 @@ struct FrameGraph::Impl {
 
   // Forgets last frame's levels so that the next frame starts from scratch.
   void reset_temporal_state() {
+    last_morph_extra = 0;
     std::fill(state.prev_level.begin(), state.prev_level.end(), uint8_t{0});
     std::fill(state.was_visible.begin(), state.was_visible.end(), uint8_t{0});
   }

@@ -170,7 +170,7 @@ void read_run(const Reader& r, const toml::table& root, SceneConfig& c) {
 void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "budget", "budget");
   if (!t) return;
-  r.only_keys(*t, "budget", {"triangles", "count"});
+  r.only_keys(*t, "budget", {"triangles", "count", "reserve_blends"});
   if (auto v = r.integer(*t, "triangles", "budget.triangles")) {
     if (*v <= 0) r.fail("budget.triangles", "must be at least 1, got " + std::to_string(*v));
     c.selection.budget = static_cast<uint64_t>(*v);
@@ -182,6 +182,11 @@ void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
       c.selection.count = BudgetCount::levels;
     else
       r.fail("budget.count", "must be \"triangles\" or \"levels\", got \"" + *v + "\"");
+  }
+  if (const toml::node* n = t->get("reserve_blends")) {
+    const auto* b = n->as_boolean();
+    if (!b) r.fail("budget.reserve_blends", "must be true or false");
+    else c.selection.reserve_blends = b->get();
   }
 }
 

@@ -54,6 +54,9 @@ struct Frame {
   uint64_t tris_selected = 0;
   uint32_t morphing = 0;         // visible objects blending two levels (from_levels != levels)
   uint64_t tris_morph_extra = 0; // what drawing their finer level adds to tris_selected
+  // Held back from M by selection for last frame's blends (triangle budgets; at most M / 2):
+  // tris_selected <= budget - budget_morph_reserve unless over_budget.
+  uint64_t budget_morph_reserve = 0;
   uint64_t level_cost = 0;      // sum of 2^l over visible objects
   uint64_t budget = 0;          // M
   uint64_t coarsest_cost = 0;   // cost with all visible objects at their coarsest level

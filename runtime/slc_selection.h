@@ -20,6 +20,9 @@ enum class BudgetCount : uint8_t {
 struct SelectionParams {
   uint64_t budget = 2000000;  // M
   BudgetCount count = BudgetCount::triangles;
+  // For the frame graph (triangle budgets): objects blending two levels draw the finer one,
+  // so last frame's extra is held back from M (at most M / 2) to keep what is drawn near M.
+  bool reserve_blends = true;
 };
 
 struct HeapEntry {

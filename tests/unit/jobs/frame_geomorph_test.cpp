@@ -31,6 +31,7 @@ TEST(FrameGeomorph, FromLevelsFollowALevelChangeAndSettle) {
   o.threads = 2;
   o.grain = 64;
   o.selection.budget = UINT64_MAX;
+  o.selection.reserve_blends = false;  // the levels must hold still under a fixed budget
   o.geomorph_seconds = 0.25f;
   o.frame_seconds = 1.0f / 60;
   FrameGraph g(scene, o);
@@ -97,6 +98,7 @@ TEST(FrameGeomorph, GoingBackMidBlendContinuesFromTheSameShape) {
   o.threads = 2;
   o.grain = 64;
   o.selection.budget = UINT64_MAX;
+  o.selection.reserve_blends = false;  // the levels must hold still under a fixed budget
   o.geomorph_seconds = 0.25f;
   o.frame_seconds = 1.0f / 60;
   FrameGraph g(scene, o);
@@ -125,6 +127,52 @@ TEST(FrameGeomorph, GoingBackMidBlendContinuesFromTheSameShape) {
     EXPECT_NEAR(1 - f.morph[k], morph[k] + 4.f / 60, 1e-4f);  // one frame = 1/15 of the blend
   }
   EXPECT_GT(reversed, 0u) << "no object went back to its level when the budget came back";
+}
+
+// Selection holds back last frame's blend extra from M: selected + reserve stays within M,
+// and the worst drawn frame (selected + blends) is nearer M than without the reserve.
+TEST(FrameGeomorph, ReservingBlendsKeepsWhatIsDrawnNearerTheBudget) {
+  const SceneConfig config = test::synthetic_config(3000, 250);
+  const Scene scene = test::synthetic_scene(3000, 250);
+  uint64_t free_tris = 0;
+  {
+    FrameGraphOptions o;
+    o.selection.budget = UINT64_MAX;
+    FrameGraph g(scene, o);
+    Frame f;
+    g.run(view_at(config.camera, 0), f);
+    free_tris = f.tris_selected;
+  }
+  double worst[2] = {0, 0};
+  for (int reserve = 0; reserve < 2; ++reserve) {
+    FrameGraphOptions o;
+    o.threads = 2;
+    o.selection.budget = free_tris / 3;
+    o.selection.reserve_blends = reserve == 1;
+    o.geomorph_seconds = 0.25f;
+    o.frame_seconds = 1.0f / 60;
+    FrameGraph g(scene, o);
+    Frame f;
+    uint64_t last_extra = 0;
+    uint32_t morphing_frames = 0;
+    for (uint32_t n = 0; n < 240; ++n) {
+      g.run(view_at(config.camera, n), f);
+      if (reserve) {
+        EXPECT_EQ(f.budget_morph_reserve, std::min(last_extra, o.selection.budget / 2)) << "frame " << n;
+        if (!f.over_budget) {
+          EXPECT_LE(f.tris_selected + f.budget_morph_reserve, o.selection.budget) << "frame " << n;
+        }
+      } else {
+        EXPECT_EQ(f.budget_morph_reserve, 0u);
+      }
+      last_extra = f.tris_morph_extra;
+      morphing_frames += f.morphing > 0;
+      worst[reserve] = std::max(worst[reserve], double(f.tris_selected + f.tris_morph_extra) / o.selection.budget);
+    }
+    EXPECT_GT(morphing_frames, 20u) << "the path should make objects change level";
+  }
+  EXPECT_GT(worst[0], 1.0) << "without the reserve, blends push what is drawn over M";
+  EXPECT_LT(worst[1], worst[0]);
 }
 
 TEST(FrameGeomorph, NoGeomorphTimeMeansNothingBlends) {

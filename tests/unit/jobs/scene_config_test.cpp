@@ -59,6 +59,7 @@ rate_hz = 30.5
 [budget]
 triangles = 123456
 count = "levels"
+reserve_blends = false
 
 [lod]
 pixel_error = 2.5
@@ -123,6 +124,7 @@ scale = 4
   EXPECT_DOUBLE_EQ(c.rate_hz, 30.5);
   EXPECT_EQ(c.selection.budget, 123456u);
   EXPECT_EQ(c.selection.count, BudgetCount::levels);
+  EXPECT_FALSE(c.selection.reserve_blends);
   EXPECT_FLOAT_EQ(c.pixel_error, 2.5f);
   EXPECT_FLOAT_EQ(c.hysteresis, 0.5f);
   EXPECT_FLOAT_EQ(c.camera.lens.fov_y_deg, 70);
@@ -181,6 +183,7 @@ TEST(SceneConfig, MinimalConfigTakesTheDefaults) {
   EXPECT_EQ(c.threads, defaults.threads);
   EXPECT_EQ(c.selection.budget, defaults.selection.budget);
   EXPECT_EQ(c.selection.count, BudgetCount::triangles);
+  EXPECT_TRUE(c.selection.reserve_blends);
   EXPECT_EQ(c.camera.kind, PathKind::orbit);
   EXPECT_EQ(c.instances[0].seed, 1u);
   EXPECT_FALSE(c.instances[0].grid);
@@ -264,6 +267,9 @@ TEST(SceneConfig, RefusesZeroRate) {
 }
 TEST(SceneConfig, RefusesZeroBudget) {
   expect_refused("[budget]\ntriangles = 0\n" + kModel + kInstances, "budget.triangles");
+}
+TEST(SceneConfig, RefusesReserveBlendsThatIsNotABoolean) {
+  expect_refused("[budget]\nreserve_blends = 1\n" + kModel + kInstances, "budget.reserve_blends", "true or false");
 }
 TEST(SceneConfig, RefusesNegativeBudget) {
   expect_refused("[budget]\ntriangles = -100\n" + kModel + kInstances, "budget.triangles");
