@@ -75,16 +75,22 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   return rewrite ? write_lod_asset(*rewrite, chain) : Status::success();
 }
 
+// "model NAME (FILE): message", without naming the file twice when preprocess/ already did.
+std::string model_error(const ModelConfig& model, const std::string& message) {
+  const std::string file = model.file.string();
+  if (message.compare(0, file.size(), file) == 0) return "model " + model.name + ": " + message;
+  return "model " + model.name + " (" + file + "): " + message;
+}
+
 void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, LogLines& log,
               BakeTask& task) {
   const auto t0 = std::chrono::steady_clock::now();
   task.result.model = model.name;
-  const std::string where = "model " + model.name + " (" + model.file.string() + ")";
 
   Status key_status;
   const uint64_t key = bake_key(model.file, model.bake, &key_status);
   if (!key_status) {
-    task.status = Status::error(where + ": " + key_status.message);
+    task.status = Status::error(model_error(model, key_status.message));
     return;
   }
   // A hierarchy cut into parts is another asset (the levels are the same; the tree is not).
@@ -97,7 +103,7 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
     const Status read = read_lod_asset(asset, cached);
     if (read && cached.source_hash == key) {
       if (Status h = ensure_hierarchy(model, &asset, log, cached); !h) {
-        task.status = Status::error(where + ": " + h.message);
+        task.status = Status::error(model_error(model, h.message));
         return;
       }
       task.chain = std::move(cached);
@@ -132,16 +138,16 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
   };
   const Status baked = bake_model(model.file, model.name, settings, chain, &report, progress);
   if (!baked) {
-    task.status = Status::error(where + ": " + baked.message);
+    task.status = Status::error(model_error(model, baked.message));
     return;
   }
   if (Status h = ensure_hierarchy(model, nullptr, log, chain); !h) {
-    task.status = Status::error(where + ": " + h.message);
+    task.status = Status::error(model_error(model, h.message));
     return;
   }
   const Status written = write_lod_asset(asset, chain);
   if (!written) {
-    task.status = Status::error(where + ": cannot write cache " + asset.string() + ": " + written.message);
+    task.status = Status::error("model " + model.name + ": cannot write cache " + asset.string() + ": " + written.message);
     return;
   }
   task.result.levels = chain.levels.size();

@@ -737,10 +737,14 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
     const uint32_t begin = importer.polygon_offsets[f], end = importer.polygon_offsets[f + 1];
     for (uint32_t i = begin; i < end; ++i) {
       const int idx = importer.polygon_indices[i];
-      if (idx < 0 || size_t(idx) >= nv)
-        return Status::error(what + ": face " + std::to_string(f) + " references vertex " +
-                             (idx < 0 ? std::string("-1 (invalid)") : std::to_string(idx)) + " of " +
-                             std::to_string(nv) + openmesh_said);
+      if (idx < 0 || size_t(idx) >= nv) {
+        // OBJ numbers its vertices from 1: name the vertex as the file wrote it.
+        const bool obj = ext == ".obj";
+        const std::string number = idx < 0 ? std::string("-1 (invalid)") : std::to_string(obj ? idx + 1 : idx);
+        return Status::error(what + ": face " + std::to_string(f) + " references vertex " + number + " of " +
+                             std::to_string(nv) + (obj && idx >= 0 ? " (OBJ numbering, from 1)" : "") +
+                             openmesh_said);
+      }
     }
     // Fan triangulation; a polygon with fewer than 3 corners contributes nothing.
     for (uint32_t i = begin + 1; i + 1 < end; ++i)

@@ -150,6 +150,8 @@ TEST(BakeJobs, BrokenMeshNamesModelAndFileAndWritesNothingForIt) {
   ASSERT_FALSE(s.ok);
   EXPECT_NE(s.message.find("model c"), std::string::npos) << s.message;
   EXPECT_NE(s.message.find("broken.off"), std::string::npos) << s.message;
+  EXPECT_EQ(s.message.find("broken.off"), s.message.rfind("broken.off")) << "the file is named once: " << s.message;
+  EXPECT_NE(s.message.find("references vertex 7 of 3"), std::string::npos) << s.message;
   for (const fs::path& p : d.cache_files()) EXPECT_NE(p.filename().string().rfind("c-", 0), 0u) << p;
 }
 

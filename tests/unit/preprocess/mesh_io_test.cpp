@@ -149,7 +149,7 @@ TEST(MeshIo, RefusesPointsOnly) {
 TEST(MeshIo, RefusesObjIndexOutOfRange) {
   const fs::path dir = test::temp_dir("io-range");
   test::write_text(dir / "x.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 9\n");
-  expect_refused(dir / "x.obj", "face 1 references vertex 8 of 4");
+  expect_refused(dir / "x.obj", "face 1 references vertex 9 of 4 (OBJ numbering, from 1)");
   test::write_text(dir / "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
   expect_refused(dir / "zero.obj", "face 0 (line 4) has a corner without a valid vertex index ('0')");
 }
