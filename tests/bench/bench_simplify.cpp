@@ -475,8 +475,9 @@ int main(int argc, char** argv) {
   std::printf("(qem/mo t: meshopt_simplify wall time / lodkit QEM (2 threads) wall time, >= 1 is faster; cpu/cpu:\n"
               " the same with CPU seconds summed over threads, i.e. per-core efficiency; rms/mo, max/mo: error ratios,\n"
               " <= 1 is better; aggr/sl t: sloppy time / aggressive time; rms/sl@n: aggressive RMS / sloppy RMS at\n"
-              " the aggressive count (interpolated between sloppy results just below and above it); count%%: QEM achieved vs target; *: meshopt stopped above the target, errors\n"
-              " compared with QEM at the count meshopt reached)\n");
+              " the aggressive count, interpolated between sloppy results just below and above it; count%%: QEM\n"
+              " achieved vs target; *: meshopt stopped above the target, errors compared with QEM at the count\n"
+              " meshopt reached)\n");
 #endif
   return 0;
 }
