@@ -19,7 +19,7 @@ namespace lod {
 namespace {
 
 // Regularisation of each cell's 3x3 system towards the cell's vertex centroid.
-constexpr double kRegularisation = 1e-2;
+constexpr double kRegularisation = 1e-3;
 // Targets below faces / kRefineLimit are clustered to kRefine times the target and finished by
 // QEM edge collapse, which is cheap at that size and places the last faces where they matter.
 constexpr double kRefine = 2;
