@@ -27,9 +27,11 @@ struct QemOptions {
   float max_error = 0;
   // Weight of the boundary constraint planes relative to the surface's own planes.
   float border_weight = 10;
-  // Vertices on non-manifold edges (three or more faces) but on no border move like manifold
-  // ones (as in meshoptimizer); dirty scans otherwise stop far above their targets. Faces
-  // such collapses double are dropped. false locks those vertices instead.
+  // Non-manifold vertices (on edges with three or more faces, or with faces of both
+  // orientations) move like manifold ones (as in meshoptimizer), also at the open end of a fin;
+  // those on exactly one border loop slide along it. Dirty scans (Stanford's decimated ones)
+  // otherwise stop far above their targets. Faces such collapses double are dropped. false
+  // locks those vertices instead.
   bool move_nonmanifold = true;
   // Optional: nonzero = that input vertex never moves (others may collapse onto it).
   const uint8_t* vertex_lock = nullptr;
