@@ -17,7 +17,7 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITI
       -DLOD_BUILD_BENCH=OFF -DLOD_BUILD_VIEWER=OFF
 cmake --build build-tsan -j "$JOBS" --target test_jobs
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
-  ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 900 -R '^(FrameHandoff|Service|FrameGraph)\.'
+  ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 900 -R '^(FrameHandoff|Service|FrameGraph|FrameGraphVd|FrameGeomorph)\.'
 
 echo "== AddressSanitizer + UBSan: runtime, preprocess, jobs, integration =="
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=address \
