@@ -24,16 +24,23 @@ uint64_t extra_of(const Scene& scene, const Frame& f, uint32_t* morphing) {
   return extra;
 }
 
-TEST(FrameGeomorph, FromLevelsFollowALevelChangeAndSettle) {
-  const Scene scene = test::synthetic_scene(3000, 250);
-  const View view = view_at(test::synthetic_config(3000, 250).camera, 0);
+// 0.25 s blends at 60 Hz, no budget yet, and no blend reserve: the levels only change when a
+// test changes the budget.
+FrameGraphOptions still_levels_options() {
   FrameGraphOptions o;
   o.threads = 2;
   o.grain = 64;
   o.selection.budget = UINT64_MAX;
-  o.selection.reserve_blends = false;  // the levels must hold still under a fixed budget
+  o.selection.reserve_blends = false;
   o.geomorph_seconds = 0.25f;
   o.frame_seconds = 1.0f / 60;
+  return o;
+}
+
+TEST(FrameGeomorph, FromLevelsFollowALevelChangeAndSettle) {
+  const Scene scene = test::synthetic_scene(3000, 250);
+  const View view = view_at(test::synthetic_config(3000, 250).camera, 0);
+  const FrameGraphOptions o = still_levels_options();
   FrameGraph g(scene, o);
   Frame f;
   g.run(view, f);
@@ -94,13 +101,7 @@ TEST(FrameGeomorph, FromLevelsFollowALevelChangeAndSettle) {
 TEST(FrameGeomorph, GoingBackMidBlendContinuesFromTheSameShape) {
   const Scene scene = test::synthetic_scene(3000, 250);
   const View view = view_at(test::synthetic_config(3000, 250).camera, 0);
-  FrameGraphOptions o;
-  o.threads = 2;
-  o.grain = 64;
-  o.selection.budget = UINT64_MAX;
-  o.selection.reserve_blends = false;  // the levels must hold still under a fixed budget
-  o.geomorph_seconds = 0.25f;
-  o.frame_seconds = 1.0f / 60;
+  const FrameGraphOptions o = still_levels_options();
   FrameGraph g(scene, o);
   Frame f;
   g.run(view, f);
