@@ -129,10 +129,13 @@ class Updater {
   void wake(uint32_t d);
 
  private:
-  // First dependency of p that is not active, or kNoNode.
+  // First dependency of p that is not active, or kNoNode. The states are scattered: all are
+  // requested before the first is read, so their misses overlap.
   uint32_t missing_dep(uint32_t p) const {
     const uint32_t i = p - t_.leaf_count;
-    for (uint32_t k = t_.dep_offsets[i]; k < t_.dep_offsets[i + 1]; ++k)
+    const uint32_t lo = t_.dep_offsets[i], hi = t_.dep_offsets[i + 1];
+    for (uint32_t k = lo; k < hi; ++k) __builtin_prefetch(&f_.state[t_.deps[k]]);
+    for (uint32_t k = lo; k < hi; ++k)
       if (f_.state[t_.deps[k]] != VertexFront::kActive) return t_.deps[k];
     return kNoNode;
   }
@@ -495,12 +498,7 @@ bool Updater::force_split(uint32_t v) {
       continue;
     }
     const uint32_t i = x - t_.leaf_count;
-    uint32_t missing = kNoNode;
-    for (uint32_t k = t_.dep_offsets[i]; k < t_.dep_offsets[i + 1]; ++k)
-      if (f_.state[t_.deps[k]] != VertexFront::kActive) {
-        missing = t_.deps[k];
-        break;
-      }
+    const uint32_t missing = missing_dep(x);
     if (missing == kNoNode) {
       if ((p_.max_triangles && f_.tri_count + new_faces(x) > p_.max_triangles) ||
           (p_.max_operations && ops_ >= p_.max_operations)) {

@@ -72,13 +72,17 @@ struct FrontStats {
 struct VertexFront {
   static constexpr uint8_t kBelow = 0, kActive = 1, kSplit = 2;
 
-  std::vector<uint8_t> state;         // per node
+  // Per-node arrays a frame reads at random live on huge pages (fewer TLB misses).
+  template <class T>
+  using NodeArray = std::vector<T, HugePageAllocator<T>>;
+
+  NodeArray<uint8_t> state;           // per node
   // Per node: how many of its children are active (kKidsMask bits), and kFirstChild when it is
   // its parent's first child, the one that judges whether the parent should merge.
   static constexpr uint8_t kKidsMask = 3, kFirstChild = 0x80;
-  std::vector<uint8_t> kids;
+  NodeArray<uint8_t> kids;
   std::vector<uint32_t> active;       // active node ids, [0, active_count)
-  std::vector<uint32_t> active_pos;   // per node: index in `active`
+  NodeArray<uint32_t> active_pos;     // per node: index in `active`
   std::vector<uint32_t> tri_indices;  // 3 node ids per active triangle, [0, 3 * tri_count)
   std::vector<uint32_t> tri_face;     // face id per triangle slot
   std::vector<uint32_t> face_slot;    // per face: triangle slot or kNoNode
@@ -110,9 +114,9 @@ struct VertexFront {
     uint32_t stamp = 0;
     uint16_t bucket[2] = {0xffff, 0xffff};  // per calendar; 0xffff = not filed there
   };
-  std::vector<Filing> filing;   // per node
+  NodeArray<Filing> filing;     // per node
   std::vector<Bucket> buckets;  // per calendar kBuckets + 1; the last of calendar 0: retry
-  std::vector<Chunk> chunks;
+  NodeArray<Chunk> chunks;
   uint32_t free_chunk = kNoNode;
   double motion[2] = {0, 0};          // accumulated bound on view change per calendar
   int64_t cursor[2] = {0, 0};         // first bucket not yet visited
@@ -125,7 +129,7 @@ struct VertexFront {
 
   // Collapses blocked by a finer neighbour wait on it (intrusive lists keyed by the neighbour)
   // and are woken when it becomes active, so they are not polled every frame.
-  std::vector<uint32_t> wait_on, wait_next, wait_prev, wait_head;  // per node
+  NodeArray<uint32_t> wait_on, wait_next, wait_prev, wait_head;  // per node
   uint32_t waiting = 0;                                            // nodes on some wait list
 
   // Deferred collapses (geomorphing): per interior node the time it may collapse.

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "runtime/huge_page_allocator.h"
+
 namespace lod {
 
 inline constexpr uint32_t kNoNode = 0xffffffffu;
@@ -67,7 +69,7 @@ struct VertexTree {
 
   // Derived (pack_vertex_bounds): per node, what refinement tests read; per face corner, the
   // leaf's depth-first rank (so a split finds a corner's child without a leaf lookup).
-  std::vector<VertexBounds> bounds;
+  std::vector<VertexBounds, HugePageAllocator<VertexBounds>> bounds;
   std::vector<uint32_t> face_ranks;
   // Per incidence entry (inc_faces[k]): the leaf rank of the face's corner below its node,
   // times 4, plus that corner's index (0..2): a split or collapse touches only that corner.
