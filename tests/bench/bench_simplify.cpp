@@ -64,6 +64,19 @@ double time_best(int repeats, const std::function<void()>& fn) {
   return best;
 }
 
+// Best wall time of one method over repeats interleaved with its peers' (so that a neighbour's
+// burst on the shared machine hits every method alike), with the CPU seconds of that run.
+struct BestOf {
+  double wall = 1e30, cpu = 0;
+  void run(const std::function<void()>& fn) {
+    const double c0 = process_cpu_seconds();
+    const auto t0 = std::chrono::steady_clock::now();
+    fn();
+    const double w = seconds_since(t0);
+    if (w < wall) wall = w, cpu = process_cpu_seconds() - c0;
+  }
+};
+
 const lod::ParallelFor kTwoThreads = [](size_t n, const std::function<void(size_t)>& body) {
   std::vector<std::thread> threads;
   for (size_t i = 1; i < n; ++i) threads.emplace_back(body, i);
@@ -169,7 +182,7 @@ void run_mesh(Bench& b, const std::string& name, const MeshData& mesh, const std
   }
   const size_t T = mesh.triangle_count();
   // Best of several runs: the machine is shared, and a single run measures the neighbours too.
-  const int repeats = T < 200000 ? 5 : T < 2000000 ? 3 : 1;
+  const int repeats = T < 200000 ? 9 : T < 2000000 ? 5 : 2;
   std::printf("\n== %s: %zu triangles, %zu vertices\n", name.c_str(), T, mesh.vertex_count());
   std::vector<size_t> targets;
   for (double r : ratios) targets.push_back(size_t(std::llround(r * double(T))));
@@ -192,56 +205,64 @@ void run_mesh(Bench& b, const std::string& name, const MeshData& mesh, const std
   for (size_t i = 0; i < ratios.size(); ++i) {
     const double ratio = ratios[i];
     const size_t target = targets[i];
-    {
-      ChainLevelOut level;
-      const double sec = time_best(repeats, [&] {
+    // The four methods take turns, best of `repeats` each.
+    BestOf qem_time, aggressive_time, meshopt_time, sloppy_time;
+    ChainLevelOut level;
+    std::vector<uint32_t> aggressive_idx(mesh.indices.size());
+    std::vector<float> aggressive_pos(mesh.positions.size());
+    lod::ClusterResult res;
+    std::vector<uint32_t> meshopt_idx(mesh.indices.size()), sloppy_idx(mesh.indices.size());
+    size_t meshopt_n = 0, sloppy_n = 0;
+    for (int rep = 0; rep < repeats; ++rep) {
+      qem_time.run([&] {
         lod::qem_simplify_chain_split(&level, mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
                                       mesh.indices.size(), &target, 1, {}, kTwoThreads);
       });
-      b.add("lodkit-qem-2t", ratio, target, sec, level.positions.data(), level.positions.size() / 3,
-            level.indices.data(), level.indices.size());
-    }
-    size_t aggressive_count = 0;
-    {
-      std::vector<uint32_t> idx(mesh.indices.size());
-      std::vector<float> pos(mesh.positions.size());
-      lod::ClusterResult res;
-      const double sec = time_best(repeats, [&] {
-        lod::cluster_simplify(idx.data(), pos.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
-                              mesh.indices.size(), target, {}, &res);
+      aggressive_time.run([&] {
+        lod::cluster_simplify(aggressive_idx.data(), aggressive_pos.data(), mesh.positions.data(), mesh.vertex_count(),
+                              mesh.indices.data(), mesh.indices.size(), target, {}, &res);
       });
-      aggressive_count = res.triangles;
-      b.add("lodkit-aggressive", ratio, target, sec, pos.data(), res.vertices, idx.data(), 3 * res.triangles);
+#ifdef LOD_HAVE_MESHOPTIMIZER
+      meshopt_time.run([&] {
+        float err = 0;
+        meshopt_n = meshopt_simplify(meshopt_idx.data(), mesh.indices.data(), mesh.indices.size(), mesh.positions.data(),
+                                     mesh.vertex_count(), 12, 3 * target, 1.0f, 0, &err);
+      });
+      sloppy_time.run([&] {
+        float err = 0;
+        sloppy_n = meshopt_simplifySloppy(sloppy_idx.data(), mesh.indices.data(), mesh.indices.size(),
+                                          mesh.positions.data(), mesh.vertex_count(), 12, 3 * target, 1.0f, &err);
+      });
+#endif
     }
+    g_last_cpu = qem_time.cpu;
+    b.add("lodkit-qem-2t", ratio, target, qem_time.wall, level.positions.data(), level.positions.size() / 3,
+          level.indices.data(), level.indices.size());
+    const size_t aggressive_count = res.triangles;
+    g_last_cpu = aggressive_time.cpu;
+    b.add("lodkit-aggressive", ratio, target, aggressive_time.wall, aggressive_pos.data(), res.vertices,
+          aggressive_idx.data(), 3 * res.triangles);
 #ifdef LOD_HAVE_MESHOPTIMIZER
     {
-      std::vector<uint32_t> idx(mesh.indices.size());
-      size_t n = 0;
-      const double sec = time_best(repeats, [&] {
-        float err = 0;
-        n = meshopt_simplify(idx.data(), mesh.indices.data(), mesh.indices.size(), mesh.positions.data(),
-                             mesh.vertex_count(), 12, 3 * target, 1.0f, 0, &err);
-      });
-      b.add("meshopt", ratio, target, sec, mesh.positions.data(), mesh.vertex_count(), idx.data(), n);
-      if (double(n / 3) > 1.02 * double(target)) {
+      g_last_cpu = meshopt_time.cpu;
+      b.add("meshopt", ratio, target, meshopt_time.wall, mesh.positions.data(), mesh.vertex_count(),
+            meshopt_idx.data(), meshopt_n);
+      if (double(meshopt_n / 3) > 1.02 * double(target)) {
         // meshopt_simplify stopped above the target: compare errors at the count it reached too.
-        ChainLevelOut level;
-        const size_t reached = n / 3;
-        lod::qem_simplify_chain_split(&level, mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
+        ChainLevelOut at_count;
+        const size_t reached = meshopt_n / 3;
+        lod::qem_simplify_chain_split(&at_count, mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
                                       mesh.indices.size(), &reached, 1, {}, kTwoThreads);
-        b.add("qem@meshopt-count", ratio, reached, 0, level.positions.data(), level.positions.size() / 3,
-              level.indices.data(), level.indices.size());
+        b.add("qem@meshopt-count", ratio, reached, 0, at_count.positions.data(), at_count.positions.size() / 3,
+              at_count.indices.data(), at_count.indices.size());
       }
     }
     {
+      g_last_cpu = sloppy_time.cpu;
+      b.add("meshopt-sloppy", ratio, target, sloppy_time.wall, mesh.positions.data(), mesh.vertex_count(),
+            sloppy_idx.data(), sloppy_n);
       std::vector<uint32_t> idx(mesh.indices.size());
       size_t n = 0;
-      const double sec = time_best(repeats, [&] {
-        float err = 0;
-        n = meshopt_simplifySloppy(idx.data(), mesh.indices.data(), mesh.indices.size(), mesh.positions.data(),
-                                   mesh.vertex_count(), 12, 3 * target, 1.0f, &err);
-      });
-      b.add("meshopt-sloppy", ratio, target, sec, mesh.positions.data(), mesh.vertex_count(), idx.data(), n);
       // Sloppy at the count the aggressive one reached, for RMS at equal count. Its grid
       // steps rarely land on that count exactly, so the requests bracket it (one result below,
       // one above) and its RMS there is interpolated (log-log) between the two.
