@@ -160,6 +160,9 @@ class Updater {
   // A visit reads scattered records of the node and of its parent; fetching them a few queue
   // entries ahead overlaps those misses instead of paying them one after another.
   void prefetch_ahead() {
+    // A compiler barrier keeps these prefetches at the top of each visit: left free, GCC sank
+    // them behind the inlined visit and the bench ran ~1.5x slower (1.15 vs 0.75 ms).
+    asm volatile("" ::: "memory");
     constexpr uint32_t kNear = 6, kFar = 12;
     if (head_ + kFar < tail_) {
       const uint32_t v = f_.queue[head_ + kFar];
