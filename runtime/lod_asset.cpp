@@ -20,6 +20,10 @@
 // The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
 #include "runtime/lod_asset.h"
 
+#include <unistd.h>
+
+#include <atomic>
+
 #include <algorithm>
 #include <bit>
 #include <cerrno>
@@ -457,8 +461,16 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
 
 Status write_lod_asset(const std::filesystem::path& path, const LodChain& chain) {
   const std::vector<uint8_t> bytes = encode_lod_asset(chain);
+  // A temporary name of its own per process and call: runs sharing a cache folder may write the
+  // same asset at once, and each rename then replaces the file whole (last one wins).
+  static std::atomic<uint64_t> serial{0};
   std::filesystem::path tmp = path;
-  tmp += ".tmp";
+  std::string suffix = ".";
+  suffix += std::to_string(::getpid());
+  suffix += '-';
+  suffix += std::to_string(serial++);
+  suffix += ".tmp";
+  tmp += suffix;
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
     if (!f) return refuse(path.string(), std::string("cannot create ") + tmp.string() + ": " + std::strerror(errno));

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstring>
 #include <filesystem>
+#include <functional>
+#include <thread>
 
 #include "runtime/lod_asset.h"
 #include "test_support.h"
@@ -63,7 +66,9 @@ TEST(LodAsset, WritesThroughTemporaryFileAndReadsBack) {
   const auto path = dir / "bunny.lod";
   const LodChain c = sample_chain();
   ASSERT_TRUE(write_lod_asset(path, c));
-  EXPECT_FALSE(std::filesystem::exists(dir / "bunny.lod.tmp"));
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1u) << "no temporary file is left behind";
   LodChain back;
   const Status st = read_lod_asset(path, back);
   ASSERT_TRUE(st) << st.message;
@@ -71,6 +76,30 @@ TEST(LodAsset, WritesThroughTemporaryFileAndReadsBack) {
   ASSERT_TRUE(write_lod_asset(path, test::fan_chain("other", {2})));  // replaces
   ASSERT_TRUE(read_lod_asset(path, back));
   EXPECT_EQ(back.name, "other");
+}
+
+// Two runs sharing a cache folder may write the same asset at the same moment: both must
+// succeed and leave one whole asset (ctest -j2 once failed on exactly this).
+TEST(LodAsset, ConcurrentWritersOfOneAssetAllSucceed) {
+  const auto dir = test::temp_dir("asset-race");
+  const auto path = dir / "same.lod";
+  const LodChain a = sample_chain(), b = test::fan_chain("other", {2});
+  std::atomic<int> failures{0};
+  auto writer = [&](const LodChain& c) {
+    for (int i = 0; i < 400; ++i)
+      if (!write_lod_asset(path, c)) ++failures;
+  };
+  std::thread t1(writer, std::cref(a)), t2(writer, std::cref(b));
+  t1.join();
+  t2.join();
+  EXPECT_EQ(failures.load(), 0);
+  LodChain back;
+  const Status st = read_lod_asset(path, back);
+  ASSERT_TRUE(st) << st.message;
+  EXPECT_TRUE(back.name == a.name || back.name == b.name);
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1u) << "no temporary file is left behind";
 }
 
 TEST(LodAsset, RefusesTruncationAtEveryOffset) {
