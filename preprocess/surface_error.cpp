@@ -138,9 +138,15 @@ Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const st
   return Status::success();
 }
 
-// Every vertex, then `count` area-weighted surface points.
+// Every vertex some triangle uses (an unused one is not on the surface: at distance 0 it would
+// only dilute the RMS), then `count` area-weighted surface points.
 std::vector<float> sample_surface(const TriangleMeshView& view, size_t count, uint64_t seed) {
-  std::vector<float> samples(view.positions, view.positions + 3 * view.vertex_count);
+  std::vector<uint8_t> used(view.vertex_count, 0);
+  for (size_t i = 0; i < view.index_count; ++i) used[view.indices[i]] = 1;
+  std::vector<float> samples;
+  samples.reserve(3 * view.vertex_count);
+  for (size_t v = 0; v < view.vertex_count; ++v)
+    if (used[v]) samples.insert(samples.end(), view.positions + 3 * v, view.positions + 3 * v + 3);
   const size_t nt = view.index_count / 3;
   std::vector<double> cumulative(nt);
   double total = 0;

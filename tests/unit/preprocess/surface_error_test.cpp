@@ -34,6 +34,22 @@ TEST(SurfaceError, OfAShiftedCopyIsTheShift) {
   EXPECT_NEAR(e.rms, 0.25f, 1e-6f);
 }
 
+// Vertices no triangle uses are not on the surface: they must not be sampled (a simplifier's
+// output that indexes the whole input would otherwise look closer than it is).
+TEST(SurfaceError, IgnoresVerticesNoTriangleUses) {
+  std::vector<float> shifted = kSquare;
+  for (size_t v = 0; v < 4; ++v) shifted[3 * v + 2] += 0.25f;
+  std::vector<float> padded = shifted;
+  for (int k = 0; k < 1000; ++k) padded.insert(padded.end(), {0.5f, 0.5f, 0.f});  // on the reference, unused
+  SurfaceError plain, with_unused;
+  SurfaceErrorSettings few;
+  few.surface_samples = 200;
+  ASSERT_TRUE(measure_surface_error(view(kSquare, kSquareTris), view(shifted, kSquareTris), few, plain).ok);
+  ASSERT_TRUE(measure_surface_error(view(kSquare, kSquareTris), view(padded, kSquareTris), few, with_unused).ok);
+  EXPECT_NEAR(with_unused.rms, 0.25f, 1e-6f);
+  EXPECT_EQ(with_unused.samples, plain.samples);
+}
+
 TEST(SurfaceError, IsSymmetricAndSeesWhatOnlyOneSideHas) {
   // b = a plus a far triangle: h(a,b) = 0 but h(b,a) is large; both orders report it.
   std::vector<float> b = kSquare;
