@@ -8,14 +8,19 @@
 // R2 (Luebke) for temporal coherence and coherent arrays: active vertices and triangles live
 // in dense arrays kept packed by swaps, so a consumer draws triangles [0, tri_count).
 //
-// Only changed nodes are visited: each active node is filed in a calendar of "camera motion"
-// buckets by how far the view may move before its decision could change (its slack, from
-// frustum plane distances, normal-cone angle and distance to the error's critical distance);
-// a frame visits only the buckets the accumulated motion has passed, plus nodes just made by
-// splits and collapses. A teleport passes every bucket and so re-evaluates the whole front.
+// Only changed nodes are visited: each active node is filed in calendars of view-motion
+// buckets by how much the view may change before its decision could (its slack: eye travel
+// for the error and normal-cone tests, plane turning scaled by the node's distance for the
+// frustum); a frame visits only the buckets the accumulated motion has passed, plus nodes just
+// made by splits and collapses, in node order with their records prefetched. A teleport passes
+// every bucket and so re-evaluates the whole front. Only a pair's first child watches whether
+// the pair should merge. front_stale_decisions checks that nothing a full re-evaluation would
+// change was missed.
 //
 // Everything is allocated by front_init; front_update allocates nothing and owns no threads.
-// Fronts of different objects (or of one tree by different views) are independent.
+// Fronts of different objects (or of one tree by different views) are independent, and so are
+// the fronts of the regions of one tree (vertex_tree_regions), which may run on different
+// threads at once.
 #pragma once
 #include <cstdint>
 #include <span>
