@@ -83,6 +83,30 @@ TEST(VertexFrontRegions, PartsGiveIndependentRegionsWithAFixedSeam) {
   }
 }
 
+// Absurd part counts on a tiny mesh: almost every vertex is on a seam, and it all still works.
+TEST(VertexFrontRegions, ManyPartsOnATinyMeshStayValid) {
+  const MeshData m = test::vd_sphere(6, 8);
+  for (uint32_t parts : {64u, 1000u}) {
+    Regions r = build(m, parts);
+    std::string msg;
+    ASSERT_TRUE(validate_vertex_tree(r.tree, &msg)) << msg;
+    ASSERT_GE(r.count, 1u);
+    std::vector<VertexFront> f(r.count);
+    for (uint32_t k = 0; k < r.count; ++k) front_init(f[k], r.tree, 1.f, r.region, uint8_t(k));
+    for (auto& fr : f) {
+      front_update(fr, r.tree, view_at({0, 0.3f, 2.5f}, {0, 0, 0}), FrontParams{});
+      ASSERT_TRUE(check_front(fr, r.tree, EdgeCheck::closed, &msg)) << parts << " parts: " << msg;
+    }
+    std::vector<const VertexFront*> fronts;
+    for (auto& fr : f) fronts.push_back(&fr);
+    std::vector<float> pos(3 * size_t(r.tree.node_count()));
+    std::vector<uint32_t> idx(3 * size_t(r.tree.face_count)), scratch(r.tree.node_count());
+    uint32_t nv = 0;
+    const uint32_t nt = fronts_compact_mesh(pos, idx, scratch, fronts, r.tree, {}, &nv);
+    EXPECT_TRUE(check_triangles({idx.data(), 3 * size_t(nt)}, nv, EdgeCheck::closed, &msg)) << msg;
+  }
+}
+
 TEST(VertexFrontRegions, OnePartHierarchyIsOneRegionPerComponent) {
   const MeshData two = test::vd_concat(test::vd_sphere(12, 16), test::vd_sphere(12, 16, 1, 3, 0));
   const Regions r = build(two, 1);
