@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <string>
 
@@ -208,6 +209,7 @@ VertexFront::Bucket& Updater::bucket(int c, uint32_t b) { return f_.buckets[size
 // Takes v out of every bucket: its entries die with the old stamp.
 void Updater::unfile(uint32_t v) {
   VertexFront::Filing& fl = f_.filing[v];
+  ++fl.stamp;  // first: a compaction below must already see v's entries as dead
   for (int c = 0; c < 2; ++c) {
     if (fl.bucket[c] == kUnfiled) continue;
     const uint32_t b = fl.bucket[c];
@@ -216,7 +218,6 @@ void Updater::unfile(uint32_t v) {
     --bk.live;
     if (bk.total > 4 * bk.live + 4 * VertexFront::kChunkEntries) compact(c, b);
   }
-  ++fl.stamp;
 }
 
 // Drops the dead entries of a bucket in place (the live ones keep their order) and returns the
@@ -263,8 +264,12 @@ void Updater::release_chunks(uint32_t chunk) {
 void Updater::append(int c, uint32_t b, uint32_t v) {
   VertexFront::Bucket& bk = bucket(c, b);
   if (bk.head == kNoNode || f_.chunks[bk.head].count == VertexFront::kChunkEntries) {
-    // front_init sizes the pool for the worst case the compaction rule allows.
-    assert(f_.free_chunk != kNoNode);
+    // front_init sizes the pool for the worst case the compaction rule allows; should that
+    // ever fall short, compact everything rather than write past the pool.
+    if (f_.free_chunk == kNoNode)
+      for (int cc = 0; cc < 2; ++cc)
+        for (uint32_t bb = 0; bb <= kBuckets; ++bb) compact(cc, bb);
+    if (f_.free_chunk == kNoNode) std::abort();  // unreachable: live entries fit the pool
     const uint32_t k = f_.free_chunk;
     f_.free_chunk = f_.chunks[k].next;
     f_.chunks[k].next = bk.head;
@@ -977,6 +982,35 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
     }
     if (c[0] != c[1] && c[1] != c[2] && c[0] != c[2])
       return fail("face " + std::to_string(face) + " has three distinct active corners but is not drawn");
+  }
+  // The calendars' books: each bucket's live count is the entries that are still current,
+  // every filed node sits in the bucket it says, and only active nodes are filed.
+  if (!f.buckets.empty()) {
+    std::vector<uint8_t> seen(2 * size_t(n), 0);
+    for (int c = 0; c < 2; ++c)
+      for (uint32_t b = 0; b <= kBuckets; ++b) {
+        const VertexFront::Bucket& bk = f.buckets[size_t(c) * (kBuckets + 1) + b];
+        uint32_t live = 0, total = 0;
+        for (uint32_t k = bk.head; k != kNoNode; k = f.chunks[k].next)
+          for (uint32_t i = 0; i < f.chunks[k].count; ++i, ++total) {
+            const uint32_t v = f.chunks[k].node[i];
+            if (f.filing[v].stamp != f.chunks[k].stamp[i]) continue;
+            if (f.filing[v].bucket[c] != b || seen[2 * size_t(v) + c]++)
+              return fail("calendar " + std::to_string(c) + " bucket " + std::to_string(b) + " holds node " +
+                          std::to_string(v) + " which is filed elsewhere");
+            if (f.state[v] != VertexFront::kActive)
+              return fail("calendar holds node " + std::to_string(v) + " which is not active");
+            ++live;
+          }
+        if (live != bk.live || total != bk.total)
+          return fail("calendar " + std::to_string(c) + " bucket " + std::to_string(b) + " counts " +
+                      std::to_string(bk.live) + " live of " + std::to_string(bk.total) + " but holds " +
+                      std::to_string(live) + " of " + std::to_string(total));
+      }
+    for (uint32_t v = 0; v < n; ++v)
+      for (int c = 0; c < 2; ++c)
+        if (f.filing[v].bucket[c] != kUnfiled && !seen[2 * size_t(v) + c])
+          return fail("node " + std::to_string(v) + " is filed in a bucket that does not hold it");
   }
   if (edges == EdgeCheck::corners) return true;
   std::sort(directed.begin(), directed.end());

@@ -192,6 +192,23 @@ TEST(VertexFrontWalk, CoherentFramesAgreeWithAFullReevaluation) {
   }
 }
 
+// Turning on the spot never moves the eye calendar on, so its far buckets collect the dead
+// entries of every re-filed node and must be compacted; check_front audits the books.
+TEST(VertexFrontWalk, TurningInPlaceKeepsTheCalendarBooks) {
+  const MeshData m = test::vd_sphere(60, 80);
+  const VertexTree t = build(m);
+  VertexFront f;
+  front_init(f, t, 0.5f);
+  const glm::vec3 eye(0, 0.2f, 1.6f);
+  std::string msg;
+  for (int i = 0; i < 1500; ++i) {
+    const float a = 0.02f * i;
+    const glm::vec3 look = eye + glm::vec3(std::sin(a), 0.3f * std::sin(0.7f * a), -std::cos(a));
+    front_update(f, t, view_at(eye, look), FrontParams{});
+    if (i % 50 == 49) ASSERT_TRUE(check_front(f, t, EdgeCheck::closed, &msg)) << "frame " << i << ": " << msg;
+  }
+}
+
 TEST(VertexFrontWalk, FeedbackBringsTrianglesToTheTarget) {
   const MeshData m = test::vd_sphere(80, 100);
   const VertexTree t = build(m);
