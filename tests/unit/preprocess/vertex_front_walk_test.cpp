@@ -205,7 +205,9 @@ TEST(VertexFrontWalk, TurningInPlaceKeepsTheCalendarBooks) {
     const float a = 0.02f * i;
     const glm::vec3 look = eye + glm::vec3(std::sin(a), 0.3f * std::sin(0.7f * a), -std::cos(a));
     front_update(f, t, view_at(eye, look), FrontParams{});
-    if (i % 50 == 49) ASSERT_TRUE(check_front(f, t, EdgeCheck::closed, &msg)) << "frame " << i << ": " << msg;
+    if (i % 50 == 49) {
+      ASSERT_TRUE(check_front(f, t, EdgeCheck::closed, &msg)) << "frame " << i << ": " << msg;
+    }
   }
 }
 
