@@ -327,6 +327,27 @@ bool collapse_allowed(Work& w, const QemMesh& mesh, uint32_t a, uint32_t b, cons
   return w.kind[b] == kManifold ? left >= 3 : left >= 1;
 }
 
+constexpr size_t kDuplicateFace = ~size_t(0);
+
+// Face t's slot in an open-addressed table of face ids (a power-of-two size, ~0u = empty) keyed
+// by its vertex set, or kDuplicateFace when a face already in the table has the same three
+// vertices in any order.
+size_t face_set_slot(const std::vector<uint32_t>& table, const uint32_t* idx, size_t t) {
+  const size_t mask = table.size() - 1;
+  uint32_t k[3] = {idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]};
+  std::sort(k, k + 3);
+  size_t slot = size_t(((uint64_t(k[0]) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k[1]) * 0xc2b2ae3d27d4eb4full) ^
+                        (uint64_t(k[2]) * 0x165667b19e3779f9ull)) >> 7) & mask;
+  while (table[slot] != ~0u) {
+    const size_t f = table[slot];
+    uint32_t o[3] = {idx[3 * f], idx[3 * f + 1], idx[3 * f + 2]};
+    std::sort(o, o + 3);
+    if (o[0] == k[0] && o[1] == k[1] && o[2] == k[2]) return kDuplicateFace;
+    slot = (slot + 1) & mask;
+  }
+  return slot;
+}
+
 // Removes faces on the same three vertices as an earlier face; returns the faces left.
 size_t drop_duplicate_faces(Work& w, std::vector<uint32_t>& indices) {
   const size_t nf = indices.size() / 3;
@@ -337,21 +358,8 @@ size_t drop_duplicate_faces(Work& w, std::vector<uint32_t>& indices) {
   uint32_t* idx = indices.data();
   size_t kept = 0;
   for (size_t t = 0; t < nf; ++t) {
-    uint32_t k[3] = {idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]};
-    std::sort(k, k + 3);
-    size_t slot = size_t(((uint64_t(k[0]) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k[1]) * 0xc2b2ae3d27d4eb4full) ^
-                          (uint64_t(k[2]) * 0x165667b19e3779f9ull)) >> 7) & (cap - 1);
-    bool duplicate = false;
-    while (table[slot] != ~0u) {
-      uint32_t o[3] = {idx[3 * size_t(table[slot])], idx[3 * size_t(table[slot]) + 1], idx[3 * size_t(table[slot]) + 2]};
-      std::sort(o, o + 3);
-      if (o[0] == k[0] && o[1] == k[1] && o[2] == k[2]) {
-        duplicate = true;
-        break;
-      }
-      slot = (slot + 1) & (cap - 1);
-    }
-    if (duplicate) continue;
+    const size_t slot = face_set_slot(table, idx, t);
+    if (slot == kDuplicateFace) continue;
     // Kept faces move down in place; the table refers to their new slots.
     for (int c = 0; c < 3; ++c) idx[3 * kept + c] = idx[3 * t + c];
     table[slot] = uint32_t(kept);
@@ -597,21 +605,8 @@ void snapshot(ChainLevelOut& level, Work& w, const QemMesh& mesh) {
   uint32_t next = 0;
   const uint32_t* idx = mesh.indices.data();
   for (size_t t = 0; t < nf; ++t) {
-    uint32_t k[3] = {idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]};
-    std::sort(k, k + 3);
-    size_t slot = size_t((uint64_t(k[0]) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k[1]) * 0xc2b2ae3d27d4eb4full) ^
-                         (uint64_t(k[2]) * 0x165667b19e3779f9ull)) >> 7 & (cap - 1);
-    bool duplicate = false;
-    while (table[slot] != ~0u) {
-      uint32_t o[3] = {idx[3 * size_t(table[slot])], idx[3 * size_t(table[slot]) + 1], idx[3 * size_t(table[slot]) + 2]};
-      std::sort(o, o + 3);
-      if (o[0] == k[0] && o[1] == k[1] && o[2] == k[2]) {
-        duplicate = true;
-        break;
-      }
-      slot = (slot + 1) & (cap - 1);
-    }
-    if (duplicate) continue;
+    const size_t slot = face_set_slot(table, idx, t);
+    if (slot == kDuplicateFace) continue;
     table[slot] = uint32_t(t);
     for (int c = 0; c < 3; ++c) {
       const uint32_t v = idx[3 * t + c];
