@@ -11,6 +11,7 @@
 #include "jobs/bake_jobs.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
+#include "jobs/scene_motion.h"
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
 #include "runtime/vertex_front.h"
@@ -26,7 +27,8 @@ bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
   uint64_t tris = 0, splits = 0, collapses = 0;
   for (size_t k = 0; k < f.vd_objects.size(); ++k) {
     const VdObjectFrame& o = f.vd_objects[k];
-    if (o.object >= scene.objects.size() || scene.chains[scene.objects.model[o.object]].hierarchy.empty()) {
+    if (o.entry >= f.models.size() || f.objects[o.entry] != o.object ||
+        scene.chains[f.models[o.entry]].hierarchy.empty()) {
       std::snprintf(buf, sizeof buf, "vd entry %zu: object %u is not view-dependent", k, o.object);
       *why = buf;
       return false;
@@ -64,19 +66,26 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
     *why = buf;
     return false;
   }
-  if (f.objects.size() != f.visible || f.levels.size() != f.visible || f.morph.size() != f.visible) {
+  if (f.objects.size() != f.visible || f.levels.size() != f.visible || f.morph.size() != f.visible ||
+      f.models.size() != f.visible || f.handles.size() != f.visible || f.transforms.size() != f.visible ||
+      f.view_masks.size() != f.visible) {
     *why = "per-object arrays do not match the visible count";
     return false;
   }
   uint64_t tris = 0;
   for (size_t i = 0; i < f.objects.size(); ++i) {
     const uint32_t id = f.objects[i];
-    if (id >= scene.objects.size() || (i > 0 && f.objects[i - 1] >= id)) {
+    if (id >= f.object_count || (i > 0 && f.objects[i - 1] >= id) || f.handles[i] == 0 || f.view_masks[i] == 0) {
       std::snprintf(buf, sizeof buf, "entry %zu: object id %u out of order or range", i, id);
       *why = buf;
       return false;
     }
-    const uint32_t m = scene.objects.model[id];
+    const uint32_t m = f.models[i];
+    if (m >= scene.models.model_count()) {
+      std::snprintf(buf, sizeof buf, "object %u: model %u of %zu", id, m, scene.models.model_count());
+      *why = buf;
+      return false;
+    }
     if (f.levels[i] >= scene.models.level_count[m]) {
       std::snprintf(buf, sizeof buf, "object %u: level %u of %u", id, f.levels[i], scene.models.level_count[m]);
       *why = buf;
@@ -140,7 +149,12 @@ int run_command(const RunArgs& args) {
   options.selection = config.selection;
   options.pixel_error = config.pixel_error;
   options.hysteresis = config.hysteresis;
-  Service service(scene, options, config.rate_hz);
+  std::vector<ObjectHandle> handles;
+  std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);
+  Service& service = *owned;
+  SceneMotion motion(config, scene.objects, handles);
+  // Frames are 1 / rate_hz apart on the service clock (1/60 s when the rate is unlimited).
+  const double dt = config.rate_hz > 0 ? 1.0 / config.rate_hz : 1.0 / 60;
 
   RunSummary summary;
   summary.config = std::filesystem::path(args.config).filename().string();
@@ -158,11 +172,17 @@ int run_command(const RunArgs& args) {
   const uint32_t every = config.frames <= 40 ? 1 : (config.frames + 29) / 30;
   if (!args.quiet) std::printf("%s\n", table_header().c_str());
   for (uint32_t n = 0; n < config.frames; ++n) {
-    if (!service.step(view_at(config.camera, n))) {
+    if (motion.moving() > 0) {
+      motion.stage(service, (n + 1) * dt);
+      service.commit(n + 1);
+    }
+    set_view(service, 0, view_at(config.camera, n));
+    if (!service.step(dt)) {
       std::fprintf(stderr, "lod run: frame %u failed; the service kept the last good frame\n", n);
       continue;
     }
-    const Frame& frame = service.latest_frame();
+    const FrameRef held = service.acquire_frame();
+    const Frame& frame = *held;
     if (args.validate) {
       std::string why;
       if (!validate_frame(frame, scene, records.empty() ? frame.index : records.back().frame + 1, &why)) {

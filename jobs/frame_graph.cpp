@@ -1,17 +1,15 @@
-// FrameGraph: wiring of the per-frame stages into one tbb::flow::graph.
+// FrameGraph: the node table of the per-frame stages, wired into one tbb::flow::graph.
 //
-//   view -> visibility -> importance -> selection -> vdlod -> geomorph -> publish
+// Every node names the columns it reads and writes (kNodes); a node depends on an earlier one
+// when one writes what the other reads or writes, the edges are those dependencies with the
+// implied ones removed, and the DOT comes from the same table. Adding a stage is one row of
+// the table and one member that runs it.
 //
-// Each node is a continue_node that coordinates one stage; the data-parallel stages split
-// the objects into fixed chunks of `grain` and run the runtime/ function per chunk inside a
-// parallel_for. Chunk boundaries do not depend on the thread count and every per-chunk
-// result lands in its own slot, merged in chunk order, so 1, 2 or N threads give
-// bit-identical frames. Selection is global (one budget) and runs serially, on the visible
-// objects that importance compacts in object order. vdlod updates the vertex front of every
-// visible view-dependent object (a model with a vertex hierarchy), one task per object, its
-// triangle target being the level selection gave it (its share of M); geomorph advances the
-// morph factor of level changes and the per-vertex morphs of splits and collapses, and writes
-// each view-dependent object's compact, geomorphed mesh into the frame.
+// The data-parallel nodes split the objects into fixed chunks of `grain` and run the runtime/
+// function per chunk inside a parallel_for. Chunk boundaries do not depend on the thread count
+// and every per-chunk result lands in its own slot, merged in chunk order, so 1, 2 or N threads
+// give bit-identical frames. Selection is global (one budget) and runs serially, on the visible
+// objects that importance compacts in object order.
 #include "jobs/frame_graph.h"
 
 #include <oneapi/tbb/blocked_range.h>
@@ -21,6 +19,8 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cassert>
 #include <chrono>
 #include <memory>
@@ -29,19 +29,27 @@
 
 #include "runtime/geomorph.h"
 #include "runtime/importance.h"
+#include "runtime/level_blend.h"
+#include "runtime/level_caps.h"
+#include "runtime/object_controls.h"
+#include "runtime/vd_share.h"
 #include "runtime/vertex_front.h"
+#include "runtime/view_masks.h"
 #include "runtime/visibility.h"
+#include "runtime/world_bounds.h"
 
 namespace lod {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Node = tbb::flow::continue_node<tbb::flow::continue_msg, tbb::flow::lightweight>;
+// Not lightweight: a lightweight node runs inside its predecessor's task, so two successors
+// of one node would run one after the other.
+using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 
-// ThreadSanitizer cannot see the synchronisation inside libtbb (a library not built with
-// it), so it would report every hand-over between a spawning thread and a task. These mark
-// the edges TBB guarantees: what precedes a spawn happens before the task runs, and what a
-// task does happens before the wait that joins it. No-ops in other builds.
+// ThreadSanitizer cannot see the synchronisation inside libtbb (a library not built with it),
+// so these mark the edges TBB guarantees, each on its own address so that work TBB runs side
+// by side (sibling chunks, independent nodes) gets no false ordering: a spawner releases
+// `spawn` and its tasks acquire it; tasks release `join` and the waiter acquires it.
 #if defined(__SANITIZE_THREAD__)
 #define LOD_TSAN 1
 #elif defined(__has_feature)
@@ -49,21 +57,18 @@ using Node = tbb::flow::continue_node<tbb::flow::continue_msg, tbb::flow::lightw
 #define LOD_TSAN 1
 #endif
 #endif
-// One address for every graph: a task must acquire before it reads its own captures.
 #ifdef LOD_TSAN
 extern "C" void __tsan_acquire(void* addr);
 extern "C" void __tsan_release(void* addr);
-char tbb_edge;
-void before_spawn() { __tsan_release(&tbb_edge); }
-void task_begins() { __tsan_acquire(&tbb_edge); }
-void task_ends() { __tsan_release(&tbb_edge); }
-void after_join() { __tsan_acquire(&tbb_edge); }
+inline void tsan_release(void* a) { __tsan_release(a); }
+inline void tsan_acquire(void* a) { __tsan_acquire(a); }
 #else
-inline void before_spawn() {}
-inline void task_begins() {}
-inline void task_ends() {}
-inline void after_join() {}
+inline void tsan_release(void*) {}
+inline void tsan_acquire(void*) {}
 #endif
+struct TsanEdge {
+  char spawn = 0, join = 0;
+};
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
@@ -86,22 +91,23 @@ std::span<const T> sub(const std::vector<T>& v, size_t begin, size_t end) {
   return std::span<const T>(v.data() + begin, end - begin);
 }
 
-struct StageEntry {
-  const char* name;
-  const char* does;
+// Columns the nodes share (bits of NodeSpec::reads / writes).
+enum Column : uint32_t {
+  kObjects = 1u << 0,     // the store's objects and options (commit writes them)
+  kBounds = 1u << 1,      // world spheres
+  kControls = 1u << 2,    // per-object rows, min levels, error scales, priorities, never_cull
+  kViews = 1u << 3,       // frusta and focal lengths
+  kVisibility = 1u << 4,  // per-view visibility, view masks, per-chunk visible counts
+  kEntries = 1u << 5,     // the frame's per-entry columns and the compacted selection inputs
+  kLevels = 1u << 6,      // the frame's levels (initial, then selected)
+  kBlend = 1u << 7,       // the store's blend state, the frame's morph factors and from-levels
+  kFronts = 1u << 8,      // view-dependent fronts and vertex morphs
+  kVdMesh = 1u << 9,      // the frame's view-dependent meshes
+  kTotals = 1u << 10,     // the frame's totals
+  kHistory = 1u << 11,    // the store's last-frame levels and visibility
 };
-// The node/edge table: one node per stage, a chain of edges in this order.
-constexpr StageEntry kStageTable[kStageCount] = {
-    {"view", "frustum planes, focal length, budget"},
-    {"visibility", "cull_spheres, parallel over chunks"},
-    {"importance",
-     "measure_objects + minima, importance_weights + choose_initial_levels, compaction, gather_selection, "
-     "parallel"},
-    {"selection", "lower_under_budget: heap over the visible set, serial (its gather pass runs in importance)"},
-    {"vdlod", "front_update per visible view-dependent object, parallel over objects"},
-    {"geomorph", "level morph factors; vertex morphs + compact meshes of vd objects, parallel"},
-    {"publish", "totals, levels -> prev_level, parallel"},
-};
+constexpr const char* kColumnNames[] = {"objects", "bounds",  "controls", "views",  "visibility", "entries",
+                                        "levels",  "blend",   "fronts",   "vd_mesh", "totals",    "history"};
 
 }  // namespace
 
@@ -110,238 +116,306 @@ constexpr StageEntry kStageTable[kStageCount] = {
 constexpr uint32_t kMaxVdRegions = 8;
 
 struct FrameGraph::Impl {
-  const Scene& scene;
+  struct NodeSpec {
+    Stage stage;
+    const char* does;
+    uint32_t reads, writes;
+    void (Impl::*run)();
+  };
+  static const NodeSpec kNodes[];
+  static constexpr size_t kNodeCount = kStageCount;
+
   FrameGraphOptions options;
-  size_t count = 0;  // objects
-  size_t grain = 1;
-  size_t chunks = 0;
-
-  ObjectState state;
-  // Visible objects compacted in object order (slot k <-> Frame::objects[k]), so that the
-  // serial selection streams over the visible set only, without a branch per object.
-  std::vector<float> visible_weight;
-  std::vector<uint32_t> visible_model;
-  std::vector<uint8_t> all_ones;  // the `visible` column of the compacted set
-  std::vector<HeapEntry> heap;           // selection: one entry per visible slot
-  SelectionTables selection_tables;      // per level: SLC of the next step, lowerable
-  std::vector<uint32_t> selection_counts;  // chunks x level_total: visible objects per level
-  std::vector<uint32_t> selection_total;   // level_total: the chunks' counts summed
-  std::vector<uint32_t> chunk_visible;  // visibility: visible objects per chunk
-  std::vector<uint32_t> chunk_offset;   // first compacted slot of each chunk
-  std::vector<ViewMinima> chunk_minima;
-  std::vector<ChunkTotals> chunk_totals;
-  // Publish counts objects per chain level (index into the ModelTable's per-level arrays),
-  // in kCountLanes interleaved copies so that consecutive increments of one level do not
-  // wait on each other; totals follow from the counts and these per-level tables.
-  static constexpr size_t kCountLanes = 4;
-  size_t level_total = 0;                // levels of all models
-  std::vector<uint32_t> level_counts;    // chunks x kCountLanes x level_total
-  std::vector<uint32_t> full_triangles;  // per level: triangles of its model's level 0
-  uint32_t visible_total = 0;
-
-  // View-dependent objects: one front and one morph state per object of a model with a
-  // vertex hierarchy, in object order.
-  struct VdObject {
-    uint32_t object = 0;
-    uint32_t model = 0;
+  std::shared_ptr<const ModelSet> set;
+  // Derived from the model set.
+  LevelCaps caps;                        // selection rows: models, then capped prefixes
+  SelectionTables selection_tables;      // per row level
+  size_t level_total = 0;                // levels of all rows
+  std::vector<uint32_t> full_triangles;  // per row level: triangles of its model's level 0
+  std::vector<uint8_t> model_blends;     // per model: discrete levels with morph targets (not vd)
+  struct VdModel {
     EdgeCheck edges = EdgeCheck::corners;  // what its full mesh passes, so every front must
-    // One front per region of its model's hierarchy (vertex_tree_regions): regions update as
-    // separate tasks and share one pixel threshold.
-    std::vector<VertexFront> fronts;
+    std::vector<uint8_t> regions;          // region per hierarchy node (empty: one front)
+    uint32_t region_count = 1;
+    uint32_t shared = 0;                   // nodes active in every region (seams)
+  };
+  std::vector<VdModel> vd_models;  // per model with a hierarchy (else default)
+
+  // The fixed scene's objects (FrameGraph(scene)).
+  ObjectStore own_store;
+  double own_clock = 0;
+
+  // Per frame.
+  ObjectStore* store = nullptr;
+  const FrameInput* input = nullptr;
+  Frame* out = nullptr;
+  uint32_t view_count = 1;
+  std::array<View, kMaxViews> views{};
+  std::array<Frustum, kMaxViews> frusta{};
+  std::array<float, kMaxViews> focal{};
+  double time = 0;
+  uint64_t tick = 0;
+  size_t count = 0, grain = 1, chunks = 0;
+
+  // Per object (dense), per frame.
+  std::vector<float> cx, cy, cz, radius;
+  std::vector<uint32_t> row;
+  std::vector<uint8_t> min_level, never_cull, mask;
+  std::vector<float> error_scale, inv_priority;
+  struct PerView {  // [0] holds the combined choice after importance
+    std::vector<uint8_t> visible, level;
+    std::vector<float> distance, area, weight;
+  };
+  std::array<PerView, kMaxViews> per_view;
+  // Visible objects compacted in object order (slot k <-> Frame entry k).
+  std::vector<float> visible_weight;
+  std::vector<uint32_t> visible_row;
+  std::vector<uint8_t> all_ones;
+  std::vector<HeapEntry> heap;
+  std::vector<uint32_t> selection_counts;  // chunks x level_total
+  std::vector<uint32_t> selection_total;   // level_total
+  std::vector<uint32_t> chunk_visible, chunk_offset;
+  std::vector<ViewMinima> chunk_minima;    // chunks x kMaxViews
+  std::array<ViewMinima, kMaxViews> minima{};
+  std::vector<ChunkTotals> chunk_totals;
+  static constexpr size_t kCountLanes = 4;  // interleaved per-level counters (no store chains)
+  std::vector<uint32_t> level_counts;       // chunks x kCountLanes x level_total
+  std::vector<BlendTotals> chunk_blend;
+  uint32_t visible_total = 0;
+  uint64_t last_morph_extra = 0;
+  uint64_t morph_reserve = 0;
+  SelectionResult selected;
+  std::array<double, kStageCount> stage_ms{};
+  uint64_t frame_index = 0;
+  std::vector<uint32_t> freed_slots;
+
+  // View-dependent objects, by handle slot (state follows the object, whatever moves).
+  struct VdObject {
+    ObjectHandle handle = 0;
+    uint32_t model = 0;
+    std::vector<VertexFront> fronts;  // one per region
     std::vector<FrontStats> region_stats;
+    std::vector<uint32_t> region_tris, region_caps;
     std::vector<uint32_t> node_index;  // fronts_compact_mesh scratch (several regions only)
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
     FrontStats stats;          // summed over the regions
-    uint32_t moving = 0;
-    int32_t slot = -1;  // this frame: index in Frame::objects, -1 = not visible
+    uint32_t entry = 0;        // this frame's entry
   };
-  std::vector<VdObject> vd;
-  std::vector<uint32_t> vd_visible;  // this frame: indices into vd
+  std::vector<std::unique_ptr<VdObject>> vd_by_slot;
+  std::vector<VdObject*> vd_visible;
   struct VdTask {
-    uint32_t vd_index, region;
-    uint32_t cap;  // max_triangles of this front this frame
+    VdObject* object;
+    uint32_t region;
   };
-  std::vector<VdTask> vd_tasks;                   // this frame: one per (visible vd object, region)
-  std::vector<std::vector<uint8_t>> vd_regions;   // per model: region per hierarchy node
-  std::vector<uint32_t> vd_shared;                // per model: nodes active in every region
-  std::vector<double> morph_start;   // per object: when its level last changed (seconds)
-  std::vector<uint8_t> morph_from;   // per object: the level it morphs from
-  std::vector<uint8_t> model_blends;  // per model: discrete levels with morph targets (not vd)
-  struct MorphTotals {
-    uint32_t morphing = 0;
-    uint64_t extra_tris = 0;
-  };
-  std::vector<MorphTotals> chunk_morph;  // geomorph: per chunk
-  uint64_t last_morph_extra = 0;         // last frame's Frame::tris_morph_extra
-  uint64_t morph_reserve = 0;            // this frame: held back from M for blends
-
-  // Per frame.
-  View view;
-  Frustum frustum{};
-  float focal = 1;
-  Frame* out = nullptr;
-  ViewMinima minima{};
-  SelectionResult selected;
-  std::array<double, kStageCount> stage_ms{};
-  uint64_t frame_index = 0;
+  std::vector<VdTask> vd_tasks;
 
   tbb::task_arena arena;
   std::optional<tbb::flow::graph> graph;
-  std::vector<std::unique_ptr<Node>> nodes;  // kStageCount, in stage order; destroyed before the graph
+  std::optional<tbb::flow::broadcast_node<tbb::flow::continue_msg>> start;
+  std::vector<std::unique_ptr<Node>> nodes;  // kNodeCount, destroyed before the graph
+  std::array<TsanEdge, kNodeCount> tsan_inner{};
+  std::array<char, kNodeCount> tsan_done{};
+  char tsan_start = 0;
 
-  Impl(const Scene& s, const FrameGraphOptions& o)
-      : scene(s),
-        options(o),
-        count(s.objects.size()),
+  Impl(std::shared_ptr<const ModelSet> models, const FrameGraphOptions& o)
+      : options(o),
         grain(std::max<uint32_t>(1, o.grain)),
-        chunks((count + grain - 1) / grain),
         arena(o.threads == 0 ? tbb::task_arena::automatic : static_cast<int>(o.threads)) {
-    state.resize(count);
-    std::fill(state.prev_level.begin(), state.prev_level.end(), uint8_t{0});
-    std::fill(state.was_visible.begin(), state.was_visible.end(), uint8_t{0});
-    visible_weight.resize(count);
-    visible_model.resize(count);
-    all_ones.assign(count, 1);
-    heap.resize(count);
-    chunk_visible.resize(chunks);
-    chunk_offset.resize(chunks);
-    chunk_minima.resize(chunks);
-    chunk_totals.resize(chunks);
-    const ModelTable& models = scene.models;
-    level_total = models.triangles.size();
-    level_counts.resize(chunks * kCountLanes * level_total);
-    selection_tables = build_selection_tables(models);
-    selection_counts.resize(chunks * level_total);
-    selection_total.resize(level_total);
-    full_triangles.resize(level_total);
-    for (size_t m = 0; m < models.model_count(); ++m)
-      for (size_t k = 0; k < models.level_count[m]; ++k)
-        full_triangles[models.first_level[m] + k] = models.triangles[models.first_level[m]];
-    morph_start.assign(count, -1e300);
-    morph_from.assign(count, 0);
-    chunk_morph.resize(chunks);
-    model_blends.resize(models.model_count());
-    for (size_t m = 0; m < models.model_count(); ++m)
-      model_blends[m] = scene.chains[m].hierarchy.empty() && can_morph_levels(scene.chains[m]);
-    std::vector<EdgeCheck> edges(models.model_count(), EdgeCheck::corners);
-    for (size_t m = 0; m < models.model_count(); ++m) {
-      const LodChain& chain = scene.chains[m];
-      if (chain.hierarchy.empty()) continue;
-      const LodLevel& l0 = chain.levels[0];
-      edges[m] = edge_check_of(std::span(chain.indices.data() + l0.first_index, l0.index_count));
-    }
-    vd_regions.resize(models.model_count());
-    vd_shared.assign(models.model_count(), 0);
-    for (size_t m = 0; m < models.model_count(); ++m) {
-      const VertexTree& tree = scene.chains[m].hierarchy;
-      if (tree.empty()) continue;
-      // Regions only pay off when the hierarchy was built in parts: a one-part tree's extra
-      // regions are tiny components, kept together in one front.
-      if (vertex_tree_regions(vd_regions[m], tree, kMaxVdRegions) < 2) {
-        vd_regions[m].clear();
-        continue;
-      }
-      for (uint8_t r : vd_regions[m]) vd_shared[m] += r == kSharedRegion;
-    }
-    for (uint32_t id = 0; id < count; ++id) {
-      const uint32_t m = scene.objects.model[id];
-      const VertexTree& tree = scene.chains[m].hierarchy;
-      if (tree.empty()) continue;
-      VdObject& obj = vd.emplace_back();
-      obj.object = id;
-      obj.model = m;
-      obj.edges = edges[m];
-      const float tau = std::max(o_pixel_error(), 0.05f);
-      if (vd_regions[m].empty()) {
-        front_init(obj.fronts.emplace_back(), tree, tau);
-      } else {
-        uint32_t regions = 0;
-        for (uint8_t r : vd_regions[m])
-          if (r != kSharedRegion) regions = std::max<uint32_t>(regions, r + 1u);
-        obj.fronts.resize(regions);
-        for (uint32_t r = 0; r < regions; ++r) front_init(obj.fronts[r], tree, tau, vd_regions[m], uint8_t(r));
-        obj.node_index.assign(tree.node_count(), 0);
-      }
-      obj.region_stats.resize(obj.fronts.size());
-      vertex_morph_init(obj.morph, tree, options.geomorph_seconds);
-      obj.shown = tree.positions;
-    }
-    vd_visible.reserve(vd.size());
+    set_models(std::move(models));
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
   }
 
-  void build() {
-    graph.emplace();
-    nodes.reserve(kStageCount);
-    for (size_t i = 0; i < kStageCount; ++i) {
-      const Stage stage = static_cast<Stage>(i);
-      nodes.push_back(std::make_unique<Node>(*graph, [this, stage](const tbb::flow::continue_msg&) {
-        task_begins();
-        const auto t0 = Clock::now();
-        try {
-          if (options.stage_hook) options.stage_hook(stage);
-          run_stage(stage);
-        } catch (...) {
-          task_ends();
-          throw;
-        }
-        stage_ms[static_cast<size_t>(stage)] = ms_between(t0, Clock::now());
-        task_ends();
-      }));
+  // ---- the model set ----------------------------------------------------------------------
+
+  void set_models(std::shared_ptr<const ModelSet> models) {
+    set = std::move(models);
+    const ModelTable& m = set->models;
+    caps = build_level_caps(m);
+    level_total = caps.rows.triangles.size();
+    selection_tables = build_selection_tables(caps.rows);
+    selection_total.assign(level_total, 0);
+    full_triangles.resize(level_total);
+    for (size_t r = 0; r < caps.rows.model_count(); ++r) {
+      const uint32_t base = m.first_level[caps.model_of[r]];
+      for (size_t k = 0; k < caps.rows.level_count[r]; ++k)
+        full_triangles[caps.rows.first_level[r] + k] = m.triangles[base];
     }
-    for (size_t i = 0; i + 1 < kStageCount; ++i) tbb::flow::make_edge(*nodes[i], *nodes[i + 1]);
+    model_blends.resize(m.model_count());
+    vd_models.assign(m.model_count(), VdModel{});
+    for (size_t i = 0; i < m.model_count(); ++i) {
+      const LodChain& chain = *set->chains[i];
+      model_blends[i] = chain.hierarchy.empty() && can_morph_levels(chain);
+      if (!chain.hierarchy.empty()) vd_models[i] = vd_model_of(chain);
+    }
+    resize_chunks();
   }
 
-  void run_stage(Stage stage) {
-    switch (stage) {
-      case Stage::view:
-        return stage_view();
-      case Stage::visibility:
-        return stage_visibility();
-      case Stage::importance:
-        return stage_importance();
-      case Stage::selection:
-        return stage_selection();
-      case Stage::vdlod:
-        return stage_vdlod();
-      case Stage::geomorph:
-        return stage_geomorph();
-      case Stage::publish:
-        return stage_publish();
-      case Stage::count:
-        break;
+  static VdModel vd_model_of(const LodChain& chain) {
+    VdModel v;
+    const LodLevel& l0 = chain.levels[0];
+    v.edges = edge_check_of(std::span(chain.indices.data() + l0.first_index, l0.index_count));
+    // Regions only pay off when the hierarchy was built in parts: a one-part tree's extra
+    // regions are tiny components, kept together in one front.
+    if (vertex_tree_regions(v.regions, chain.hierarchy, kMaxVdRegions) < 2) {
+      v.regions.clear();
+      return v;
     }
-    assert(false);
+    v.region_count = 0;
+    for (uint8_t r : v.regions) {
+      if (r == kSharedRegion)
+        ++v.shared;
+      else
+        v.region_count = std::max<uint32_t>(v.region_count, r + 1u);
+    }
+    return v;
+  }
+
+  // Per-object and per-chunk scratch for `count` objects; capacity is kept, so a steady
+  // object count allocates nothing.
+  void resize_chunks() {
+    chunks = (count + grain - 1) / grain;
+    for (auto* v : {&cx, &cy, &cz, &radius, &error_scale, &inv_priority, &visible_weight}) v->resize(count);
+    for (auto* v : {&min_level, &never_cull, &mask}) v->resize(count);
+    row.resize(count);
+    visible_row.resize(count);
+    all_ones.resize(count, 1);  // only ever ones
+    heap.resize(count);
+    for (uint32_t v = 0; v < view_count; ++v) {
+      PerView& p = per_view[v];
+      p.visible.resize(count), p.level.resize(count);
+      p.distance.resize(count), p.area.resize(count), p.weight.resize(count);
+    }
+    chunk_visible.resize(chunks);
+    chunk_offset.resize(chunks);
+    chunk_minima.resize(chunks * kMaxViews);
+    chunk_totals.resize(chunks);
+    chunk_blend.resize(chunks);
+    selection_counts.resize(chunks * level_total);
+    level_counts.resize(chunks * kCountLanes * level_total);
+  }
+
+  // ---- the graph --------------------------------------------------------------------------
+
+  // Node j depends on node i < j when one writes a column the other reads or writes.
+  static bool conflicts(const NodeSpec& a, const NodeSpec& b) {
+    return (a.writes & (b.reads | b.writes)) || (a.reads & b.writes);
+  }
+  // Edges i -> j without those implied by a longer path (pred[j] bit i).
+  static std::array<uint32_t, kNodeCount> reduced_predecessors() {
+    std::array<uint32_t, kNodeCount> pred{}, reach{};
+    for (size_t j = 0; j < kNodeCount; ++j)
+      for (size_t i = 0; i < j; ++i)
+        if (conflicts(kNodes[i], kNodes[j])) pred[j] |= 1u << i;
+    for (size_t j = 0; j < kNodeCount; ++j) {
+      for (size_t i = 0; i < j; ++i)
+        if (pred[j] >> i & 1) reach[j] |= reach[i] | (1u << i);
+    }
+    for (size_t j = 0; j < kNodeCount; ++j) {
+      uint32_t implied = 0;
+      for (size_t i = 0; i < j; ++i)
+        if (pred[j] >> i & 1) implied |= reach[i];
+      pred[j] &= ~implied;
+    }
+    return pred;
+  }
+
+  void build() {
+    graph.emplace();
+    start.emplace(*graph);
+    const auto pred = reduced_predecessors();
+    nodes.reserve(kNodeCount);
+    for (size_t i = 0; i < kNodeCount; ++i) {
+      const uint32_t before = pred[i];
+      nodes.push_back(std::make_unique<Node>(*graph, [this, i, before](const tbb::flow::continue_msg&) {
+        tsan_acquire(&tsan_start);
+        for (uint32_t p = before; p; p &= p - 1) tsan_acquire(&tsan_done[std::countr_zero(p)]);
+        const NodeSpec& spec = kNodes[i];
+        const auto t0 = Clock::now();
+        if (options.stage_hook) options.stage_hook(spec.stage);
+        (this->*spec.run)();
+        stage_ms[static_cast<size_t>(spec.stage)] = ms_between(t0, Clock::now());
+        tsan_release(&tsan_done[i]);
+      }));
+    }
+    for (size_t j = 0; j < kNodeCount; ++j) {
+      if (pred[j] == 0) tbb::flow::make_edge(*start, *nodes[j]);
+      for (uint32_t p = pred[j]; p; p &= p - 1) tbb::flow::make_edge(*nodes[std::countr_zero(p)], *nodes[j]);
+    }
   }
 
   // Runs body(chunk, begin, end) for every chunk; one task per chunk.
   template <class Body>
-  void for_chunks(const Body& body) {
-    before_spawn();
+  void for_chunks(Stage stage, const Body& body) {
+    TsanEdge& edge = tsan_inner[static_cast<size_t>(stage)];
+    tsan_release(&edge.spawn);
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, chunks, 1),
         [&](const tbb::blocked_range<size_t>& r) {
-          task_begins();
+          tsan_acquire(&edge.spawn);
           for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
-          task_ends();
+          tsan_release(&edge.join);
         },
         tbb::simple_partitioner());
-    after_join();
+    tsan_acquire(&edge.join);
   }
 
-  void stage_view() {
-    frustum = frustum_of(view);
-    focal = focal_pixels(view);
+  template <class Body>
+  void for_items(Stage stage, size_t n, const Body& body) {
+    if (n == 0) return;
+    TsanEdge& edge = tsan_inner[static_cast<size_t>(stage)];
+    tsan_release(&edge.spawn);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& r) {
+      tsan_acquire(&edge.spawn);
+      for (size_t j = r.begin(); j != r.end(); ++j) body(j);
+      tsan_release(&edge.join);
+    });
+    tsan_acquire(&edge.join);
   }
 
-  void stage_visibility() {
-    const ObjectSet& o = scene.objects;
-    for_chunks([&](size_t c, size_t b, size_t e) {
-      chunk_visible[c] =
-          static_cast<uint32_t>(cull_spheres(sub(state.visible, b, e), sub(o.cx, b, e), sub(o.cy, b, e),
-                                             sub(o.cz, b, e), sub(o.radius, b, e), frustum));
+  // ---- nodes ------------------------------------------------------------------------------
+
+  // Staged creates, destroys, moves and options, in commit order; then scratch for the count.
+  void node_commit() {
+    freed_slots.clear();
+    for (const CommitBatchRef& batch : input->commits) {
+      apply_commands(*store, batch.commands, static_cast<uint32_t>(set->models.model_count()), freed_slots);
+      tick = batch.tick;
+    }
+    for (uint32_t slot : freed_slots)
+      if (slot < vd_by_slot.size()) vd_by_slot[slot].reset();
+    count = store->size();
+    resize_chunks();
+  }
+
+  void node_bounds() {
+    ObjectStore& s = *store;
+    for_chunks(Stage::bounds, [&](size_t, size_t b, size_t e) {
+      world_spheres(sub(cx, b, e), sub(cy, b, e), sub(cz, b, e), sub(radius, b, e), sub(s.transform, b, e),
+                    sub(s.model, b, e), set->spheres);
+      object_controls(sub(row, b, e), sub(min_level, b, e), sub(error_scale, b, e), sub(inv_priority, b, e),
+                      sub(never_cull, b, e), sub(s.options, b, e), sub(s.transform, b, e), sub(s.model, b, e),
+                      caps);
+    });
+  }
+
+  void node_view() {
+    for (uint32_t v = 0; v < view_count; ++v) {
+      frusta[v] = frustum_of(views[v]);
+      focal[v] = focal_pixels(views[v]);
+    }
+  }
+
+  void node_visibility() {
+    for_chunks(Stage::visibility, [&](size_t c, size_t b, size_t e) {
+      std::array<std::span<uint8_t>, kMaxViews> vis;
+      for (uint32_t v = 0; v < view_count; ++v) {
+        vis[v] = sub(per_view[v].visible, b, e);
+        cull_spheres(vis[v], sub(cx, b, e), sub(cy, b, e), sub(cz, b, e), sub(radius, b, e), frusta[v]);
+      }
+      chunk_visible[c] = static_cast<uint32_t>(
+          combine_view_masks(sub(mask, b, e), std::span(vis.data(), view_count), sub(never_cull, b, e)));
     });
     // Exclusive prefix sum over the chunks: where each chunk's visible objects go.
     visible_total = 0;
@@ -351,62 +425,97 @@ struct FrameGraph::Impl {
     }
   }
 
-  void stage_importance() {
-    const ObjectSet& o = scene.objects;
-    for_chunks([&](size_t c, size_t b, size_t e) {
-      chunk_minima[c] = measure_objects(sub(state.distance, b, e), sub(state.area, b, e),
-                                        sub(state.visible, b, e), sub(o.cx, b, e), sub(o.cy, b, e),
-                                        sub(o.cz, b, e), sub(o.radius, b, e), view.eye, focal);
+  void node_importance() {
+    for_chunks(Stage::importance, [&](size_t c, size_t b, size_t e) {
+      for (uint32_t v = 0; v < view_count; ++v) {
+        PerView& p = per_view[v];
+        chunk_minima[c * kMaxViews + v] =
+            measure_objects(sub(p.distance, b, e), sub(p.area, b, e), sub(p.visible, b, e), sub(cx, b, e),
+                            sub(cy, b, e), sub(cz, b, e), sub(radius, b, e), views[v].eye, focal[v]);
+      }
     });
     // min() is order-free, but merging in chunk order keeps even that obvious.
-    minima = empty_minima();
-    for (const ViewMinima& m : chunk_minima) minima = merge_minima(minima, m);
-    assert(minima.visible == visible_total);
-
+    for (uint32_t v = 0; v < view_count; ++v) {
+      minima[v] = empty_minima();
+      for (size_t c = 0; c < chunks; ++c) minima[v] = merge_minima(minima[v], chunk_minima[c * kMaxViews + v]);
+    }
     Frame& f = *out;
+    for (auto* col : {&f.levels, &f.view_masks}) col->resize(visible_total);
     f.objects.resize(visible_total);
-    f.levels.resize(visible_total);
+    f.models.resize(visible_total);
+    f.handles.resize(visible_total);
+    f.transforms.resize(visible_total);
     if (visible_total == 0) return;
-    const InitialLevelParams params{focal, options.pixel_error, options.hysteresis};
-    for_chunks([&](size_t c, size_t b, size_t e) {
-      importance_weights(sub(state.weight, b, e), sub(state.visible, b, e), sub(state.distance, b, e),
-                         sub(state.area, b, e), minima);
-      choose_initial_levels(sub(state.level, b, e), sub(state.visible, b, e), sub(state.prev_level, b, e),
-                            sub(state.was_visible, b, e), sub(state.distance, b, e), sub(o.scale, b, e),
-                            sub(o.model, b, e), scene.models, params);
-      // Compact this chunk's visible objects into their slots. Branch-free (visibility is
-      // random in object order): every object is written to the next free slot, which only
-      // advances past visible ones. Stopping once the chunk's slots are full keeps the
-      // writes inside them; every object left is then invisible.
-      const uint32_t end_slot = chunk_offset[c] + chunk_visible[c];
-      uint32_t slot = chunk_offset[c];
-      uint32_t* __restrict ids = f.objects.data();
-      uint8_t* __restrict levels = f.levels.data();
-      for (size_t i = b; i < e && slot < end_slot; ++i) {
-        ids[slot] = static_cast<uint32_t>(i);
-        levels[slot] = state.level[i];
-        visible_weight[slot] = state.weight[i];
-        visible_model[slot] = o.model[i];
-        slot += state.visible[i];
-      }
-      assert(slot == end_slot);
-      // Selection's streaming pass on this chunk's slots (heap keys, visible per level), so
-      // that only the heap work stays serial.
-      const size_t b0 = chunk_offset[c], n0 = chunk_visible[c];
-      const std::span<uint32_t> counts(selection_counts.data() + c * level_total, level_total);
-      std::fill(counts.begin(), counts.end(), 0u);
-      gather_selection(std::span<HeapEntry>(heap.data() + b0, n0), counts,
-                       std::span<const uint8_t>(f.levels.data() + b0, n0),
-                       std::span<const uint8_t>(all_ones.data() + b0, n0),
-                       std::span<const float>(visible_weight.data() + b0, n0),
-                       std::span<const uint32_t>(visible_model.data() + b0, n0), static_cast<uint32_t>(b0),
-                       scene.models, selection_tables);
+    for_chunks(Stage::importance, [&](size_t c, size_t b, size_t e) {
+      choose_chunk_levels(b, e);
+      compact_chunk(c, b, e);
     });
+  }
+
+  // Each view's weights and initial levels, folded into view 0's columns, then the options.
+  void choose_chunk_levels(size_t b, size_t e) {
+    const ObjectStore& s = *store;
+    for (uint32_t v = 0; v < view_count; ++v) {
+      PerView& p = per_view[v];
+      importance_weights(sub(p.weight, b, e), sub(p.visible, b, e), sub(p.distance, b, e), sub(p.area, b, e),
+                         minima[v]);
+      const InitialLevelParams params{focal[v], options.pixel_error, options.hysteresis};
+      choose_initial_levels(sub(p.level, b, e), sub(p.visible, b, e), sub(s.prev_level, b, e),
+                            sub(s.was_visible, b, e), sub(p.distance, b, e), sub(error_scale, b, e), sub(row, b, e),
+                            caps.rows, params);
+    }
+    PerView& p0 = per_view[0];
+    for (uint32_t v = 1; v < view_count; ++v) {
+      const PerView& p = per_view[v];
+      combine_view_choice(sub(p0.level, b, e), sub(p0.weight, b, e), sub(p0.visible, b, e), sub(p.level, b, e),
+                          sub(p.weight, b, e), sub(p.visible, b, e));
+    }
+    apply_object_controls(sub(p0.level, b, e), sub(p0.weight, b, e), sub(p0.visible, b, e), sub(min_level, b, e),
+                          sub(inv_priority, b, e));
+  }
+
+  // This chunk's visible objects into their slots, then selection's streaming pass on them.
+  void compact_chunk(size_t c, size_t b, size_t e) {
+    Frame& f = *out;
+    const ObjectStore& s = *store;
+    const PerView& p0 = per_view[0];
+    // Branch-free (visibility is random in object order): every object is written to the
+    // next free slot, which only advances past visible ones. Stopping once the chunk's slots
+    // are full keeps the writes inside them; every object left is then invisible.
+    const uint32_t end_slot = chunk_offset[c] + chunk_visible[c];
+    uint32_t slot = chunk_offset[c];
+    uint32_t* __restrict ids = f.objects.data();
+    uint8_t* __restrict levels = f.levels.data();
+    for (size_t i = b; i < e && slot < end_slot; ++i) {
+      ids[slot] = static_cast<uint32_t>(i);
+      levels[slot] = p0.level[i];
+      visible_weight[slot] = p0.weight[i];
+      visible_row[slot] = row[i];
+      slot += p0.visible[i];
+    }
+    assert(slot == end_slot);
+    // The entries' own columns: gathered, since only visible objects are written.
+    for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) {
+      const uint32_t i = ids[k];
+      f.handles[k] = s.handle[i];
+      f.models[k] = s.model[i];
+      f.transforms[k] = s.transform[i];
+      f.view_masks[k] = mask[i];
+    }
+    const size_t b0 = chunk_offset[c], n0 = chunk_visible[c];
+    const std::span<uint32_t> counts(selection_counts.data() + c * level_total, level_total);
+    std::fill(counts.begin(), counts.end(), 0u);
+    gather_selection(std::span<HeapEntry>(heap.data() + b0, n0), counts,
+                     std::span<const uint8_t>(f.levels.data() + b0, n0),
+                     std::span<const uint8_t>(all_ones.data() + b0, n0),
+                     std::span<const float>(visible_weight.data() + b0, n0),
+                     std::span<const uint32_t>(visible_row.data() + b0, n0), static_cast<uint32_t>(b0), caps.rows,
+                     selection_tables);
   }
 
   // On the compacted visible set: the same result as on the whole range (selection breaks
   // ties by position, and compaction keeps object order), with less to stream through.
-  void stage_selection() {
+  void node_selection() {
     const size_t v = visible_total;
     std::fill(selection_total.begin(), selection_total.end(), 0u);
     for (size_t c = 0; c < chunks; ++c) {
@@ -424,151 +533,125 @@ struct FrameGraph::Impl {
     }
     selected = lower_under_budget(
         std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
-        std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_model.data(), v),
-        scene.models, so, selection_total, std::span<HeapEntry>(heap.data(), v));
+        std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_row.data(), v),
+        caps.rows, so, selection_total, std::span<HeapEntry>(heap.data(), v));
   }
 
-  float o_pixel_error() const { return options.pixel_error; }
-  double now() const { return double(frame_index) * options.frame_seconds; }
-
-  // One task per visible view-dependent object; fronts are independent, so the result does
-  // not depend on the thread count.
-  void stage_vdlod() {
-    const Frame& f = *out;
-    vd_visible.clear();
-    // Both lists are in object order: one merge finds each vd object's visible slot.
-    size_t k = 0;
-    for (uint32_t i = 0; i < vd.size(); ++i) {
-      VdObject& o = vd[i];
-      while (k < visible_total && f.objects[k] < o.object) ++k;
-      o.slot = (k < visible_total && f.objects[k] == o.object) ? static_cast<int32_t>(k) : -1;
-      if (o.slot >= 0) vd_visible.push_back(i);
-    }
-    const ObjectSet& objs = scene.objects;
-    const ModelTable& models = scene.models;
-    auto share_of = [&](const VdObject& o) {
-      // Its share of the budget: the triangles of the level selection gave it.
-      return std::max<uint32_t>(models.triangles[models.first_level[o.model] + f.levels[o.slot]], 1);
-    };
-    vd_tasks.clear();
-    for (uint32_t j : vd_visible) {
-      const VdObject& o = vd[j];
-      const uint32_t share = share_of(o);
-      const uint64_t cap = share + share / 10 + 16;
-      // Regions share the cap: each keeps what it had and may grow by an equal part of the
-      // room left, so their sum never passes it.
-      uint64_t used = 0;
-      for (const VertexFront& fr : o.fronts) used += fr.tri_count;
-      const uint64_t room = used < cap ? (cap - used) / o.fronts.size() : 0;
-      for (uint32_t r = 0; r < o.fronts.size(); ++r) {
-        const uint64_t c = o.fronts.size() == 1 ? cap : std::max<uint64_t>(o.fronts[r].tri_count + room, 1);
-        vd_tasks.push_back({j, r, static_cast<uint32_t>(std::min<uint64_t>(c, UINT32_MAX))});
-      }
-    }
-    if (vd_tasks.empty()) return;
-    before_spawn();
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, vd_tasks.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
-          task_begins();
-          for (size_t j = range.begin(); j != range.end(); ++j) {
-            VdObject& o = vd[vd_tasks[j].vd_index];
-            const uint32_t r = vd_tasks[j].region;
-            const float pos[3] = {objs.x[o.object], objs.y[o.object], objs.z[o.object]};
-            const FrontView fv = front_view_of(view, pos, objs.scale[o.object], objs.yaw[o.object]);
-            FrontParams p;
-            p.time = now();
-            p.collapse_delay = options.geomorph_seconds;
-            p.hysteresis = options.vd_hysteresis;
-            p.max_triangles = vd_tasks[j].cap;
-            // One front: its own feedback; regions: feedback once per object after the join.
-            if (o.fronts.size() == 1) p.target_triangles = share_of(o);
-            const VertexTree& tree = scene.chains[o.model].hierarchy;
-            o.region_stats[r] = front_update(o.fronts[r], tree, fv, p);
-            vertex_morph_apply(o.morph, tree, o.fronts[r].frame_events(), p.time);
-          }
-          task_ends();
-        });
-    after_join();
-    for (uint32_t j : vd_visible) {
-      VdObject& o = vd[j];
-      if (o.fronts.size() == 1) {
-        o.stats = o.region_stats[0];
-        continue;
-      }
-      FrontStats sum;
-      for (const FrontStats& st : o.region_stats) {
-        sum.splits += st.splits, sum.collapses += st.collapses, sum.visited += st.visited;
-        sum.blocked += st.blocked, sum.active_tris += st.active_tris;
-        sum.full_pass = sum.full_pass || st.full_pass;
-      }
-      FrontParams p;
-      const float next = front_next_threshold(o.fronts[0].threshold, sum.active_tris, share_of(o), p);
-      for (VertexFront& fr : o.fronts) front_set_threshold(fr, next);
-      sum.threshold = next;
-      o.stats = sum;
-    }
-  }
-
-  // Level changes restart a per-object morph factor from the level last selected (newly
-  // visible objects appear settled; a reversal mid-blend continues backwards); view-dependent
-  // objects get their geomorphed vertices and compact mesh into the frame.
-  void stage_geomorph() {
+  // Level changes blend (runtime/level_blend.h), in parallel over each chunk's entries.
+  void node_geomorph() {
     Frame& f = *out;
     f.morph.resize(visible_total);
     f.from_levels.resize(visible_total);
-    const double t = now();
-    const ModelTable& models = scene.models;
-    // Per object and independent: parallel over each chunk's visible slots.
-    for_chunks([&](size_t c, size_t, size_t) {
-      const uint32_t end_slot = chunk_offset[c] + chunk_visible[c];
-      MorphTotals totals;
-      for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) {
-        const uint32_t id = f.objects[k];
-        const uint8_t level = f.levels[k];
-        if (state.was_visible[id] && state.prev_level[id] != level) {
-          // Going back to the level it was leaving, mid-blend, runs the same blend backwards
-          // from where it is (no jump); any other change starts from the level last selected.
-          const float m = morph_factor(t, morph_start[id], options.geomorph_seconds);
-          const bool reverses = m < 1 && morph_from[id] == level;
-          morph_start[id] = reverses ? t - double(1 - m) * options.geomorph_seconds : t;
-          morph_from[id] = state.prev_level[id];
-        }
-        if (!state.was_visible[id]) morph_start[id] = -1e300;
-        f.morph[k] = morph_factor(t, morph_start[id], options.geomorph_seconds);
-        const uint32_t model = visible_model[k];
-        const bool blends = f.morph[k] < 1 && model_blends[model] && morph_from[id] != level;
-        f.from_levels[k] = blends ? morph_from[id] : level;
-        if (blends) {
-          const uint32_t first = models.first_level[model];
-          ++totals.morphing;
-          totals.extra_tris += models.triangles[first + std::min(level, morph_from[id])] - models.triangles[first + level];
-        }
-      }
-      chunk_morph[c] = totals;
+    ObjectStore& s = *store;
+    const LevelBlendState state{s.morph_start, s.morph_from, s.prev_level, s.was_visible};
+    for_chunks(Stage::geomorph, [&](size_t c, size_t, size_t) {
+      const size_t b = chunk_offset[c], e = b + chunk_visible[c];
+      chunk_blend[c] = advance_level_blends(sub(f.morph, b, e), sub(f.from_levels, b, e), sub(f.objects, b, e),
+                                            sub(f.levels, b, e), sub(f.models, b, e), state, model_blends,
+                                            set->models, time, options.geomorph_seconds);
     });
     f.morphing = 0;
     f.tris_morph_extra = 0;
-    for (const MorphTotals& m : chunk_morph) f.morphing += m.morphing, f.tris_morph_extra += m.extra_tris;
+    for (size_t c = 0; c < chunks; ++c) f.morphing += chunk_blend[c].morphing, f.tris_morph_extra += chunk_blend[c].extra_tris;
     last_morph_extra = f.tris_morph_extra;
+  }
+
+  VdObject& vd_state(ObjectHandle h, uint32_t model) {
+    const uint32_t slot = handle_slot(h);
+    if (slot >= vd_by_slot.size()) vd_by_slot.resize(size_t{slot} + 1);
+    std::unique_ptr<VdObject>& p = vd_by_slot[slot];
+    if (p && p->handle == h && p->model == model) return *p;
+    p = std::make_unique<VdObject>();
+    p->handle = h;
+    p->model = model;
+    const VertexTree& tree = set->chains[model]->hierarchy;
+    const VdModel& vm = vd_models[model];
+    const float tau = std::max(options.pixel_error, 0.05f);
+    if (vm.regions.empty()) {
+      front_init(p->fronts.emplace_back(), tree, tau);
+    } else {
+      p->fronts.resize(vm.region_count);
+      for (uint32_t r = 0; r < vm.region_count; ++r) front_init(p->fronts[r], tree, tau, vm.regions, uint8_t(r));
+      p->node_index.assign(tree.node_count(), 0);
+    }
+    p->region_stats.resize(p->fronts.size());
+    p->region_tris.resize(p->fronts.size());
+    p->region_caps.resize(p->fronts.size());
+    vertex_morph_init(p->morph, tree, options.geomorph_seconds);
+    p->shown = tree.positions;
+    return *p;
+  }
+
+  uint32_t share_of(const VdObject& o) const {
+    const ModelTable& m = set->models;
+    return std::max<uint32_t>(m.triangles[m.first_level[o.model] + out->levels[o.entry]], 1);
+  }
+
+  // One task per (visible view-dependent object, region); fronts are independent, so the
+  // result does not depend on the thread count. View 0 drives the fronts.
+  void node_vdlod() {
+    const Frame& f = *out;
+    vd_visible.clear();
+    vd_tasks.clear();
+    for (uint32_t k = 0; k < visible_total; ++k) {
+      if (set->chains[f.models[k]]->hierarchy.empty()) continue;
+      VdObject& o = vd_state(f.handles[k], f.models[k]);
+      o.entry = k;
+      vd_visible.push_back(&o);
+      for (size_t r = 0; r < o.fronts.size(); ++r) o.region_tris[r] = o.fronts[r].tri_count;
+      share_region_caps(o.region_caps, o.region_tris, vd_cap_of_share(share_of(o)));
+      for (uint32_t r = 0; r < o.fronts.size(); ++r) vd_tasks.push_back({&o, r});
+    }
+    for_items(Stage::vdlod, vd_tasks.size(), [&](size_t j) {
+      VdObject& o = *vd_tasks[j].object;
+      const uint32_t r = vd_tasks[j].region;
+      const Transform& t = f.transforms[o.entry];
+      const FrontView fv = front_view_of(views[0], t.position, t.scale, t.rotation);
+      FrontParams p;
+      p.time = time;
+      p.collapse_delay = options.geomorph_seconds;
+      p.hysteresis = options.vd_hysteresis;
+      p.max_triangles = o.region_caps[r];
+      // One front: its own feedback; regions: feedback once per object after the join.
+      if (o.fronts.size() == 1) p.target_triangles = share_of(o);
+      const VertexTree& tree = set->chains[o.model]->hierarchy;
+      o.region_stats[r] = front_update(o.fronts[r], tree, fv, p);
+      vertex_morph_apply(o.morph, tree, o.fronts[r].frame_events(), p.time);
+    });
+    for (VdObject* po : vd_visible) {
+      VdObject& o = *po;
+      o.stats = sum_region_stats(o.region_stats);
+      if (o.fronts.size() == 1) continue;
+      const float next = front_next_threshold(o.fronts[0].threshold, o.stats.active_tris, share_of(o), FrontParams{});
+      for (VertexFront& fr : o.fronts) front_set_threshold(fr, next);
+      o.stats.threshold = next;
+    }
+  }
+
+  // View-dependent objects' geomorphed vertices and compact meshes into the frame.
+  void node_vd_mesh() {
+    Frame& f = *out;
     f.vd_objects.resize(vd_visible.size());
     uint32_t vertices = 0, indices = 0;
     f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;
     for (size_t j = 0; j < vd_visible.size(); ++j) {
-      const VdObject& o = vd[vd_visible[j]];
+      const VdObject& o = *vd_visible[j];
+      const VdModel& vm = vd_models[o.model];
       VdObjectFrame& e = f.vd_objects[j];
-      e.object = o.object;
+      e.object = f.objects[o.entry];
+      e.entry = o.entry;
       // Fixed seam vertices are active in every region but written once.
       uint32_t active = 0, tris = 0;
       for (const VertexFront& fr : o.fronts) active += fr.active_count, tris += fr.tri_count;
       e.first_vertex = vertices;
-      e.vertex_count = active - uint32_t(o.fronts.size() - 1) * vd_shared[o.model];
+      e.vertex_count = active - uint32_t(o.fronts.size() - 1) * vm.shared;
       e.first_index = indices;
       e.index_count = 3 * tris;
       e.splits = o.stats.splits;
       e.collapses = o.stats.collapses;
       e.threshold = o.stats.threshold;
-      e.closed = o.edges == EdgeCheck::closed;
-      e.oriented = o.edges != EdgeCheck::corners;
+      e.closed = vm.edges == EdgeCheck::closed;
+      e.oriented = vm.edges != EdgeCheck::corners;
       vertices += e.vertex_count;
       indices += e.index_count;
       f.vd_active_tris += tris;
@@ -577,71 +660,53 @@ struct FrameGraph::Impl {
     }
     f.vd_positions.resize(3 * size_t(vertices));
     f.vd_indices.resize(indices);
-    if (vd_visible.empty()) return;
-    before_spawn();
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, vd_visible.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-          task_begins();
-          for (size_t j = r.begin(); j != r.end(); ++j) {
-            VdObject& o = vd[vd_visible[j]];
-            VdObjectFrame& e = f.vd_objects[j];
-            const VertexTree& tree = scene.chains[o.model].hierarchy;
-            const std::span positions(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count));
-            const std::span tris(f.vd_indices.data() + e.first_index, e.index_count);
-            e.moving = 0;
-            for (const VertexFront& fr : o.fronts)
-              e.moving += static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, fr.vertices(), t));
-            if (o.fronts.size() == 1) {
-              front_compact_mesh(positions, tris, o.fronts[0], tree, o.shown);
-            } else {
-              const VertexFront* fronts[kMaxVdRegions];
-              for (size_t k = 0; k < o.fronts.size(); ++k) fronts[k] = &o.fronts[k];
-              uint32_t written = 0;
-              fronts_compact_mesh(positions, tris, o.node_index, std::span(fronts, o.fronts.size()), tree,
-                                  o.shown, &written);
-              assert(written == e.vertex_count);
-            }
-          }
-          task_ends();
-        });
-    after_join();
+    for_items(Stage::vd_mesh, vd_visible.size(), [&](size_t j) {
+      VdObject& o = *vd_visible[j];
+      VdObjectFrame& e = f.vd_objects[j];
+      const VertexTree& tree = set->chains[o.model]->hierarchy;
+      const std::span positions(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count));
+      const std::span tris(f.vd_indices.data() + e.first_index, e.index_count);
+      e.moving = 0;
+      for (const VertexFront& fr : o.fronts)
+        e.moving += static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, fr.vertices(), time));
+      if (o.fronts.size() == 1) {
+        front_compact_mesh(positions, tris, o.fronts[0], tree, o.shown);
+        return;
+      }
+      const VertexFront* fronts[kMaxVdRegions];
+      for (size_t k = 0; k < o.fronts.size(); ++k) fronts[k] = &o.fronts[k];
+      uint32_t written = 0;
+      fronts_compact_mesh(positions, tris, o.node_index, std::span(fronts, o.fronts.size()), tree, o.shown,
+                          &written);
+      assert(written == e.vertex_count);
+    });
   }
 
-  void stage_publish() {
+  void node_publish() {
     Frame& f = *out;
-    const ModelTable& models = scene.models;
-    for_chunks([&](size_t c, size_t b, size_t e) {
+    ObjectStore& s = *store;
+    const ModelTable& rows = caps.rows;
+    const PerView& p0 = per_view[0];
+    for_chunks(Stage::publish, [&](size_t c, size_t b, size_t e) {
       // Temporal state for the next frame: who was visible, at which level.
-      std::copy(state.visible.begin() + b, state.visible.begin() + e, state.was_visible.begin() + b);
+      std::copy(p0.visible.begin() + b, p0.visible.begin() + e, s.was_visible.begin() + b);
       uint32_t* counts = level_counts.data() + c * kCountLanes * level_total;
       std::fill(counts, counts + kCountLanes * level_total, 0u);
       const uint32_t first_slot = chunk_offset[c], end_slot = first_slot + chunk_visible[c];
-      const uint32_t* first_level = models.first_level.data();
+      const uint32_t* first_level = rows.first_level.data();
       for (uint32_t k = first_slot; k < end_slot; ++k) {
         const uint8_t level = f.levels[k];
-        state.prev_level[f.objects[k]] = level;
-        ++counts[(k % kCountLanes) * level_total + first_level[visible_model[k]] + level];
+        s.prev_level[f.objects[k]] = level;
+        ++counts[(k % kCountLanes) * level_total + first_level[visible_row[k]] + level];
       }
-      ChunkTotals t;
-      for (size_t at = 0; at < level_total; ++at) {
-        uint64_t n = 0;
-        for (size_t lane = 0; lane < kCountLanes; ++lane) n += counts[lane * level_total + at];
-        if (n == 0) continue;
-        const int32_t l = models.level_l[at];
-        t.tris_in_view += n * full_triangles[at];
-        t.tris_selected += n * models.triangles[at];
-        t.level_cost += n << std::clamp(l, 0, 63);
-        t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))] +=
-            static_cast<uint32_t>(n);
-      }
-      chunk_totals[c] = t;
+      chunk_totals[c] = sum_counts(counts);
     });
-
     f.object_count = static_cast<uint32_t>(count);
     f.visible = visible_total;
     f.tris_in_view = f.tris_selected = f.level_cost = 0;
     f.level_histogram.fill(0);
-    for (const ChunkTotals& t : chunk_totals) {
+    for (size_t c = 0; c < chunks; ++c) {
+      const ChunkTotals& t = chunk_totals[c];
       f.tris_in_view += t.tris_in_view;
       f.tris_selected += t.tris_selected;
       f.level_cost += t.level_cost;
@@ -654,70 +719,173 @@ struct FrameGraph::Impl {
     f.lowered_steps = selected.lowered_steps;
   }
 
+  ChunkTotals sum_counts(const uint32_t* counts) const {
+    const ModelTable& rows = caps.rows;
+    ChunkTotals t;
+    for (size_t at = 0; at < level_total; ++at) {
+      uint64_t n = 0;
+      for (size_t lane = 0; lane < kCountLanes; ++lane) n += counts[lane * level_total + at];
+      if (n == 0) continue;
+      const int32_t l = rows.level_l[at];
+      t.tris_in_view += n * full_triangles[at];
+      t.tris_selected += n * rows.triangles[at];
+      t.level_cost += n << std::clamp(l, 0, 63);
+      t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))] += static_cast<uint32_t>(n);
+    }
+    return t;
+  }
+
   // Forgets last frame's levels so that the next frame starts from scratch.
   void reset_temporal_state() {
     last_morph_extra = 0;
-    std::fill(state.prev_level.begin(), state.prev_level.end(), uint8_t{0});
-    std::fill(state.was_visible.begin(), state.was_visible.end(), uint8_t{0});
+    store->reset_temporal_state();
+  }
+
+  void run(const FrameInput& in, ObjectStore& objects, Frame& f) {
+    const auto t0 = Clock::now();
+    assert(!in.views.empty() && in.views.size() <= kMaxViews);
+    input = &in;
+    store = &objects;
+    out = &f;
+    time = in.time;
+    const uint32_t vc = static_cast<uint32_t>(std::clamp<size_t>(in.views.size(), 1, kMaxViews));
+    if (vc != view_count) {
+      view_count = vc;
+      resize_chunks();
+    }
+    for (uint32_t v = 0; v < view_count; ++v) views[v] = in.views[std::min<size_t>(v, in.views.size() - 1)];
+    stage_ms.fill(0);
+    f.index = ++frame_index;
+    f.time_s = time;
+    tsan_release(&tsan_start);
+    try {
+      arena.execute([&] {  // may run on a worker when the arena has no free slot
+        start->try_put(tbb::flow::continue_msg());
+        graph->wait_for_all();
+      });
+    } catch (...) {
+      for (char& d : tsan_done) tsan_acquire(&d);
+      graph->reset();
+      reset_temporal_state();
+      out = nullptr;
+      f.tick = tick;
+      throw;
+    }
+    for (char& d : tsan_done) tsan_acquire(&d);
+    out = nullptr;
+    input = nullptr;
+    f.tick = tick;
+    f.view_count = view_count;
+    for (uint32_t v = 0; v < kMaxViews; ++v) f.views[v] = v < view_count ? camera_of(views[v]) : Camera{};
+    f.stage_ms = stage_ms;
+    f.total_ms = ms_between(t0, Clock::now());
   }
 };
 
+// The node table. Reads/writes are what each node's runtime stages touch; edges follow.
+const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
+    {Stage::commit, "apply_commands: staged creates, destroys, moves, options", 0, kObjects,
+     &Impl::node_commit},
+    {Stage::bounds, "world_spheres + object_controls, parallel", kObjects, kBounds | kControls, &Impl::node_bounds},
+    {Stage::view, "frustum planes, focal length per view", 0, kViews, &Impl::node_view},
+    {Stage::visibility, "cull_spheres per view + combine_view_masks, parallel", kBounds | kControls | kViews,
+     kVisibility, &Impl::node_visibility},
+    {Stage::importance,
+     "measure_objects + minima, importance_weights + choose_initial_levels per view, combine_view_choice, "
+     "apply_object_controls, compaction, gather_selection, parallel",
+     kObjects | kBounds | kControls | kViews | kVisibility | kHistory, kEntries | kLevels, &Impl::node_importance},
+    {Stage::selection, "lower_under_budget: heap over the visible set, serial", kEntries | kLevels, kLevels,
+     &Impl::node_selection},
+    {Stage::geomorph, "advance_level_blends, parallel", kEntries | kLevels | kHistory, kBlend, &Impl::node_geomorph},
+    {Stage::vdlod, "front_update per visible view-dependent object (view 0), parallel", kEntries | kLevels | kViews,
+     kFronts, &Impl::node_vdlod},
+    {Stage::vd_mesh, "vertex_morph_positions + compact meshes of vd objects, parallel", kEntries | kFronts, kVdMesh,
+     &Impl::node_vd_mesh},
+    {Stage::publish, "totals, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend,
+     kTotals | kHistory, &Impl::node_publish},
+};
+
+std::shared_ptr<const ModelSet> make_model_set(std::vector<std::shared_ptr<const LodChain>> chains) {
+  auto s = std::make_shared<ModelSet>();
+  s->chains = std::move(chains);
+  ModelTable& t = s->models;
+  for (const auto& c : s->chains) {
+    assert(!c->levels.empty() && c->levels.size() <= kMaxLevels);
+    t.first_level.push_back(static_cast<uint32_t>(t.triangles.size()));
+    t.level_count.push_back(static_cast<uint8_t>(c->levels.size()));
+    t.radius.push_back(c->levels.front().bounds.radius);
+    for (const LodLevel& lv : c->levels) {
+      t.triangles.push_back(lv.triangles());
+      t.level_l.push_back(lv.level);
+      t.error.push_back(lv.error);
+    }
+    s->spheres.push_back(chain_sphere(*c));
+  }
+  return s;
+}
+
+namespace {
+
+std::shared_ptr<const ModelSet> model_set_of(const Scene& scene) {
+  std::vector<std::shared_ptr<const LodChain>> chains;
+  for (const LodChain& c : scene.chains) chains.push_back(std::make_shared<const LodChain>(c));
+  return make_model_set(std::move(chains));
+}
+
+}  // namespace
+
+FrameGraph::FrameGraph(std::shared_ptr<const ModelSet> models, const FrameGraphOptions& options)
+    : impl_(std::make_unique<Impl>(std::move(models), options)) {}
+
 FrameGraph::FrameGraph(const Scene& scene, const FrameGraphOptions& options)
-    : impl_(std::make_unique<Impl>(scene, options)) {}
+    : impl_(std::make_unique<Impl>(model_set_of(scene), options)) {
+  ObjectStore& s = impl_->own_store;
+  const ObjectSet& o = scene.objects;
+  for (uint32_t i = 0; i < o.size(); ++i) s.insert(make_handle(i, 1), o.model[i], transform_of(o, i), ObjectOptions{});
+}
 
 FrameGraph::~FrameGraph() = default;
 
+void FrameGraph::run(const FrameInput& input, ObjectStore& objects, Frame& out) { impl_->run(input, objects, out); }
+
 void FrameGraph::run(const View& view, Frame& out) {
   Impl& m = *impl_;
-  const auto t0 = Clock::now();
-  m.view = view;
-  m.out = &out;
-  m.stage_ms.fill(0);
-  out.index = ++m.frame_index;
-  out.view = view;
-  before_spawn();
-  try {
-    m.arena.execute([&] {  // may run on a worker when the arena has no free slot
-      task_begins();
-      m.nodes.front()->try_put(tbb::flow::continue_msg());
-      m.graph->wait_for_all();
-      task_ends();
-    });
-  } catch (...) {
-    after_join();
-    m.graph->reset();
-    m.reset_temporal_state();
-    m.out = nullptr;
-    throw;
-  }
-  after_join();
-  m.out = nullptr;
-  out.stage_ms = m.stage_ms;
-  out.total_ms = ms_between(t0, Clock::now());
+  m.own_clock = double(m.frame_index + 1) * m.options.frame_seconds;
+  FrameInput in;
+  in.views = std::span(&view, 1);
+  in.time = m.own_clock;
+  m.run(in, m.own_store, out);
 }
 
+void FrameGraph::set_models(std::shared_ptr<const ModelSet> models) { impl_->set_models(std::move(models)); }
 void FrameGraph::set_budget(uint64_t budget) { impl_->options.selection.budget = budget; }
-
+void FrameGraph::set_pixel_error(float pixels) { impl_->options.pixel_error = pixels; }
+void FrameGraph::set_hysteresis(float band) { impl_->options.hysteresis = band; }
+void FrameGraph::set_geomorph_seconds(float seconds) { impl_->options.geomorph_seconds = seconds; }
 const FrameGraphOptions& FrameGraph::options() const { return impl_->options; }
+ObjectStore& FrameGraph::scene_objects() { return impl_->own_store; }
 
 std::string FrameGraph::dot() {
+  using Impl = FrameGraph::Impl;
+  static_assert(std::size(Impl::kNodes) == kStageCount, "one node per Stage");
+  const auto pred = Impl::reduced_predecessors();
   std::string s = "digraph frame_graph {\n  rankdir=LR;\n  node [shape=box, fontname=\"Helvetica\"];\n";
-  for (const StageEntry& e : kStageTable) {
-    s += "  ";
-    s += e.name;
-    s += " [label=\"";
-    s += e.name;
-    s += "\\n";
-    s += e.does;
-    s += "\"];\n";
+  auto columns = [](uint32_t bits) {
+    std::string c;
+    for (uint32_t b = bits; b; b &= b - 1) {
+      if (!c.empty()) c += ", ";
+      c += kColumnNames[std::countr_zero(b)];
+    }
+    return c.empty() ? std::string("-") : c;
+  };
+  for (const Impl::NodeSpec& n : Impl::kNodes) {
+    const char* name = kStageNames[static_cast<size_t>(n.stage)];
+    s += "  " + std::string(name) + " [label=\"" + name + "\\n" + n.does + "\\nreads: " + columns(n.reads) +
+         "\\nwrites: " + columns(n.writes) + "\"];\n";
   }
-  for (size_t i = 0; i + 1 < kStageCount; ++i) {
-    s += "  ";
-    s += kStageTable[i].name;
-    s += " -> ";
-    s += kStageTable[i + 1].name;
-    s += ";\n";
-  }
+  for (size_t j = 0; j < Impl::kNodeCount; ++j)
+    for (uint32_t p = pred[j]; p; p &= p - 1)
+      s += "  " + std::string(kStageNames[std::countr_zero(p)]) + " -> " + kStageNames[j] + ";\n";
   s += "}\n";
   return s;
 }

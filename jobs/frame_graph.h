@@ -1,19 +1,27 @@
-// FrameGraph: the per-frame tbb::flow::graph, built once and fired every frame.
+// FrameGraph: the per-frame tbb::flow::graph, built once from a table of nodes and fired every
+// frame. Each node runs runtime/ stages over the columns it names; edges follow from what the
+// nodes read and write (FrameGraph::dot() draws the same table), so nodes with no data
+// dependency run at the same time:
 //
-//   view -> visibility -> importance -> selection -> vdlod -> geomorph -> publish
+//   commit -> bounds --+
+//   view --------------+-> visibility -> importance -> selection -+-> geomorph -> publish
+//                                                                  +-> vdlod -> vd_mesh
 //
-// Nodes only coordinate; the work is the pure stages of runtime/, run data-parallel
-// (parallel_for over object chunks) inside visibility and importance. The flow-graph
-// headers stay in frame_graph.cpp.
+// The flow-graph headers stay in frame_graph.cpp.
 #pragma once
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "jobs/scene.h"
 #include "runtime/frame.h"
 #include "runtime/initial_levels.h"
+#include "runtime/object_commands.h"
+#include "runtime/object_store.h"
 #include "runtime/slc_selection.h"
+#include "runtime/view.h"
 
 namespace lod {
 
@@ -24,7 +32,7 @@ struct FrameGraphOptions {
   float hysteresis = 0.25f;
   uint32_t grain = 2048;           // objects per parallel chunk
   // View-dependent objects and geomorphing: a level change, split or collapse blends over
-  // geomorph_seconds (0 = none); frames are frame_seconds apart on the geomorph clock.
+  // geomorph_seconds (0 = none). run(view, out) steps the clock by frame_seconds.
   float geomorph_seconds = 0.25f;
   float frame_seconds = 1.0f / 60;
   float vd_hysteresis = 1.5f;      // FrontParams::hysteresis
@@ -33,22 +41,49 @@ struct FrameGraphOptions {
   std::function<void(Stage)> stage_hook;
 };
 
+// The models a graph draws from: chains shared (adding a model copies none), plus the tables
+// the stages read. Immutable once made.
+struct ModelSet {
+  std::vector<std::shared_ptr<const LodChain>> chains;
+  ModelTable models;
+  std::vector<Sphere> spheres;  // per model: chain_sphere
+};
+std::shared_ptr<const ModelSet> make_model_set(std::vector<std::shared_ptr<const LodChain>> chains);
+
+// What one frame runs on besides the objects.
+struct FrameInput {
+  std::span<const View> views;               // 1..kMaxViews; view 0 drives view-dependent fronts
+  double time = 0;                           // seconds on the blend clock, non-decreasing
+  std::span<const CommitBatchRef> commits;   // applied in order by the commit node
+};
+
 class FrameGraph {
  public:
+  FrameGraph(std::shared_ptr<const ModelSet> models, const FrameGraphOptions& options);
+  // A fixed scene: its objects go into a store the graph owns (run(view, out) uses it).
   FrameGraph(const Scene& scene, const FrameGraphOptions& options);
   ~FrameGraph();
   FrameGraph(const FrameGraph&) = delete;
   FrameGraph& operator=(const FrameGraph&) = delete;
 
-  // Runs one frame for `view` and fills `out` (reusing its capacity). Not re-entrant.
-  // Frame indices start at 1 and increase by one per call. If a stage throws, the graph
-  // and the temporal state (last frame's levels) are reset, `out` is left partly written,
-  // and the exception propagates.
+  // Runs one frame over `objects` and fills `out` (reusing its capacity). Not re-entrant.
+  // Frame indices start at 1 and increase by one per call; out.tick is the tick of the last
+  // commit applied so far. If a stage throws, the graph and the temporal state are reset,
+  // `out` is left partly written, and the exception propagates (commits already applied stay).
+  void run(const FrameInput& input, ObjectStore& objects, Frame& out);
+  // The fixed scene's store, the clock advanced by frame_seconds per call.
   void run(const View& view, Frame& out);
 
+  // Between frames (the LOD thread's own calls).
+  void set_models(std::shared_ptr<const ModelSet> models);
   void set_budget(uint64_t budget);
+  void set_pixel_error(float pixels);
+  void set_hysteresis(float band);
+  void set_geomorph_seconds(float seconds);
   const FrameGraphOptions& options() const;
-  // The node/edge table as Graphviz DOT, for `lod run --report`.
+  ObjectStore& scene_objects();  // the fixed scene's store
+
+  // The node table as Graphviz DOT (nodes with what they do, edges from their columns).
   static std::string dot();
 
  private:

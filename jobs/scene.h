@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "jobs/scene_config.h"
+#include "lodkit/types.hpp"
 #include "runtime/lod_chain.h"
 #include "runtime/model_table.h"
 #include "runtime/object_set.h"
@@ -18,6 +19,9 @@ struct Scene {
 // Places every [[instances]] block (seeded random in its box, or a grid filling it) and
 // fills the world bounding spheres from each chain's level-0 sphere. Deterministic.
 ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>& chains);
+
+// Object i's placement as a Transform (its yaw as a quaternion about +y).
+Transform transform_of(const ObjectSet& objects, size_t i);
 
 // Builds models + objects from already baked chains (in config model order).
 Scene make_scene(const SceneConfig& config, std::vector<LodChain> chains);

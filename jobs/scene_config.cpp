@@ -347,6 +347,24 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
   }
 }
 
+// motion = "none" | "wander" | "orbit", speed in world units per second (> 0 when moving).
+void read_motion(const Reader& r, const toml::table& t, const std::string& key, InstanceConfig& inst) {
+  if (auto v = r.string(t, "motion", key + ".motion")) {
+    if (*v == "wander")
+      inst.motion.kind = MotionKind::wander;
+    else if (*v == "orbit")
+      inst.motion.kind = MotionKind::orbit;
+    else if (*v != "none")
+      r.fail(key + ".motion", "must be \"none\", \"wander\" or \"orbit\", got \"" + *v + "\"");
+  }
+  if (auto v = r.number(t, "speed", key + ".speed")) {
+    if (!(*v > 0 && *v <= 1e6)) r.fail(key + ".speed", "must be in (0, 1e6] units per second, got " + number_text(*v));
+    inst.motion.speed = static_cast<float>(*v);
+  }
+  if (inst.motion.kind != MotionKind::none && !t.contains("speed")) r.fail(key + ".speed", "missing (motion needs a speed)");
+  if (inst.motion.kind == MotionKind::none && t.contains("speed")) r.fail(key + ".speed", "needs motion = \"wander\" or \"orbit\"");
+}
+
 void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
   const auto blocks = r.tables(root, "instances", "instances");
   if (blocks.empty()) r.fail("instances", "no [[instances]] given: a scene needs at least one object");
@@ -355,7 +373,8 @@ void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
     const toml::table& t = *blocks[i];
     const std::string key = indexed("instances", i);
     r.only_keys(t, key,
-                {"model", "count", "placement", "box_min", "box_max", "scale", "scale_range", "seed"});
+                {"model", "count", "placement", "box_min", "box_max", "scale", "scale_range", "seed", "motion",
+                 "speed"});
     InstanceConfig inst;
     auto model = r.string(t, "model", key + ".model");
     if (!model) r.fail(key + ".model", "missing");
@@ -404,6 +423,7 @@ void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
       inst.scale_max = static_cast<float>(hi);
     }
     r.integer_in(t, "seed", key + ".seed", 0, INT64_MAX, inst.seed);
+    read_motion(r, t, key, inst);
     c.instances.push_back(inst);
   }
 }

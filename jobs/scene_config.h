@@ -7,6 +7,7 @@
 
 #include "preprocess/lod_bake.h"
 #include "runtime/camera_path.h"
+#include "runtime/motion_path.h"
 #include "runtime/slc_selection.h"
 #include "runtime/status.h"
 
@@ -30,6 +31,7 @@ struct InstanceConfig {
   float box_max[3] = {500, 0, 500};
   float scale_min = 1, scale_max = 1;
   uint64_t seed = 1;
+  MotionSpec motion;           // motion = "wander" / "orbit" with a speed: moved every frame
 };
 
 struct SceneConfig {

@@ -1,94 +1,173 @@
-// lod::Service: a thread that fires the frame graph at a fixed rate and hands frames over.
+// lod::Service: staged objects, a frame graph fired by step() or by its own thread, frames
+// shared through a FramePool.
 #include "jobs/service.h"
 
-#include <atomic>
-#include <chrono>
-#include <condition_variable>
-#include <mutex>
-#include <thread>
+#include <cmath>
 
-#include "jobs/frame_handoff.h"
+#include "jobs/service_impl.h"
+#include "runtime/lod_asset.h"
+#include "runtime/object_controls.h"
 
 namespace lod {
 
-struct Service::Impl {
-  FrameGraph graph;
-  FrameHandoff<Frame> handoff;  // the service thread (or step's caller) writes, one consumer reads
-  double rate_hz;
-  std::atomic<uint64_t> budget;
-  std::atomic<bool> is_running{false};
+namespace {
+thread_local std::string t_last_error;
 
-  mutable std::mutex mutex;  // guards view, stop_requested and stats
-  std::condition_variable wake;
-  View view;
-  bool stop_requested = false;
-  ServiceStats stats;
-  std::thread thread;
+bool fail(std::string message) {
+  t_last_error = std::move(message);
+  return false;
+}
+}  // namespace
 
-  Impl(const Scene& scene, const FrameGraphOptions& options, double rate)
-      : graph(scene, options), rate_hz(rate), budget(options.selection.budget) {}
+// ---- FrameRef ------------------------------------------------------------------------------
 
-  // One frame into the back buffer; published only when every stage succeeded, so the
-  // consumer keeps the last good frame when one fails.
-  bool run_frame(const View& v) {
-    Frame& back = handoff.back();
-    try {
-      graph.set_budget(budget.load(std::memory_order_relaxed));
-      graph.run(v, back);  // resets its own state before rethrowing
-    } catch (...) {
-      std::lock_guard lock(mutex);
-      ++stats.errors;
-      return false;
-    }
-    const double ms = back.total_ms;
-    handoff.publish();
-    std::lock_guard lock(mutex);
-    ++stats.frames;
-    stats.last_ms = ms;
-    stats.mean_ms += (ms - stats.mean_ms) / static_cast<double>(stats.frames);
-    return true;
+FrameRef& FrameRef::operator=(FrameRef&& other) noexcept {
+  if (this != &other) {
+    reset();
+    slot_ = other.slot_;
+    other.slot_ = nullptr;
   }
+  return *this;
+}
 
-  void loop() {
-    using Clock = std::chrono::steady_clock;
-    // rate_hz <= 0 means free-running as fast as frames complete.
-    const Clock::duration period =
-        rate_hz > 0
-            ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz))
-            : Clock::duration::zero();
-    Clock::time_point next = Clock::now();
-    for (;;) {
-      View v;
-      {
-        std::lock_guard lock(mutex);
-        if (stop_requested) break;
-        v = view;
-      }
-      run_frame(v);
-      next += period;
-      const Clock::time_point now = Clock::now();
-      if (next < now) next = now;  // fell behind: start the next frame now, never burst to catch up
-      std::unique_lock lock(mutex);
-      // A condition variable rather than sleep_until, so that stop() wakes it at once.
-      if (wake.wait_until(lock, next, [&] { return stop_requested; })) break;
-    }
-  }
-};
+const Frame* FrameRef::get() const { return slot_ ? &slot_->frame : nullptr; }
 
-Service::Service(const Scene& scene, const FrameGraphOptions& options, double rate_hz)
-    : impl_(std::make_unique<Impl>(scene, options, rate_hz)) {}
+void FrameRef::reset() {
+  if (slot_) FramePool::release(slot_);
+  slot_ = nullptr;
+}
+
+// ---- Service -------------------------------------------------------------------------------
+
+namespace {
+
+FrameGraphOptions graph_options_of(const ServiceOptions& o) {
+  FrameGraphOptions g;
+  g.threads = o.threads;
+  g.selection.budget = o.budget;
+  g.selection.count = o.budget_unit == BudgetUnit::levels ? BudgetCount::levels : BudgetCount::triangles;
+  g.selection.reserve_blends = o.reserve_blends;
+  g.pixel_error = o.pixel_error;
+  g.hysteresis = o.hysteresis;
+  g.geomorph_seconds = o.blend_seconds;
+  return g;
+}
+
+}  // namespace
+
+Service::Service(const ServiceOptions& options)
+    : impl_(std::make_unique<Impl>(options, graph_options_of(options))) {}
 
 Service::~Service() { stop(); }
 
-void Service::start() {
+bool Service::add_model(const std::filesystem::path& path, ModelId* out) {
+  LodChain chain;
+  if (path.extension() == ".lod") {
+    if (auto st = read_lod_asset(path, chain); !st) return fail(st.message);
+  } else {
+    if (!impl_->options.baker) {
+      return fail(path.string() + ": a mesh file needs a baker (ServiceOptions::baker = lod::mesh_baker(), "
+                                  "in lodkit::lodkit); lodkit::engine loads .lod assets only");
+    }
+    std::string error;
+    std::vector<uint8_t> asset;
+    if (!impl_->options.baker(path, impl_->options.cache_dir, asset, error)) return fail(error);
+    if (auto st = decode_lod_asset(asset, path.string(), chain); !st) return fail(st.message);
+  }
+  if (std::string why; !validate_chain(chain, &why)) return fail(path.string() + ": " + why);
+  const ModelId id = impl_->add_chain(std::move(chain));
+  if (out) *out = id;
+  return true;
+}
+
+uint32_t Service::model_count() const { return impl_->model_count(); }
+
+uint32_t Service::level_count(ModelId model) const {
+  std::lock_guard lock(impl_->models_mutex);
+  return model < impl_->chains.size() ? static_cast<uint32_t>(impl_->chains[model]->levels.size()) : 0;
+}
+
+uint64_t Service::level_triangles(ModelId model, uint32_t level) const {
+  std::lock_guard lock(impl_->models_mutex);
+  if (model >= impl_->chains.size() || level >= impl_->chains[model]->levels.size()) return 0;
+  return impl_->chains[model]->levels[level].triangles();
+}
+
+ObjectHandle Service::create(ModelId model, const Transform& transform, const ObjectOptions& options) {
+  const ObjectHandle h = impl_->queue.create(model, impl_->model_count(), transform, options);
+  if (h == 0) {
+    if (model >= impl_->model_count())
+      fail("create: unknown model " + std::to_string(model));
+    else if (!transform_valid(transform))
+      fail("create: transform must be finite with scale > 0 and a non-zero quaternion");
+    else
+      fail("create: options need a finite lod_bias and a finite priority > 0");
+  }
+  return h;
+}
+
+bool Service::destroy(ObjectHandle object) {
+  return impl_->queue.destroy(object) || fail("destroy: stale or unknown handle " + std::to_string(object));
+}
+
+bool Service::set_transform(ObjectHandle object, const Transform& transform) {
+  if (impl_->queue.set_transform(object, transform)) return true;
+  return fail(transform_valid(transform) ? "set_transform: stale or unknown handle " + std::to_string(object)
+                                         : std::string("set_transform: transform must be finite with scale > 0 "
+                                                       "and a non-zero quaternion"));
+}
+
+bool Service::set_options(ObjectHandle object, const ObjectOptions& options) {
+  if (impl_->queue.set_options(object, options)) return true;
+  return fail(options_valid(options) ? "set_options: stale or unknown handle " + std::to_string(object)
+                                     : std::string("set_options: need a finite lod_bias and a finite priority > 0"));
+}
+
+size_t Service::set_transforms(std::span<const ObjectHandle> objects, std::span<const Transform> transforms) {
+  return impl_->queue.set_transforms(objects, transforms);
+}
+
+bool Service::alive(ObjectHandle object) const { return impl_->queue.live(object); }
+
+void Service::commit(uint64_t tick) { impl_->queue.commit(tick); }
+
+bool Service::set_view(uint32_t index, const Camera& camera) {
+  if (index >= kMaxViews) return fail("set_view: view index " + std::to_string(index) + " is not below 8");
+  if (const char* why = nullptr; !camera_valid(camera, &why))
+    return fail("set_view: view " + std::to_string(index) + ": " + why);
+  std::lock_guard lock(impl_->view_mutex);
+  impl_->views[index] = view_of(camera);
+  impl_->view_count = std::max(impl_->view_count, index + 1);
+  return true;
+}
+
+bool Service::set_view_count(uint32_t count) {
+  if (count < 1 || count > kMaxViews) return fail("set_view_count: " + std::to_string(count) + " is not 1..8");
+  std::lock_guard lock(impl_->view_mutex);
+  impl_->view_count = count;
+  return true;
+}
+
+void Service::set_budget(uint64_t triangles) { impl_->budget.store(std::max<uint64_t>(triangles, 1)); }
+void Service::set_pixel_error(float pixels) {
+  if (std::isfinite(pixels) && pixels > 0) impl_->pixel_error.store(pixels);
+}
+void Service::set_hysteresis(float band) {
+  if (std::isfinite(band) && band >= 0) impl_->hysteresis.store(band);
+}
+void Service::set_blend_seconds(float seconds) {
+  if (std::isfinite(seconds) && seconds >= 0) impl_->blend_seconds.store(seconds);
+}
+
+bool Service::start() {
   Impl& m = *impl_;
-  if (m.is_running.load()) return;
+  if (m.is_running.exchange(true)) return fail("start: already running");
   {
     std::lock_guard lock(m.mutex);
     m.stop_requested = false;
   }
-  m.is_running.store(true);
   m.thread = std::thread([&m] { m.loop(); });
+  return true;
 }
 
 void Service::stop() {
@@ -99,29 +178,62 @@ void Service::stop() {
     m.stop_requested = true;
   }
   m.wake.notify_all();
-  m.thread.join();
+  if (m.thread.joinable()) m.thread.join();
   m.is_running.store(false);
 }
 
 bool Service::running() const { return impl_->is_running.load(); }
 
-bool Service::step(const View& view) {
-  if (impl_->is_running.load()) return false;  // the service thread owns the graph
-  return impl_->run_frame(view);
+bool Service::step(double dt_seconds) {
+  if (impl_->is_running.load()) return fail("step: the service thread is running (stop() first)");
+  if (!(dt_seconds >= 0) || !std::isfinite(dt_seconds)) return fail("step: dt must be finite and >= 0");
+  return impl_->run_frame(dt_seconds) || fail("step: a frame graph node failed; the last good frame is kept");
 }
 
-void Service::set_view(const View& view) {
-  std::lock_guard lock(impl_->mutex);
-  impl_->view = view;
-}
-
-void Service::set_budget(uint64_t budget) { impl_->budget.store(budget, std::memory_order_relaxed); }
-
-const Frame& Service::latest_frame() { return impl_->handoff.acquire(); }
+FrameRef Service::acquire_frame() const { return FrameRef(impl_->pool.acquire()); }
 
 ServiceStats Service::stats() const {
-  std::lock_guard lock(impl_->mutex);
-  return impl_->stats;
+  ServiceStats s;
+  {
+    std::lock_guard lock(impl_->mutex);
+    s = impl_->stats;
+  }
+  s.commits = impl_->queue.commits();
+  s.live_objects = impl_->queue.live_count();
+  return s;
 }
+
+std::string Service::last_error() const { return t_last_error; }
+
+// ---- lodkit's own tools --------------------------------------------------------------------
+
+std::unique_ptr<Service> make_service(const Scene& scene, const FrameGraphOptions& graph, double rate_hz,
+                                      std::vector<ObjectHandle>* handles) {
+  ServiceOptions o;
+  o.threads = graph.threads;
+  o.rate_hz = rate_hz;
+  auto s = std::unique_ptr<Service>(new Service(o));
+  // The graph's own options (hook, grain, vd hysteresis) replace those derived from `o`.
+  Service::Impl& m = s->impl();
+  m.graph_options = graph;
+  m.graph = std::make_unique<FrameGraph>(make_model_set({}), graph);
+  m.budget = graph.selection.budget;
+  m.pixel_error = graph.pixel_error;
+  m.hysteresis = graph.hysteresis;
+  m.blend_seconds = graph.geomorph_seconds;
+  for (const LodChain& c : scene.chains) m.add_chain(c);
+  const uint32_t models = m.model_count();
+  if (handles) handles->clear();
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectHandle h = m.queue.create(scene.objects.model[i], models, transform_of(scene.objects, i), {});
+    if (handles) handles->push_back(h);
+  }
+  m.queue.commit(0);
+  return s;
+}
+
+ModelId add_chain(Service& service, LodChain chain) { return service.impl().add_chain(std::move(chain)); }
+
+bool set_view(Service& service, uint32_t index, const View& view) { return service.set_view(index, camera_of(view)); }
 
 }  // namespace lod

@@ -2,6 +2,8 @@
 // so a frame visits only nodes whose decision may have changed, threshold feedback.
 #include "runtime/vertex_front.h"
 
+#include <glm/gtc/quaternion.hpp>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -709,6 +711,12 @@ FrontStats Updater::run(const FrontView& view) {
 }  // namespace
 
 FrontView front_view_of(const View& view, const float position[3], float scale, float yaw) {
+  // R_y(yaw) as a quaternion: (0, sin(yaw / 2), 0, cos(yaw / 2)).
+  const float q[4] = {0, std::sin(0.5f * yaw), 0, std::cos(0.5f * yaw)};
+  return front_view_of(view, position, scale, q);
+}
+
+FrontView front_view_of(const View& view, const float position[3], float scale, const float rotation[4]) {
   // The planes are built from the camera's basis in double rather than extracted from the
   // float clip matrix: extraction leaves the far plane (far / near ~ 1e5) noisy by ~1e-3 of
   // its distance, and front_update reads frame-to-frame plane motion as view motion.
@@ -730,10 +738,14 @@ FrontView front_view_of(const View& view, const float position[3], float scale, 
   const double offsets[6] = {0, 0, 0, 0, -double(view.near_plane), double(view.far_plane)};
 
   FrontView out;
-  const double c = std::cos(double(yaw)), s = std::sin(double(yaw));
   const double inv = scale != 0 ? 1.0 / scale : 1.0;
-  // Object = R_y(-yaw) (world - position) / scale; R_y(t) maps (x, z) to (c x + s z, -s x + c z).
-  auto to_object_dir = [&](const V& d) { return V(c * d.x - s * d.z, d.y, s * d.x + c * d.z); };
+  // Object = R^-1 (world - position) / scale, R the unit quaternion (conjugate undoes it).
+  glm::dquat q{static_cast<double>(rotation[3]), static_cast<double>(rotation[0]), static_cast<double>(rotation[1]),
+               static_cast<double>(rotation[2])};
+  const double qn = glm::length(q);
+  q = qn > 0 ? q / qn : glm::dquat(1, 0, 0, 0);
+  const glm::dquat qi = glm::conjugate(q);
+  auto to_object_dir = [&](const V& d) { return qi * d; };
   const V eye_o = to_object_dir(eye - pos) * inv;
   for (int k = 0; k < 3; ++k) out.eye[k] = static_cast<float>(eye_o[k]);
   for (int k = 0; k < 6; ++k) {

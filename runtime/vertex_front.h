@@ -41,6 +41,8 @@ struct FrontView {
 
 // `view` seen from an object placed as ObjectSet does: world = R_y(yaw) * (scale * p) + position.
 FrontView front_view_of(const View& view, const float position[3], float scale, float yaw);
+// The same for a full rotation: world = R(q) * (scale * p) + position, q = x y z w (normalised here).
+FrontView front_view_of(const View& view, const float position[3], float scale, const float rotation[4]);
 
 enum class FrontEventKind : uint8_t { split, collapse, collapse_begin, collapse_cancel };
 

@@ -1,6 +1,7 @@
 // View matrices (GLM, OpenGL clip conventions) and the frustum planes culling tests against.
 #include "runtime/view.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -37,6 +38,49 @@ Frustum frustum_of(const View& v) {
 
 float focal_pixels(const View& v) {
   return 0.5f * static_cast<float>(v.height) / std::tan(0.5f * glm::radians(v.fov_y_deg));
+}
+
+View view_of(const Camera& c) {
+  View v;
+  v.eye = glm::vec3(c.eye[0], c.eye[1], c.eye[2]);
+  v.target = v.eye + glm::vec3(c.forward[0], c.forward[1], c.forward[2]);
+  v.up = glm::vec3(c.up[0], c.up[1], c.up[2]);
+  v.fov_y_deg = c.fov_y_deg;
+  v.width = static_cast<int>(c.width);
+  v.height = static_cast<int>(c.height);
+  v.near_plane = c.near_z;
+  v.far_plane = c.far_z;
+  return v;
+}
+
+Camera camera_of(const View& v) {
+  Camera c;
+  const glm::vec3 f = v.target - v.eye;
+  for (int k = 0; k < 3; ++k) c.eye[k] = v.eye[k], c.forward[k] = f[k], c.up[k] = v.up[k];
+  c.fov_y_deg = v.fov_y_deg;
+  c.width = static_cast<uint32_t>(std::max(v.width, 0));
+  c.height = static_cast<uint32_t>(std::max(v.height, 0));
+  c.near_z = v.near_plane;
+  c.far_z = v.far_plane;
+  return c;
+}
+
+bool camera_valid(const Camera& c, const char** why) {
+  auto fail = [&](const char* w) {
+    if (why) *why = w;
+    return false;
+  };
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(c.eye[k]) || !std::isfinite(c.forward[k]) || !std::isfinite(c.up[k]))
+      return fail("eye, forward and up must be finite");
+  const glm::dvec3 f(c.forward[0], c.forward[1], c.forward[2]), u(c.up[0], c.up[1], c.up[2]);
+  if (glm::length(f) < 1e-12) return fail("forward must not be zero");
+  if (glm::length(u) < 1e-12) return fail("up must not be zero");
+  if (glm::length(glm::cross(glm::normalize(f), glm::normalize(u))) < 1e-6) return fail("up must not be parallel to forward");
+  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180)) return fail("fov_y_deg must be in (0, 180)");
+  if (c.width == 0 || c.height == 0 || c.width > 65536 || c.height > 65536) return fail("width and height must be 1..65536");
+  if (!(c.near_z > 0 && std::isfinite(c.far_z) && c.far_z > c.near_z)) return fail("need 0 < near_z < far_z, finite");
+  return true;
 }
 
 }  // namespace lod

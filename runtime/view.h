@@ -2,6 +2,8 @@
 #pragma once
 #include <glm/glm.hpp>
 
+#include "lodkit/types.hpp"
+
 namespace lod {
 
 struct View {
@@ -18,6 +20,13 @@ struct View {
 struct Frustum {
   glm::vec4 planes[6];  // normalized, inside when dot(n, p) + w >= 0
 };
+
+// The public Camera and the View the stages use, each way (forward = target - eye).
+View view_of(const Camera& c);
+Camera camera_of(const View& v);
+// True when a camera gives a usable view: finite, forward and up not zero nor parallel,
+// 0 < fov < 180, width and height > 0, 0 < near < far. Otherwise `why` names the value.
+bool camera_valid(const Camera& c, const char** why);
 
 glm::mat4 view_matrix(const View& v);
 glm::mat4 projection_matrix(const View& v);

@@ -98,7 +98,7 @@ FrontView orbit_view(const Fixture& fx, double angle, float distance) {
   v.near_plane = 0.001f * fx.size;
   v.far_plane = 100 * fx.size;
   const float origin[3] = {0, 0, 0};
-  return front_view_of(v, origin, 1, 0);
+  return front_view_of(v, origin, 1.f, 0.f);
 }
 
 double median(std::vector<double> v) {

@@ -58,7 +58,8 @@ TEST(Stress, TenThousandObjectsTwoHundredFramesMovingCamera) {
   FrameGraphOptions options;
   options.threads = 2;
   options.selection.budget = budget;
-  Service service(scene, options, 60);
+  std::unique_ptr<Service> owned = make_service(scene, options, 60);
+  Service& service = *owned;
 
   uint64_t last_index = 0;
   uint32_t bound = 0, flagged = 0, culled_some = 0;
@@ -67,8 +68,9 @@ TEST(Stress, TenThousandObjectsTwoHundredFramesMovingCamera) {
     const bool impossible = n % 50 == 49;
     service.set_budget(impossible ? 1000 : budget);
     const View view = view_at(path, n);
-    ASSERT_TRUE(service.step(view)) << "frame " << n;
-    const Frame& f = service.latest_frame();
+    ASSERT_TRUE(set_view(service, 0, view) && service.step(1.0 / 60)) << "frame " << n;
+    const FrameRef held = service.acquire_frame();
+    const Frame& f = *held;
     SCOPED_TRACE("frame " + std::to_string(n));
 
     ASSERT_GT(f.index, last_index) << "indices strictly increase";

@@ -39,16 +39,31 @@ struct Fixture {
   CameraPath path = test::synthetic_config(2000, 200).camera;
 };
 
+std::unique_ptr<Service> service_of(const Fixture& fx, const FrameGraphOptions& o, double rate) {
+  return make_service(fx.scene, o, rate);
+}
+
+// Driven mode as the CLI uses it: the view, then one frame 1/60 s later.
+bool step(Service& s, const View& view) { return set_view(s, 0, view) && s.step(1.0 / 60); }
+
+uint64_t latest_index(const Service& s) {
+  const FrameRef f = s.acquire_frame();
+  return f ? f->index : 0;
+}
+
 TEST(Service, DrivenStepPublishesOneFrame) {
   Fixture fx;
-  Service s(fx.scene, small_options(), 60);
-  EXPECT_EQ(s.latest_frame().index, 0u) << "nothing published yet";
+  auto owned = service_of(fx, small_options(), 60);
+  Service& s = *owned;
+  EXPECT_FALSE(s.acquire_frame()) << "nothing published yet";
   const View view = view_at(fx.path, 3);
-  ASSERT_TRUE(s.step(view));
-  const Frame& f = s.latest_frame();
+  ASSERT_TRUE(step(s, view));
+  const FrameRef held = s.acquire_frame();
+  const Frame& f = *held;
   EXPECT_EQ(f.index, 1u);
   EXPECT_EQ(f.object_count, 2000u);
-  EXPECT_EQ(f.view.eye, view.eye);
+  EXPECT_EQ(f.tick, 0u) << "the scene's objects are committed at tick 0";
+  EXPECT_EQ(view_of(f.views[0]).eye, view.eye);
 
   FrameGraph g(fx.scene, small_options());
   Frame expected;
@@ -62,9 +77,10 @@ TEST(Service, DrivenStepPublishesOneFrame) {
 
 TEST(Service, StartStopAndRestart) {
   Fixture fx;
-  Service s(fx.scene, small_options(), 500);
-  s.set_view(view_at(fx.path, 0));
-  s.start();
+  auto owned = service_of(fx, small_options(), 500);
+  Service& s = *owned;
+  set_view(s, 0, view_at(fx.path, 0));
+  EXPECT_TRUE(s.start());
   EXPECT_TRUE(s.running());
   ASSERT_TRUE(eventually([&] { return s.stats().frames >= 3; }));
   s.stop();
@@ -72,31 +88,35 @@ TEST(Service, StartStopAndRestart) {
   const uint64_t after_stop = s.stats().frames;
   std::this_thread::sleep_for(20ms);
   EXPECT_EQ(s.stats().frames, after_stop) << "no frames after stop()";
-  EXPECT_EQ(s.latest_frame().index, after_stop);
+  EXPECT_EQ(latest_index(s), after_stop);
 
-  s.start();
-  s.start();  // a second start is a no-op
+  EXPECT_TRUE(s.start());
+  EXPECT_FALSE(s.start());  // a second start is refused and changes nothing
   ASSERT_TRUE(eventually([&] { return s.stats().frames >= after_stop + 3; }));
   s.stop();
   s.stop();  // so is a second stop
-  EXPECT_GT(s.latest_frame().index, after_stop);
+  EXPECT_GT(latest_index(s), after_stop);
   EXPECT_EQ(s.stats().errors, 0u);
   EXPECT_GT(s.stats().mean_ms, 0.0);
 }
 
 TEST(Service, StepIsRefusedWhileRunning) {
   Fixture fx;
-  Service s(fx.scene, small_options(), 200);
+  auto owned = service_of(fx, small_options(), 200);
+  Service& s = *owned;
+  ASSERT_TRUE(step(s, view_at(fx.path, 0)));  // stepped, then started, stopped and stepped again
   s.start();
-  EXPECT_FALSE(s.step(view_at(fx.path, 0)));
+  EXPECT_FALSE(step(s, view_at(fx.path, 0)));
+  EXPECT_NE(s.last_error().find("running"), std::string::npos) << s.last_error();
   s.stop();
   EXPECT_EQ(s.stats().errors, 0u);
-  EXPECT_TRUE(s.step(view_at(fx.path, 0)));
+  EXPECT_TRUE(step(s, view_at(fx.path, 0)));
+  EXPECT_FALSE(s.step(-1.0)) << "a negative dt is refused";
 }
 
 TEST(Service, DestructorStopsARunningService) {
   Fixture fx;
-  auto s = std::make_unique<Service>(fx.scene, small_options(), 1000);
+  auto s = service_of(fx, small_options(), 1000);
   s->start();
   ASSERT_TRUE(eventually([&] { return s->stats().frames >= 1; }));
   s.reset();  // joins the thread; a leak or a hang fails the test run
@@ -116,13 +136,14 @@ TEST(Service, ViewsSetFromAnotherThreadGiveConsistentFrames) {
   }
   ASSERT_NE(expected_visible[0], expected_visible[1]);
 
-  Service s(fx.scene, small_options(), 2000);
-  s.set_view(views[0]);
+  auto owned = service_of(fx, small_options(), 2000);
+  Service& s = *owned;
+  set_view(s, 0, views[0]);
   s.start();
   std::atomic<bool> stop{false};
   std::thread steer([&] {
     for (int k = 0; !stop.load(); k ^= 1) {
-      s.set_view(views[k]);
+      set_view(s, 0, views[k]);
       std::this_thread::sleep_for(200us);
     }
   });
@@ -130,12 +151,14 @@ TEST(Service, ViewsSetFromAnotherThreadGiveConsistentFrames) {
   bool saw[2] = {false, false};
   const auto deadline = std::chrono::steady_clock::now() + 30s;
   while ((checked < 200 || !saw[0] || !saw[1]) && std::chrono::steady_clock::now() < deadline) {
-    const Frame& f = s.latest_frame();
-    if (f.index == 0) continue;
+    const FrameRef held = s.acquire_frame();
+    if (!held) continue;
+    const Frame& f = *held;
     if (f.index < last) ++backwards;
     if (f.index != last) {
       ++checked;
-      const int k = f.view.eye == views[0].eye ? 0 : f.view.eye == views[1].eye ? 1 : -1;
+      const glm::vec3 eye = view_of(f.views[0]).eye;
+      const int k = eye == views[0].eye ? 0 : eye == views[1].eye ? 1 : -1;
       if (k < 0 || f.visible != expected_visible[k] || f.objects.size() != f.visible ||
           f.levels.size() != f.visible || (!f.over_budget && f.tris_selected > f.budget))
         ++inconsistent;
@@ -154,14 +177,16 @@ TEST(Service, ViewsSetFromAnotherThreadGiveConsistentFrames) {
 
 TEST(Service, SetBudgetAppliesToTheNextFrame) {
   Fixture fx;
-  Service s(fx.scene, small_options(UINT64_MAX), 60);
+  auto owned = service_of(fx, small_options(UINT64_MAX), 60);
+  Service& s = *owned;
   const View view = view_at(fx.path, 0);
-  ASSERT_TRUE(s.step(view));
-  const uint64_t free_tris = s.latest_frame().tris_selected;
+  ASSERT_TRUE(step(s, view));
+  const uint64_t free_tris = s.acquire_frame()->tris_selected;
   std::thread other([&] { s.set_budget(free_tris / 3); });
   other.join();
-  ASSERT_TRUE(s.step(view));
-  const Frame& f = s.latest_frame();
+  ASSERT_TRUE(step(s, view));
+  const FrameRef held = s.acquire_frame();
+  const Frame& f = *held;
   EXPECT_EQ(f.budget, free_tris / 3);
   EXPECT_LE(f.tris_selected, free_tris / 3);
 }
@@ -173,20 +198,22 @@ TEST(Service, FailedDrivenFrameKeepsTheLastGoodFrame) {
   o.stage_hook = [&](Stage st) {
     if (st == Stage::selection && fail.load()) throw std::runtime_error("injected failure");
   };
-  Service s(fx.scene, o, 60);
-  ASSERT_TRUE(s.step(view_at(fx.path, 0)));
-  const Frame good = s.latest_frame();
+  auto owned = service_of(fx, o, 60);
+  Service& s = *owned;
+  ASSERT_TRUE(step(s, view_at(fx.path, 0)));
+  const Frame good = *s.acquire_frame();
   fail.store(true);
-  EXPECT_FALSE(s.step(view_at(fx.path, 50)));
-  const Frame& kept = s.latest_frame();
+  EXPECT_FALSE(step(s, view_at(fx.path, 50)));
+  const FrameRef held = s.acquire_frame();
+  const Frame& kept = *held;
   EXPECT_EQ(kept.index, good.index);
   EXPECT_EQ(kept.objects, good.objects);
   EXPECT_EQ(kept.levels, good.levels);
   EXPECT_EQ(s.stats().errors, 1u);
   EXPECT_EQ(s.stats().frames, 1u);
   fail.store(false);
-  ASSERT_TRUE(s.step(view_at(fx.path, 50)));
-  EXPECT_GT(s.latest_frame().index, good.index);
+  ASSERT_TRUE(step(s, view_at(fx.path, 50)));
+  EXPECT_GT(latest_index(s), good.index);
   EXPECT_EQ(s.stats().frames, 2u);
 }
 
@@ -198,14 +225,16 @@ TEST(Service, KeepsRunningThroughFailingFrames) {
     // Every third frame fails in importance.
     if (st == Stage::importance && calls.fetch_add(1) % 3 == 2) throw std::runtime_error("injected failure");
   };
-  Service s(fx.scene, o, 2000);
-  s.set_view(view_at(fx.path, 0));
+  auto owned = service_of(fx, o, 2000);
+  Service& s = *owned;
+  set_view(s, 0, view_at(fx.path, 0));
   s.start();
   ASSERT_TRUE(eventually([&] { return s.stats().errors >= 3 && s.stats().frames >= 6; }));
   EXPECT_TRUE(s.running());
-  const Frame& f = s.latest_frame();
-  EXPECT_GT(f.index, 0u);
-  EXPECT_EQ(f.objects.size(), f.visible);
+  const FrameRef held = s.acquire_frame();
+  ASSERT_TRUE(held);
+  EXPECT_GT(held->index, 0u);
+  EXPECT_EQ(held->objects.size(), held->visible);
   s.stop();
 }
 

@@ -353,7 +353,7 @@ void walk_scan(const std::filesystem::path& file) {
     v.far_plane = 100 * size;
     const float origin[3] = {0, 0, 0};
     p.time = i / 60.0;
-    const FrontStats s = front_update(f, t, front_view_of(v, origin, 1, 0), p);
+    const FrontStats s = front_update(f, t, front_view_of(v, origin, 1.f, 0.f), p);
     std::string msg;
     ASSERT_TRUE(check_front(f, t, edges, &msg)) << file << " frame " << i << ": " << msg;
     ASSERT_LE(s.active_tris, std::max(p.max_triangles, base));

@@ -21,7 +21,7 @@ FrontView facing_view(float distance) {
   v.near_plane = 0.01f;
   v.far_plane = 1000;
   const float origin[3] = {0, 0, 0};
-  return front_view_of(v, origin, 1, 0);
+  return front_view_of(v, origin, 1.f, 0.f);
 }
 
 TEST(VertexTree, HandBuiltSquareValidatesAndBrokenOnesDoNot) {
@@ -127,11 +127,11 @@ TEST(VertexFront, BackFacingAndOutsideStayCoarse) {
   v.eye = {0.5f, 0.5f, -2};
   v.target = {0.5f, 0.5f, 0};
   const float origin[3] = {0, 0, 0};
-  EXPECT_EQ(front_update(f, t, front_view_of(v, origin, 1, 0), FrontParams{}).splits, 0u);
+  EXPECT_EQ(front_update(f, t, front_view_of(v, origin, 1.f, 0.f), FrontParams{}).splits, 0u);
   // In front but looking away.
   v.eye = {0.5f, 0.5f, 2};
   v.target = {0.5f, 0.5f, 4};
-  EXPECT_EQ(front_update(f, t, front_view_of(v, origin, 1, 0), FrontParams{}).splits, 0u);
+  EXPECT_EQ(front_update(f, t, front_view_of(v, origin, 1.f, 0.f), FrontParams{}).splits, 0u);
   EXPECT_EQ(f.tri_count, 1u);
 }
 

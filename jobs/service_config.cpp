@@ -1,0 +1,73 @@
+// What needs the bake side of lodkit (lodkit::lodkit): services made from scene configs, and
+// the mesh baker that add_model uses for mesh files.
+#include <cstdio>
+#include <filesystem>
+
+#include "jobs/bake_jobs.h"
+#include "jobs/scene.h"
+#include "jobs/scene_config.h"
+#include "jobs/service.h"
+#include "jobs/service_impl.h"
+#include "runtime/lod_asset.h"
+#include "runtime/view.h"
+
+namespace lod {
+
+namespace {
+
+std::filesystem::path cache_dir_for(const std::filesystem::path& asked, const std::filesystem::path& data_dir) {
+  if (!asked.empty()) return asked;
+  return data_dir.parent_path() / "cache";
+}
+
+}  // namespace
+
+ModelBaker mesh_baker() {
+  return [](const std::filesystem::path& mesh, const std::filesystem::path& cache_dir, std::vector<uint8_t>& asset,
+            std::string& error) {
+    ModelConfig model;
+    model.name = mesh.stem().string();
+    model.file = mesh;
+    const std::filesystem::path cache =
+        cache_dir.empty() ? std::filesystem::temp_directory_path() / "lodkit-cache" : cache_dir;
+    std::vector<LodChain> chains;
+    BakeSummary summary;
+    if (auto st = bake_scene_models({model}, cache, 0, chains, summary, nullptr); !st) {
+      error = st.message;
+      return false;
+    }
+    asset = encode_lod_asset(chains.at(0));
+    return true;
+  };
+}
+
+std::unique_ptr<Service> Service::from_config(const std::filesystem::path& config, std::string* error,
+                                              const std::filesystem::path& data_dir,
+                                              const std::filesystem::path& cache_dir) {
+  auto failed = [&](const std::string& message) {
+    if (error) *error = message;
+    return std::unique_ptr<Service>();
+  };
+  const std::filesystem::path data = data_dir.empty() ? default_data_dir() : data_dir;
+  SceneConfig sc;
+  if (auto st = load_scene_config(config, data, sc); !st) return failed(st.message);
+  const std::filesystem::path cache = cache_dir_for(cache_dir, data);
+  std::vector<LodChain> chains;
+  BakeSummary summary;
+  if (auto st = bake_scene_models(sc.models, cache, sc.threads, chains, summary, nullptr); !st)
+    return failed(st.message);
+  Scene scene = make_scene(sc, std::move(chains));
+  FrameGraphOptions g;
+  g.threads = sc.threads;
+  g.selection = sc.selection;
+  g.pixel_error = sc.pixel_error;
+  g.hysteresis = sc.hysteresis;
+  std::unique_ptr<Service> s = make_service(scene, g, sc.rate_hz);
+  Impl& m = s->impl();
+  m.options.cache_dir = cache;
+  m.options.baker = mesh_baker();
+  lod::set_view(*s, 0, view_at(sc.camera, 0));
+  return s;
+}
+
+}  // namespace lod

@@ -1,0 +1,42 @@
+// Level blends: restart, reverse or settle each entry's blend.
+#include "runtime/level_blend.h"
+
+#include <algorithm>
+#include <cassert>
+
+#include "runtime/geomorph.h"
+
+namespace lod {
+
+BlendTotals advance_level_blends(std::span<float> morph, std::span<uint8_t> from_level,
+                                 std::span<const uint32_t> ids, std::span<const uint8_t> level,
+                                 std::span<const uint32_t> model, const LevelBlendState& s,
+                                 std::span<const uint8_t> model_blends, const ModelTable& models, double now,
+                                 float seconds) {
+  const size_t n = ids.size();
+  assert(morph.size() == n && from_level.size() == n && level.size() == n && model.size() == n);
+  BlendTotals totals;
+  for (size_t k = 0; k < n; ++k) {
+    const uint32_t id = ids[k];
+    const uint8_t lv = level[k];
+    if (s.was_visible[id] && s.prev_level[id] != lv) {
+      const float m = morph_factor(now, s.morph_start[id], seconds);
+      const bool reverses = m < 1 && s.morph_from[id] == lv;
+      s.morph_start[id] = reverses ? now - double(1 - m) * seconds : now;
+      s.morph_from[id] = s.prev_level[id];
+    }
+    if (!s.was_visible[id]) s.morph_start[id] = -1e300;
+    morph[k] = morph_factor(now, s.morph_start[id], seconds);
+    const uint32_t m = model[k];
+    const bool blends = morph[k] < 1 && model_blends[m] && s.morph_from[id] != lv;
+    from_level[k] = blends ? s.morph_from[id] : lv;
+    if (blends) {
+      const uint32_t first = models.first_level[m];
+      ++totals.morphing;
+      totals.extra_tris += models.triangles[first + std::min(lv, s.morph_from[id])] - models.triangles[first + lv];
+    }
+  }
+  return totals;
+}
+
+}  // namespace lod

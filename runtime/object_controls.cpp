@@ -1,0 +1,47 @@
+// Object controls: options folded into per-frame columns.
+#include "runtime/object_controls.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace lod {
+
+bool options_valid(const ObjectOptions& o) {
+  return std::isfinite(o.lod_bias) && std::isfinite(o.priority) && o.priority > 0;
+}
+
+void object_controls(std::span<uint32_t> row, std::span<uint8_t> min_level, std::span<float> error_scale,
+                     std::span<float> inv_priority, std::span<uint8_t> never_cull,
+                     std::span<const ObjectOptions> options, std::span<const Transform> transform,
+                     std::span<const uint32_t> model, const LevelCaps& caps) {
+  const size_t n = options.size();
+  assert(row.size() == n && min_level.size() == n && error_scale.size() == n && inv_priority.size() == n &&
+         never_cull.size() == n && transform.size() == n && model.size() == n);
+  for (size_t i = 0; i < n; ++i) {
+    const ObjectOptions& o = options[i];
+    const uint32_t last = caps.rows.level_count[model[i]] - 1u;
+    uint32_t finest = std::min<uint32_t>(o.min_level, last);
+    uint32_t coarsest = std::clamp<uint32_t>(o.max_level, finest, last);
+    if (o.forced_level >= 0) finest = coarsest = std::min<uint32_t>(uint32_t(o.forced_level), last);
+    row[i] = caps.row(model[i], coarsest);
+    min_level[i] = static_cast<uint8_t>(finest);
+    // Bias is clamped to +-30 octaves so that 2^-bias stays a normal float.
+    error_scale[i] = transform[i].scale * std::exp2(-std::clamp(o.lod_bias, -30.f, 30.f));
+    inv_priority[i] = o.priority > 0 ? 1.0f / o.priority : 1.0f;
+    never_cull[i] = o.never_cull ? 1 : 0;
+  }
+}
+
+void apply_object_controls(std::span<uint8_t> level, std::span<float> weight, std::span<const uint8_t> visible,
+                           std::span<const uint8_t> min_level, std::span<const float> inv_priority) {
+  const size_t n = visible.size();
+  assert(level.size() == n && weight.size() == n && min_level.size() == n && inv_priority.size() == n);
+  for (size_t i = 0; i < n; ++i) {
+    if (!visible[i]) continue;
+    level[i] = std::max(level[i], min_level[i]);
+    weight[i] *= inv_priority[i];
+  }
+}
+
+}  // namespace lod
