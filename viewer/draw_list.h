@@ -8,21 +8,25 @@
 #include <vector>
 
 #include "runtime/frame.h"
-#include "runtime/object_set.h"
 #include "viewer/mesh_layout.h"
 
 namespace lod::viewer {
 
 // Per-instance vertex attributes (divisor 1). Layout shared with instance_renderer's shader.
+// The transform is the frame's own (lod::Transform): world = position + scale * rotate(q, p).
 struct InstanceData {
   float position_scale[4];  // world position of the model origin, uniform scale
-  float yaw = 0;            // radians about +y
+  float rotation[4];        // quaternion x y z w exactly as the frame gives it (the shader normalises)
   float morph = 1;          // geomorph factor towards the selected level (1 = settled)
   // Position = mix(own, morph target in the batch's target level, weight): 0 draws the batch's
   // level as it is, 1 puts every vertex on the target level's surface.
   float weight = 0;
 };
-static_assert(sizeof(InstanceData) == 28, "instance attributes are tightly packed");
+static_assert(sizeof(InstanceData) == 40, "instance attributes are tightly packed");
+
+// The instance attributes of one frame transform (finite, scale > 0, non-zero quaternion), or
+// false for a transform no renderer can draw.
+bool instance_of(const Transform& t, float morph, float weight, InstanceData* out);
 
 // How an object with level `to`, morphing from `from` with factor `morph`, is drawn: the finer
 // level, blended towards the coarser by `weight` (morph when coarsening, 1 - morph when refining).
@@ -49,7 +53,8 @@ struct DrawBatch {
 // One view-dependent object's active mesh (Frame::vd_objects): drawn from the frame's own
 // vd_positions / vd_indices with the object's transform, never at its discrete level.
 struct VdDraw {
-  uint32_t object = 0;
+  uint32_t object = 0;        // Frame::objects value
+  uint32_t entry = 0;         // its frame entry (transform, model)
   uint32_t first_vertex = 0;  // into Frame::vd_positions, in vertices
   uint32_t vertex_count = 0;
   uint32_t first_index = 0;   // into Frame::vd_indices; local to this object's vertices
@@ -64,7 +69,9 @@ struct DrawList {
   uint64_t indices = 0;                   // indices submitted (instanced only)
   uint32_t morphing = 0;                  // instances blending two levels
   uint64_t morph_triangles = 0;           // what drawing their finer level adds (vs their frame level)
-  uint32_t rejected = 0;                  // frame entries naming an unknown object or level, bad vd meshes
+  // Frame entries not drawn: past the shortest per-entry column (a torn frame), an unknown
+  // model or level, a transform that is not finite; vd meshes out of range (drawn at their level).
+  uint32_t rejected = 0;
   std::vector<VdDraw> vd;                 // view-dependent objects, in frame order
   uint64_t vd_triangles = 0;              // sum of vd index_count / 3
   uint64_t vd_level_triangles = 0;        // what Frame::tris_selected counts for those objects (their level)
@@ -73,13 +80,16 @@ struct DrawList {
   std::vector<uint8_t> is_vd;             // scratch: per frame entry, drawn from its active mesh
 };
 
-// Rebuilds `out` from `frame` (reusing its capacity). Entries whose object id, level or from
-// level is out of range are not drawn and are counted in `rejected`: a well-formed frame has
-// none. A frame without from_levels (hand-built) is settled; models without morph targets never
-// blend.
-// Objects listed in frame.vd_objects are drawn from their active mesh (out.vd) instead of an
-// instance; a vd entry whose ranges or indices fall outside the frame's arrays is rejected.
-void build_draw_list(const Frame& frame, const ObjectSet& objects, const MeshLayout& layout, DrawList& out);
+// Rebuilds `out` from `frame` alone (reusing its capacity): entry i is model frame.models[i]
+// at frame.transforms[i], drawn at its level (blending from frame.from_levels[i]). Entries are
+// refused one by one and counted in `rejected`: those past the shortest of models, transforms,
+// levels and morph (a torn frame draws the common prefix), with a model or level the layout
+// does not have, or with a transform that is not drawable. A well-formed frame has none. A
+// frame without from_levels (hand-built) is settled; models without morph targets never blend.
+// Entries listed in frame.vd_objects (by VdObjectFrame::entry) are drawn from their active mesh
+// (out.vd) instead of an instance; a vd entry whose entry, ranges or indices fall outside the
+// frame's arrays is rejected and its object drawn at its level.
+void build_draw_list(const Frame& frame, const MeshLayout& layout, DrawList& out);
 
 // The frame's selected triangles as a renderer draws them: Frame::tris_selected counts a
 // view-dependent object at its discrete level, but what is drawn is its active mesh.

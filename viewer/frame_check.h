@@ -8,12 +8,14 @@
 
 namespace lod::viewer {
 
-// True when the per-object arrays all have `visible` entries, ids are increasing and in
-// range, levels exist, the histogram counts `visible` objects, and the selected levels' triangles
-// add up to `tris_selected`, the levels objects morph from exist and their finer levels add
-// `tris_morph_extra` over `morphing` objects, and the view-dependent meshes are visible objects in order, packed
-// back to back over vd_positions / vd_indices, adding up to `vd_active_tris`. Otherwise false
-// with the first broken invariant in `why`.
+// True when every per-entry column (handles, models, transforms, view_masks, objects, levels,
+// morph, from_levels) has `visible` entries, object ids are increasing and below object_count,
+// each entry's model (frame.models, not a scene's placement) is one of `scene`'s and its levels
+// exist, the histogram counts `visible` objects, the selected levels' triangles add up to
+// `tris_selected`, the finer levels of morphing entries add `tris_morph_extra` over `morphing`
+// of them, and the view-dependent meshes name their own entries in order, packed back to back
+// over vd_positions / vd_indices, adding up to `vd_active_tris`. Otherwise false with the first
+// broken invariant in `why`.
 bool frame_is_whole(const Frame& frame, const Scene& scene, std::string* why);
 
 }  // namespace lod::viewer

@@ -1,5 +1,7 @@
 #include "viewer/frame_renderer.h"
 
+#include <algorithm>
+
 #include "viewer/level_palette.h"
 
 namespace lod::viewer {
@@ -28,26 +30,32 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
   glDisable(GL_BLEND);
   glDisable(GL_SCISSOR_TEST);
 
-  build_draw_list(frame, scene_->objects, meshes_.layout(), list_);
+  build_draw_list(frame, meshes_.layout(), list_);
   vd_meshes_.upload(frame);
   return instances_.draw(list_, meshes_, &morphs_, &vd_meshes_, view_matrix(viewing), projection_matrix(viewing),
                          settings);
 }
 
-void FrameRenderer::render_culled(const Frame& frame, const View& viewing) {
+void FrameRenderer::render_culled(const Frame& frame, std::span<const ObjectHandle> handles,
+                                  const View& viewing) {
+  // Culled objects have no frame entry, so no transform this frame: they are drawn at the
+  // scene's placement, which for a moving object is its start position, not where it is now.
+  frame_handles_.assign(frame.handles.begin(), frame.handles.end());
+  std::sort(frame_handles_.begin(), frame_handles_.end());
   const ObjectSet& objects = scene_->objects;
-  culled_.objects.clear();
+  culled_.models.clear();
+  culled_.transforms.clear();
   culled_.levels.clear();
   culled_.morph.clear();
-  size_t next = 0;  // frame.objects is sorted by id
-  for (uint32_t id = 0; id < objects.size(); ++id) {
-    while (next < frame.objects.size() && frame.objects[next] < id) ++next;
-    if (next < frame.objects.size() && frame.objects[next] == id) continue;
-    culled_.objects.push_back(id);
-    culled_.levels.push_back(uint8_t(scene_->models.level_count[objects.model[id]] - 1));
+  for (size_t id = 0; id < objects.size() && id < handles.size(); ++id) {
+    if (std::binary_search(frame_handles_.begin(), frame_handles_.end(), handles[id])) continue;
+    const uint32_t model = objects.model[id];
+    culled_.models.push_back(model);
+    culled_.transforms.push_back(transform_of(objects, id));
+    culled_.levels.push_back(uint8_t(scene_->models.level_count[model] - 1));
     culled_.morph.push_back(1.f);
   }
-  build_draw_list(culled_, objects, meshes_.layout(), culled_list_);
+  build_draw_list(culled_, meshes_.layout(), culled_list_);
   RenderSettings dark;
   dark.colour_override = true;
   dark.colour = kCulledColour;

@@ -4,6 +4,7 @@
 #pragma once
 #include <span>
 #include <string>
+#include <vector>
 
 #include "jobs/scene.h"
 #include "runtime/frame.h"
@@ -23,9 +24,10 @@ class FrameRenderer {
   // `viewing` also gives the viewport size (width x height pixels).
   DrawStats render(const Frame& frame, const View& viewing, const RenderSettings& settings);
 
-  // Objects the frame culled, drawn dark at their coarsest level, for views from outside the
-  // LOD camera (bird's-eye, frozen LOD). Call after render(); not counted in DrawStats.
-  void render_culled(const Frame& frame, const View& viewing);
+  // Objects the frame culled (scene objects whose handle, `handles[i]` for scene object i, has
+  // no frame entry), drawn dark at their coarsest level, for views from outside the LOD camera
+  // (bird's-eye, frozen LOD). Call after render(); not counted in DrawStats.
+  void render_culled(const Frame& frame, std::span<const ObjectHandle> handles, const View& viewing);
 
   const DrawList& draw_list() const { return list_; }
   const MeshBuffers& meshes() const { return meshes_; }
@@ -38,7 +40,8 @@ class FrameRenderer {
   VdMeshBuffers vd_meshes_;
   InstanceRenderer instances_;
   DrawList list_;
-  Frame culled_;        // scratch: the culled objects as a frame
+  Frame culled_;                             // scratch: the culled objects as a frame
+  std::vector<ObjectHandle> frame_handles_;  // scratch: the frame's handles, sorted
   DrawList culled_list_;
 };
 

@@ -1,5 +1,6 @@
 #include "viewer/instance_renderer.h"
 
+#include <cstddef>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "viewer/level_palette.h"
@@ -9,33 +10,40 @@ namespace lod::viewer {
 
 namespace {
 
-// world = R_y(yaw) * (scale * p) + position, the transform place_instances gives objects.
+// world = position + scale * rotate(q, p), the frame's lod::Transform. The quaternion comes as
+// the frame gives it (the API uses it normalised), so it is normalised here; normals turn with
+// it (a uniform scale leaves their direction alone).
 // Blended draws (u_blend = 1): p = mix(own, morph target, weight), exact at weight 0 and 1;
 // other draws have no target stream bound and use the vertex's own position.
 const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 i_position_scale;
-layout(location = 3) in vec3 i_yaw_morph_weight;
-layout(location = 4) in vec3 a_target_position;
-layout(location = 5) in vec3 a_target_normal;
+layout(location = 3) in vec4 i_rotation;
+layout(location = 4) in vec2 i_morph_weight;
+layout(location = 5) in vec3 a_target_position;
+layout(location = 6) in vec3 a_target_normal;
 uniform mat4 u_view;
 uniform mat4 u_projection;
 uniform int u_blend;
 out vec3 v_position_view;
 out vec3 v_normal_view;
 out float v_morph;
-vec3 rotate_y(vec3 p, float c, float s) { return vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z); }
+// q v q* for a unit quaternion, without building a matrix.
+vec3 rotate(vec4 q, vec3 v) {
+  vec3 t = 2.0 * cross(q.xyz, v);
+  return v + q.w * t + cross(q.xyz, t);
+}
 void main() {
-  float c = cos(i_yaw_morph_weight.x), s = sin(i_yaw_morph_weight.x);
-  float w = i_yaw_morph_weight.z;
+  vec4 q = normalize(i_rotation);
+  float w = i_morph_weight.y;
   vec3 p = u_blend != 0 ? mix(a_position, a_target_position, w) : a_position;
   vec3 n = u_blend != 0 ? mix(a_normal, a_target_normal, w) : a_normal;
-  vec3 world = rotate_y(p * i_position_scale.w, c, s) + i_position_scale.xyz;
+  vec3 world = rotate(q, p * i_position_scale.w) + i_position_scale.xyz;
   vec4 view_pos = u_view * vec4(world, 1.0);
   v_position_view = view_pos.xyz;
-  v_normal_view = mat3(u_view) * rotate_y(n, c, s);
-  v_morph = i_yaw_morph_weight.y;
+  v_normal_view = mat3(u_view) * rotate(q, n);
+  v_morph = i_morph_weight.x;
   gl_Position = u_projection * view_pos;
 }
 )";
@@ -58,6 +66,21 @@ void main() {
   o_colour = vec4(base * (0.25 + 0.75 * lambert), 1.0);
 }
 )";
+
+// The instance attributes of InstanceData records starting `offset` bytes into the bound
+// instance buffer (GL 3.3 has no base instance, so each batch re-points them).
+void point_instance_attributes(size_t offset) {
+  auto at = [offset](size_t field) { return reinterpret_cast<const void*>(offset + field); };
+  const GLsizei stride = sizeof(InstanceData);
+  glVertexAttribPointer(kAttribInstancePositionScale, 4, GL_FLOAT, GL_FALSE, stride,
+                        at(offsetof(InstanceData, position_scale)));
+  glVertexAttribPointer(kAttribInstanceRotation, 4, GL_FLOAT, GL_FALSE, stride,
+                        at(offsetof(InstanceData, rotation)));
+  // morph and weight are adjacent: one vec2.
+  static_assert(offsetof(InstanceData, weight) == offsetof(InstanceData, morph) + sizeof(float));
+  glVertexAttribPointer(kAttribInstanceMorph, 2, GL_FLOAT, GL_FALSE, stride,
+                        at(offsetof(InstanceData, morph)));
+}
 
 }  // namespace
 
@@ -99,10 +122,10 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   // Fresh (orphaned) storage every frame, so the driver never waits for last frame's draws.
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(instance_capacity_), nullptr, GL_STREAM_DRAW);
   if (bytes) glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), list.instances.data());
-  glEnableVertexAttribArray(kAttribInstancePositionScale);
-  glEnableVertexAttribArray(kAttribInstanceYawMorph);
-  glVertexAttribDivisor(kAttribInstancePositionScale, 1);
-  glVertexAttribDivisor(kAttribInstanceYawMorph, 1);
+  for (GLuint a : {kAttribInstancePositionScale, kAttribInstanceRotation, kAttribInstanceMorph}) {
+    glEnableVertexAttribArray(a);
+    glVertexAttribDivisor(a, 1);
+  }
   glDisableVertexAttribArray(kAttribTargetPosition);
   glDisableVertexAttribArray(kAttribTargetNormal);
 
@@ -111,11 +134,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
 
   for (const DrawBatch& b : list.batches) {
     // GL 3.3 has no base instance: point the instance attributes at the batch's first one.
-    const size_t offset = size_t(b.first_instance) * sizeof(InstanceData);
-    glVertexAttribPointer(kAttribInstancePositionScale, 4, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
-                          reinterpret_cast<const void*>(offset));
-    glVertexAttribPointer(kAttribInstanceYawMorph, 3, GL_FLOAT, GL_FALSE, sizeof(InstanceData),
-                          reinterpret_cast<const void*>(offset + 4 * sizeof(float)));
+    point_instance_attributes(size_t(b.first_instance) * sizeof(InstanceData));
     const auto& c = settings.colour_override ? settings.colour
                     : settings.colour_by_level ? level_colour(b.level)
                                                : kModelColour;
@@ -172,7 +191,8 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
     glUniform3f(u_colour_, c[0], c[1], c[2]);
     for (const VdDraw& d : list.vd) {
       glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
-      glVertexAttrib3f(kAttribInstanceYawMorph, d.transform.yaw, d.transform.morph, 0.f);
+      glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
+      glVertexAttrib2f(kAttribInstanceMorph, d.transform.morph, 0.f);
       glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(d.index_count), GL_UNSIGNED_INT,
                                reinterpret_cast<const void*>(size_t(d.first_index) * sizeof(uint32_t)),
                                GLint(d.first_vertex));

@@ -1,5 +1,5 @@
 // InstanceRenderer: draws a DrawList with one instanced draw per (model, level, target level)
-// batch; per-instance position, scale, yaw, geomorph factor and blend weight are vertex
+// batch; per-instance position, scale, rotation quaternion, geomorph factor and blend weight are vertex
 // attributes with divisor 1. A blended batch adds the composed morph-target stream of its
 // (level, target level) pair as a second vertex stream. Lighting is a headlight Lambert term.
 #pragma once

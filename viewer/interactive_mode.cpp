@@ -1,12 +1,15 @@
 // The interactive viewer: lod::Service free-running on its own thread; every viewer frame
-// sends the LOD camera with set_view() and draws service.latest_frame(), whatever frame that
-// is. Nothing here waits on the LOD thread.
+// stages the moving instances at wall time and commits them, sends the LOD camera with
+// set_view() and draws the frame acquire_frame() holds, whatever frame that is. Nothing here
+// waits on the LOD thread (holding a frame never blocks it either).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
+#include "jobs/scene_motion.h"
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
 #include "viewer/fly_camera.h"
@@ -34,6 +37,60 @@ float axis(GLFWwindow* w, int plus, int minus) {
   return (glfwGetKey(w, plus) == GLFW_PRESS ? 1.f : 0.f) - (glfwGetKey(w, minus) == GLFW_PRESS ? 1.f : 0.f);
 }
 
+// Key presses of this viewer frame, in order (a toggle pressed twice is back where it was).
+void apply_keys(const std::vector<int>& keys, ViewerControls& controls) {
+  for (int key : keys) {
+    switch (key) {
+      case GLFW_KEY_ESCAPE:
+        controls.quit = true;
+        break;
+      case GLFW_KEY_1:
+        controls.mode = CameraMode::path;
+        break;
+      case GLFW_KEY_2:
+        controls.mode = CameraMode::fly;
+        break;
+      case GLFW_KEY_3:
+        controls.mode = CameraMode::orbit;
+        break;
+      case GLFW_KEY_4:
+        controls.mode = CameraMode::overhead;
+        break;
+      case GLFW_KEY_P:
+        controls.paused = !controls.paused;
+        break;
+      case GLFW_KEY_L:
+        controls.freeze_lod = !controls.freeze_lod;
+        break;
+      case GLFW_KEY_Z:
+        controls.wireframe = !controls.wireframe;
+        break;
+      case GLFW_KEY_C:
+        controls.colour_by_level = !controls.colour_by_level;
+        break;
+      case GLFW_KEY_F:
+        controls.flat_normals = !controls.flat_normals;
+        break;
+      case GLFW_KEY_H:
+        controls.show_overlay = !controls.show_overlay;
+        break;
+      case GLFW_KEY_LEFT_BRACKET:
+        controls.budget = std::max<uint64_t>(controls.budget / 2, 1);
+        controls.budget_changed = true;
+        break;
+      case GLFW_KEY_RIGHT_BRACKET:
+        controls.budget = std::min<uint64_t>(controls.budget * 2, uint64_t(1) << 40);
+        controls.budget_changed = true;
+        break;
+      default:
+        break;
+    }
+  }
+}
+
+// The frame drawn before the service has published one: nothing visible.
+const Frame kNoFrame;
+
 }  // namespace
 
 int run_interactive(ViewerSession& s) {
@@ -56,7 +113,9 @@ int run_interactive(ViewerSession& s) {
   const double rate_hz = o.lod_rate_hz > 0 ? o.lod_rate_hz : s.loaded.config.rate_hz;
   const double path_rate = s.loaded.config.rate_hz > 0 ? s.loaded.config.rate_hz : 60;  // path frames per second
   CameraPath path = s.loaded.config.camera;
-  Service service(s.loaded.scene, s.graph, rate_hz);
+  const std::unique_ptr<Service> owned = s.make_service(rate_hz);
+  Service& service = *owned;
+  SceneMotion motion(s.loaded.config, s.loaded.scene.objects, s.handles);
 
   ViewerControls controls;
   controls.colour_by_level = o.colour_by_level;
@@ -78,7 +137,7 @@ int run_interactive(ViewerSession& s) {
     fly.speed = std::max(1.f, 0.1f * glm::length(top.eye - top.target));
   }
   View lod_view = viewing;
-  service.set_view(lod_view);
+  set_view(service, 0, lod_view);
   service.start();
 
   RenderSettings settings;
@@ -102,31 +161,7 @@ int run_interactive(ViewerSession& s) {
     const bool dragging = !overlay.wants_mouse() && glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
     const float wheel = overlay.wants_mouse() ? 0.f : float(g_scroll);
     g_scroll = 0;
-    for (int key : g_pressed_keys) {
-      if (overlay.wants_keyboard()) break;
-      switch (key) {
-        case GLFW_KEY_ESCAPE: controls.quit = true; break;
-        case GLFW_KEY_1: controls.mode = CameraMode::path; break;
-        case GLFW_KEY_2: controls.mode = CameraMode::fly; break;
-        case GLFW_KEY_3: controls.mode = CameraMode::orbit; break;
-        case GLFW_KEY_4: controls.mode = CameraMode::overhead; break;
-        case GLFW_KEY_P: controls.paused = !controls.paused; break;
-        case GLFW_KEY_L: controls.freeze_lod = !controls.freeze_lod; break;
-        case GLFW_KEY_Z: controls.wireframe = !controls.wireframe; break;
-        case GLFW_KEY_C: controls.colour_by_level = !controls.colour_by_level; break;
-        case GLFW_KEY_F: controls.flat_normals = !controls.flat_normals; break;
-        case GLFW_KEY_H: controls.show_overlay = !controls.show_overlay; break;
-        case GLFW_KEY_LEFT_BRACKET:
-          controls.budget = std::max<uint64_t>(controls.budget / 2, 1);
-          controls.budget_changed = true;
-          break;
-        case GLFW_KEY_RIGHT_BRACKET:
-          controls.budget = std::min<uint64_t>(controls.budget * 2, uint64_t(1) << 40);
-          controls.budget_changed = true;
-          break;
-        default: break;
-      }
-    }
+    if (!overlay.wants_keyboard()) apply_keys(g_pressed_keys, controls);
     g_pressed_keys.clear();
 
     glfwGetFramebufferSize(window, &width, &height);
@@ -142,6 +177,18 @@ int run_interactive(ViewerSession& s) {
     }
     if (!controls.paused && (controls.mode == CameraMode::path || controls.mode == CameraMode::overhead))
       path_frame += double(dt) * path_rate;
+    // Movers where they are now (wall time), committed for the LOD thread's next frame; then
+    // the newest frame, held until this viewer frame ends.
+    auto service_start = std::chrono::steady_clock::now();
+    if (motion.moving() > 0) {
+      motion.stage(service, std::chrono::duration<double>(now - start).count());
+      service.commit(n + 1);
+    }
+    const FrameRef held = service.acquire_frame();  // never waits
+    const Frame& frame = held ? *held : kNoFrame;
+    double service_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - service_start).count();
+
     const View path_view = view_at(path, uint32_t(std::fmod(path_frame, 4294967296.0)));
     View lod_camera = path_view;  // what the LOD thread should see, unless frozen
     switch (controls.mode) {
@@ -149,7 +196,7 @@ int run_interactive(ViewerSession& s) {
         viewing = path_view;
         break;
       case CameraMode::overhead:
-        viewing = overhead_view(s.loaded.scene.objects, path.lens);
+        viewing = s.overhead(frame, path.lens);
         break;
       case CameraMode::fly: {
         FlyInput in;
@@ -173,19 +220,18 @@ int run_interactive(ViewerSession& s) {
         lod_camera = viewing;
         break;
     }
-    const auto service_start = std::chrono::steady_clock::now();
+    service_start = std::chrono::steady_clock::now();
     if (!controls.freeze_lod) {
       lod_view = lod_camera;
-      service.set_view(lod_view);
+      set_view(service, 0, lod_view);
     }
     if (controls.budget_changed) {
       service.set_budget(controls.budget);
       controls.budget_changed = false;
     }
 
-    const Frame& frame = service.latest_frame();  // newest complete frame; never waits
     const ServiceStats service_stats = service.stats();
-    const double service_ms =
+    service_ms +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - service_start).count();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     settings.colour_by_level = controls.colour_by_level;
@@ -193,21 +239,12 @@ int run_interactive(ViewerSession& s) {
     settings.flat_normals = controls.flat_normals;
     const DrawStats drawn = s.renderer.render(frame, viewing, settings);
     if (controls.freeze_lod || controls.mode == CameraMode::overhead) {
-      s.renderer.render_culled(frame, viewing);
+      s.renderer.render_culled(frame, s.handles, viewing);
       frustum_lines.draw(lod_view, viewing);
     }
     if (controls.show_overlay) {
-      OverlayFacts facts;
-      facts.time_s = std::chrono::duration<double>(now - start).count();
-      facts.viewer_ms = last_ms;
-      facts.frame = &frame;
-      facts.selected = selected_as_drawn(frame, s.renderer.draw_list());
-      facts.drawn = drawn;
-      facts.service = service_stats;
-      facts.threads = s.threads;
-      facts.objects = s.loaded.scene.objects.size();
-      facts.levels_in_scene = s.max_levels();
-      facts.gl = s.window.description();
+      const OverlayFacts facts = s.overlay_facts(held.get(), drawn, service_stats,
+                                                 std::chrono::duration<double>(now - start).count(), last_ms);
       overlay.draw(facts, controls, /*with_controls=*/true);
     }
     glfwSwapBuffers(window);

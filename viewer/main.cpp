@@ -57,7 +57,7 @@ int run(const lod::viewer::ViewerOptions& o) {
     return kExitNoGl;
   }
 
-  ViewerSession session{o, loaded, window, renderer, {}, 0, {}};
+  ViewerSession session{o, loaded, window, renderer, {}, 0, {}, {}, {}};
   session.graph.threads = loaded.config.threads;
   session.graph.selection = loaded.config.selection;
   if (o.budget > 0) session.graph.selection.budget = uint64_t(o.budget);

@@ -13,10 +13,11 @@ namespace lod::viewer {
 // Vertex attribute locations shared with the shaders.
 inline constexpr GLuint kAttribPosition = 0;
 inline constexpr GLuint kAttribNormal = 1;
-inline constexpr GLuint kAttribInstancePositionScale = 2;
-inline constexpr GLuint kAttribInstanceYawMorph = 3;  // yaw, morph, blend weight
-inline constexpr GLuint kAttribTargetPosition = 4;    // morph target stream (MorphBuffers)
-inline constexpr GLuint kAttribTargetNormal = 5;
+inline constexpr GLuint kAttribInstancePositionScale = 2;  // InstanceData::position_scale
+inline constexpr GLuint kAttribInstanceRotation = 3;       // InstanceData::rotation (quaternion x y z w)
+inline constexpr GLuint kAttribInstanceMorph = 4;          // InstanceData morph, blend weight
+inline constexpr GLuint kAttribTargetPosition = 5;         // morph target stream (MorphBuffers)
+inline constexpr GLuint kAttribTargetNormal = 6;
 
 class MeshBuffers {
  public:

@@ -1,9 +1,12 @@
 // --screenshot: the service in driven mode, N frames along the config's camera path, each
 // stepped then drawn into an offscreen target of the requested size, then the last picture
-// written as PNG. Deterministic: the same config and N give the same frame and picture.
+// written as PNG. Moving instances are staged at each frame's time and committed before the
+// step, as `lod run` does. Deterministic: the same config and N give the same frame and picture.
 #include <chrono>
 #include <cstdio>
+#include <memory>
 
+#include "jobs/scene_motion.h"
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
 #include "viewer/frustum_lines.h"
@@ -14,6 +17,27 @@
 #include "viewer/viewer_session.h"
 
 namespace lod::viewer {
+
+namespace {
+
+// The frame drawn before the service has published one: nothing visible.
+const Frame kNoFrame;
+
+// Morphing objects are drawn at their finer level: the frame says what that adds. False (and
+// says so) when what was submitted or what the GL counted differs from that.
+bool drew_what_was_selected(uint32_t n, const FrameRow& row) {
+  if (row.gpu_primitives == int64_t(row.drawn) && row.drawn == row.tris_selected + row.morph_extra)
+    return true;
+  std::fprintf(
+      stderr,
+      "lod-viewer: frame %u: selected %llu + %llu for %u morphing objects, submitted %llu, GL counted "
+      "%lld triangles\n",
+      n, (unsigned long long)row.tris_selected, (unsigned long long)row.morph_extra, row.morphing,
+      (unsigned long long)row.drawn, (long long)row.gpu_primitives);
+  return false;
+}
+
+}  // namespace
 
 int run_screenshot(ViewerSession& s) {
   const ViewerOptions& o = s.options;
@@ -36,7 +60,11 @@ int run_screenshot(ViewerSession& s) {
 
   CameraPath path = s.loaded.config.camera;
   path.lens = s.lens(o.width, o.height);
-  Service service(s.loaded.scene, s.graph, s.loaded.config.rate_hz);
+  const std::unique_ptr<Service> owned = s.make_service(s.loaded.config.rate_hz);
+  Service& service = *owned;
+  SceneMotion motion(s.loaded.config, s.loaded.scene.objects, s.handles);
+  // Frames are 1 / rate_hz apart on the service clock (1/60 s when the rate is unlimited).
+  const double dt = s.loaded.config.rate_hz > 0 ? 1.0 / s.loaded.config.rate_hz : 1.0 / 60;
   RenderSettings settings;
   settings.colour_by_level = o.colour_by_level;
   settings.wireframe = o.wireframe;
@@ -54,44 +82,33 @@ int run_screenshot(ViewerSession& s) {
   const auto start = std::chrono::steady_clock::now();
   for (uint32_t n = 0; n < frames; ++n) {
     const auto t0 = std::chrono::steady_clock::now();
+    if (motion.moving() > 0) {  // where the movers are at this frame's time, in the frame it computes
+      motion.stage(service, (n + 1) * dt);
+      service.commit(n + 1);
+    }
     const View view = view_at(path, n);
-    if (!service.step(view)) ++failed;
-    const Frame& frame = service.latest_frame();
+    set_view(service, 0, view);
+    if (!service.step(dt)) ++failed;
+    const FrameRef held = service.acquire_frame();
+    const Frame& frame = held ? *held : kNoFrame;
     const double service_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     target.bind();
-    const View viewing = o.bird_eye ? overhead_view(s.loaded.scene.objects, path.lens) : view;
+    const View viewing = o.bird_eye ? s.overhead(frame, path.lens) : view;
     last = s.renderer.render(frame, viewing, settings);
     if (o.bird_eye) {
-      s.renderer.render_culled(frame, viewing);
+      s.renderer.render_culled(frame, s.handles, viewing);
       frustum_lines.draw(view, viewing);
     }
     if (o.overlay) {
-      OverlayFacts facts;
-      facts.time_s = std::chrono::duration<double>(t0 - start).count();
-      facts.viewer_ms = s.log.rows().empty() ? 0 : s.log.rows().back().viewer_ms;
-      facts.frame = &frame;
-      facts.selected = selected_as_drawn(frame, s.renderer.draw_list());
-      facts.drawn = last;
-      facts.service = service.stats();
-      facts.threads = s.threads;
-      facts.objects = s.loaded.scene.objects.size();
-      facts.levels_in_scene = s.max_levels();
-      facts.gl = s.window.description();
+      const double viewer_ms = s.log.rows().empty() ? 0 : s.log.rows().back().viewer_ms;
+      const OverlayFacts facts = s.overlay_facts(
+          held.get(), last, service.stats(), std::chrono::duration<double>(t0 - start).count(), viewer_ms);
       overlay.draw(facts, controls, /*with_controls=*/false);
     }
     glfwPollEvents();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    const FrameRow& row = s.record(n, frame, last, ms, service_ms);
-    // Morphing objects are drawn at their finer level: the frame says what that adds.
-    if (row.gpu_primitives != int64_t(row.drawn) || row.drawn != row.tris_selected + row.morph_extra) {
-      ++mismatched;
-      std::fprintf(stderr,
-                   "lod-viewer: frame %u: selected %llu + %llu for %u morphing objects, submitted %llu, GL counted "
-                   "%lld triangles\n",
-                   n, (unsigned long long)row.tris_selected, (unsigned long long)row.morph_extra, row.morphing,
-                   (unsigned long long)row.drawn, (long long)row.gpu_primitives);
-    }
+    if (!drew_what_was_selected(n, s.record(n, frame, last, ms, service_ms))) ++mismatched;
   }
 
   target.bind();

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstdio>
 
+#include "jobs/service.h"
 #include "viewer/frame_check.h"
 
 namespace lod::viewer {
@@ -13,6 +14,33 @@ View ViewerSession::lens(int width, int height) const {
   v.width = width;
   v.height = height;
   return v;
+}
+
+std::unique_ptr<Service> ViewerSession::make_service(double rate_hz) {
+  spheres = model_spheres(loaded.scene.chains);
+  return lod::make_service(loaded.scene, graph, rate_hz, &handles);
+}
+
+View ViewerSession::overhead(const Frame& frame, const View& lens) const {
+  return overhead_view(loaded.scene.objects, frame, spheres, lens);
+}
+
+OverlayFacts ViewerSession::overlay_facts(const Frame* frame, const DrawStats& drawn,
+                                          const ServiceStats& service, double time_s,
+                                          double viewer_ms) const {
+  OverlayFacts facts;
+  facts.time_s = time_s;
+  facts.viewer_ms = viewer_ms;
+  facts.frame = frame;
+  facts.selected = frame ? selected_as_drawn(*frame, renderer.draw_list()) : 0;
+  facts.drawn = drawn;
+  facts.service = service;
+  facts.threads = threads;
+  facts.objects =
+      frame ? frame->object_count : loaded.scene.objects.size();  // live objects at the frame's tick
+  facts.levels_in_scene = max_levels();
+  facts.gl = window.description();
+  return facts;
 }
 
 size_t ViewerSession::max_levels() const {

@@ -3,14 +3,19 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "jobs/frame_graph.h"
+#include "lodkit/service.hpp"
 #include "runtime/frame.h"
 #include "runtime/view.h"
 #include "viewer/frame_log.h"
 #include "viewer/frame_renderer.h"
 #include "viewer/gl_context.h"
+#include "viewer/overhead_camera.h"
+#include "viewer/overlay.h"
 #include "viewer/scene_loader.h"
 
 namespace lod::viewer {
@@ -42,9 +47,19 @@ struct ViewerSession {
   FrameGraphOptions graph;
   uint32_t threads = 0;  // resolved LOD pool size, for display
   FrameLog log;
+  std::vector<ObjectHandle> handles;  // scene object i's handle in the service (make_service)
+  std::vector<ModelSphere> spheres;   // per model, for the bird's-eye camera
 
+  // The service over the loaded scene (objects created and committed at tick 0), filling
+  // `handles` and `spheres`. `rate_hz` is its free-running rate.
+  std::unique_ptr<Service> make_service(double rate_hz);
+  // Bird's-eye view over the scene and where `frame` puts its entries (moving objects).
+  View overhead(const Frame& frame, const View& lens) const;
   // The config's lens at the size being drawn (projected areas must match the picture).
   View lens(int width, int height) const;
+  // What the overlay shows for `frame` drawn as `drawn` (null: no LOD frame published yet).
+  OverlayFacts overlay_facts(const Frame* frame, const DrawStats& drawn, const ServiceStats& service,
+                             double time_s, double viewer_ms) const;
   // Most levels any model has.
   size_t max_levels() const;
   // Checks the frame, fills a row from the draw, appends it to the log.

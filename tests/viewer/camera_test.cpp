@@ -125,3 +125,57 @@ TEST(OverheadCamera, EmptySceneGivesAFiniteView) {
 }
 
 }  // namespace
+
+namespace {
+
+// The bird's-eye camera also frames where the frame puts its entries (the frame's models and
+// transforms, not the scene's start placements), so moving objects stay in the picture.
+TEST(OverheadCamera, FramesTheFramesEntriesWhereTheFrameSaysTheyAre) {
+  lod::ObjectSet placed;
+  placed.resize(1);
+  placed.cx[0] = 0;
+  placed.cz[0] = 0;
+  placed.radius[0] = 1;
+  // Model 1's sphere sits off its origin: +x by 2, radius 0.5.
+  std::vector<lod::viewer::ModelSphere> models(2);
+  models[1].center = {2, 0, 0};
+  models[1].radius = 0.5f;
+  lod::Frame frame;
+  frame.models = {1};
+  lod::Transform t;
+  t.position[0] = 300;
+  t.position[2] = -40;
+  const float h = std::sqrt(0.5f);  // 90 degrees about +y: model +x turns to world -z
+  t.rotation[1] = h;
+  t.rotation[3] = h;
+  t.scale = 10;
+  frame.transforms = {t};
+  lod::View lens;
+  lens.width = 640;
+  lens.height = 360;
+  const lod::View v = lod::viewer::overhead_view(placed, frame, models, lens);
+  const glm::mat4 m = lod::projection_matrix(v) * lod::view_matrix(v);
+  // The entry's world sphere: (300, 0, -40) + 10 * (0, 0, -2), radius 5.
+  for (glm::vec3 p :
+       {glm::vec3(305, 0, -60), glm::vec3(295, 0, -60), glm::vec3(300, 0, -65), glm::vec3(-1, 0, 1)}) {
+    const glm::vec4 clip = m * glm::vec4(p, 1);
+    EXPECT_LE(std::abs(clip.x / clip.w), 1.f) << p.x << " " << p.z;
+    EXPECT_LE(std::abs(clip.y / clip.w), 1.f) << p.x << " " << p.z;
+  }
+  // Only that far: the view is centred between the placement and the entry.
+  EXPECT_NEAR(v.target.x, 0.5f * (-1 + 305), 1e-3f);
+  EXPECT_NEAR(v.target.z, 0.5f * (1 + -65), 1e-3f);
+}
+
+TEST(OverheadCamera, ModelSpheresHoldEveryLevel) {
+  lod::LodChain c;
+  c.levels.resize(2);
+  c.levels[0].bounds = {{1, 0, 0}, 2};
+  c.levels[1].bounds = {{2, 0, 0}, 2};  // bulges 1 past level 0's sphere
+  const auto s = lod::viewer::model_spheres(std::vector<lod::LodChain>{c});
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].center, glm::vec3(1, 0, 0));
+  EXPECT_FLOAT_EQ(s[0].radius, 3.f);
+}
+
+}  // namespace

@@ -1,6 +1,8 @@
 // DrawList and MeshLayout: what the viewer would submit for a frame, without a GL context.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "viewer/draw_list.h"
 #include "viewer/mesh_layout.h"
 
@@ -28,26 +30,33 @@ LodChain chain_with_levels(std::vector<uint32_t> tris) {
   return c;
 }
 
-ObjectSet objects_of_models(std::vector<uint32_t> models) {
-  ObjectSet o;
-  o.resize(models.size());
-  for (size_t i = 0; i < models.size(); ++i) {
-    o.model[i] = models[i];
-    o.x[i] = float(i);
-    o.y[i] = 2 * float(i);
-    o.z[i] = 3 * float(i);
-    o.scale[i] = 1 + float(i);
-    o.yaw[i] = 0.5f * float(i);
-  }
-  return o;
+// Entry i's transform in frame_of: at (i, 2i, 3i), scale 1 + i, turned 0.5 i radians about +y.
+Transform transform_at(size_t i) {
+  Transform t;
+  t.position[0] = float(i);
+  t.position[1] = 2 * float(i);
+  t.position[2] = 3 * float(i);
+  t.rotation[1] = std::sin(0.25f * float(i));
+  t.rotation[3] = std::cos(0.25f * float(i));
+  t.scale = 1 + float(i);
+  return t;
 }
 
-Frame frame_of(std::vector<uint32_t> objects, std::vector<uint8_t> levels) {
+// A whole hand-built frame: entry i is object i of model models[i] at levels[i], settled, at
+// transform_at(i). No scene is involved: the draw list reads the frame alone.
+Frame frame_of(std::vector<uint32_t> models, std::vector<uint8_t> levels) {
   Frame f;
-  f.objects = objects;
+  f.models = models;
   f.levels = levels;
-  f.morph.assign(objects.size(), 1.f);
-  f.visible = uint32_t(objects.size());
+  f.morph.assign(models.size(), 1.f);
+  for (size_t i = 0; i < models.size(); ++i) {
+    f.transforms.push_back(transform_at(i));
+    f.objects.push_back(uint32_t(i));
+    f.handles.push_back(ObjectHandle(i + 1));
+    f.view_masks.push_back(1);
+  }
+  f.visible = uint32_t(models.size());
+  f.object_count = f.visible;
   return f;
 }
 
@@ -92,12 +101,11 @@ TEST(MeshLayout, ChainWithoutNormalsGetsZeroNormals) {
 TEST(DrawList, OneBatchPerModelAndLevelWithInstancesGrouped) {
   const std::vector<LodChain> chains = {chain_with_levels({4, 2}), chain_with_levels({5, 3, 1})};
   const MeshLayout m = layout_meshes(chains);
-  const ObjectSet objects = objects_of_models({0, 1, 0, 1, 0, 1});
-  // Objects 0, 2 at model 0 level 1; object 4 at model 0 level 0; 1, 5 at model 1 level 2; 3 at level 0.
-  Frame f = frame_of({0, 1, 2, 3, 4, 5}, {1, 2, 1, 0, 0, 2});
+  // Entries 0, 2 at model 0 level 1; entry 4 at model 0 level 0; 1, 5 at model 1 level 2; 3 at level 0.
+  Frame f = frame_of({0, 1, 0, 1, 0, 1}, {1, 2, 1, 0, 0, 2});
   f.morph = {1, 0.25f, 1, 1, 1, 0.5f};
   DrawList list;
-  build_draw_list(f, objects, m, list);
+  build_draw_list(f, m, list);
   ASSERT_EQ(list.batches.size(), 4u);
   EXPECT_EQ(list.rejected, 0u);
   // In (model, level) order.
@@ -110,64 +118,117 @@ TEST(DrawList, OneBatchPerModelAndLevelWithInstancesGrouped) {
   EXPECT_EQ(list.batches[2].level, 0u);
   EXPECT_EQ(list.batches[3].level, 2u);
   EXPECT_EQ(list.batches[3].range, m.range_of(1, 2));
-  // Instances of a batch are contiguous and carry their object's transform and morph.
+  // Instances of a batch are contiguous and carry their entry's transform and morph.
   const DrawBatch& b = list.batches[3];
   const InstanceData& a = list.instances[b.first_instance];
   const InstanceData& c = list.instances[b.first_instance + 1];
-  EXPECT_EQ(a.position_scale[0], 1.f);   // object 1
+  EXPECT_EQ(a.position_scale[0], 1.f);  // entry 1
   EXPECT_EQ(a.morph, 0.25f);
-  EXPECT_EQ(c.position_scale[2], 15.f);  // object 5: z = 3 * 5
+  EXPECT_EQ(c.position_scale[2], 15.f);  // entry 5: z = 3 * 5
   EXPECT_EQ(c.position_scale[3], 6.f);
-  EXPECT_EQ(c.yaw, 2.5f);
+  EXPECT_EQ(c.rotation[1], std::sin(1.25f));
+  EXPECT_EQ(c.rotation[3], std::cos(1.25f));
   EXPECT_EQ(c.morph, 0.5f);
   // Triangles: 4 + 2*2 + 5 + 2*1.
   EXPECT_EQ(list.triangles, 4u + 4u + 5u + 2u);
   EXPECT_EQ(list.indices, 3 * list.triangles);
 }
 
-TEST(DrawList, RefusesUnknownObjectsAndLevelsAndCountsThem) {
+TEST(DrawList, InstanceCarriesTheFramesRotationQuaternionPositionAndScaleExactly) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2}), chain_with_levels({5, 3, 1})};
+  const MeshLayout m = layout_meshes(chains);
+  Frame f = frame_of({1}, {1});
+  // 90 degrees about +x, somewhere no placement rule would put it.
+  Transform& t = f.transforms[0];
+  const float h = std::sqrt(0.5f);
+  t = Transform{{5.5f, -2.25f, 7.f}, {h, 0.f, 0.f, h}, 2.5f};
+  DrawList list;
+  build_draw_list(f, m, list);
+  ASSERT_EQ(list.instances.size(), 1u);
+  ASSERT_EQ(list.batches.size(), 1u);
+  EXPECT_EQ(list.batches[0].model, 1u) << "the frame's model column";
+  EXPECT_EQ(list.batches[0].level, 1u);
+  const InstanceData& d = list.instances[0];
+  EXPECT_EQ(d.rotation[0], h);
+  EXPECT_EQ(d.rotation[1], 0.f);
+  EXPECT_EQ(d.rotation[2], 0.f);
+  EXPECT_EQ(d.rotation[3], h);
+  EXPECT_EQ(d.position_scale[0], 5.5f);
+  EXPECT_EQ(d.position_scale[1], -2.25f);
+  EXPECT_EQ(d.position_scale[2], 7.f);
+  EXPECT_EQ(d.position_scale[3], 2.5f);
+  // A quaternion is handed on as the frame gives it (the shader normalises): not rescaled.
+  t.rotation[0] = 2 * h;
+  t.rotation[3] = 2 * h;
+  build_draw_list(f, m, list);
+  ASSERT_EQ(list.instances.size(), 1u);
+  EXPECT_EQ(list.instances[0].rotation[0], 2 * h);
+  EXPECT_EQ(list.instances[0].rotation[3], 2 * h);
+}
+
+TEST(DrawList, RefusesUnknownModelsAndLevelsAndCountsThem) {
   const std::vector<LodChain> chains = {chain_with_levels({4, 2})};
   const MeshLayout m = layout_meshes(chains);
-  const ObjectSet objects = objects_of_models({0, 0});
-  const Frame f = frame_of({0, 1, 9}, {1, 2, 0});  // level 2 does not exist; object 9 neither
+  const Frame f = frame_of({0, 0, 9}, {1, 2, 0});  // level 2 does not exist; model 9 neither
   DrawList list;
-  build_draw_list(f, objects, m, list);
+  build_draw_list(f, m, list);
   EXPECT_EQ(list.rejected, 2u);
   ASSERT_EQ(list.batches.size(), 1u);
   EXPECT_EQ(list.instances.size(), 1u);
   EXPECT_EQ(list.triangles, 2u);
 }
 
-TEST(DrawList, ArraysOfDifferentLengthDrawOnlyTheCommonPrefix) {
+TEST(DrawList, RefusesTransformsNoRendererCanDraw) {
   const std::vector<LodChain> chains = {chain_with_levels({4, 2})};
   const MeshLayout m = layout_meshes(chains);
-  const ObjectSet objects = objects_of_models({0, 0, 0});
-  Frame f = frame_of({0, 1, 2}, {0, 0, 0});
-  f.levels.pop_back();
+  Frame f = frame_of({0, 0, 0, 0}, {0, 0, 0, 0});
+  f.transforms[0].rotation[3] = 0;  // entry 0 has no rotation at all: (0, 0, 0, 0)
+  f.transforms[1].scale = 0;
+  f.transforms[2].position[1] = std::nanf("");
   DrawList list;
-  build_draw_list(f, objects, m, list);
-  EXPECT_EQ(list.instances.size(), 2u);
-  EXPECT_EQ(list.triangles, 8u);
+  build_draw_list(f, m, list);
+  EXPECT_EQ(list.rejected, 3u);
+  ASSERT_EQ(list.instances.size(), 1u);
+  EXPECT_EQ(list.instances[0].position_scale[0], 3.f) << "entry 3 only";
+}
+
+TEST(DrawList, ColumnsOfDifferentLengthDrawTheCommonPrefixAndRefuseTheRest) {
+  const std::vector<LodChain> chains = {chain_with_levels({4, 2})};
+  const MeshLayout m = layout_meshes(chains);
+  for (int column = 0; column < 4; ++column) {
+    SCOPED_TRACE("shortened column " + std::to_string(column));
+    Frame f = frame_of({0, 0, 0}, {0, 0, 0});
+    if (column == 0) f.levels.pop_back();
+    if (column == 1) f.models.pop_back();
+    if (column == 2) f.transforms.pop_back();
+    if (column == 3) f.morph.pop_back();
+    DrawList list;
+    build_draw_list(f, m, list);
+    EXPECT_EQ(list.instances.size(), 2u);
+    EXPECT_EQ(list.triangles, 8u);
+    EXPECT_EQ(list.rejected, 1u);
+  }
 }
 
 TEST(DrawList, EmptyFrameDrawsNothingAndReusesTheList) {
   const std::vector<LodChain> chains = {chain_with_levels({4})};
   const MeshLayout m = layout_meshes(chains);
-  const ObjectSet objects = objects_of_models({0});
   DrawList list;
-  build_draw_list(frame_of({0}, {0}), objects, m, list);
+  build_draw_list(frame_of({0}, {0}), m, list);
   EXPECT_EQ(list.batches.size(), 1u);
-  build_draw_list(Frame{}, objects, m, list);
+  build_draw_list(Frame{}, m, list);
   EXPECT_TRUE(list.batches.empty());
   EXPECT_TRUE(list.instances.empty());
   EXPECT_EQ(list.triangles, 0u);
+  EXPECT_EQ(list.rejected, 0u);
 }
 
-// A vd entry for `object` with `vertices` vertices and the given local indices, appended to
-// the frame's vd arrays.
-void add_vd(Frame& f, uint32_t object, uint32_t vertices, std::vector<uint32_t> indices) {
+// A vd entry for frame entry `entry` (its object, or `object` when given) with `vertices`
+// vertices and the given local indices, appended to the frame's vd arrays.
+void add_vd(Frame& f, uint32_t entry, uint32_t vertices, std::vector<uint32_t> indices, int64_t object = -1) {
   VdObjectFrame v;
-  v.object = object;
+  v.entry = entry;
+  v.object = object >= 0 ? uint32_t(object) : entry < f.objects.size() ? f.objects[entry] : entry;
   v.first_vertex = uint32_t(f.vd_positions.size() / 3);
   v.vertex_count = vertices;
   v.first_index = uint32_t(f.vd_indices.size());
@@ -181,28 +242,29 @@ void add_vd(Frame& f, uint32_t object, uint32_t vertices, std::vector<uint32_t> 
 TEST(DrawList, VdObjectsDrawFromTheirActiveMeshNotAnInstance) {
   const std::vector<LodChain> chains = {chain_with_levels({4, 2}), chain_with_levels({5, 3, 1})};
   const MeshLayout m = layout_meshes(chains);
-  const ObjectSet objects = objects_of_models({0, 1, 0, 1});
-  Frame f = frame_of({0, 1, 2, 3}, {0, 1, 1, 2});
+  Frame f = frame_of({0, 1, 0, 1}, {0, 1, 1, 2});
   f.morph = {1, 0.25f, 1, 1};
+  f.objects = {0, 10, 20, 30};  // entries and object ids differ: the vd entry says which entry
   f.tris_selected = 4 + 3 + 2 + 1;
-  add_vd(f, 1, 4, {0, 1, 2, 0, 2, 3});        // 2 triangles instead of level 1's 3
+  add_vd(f, 1, 4, {0, 1, 2, 0, 2, 3});           // 2 triangles instead of level 1's 3
   add_vd(f, 3, 3, {0, 1, 2, 2, 1, 0, 0, 2, 1});  // 3 triangles instead of level 2's 1
   DrawList list;
-  build_draw_list(f, objects, m, list);
+  build_draw_list(f, m, list);
   EXPECT_EQ(list.rejected, 0u);
-  EXPECT_EQ(list.instances.size(), 2u) << "objects 0 and 2 only";
+  EXPECT_EQ(list.instances.size(), 2u) << "entries 0 and 2 only";
   EXPECT_EQ(list.triangles, 4u + 2u);
   ASSERT_EQ(list.vd.size(), 2u);
   EXPECT_EQ(list.vd_triangles, 5u);
   EXPECT_EQ(list.vd_level_triangles, 3u + 1u);
   EXPECT_EQ(selected_as_drawn(f, list), list.triangles + list.vd_triangles);
   const VdDraw& a = list.vd[0];
-  EXPECT_EQ(a.object, 1u);
+  EXPECT_EQ(a.object, 10u);
+  EXPECT_EQ(a.entry, 1u);
   EXPECT_EQ(a.first_vertex, 0u);
   EXPECT_EQ(a.index_count, 6u);
-  EXPECT_EQ(a.transform.position_scale[0], 1.f);  // object 1's transform
+  EXPECT_EQ(a.transform.position_scale[0], 1.f);  // entry 1's transform
   EXPECT_EQ(a.transform.position_scale[3], 2.f);
-  EXPECT_EQ(a.transform.yaw, 0.5f);
+  EXPECT_EQ(a.transform.rotation[1], std::sin(0.25f));
   EXPECT_EQ(a.transform.morph, 1.f) << "the vd mesh is already geomorphed";
   EXPECT_EQ(list.vd[1].first_vertex, 4u);
   EXPECT_EQ(list.vd[1].first_index, 6u);
@@ -212,20 +274,20 @@ TEST(DrawList, VdObjectsDrawFromTheirActiveMeshNotAnInstance) {
 TEST(DrawList, VdEntriesOutsideTheFrameAreRejectedAndDrawnAtTheirLevel) {
   const std::vector<LodChain> chains = {chain_with_levels({4, 2})};
   const MeshLayout m = layout_meshes(chains);
-  const ObjectSet objects = objects_of_models({0, 0, 0, 0});
-  Frame f = frame_of({0, 1, 2}, {1, 1, 1});
-  add_vd(f, 0, 3, {0, 1, 3});  // index 3 of 3 vertices
-  add_vd(f, 1, 3, {0, 1});     // not whole triangles
-  add_vd(f, 3, 3, {0, 1, 2});  // object 3 is not visible in this frame
+  Frame f = frame_of({0, 0, 0}, {1, 1, 1});
+  add_vd(f, 0, 3, {0, 1, 3});     // index 3 of 3 vertices
+  add_vd(f, 1, 3, {0, 1});        // not whole triangles
+  add_vd(f, 3, 3, {0, 1, 2});     // entry 3: there is none
+  add_vd(f, 2, 3, {0, 1, 2}, 7);  // entry 2 is object 2, not 7
   add_vd(f, 2, 3, {0, 1, 2});
   f.vd_objects.back().first_index = 100;  // past vd_indices
   DrawList list;
-  build_draw_list(f, objects, m, list);
-  EXPECT_EQ(list.rejected, 4u);
+  build_draw_list(f, m, list);
+  EXPECT_EQ(list.rejected, 5u);
   EXPECT_TRUE(list.vd.empty());
   EXPECT_EQ(list.vd_triangles, 0u);
   EXPECT_EQ(list.vd_level_triangles, 0u);
-  EXPECT_EQ(list.instances.size(), 3u) << "a refused vd mesh falls back to the object's level";
+  EXPECT_EQ(list.instances.size(), 3u) << "a refused vd mesh falls back to the entry's level";
   EXPECT_EQ(list.triangles, 3u * 2u);
 }
 

@@ -1,12 +1,14 @@
 // The viewer sees only whole frames: a reader loop doing what the viewer's frame loop does
-// (set the view, take latest_frame(), build the draw list) while the service publishes on its
-// own thread as fast as it can. Every frame read must be self-consistent, and what would be
-// submitted must equal its tris_selected plus what its morphing objects add.
+// (stage the movers and commit, set the view, hold acquire_frame(), build the draw list) while
+// the service publishes on its own thread as fast as it can. Every frame read must be self-consistent, and
+// what would be submitted must equal its tris_selected plus what its morphing objects add.
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <memory>
 #include <set>
 
+#include "jobs/scene_motion.h"
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
 #include "viewer/draw_list.h"
@@ -32,6 +34,8 @@ count = 200
 box_min = [-40.0, 0.0, -40.0]
 box_max = [40.0, 0.0, 40.0]
 seed = 5
+motion = "wander"
+speed = 30.0
 [[instances]]
 model = "box"
 count = 200
@@ -51,8 +55,12 @@ TEST(ViewerFrames, ReaderNeverSeesATornFrameWhileTheServicePublishes) {
   FrameGraphOptions options;
   options.threads = 2;
   options.selection = loaded.config.selection;
-  Service service(scene, options, loaded.config.rate_hz);
-  service.set_view(view_at(loaded.config.camera, 0));
+  std::vector<ObjectHandle> handles;
+  const std::unique_ptr<Service> owned = make_service(scene, options, loaded.config.rate_hz, &handles);
+  Service& service = *owned;
+  SceneMotion motion(loaded.config, scene.objects, handles);
+  ASSERT_EQ(motion.moving(), 200u);
+  set_view(service, 0, view_at(loaded.config.camera, 0));
   service.start();
 
   viewer::DrawList list;
@@ -63,13 +71,17 @@ TEST(ViewerFrames, ReaderNeverSeesATornFrameWhileTheServicePublishes) {
   // Bounded by distinct frames seen or wall time, whichever comes first; nothing is timed.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   for (uint32_t i = 0; seen.size() < 300 && std::chrono::steady_clock::now() < deadline; ++i) {
-    service.set_view(view_at(loaded.config.camera, i / 16));  // the camera moves: levels change
+    set_view(service, 0, view_at(loaded.config.camera, i / 16));  // the camera moves: levels change
     if (i % 64 == 0) service.set_budget(i % 128 == 0 ? 20000 : 60000);
-    const Frame& f = service.latest_frame();
+    motion.stage(service, 0.001 * i);  // and so do half the objects
+    service.commit(i + 1);
+    const FrameRef held = service.acquire_frame();
+    if (!held) continue;  // nothing published yet
+    const Frame& f = *held;
     ++reads;
     std::string why;
     const bool whole = viewer::frame_is_whole(f, scene, &why);
-    viewer::build_draw_list(f, scene.objects, layout, list);
+    viewer::build_draw_list(f, layout, list);
     // Objects blending two levels are drawn at the finer one: the frame says what that adds.
     if (!whole || list.rejected != 0 || list.triangles != f.tris_selected + f.tris_morph_extra ||
         list.morphing != f.morphing || f.index < last_index) {

@@ -40,14 +40,10 @@ LodChain chain_with_targets(std::vector<uint32_t> tris) {
   return c;
 }
 
-ObjectSet objects_of_models(std::vector<uint32_t> models) {
-  ObjectSet o;
-  o.resize(models.size());
-  for (size_t i = 0; i < models.size(); ++i) {
-    o.model[i] = models[i];
-    o.scale[i] = 1;
-  }
-  return o;
+// The frame's own model and (identity) transform column for entries of these models.
+void set_models(Frame& f, std::vector<uint32_t> models) {
+  f.models = models;
+  f.transforms.assign(models.size(), Transform{});
 }
 
 TEST(MorphDraw, DrawsTheFinerLevelWeightedSoBothEndsLookLikeTheirLevel) {
@@ -75,15 +71,15 @@ TEST(DrawList, GroupsMorphingObjectsByLevelAndTargetAndCountsWhatTheyAdd) {
   const std::vector<LodChain> chains = {chain_with_targets({8, 4, 2}), chain_with_targets({6, 3})};
   const MeshLayout m = layout_meshes(chains);
   ASSERT_EQ(m.morphable, (std::vector<uint8_t>{1, 1}));
-  const ObjectSet objects = objects_of_models({0, 0, 0, 0, 1, 1});
   Frame f;
+  set_models(f, {0, 0, 0, 0, 1, 1});
   f.objects = {0, 1, 2, 3, 4, 5};
   f.levels = {2, 2, 0, 1, 1, 1};
   f.from_levels = {0, 2, 2, 1, 0, 1};
   f.morph = {0.25f, 1, 0.5f, 1, 0.75f, 1};
   f.visible = 6;
   DrawList list;
-  build_draw_list(f, objects, m, list);
+  build_draw_list(f, m, list);
   EXPECT_EQ(list.rejected, 0u);
   // Model 0: object 0 coarsens 0 -> 2 and object 2 refines 2 -> 0: both draw level 0 blending
   // to level 2; object 3 level 1; object 1 level 2. Model 1: object 4 coarsens 0 -> 1; object 5 at 1.
@@ -119,15 +115,15 @@ TEST(DrawList, BadFromLevelsAreRefusedAndChainsWithoutTargetsNeverBlend) {
   chains[1].morph_targets.clear();
   const MeshLayout m = layout_meshes(chains);
   EXPECT_EQ(m.morphable, (std::vector<uint8_t>{1, 0}));
-  const ObjectSet objects = objects_of_models({0, 0, 1});
   Frame f;
+  set_models(f, {0, 0, 1});
   f.objects = {0, 1, 2};
   f.levels = {1, 1, 1};
   f.from_levels = {7, 1, 0};
   f.morph = {0.5f, 1, 0.5f};
   f.visible = 3;
   DrawList list;
-  build_draw_list(f, objects, m, list);
+  build_draw_list(f, m, list);
   EXPECT_EQ(list.rejected, 1u);  // object 0 morphs from a level its model lacks
   ASSERT_EQ(list.batches.size(), 2u);
   EXPECT_EQ(list.batches[1].model, 1u);
@@ -136,7 +132,7 @@ TEST(DrawList, BadFromLevelsAreRefusedAndChainsWithoutTargetsNeverBlend) {
   EXPECT_EQ(list.morphing, 0u);
   // A frame without from_levels (hand-built, culled objects) is settled.
   f.from_levels.clear();
-  build_draw_list(f, objects, m, list);
+  build_draw_list(f, m, list);
   EXPECT_EQ(list.rejected, 0u);
   EXPECT_EQ(list.morphing, 0u);
 }

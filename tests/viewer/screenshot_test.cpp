@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <array>
-#include <map>
 #include <cmath>
+#include <map>
+#include <numbers>
 #include <set>
+#include <utility>
 
 #include "runtime/view.h"
 #include "viewer/level_palette.h"
@@ -243,6 +245,78 @@ TEST(ViewerScreenshot, SameConfigAndFrameCountGiveTheSamePicture) {
   size_t differing = 0;
   for (size_t i = 0; i < a.rgb.size(); ++i) differing += a.rgb[i] != b.rgb[i] ? 1 : 0;
   EXPECT_EQ(differing, 0u);
+}
+
+}  // namespace
+
+namespace {
+
+// Two spheres orbiting (-8, 0, 0) at radius 2 (20 units/s: 10 rad/s), the box standing still.
+const char* kOrbitingSpheres = R"([[instances]]
+model = "sphere"
+count = 2
+placement = "grid"
+box_min = [-12.0, 0.0, 0.0]
+box_max = [-4.0, 0.0, 0.0]
+scale = 1.5
+motion = "orbit"
+speed = 20.0
+[[instances]]
+model = "box"
+count = 1
+placement = "grid"
+box_min = [8.0, 0.0, 0.0]
+box_max = [8.0, 0.0, 0.0]
+scale = 3.0
+)";
+
+// Where the orbit puts a sphere that started at angle a0 (radians, in x-z about (-8, 0, 0))
+// after `frames` driven frames at 60 Hz: frame n is staged at (n + 1) / 60 s.
+glm::vec3 orbit_position(float a0, int frames) {
+  const float a = a0 + 10.f * float(frames) / 60.f;
+  return {-8.f + 2.f * std::cos(a), 0.f, 2.f * std::sin(a)};
+}
+
+// Moving instances are drawn from the frame's transforms: after a different number of frames
+// the spheres are somewhere else, drawn where their motion puts them.
+TEST(ViewerScreenshot, MovingInstancesAreDrawnWhereTheFrameSaysTheyAre) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("moving", kRun, kFrontCamera, kOrbitingSpheres);
+  Image early, late;
+  for (auto [img, frames] : {std::pair{&early, 1}, std::pair{&late, 8}}) {
+    const auto png = scene.dir / ("moving-" + std::to_string(frames) + ".png");
+    const auto csv = scene.dir / ("moving-" + std::to_string(frames) + ".csv");
+    const auto r = lod::test::run_viewer(
+        scene, "--screenshot '" + png.string() + "' --frames " + std::to_string(frames) +
+                   " --width 400 --height 250 --stats '" + csv.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    ASSERT_TRUE(lod::test::load_png(png, *img));
+    CsvTable t;
+    ASSERT_TRUE(lod::test::load_csv(csv, t));
+    for (size_t i = 0; i < t.rows.size(); ++i) {
+      EXPECT_EQ(t.get(i, "whole"), 1) << "frame " << i;
+      EXPECT_EQ(t.get(i, "rejected"), 0) << "frame " << i;
+    }
+    // Both spheres' centres, at this frame's time, are drawn.
+    for (float a0 : {std::numbers::pi_v<float>, 0.f}) {
+      const auto [x, y] = project(orbit_position(a0, frames), img->width, img->height);
+      EXPECT_FALSE(is_background(img->at(x, y)))
+          << frames << " frames: no sphere at (" << x << ", " << y << ")";
+    }
+  }
+  ASSERT_EQ(early.rgb.size(), late.rgb.size());
+  // The drawn region itself moved: pixels drawn in one picture and background in the other.
+  size_t drawn_early = 0, drawn_late = 0, moved = 0;
+  for (int y = 0; y < early.height; ++y)
+    for (int x = 0; x < early.width; ++x) {
+      const bool a = !is_background(early.at(x, y)), b = !is_background(late.at(x, y));
+      drawn_early += a;
+      drawn_late += b;
+      moved += a != b;
+    }
+  EXPECT_GT(drawn_early, 200u) << "first picture (nearly) blank";
+  EXPECT_GT(drawn_late, 200u) << "second picture (nearly) blank";
+  EXPECT_GT(moved, 100u) << "the orbiting spheres were drawn in the same place after 1 and 8 frames";
 }
 
 }  // namespace
