@@ -93,6 +93,11 @@ uint64_t CommitQueue::live_count() const {
   return handles_.live_count();
 }
 
+uint64_t CommitQueue::slots() const {
+  std::lock_guard lock(stage_mutex_);
+  return handles_.slots();
+}
+
 uint64_t CommitQueue::commits() const {
   std::lock_guard lock(stage_mutex_);
   return commits_;

@@ -30,6 +30,7 @@ class CommitQueue {
   size_t set_transforms(std::span<const ObjectHandle> h, std::span<const Transform> t);
   bool live(ObjectHandle h) const;
   uint64_t live_count() const;
+  uint64_t slots() const;
   uint64_t commits() const;
   void commit(uint64_t tick);
 

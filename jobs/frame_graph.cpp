@@ -30,6 +30,7 @@
 #include "runtime/geomorph.h"
 #include "runtime/importance.h"
 #include "runtime/level_blend.h"
+#include "runtime/derived_columns.h"
 #include "runtime/level_caps.h"
 #include "runtime/object_controls.h"
 #include "runtime/vd_share.h"
@@ -158,10 +159,8 @@ struct FrameGraph::Impl {
   size_t count = 0, grain = 1, chunks = 0;
 
   // Per object (dense), per frame.
-  std::vector<float> cx, cy, cz, radius;
-  std::vector<uint32_t> row;
-  std::vector<uint8_t> min_level, never_cull, mask;
-  std::vector<float> error_scale, inv_priority;
+  std::vector<uint8_t> mask;
+  bool models_changed = true;  // every object's derived columns need the new tables
   struct PerView {  // [0] holds the combined choice after importance
     std::vector<uint8_t> visible, level;
     std::vector<float> distance, area, weight;
@@ -249,6 +248,7 @@ struct FrameGraph::Impl {
       model_blends[i] = chain.hierarchy.empty() && can_morph_levels(chain);
       if (!chain.hierarchy.empty()) vd_models[i] = vd_model_of(chain);
     }
+    models_changed = true;
     resize_chunks();
   }
 
@@ -276,9 +276,8 @@ struct FrameGraph::Impl {
   // object count allocates nothing.
   void resize_chunks() {
     chunks = (count + grain - 1) / grain;
-    for (auto* v : {&cx, &cy, &cz, &radius, &error_scale, &inv_priority, &visible_weight}) v->resize(count);
-    for (auto* v : {&min_level, &never_cull, &mask}) v->resize(count);
-    row.resize(count);
+    visible_weight.resize(count);
+    mask.resize(count);
     visible_row.resize(count);
     all_ones.resize(count, 1);  // only ever ones
     heap.resize(count);
@@ -389,15 +388,16 @@ struct FrameGraph::Impl {
     resize_chunks();
   }
 
+  // World spheres and controls of the objects that changed since they were last computed.
   void node_bounds() {
     ObjectStore& s = *store;
+    if (models_changed) s.mark_all_dirty();
+    models_changed = false;
+    if (!s.any_dirty) return;
     for_chunks(Stage::bounds, [&](size_t, size_t b, size_t e) {
-      world_spheres(sub(cx, b, e), sub(cy, b, e), sub(cz, b, e), sub(radius, b, e), sub(s.transform, b, e),
-                    sub(s.model, b, e), set->spheres);
-      object_controls(sub(row, b, e), sub(min_level, b, e), sub(error_scale, b, e), sub(inv_priority, b, e),
-                      sub(never_cull, b, e), sub(s.options, b, e), sub(s.transform, b, e), sub(s.model, b, e),
-                      caps);
+      refresh_derived_columns(s, b, e, caps, set->spheres);
     });
+    s.any_dirty = false;
   }
 
   void node_view() {
@@ -408,14 +408,15 @@ struct FrameGraph::Impl {
   }
 
   void node_visibility() {
+    const ObjectStore& s = *store;
     for_chunks(Stage::visibility, [&](size_t c, size_t b, size_t e) {
       std::array<std::span<uint8_t>, kMaxViews> vis;
       for (uint32_t v = 0; v < view_count; ++v) {
         vis[v] = sub(per_view[v].visible, b, e);
-        cull_spheres(vis[v], sub(cx, b, e), sub(cy, b, e), sub(cz, b, e), sub(radius, b, e), frusta[v]);
+        cull_spheres(vis[v], sub(s.cx, b, e), sub(s.cy, b, e), sub(s.cz, b, e), sub(s.radius, b, e), frusta[v]);
       }
       chunk_visible[c] = static_cast<uint32_t>(
-          combine_view_masks(sub(mask, b, e), std::span(vis.data(), view_count), sub(never_cull, b, e)));
+          combine_view_masks(sub(mask, b, e), std::span(vis.data(), view_count), sub(s.never_cull, b, e)));
     });
     // Exclusive prefix sum over the chunks: where each chunk's visible objects go.
     visible_total = 0;
@@ -426,12 +427,13 @@ struct FrameGraph::Impl {
   }
 
   void node_importance() {
+    const ObjectStore& s = *store;
     for_chunks(Stage::importance, [&](size_t c, size_t b, size_t e) {
       for (uint32_t v = 0; v < view_count; ++v) {
         PerView& p = per_view[v];
         chunk_minima[c * kMaxViews + v] =
-            measure_objects(sub(p.distance, b, e), sub(p.area, b, e), sub(p.visible, b, e), sub(cx, b, e),
-                            sub(cy, b, e), sub(cz, b, e), sub(radius, b, e), views[v].eye, focal[v]);
+            measure_objects(sub(p.distance, b, e), sub(p.area, b, e), sub(p.visible, b, e), sub(s.cx, b, e),
+                            sub(s.cy, b, e), sub(s.cz, b, e), sub(s.radius, b, e), views[v].eye, focal[v]);
       }
     });
     // min() is order-free, but merging in chunk order keeps even that obvious.
@@ -461,8 +463,8 @@ struct FrameGraph::Impl {
                          minima[v]);
       const InitialLevelParams params{focal[v], options.pixel_error, options.hysteresis};
       choose_initial_levels(sub(p.level, b, e), sub(p.visible, b, e), sub(s.prev_level, b, e),
-                            sub(s.was_visible, b, e), sub(p.distance, b, e), sub(error_scale, b, e), sub(row, b, e),
-                            caps.rows, params);
+                            sub(s.was_visible, b, e), sub(p.distance, b, e), sub(s.error_scale, b, e),
+                            sub(s.row, b, e), caps.rows, params);
     }
     PerView& p0 = per_view[0];
     for (uint32_t v = 1; v < view_count; ++v) {
@@ -470,8 +472,8 @@ struct FrameGraph::Impl {
       combine_view_choice(sub(p0.level, b, e), sub(p0.weight, b, e), sub(p0.visible, b, e), sub(p.level, b, e),
                           sub(p.weight, b, e), sub(p.visible, b, e));
     }
-    apply_object_controls(sub(p0.level, b, e), sub(p0.weight, b, e), sub(p0.visible, b, e), sub(min_level, b, e),
-                          sub(inv_priority, b, e));
+    apply_object_controls(sub(p0.level, b, e), sub(p0.weight, b, e), sub(p0.visible, b, e), sub(s.min_level, b, e),
+                          sub(s.inv_priority, b, e));
   }
 
   // This chunk's visible objects into their slots, then selection's streaming pass on them.
@@ -490,7 +492,7 @@ struct FrameGraph::Impl {
       ids[slot] = static_cast<uint32_t>(i);
       levels[slot] = p0.level[i];
       visible_weight[slot] = p0.weight[i];
-      visible_row[slot] = row[i];
+      visible_row[slot] = s.row[i];
       slot += p0.visible[i];
     }
     assert(slot == end_slot);

@@ -30,10 +30,12 @@ ApplyCounts apply_commands(ObjectStore& store, std::span<const ObjectCommand> co
         break;
       case CommandKind::transform:
         store.transform[i] = c.transform;
+        store.mark_dirty(i);
         ++n.moved;
         break;
       case CommandKind::options:
         store.options[i] = c.options;
+        store.mark_dirty(i);
         ++n.changed;
         break;
       case CommandKind::create:

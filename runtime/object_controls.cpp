@@ -11,6 +11,21 @@ bool options_valid(const ObjectOptions& o) {
   return std::isfinite(o.lod_bias) && std::isfinite(o.priority) && o.priority > 0;
 }
 
+ObjectControl control_of(const ObjectOptions& o, float scale, uint32_t model, const LevelCaps& caps) {
+  const uint32_t last = caps.rows.level_count[model] - 1u;
+  uint32_t finest = std::min<uint32_t>(o.min_level, last);
+  uint32_t coarsest = std::clamp<uint32_t>(o.max_level, finest, last);
+  if (o.forced_level >= 0) finest = coarsest = std::min<uint32_t>(uint32_t(o.forced_level), last);
+  ObjectControl c;
+  c.row = caps.row(model, coarsest);
+  c.min_level = static_cast<uint8_t>(finest);
+  // Bias is clamped to +-30 octaves so that 2^-bias stays a normal float.
+  c.error_scale = o.lod_bias == 0 ? scale : scale * std::exp2(-std::clamp(o.lod_bias, -30.f, 30.f));
+  c.inv_priority = o.priority > 0 ? 1.0f / o.priority : 1.0f;
+  c.never_cull = o.never_cull ? 1 : 0;
+  return c;
+}
+
 void object_controls(std::span<uint32_t> row, std::span<uint8_t> min_level, std::span<float> error_scale,
                      std::span<float> inv_priority, std::span<uint8_t> never_cull,
                      std::span<const ObjectOptions> options, std::span<const Transform> transform,
@@ -19,17 +34,9 @@ void object_controls(std::span<uint32_t> row, std::span<uint8_t> min_level, std:
   assert(row.size() == n && min_level.size() == n && error_scale.size() == n && inv_priority.size() == n &&
          never_cull.size() == n && transform.size() == n && model.size() == n);
   for (size_t i = 0; i < n; ++i) {
-    const ObjectOptions& o = options[i];
-    const uint32_t last = caps.rows.level_count[model[i]] - 1u;
-    uint32_t finest = std::min<uint32_t>(o.min_level, last);
-    uint32_t coarsest = std::clamp<uint32_t>(o.max_level, finest, last);
-    if (o.forced_level >= 0) finest = coarsest = std::min<uint32_t>(uint32_t(o.forced_level), last);
-    row[i] = caps.row(model[i], coarsest);
-    min_level[i] = static_cast<uint8_t>(finest);
-    // Bias is clamped to +-30 octaves so that 2^-bias stays a normal float.
-    error_scale[i] = transform[i].scale * std::exp2(-std::clamp(o.lod_bias, -30.f, 30.f));
-    inv_priority[i] = o.priority > 0 ? 1.0f / o.priority : 1.0f;
-    never_cull[i] = o.never_cull ? 1 : 0;
+    const ObjectControl c = control_of(options[i], transform[i].scale, model[i], caps);
+    row[i] = c.row, min_level[i] = c.min_level, error_scale[i] = c.error_scale;
+    inv_priority[i] = c.inv_priority, never_cull[i] = c.never_cull;
   }
 }
 

@@ -14,7 +14,18 @@
 
 namespace lod {
 
-// Clamps what it reads, so any option values give valid columns. Sub-range safe.
+struct ObjectControl {
+  uint32_t row = 0;
+  uint8_t min_level = 0;
+  float error_scale = 1;
+  float inv_priority = 1;
+  uint8_t never_cull = 0;
+};
+
+// One object's controls; clamps what it reads, so any option values give valid columns.
+ObjectControl control_of(const ObjectOptions& o, float scale, uint32_t model, const LevelCaps& caps);
+
+// The same over columns. Sub-range safe.
 void object_controls(std::span<uint32_t> row, std::span<uint8_t> min_level, std::span<float> error_scale,
                      std::span<float> inv_priority, std::span<uint8_t> never_cull,
                      std::span<const ObjectOptions> options, std::span<const Transform> transform,

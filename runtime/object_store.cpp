@@ -37,6 +37,12 @@ uint32_t ObjectStore::insert(ObjectHandle h, uint32_t m, const Transform& t, con
   was_visible.push_back(0);
   morph_from.push_back(0);
   morph_start.push_back(-1e300);
+  for (auto* c : {&cx, &cy, &cz, &radius, &error_scale, &inv_priority}) c->push_back(0);
+  row.push_back(0);
+  min_level.push_back(0);
+  never_cull.push_back(0);
+  dirty.push_back(1);
+  any_dirty = true;
   return index;
 }
 
@@ -52,12 +58,25 @@ void ObjectStore::erase(uint32_t index) {
   move_last_into(was_visible, index);
   move_last_into(morph_from, index);
   move_last_into(morph_start, index);
+  for (auto* c : {&cx, &cy, &cz, &radius, &error_scale, &inv_priority}) move_last_into(*c, index);
+  move_last_into(row, index);
+  move_last_into(min_level, index);
+  move_last_into(never_cull, index);
+  move_last_into(dirty, index);
+}
+
+void ObjectStore::mark_all_dirty() {
+  std::fill(dirty.begin(), dirty.end(), uint8_t{1});
+  any_dirty = !dirty.empty();
 }
 
 void ObjectStore::clear() {
   for (ObjectHandle h : handle) index_of_slot[handle_slot(h)] = kNoIndex;
   handle.clear(), model.clear(), transform.clear(), options.clear();
   prev_level.clear(), was_visible.clear(), morph_from.clear(), morph_start.clear();
+  for (auto* c : {&cx, &cy, &cz, &radius, &error_scale, &inv_priority}) c->clear();
+  row.clear(), min_level.clear(), never_cull.clear(), dirty.clear();
+  any_dirty = false;
 }
 
 void ObjectStore::reset_temporal_state() {

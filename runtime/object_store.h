@@ -26,6 +26,17 @@ struct ObjectStore {
   std::vector<uint32_t> model;
   std::vector<Transform> transform;    // exactly as the caller set it
   std::vector<ObjectOptions> options;  // exactly as the caller set it
+  // Derived from transform, options and model (world_bounds.h, object_controls.h), kept until
+  // they change: recomputed only where `dirty` is set (inserted, moved, options changed, or
+  // every object after the models changed), so a static object costs nothing per frame.
+  std::vector<float> cx, cy, cz, radius;  // world bounding sphere
+  std::vector<uint32_t> row;              // selection row (LevelCaps)
+  std::vector<uint8_t> min_level;
+  std::vector<float> error_scale;
+  std::vector<float> inv_priority;
+  std::vector<uint8_t> never_cull;
+  std::vector<uint8_t> dirty;
+  bool any_dirty = false;
   // Written by frames, read by the next one.
   std::vector<uint8_t> prev_level;     // last published level
   std::vector<uint8_t> was_visible;    // visible last frame
@@ -43,6 +54,11 @@ struct ObjectStore {
   void erase(uint32_t index);
   void clear();
   void reset_temporal_state();  // as if no frame had run
+  void mark_dirty(uint32_t index) {
+    dirty[index] = 1;
+    any_dirty = true;
+  }
+  void mark_all_dirty();
 };
 
 }  // namespace lod

@@ -16,6 +16,9 @@ Sphere chain_sphere(const LodChain& chain);
 // rotate(q, v) for a unit quaternion q = x y z w.
 void rotate_by_quaternion(const float q[4], const float v[3], float out[3]);
 
+// One object's world sphere.
+Sphere world_sphere(const Transform& t, const Sphere& model_sphere);
+
 // Sub-range safe: run it on chunks.
 void world_spheres(std::span<float> cx, std::span<float> cy, std::span<float> cz, std::span<float> radius,
                    std::span<const Transform> transform, std::span<const uint32_t> model,

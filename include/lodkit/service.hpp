@@ -85,6 +85,7 @@ struct ServiceStats {
   double mean_ms = 0;
   uint64_t commits = 0;       // commit() calls
   uint64_t live_objects = 0;  // objects created and not destroyed (as staged)
+  uint64_t handle_slots = 0;  // slots the handle table holds: its peak of live objects
 };
 
 class Service {

@@ -1,7 +1,8 @@
-// The whole per-frame graph (view -> visibility -> importance -> selection -> vdlod ->
-// geomorph -> publish) on hand-built scenes of 1k, 10k and 100k objects, with 1 and 2 threads,
-// the camera orbiting and a budget that binds. The 1-thread run of each size is the baseline
-// of its 2-thread run: the ratio is printed after the table.
+// The whole per-frame graph (the node table of jobs/frame_graph.cpp) on hand-built scenes of
+// 1k, 10k and 100k objects, with 1 and 2 threads, the camera orbiting and a budget that binds,
+// static or with 10 % of the objects given a new transform every tick (committed commands the
+// commit node applies). Baselines from the same run: 1 thread for 2, static for dynamic; the
+// ratios are printed after the table.
 //
 // Counters: min_ms / median_ms / p99_ms of the per-frame total, per-stage mean ms (st_<stage>), the
 // share of selection in the frame, visible objects and heap pops per frame.
@@ -52,18 +53,54 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
+// Every tick, `percent` of the objects (a window sliding through them) get a new transform:
+// the commands a simulation thread would have committed, applied by the commit node.
+struct Movers {
+  std::vector<ObjectCommand> commands;
+  std::vector<Transform> start;
+  uint32_t next = 0;
+
+  Movers(const Scene& scene, uint32_t percent) {
+    commands.resize(scene.objects.size() * percent / 100);
+    for (size_t i = 0; i < scene.objects.size(); ++i) start.push_back(transform_of(scene.objects, i));
+  }
+  std::span<const CommitBatchRef> tick(uint64_t t, CommitBatchRef& batch) {
+    const uint32_t n = static_cast<uint32_t>(start.size());
+    for (ObjectCommand& c : commands) {
+      const uint32_t i = next++ % n;
+      c.handle = make_handle(i, 1);  // the handles FrameGraph(scene) gives its objects
+      c.kind = CommandKind::transform;
+      c.transform = start[i];
+      c.transform.position[0] += float(t % 7);  // a small move, the same on every run
+    }
+    batch = {t, commands};
+    return commands.empty() ? std::span<const CommitBatchRef>() : std::span<const CommitBatchRef>(&batch, 1);
+  }
+};
+
 void BM_FrameGraph(benchmark::State& state) {
   const uint32_t objects = static_cast<uint32_t>(state.range(0));
   const uint32_t threads = static_cast<uint32_t>(state.range(1));
+  const uint32_t moving = static_cast<uint32_t>(state.range(2));
   const BenchScene& bs = scene_of(objects);
   FrameGraphOptions o;
   o.threads = threads;
   o.selection.budget = bs.budget;
   FrameGraph graph(bs.scene, o);
+  Movers movers(bs.scene, moving);
+  CommitBatchRef batch;
   Frame frame;
+  auto run = [&](uint32_t n) {
+    const View view = view_at(bs.path, n);
+    FrameInput in;
+    in.views = std::span(&view, 1);
+    in.time = n / 60.0;
+    in.commits = movers.tick(n, batch);
+    graph.run(in, graph.scene_objects(), frame);
+  };
   // Two warm-up frames: the first has no temporal state, allocation happens once.
-  graph.run(view_at(bs.path, 0), frame);
-  graph.run(view_at(bs.path, 1), frame);
+  run(0);
+  run(1);
 
   std::vector<double> totals;
   std::array<double, kStageCount> stage_sum{};
@@ -71,7 +108,7 @@ void BM_FrameGraph(benchmark::State& state) {
   uint64_t over = 0;
   uint32_t n = 2;
   for (auto _ : state) {
-    graph.run(view_at(bs.path, n++), frame);
+    run(n++);
     totals.push_back(frame.total_ms);
     for (size_t s = 0; s < kStageCount; ++s) stage_sum[s] += frame.stage_ms[s];
     visible += frame.visible;
@@ -94,8 +131,8 @@ void BM_FrameGraph(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FrameGraph)
-    ->ArgNames({"objects", "threads"})
-    ->ArgsProduct({{1000, 10000, 100000}, {1, 2}})
+    ->ArgNames({"objects", "threads", "moving"})
+    ->ArgsProduct({{1000, 10000, 100000}, {1, 2}, {0, 10}})
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
@@ -115,17 +152,29 @@ class RatioReporter : public benchmark::ConsoleReporter {
     }
   }
   void print_ratios() const {
+    auto find = [&](uint32_t objects, int threads, int moving) -> const Times* {
+      const auto it = times_.find("BM_FrameGraph/objects:" + std::to_string(objects) + "/threads:" +
+                                  std::to_string(threads) + "/moving:" + std::to_string(moving) + "/real_time");
+      return it == times_.end() ? nullptr : &it->second;
+    };
     for (uint32_t objects : {1000u, 10000u, 100000u}) {
-      const std::string base = "BM_FrameGraph/objects:" + std::to_string(objects) + "/threads:";
-      const auto one = times_.find(base + "1/real_time");
-      const auto two = times_.find(base + "2/real_time");
-      if (one == times_.end() || two == times_.end()) continue;
-      const Times& a = one->second;
-      const Times& b = two->second;
-      std::printf(
-          "speed-up %6u objects, 2 vs 1 thread: mean %.2fx, median %.2fx (%.3f -> %.3f ms), min %.2fx (%.3f "
-          "-> %.3f ms)\n",
-          objects, a.mean / b.mean, a.median / b.median, a.median, b.median, a.min / b.min, a.min, b.min);
+      for (int moving : {0, 10}) {
+        const Times* a = find(objects, 1, moving);
+        const Times* b = find(objects, 2, moving);
+        if (!a || !b) continue;
+        std::printf(
+            "speed-up %6u objects, %2d %% moving, 2 vs 1 thread: mean %.2fx, median %.2fx (%.3f -> %.3f ms), min "
+            "%.2fx (%.3f -> %.3f ms)\n",
+            objects, moving, a->mean / b->mean, a->median / b->median, a->median, b->median, a->min / b->min, a->min,
+            b->min);
+      }
+      for (int threads : {1, 2}) {
+        const Times* s = find(objects, threads, 0);
+        const Times* d = find(objects, threads, 10);
+        if (!s || !d) continue;
+        std::printf("dynamic  %6u objects, %d thread(s): 10 %% moving / static, median %.2fx (%.3f vs %.3f ms)\n",
+                    objects, threads, d->median / s->median, d->median, s->median);
+      }
     }
   }
 
