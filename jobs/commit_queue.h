@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "jobs/spin_lock.h"
 #include "runtime/handle_table.h"
 #include "runtime/object_commands.h"
 
@@ -40,7 +41,7 @@ class CommitQueue {
   void recycle(std::vector<Batch>& used);
 
  private:
-  mutable std::mutex stage_mutex_;  // staged_, handles_, commits_
+  mutable SpinLock stage_mutex_;  // staged_, handles_, commits_
   std::vector<ObjectCommand> staged_;
   HandleTable handles_;
   uint64_t commits_ = 0;
