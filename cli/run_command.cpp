@@ -155,6 +155,10 @@ int run_command(const RunArgs& args) {
   SceneMotion motion(config, scene.objects, handles);
   // Frames are 1 / rate_hz apart on the service clock (1/60 s when the rate is unlimited).
   const double dt = config.rate_hz > 0 ? 1.0 / config.rate_hz : 1.0 / 60;
+  if (motion.moving() > 0 && !args.quiet)
+    std::printf("motion: %zu of %zu objects move; their transforms are staged and committed every frame (tick = "
+                "frame number)\n",
+                motion.moving(), scene.objects.size());
 
   RunSummary summary;
   summary.config = std::filesystem::path(args.config).filename().string();

@@ -423,3 +423,34 @@ TEST(SceneConfig, DefaultDataDirIsTheCompiledInOne) { EXPECT_EQ(default_data_dir
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+TEST(SceneConfigMotion, ParsesMotionAndSpeed) {
+  ConfigDir d;
+  SceneConfig c;
+  const Status s = load(d, kModel + kInstances + "motion = \"wander\"\nspeed = 12.5\n", c);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(c.instances.size(), 1u);
+  EXPECT_EQ(c.instances[0].motion.kind, MotionKind::wander);
+  EXPECT_EQ(c.instances[0].motion.speed, 12.5f);
+  SceneConfig o;
+  ASSERT_TRUE(load(d, kModel + kInstances + "motion = \"orbit\"\nspeed = 3\n", o).ok);
+  EXPECT_EQ(o.instances[0].motion.kind, MotionKind::orbit);
+  SceneConfig n;
+  ASSERT_TRUE(load(d, kModel + kInstances, n).ok);
+  EXPECT_EQ(n.instances[0].motion.kind, MotionKind::none);
+}
+
+TEST(SceneConfigMotion, RefusesBadMotion) {
+  expect_refused(kModel + kInstances + "motion = \"teleport\"\nspeed = 1\n", "instances[0].motion", "wander");
+  expect_refused(kModel + kInstances + "motion = \"wander\"\n", "instances[0].speed", "missing");
+  expect_refused(kModel + kInstances + "motion = \"wander\"\nspeed = 0\n", "instances[0].speed", "(0, 1e6]");
+  expect_refused(kModel + kInstances + "motion = \"orbit\"\nspeed = -3\n", "instances[0].speed");
+  expect_refused(kModel + kInstances + "motion = \"orbit\"\nspeed = nan\n", "instances[0].speed");
+  expect_refused(kModel + kInstances + "speed = 4\n", "instances[0].speed", "needs motion");
+}
+
+}  // namespace
+}  // namespace lod
