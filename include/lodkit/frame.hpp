@@ -1,10 +1,11 @@
 // Frame: what one pass of the per-frame graph publishes for a consumer (renderer, viewer).
+// Part of the public API: plain columns, one entry per visible object, no library types.
 #pragma once
 #include <array>
 #include <cstdint>
 #include <vector>
 
-#include "runtime/view.h"
+#include "lodkit/types.hpp"
 
 namespace lod {
 
@@ -17,7 +18,8 @@ inline constexpr size_t kHistogramLevels = 32;  // histogram bins by l = round(l
 // One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
 // draws instead of a discrete level. Positions are object space and already geomorphed.
 struct VdObjectFrame {
-  uint32_t object = 0;        // object id
+  uint32_t object = 0;        // Frame::objects value of this object (its entry is `entry`)
+  uint32_t entry = 0;         // index of its entry in the frame's per-entry columns
   uint32_t first_vertex = 0;  // into Frame::vd_positions, in vertices
   uint32_t vertex_count = 0;
   uint32_t first_index = 0;   // into Frame::vd_indices; indices are local to this object's vertices
@@ -31,11 +33,19 @@ struct VdObjectFrame {
 };
 
 struct Frame {
-  uint64_t index = 0;  // frame number, increasing
-  View view;
+  uint64_t index = 0;   // frame number, increasing
+  uint64_t tick = 0;    // the tick of the last commit this frame was computed from
+  double time_s = 0;    // service clock (seconds of step(dt) or of free-running) at this frame
+  uint32_t view_count = 1;
+  std::array<Camera, kMaxViews> views{};  // the views it was computed for (first view_count)
 
-  // One entry per visible object, in object order.
-  std::vector<uint32_t> objects;  // object ids
+  // One entry per visible object, in the service's object order (which changes as objects
+  // come and go: use `handles` to follow an object from frame to frame).
+  std::vector<ObjectHandle> handles;   // the object's handle
+  std::vector<uint32_t> models;        // its model
+  std::vector<Transform> transforms;   // the transform this frame was computed with
+  std::vector<uint8_t> view_masks;     // bit v set: view v sees it (never_cull: every view)
+  std::vector<uint32_t> objects;       // its dense index in the service at this frame
   std::vector<uint8_t> levels;    // chain level index (0 = full detail)
   std::vector<float> morph;       // geomorph factor in [0, 1] towards `levels` (1 = settled)
   // Level each object morphs FROM (equal to `levels` once settled, and always for view-dependent
@@ -48,7 +58,7 @@ struct Frame {
   // mid-morph starts from the level the object was heading to.
   std::vector<uint8_t> from_levels;
 
-  uint32_t object_count = 0;
+  uint32_t object_count = 0;      // live objects at this frame's tick
   uint32_t visible = 0;
   uint64_t tris_in_view = 0;    // visible objects at full detail
   uint64_t tris_selected = 0;

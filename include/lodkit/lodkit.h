@@ -1,0 +1,97 @@
+/* lodkit's C API (C99), for engines in other languages (C# P/Invoke, Python ctypes, Rust).
+ *
+ * Object calls and lod_commit may come from any thread (the library serialises them); frames
+ * may be acquired from any thread by any number of consumers. Nothing here aborts the host:
+ * a bad path, a stale handle or a bad view gives a nonzero return (or 0 / NULL) and, where
+ * there is an error buffer, a message naming the file or value. */
+#ifndef LODKIT_LODKIT_H
+#define LODKIT_LODKIT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct lod_service lod_service;
+typedef struct lod_frame lod_frame;
+typedef uint64_t lod_object; /* 0 is never a valid handle */
+typedef uint32_t lod_model;
+
+typedef struct lod_transform {
+  float position[3];
+  float rotation[4]; /* x y z w */
+  float scale;
+} lod_transform;
+
+typedef struct lod_view {
+  float eye[3], forward[3], up[3];
+  float fov_y_deg;
+  uint32_t width, height;
+  float near_z, far_z;
+} lod_view;
+
+typedef struct lod_frame_info {
+  uint64_t index, tick;
+  uint32_t objects, visible;
+  uint64_t tris_selected, budget;
+  int over_budget;
+} lod_frame_info;
+
+typedef struct lod_frame_entry {
+  lod_object object;
+  uint32_t level, from_level;
+  float morph;
+  uint32_t view_mask;
+  lod_transform transform;
+} lod_frame_entry;
+
+typedef struct lod_object_options {
+  float lod_bias;       /* tolerates pixel_error * 2^lod_bias */
+  uint32_t min_level;   /* finest level allowed */
+  uint32_t max_level;   /* coarsest level allowed (clamped to the chain) */
+  float priority;       /* > 0; importance divided by it */
+  int32_t forced_level; /* >= 0: always this level */
+  int never_cull;       /* nonzero: visible to every view */
+} lod_object_options;
+
+/* A scene TOML; [[model]]/[[instances]] optional. NULL on error, with the message. */
+lod_service* lod_service_create(const char* config_path, char* error, size_t error_size);
+void lod_service_destroy(lod_service*);
+
+/* A mesh (baked, cached) or a .lod asset; 0 = ok. */
+int lod_model_add(lod_service*, const char* path, lod_model* out, char* error, size_t error_size);
+uint32_t lod_model_level_count(lod_service*, lod_model);
+uint64_t lod_model_level_triangles(lod_service*, lod_model, uint32_t level);
+
+lod_object lod_object_create(lod_service*, lod_model, const lod_transform*); /* 0 on error */
+int lod_object_destroy(lod_service*, lod_object);                            /* nonzero: stale or unknown */
+int lod_object_set_transform(lod_service*, lod_object, const lod_transform*); /* nonzero: stale or unknown */
+void lod_object_options_default(lod_object_options* out);
+int lod_object_set_options(lod_service*, lod_object, const lod_object_options*); /* nonzero: stale, unknown, bad */
+void lod_commit(lod_service*, uint64_t tick);
+
+int lod_set_view(lod_service*, uint32_t view_index, const lod_view*); /* nonzero: index >= 8 or a bad view */
+int lod_set_view_count(lod_service*, uint32_t count);                 /* 1..8 */
+void lod_set_budget(lod_service*, uint64_t triangles);
+void lod_set_pixel_error(lod_service*, float pixels);
+void lod_set_hysteresis(lod_service*, float band);
+void lod_set_blend_seconds(lod_service*, float seconds);
+
+int lod_start(lod_service*); /* free-running LOD thread at [run] rate_hz; 0 = ok */
+void lod_stop(lod_service*);
+int lod_step(lod_service*, double dt_seconds); /* driven mode: one frame on the caller's thread; 0 = ok */
+
+const lod_frame* lod_frame_acquire(lod_service*); /* newest complete frame (NULL before the first), held until released */
+void lod_frame_release(lod_service*, const lod_frame*);
+void lod_frame_info_get(const lod_frame*, lod_frame_info*); /* objects = live objects at the frame's tick; visible = entries */
+int lod_frame_entry_get(const lod_frame*, uint32_t i, lod_frame_entry*); /* i < visible; transform exactly as the caller set it */
+
+/* The calling thread's last error message ("" when none). */
+const char* lod_last_error(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* LODKIT_LODKIT_H */

@@ -1,0 +1,141 @@
+// lod::Service: the LOD thread a simulator embeds.
+//
+// Threading contract
+// - Object calls (create, destroy, set_transform, set_options) and commit() may come from any
+//   thread; the service serialises them with a short lock that is never held across a frame.
+//   They are staged: nothing a frame sees changes until commit(tick) publishes everything
+//   staged since the last commit. The next frame computed after a commit uses exactly that
+//   state and carries its tick (Frame::tick).
+// - Runtime settings (budget, pixel error, hysteresis, blend time, views) may be set from any
+//   thread and apply from the next frame on.
+// - Frames: acquire_frame() from any thread, by any number of consumers; a FrameRef keeps its
+//   frame unchanged until it is released (destroyed). The LOD thread never waits for a
+//   consumer: when every frame is held it writes a new one.
+// - step(dt) runs one frame on the caller's thread (driven mode); start() runs frames on the
+//   service's own thread at rate_hz (free-running). A service may be stepped, then started,
+//   stopped and stepped again; step() while running returns false.
+// - Errors never abort the host: calls return false / 0 and say why through last_error().
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "lodkit/frame.hpp"
+#include "lodkit/types.hpp"
+
+namespace lod {
+
+struct FrameSlot;  // where a published frame lives (internal)
+
+// Shared read access to one published frame; move-only, released on destruction.
+class FrameRef {
+ public:
+  FrameRef() = default;
+  FrameRef(FrameRef&& other) noexcept : slot_(other.slot_) { other.slot_ = nullptr; }
+  FrameRef& operator=(FrameRef&& other) noexcept;
+  FrameRef(const FrameRef&) = delete;
+  FrameRef& operator=(const FrameRef&) = delete;
+  ~FrameRef() { reset(); }
+
+  const Frame* get() const;  // nullptr when empty (before the first frame)
+  const Frame& operator*() const { return *get(); }
+  const Frame* operator->() const { return get(); }
+  explicit operator bool() const { return slot_ != nullptr; }
+  void reset();
+
+ private:
+  friend class Service;
+  explicit FrameRef(FrameSlot* slot) : slot_(slot) {}
+  FrameSlot* slot_ = nullptr;
+};
+
+enum class BudgetUnit : uint8_t {
+  triangles,  // sum of selected triangles <= M
+  levels,     // R0's sum of 2^l <= M
+};
+
+struct ServiceOptions {
+  uint32_t threads = 0;              // task arena size; 0 = all cores
+  double rate_hz = 60;               // free-running frame rate; <= 0 = as fast as frames finish
+  uint64_t budget = 2000000;         // M
+  BudgetUnit budget_unit = BudgetUnit::triangles;
+  bool reserve_blends = true;        // hold last frame's blend extra back from M
+  float pixel_error = 1.0f;          // screen-space error wanted before the budget applies
+  float hysteresis = 0.25f;          // relative band against level flicker
+  float blend_seconds = 0.25f;       // level changes, splits and collapses blend this long
+  std::filesystem::path cache_dir;   // baked assets of add_model(mesh); empty = no cache
+};
+
+struct ServiceStats {
+  uint64_t frames = 0;        // frames published
+  uint64_t errors = 0;        // frames lost to an exception in a node (last good frame kept)
+  double last_ms = 0;
+  double mean_ms = 0;
+  uint64_t commits = 0;       // commit() calls
+  uint64_t live_objects = 0;  // objects created and not destroyed (as staged)
+};
+
+class Service {
+ public:
+  explicit Service(const ServiceOptions& options = {});
+  ~Service();  // stops the thread; outstanding FrameRefs must be released first
+  Service(const Service&) = delete;
+  Service& operator=(const Service&) = delete;
+
+  // A scene config (TOML): its [run]/[budget]/[lod] settings, its [[model]]s baked (cached in
+  // cache_dir, or the config's cache) and its [[instances]] created and committed at tick 0.
+  // nullptr on error, with the message (naming the file and key) in *error.
+  static std::unique_ptr<Service> from_config(const std::filesystem::path& config, std::string* error,
+                                              const std::filesystem::path& data_dir = {},
+                                              const std::filesystem::path& cache_dir = {});
+
+  // Models: a mesh (OBJ, PLY, OFF, STL: baked, cached in cache_dir) or a baked .lod asset.
+  // Returns false with last_error() naming the file. Models are never removed.
+  bool add_model(const std::filesystem::path& path, ModelId* out);
+  uint32_t model_count() const;
+  uint32_t level_count(ModelId model) const;                   // 0 for an unknown model
+  uint64_t level_triangles(ModelId model, uint32_t level) const;  // 0 when out of range
+
+  // Objects (staged until commit). 0 / false for an unknown model, a stale or unknown handle,
+  // or a transform that is not finite (scale <= 0, zero quaternion).
+  ObjectHandle create(ModelId model, const Transform& transform, const ObjectOptions& options = {});
+  bool destroy(ObjectHandle object);
+  bool set_transform(ObjectHandle object, const Transform& transform);
+  bool set_options(ObjectHandle object, const ObjectOptions& options);
+  // Many transforms under one lock; returns how many were accepted (stale handles skipped).
+  size_t set_transforms(std::span<const ObjectHandle> objects, std::span<const Transform> transforms);
+  bool alive(ObjectHandle object) const;  // as staged
+  void commit(uint64_t tick);
+
+  // Views: up to kMaxViews; an object's level is the finest any view needs and it counts once
+  // against M. set_view_count(n) uses views 0..n-1 (set_view(i) raises the count to i + 1).
+  bool set_view(uint32_t index, const Camera& camera);
+  bool set_view_count(uint32_t count);
+
+  void set_budget(uint64_t triangles);
+  void set_pixel_error(float pixels);
+  void set_hysteresis(float band);
+  void set_blend_seconds(float seconds);
+
+  bool start();  // free-running at rate_hz; false when already running
+  void stop();
+  bool running() const;
+  // Driven mode: one frame on the caller's thread, the clock advanced by dt_seconds (>= 0).
+  // False while running, or when the frame failed (counted in stats().errors).
+  bool step(double dt_seconds);
+
+  FrameRef acquire_frame() const;  // newest complete frame; empty before the first
+  ServiceStats stats() const;
+  std::string last_error() const;  // of the calling thread's last failed call
+
+  struct Impl;
+  Impl& impl() { return *impl_; }  // for lodkit's own tools (internal)
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lod

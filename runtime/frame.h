@@ -1,0 +1,80 @@
+// Frame: what one pass of the per-frame graph publishes for a consumer (renderer, viewer).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "runtime/view.h"
+
+namespace lod {
+
+enum class Stage : uint8_t { view, visibility, importance, selection, vdlod, geomorph, publish, count };
+inline constexpr const char* kStageNames[] = {"view",     "visibility", "importance", "selection",
+                                              "vdlod",    "geomorph",   "publish"};
+inline constexpr size_t kStageCount = static_cast<size_t>(Stage::count);
+inline constexpr size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
+
+// One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
+// draws instead of a discrete level. Positions are object space and already geomorphed.
+struct VdObjectFrame {
+  uint32_t object = 0;        // object id
+  uint32_t first_vertex = 0;  // into Frame::vd_positions, in vertices
+  uint32_t vertex_count = 0;
+  uint32_t first_index = 0;   // into Frame::vd_indices; indices are local to this object's vertices
+  uint32_t index_count = 0;   // 3 per triangle
+  uint32_t splits = 0;        // this frame
+  uint32_t collapses = 0;
+  uint32_t moving = 0;        // vertices still geomorphing
+  float threshold = 0;        // pixel threshold after this frame's feedback
+  bool closed = false;        // the object's full mesh is closed (every edge in two faces)
+  bool oriented = false;      // ... consistently oriented (each directed edge once)
+};
+
+struct Frame {
+  uint64_t index = 0;  // frame number, increasing
+  View view;
+
+  // One entry per visible object, in object order.
+  std::vector<uint32_t> objects;  // object ids
+  std::vector<uint8_t> levels;    // chain level index (0 = full detail)
+  std::vector<float> morph;       // geomorph factor in [0, 1] towards `levels` (1 = settled)
+  // Level each object morphs FROM (equal to `levels` once settled, and always for view-dependent
+  // objects, which draw their active mesh, and for chains without morph targets). To blend, a renderer draws the FINER of (from, to)
+  // with every vertex at mix(own, target in the coarser level, w), the targets composed through
+  // the levels in between (i -> i+1 -> ... -> j, LodChain::morph_targets); w = morph when the
+  // object coarsens (from < to) and 1 - morph when it refines, so morph 0 looks exactly like
+  // the old level and morph 1 exactly like the new one. Going back mid-morph to the level it
+  // came from continues from the same shape (morph restarts at 1 - morph); any other change in
+  // mid-morph starts from the level the object was heading to.
+  std::vector<uint8_t> from_levels;
+
+  uint32_t object_count = 0;
+  uint32_t visible = 0;
+  uint64_t tris_in_view = 0;    // visible objects at full detail
+  uint64_t tris_selected = 0;
+  uint32_t morphing = 0;         // visible objects blending two levels (from_levels != levels)
+  uint64_t tris_morph_extra = 0; // what drawing their finer level adds to tris_selected
+  // Held back from M by selection for last frame's blends (triangle budgets; at most M / 2):
+  // tris_selected <= budget - budget_morph_reserve unless over_budget.
+  uint64_t budget_morph_reserve = 0;
+  uint64_t level_cost = 0;      // sum of 2^l over visible objects
+  uint64_t budget = 0;          // M
+  uint64_t coarsest_cost = 0;   // cost with all visible objects at their coarsest level
+  bool over_budget = false;     // even the coarsest levels exceed M
+  uint32_t lowered_steps = 0;   // heap pops in selection
+  std::array<uint32_t, kHistogramLevels> level_histogram{};  // objects per l
+
+  // View-dependent objects (models with view_dependent = true), visible ones only, in object
+  // order; their discrete level above still says the share of the budget they were given.
+  std::vector<VdObjectFrame> vd_objects;
+  std::vector<float> vd_positions;   // xyz per vertex, all vd objects back to back
+  std::vector<uint32_t> vd_indices;  // all vd objects back to back
+  uint64_t vd_active_tris = 0;
+  uint64_t vd_splits = 0;
+  uint64_t vd_collapses = 0;
+
+  std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds
+  double total_ms = 0;
+};
+
+}  // namespace lod
