@@ -13,7 +13,7 @@ echo "== Release build + ctest =="
 ./scripts/configure.sh build
 cmake --build build -j "$JOBS"
 # Each layer's binary must have registered its tests: a build that lost one fails here.
-for label in unit integration stress viewer; do
+for label in unit integration stress viewer package; do
   n=$(ctest --test-dir build -N -L "^$label\$" | sed -n 's/^Total Tests: *//p')
   echo "[ctest] build: label $label lists ${n:-0} tests"
   [ "${n:-0}" -gt 0 ] || { echo "[ctest] build: no $label tests registered" >&2; exit 1; }

@@ -2,6 +2,7 @@
 // Part of the public API: plain columns, one entry per visible object, no library types.
 #pragma once
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -12,8 +13,8 @@ namespace lod {
 enum class Stage : uint8_t { view, visibility, importance, selection, vdlod, geomorph, publish, count };
 inline constexpr const char* kStageNames[] = {"view",     "visibility", "importance", "selection",
                                               "vdlod",    "geomorph",   "publish"};
-inline constexpr size_t kStageCount = static_cast<size_t>(Stage::count);
-inline constexpr size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
+inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::count);
+inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 
 // One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
 // draws instead of a discrete level. Positions are object space and already geomorphed.
