@@ -312,7 +312,7 @@ void simulate(lod::Service& service, const Args& args, const Town& town, const s
     service.commit(tick);
 
     c.ticks = tick;
-    c.spawned += leaving.size();
+    c.spawned += vehicles.size() - kept;  // the newcomers that were accepted
     c.despawned += leaving.size();
     c.live_vehicles = vehicles.size();
     c.sim_ms = c.sim_ms.load() + std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
