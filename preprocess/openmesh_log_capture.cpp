@@ -19,20 +19,20 @@ thread_local std::string* tls_capture = nullptr;
 
 class RoutingBuf final : public std::streambuf {
  public:
-  explicit RoutingBuf(std::streambuf* next) : next_(next) {}
+  RoutingBuf(const OpenMesh::mostream* stream, std::streambuf* next) : stream_(stream), next_(next) {}
 
  protected:
   int_type overflow(int_type c) override {
     if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
     if (tls_capture) {
-      tls_capture->push_back(traits_type::to_char_type(c));
+      if (stream_->is_enabled()) tls_capture->push_back(traits_type::to_char_type(c));
       return c;
     }
     return next_ ? next_->sputc(traits_type::to_char_type(c)) : c;
   }
   std::streamsize xsputn(const char* s, std::streamsize n) override {
     if (tls_capture) {
-      tls_capture->append(s, size_t(n));
+      if (stream_->is_enabled()) tls_capture->append(s, size_t(n));
       return n;
     }
     return next_ ? next_->sputn(s, n) : n;
@@ -40,6 +40,9 @@ class RoutingBuf final : public std::streambuf {
   int sync() override { return tls_capture || !next_ ? 0 : next_->pubsync(); }
 
  private:
+  // A disabled stream (OpenMesh's omlog() in release builds, or one the host turned off)
+  // stays silent in captures too: a capture sees what the terminal would have.
+  const OpenMesh::mostream* stream_;
   std::streambuf* next_;  // OpenMesh's multiplexer (it lives as long as its stream)
 };
 
@@ -48,9 +51,9 @@ class RoutingBuf final : public std::streambuf {
 void install_routers() {
   static std::once_flag once;
   std::call_once(once, [] {
-    for (std::ostream* s : {&::omerr(), &::omout(), &::omlog()}) {
+    for (OpenMesh::mostream* s : {&::omerr(), &::omout(), &::omlog()}) {
       s->flush();  // a partial line someone left belongs to them, not to the first capture
-      auto* router = new RoutingBuf(s->rdbuf());
+      auto* router = new RoutingBuf(s, s->rdbuf());
       s->rdbuf(router);
     }
   });

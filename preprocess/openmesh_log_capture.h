@@ -7,7 +7,8 @@
 namespace lod::detail {
 
 // While an OpenMeshLogCapture lives, every character the *constructing thread* writes to
-// OpenMesh's three log streams lands in text() instead of the terminal; other threads' writes
+// OpenMesh's three log streams lands in text() instead of the terminal (nothing, for a stream
+// that is disabled, as it would have printed nothing); other threads' writes
 // to those streams go where they always went. Captures nest on one thread (the inner one
 // gets the text until it ends). OpenMesh's readers that write to std::cerr
 // directly (a few PLY/OFF conversion warnings) are not caught: doing so would need the
