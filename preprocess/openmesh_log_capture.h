@@ -12,7 +12,9 @@ namespace lod::detail {
 // to those streams go where they always went. Captures nest on one thread (the inner one
 // gets the text until it ends). OpenMesh's readers that write to std::cerr
 // directly (a few PLY/OFF conversion warnings) are not caught: doing so would need the
-// process-wide swap this class exists to avoid.
+// process-wide swap this class exists to avoid. Writing to one OpenMesh stream from several
+// threads at once is as safe as OpenMesh makes it (its buffer locks; the std::ostream's
+// formatting state is shared), with or without a capture.
 class OpenMeshLogCapture {
  public:
   OpenMeshLogCapture();

@@ -1,11 +1,11 @@
 // Loading meshes must not touch the host's standard streams: a host thread logging to
-// std::cerr / std::cout (or to OpenMesh's omerr()) while lodkit reads meshes loses nothing,
-// and the streams keep the buffers the host gave them.
+// std::cerr / std::cout while lodkit reads meshes loses nothing, and the streams keep the
+// buffers the host gave them. (The host does not write to OpenMesh's omerr() here while
+// loads run: two threads formatting into one non-standard std::ostream race on its state
+// whatever lodkit does; openmesh_log_capture_test covers other threads' omerr() lines.)
 #include "preprocess/mesh_io.h"
 
 #include <gtest/gtest.h>
-
-#include <OpenMesh/Core/System/omstream.hh>
 
 #include <atomic>
 #include <iostream>
@@ -65,7 +65,6 @@ TEST(HostLogging, ConcurrentLoadsNeitherSwallowNorRedirectTheHostsStreams) {
     for (int i = 0; loaders_left.load() > 0 || i < 300; ++i) {
       std::cerr << "cerr " << i << '\n';
       std::cout << "cout " << i << '\n';
-      ::omerr() << "omerr " << i << '\n';  // OpenMesh forwards it to std::cerr, i.e. host_err
       if (std::cerr.rdbuf() != err_buf || std::cout.rdbuf() != out_buf) ++rdbuf_changes;
       written = i + 1;
     }
@@ -93,7 +92,6 @@ TEST(HostLogging, ConcurrentLoadsNeitherSwallowNorRedirectTheHostsStreams) {
   std::vector<std::string> want_err, want_out;
   for (int i = 0; i < written; ++i) {
     want_err.push_back("cerr " + std::to_string(i));
-    want_err.push_back("omerr " + std::to_string(i));
     want_out.push_back("cout " + std::to_string(i));
   }
   EXPECT_EQ(lines_of(host_err.str()), want_err);
