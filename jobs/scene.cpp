@@ -79,17 +79,6 @@ ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>
   return objects;
 }
 
-Transform transform_of(const ObjectSet& objects, size_t i) {
-  Transform t;
-  t.position[0] = objects.x[i];
-  t.position[1] = objects.y[i];
-  t.position[2] = objects.z[i];
-  t.rotation[1] = std::sin(0.5f * objects.yaw[i]);
-  t.rotation[3] = std::cos(0.5f * objects.yaw[i]);
-  t.scale = objects.scale[i];
-  return t;
-}
-
 Scene make_scene(const SceneConfig& config, std::vector<LodChain> chains) {
   Scene scene;
   scene.objects = place_instances(config, chains);

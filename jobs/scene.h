@@ -20,9 +20,6 @@ struct Scene {
 // fills the world bounding spheres from each chain's level-0 sphere. Deterministic.
 ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>& chains);
 
-// Object i's placement as a Transform (its yaw as a quaternion about +y).
-Transform transform_of(const ObjectSet& objects, size_t i);
-
 // Builds models + objects from already baked chains (in config model order).
 Scene make_scene(const SceneConfig& config, std::vector<LodChain> chains);
 

@@ -291,9 +291,9 @@ std::filesystem::path resolve_mesh(const Reader& r, const std::string& key, cons
 }
 
 void read_models(const Reader& r, const toml::table& root, const std::filesystem::path& config_dir,
-                 const std::filesystem::path& data_dir, SceneConfig& c) {
+                 const std::filesystem::path& data_dir, bool required, SceneConfig& c) {
   const auto models = r.tables(root, "model", "model");
-  if (models.empty()) r.fail("model", "no [[model]] given: a scene needs at least one");
+  if (models.empty() && required) r.fail("model", "no [[model]] given: a scene needs at least one");
   for (size_t i = 0; i < models.size(); ++i) {
     const toml::table& t = *models[i];
     const std::string key = indexed("model", i);
@@ -365,9 +365,9 @@ void read_motion(const Reader& r, const toml::table& t, const std::string& key, 
   if (inst.motion.kind == MotionKind::none && t.contains("speed")) r.fail(key + ".speed", "needs motion = \"wander\" or \"orbit\"");
 }
 
-void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
+void read_instances(const Reader& r, const toml::table& root, bool required, SceneConfig& c) {
   const auto blocks = r.tables(root, "instances", "instances");
-  if (blocks.empty()) r.fail("instances", "no [[instances]] given: a scene needs at least one object");
+  if (blocks.empty() && required) r.fail("instances", "no [[instances]] given: a scene needs at least one object");
   uint64_t total = 0;
   for (size_t i = 0; i < blocks.size(); ++i) {
     const toml::table& t = *blocks[i];
@@ -431,7 +431,7 @@ void read_instances(const Reader& r, const toml::table& root, SceneConfig& c) {
 }  // namespace
 
 Status load_scene_config(const std::filesystem::path& file, const std::filesystem::path& data_dir,
-                         SceneConfig& out) {
+                         SceneConfig& out, bool objects_optional) {
   const std::string name = file.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) return Status::error(name + ": config file not found");
@@ -454,8 +454,8 @@ Status load_scene_config(const std::filesystem::path& file, const std::filesyste
     read_camera(r, root, c);
     const std::filesystem::path dir =
         file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-    read_models(r, root, dir, data_dir, c);
-    read_instances(r, root, c);
+    read_models(r, root, dir, data_dir, !objects_optional, c);
+    read_instances(r, root, !objects_optional, c);
   } catch (const ConfigError& e) {
     return Status::error(e.message);
   }

@@ -50,8 +50,10 @@ struct SceneConfig {
 // Refuses unknown paths, wrong types, absurd values (negative counts, zero size windows,
 // budgets of 0, thread counts over 1024, unknown model names) naming the file and key.
 // `data_dir` is where mesh files are looked for after the config's own folder.
+// `objects_optional`: a config without [[model]] or [[instances]] is fine (a service that a
+// program fills itself); `lod run` and the viewer need both.
 Status load_scene_config(const std::filesystem::path& file, const std::filesystem::path& data_dir,
-                         SceneConfig& out);
+                         SceneConfig& out, bool objects_optional = false);
 
 // The data directory the set-up fills (Debian's CGAL meshes), compiled in.
 std::filesystem::path default_data_dir();

@@ -50,7 +50,7 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
   };
   const std::filesystem::path data = data_dir.empty() ? default_data_dir() : data_dir;
   SceneConfig sc;
-  if (auto st = load_scene_config(config, data, sc); !st) return failed(st.message);
+  if (auto st = load_scene_config(config, data, sc, /*objects_optional=*/true); !st) return failed(st.message);
   const std::filesystem::path cache = cache_dir_for(cache_dir, data);
   std::vector<LodChain> chains;
   BakeSummary summary;

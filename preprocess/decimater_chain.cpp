@@ -8,8 +8,9 @@
 // decimate_to_faces, snapshot into a compact level.
 #include "preprocess/decimater_chain.h"
 
+#include "preprocess/openmesh_log_capture.h"
+
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#include <OpenMesh/Core/System/omstream.hh>
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
@@ -68,10 +69,10 @@ void build_trimesh(const MeshData& mesh, TriMesh& m, DecimaterChainStats& stats)
   };
 
   // add_face complains on omerr() for every refused face; that is expected here, so keep
-  // it off the terminal (the count goes into the stats instead).
+  // it off the terminal (the count goes into the stats instead). A capture, not
+  // omerr().disable(), which would also drop other threads' OpenMesh messages.
   std::lock_guard<std::mutex> lock(detail::openmesh_global_mutex());
-  const bool err_enabled = ::omerr().is_enabled();
-  ::omerr().disable();
+  const detail::OpenMeshLogCapture refused_face_chatter;
 
   std::vector<uint32_t> pending;
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
@@ -103,7 +104,6 @@ void build_trimesh(const MeshData& mesh, TriMesh& m, DecimaterChainStats& stats)
     stats.copied_vertices += 3;
     m.add_face(c[0], c[1], c[2]);
   }
-  if (err_enabled) ::omerr().enable();
 }
 
 // Copies the live triangles of `m` into a compact level (vertices in order of first use).

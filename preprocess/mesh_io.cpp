@@ -10,6 +10,7 @@
 #include "preprocess/mesh_io.h"
 
 #include "preprocess/decimater_chain.h"  // detail::openmesh_global_mutex
+#include "preprocess/openmesh_log_capture.h"
 
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/MeshIO.hh>
@@ -25,7 +26,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <iostream>
 #include <mutex>
 #include <optional>
 #include <sstream>
@@ -111,57 +111,6 @@ class FlatImporter final : public OpenMesh::IO::BaseImporter {
   size_t n_edges() const override { return 0; }
 
   unsigned int reserve_cap = 0;
-};
-
-// Everything OpenMesh says during one read goes into a string. omerr()/omlog()/omout()
-// multiplex into std::cerr/std::clog/std::cout (and some readers write to std::cerr
-// directly), so swapping those streams' buffers catches all of it. Connecting our own
-// stream to the multiplexers instead would leak: mostream::disconnect never frees the
-// target that connect allocated. OpenMesh's readers are singletons with per-read state, so
-// reads are serialised anyway; the same lock protects the swap.
-class OpenMeshOutputCapture {
- public:
-  OpenMeshOutputCapture() {
-    flush_openmesh();  // anything pending belongs to someone else
-    old_cerr_ = std::cerr.rdbuf(text_.rdbuf());
-    old_cout_ = std::cout.rdbuf(text_.rdbuf());
-    old_clog_ = std::clog.rdbuf(text_.rdbuf());
-  }
-  ~OpenMeshOutputCapture() {
-    flush_openmesh();
-    std::cerr.rdbuf(old_cerr_);
-    std::cout.rdbuf(old_cout_);
-    std::clog.rdbuf(old_clog_);
-  }
-  OpenMeshOutputCapture(const OpenMeshOutputCapture&) = delete;
-  OpenMeshOutputCapture& operator=(const OpenMeshOutputCapture&) = delete;
-
-  // One line, trimmed, at most ~300 characters.
-  std::string text() {
-    flush_openmesh();
-    std::string s = text_.str();
-    for (char& c : s)
-      if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-    std::string out;
-    for (char c : s)
-      if (!(c == ' ' && (out.empty() || out.back() == ' '))) out += c;
-    while (!out.empty() && out.back() == ' ') out.pop_back();
-    if (out.size() > 300) out = out.substr(0, 297) + "...";
-    return out;
-  }
-
- private:
-  std::ostringstream text_;
-  std::streambuf* old_cerr_ = nullptr;
-  std::streambuf* old_cout_ = nullptr;
-  std::streambuf* old_clog_ = nullptr;
-
-  // The multiplexers hold a partial line until '\n'; push it out.
-  static void flush_openmesh() {
-    ::omerr().flush();
-    ::omlog().flush();
-    ::omout().flush();
-  }
 };
 
 std::string lower(std::string s) {
@@ -698,8 +647,10 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   bool read_ok = false;
   std::string said;
   {
+    // OpenMesh's readers are singletons with per-read state: one read at a time. What they
+    // say on omerr()/omlog() goes into the message, not onto the host's terminal.
     std::lock_guard<std::mutex> lock(openmesh_global_mutex());
-    OpenMeshOutputCapture capture;
+    OpenMeshLogCapture capture;
     OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
     try {
       read_ok = OpenMesh::IO::IOManager().read(path.string(), importer, options);

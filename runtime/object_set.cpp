@@ -1,6 +1,8 @@
 // Column resizing for the object structs of arrays.
 #include "runtime/object_set.h"
 
+#include <cmath>
+
 namespace lod {
 
 void ObjectSet::resize(size_t n) {
@@ -24,6 +26,17 @@ void ObjectState::resize(size_t n) {
   level.resize(n, 0);
   prev_level.resize(n, 0);
   was_visible.resize(n, 0);
+}
+
+Transform transform_of(const ObjectSet& objects, size_t i) {
+  Transform t;
+  t.position[0] = objects.x[i];
+  t.position[1] = objects.y[i];
+  t.position[2] = objects.z[i];
+  t.rotation[1] = std::sin(0.5f * objects.yaw[i]);
+  t.rotation[3] = std::cos(0.5f * objects.yaw[i]);
+  t.scale = objects.scale[i];
+  return t;
 }
 
 }  // namespace lod

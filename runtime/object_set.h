@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "lodkit/types.hpp"
+
 namespace lod {
 
 // Placement of every instance: fixed for a run (a simulator may rewrite it between frames).
@@ -30,5 +32,8 @@ struct ObjectState {
 
   void resize(size_t n);
 };
+
+// Object i's placement as a Transform (its yaw as a quaternion about +y).
+Transform transform_of(const ObjectSet& objects, size_t i);
 
 }  // namespace lod

@@ -13,7 +13,7 @@ echo "== Release build + ctest =="
 ./scripts/configure.sh build
 cmake --build build -j "$JOBS"
 # Each layer's binary must have registered its tests: a build that lost one fails here.
-for label in unit integration stress viewer; do
+for label in unit integration stress viewer package; do
   n=$(ctest --test-dir build -N -L "^$label\$" | sed -n 's/^Total Tests: *//p')
   echo "[ctest] build: label $label lists ${n:-0} tests"
   [ "${n:-0}" -gt 0 ] || { echo "[ctest] build: no $label tests registered" >&2; exit 1; }
@@ -30,7 +30,7 @@ TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
 echo "== AddressSanitizer + UBSan: runtime, preprocess, jobs, integration =="
 ./scripts/configure.sh build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=address \
       -DLOD_BUILD_BENCH=OFF -DLOD_BUILD_VIEWER=OFF
-cmake --build build-asan -j "$JOBS" --target test_runtime test_preprocess test_jobs test_integration
+cmake --build build-asan -j "$JOBS" --target test_runtime test_preprocess test_jobs test_c_api test_integration
 ASAN_OPTIONS="detect_leaks=1" UBSAN_OPTIONS="print_stacktrace=1" \
   ./scripts/ctest-all.sh build-asan -j "$JOBS" --timeout 900 -L 'unit|integration'
 echo "== all tests passed =="

@@ -16,8 +16,8 @@ enum class Stage : uint8_t {
 };
 inline constexpr const char* kStageNames[] = {"commit",    "bounds",    "view",     "visibility", "importance",
                                               "selection", "geomorph",  "vdlod",    "vd_mesh",    "publish"};
-inline constexpr size_t kStageCount = static_cast<size_t>(Stage::count);
-inline constexpr size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
+inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::count);
+inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 
 // One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
 // draws instead of a discrete level. Positions are object space and already geomorphed.
