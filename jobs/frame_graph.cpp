@@ -48,9 +48,10 @@ using Clock = std::chrono::steady_clock;
 using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 
 // ThreadSanitizer cannot see the synchronisation inside libtbb (a library not built with it),
-// so these mark the edges TBB guarantees, each on its own address so that work TBB runs side
-// by side (sibling chunks, independent nodes) gets no false ordering: a spawner releases
-// `spawn` and its tasks acquire it; tasks release `join` and the waiter acquires it.
+// so these mark the edges TBB guarantees: what precedes a spawn happens before the task runs,
+// and what a task does happens before the wait that joins it (and before the tasks TBB runs
+// after it: range splits and successor nodes happen inside TBB). One address for every graph,
+// since a task must acquire before it reads even its own captures. No-ops in other builds.
 #if defined(__SANITIZE_THREAD__)
 #define LOD_TSAN 1
 #elif defined(__has_feature)
@@ -61,15 +62,17 @@ using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 #ifdef LOD_TSAN
 extern "C" void __tsan_acquire(void* addr);
 extern "C" void __tsan_release(void* addr);
-inline void tsan_release(void* a) { __tsan_release(a); }
-inline void tsan_acquire(void* a) { __tsan_acquire(a); }
+char tbb_edge;
+void before_spawn() { __tsan_release(&tbb_edge); }
+void task_begins() { __tsan_acquire(&tbb_edge); }
+void task_ends() { __tsan_release(&tbb_edge); }
+void after_join() { __tsan_acquire(&tbb_edge); }
 #else
-inline void tsan_release(void*) {}
-inline void tsan_acquire(void*) {}
+inline void before_spawn() {}
+inline void task_begins() {}
+inline void task_ends() {}
+inline void after_join() {}
 #endif
-struct TsanEdge {
-  char spawn = 0, join = 0;
-};
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
@@ -213,9 +216,6 @@ struct FrameGraph::Impl {
   std::optional<tbb::flow::graph> graph;
   std::optional<tbb::flow::broadcast_node<tbb::flow::continue_msg>> start;
   std::vector<std::unique_ptr<Node>> nodes;  // kNodeCount, destroyed before the graph
-  std::array<TsanEdge, kNodeCount> tsan_inner{};
-  std::array<char, kNodeCount> tsan_done{};
-  char tsan_start = 0;
 
   Impl(std::shared_ptr<const ModelSet> models, const FrameGraphOptions& o)
       : options(o),
@@ -326,16 +326,19 @@ struct FrameGraph::Impl {
     const auto pred = reduced_predecessors();
     nodes.reserve(kNodeCount);
     for (size_t i = 0; i < kNodeCount; ++i) {
-      const uint32_t before = pred[i];
-      nodes.push_back(std::make_unique<Node>(*graph, [this, i, before](const tbb::flow::continue_msg&) {
-        tsan_acquire(&tsan_start);
-        for (uint32_t p = before; p; p &= p - 1) tsan_acquire(&tsan_done[std::countr_zero(p)]);
+        nodes.push_back(std::make_unique<Node>(*graph, [this, i](const tbb::flow::continue_msg&) {
+        task_begins();
         const NodeSpec& spec = kNodes[i];
         const auto t0 = Clock::now();
-        if (options.stage_hook) options.stage_hook(spec.stage);
-        (this->*spec.run)();
+        try {
+          if (options.stage_hook) options.stage_hook(spec.stage);
+          (this->*spec.run)();
+        } catch (...) {
+          task_ends();
+          throw;
+        }
         stage_ms[static_cast<size_t>(spec.stage)] = ms_between(t0, Clock::now());
-        tsan_release(&tsan_done[i]);
+        task_ends();
       }));
     }
     for (size_t j = 0; j < kNodeCount; ++j) {
@@ -346,31 +349,29 @@ struct FrameGraph::Impl {
 
   // Runs body(chunk, begin, end) for every chunk; one task per chunk.
   template <class Body>
-  void for_chunks(Stage stage, const Body& body) {
-    TsanEdge& edge = tsan_inner[static_cast<size_t>(stage)];
-    tsan_release(&edge.spawn);
+  void for_chunks(Stage, const Body& body) {
+    before_spawn();
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, chunks, 1),
         [&](const tbb::blocked_range<size_t>& r) {
-          tsan_acquire(&edge.spawn);
+          task_begins();
           for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
-          tsan_release(&edge.join);
+          task_ends();
         },
         tbb::simple_partitioner());
-    tsan_acquire(&edge.join);
+    after_join();
   }
 
   template <class Body>
-  void for_items(Stage stage, size_t n, const Body& body) {
+  void for_items(Stage, size_t n, const Body& body) {
     if (n == 0) return;
-    TsanEdge& edge = tsan_inner[static_cast<size_t>(stage)];
-    tsan_release(&edge.spawn);
+    before_spawn();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& r) {
-      tsan_acquire(&edge.spawn);
+      task_begins();
       for (size_t j = r.begin(); j != r.end(); ++j) body(j);
-      tsan_release(&edge.join);
+      task_ends();
     });
-    tsan_acquire(&edge.join);
+    after_join();
   }
 
   // ---- nodes ------------------------------------------------------------------------------
@@ -759,21 +760,23 @@ struct FrameGraph::Impl {
     stage_ms.fill(0);
     f.index = ++frame_index;
     f.time_s = time;
-    tsan_release(&tsan_start);
+    before_spawn();
     try {
       arena.execute([&] {  // may run on a worker when the arena has no free slot
+        task_begins();
         start->try_put(tbb::flow::continue_msg());
         graph->wait_for_all();
+        task_ends();
       });
     } catch (...) {
-      for (char& d : tsan_done) tsan_acquire(&d);
+      after_join();
       graph->reset();
       reset_temporal_state();
       out = nullptr;
       f.tick = tick;
       throw;
     }
-    for (char& d : tsan_done) tsan_acquire(&d);
+    after_join();
     out = nullptr;
     input = nullptr;
     f.tick = tick;
