@@ -109,9 +109,10 @@ enum Column : uint32_t {
   kVdMesh = 1u << 9,      // the frame's view-dependent meshes
   kTotals = 1u << 10,     // the frame's totals
   kHistory = 1u << 11,    // the store's last-frame levels and visibility
+  kPlacing = 1u << 12,    // the frame's handles, transforms and view masks per entry
 };
-constexpr const char* kColumnNames[] = {"objects", "bounds",  "controls", "views",  "visibility", "entries",
-                                        "levels",  "blend",   "fronts",   "vd_mesh", "totals",    "history"};
+constexpr const char* kColumnNames[] = {"objects", "bounds", "controls", "views",  "visibility", "entries", "levels",
+                                        "blend",   "fronts", "vd_mesh",  "totals", "history",    "placing"};
 
 }  // namespace
 
@@ -144,6 +145,8 @@ struct FrameGraph::Impl {
     uint32_t shared = 0;                   // nodes active in every region (seams)
   };
   std::vector<VdModel> vd_models;  // per model with a hierarchy (else default)
+  std::vector<uint8_t> has_vd;      // per model: has a hierarchy
+  bool any_vd = false;
 
   // The fixed scene's objects (FrameGraph(scene)).
   ObjectStore own_store;
@@ -243,10 +246,15 @@ struct FrameGraph::Impl {
     }
     model_blends.resize(m.model_count());
     vd_models.assign(m.model_count(), VdModel{});
+    has_vd.assign(m.model_count(), 0);
+    any_vd = false;
     for (size_t i = 0; i < m.model_count(); ++i) {
       const LodChain& chain = *set->chains[i];
       model_blends[i] = chain.hierarchy.empty() && can_morph_levels(chain);
-      if (!chain.hierarchy.empty()) vd_models[i] = vd_model_of(chain);
+      if (chain.hierarchy.empty()) continue;
+      vd_models[i] = vd_model_of(chain);
+      has_vd[i] = 1;
+      any_vd = true;
     }
     models_changed = true;
     resize_chunks();
@@ -443,11 +451,9 @@ struct FrameGraph::Impl {
       for (size_t c = 0; c < chunks; ++c) minima[v] = merge_minima(minima[v], chunk_minima[c * kMaxViews + v]);
     }
     Frame& f = *out;
-    for (auto* col : {&f.levels, &f.view_masks}) col->resize(visible_total);
+    f.levels.resize(visible_total);
     f.objects.resize(visible_total);
     f.models.resize(visible_total);
-    f.handles.resize(visible_total);
-    f.transforms.resize(visible_total);
     if (visible_total == 0) return;
     for_chunks(Stage::importance, [&](size_t c, size_t b, size_t e) {
       choose_chunk_levels(b, e);
@@ -497,14 +503,7 @@ struct FrameGraph::Impl {
       slot += p0.visible[i];
     }
     assert(slot == end_slot);
-    // The entries' own columns: gathered, since only visible objects are written.
-    for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) {
-      const uint32_t i = ids[k];
-      f.handles[k] = s.handle[i];
-      f.models[k] = s.model[i];
-      f.transforms[k] = s.transform[i];
-      f.view_masks[k] = mask[i];
-    }
+    for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) f.models[k] = s.model[ids[k]];
     const size_t b0 = chunk_offset[c], n0 = chunk_visible[c];
     const std::span<uint32_t> counts(selection_counts.data() + c * level_total, level_total);
     std::fill(counts.begin(), counts.end(), 0u);
@@ -538,6 +537,25 @@ struct FrameGraph::Impl {
         std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
         std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_row.data(), v),
         caps.rows, so, selection_total, std::span<HeapEntry>(heap.data(), v));
+  }
+
+  // Each entry's handle, transform and view mask, gathered from its object; beside selection,
+  // which is serial, so it takes the other cores.
+  void node_entries() {
+    Frame& f = *out;
+    const ObjectStore& s = *store;
+    f.handles.resize(visible_total);
+    f.transforms.resize(visible_total);
+    f.view_masks.resize(visible_total);
+    for_chunks(Stage::entries, [&](size_t c, size_t, size_t) {
+      const uint32_t b = chunk_offset[c], e = b + chunk_visible[c];
+      for (uint32_t k = b; k < e; ++k) {
+        const uint32_t i = f.objects[k];
+        f.handles[k] = s.handle[i];
+        f.transforms[k] = s.transform[i];
+        f.view_masks[k] = mask[i];
+      }
+    });
   }
 
   // Level changes blend (runtime/level_blend.h), in parallel over each chunk's entries.
@@ -596,8 +614,9 @@ struct FrameGraph::Impl {
     const Frame& f = *out;
     vd_visible.clear();
     vd_tasks.clear();
+    if (!any_vd) return;
     for (uint32_t k = 0; k < visible_total; ++k) {
-      if (set->chains[f.models[k]]->hierarchy.empty()) continue;
+      if (!has_vd[f.models[k]]) continue;
       VdObject& o = vd_state(f.handles[k], f.models[k]);
       o.entry = k;
       vd_visible.push_back(&o);
@@ -801,9 +820,11 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      kObjects | kBounds | kControls | kViews | kVisibility | kHistory, kEntries | kLevels, &Impl::node_importance},
     {Stage::selection, "lower_under_budget: heap over the visible set, serial", kEntries | kLevels, kLevels,
      &Impl::node_selection},
+    {Stage::entries, "handles, transforms, view masks of the entries, parallel", kEntries | kObjects | kVisibility,
+     kPlacing, &Impl::node_entries},
     {Stage::geomorph, "advance_level_blends, parallel", kEntries | kLevels | kHistory, kBlend, &Impl::node_geomorph},
-    {Stage::vdlod, "front_update per visible view-dependent object (view 0), parallel", kEntries | kLevels | kViews,
-     kFronts, &Impl::node_vdlod},
+    {Stage::vdlod, "front_update per visible view-dependent object (view 0), parallel",
+     kEntries | kPlacing | kLevels | kViews, kFronts, &Impl::node_vdlod},
     {Stage::vd_mesh, "vertex_morph_positions + compact meshes of vd objects, parallel", kEntries | kFronts, kVdMesh,
      &Impl::node_vd_mesh},
     {Stage::publish, "totals, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend,

@@ -44,10 +44,12 @@ void apply_object_controls(std::span<uint8_t> level, std::span<float> weight, st
                            std::span<const uint8_t> min_level, std::span<const float> inv_priority) {
   const size_t n = visible.size();
   assert(level.size() == n && weight.size() == n && min_level.size() == n && inv_priority.size() == n);
+  // Branch-free so that it vectorizes: an invisible object's level and weight are not read.
+  uint8_t* __restrict l = level.data();
+  float* __restrict w = weight.data();
   for (size_t i = 0; i < n; ++i) {
-    if (!visible[i]) continue;
-    level[i] = std::max(level[i], min_level[i]);
-    weight[i] *= inv_priority[i];
+    l[i] = std::max(l[i], min_level[i]);
+    w[i] *= inv_priority[i];
   }
 }
 

@@ -31,8 +31,8 @@ void object_controls(std::span<uint32_t> row, std::span<uint8_t> min_level, std:
                      std::span<const ObjectOptions> options, std::span<const Transform> transform,
                      std::span<const uint32_t> model, const LevelCaps& caps);
 
-// level[i] = max(level[i], min_level[i]) for visible objects, then weight[i] *= inv_priority[i].
-// Sub-range safe.
+// level[i] = max(level[i], min_level[i]) and weight[i] *= inv_priority[i], for every object
+// (an invisible one's values are not read), so that the loop vectorizes. Sub-range safe.
 void apply_object_controls(std::span<uint8_t> level, std::span<float> weight, std::span<const uint8_t> visible,
                            std::span<const uint8_t> min_level, std::span<const float> inv_priority);
 

@@ -12,6 +12,18 @@ size_t combine_view_masks(std::span<uint8_t> mask, std::span<const std::span<uin
   assert(never_cull.size() == n && !visible.empty() && visible.size() <= 8);
   const uint8_t all = static_cast<uint8_t>((1u << visible.size()) - 1u);
   size_t count = 0;
+  if (visible.size() == 1) {  // the usual case, branch-free so that it vectorizes
+    uint8_t* __restrict v = visible[0].data();
+    uint8_t* __restrict m = mask.data();
+    const uint8_t* __restrict nc = never_cull.data();
+    for (size_t i = 0; i < n; ++i) {
+      const uint8_t seen = static_cast<uint8_t>((v[i] != 0) | (nc[i] != 0));
+      v[i] = seen;
+      m[i] = seen;
+      count += seen;
+    }
+    return count;
+  }
   for (size_t i = 0; i < n; ++i) {
     uint8_t m = 0;
     for (size_t v = 0; v < visible.size(); ++v) m |= static_cast<uint8_t>((visible[v][i] != 0) << v);

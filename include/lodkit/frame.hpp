@@ -12,10 +12,10 @@ namespace lod {
 
 // The frame graph's nodes (FrameGraph::dot() shows their edges); Frame::stage_ms per node.
 enum class Stage : uint8_t {
-  commit, bounds, view, visibility, importance, selection, geomorph, vdlod, vd_mesh, publish, count
+  commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, publish, count
 };
-inline constexpr const char* kStageNames[] = {"commit",    "bounds",    "view",     "visibility", "importance",
-                                              "selection", "geomorph",  "vdlod",    "vd_mesh",    "publish"};
+inline constexpr const char* kStageNames[] = {"commit",    "bounds",  "view",     "visibility", "importance", "selection",
+                                              "entries",   "geomorph", "vdlod",   "vd_mesh",    "publish"};
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::count);
 inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 

@@ -222,6 +222,7 @@ constexpr std::pair<Stage, Stage> kDataEdges[] = {
     {Stage::commit, Stage::bounds},       {Stage::bounds, Stage::visibility},  {Stage::view, Stage::visibility},
     {Stage::visibility, Stage::importance}, {Stage::importance, Stage::selection}, {Stage::selection, Stage::geomorph},
     {Stage::selection, Stage::vdlod},     {Stage::vdlod, Stage::vd_mesh},      {Stage::geomorph, Stage::publish},
+    {Stage::importance, Stage::entries},  {Stage::entries, Stage::vdlod},
 };
 
 TEST(FrameGraph, StageHookSeesEveryStageOnceAfterItsInputs) {
@@ -356,6 +357,7 @@ TEST(FrameGraph, DotIsTheNodeTable) {
   }
   // Independent nodes get no edge, and implied edges are left out.
   EXPECT_EQ(dot.find("geomorph -> vdlod;"), std::string::npos);
+  EXPECT_EQ(dot.find("selection -> entries;"), std::string::npos) << "entries runs beside selection";
   EXPECT_EQ(dot.find("commit -> visibility;"), std::string::npos);
   EXPECT_NE(dot.find("reads: "), std::string::npos);
   EXPECT_EQ(dot.back(), '\n');
