@@ -82,42 +82,61 @@ void BM_StageTransforms(benchmark::State& state) {
 BENCHMARK(BM_StageTransforms)->ArgName("batched")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The service free-runs at 60 Hz on its own thread; the simulation stages 10 % of the objects
-// and commits every 2 ms, timing commit() itself and the wait until a frame carries the tick.
+// and commits every 2 ms, timing commit() itself. A consumer thread polls frames every 0.1 ms
+// (not spinning: this machine has two cores for it, the simulation and the LOD thread) and
+// notes when each tick first appears, so commit -> visible is measured to within 0.1 ms.
 void BM_CommitWhileRunning(benchmark::State& state) {
   Sim sim = make_sim(100000, 60);
   Service& s = *sim.service;
   const size_t moving = sim.handles.size() / 10;
-  std::vector<double> commit_us, visible_periods;
+  std::vector<double> commit_us;
+  std::vector<Clock::time_point> committed_at, first_seen;
+  committed_at.reserve(4096);
+  first_seen.assign(4096, Clock::time_point{});
+  std::atomic<bool> stop{false};
+  std::thread consumer([&] {
+    uint64_t seen = 0;
+    while (!stop.load(std::memory_order_relaxed)) {
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+      const FrameRef f = s.acquire_frame();
+      if (!f || f->tick <= seen) continue;
+      const auto now = Clock::now();
+      for (uint64_t t = seen + 1; t <= f->tick && t < first_seen.size(); ++t) first_seen[t] = now;
+      seen = f->tick;
+    }
+  });
   uint64_t tick = 1;
   s.start();
-  std::vector<std::pair<uint64_t, Clock::time_point>> pending;
   for (auto _ : state) {
     for (size_t k = 0; k < moving; ++k) {
       const size_t i = (tick * moving + k) % sim.handles.size();
       s.set_transform(sim.handles[i], nudged(sim.start[i], tick));
     }
+    if (committed_at.size() <= tick) committed_at.resize(tick + 1);
     const auto t0 = Clock::now();
     s.commit(tick);
     const auto t1 = Clock::now();
+    committed_at[tick] = t1;
     commit_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
-    pending.emplace_back(tick, t1);
     ++tick;
-    // Which commits have reached a published frame by now.
-    const FrameRef f = s.acquire_frame();
-    const uint64_t seen = f ? f->tick : 0;
-    while (!pending.empty() && pending.front().first <= seen) {
-      visible_periods.push_back(std::chrono::duration<double>(Clock::now() - pending.front().second).count() * 60.0);
-      pending.erase(pending.begin());
-    }
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the last commits reach a frame
+  stop.store(true);
+  consumer.join();
   s.stop();
+  std::vector<double> visible_periods;
+  for (uint64_t t = 1; t < tick && t < first_seen.size(); ++t)
+    if (first_seen[t] != Clock::time_point{})
+      visible_periods.push_back(std::chrono::duration<double>(first_seen[t] - committed_at[t]).count() * 60.0);
+  const ServiceStats st = s.stats();
   state.counters["commit_p50_us"] = percentile(commit_us, 0.5);
   state.counters["commit_p99_us"] = percentile(commit_us, 0.99);
   state.counters["commit_max_us"] = percentile(commit_us, 1.0);
-  // An upper bound: polled every ~2 ms after the commit, so it includes up to one poll.
   state.counters["visible_p50_periods"] = percentile(visible_periods, 0.5);
   state.counters["visible_p99_periods"] = percentile(visible_periods, 0.99);
+  state.counters["visible_max_periods"] = percentile(visible_periods, 1.0);
+  state.counters["frame_mean_periods"] = st.mean_ms * 60.0 / 1000.0;
 }
 BENCHMARK(BM_CommitWhileRunning)->Iterations(600)->Unit(benchmark::kMillisecond)->UseRealTime();
 
