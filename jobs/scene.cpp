@@ -1,6 +1,8 @@
 // Scene: placing every [[instances]] block and building the model table.
 #include "jobs/scene.h"
 
+#include "runtime/world_bounds.h"
+
 #include <cassert>
 #include <cmath>
 #include <numbers>
@@ -15,21 +17,6 @@ double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x
 
 float lerp(float a, float b, double t) { return static_cast<float>(a + (static_cast<double>(b) - a) * t); }
 
-// Level 0's sphere centre, with a radius that also holds every coarser level: simplified
-// levels may bulge slightly past the original surface, and culling must not cut them.
-Sphere model_sphere(const LodChain& chain) {
-  Sphere s;
-  if (chain.levels.empty()) return s;
-  s = chain.levels[0].bounds;
-  for (const LodLevel& l : chain.levels) {
-    const float dx = l.bounds.center[0] - s.center[0];
-    const float dy = l.bounds.center[1] - s.center[1];
-    const float dz = l.bounds.center[2] - s.center[2];
-    s.radius = std::max(s.radius, std::sqrt(dx * dx + dy * dy + dz * dz) + l.bounds.radius);
-  }
-  return s;
-}
-
 }  // namespace
 
 ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>& chains) {
@@ -41,7 +28,7 @@ ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>
   size_t o = 0;
   for (const InstanceConfig& inst : config.instances) {
     assert(inst.model < chains.size());
-    const Sphere sphere = model_sphere(chains[inst.model]);
+    const Sphere sphere = chain_sphere(chains[inst.model]);
     std::mt19937_64 rng(inst.seed);
     // Grid: ceil(sqrt(n)) columns along x, as many rows along z as needed, one object per
     // cell centre; y at the middle of the box.

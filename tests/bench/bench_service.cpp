@@ -140,6 +140,51 @@ void BM_CommitWhileRunning(benchmark::State& state) {
 }
 BENCHMARK(BM_CommitWhileRunning)->Iterations(600)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// create then destroy, staged (commits every 1,000 pairs, outside the timing).
+void BM_CreateDestroy(benchmark::State& state) {
+  Sim sim = make_sim(1000, 60);
+  Service& s = *sim.service;
+  Transform t;
+  uint64_t tick = 1, n = 0;
+  for (auto _ : state) {
+    const ObjectHandle h = s.create(0, t);
+    benchmark::DoNotOptimize(s.destroy(h));
+    if (++n % 1000 == 0) {
+      state.PauseTiming();
+      s.commit(tick++);
+      s.step(1.0 / 60);
+      state.ResumeTiming();
+    }
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_CreateDestroy);
+
+// acquire_frame + release while the LOD thread free-runs (10,000 objects).
+void BM_AcquireRelease(benchmark::State& state) {
+  Sim sim = make_sim(10000, 60);
+  Service& s = *sim.service;
+  s.start();
+  for (auto _ : state) {
+    const FrameRef f = s.acquire_frame();
+    benchmark::DoNotOptimize(f.get());
+  }
+  s.stop();
+}
+BENCHMARK(BM_AcquireRelease);
+
+// One driven frame through the public API (set_view + step), 10k and 100k objects, 2 threads.
+void BM_Step(benchmark::State& state) {
+  Sim sim = make_sim(uint32_t(state.range(0)), 60);
+  Service& s = *sim.service;
+  uint32_t n = 1;
+  for (auto _ : state) {
+    set_view(s, 0, view_at(sim.path, n++));
+    benchmark::DoNotOptimize(s.step(1.0 / 60));
+  }
+}
+BENCHMARK(BM_Step)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 }  // namespace
 
 BENCHMARK_MAIN();
