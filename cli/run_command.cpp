@@ -144,11 +144,7 @@ int run_command(const RunArgs& args) {
                bake.cached, cache_dir.c_str(), bake.ms);
 
   Scene scene = make_scene(config, std::move(chains));
-  FrameGraphOptions options;
-  options.threads = config.threads;
-  options.selection = config.selection;
-  options.pixel_error = config.pixel_error;
-  options.hysteresis = config.hysteresis;
+  const FrameGraphOptions options = frame_graph_options(config);
   std::vector<ObjectHandle> handles;
   std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);
   Service& service = *owned;

@@ -17,6 +17,9 @@ namespace lod {
 std::unique_ptr<Service> make_service(const Scene& scene, const FrameGraphOptions& graph, double rate_hz,
                                       std::vector<ObjectHandle>* handles = nullptr);
 
+// The frame graph options a scene config asks for (threads, budget, pixel error, hysteresis).
+FrameGraphOptions frame_graph_options(const SceneConfig& config);
+
 // Adds a baked chain as the next model (the chain must pass validate_chain).
 ModelId add_chain(Service& service, LodChain chain);
 

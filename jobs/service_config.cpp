@@ -22,6 +22,15 @@ std::filesystem::path cache_dir_for(const std::filesystem::path& asked, const st
 
 }  // namespace
 
+FrameGraphOptions frame_graph_options(const SceneConfig& config) {
+  FrameGraphOptions g;
+  g.threads = config.threads;
+  g.selection = config.selection;
+  g.pixel_error = config.pixel_error;
+  g.hysteresis = config.hysteresis;
+  return g;
+}
+
 ModelBaker mesh_baker() {
   return [](const std::filesystem::path& mesh, const std::filesystem::path& cache_dir, std::vector<uint8_t>& asset,
             std::string& error) {
@@ -57,12 +66,7 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
   if (auto st = bake_scene_models(sc.models, cache, sc.threads, chains, summary, nullptr); !st)
     return failed(st.message);
   Scene scene = make_scene(sc, std::move(chains));
-  FrameGraphOptions g;
-  g.threads = sc.threads;
-  g.selection = sc.selection;
-  g.pixel_error = sc.pixel_error;
-  g.hysteresis = sc.hysteresis;
-  std::unique_ptr<Service> s = make_service(scene, g, sc.rate_hz);
+  std::unique_ptr<Service> s = make_service(scene, frame_graph_options(sc), sc.rate_hz);
   Impl& m = s->impl();
   m.options.cache_dir = cache;
   m.options.baker = mesh_baker();

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "jobs/service.h"
 #include "viewer/frame_renderer.h"
 #include "viewer/gl_context.h"
 #include "viewer/scene_loader.h"
@@ -58,11 +59,8 @@ int run(const lod::viewer::ViewerOptions& o) {
   }
 
   ViewerSession session{o, loaded, window, renderer, {}, 0, {}, {}, {}};
-  session.graph.threads = loaded.config.threads;
-  session.graph.selection = loaded.config.selection;
+  session.graph = frame_graph_options(loaded.config);
   if (o.budget > 0) session.graph.selection.budget = uint64_t(o.budget);
-  session.graph.pixel_error = loaded.config.pixel_error;
-  session.graph.hysteresis = loaded.config.hysteresis;
   if (o.lod_delay_ms > 0) {
     // Through the graph's stage hook, so the delay sits inside the LOD frame, on its thread.
     const auto delay = std::chrono::duration<double, std::milli>(o.lod_delay_ms);
