@@ -401,7 +401,9 @@ int main(int argc, char** argv) {
   options.rate_hz = args.rate_hz;
   options.budget = args.budget;
   options.cache_dir = args.cache;
-  options.baker = lod::mesh_baker();  // models here are meshes: bake them (cached)
+  // Models here are meshes: bake them (cached), with chains deep enough that 20,000 vehicles
+  // and a town fit M at their coarsest levels (lodkit's defaults stop near 6 %).
+  options.baker = lod::mesh_baker({1.0f, 0.5f, 0.25f, 0.12f, 0.06f, 0.03f, 0.015f, 0.0075f, 0.004f});
   lod::Service service(options);
 
   // Models: buildings and vehicles, baked on first use.

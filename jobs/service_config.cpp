@@ -31,12 +31,19 @@ FrameGraphOptions frame_graph_options(const SceneConfig& config) {
   return g;
 }
 
-ModelBaker mesh_baker() {
-  return [](const std::filesystem::path& mesh, const std::filesystem::path& cache_dir, std::vector<uint8_t>& asset,
-            std::string& error) {
+ModelBaker mesh_baker(std::vector<float> ratios) {
+  return [ratios](const std::filesystem::path& mesh, const std::filesystem::path& cache_dir,
+                  std::vector<uint8_t>& asset, std::string& error) {
+    for (size_t i = 0; i < ratios.size(); ++i) {
+      if (!(ratios[i] > 0 && ratios[i] <= 1) || (i == 0 && ratios[i] != 1) || (i > 0 && !(ratios[i] < ratios[i - 1]))) {
+        error = mesh.string() + ": baker ratios must start at 1 and decrease within (0, 1]";
+        return false;
+      }
+    }
     ModelConfig model;
     model.name = mesh.stem().string();
     model.file = mesh;
+    model.bake.ratios = ratios;
     const std::filesystem::path cache =
         cache_dir.empty() ? std::filesystem::temp_directory_path() / "lodkit-cache" : cache_dir;
     std::vector<LodChain> chains;

@@ -63,7 +63,10 @@ enum class BudgetUnit : uint8_t {
 // loads .lod assets only.
 using ModelBaker = std::function<bool(const std::filesystem::path& mesh, const std::filesystem::path& cache_dir,
                                       std::vector<uint8_t>& asset, std::string& error)>;
-ModelBaker mesh_baker();
+// `ratios`: the levels' triangle counts as fractions of the mesh's, 1.0 first and decreasing
+// (empty: lodkit's defaults by size, which stop near 6 %; scenes of tens of thousands of
+// objects want deeper chains, e.g. down to 0.5 %).
+ModelBaker mesh_baker(std::vector<float> ratios = {});
 
 struct ServiceOptions {
   uint32_t threads = 0;              // task arena size; 0 = all cores
