@@ -1,15 +1,18 @@
-// Mesh loading through OpenMesh's readers into flat arrays.
+// Mesh loading: the file is read once into memory (a regular file only, opened so that a FIFO
+// or device never blocks), then parsed by the reader for its extension. PLY, OFF and STL have
+// single-pass readers of our own (ply_reader.cpp, off_reader.cpp, stl_reader.cpp): OpenMesh's
+// PLY header parser loops forever on some unknown words and its PLY/OFF readers reserve
+// whatever a header declares. OBJ still goes through OpenMesh's reader, fed from the bytes
+// in memory after a pre-check that refuses everything it mishandles (unparsable 'v' lines it
+// would drop, corners it asserts on, indices out of range) with the file's own numbers.
 //
-// OpenMesh's readers feed a BaseImporter. Reading straight into a TriMesh would lose faces:
+// OpenMesh's reader feeds a BaseImporter. Reading straight into a TriMesh would lose faces:
 // its add_face refuses non-manifold faces (dragon/buddha scans have thousands) with only a
-// line on omerr(). So FlatImporter records raw vertices and polygons, and everything is
-// validated here afterwards. OpenMesh's readers also stop quietly at the end of a truncated
-// file and trust header counts, so a cheap pre-check of each format's header runs first:
-// it refuses files whose declared counts cannot fit in the file (no multi-gigabyte reserve,
-// no endless loop) and gives the declared counts to compare with what was read.
+// line on omerr(). So FlatImporter records raw vertices and polygons.
 #include "preprocess/mesh_io.h"
 
 #include "preprocess/decimater_chain.h"  // detail::openmesh_global_mutex
+#include "preprocess/mesh_readers.h"
 #include "preprocess/openmesh_log_capture.h"
 
 #include <OpenMesh/Core/IO/IOManager.hh>
@@ -17,22 +20,132 @@
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <mutex>
-#include <optional>
+#include <new>
 #include <sstream>
 #include <string_view>
 
 namespace lod {
 namespace detail {
+
+// ---- shared helpers (mesh_readers.h) -----------------------------------------------------
+
+std::string quote_token(std::string_view tok) {
+  std::string s(tok.substr(0, 32));
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7F) c = '?';
+  return s;
+}
+
+namespace {
+bool is_space(uint8_t c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
+}  // namespace
+
+bool TextTokens::next(std::string_view& tok) {
+  for (;;) {
+    while (i_ < n_ && is_space(d_[i_])) {
+      if (d_[i_] == '\n') ++line_;
+      ++i_;
+    }
+    if (comments_ && i_ < n_ && d_[i_] == '#') {
+      while (i_ < n_ && d_[i_] != '\n') ++i_;
+      continue;
+    }
+    break;
+  }
+  if (i_ >= n_) return false;
+  const size_t start = i_;
+  while (i_ < n_ && !is_space(d_[i_]) && !(comments_ && d_[i_] == '#')) ++i_;
+  tok = std::string_view(reinterpret_cast<const char*>(d_) + start, i_ - start);
+  return true;
+}
+
+void TextTokens::skip_line() {
+  while (i_ < n_ && d_[i_] != '\n') ++i_;
+  if (i_ < n_) {
+    ++i_;
+    ++line_;
+  }
+}
+
+bool TextTokens::more_on_line() const {
+  size_t i = i_;
+  while (i < n_ && d_[i] != '\n' && is_space(d_[i])) ++i;
+  return i < n_ && d_[i] != '\n' && !(comments_ && d_[i] == '#');
+}
+
+bool parse_uint(std::string_view tok, uint64_t& out) {
+  if (tok.empty() || tok[0] < '0' || tok[0] > '9') return false;
+  const auto r = std::from_chars(tok.data(), tok.data() + tok.size(), out);
+  return r.ec == std::errc() && r.ptr == tok.data() + tok.size();
+}
+
+bool parse_int(std::string_view tok, int64_t& out) {
+  if (tok.empty()) return false;
+  const auto r = std::from_chars(tok.data(), tok.data() + tok.size(), out);
+  return r.ec == std::errc() && r.ptr == tok.data() + tok.size();
+}
+
+bool parse_real(std::string_view tok, double& out) {
+  if (tok.empty() || tok.size() > 64) return false;
+  char buf[65];
+  std::memcpy(buf, tok.data(), tok.size());
+  buf[tok.size()] = 0;
+  char* end = nullptr;
+  out = std::strtod(buf, &end);
+  return end == buf + tok.size();
+}
+
+Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out, bool obj_numbering) {
+  const size_t nv = raw.vertex_count();
+  const size_t nf = raw.polygon_count();
+  if (nf == 0) return Status::error(what + ": has no faces (points only: " + std::to_string(nv) + " vertices)");
+  size_t triangles = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t begin = raw.offsets[f], end = raw.offsets[f + 1];
+    for (uint32_t i = begin; i < end; ++i) {
+      const int64_t idx = raw.corners[i];
+      if (idx < 0 || uint64_t(idx) >= nv) {
+        const std::string number = obj_numbering ? (idx < 0 ? std::string("-1 (invalid)") : std::to_string(idx + 1))
+                                                 : std::to_string(idx);
+        return Status::error(what + ": face " + std::to_string(f) + " references vertex " + number + " of " +
+                             std::to_string(nv) + (obj_numbering && idx >= 0 ? " (OBJ numbering, from 1)" : ""));
+      }
+    }
+    if (end - begin >= 3) triangles += end - begin - 2;
+  }
+  if (triangles == 0)
+    return Status::error(what + ": has no triangles (" + std::to_string(nf) + " faces with fewer than 3 corners)");
+  MeshData mesh;
+  mesh.source = what;
+  mesh.indices.reserve(3 * triangles);
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t begin = raw.offsets[f], end = raw.offsets[f + 1];
+    // Fan triangulation; a polygon with fewer than 3 corners contributes nothing.
+    for (uint32_t i = begin + 1; i + 1 < end; ++i)
+      mesh.indices.insert(mesh.indices.end(), {uint32_t(raw.corners[begin]), uint32_t(raw.corners[i]),
+                                               uint32_t(raw.corners[i + 1])});
+  }
+  mesh.positions = std::move(raw.positions);
+  out = std::move(mesh);
+  return Status::success();
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -118,447 +231,71 @@ std::string lower(std::string s) {
   return s;
 }
 
-std::string describe_number(float v) {
-  if (std::isnan(v)) return "nan";
-  return v > 0 ? "inf" : "-inf";
-}
-
-// What a header pre-check learned. Counts are what the header declares.
-struct Declared {
-  std::optional<uint64_t> vertices;
-  std::optional<uint64_t> faces;
-};
-
-// Reads the text tokens of an ASCII file, skipping '#' comments.
-class TextTokens {
- public:
-  explicit TextTokens(const std::vector<uint8_t>& bytes, size_t start = 0, size_t line = 1)
-      : b_(bytes), i_(start), line_(line) {}
-  bool next(std::string_view& tok) {
-    for (;;) {
-      while (i_ < b_.size() && std::isspace(b_[i_])) {
-        if (b_[i_] == '\n') ++line_;
-        ++i_;
-      }
-      if (i_ < b_.size() && b_[i_] == '#') {
-        while (i_ < b_.size() && b_[i_] != '\n') ++i_;
-        continue;
-      }
-      break;
-    }
-    if (i_ >= b_.size()) return false;
-    const size_t start = i_;
-    while (i_ < b_.size() && !std::isspace(b_[i_]) && b_[i_] != '#') ++i_;
-    tok = std::string_view(reinterpret_cast<const char*>(b_.data()) + start, i_ - start);
-    return true;
-  }
-  // Moves past the end of the current line (extra per-element values such as colours).
-  void skip_line() {
-    while (i_ < b_.size() && b_[i_] != '\n') ++i_;
-  }
-  size_t line() const { return line_; }
-  size_t offset() const { return i_; }
-
- private:
-  const std::vector<uint8_t>& b_;
-  size_t i_;
-  size_t line_;
-};
-
-bool parse_count(std::string_view tok, uint64_t& out) {
-  if (tok.empty() || tok.size() > 19) return false;
-  uint64_t v = 0;
-  for (char c : tok) {
-    if (c < '0' || c > '9') return false;
-    v = v * 10 + uint64_t(c - '0');
-  }
-  out = v;
-  return true;
-}
-
-// A coordinate token as strtod sees it (accepts nan/inf, which iostreams refuse silently).
-// The whole token must be the number: iostreams would stop inside "2-1" and read the rest
-// as the next value, shifting everything after it.
-bool parse_coordinate(std::string_view tok, float& out) {
-  std::string s(tok);
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != 0) return false;
-  out = static_cast<float>(v);
-  return true;
-}
-
-// An integer token, optionally negative, nothing else.
-bool is_integer_token(std::string_view tok) {
-  if (!tok.empty() && tok[0] == '-') tok.remove_prefix(1);
-  if (tok.empty() || tok.size() > 20) return false;
-  for (char c : tok)
-    if (c < '0' || c > '9') return false;
-  return true;
-}
-
-Status check_coordinates(const std::string& what, uint64_t vertex, size_t line, const float* xyz, int n) {
-  for (int k = 0; k < n; ++k)
-    if (!std::isfinite(xyz[k]))
-      return Status::error(what + ": vertex " + std::to_string(vertex) + " (line " + std::to_string(line) +
-                           ") has a non-finite coordinate (" + describe_number(xyz[k]) + ")");
-  return Status::success();
-}
-
-// ---- PLY -------------------------------------------------------------------------------
-
-struct PlyProperty {
-  std::string name;
-  int size = 0;          // scalar size in bytes, 0 if unknown type
-  bool is_list = false;
-  int count_size = 0;    // list count type size
-  bool count_signed = false;
-  bool is_float = false; // value type
-};
-struct PlyElement {
-  std::string name;
-  uint64_t count = 0;
-  std::vector<PlyProperty> properties;
-};
-
-int ply_type_size(const std::string& t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
-  return 0;
-}
-
-bool is_float_type(const std::string& t) {
-  return t == "float" || t == "float32" || t == "double" || t == "float64";
-}
-
-uint64_t read_uint_le(const uint8_t* p, int size, bool big_endian) {
-  uint64_t v = 0;
-  for (int i = 0; i < size; ++i) {
-    const int shift = big_endian ? 8 * (size - 1 - i) : 8 * i;
-    v |= uint64_t(p[i]) << shift;
-  }
-  return v;
-}
-
-Status precheck_ply(const std::string& what, const std::vector<uint8_t>& bytes, Declared& declared) {
-  // Header: text lines up to "end_header".
-  size_t pos = 0;
-  auto next_line = [&](std::string& line) {
-    if (pos >= bytes.size()) return false;
-    size_t end = pos;
-    while (end < bytes.size() && bytes[end] != '\n') ++end;
-    line.assign(reinterpret_cast<const char*>(bytes.data()) + pos, end - pos);
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    pos = std::min(end + 1, bytes.size());
-    return true;
-  };
-  std::string line;
-  if (!next_line(line) || line != "ply") return Status::error(what + ": not a PLY file (first line is not 'ply')");
-  std::string format;
-  std::vector<PlyElement> elements;
-  bool ended = false;
-  size_t header_line = 1;
-  // OpenMesh's header parser can loop forever on a malformed header, so anything it might
-  // not understand is refused here, naming the line.
-  auto bad_header = [&](const std::string& why) {
-    return Status::error(what + ": PLY header line " + std::to_string(header_line) + ": " + why);
-  };
-  while (next_line(line)) {
-    ++header_line;
-    std::istringstream ls(line);
-    std::string word;
-    ls >> word;
-    if (word.empty() || word == "comment" || word == "obj_info") continue;
-    if (word == "format") {
-      std::string version, extra;
-      ls >> format >> version >> extra;
-      char* end = nullptr;
-      std::strtod(version.c_str(), &end);
-      if (version.empty() || *end != 0 || !extra.empty())
-        return bad_header("malformed format line '" + line.substr(0, 80) + "'");
-    } else if (word == "element") {
-      PlyElement e;
-      std::string count_text, extra;
-      ls >> e.name >> count_text >> extra;
-      if (e.name.empty() || !extra.empty()) return bad_header("malformed element line '" + line.substr(0, 80) + "'");
-      char* end = nullptr;
-      errno = 0;
-      const unsigned long long n = std::strtoull(count_text.c_str(), &end, 10);
-      if (count_text.empty() || *end != 0 || errno != 0 || count_text[0] == '-')
-        return Status::error(what + ": PLY header: element '" + e.name + "' has a bad count '" + count_text + "'");
-      e.count = n;
-      elements.push_back(e);
-    } else if (word == "property") {
-      if (elements.empty()) return Status::error(what + ": PLY header: property before any element");
-      PlyProperty p;
-      std::string type;
-      ls >> type;
-      std::string extra;
-      if (type == "list") {
-        std::string count_type, value_type;
-        ls >> count_type >> value_type >> p.name >> extra;
-        p.is_list = true;
-        p.count_size = ply_type_size(count_type);
-        p.count_signed = count_type == "char" || count_type == "int8" || count_type == "short" ||
-                         count_type == "int16" || count_type == "int" || count_type == "int32";
-        p.size = ply_type_size(value_type);
-        p.is_float = is_float_type(value_type);
-        if (p.count_size == 0 || p.size == 0 || p.name.empty() || !extra.empty())
-          return bad_header("malformed list property '" + line.substr(0, 80) + "'");
-        if (p.count_size > 4 || p.size > 4)
-          return bad_header("list property '" + p.name + "' has a non-integer type");
-      } else {
-        ls >> p.name >> extra;
-        p.size = ply_type_size(type);
-        p.is_float = is_float_type(type);
-        if (p.size == 0 || p.name.empty() || !extra.empty())
-          return bad_header("malformed property '" + line.substr(0, 80) + "'");
-      }
-      elements.back().properties.push_back(p);
-    } else if (word == "end_header") {
-      ended = true;
-      break;
-    } else {
-      // OpenMesh skips unknown words one by one (some exporters write a bare "Created by
-      // ..." line); it would act on a keyword further along the line, so refuse those.
-      std::string rest;
-      while (ls >> rest)
-        if (rest == "element" || rest == "property" || rest == "format" || rest == "end_header")
-          return bad_header("unknown keyword '" + word.substr(0, 32) + "' before '" + rest + "'");
-    }
-  }
-  if (!ended) return Status::error(what + ": PLY header has no 'end_header' line (file truncated?)");
-
-  bool has_face = false;
-  bool has_tristrips = false;
-  for (const PlyElement& e : elements) {
-    if (e.name == "vertex") declared.vertices = e.count;
-    if (e.name == "face") {
-      declared.faces = e.count;
-      has_face = true;
-      bool has_indices = false;
-      for (const PlyProperty& p : e.properties)
-        has_indices |= p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
-      if (!has_indices)
-        return Status::error(what + ": PLY element 'face' has no 'vertex_indices' list property");
-    }
-    if (e.name == "tristrips") has_tristrips = true;
-  }
-  if (!declared.vertices) return Status::error(what + ": PLY header declares no 'vertex' element");
-  if (!has_face && has_tristrips)
-    return Status::error(what + ": stores its triangles in a 'tristrips' element, which OpenMesh's PLY reader "
-                         "does not read (convert it to a 'face' element)");
-  if (!has_face || *declared.faces == 0)
-    return Status::error(what + ": has no faces (points only: " + std::to_string(*declared.vertices) +
-                         " vertices)");
-
-  const bool binary = format == "binary_little_endian" || format == "binary_big_endian";
-  if (!binary && format != "ascii")
-    return Status::error(what + ": PLY header: unknown format '" + format + "'");
-  if (!binary) {
-    // Walk the values as text: iostreams stop silently at "nan" or at the end of a
-    // truncated file (repeating the last face), so check counts and coordinates here.
-    size_t header_lines = 1;
-    for (size_t i = 0; i < pos; ++i) header_lines += bytes[i] == '\n';
-    TextTokens tokens(bytes, pos, header_lines);
-    std::string_view tok;
-    for (const PlyElement& e : elements) {
-      const bool is_vertex = e.name == "vertex";
-      for (uint64_t i = 0; i < e.count; ++i) {
-        float xyz[3] = {0, 0, 0};
-        for (const PlyProperty& p : e.properties) {
-          uint64_t values = 1;
-          if (p.is_list) {
-            if (!tokens.next(tok))
-              return Status::error(what + ": truncated: the data ends inside " + e.name + " " + std::to_string(i) +
-                                   " of " + std::to_string(e.count) + " declared");
-            if (!parse_count(tok, values))
-              return Status::error(what + ": " + e.name + " " + std::to_string(i) + " (line " +
-                                   std::to_string(tokens.line()) + ") has a bad list length '" +
-                                   std::string(tok.substr(0, 32)) + "'");
-          }
-          for (uint64_t k = 0; k < values; ++k) {
-            if (!tokens.next(tok))
-              return Status::error(what + ": truncated: the data ends inside " + e.name + " " + std::to_string(i) +
-                                   " of " + std::to_string(e.count) + " declared");
-            float value = 0;
-            if (p.is_float ? !parse_coordinate(tok, value) : !is_integer_token(tok))
-              return Status::error(what + ": " + e.name + " " + std::to_string(i) + " (line " +
-                                   std::to_string(tokens.line()) + ") has a value that is not " +
-                                   (p.is_float ? "a number" : "an integer") + " ('" +
-                                   std::string(tok.substr(0, 32)) + "')");
-            if (is_vertex && !p.is_list && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z')
-              xyz[p.name[0] - 'x'] = p.is_float ? value : float(std::strtod(std::string(tok).c_str(), nullptr));
-          }
-        }
-        if (is_vertex) {
-          Status st = check_coordinates(what, i, tokens.line(), xyz, 3);
-          if (!st) return st;
-        }
-      }
-      if (e.name == "face") break;
-    }
-    return Status::success();
-  }
-
-  // Binary: walk every element up to and including the faces, so that a truncated file or
-  // an absurd list length is refused here rather than inside OpenMesh.
-  const bool big_endian = format == "binary_big_endian";
-  size_t at = pos;
-  for (const PlyElement& e : elements) {
-    for (const PlyProperty& p : e.properties)
-      if (p.size == 0 || (p.is_list && p.count_size == 0))
-        return Status::error(what + ": PLY header: property '" + p.name + "' of element '" + e.name +
-                             "' has an unknown type");
-    bool all_scalar = true;
-    size_t row = 0;
-    for (const PlyProperty& p : e.properties) {
-      if (p.is_list) all_scalar = false;
-      row += size_t(p.size);
-    }
-    auto truncated = [&](uint64_t index) {
-      return Status::error(what + ": truncated: the data ends inside " + e.name + " " + std::to_string(index) +
-                           " of " + std::to_string(e.count) + " declared");
-    };
-    if (all_scalar) {
-      if (row != 0 && e.count > (bytes.size() - at) / row) return truncated((bytes.size() - at) / row);
-      at += size_t(e.count) * row;
-    } else {
-      for (uint64_t i = 0; i < e.count; ++i) {
-        for (const PlyProperty& p : e.properties) {
-          if (!p.is_list) {
-            if (bytes.size() - at < size_t(p.size)) return truncated(i);
-            at += size_t(p.size);
-            continue;
-          }
-          if (bytes.size() - at < size_t(p.count_size)) return truncated(i);
-          uint64_t n = read_uint_le(&bytes[at], p.count_size, big_endian);
-          if (p.count_signed && (n >> (8 * p.count_size - 1)) != 0)
-            return Status::error(what + ": " + e.name + " " + std::to_string(i) + " has a negative list length");
-          at += size_t(p.count_size);
-          if (n > (bytes.size() - at) / size_t(p.size)) return truncated(i);
-          at += size_t(n) * size_t(p.size);
-        }
-      }
-    }
-    if (e.name == "face") break;
-  }
-  return Status::success();
-}
-
-// ---- OFF -------------------------------------------------------------------------------
-
-Status precheck_off(const std::string& what, const std::vector<uint8_t>& bytes, Declared& declared) {
-  TextTokens tokens(bytes);
-  std::string_view tok;
-  if (!tokens.next(tok)) return Status::error(what + ": file is empty");
-  std::string magic(tok);
-  if (magic.find("OFF") == std::string::npos)
-    return Status::error(what + ": not an OFF file (first word is '" + magic.substr(0, 32) + "')");
-  const bool binary = magic.find("BINARY") != std::string::npos;
-  if (!binary && tokens.next(tok) && tok == "BINARY")
-    return Status::error(what + ": binary OFF is not supported");
-  if (binary) return Status::error(what + ": binary OFF is not supported");
-  if (magic.find("n") == 0) return Status::error(what + ": OFF with a vertex dimension ('nOFF') is not supported");
-  uint64_t nv = 0, nf = 0;
-  // The counts follow the magic word (OpenMesh takes the same three numbers).
-  TextTokens t2(bytes);
-  t2.next(tok);
-  std::string_view a, b;
-  if (!t2.next(a) || !t2.next(b) || !parse_count(a, nv) || !parse_count(b, nf))
-    return Status::error(what + ": OFF header has no vertex and face counts");
-  {
-    // An edge count may follow on the same line; otherwise the next token is a coordinate.
-    TextTokens peek = t2;
-    std::string_view edges_tok;
-    const size_t counts_line = t2.line();
-    if (peek.next(edges_tok) && peek.line() == counts_line) t2.next(edges_tok);
-  }
-  declared.vertices = nv;
-  declared.faces = nf;
-  const size_t size = bytes.size();
-  // An ASCII vertex needs at least 6 characters ("0 0 0\n"), a triangle 8 ("3 0 1 2\n").
-  if (nv > size / 6 || nf > size / 8 || nv * 6 + nf * 8 > size + 16)
-    return Status::error(what + ": truncated or corrupt: the header declares " + std::to_string(nv) +
-                         " vertices and " + std::to_string(nf) + " faces, more than " + std::to_string(size) +
-                         " bytes can hold");
-  if (nf == 0) return Status::error(what + ": has no faces (points only: " + std::to_string(nv) + " vertices)");
-  // Check coordinates and counts as text: iostreams stop silently at 'nan' (losing every
-  // later value) and at the end of a truncated file (repeating the last face). Colours and
-  // normals may follow xyz or a face's indices on the same line.
-  for (uint64_t v = 0; v < nv; ++v) {
-    float xyz[3];
-    for (int k = 0; k < 3; ++k) {
-      if (!t2.next(tok))
-        return Status::error(what + ": truncated: the data ends inside vertex " + std::to_string(v) + " of " +
-                             std::to_string(nv) + " declared");
-      if (!parse_coordinate(tok, xyz[k]))
-        return Status::error(what + ": vertex " + std::to_string(v) + " (line " + std::to_string(t2.line()) +
-                             ") has a coordinate that is not a number ('" + std::string(tok.substr(0, 32)) + "')");
-    }
-    Status s = check_coordinates(what, v, t2.line(), xyz, 3);
-    if (!s) return s;
-    t2.skip_line();
-  }
-  for (uint64_t f = 0; f < nf; ++f) {
-    uint64_t n = 0;
-    if (!t2.next(tok))
-      return Status::error(what + ": truncated: the data ends before face " + std::to_string(f) + " of " +
-                           std::to_string(nf) + " declared");
-    if (!parse_count(tok, n))
-      return Status::error(what + ": face " + std::to_string(f) + " (line " + std::to_string(t2.line()) +
-                           ") has a bad corner count '" + std::string(tok.substr(0, 32)) + "'");
-    for (uint64_t k = 0; k < n; ++k) {
-      if (!t2.next(tok))
-        return Status::error(what + ": truncated: the data ends inside face " + std::to_string(f) + " of " +
-                             std::to_string(nf) + " declared");
-      if (!is_integer_token(tok))
-        return Status::error(what + ": face " + std::to_string(f) + " (line " + std::to_string(t2.line()) +
-                             ") has a vertex index that is not an integer ('" + std::string(tok.substr(0, 32)) + "')");
-    }
-    t2.skip_line();
-  }
-  return Status::success();
-}
-
 // ---- OBJ -------------------------------------------------------------------------------
 
 // OpenMesh's OBJ reader drops a 'v' line it cannot parse (e.g. "v nan 0 0"), which shifts
-// every later index; find such lines first and name them.
-Status precheck_obj(const std::string& what, const std::vector<uint8_t>& bytes) {
-  if (bytes.size() >= 2 && ((bytes[0] == 0xFE && bytes[1] == 0xFF) || (bytes[0] == 0xFF && bytes[1] == 0xFE)))
+// every later index, asserts on a corner without a vertex index, and turns an index out of
+// range into whatever handle arithmetic gives; find such lines first and name them with the
+// file's own numbers (OBJ numbers vertices from 1; -1 is the last vertex before the face).
+Status precheck_obj(const std::string& what, const uint8_t* data, size_t size) {
+  if (size >= 2 && ((data[0] == 0xFE && data[1] == 0xFF) || (data[0] == 0xFF && data[1] == 0xFE)))
     return Status::error(what + ": is UTF-16 text; OBJ files must be ASCII or UTF-8");
-  size_t pos = 0, line_no = 0;
+  auto is_v = [](std::string_view line, size_t s) {
+    return line.size() >= s + 2 && line[s] == 'v' && (line[s + 1] == ' ' || line[s + 1] == '\t');
+  };
+  auto is_f = [](std::string_view line, size_t s) {
+    return line.size() >= s + 2 && line[s] == 'f' && (line[s + 1] == ' ' || line[s + 1] == '\t');
+  };
+  auto lines = [&](auto&& visit) -> Status {
+    size_t pos = 0, line_no = 0;
+    while (pos < size) {
+      const void* nl = std::memchr(data + pos, '\n', size - pos);
+      const size_t end = nl ? size_t(static_cast<const uint8_t*>(nl) - data) : size;
+      ++line_no;
+      std::string_view line(reinterpret_cast<const char*>(data) + pos, end - pos);
+      pos = end + 1;
+      size_t s = 0;
+      while (s < line.size() && (line[s] == ' ' || line[s] == '\t')) ++s;
+      Status st = visit(line, s, line_no);
+      if (!st) return st;
+    }
+    return Status::success();
+  };
+  // Pass 1 (in memory): how many vertices, so that a forward reference can be checked.
+  uint64_t total = 0;
+  (void)lines([&](std::string_view line, size_t s, size_t) {
+    total += is_v(line, s);
+    return Status::success();
+  });
   uint64_t vertex = 0, faces = 0;
-  std::string line;
-  while (pos < bytes.size()) {
-    size_t end = pos;
-    while (end < bytes.size() && bytes[end] != '\n') ++end;
-    ++line_no;
-    line.assign(reinterpret_cast<const char*>(bytes.data()) + pos, end - pos);
-    pos = end + 1;
-    size_t s = 0;
-    while (s < line.size() && (line[s] == ' ' || line[s] == '\t')) ++s;
-    if (line.compare(s, 2, "f ") == 0 || line.compare(s, 2, "f\t") == 0) {
+  std::string buf;
+  Status st = lines([&](std::string_view line, size_t s, size_t line_no) -> Status {
+    if (is_f(line, s)) {
       // Every corner must start with a vertex index: OpenMesh's reader asserts (aborts the
       // process) on a corner like "/1/1".
-      std::istringstream corners(line.substr(s + 2));
-      std::string corner;
-      while (corners >> corner) {
-        const size_t slash = corner.find('/');
-        const std::string index = corner.substr(0, slash);
-        char* e = nullptr;
-        const long v = std::strtol(index.c_str(), &e, 10);
-        if (index.empty() || *e != 0 || v == 0)
+      TextTokens corners(reinterpret_cast<const uint8_t*>(line.data()), line.size(), s + 2, line_no, false);
+      std::string_view corner;
+      while (corners.next(corner)) {
+        const std::string_view index = corner.substr(0, corner.find('/'));
+        int64_t v = 0;
+        if (!parse_int(index, v) || v == 0)
           return Status::error(what + ": face " + std::to_string(faces) + " (line " + std::to_string(line_no) +
-                               ") has a corner without a valid vertex index ('" + corner.substr(0, 32) + "')");
+                               ") has a corner without a valid vertex index ('" + quote_token(corner) + "')");
+        if (v < 0 && uint64_t(-(v + 1)) >= vertex)
+          return Status::error(what + ": face " + std::to_string(faces) + " references vertex " + std::to_string(v) +
+                               " (relative) of " + std::to_string(vertex) + " before it, on line " +
+                               std::to_string(line_no));
+        if (v > 0 && (uint64_t(v) > total || v > std::numeric_limits<int>::max()))
+          return Status::error(what + ": face " + std::to_string(faces) + " references vertex " + std::to_string(v) +
+                               " of " + std::to_string(total) + " (OBJ numbering, from 1), on line " +
+                               std::to_string(line_no));
       }
       ++faces;
+      return Status::success();
     }
-    if (!(line.compare(s, 2, "v ") == 0 || line.compare(s, 2, "v\t") == 0)) continue;
-    const char* p = line.c_str() + s + 2;
+    if (!is_v(line, s)) return Status::success();
+    buf.assign(line.substr(s + 2));
+    const char* p = buf.c_str();
     float xyz[3];
     for (int k = 0; k < 3; ++k) {
       char* e = nullptr;
@@ -569,81 +306,28 @@ Status precheck_obj(const std::string& what, const std::vector<uint8_t>& bytes) 
       xyz[k] = static_cast<float>(d);
       p = e;
     }
-    Status st = check_coordinates(what, vertex, line_no, xyz, 3);
-    if (!st) return st;
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(xyz[k]))
+        return Status::error(what + ": vertex " + std::to_string(vertex) + " (line " + std::to_string(line_no) +
+                             ") has a non-finite coordinate (" + describe_nonfinite(xyz[k]) + ")");
     ++vertex;
-  }
+    return Status::success();
+  });
+  if (!st) return st;
   if (faces == 0) return Status::error(what + ": has no faces (points only: " + std::to_string(vertex) + " vertices)");
+  if (vertex > uint64_t(std::numeric_limits<int>::max()))
+    return Status::error(what + ": has " + std::to_string(vertex) + " vertices, more than OpenMesh's reader numbers");
   return Status::success();
 }
 
-// ---- STL -------------------------------------------------------------------------------
-
-Status precheck_stl(const std::string& what, const std::vector<uint8_t>& bytes, Declared& declared) {
-  // Binary STL may also start with "solid"; the size formula decides, as OpenMesh does.
-  const uint64_t n = bytes.size() >= 84 ? read_uint_le(&bytes[80], 4, false) : 0;
-  const bool sized_as_binary = bytes.size() >= 84 && 84 + 50 * n == bytes.size();
-  if (!sized_as_binary && bytes.size() >= 5 && std::memcmp(bytes.data(), "solid", 5) == 0) return Status::success();
-  if (bytes.size() < 84)
-    return Status::error(what + ": truncated binary STL (" + std::to_string(bytes.size()) +
-                         " bytes; the header alone is 84)");
-  declared.faces = n;
-  if (n == 0) return Status::error(what + ": has no faces (binary STL declares 0 triangles)");
-  if (84 + 50 * n > bytes.size())
-    return Status::error(what + ": truncated: binary STL declares " + std::to_string(n) + " triangles (" +
-                         std::to_string(84 + 50 * n) + " bytes) but the file has " + std::to_string(bytes.size()) +
-                         " bytes");
-  for (uint64_t t = 0; t < n; ++t) {
-    float xyz[9];
-    std::memcpy(xyz, &bytes[84 + 50 * t + 12], sizeof xyz);
-    for (float v : xyz)
-      if (!std::isfinite(v))
-        return Status::error(what + ": triangle " + std::to_string(t) + " has a non-finite coordinate (" +
-                             describe_number(v) + ")");
-  }
-  return Status::success();
-}
-
-}  // namespace
-}  // namespace detail
-
-Status load_mesh(const std::filesystem::path& path, MeshData& out) {
-  using namespace detail;
-  const std::string what = path.string();
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return Status::error(what + ": no such file");
-  if (!fs::is_regular_file(path, ec)) return Status::error(what + ": not a regular file");
-  const std::string ext = lower(path.extension().string());
-  if (ext == ".gz" || ext == ".zip" || ext == ".bz2" || ext == ".xz")
-    return Status::error(what + ": is compressed ('" + path.extension().string() +
-                         "'); decompress it first (.obj, .ply, .off or .stl)");
-  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl")
-    return Status::error(what + ": unknown mesh format '" + path.extension().string() +
-                         "' (expected .obj, .ply, .off or .stl)");
-
-  std::vector<uint8_t> bytes;
-  {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return Status::error(what + ": cannot be opened for reading");
-    bytes.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-    if (f.bad()) return Status::error(what + ": read error");
-  }
-  if (bytes.empty()) return Status::error(what + ": file is empty");
-
-  Declared declared;
-  Status pre;
-  if (ext == ".ply") pre = precheck_ply(what, bytes, declared);
-  else if (ext == ".off") pre = precheck_off(what, bytes, declared);
-  else if (ext == ".obj") pre = precheck_obj(what, bytes);
-  else pre = precheck_stl(what, bytes, declared);
+Status read_obj(const std::string& what, const uint8_t* data, size_t size, MeshData& out) {
+  // A UTF-8 byte-order mark before the first line is not part of it (OpenMesh would drop
+  // the first 'v' and shift every index).
+  if (size >= 3 && data[0] == 0xEF && data[1] == 0xBB && data[2] == 0xBF) data += 3, size -= 3;
+  Status pre = precheck_obj(what, data, size);
   if (!pre) return pre;
-
   FlatImporter importer;
-  // Nothing legitimate needs more elements than the file has bytes.
-  importer.reserve_cap = static_cast<unsigned int>(std::min<size_t>(bytes.size(), 1u << 30));
-  bytes.clear();
-  bytes.shrink_to_fit();
-
+  importer.reserve_cap = static_cast<unsigned int>(std::min<size_t>(size, 1u << 30));
   bool read_ok = false;
   std::string said;
   {
@@ -653,7 +337,8 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
     OpenMeshLogCapture capture;
     OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
     try {
-      read_ok = OpenMesh::IO::IOManager().read(path.string(), importer, options);
+      std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
+      read_ok = OpenMesh::IO::IOManager().read(in, "obj", importer, options);
     } catch (const std::exception& e) {
       read_ok = false;
       ::omerr() << "exception: " << e.what();
@@ -662,52 +347,109 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   }
   const std::string openmesh_said = said.empty() ? "" : " (OpenMesh: " + said + ")";
   if (!read_ok) return Status::error(what + ": OpenMesh could not read it" + openmesh_said);
+  RawPolygons raw;
+  raw.positions = std::move(importer.positions);
+  raw.corners.assign(importer.polygon_indices.begin(), importer.polygon_indices.end());
+  raw.offsets = std::move(importer.polygon_offsets);
+  for (float c : raw.positions)
+    if (!std::isfinite(c)) return Status::error(what + ": has a non-finite coordinate (" + describe_nonfinite(c) + ")");
+  Status st = finish_polygons(what, raw, out, /*obj_numbering=*/true);
+  if (!st) st.message += openmesh_said;
+  return st;
+}
 
-  const size_t nv = importer.n_vertices();
-  const size_t nf = importer.n_faces();
-  if (declared.vertices && nv < *declared.vertices)
-    return Status::error(what + ": truncated: read " + std::to_string(nv) + " of " +
-                         std::to_string(*declared.vertices) + " declared vertices" + openmesh_said);
-  if (declared.faces && nf < *declared.faces && ext != ".stl")
-    return Status::error(what + ": truncated: read " + std::to_string(nf) + " of " + std::to_string(*declared.faces) +
-                         " declared faces" + openmesh_said);
-  if (nf == 0) return Status::error(what + ": has no faces (points only: " + std::to_string(nv) + " vertices)" + openmesh_said);
-
-  for (size_t v = 0; v < nv; ++v)
-    for (int k = 0; k < 3; ++k) {
-      const float c = importer.positions[3 * v + k];
-      if (!std::isfinite(c))
-        return Status::error(what + ": vertex " + std::to_string(v) + " has a non-finite coordinate (" +
-                             describe_number(c) + ")");
-    }
-
-  MeshData mesh;
-  mesh.source = what;
-  mesh.indices.reserve(3 * nf);
-  for (size_t f = 0; f < nf; ++f) {
-    const uint32_t begin = importer.polygon_offsets[f], end = importer.polygon_offsets[f + 1];
-    for (uint32_t i = begin; i < end; ++i) {
-      const int idx = importer.polygon_indices[i];
-      if (idx < 0 || size_t(idx) >= nv) {
-        // OBJ numbers its vertices from 1: name the vertex as the file wrote it.
-        const bool obj = ext == ".obj";
-        const std::string number = idx < 0 ? std::string("-1 (invalid)") : std::to_string(obj ? idx + 1 : idx);
-        return Status::error(what + ": face " + std::to_string(f) + " references vertex " + number + " of " +
-                             std::to_string(nv) + (obj && idx >= 0 ? " (OBJ numbering, from 1)" : "") +
-                             openmesh_said);
-      }
-    }
-    // Fan triangulation; a polygon with fewer than 3 corners contributes nothing.
-    for (uint32_t i = begin + 1; i + 1 < end; ++i)
-      mesh.indices.insert(mesh.indices.end(), {uint32_t(importer.polygon_indices[begin]),
-                                               uint32_t(importer.polygon_indices[i]),
-                                               uint32_t(importer.polygon_indices[i + 1])});
+// Reads a regular file whole. stat first (a directory, FIFO, socket or device is refused by
+// name without opening it), then open with O_NONBLOCK (a FIFO swapped in meanwhile does not
+// block the open) and fstat the descriptor (refused unless still a regular file).
+Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
+  const std::string what = path.string();
+  auto kind = [](mode_t m) -> const char* {
+    if (S_ISDIR(m)) return "is a directory, not a mesh file";
+    if (S_ISFIFO(m)) return "is a FIFO (named pipe), not a regular file";
+    if (S_ISSOCK(m)) return "is a socket, not a regular file";
+    if (S_ISCHR(m) || S_ISBLK(m)) return "is a device, not a regular file";
+    if (!S_ISREG(m)) return "is not a regular file";
+    return nullptr;
+  };
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    const int e = errno;
+    if (e == ENOENT) return Status::error(what + ": no such file");
+    if (e == ENOTDIR) return Status::error(what + ": no such file (a parent is not a directory)");
+    return Status::error(what + ": cannot be read (" + std::strerror(e) + ")");
   }
-  if (mesh.indices.empty())
-    return Status::error(what + ": has no triangles (" + std::to_string(nf) + " faces with fewer than 3 corners)");
-  mesh.positions = std::move(importer.positions);
-  out = std::move(mesh);
+  if (const char* k = kind(st.st_mode)) return Status::error(what + ": " + k);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    const int e = errno;
+    return Status::error(what + ": cannot be opened for reading (" + std::strerror(e) + ")");
+  }
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  if (::fstat(fd, &st) != 0) return Status::error(what + ": cannot be read (" + std::strerror(errno) + ")");
+  if (const char* k = kind(st.st_mode)) return Status::error(what + ": " + k);
+  if (st.st_size == 0) return Status::error(what + ": file is empty");
+  if (uint64_t(st.st_size) > std::numeric_limits<size_t>::max() / 2)
+    return Status::error(what + ": is too large (" + std::to_string(st.st_size) + " bytes)");
+  try {
+    bytes.resize(size_t(st.st_size));
+  } catch (const std::bad_alloc&) {
+    return Status::error(what + ": not enough memory to read its " + std::to_string(st.st_size) + " bytes");
+  }
+  size_t got = 0;
+  while (got < bytes.size()) {
+    const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) return Status::error(what + ": read error (" + std::strerror(errno) + ")");
+    if (r == 0) break;  // shrank while reading
+    got += size_t(r);
+  }
+  bytes.resize(got);
+  if (bytes.empty()) return Status::error(what + ": file is empty");
   return Status::success();
+}
+
+}  // namespace
+}  // namespace detail
+
+Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
+                             MeshData& out) {
+  using namespace detail;
+  static_assert(std::endian::native == std::endian::little, "the binary readers assume a little-endian host");
+  const std::string ext = lower(extension);
+  if (size == 0) return Status::error(name + ": file is empty");
+  try {
+    if (ext == ".obj") return read_obj(name, data, size, out);
+    RawPolygons raw;
+    Status s;
+    if (ext == ".ply") s = read_ply(name, data, size, raw);
+    else if (ext == ".off") s = read_off(name, data, size, raw);
+    else if (ext == ".stl") s = read_stl(name, data, size, raw);
+    else
+      return Status::error(name + ": unknown mesh format '" + extension + "' (expected .obj, .ply, .off or .stl)");
+    if (!s) return s;
+    return finish_polygons(name, raw, out);
+  } catch (const std::bad_alloc&) {
+    return Status::error(name + ": not enough memory to load it (" + std::to_string(size) + " bytes)");
+  }
+}
+
+Status load_mesh(const std::filesystem::path& path, MeshData& out) {
+  using namespace detail;
+  const std::string what = path.string();
+  const std::string ext = lower(path.extension().string());
+  if (ext == ".gz" || ext == ".zip" || ext == ".bz2" || ext == ".xz")
+    return Status::error(what + ": is compressed ('" + path.extension().string() +
+                         "'); decompress it first (.obj, .ply, .off or .stl)");
+  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl")
+    return Status::error(what + ": unknown mesh format '" + path.extension().string() +
+                         "' (expected .obj, .ply, .off or .stl)");
+  std::vector<uint8_t> bytes;
+  Status r = read_regular_file(path, bytes);
+  if (!r) return r;
+  return load_mesh_from_memory(what, path.extension().string(), bytes.data(), bytes.size(), out);
 }
 
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,

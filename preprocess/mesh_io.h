@@ -1,17 +1,28 @@
-// Mesh loading through OpenMesh's readers (OBJ, PLY, OFF, STL) into flat arrays.
-// Every failure names the file and what is wrong; `out` is only written on success.
+// Mesh loading (OBJ, PLY, OFF, STL) into flat arrays: PLY, OFF and STL by single-pass
+// readers of our own, OBJ by OpenMesh's reader behind a pre-check. Every failure names the
+// file and what is wrong; `out` is only written on success.
 #pragma once
+#include <cstdint>
 #include <filesystem>
+#include <string>
 
 #include "preprocess/mesh.h"
 #include "runtime/status.h"
 
 namespace lod {
 
-// Refuses: missing or unreadable files, unknown extensions, empty files, meshes without
-// triangles, non-finite coordinates, faces referencing vertices that do not exist.
-// Polygons are triangulated; points-only files are refused.
+// Refuses: missing or unreadable files, anything but a regular file (a directory, FIFO or
+// device is named as such and never blocks), unknown extensions, empty files, declared
+// counts the file cannot hold, meshes without triangles, non-finite coordinates (also values
+// finite as double but not as float), faces referencing vertices that do not exist (the
+// vertex named as the file numbers it). A UTF-8 byte-order mark before an OBJ or ASCII STL
+// is skipped. Polygons are fan-triangulated; points-only files are refused.
 Status load_mesh(const std::filesystem::path& path, MeshData& out);
+
+// The same readers over bytes already in memory; `extension` picks the format (".ply",
+// ".off", ".stl", ".obj"; any case), `name` is used in messages. Never reads past `size`.
+Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
+                             MeshData& out);
 
 // Writes positions + triangles as binary PLY (for --export and outside tools).
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,

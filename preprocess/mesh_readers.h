@@ -1,0 +1,81 @@
+// Internal to preprocess/: the per-format mesh readers behind load_mesh (mesh_io.cpp).
+//
+// Every reader works on the file's bytes, already in memory (read once, a regular file
+// only), in a single pass: declared counts are checked against the bytes left before
+// anything is reserved, every value is checked as it is read, and an error names the
+// element as the file numbers it. The readers never throw and never index past `size`.
+#pragma once
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "preprocess/mesh.h"
+#include "runtime/status.h"
+
+namespace lod::detail {
+
+// What a reader produces: vertices and polygons with indices exactly as the file gave them
+// (range-checked by finish_polygons, so the message can quote the file's own number).
+struct RawPolygons {
+  std::vector<float> positions;          // xyz per vertex
+  std::vector<int64_t> corners;          // vertex numbers as written in the file
+  std::vector<uint32_t> offsets{0};      // polygon p is corners[offsets[p], offsets[p+1])
+  size_t vertex_count() const { return positions.size() / 3; }
+  size_t polygon_count() const { return offsets.size() - 1; }
+};
+
+// Readers: `what` is the name used in messages (the path). On success `raw` holds at least
+// one polygon; coordinates are finite.
+Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
+Status read_off(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
+Status read_stl(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
+
+// Range-checks every corner (first bad one reported: "face F references vertex N of V",
+// N as the file wrote it) and fan-triangulates into `out` (positions moved out of `raw`).
+// With `obj_numbering` the corners are 0-based handles of a file that numbers from 1, and
+// the message adds 1 back.
+Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out, bool obj_numbering = false);
+
+// ---- helpers shared by the text readers ------------------------------------------------
+
+inline std::string describe_nonfinite(float v) {
+  if (std::isnan(v)) return "nan";
+  return v > 0 ? "inf" : "-inf";
+}
+
+// At most 32 bytes of a token, control bytes shown as '?', for quoting in messages.
+std::string quote_token(std::string_view tok);
+
+// Whitespace-separated tokens of a text buffer with line numbers; optional '#' comments
+// (OFF has them, PLY's data section does not).
+class TextTokens {
+ public:
+  TextTokens(const uint8_t* data, size_t size, size_t start, size_t line, bool hash_comments)
+      : d_(data), n_(size), i_(start), line_(line), comments_(hash_comments) {}
+  bool next(std::string_view& tok);
+  // Moves to the start of the next line (extra per-element values such as colours).
+  void skip_line();
+  // True if another token follows on the current line (comments end the line).
+  bool more_on_line() const;
+  size_t line() const { return line_; }
+  size_t offset() const { return i_; }
+  size_t remaining() const { return n_ - i_; }
+
+ private:
+  const uint8_t* d_;
+  size_t n_;
+  size_t i_;
+  size_t line_;
+  bool comments_;
+};
+
+// Whole-token parsers: the token must be exactly the number (iostreams would stop inside
+// "2-1" and read the rest as the next value).
+bool parse_uint(std::string_view tok, uint64_t& out);   // decimal digits only, no overflow
+bool parse_int(std::string_view tok, int64_t& out);     // optional '-', no overflow
+bool parse_real(std::string_view tok, double& out);     // strtod syntax incl. nan/inf
+
+}  // namespace lod::detail

@@ -1,0 +1,334 @@
+// PLY reader (ASCII, binary little and big endian), single pass over the bytes in memory.
+//
+// Replaces OpenMesh's PLY reader, whose header parser loops forever on some unknown words
+// and which reserves whatever a header declares. Reads element "vertex" (x, y, z of any
+// scalar type) and element "face" (list "vertex_indices" or "vertex_index" with an integer
+// count and integer indices); every other element and property is skipped by its declared
+// size. Before an element's rows are read its count is checked against the bytes left (a row
+// takes at least its fixed size in binary, two bytes per property in ASCII), so nothing is
+// reserved that the file cannot hold; an element whose rows take no bytes is skipped in O(1).
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include "preprocess/mesh_readers.h"
+
+namespace lod::detail {
+namespace {
+
+enum class Type { none, i8, u8, i16, u16, i32, u32, f32, f64 };
+
+Type parse_type(std::string_view t) {
+  if (t == "char" || t == "int8") return Type::i8;
+  if (t == "uchar" || t == "uint8") return Type::u8;
+  if (t == "short" || t == "int16") return Type::i16;
+  if (t == "ushort" || t == "uint16") return Type::u16;
+  if (t == "int" || t == "int32") return Type::i32;
+  if (t == "uint" || t == "uint32") return Type::u32;
+  if (t == "float" || t == "float32") return Type::f32;
+  if (t == "double" || t == "float64") return Type::f64;
+  return Type::none;
+}
+size_t type_size(Type t) {
+  switch (t) {
+    case Type::i8: case Type::u8: return 1;
+    case Type::i16: case Type::u16: return 2;
+    case Type::i32: case Type::u32: case Type::f32: return 4;
+    case Type::f64: return 8;
+    default: return 0;
+  }
+}
+bool is_real(Type t) { return t == Type::f32 || t == Type::f64; }
+
+enum class Role { skip, x, y, z, indices };
+
+struct Property {
+  std::string name;
+  Type type = Type::none;      // value type
+  bool is_list = false;
+  Type count_type = Type::none;
+  Role role = Role::skip;
+};
+struct Element {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<Property> properties;
+  size_t header_line = 0;
+};
+
+// Splits a header line into words (spaces/tabs).
+std::vector<std::string_view> words_of(std::string_view line) {
+  std::vector<std::string_view> w;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r' || line[i] == '\v' || line[i] == '\f')) ++i;
+    const size_t s = i;
+    while (i < line.size() && !(line[i] == ' ' || line[i] == '\t' || line[i] == '\r' || line[i] == '\v' || line[i] == '\f')) ++i;
+    if (i > s) w.push_back(line.substr(s, i - s));
+    if (w.size() > 64) break;  // no header line has that many words; stop quadratic work
+  }
+  return w;
+}
+
+// A binary value, widened. Reads exactly type_size(t) bytes at p (the caller checked them).
+double load_real(const uint8_t* p, Type t, bool big) {
+  uint8_t b[8];
+  const size_t n = type_size(t);
+  for (size_t i = 0; i < n; ++i) b[i] = big ? p[n - 1 - i] : p[i];
+  switch (t) {
+    case Type::i8: return double(int8_t(b[0]));
+    case Type::u8: return double(b[0]);
+    case Type::i16: { int16_t v; std::memcpy(&v, b, 2); return v; }
+    case Type::u16: { uint16_t v; std::memcpy(&v, b, 2); return v; }
+    case Type::i32: { int32_t v; std::memcpy(&v, b, 4); return v; }
+    case Type::u32: { uint32_t v; std::memcpy(&v, b, 4); return v; }
+    case Type::f32: { float v; std::memcpy(&v, b, 4); return double(v); }
+    case Type::f64: { double v; std::memcpy(&v, b, 8); return v; }
+    default: return 0;
+  }
+}
+int64_t load_int(const uint8_t* p, Type t, bool big) {
+  uint8_t b[8];
+  const size_t n = type_size(t);
+  for (size_t i = 0; i < n; ++i) b[i] = big ? p[n - 1 - i] : p[i];
+  switch (t) {
+    case Type::i8: return int8_t(b[0]);
+    case Type::u8: return b[0];
+    case Type::i16: { int16_t v; std::memcpy(&v, b, 2); return v; }
+    case Type::u16: { uint16_t v; std::memcpy(&v, b, 2); return v; }
+    case Type::i32: { int32_t v; std::memcpy(&v, b, 4); return v; }
+    case Type::u32: { uint32_t v; std::memcpy(&v, b, 4); return v; }
+    default: return 0;
+  }
+}
+
+}  // namespace
+
+Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw) {
+  if (size == 0) return Status::error(what + ": file is empty");
+  // ---- header: text lines up to "end_header" -------------------------------------------
+  size_t pos = 0;
+  size_t line_no = 0;
+  auto next_line = [&](std::string_view& line) {
+    if (pos >= size) return false;
+    const void* nl = std::memchr(data + pos, '\n', size - pos);
+    const size_t end = nl ? size_t(static_cast<const uint8_t*>(nl) - data) : size;
+    line = std::string_view(reinterpret_cast<const char*>(data) + pos, end - pos);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    pos = nl ? end + 1 : size;
+    ++line_no;
+    return true;
+  };
+  std::string_view line;
+  if (!next_line(line) || line != "ply")
+    return Status::error(what + ": not a PLY file (first line is not 'ply')");
+  auto bad_header = [&](const std::string& why) {
+    return Status::error(what + ": PLY header line " + std::to_string(line_no) + ": " + why);
+  };
+  auto quoted_line = [&] { return "'" + quote_token(line.substr(0, 80)) + "'"; };
+  std::string format;
+  std::vector<Element> elements;
+  bool ended = false;
+  while (next_line(line)) {
+    const std::vector<std::string_view> w = words_of(line);
+    if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "format") {
+      double version = 0;
+      if (w.size() != 3 || !parse_real(w[2], version)) return bad_header("malformed format line " + quoted_line());
+      if (!format.empty()) return bad_header("a second format line");
+      format = std::string(w[1]);
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+        return Status::error(what + ": PLY header: unknown format '" + quote_token(w[1]) + "'");
+    } else if (w[0] == "element") {
+      if (w.size() != 3) return bad_header("malformed element line " + quoted_line());
+      Element e;
+      e.name = std::string(w[1]);
+      e.header_line = line_no;
+      if (!parse_uint(w[2], e.count))
+        return Status::error(what + ": PLY header: element '" + quote_token(w[1]) + "' has a bad count '" +
+                             quote_token(w[2]) + "'");
+      for (const Element& other : elements)
+        if (other.name == e.name) return bad_header("element '" + quote_token(w[1]) + "' declared twice");
+      if (elements.size() >= 1024) return bad_header("more than 1024 elements");
+      elements.push_back(std::move(e));
+    } else if (w[0] == "property") {
+      if (elements.empty()) return Status::error(what + ": PLY header: property before any element");
+      Property p;
+      if (w.size() >= 2 && w[1] == "list") {
+        if (w.size() != 5) return bad_header("malformed list property " + quoted_line());
+        p.is_list = true;
+        p.count_type = parse_type(w[2]);
+        p.type = parse_type(w[3]);
+        p.name = std::string(w[4]);
+        if (p.count_type == Type::none || p.type == Type::none) return bad_header("malformed list property " + quoted_line());
+        if (is_real(p.count_type)) return bad_header("list property '" + quote_token(w[4]) + "' has a non-integer count type");
+      } else {
+        if (w.size() != 3) return bad_header("malformed property " + quoted_line());
+        p.type = parse_type(w[1]);
+        p.name = std::string(w[2]);
+        if (p.type == Type::none) return bad_header("malformed property " + quoted_line());
+      }
+      Element& e = elements.back();
+      if (e.properties.size() >= 1024) return bad_header("more than 1024 properties in element '" + quote_token(e.name) + "'");
+      for (const Property& other : e.properties)
+        if (other.name == p.name) return bad_header("property '" + quote_token(p.name) + "' declared twice");
+      e.properties.push_back(std::move(p));
+    } else if (w[0] == "end_header") {
+      ended = true;
+      break;
+    } else {
+      // Some exporters write a bare "Created by ..." line: ignore a line of unknown words,
+      // but not one that hides a keyword (a broken line that lost its newline).
+      for (size_t k = 1; k < w.size(); ++k)
+        if (w[k] == "element" || w[k] == "property" || w[k] == "format" || w[k] == "end_header")
+          return bad_header("unknown keyword '" + quote_token(w[0]) + "' before '" + std::string(w[k]) + "'");
+    }
+  }
+  if (!ended) return Status::error(what + ": PLY header has no 'end_header' line (file truncated?)");
+  if (format.empty()) return Status::error(what + ": PLY header has no 'format' line");
+
+  // ---- what we read from which element ---------------------------------------------------
+  Element* vertex = nullptr;
+  Element* face = nullptr;
+  bool has_tristrips = false;
+  for (Element& e : elements) {
+    if (e.name == "vertex") vertex = &e;
+    if (e.name == "face") face = &e;
+    if (e.name == "tristrips") has_tristrips = true;
+  }
+  if (!vertex) return Status::error(what + ": PLY header declares no 'vertex' element");
+  {
+    bool seen[3] = {false, false, false};
+    for (Property& p : vertex->properties)
+      if (!p.is_list && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z') {
+        p.role = Role(int(Role::x) + (p.name[0] - 'x'));
+        seen[p.name[0] - 'x'] = true;
+      }
+    if (vertex->count > 0 && !(seen[0] && seen[1] && seen[2]))
+      return Status::error(what + ": PLY element 'vertex' lacks an 'x', 'y' or 'z' property");
+  }
+  if (!face && has_tristrips)
+    return Status::error(what + ": stores its triangles in a 'tristrips' element, which lodkit's PLY reader "
+                         "does not read (convert it to a 'face' element)");
+  if (!face || face->count == 0)
+    return Status::error(what + ": has no faces (points only: " + std::to_string(vertex->count) + " vertices)");
+  {
+    bool has_indices = false;
+    for (Property& p : face->properties)
+      if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index") && !has_indices) {
+        if (is_real(p.type))
+          return Status::error(what + ": PLY property 'face' '" + p.name + "' has a non-integer index type");
+        p.role = Role::indices;
+        has_indices = true;
+      }
+    if (!has_indices) return Status::error(what + ": PLY element 'face' has no 'vertex_indices' list property");
+  }
+  if (vertex->count > std::numeric_limits<uint32_t>::max())
+    return Status::error(what + ": declares " + std::to_string(vertex->count) + " vertices, more than 2^32-1");
+
+  const bool ascii = format == "ascii";
+  const bool big = format == "binary_big_endian";
+  size_t at = pos;  // binary cursor
+  TextTokens tokens(data, size, pos, line_no + 1, /*hash_comments=*/false);
+  bool have_vertices = false, have_faces = false;
+
+  for (Element& e : elements) {
+    if (have_vertices && have_faces) break;  // what follows is not needed
+    const bool is_vertex = &e == vertex;
+    const bool is_face = &e == face;
+    // Least bytes a row can take, to check the count before reading or reserving.
+    size_t min_row = 0;
+    for (const Property& p : e.properties)
+      min_row += ascii ? 2 : (p.is_list ? type_size(p.count_type) : type_size(p.type));
+    const size_t left = ascii ? tokens.remaining() : size - at;
+    if (min_row == 0) {
+      if (e.count == 0 || !(is_vertex || is_face)) continue;  // rows take no bytes
+    } else if (e.count > (left + 1) / min_row) {
+      return Status::error(what + ": truncated or corrupt: element '" + quote_token(e.name) + "' declares " +
+                           std::to_string(e.count) + " rows, more than the " + std::to_string(left) +
+                           " bytes after it can hold");
+    }
+    if (is_vertex) raw.positions.reserve(size_t(e.count) * 3);
+    if (is_face) raw.offsets.reserve(size_t(e.count) + 1);
+    auto truncated = [&](uint64_t i) {
+      return Status::error(what + ": truncated: the data ends inside " + quote_token(e.name) + " " + std::to_string(i) +
+                           " of " + std::to_string(e.count) + " declared");
+    };
+    for (uint64_t i = 0; i < e.count; ++i) {
+      float xyz[3] = {0, 0, 0};
+      size_t row_line = tokens.line();
+      for (const Property& p : e.properties) {
+        if (ascii) {
+          std::string_view tok;
+          uint64_t n = 1;
+          if (p.is_list) {
+            if (!tokens.next(tok)) return truncated(i);
+            int64_t c = 0;
+            if (!parse_int(tok, c) || c < 0)
+              return Status::error(what + ": " + quote_token(e.name) + " " + std::to_string(i) + " (line " +
+                                   std::to_string(tokens.line()) + ") has a bad list length '" + quote_token(tok) + "'");
+            n = uint64_t(c);
+            if (n > (tokens.remaining() + 1) / 2) return truncated(i);
+          }
+          for (uint64_t k = 0; k < n; ++k) {
+            if (!tokens.next(tok)) return truncated(i);
+            if (k == 0) row_line = tokens.line();
+            if (is_real(p.type)) {
+              double v = 0;
+              if (!parse_real(tok, v))
+                return Status::error(what + ": " + quote_token(e.name) + " " + std::to_string(i) + " (line " +
+                                     std::to_string(tokens.line()) + ") has a value that is not a number ('" +
+                                     quote_token(tok) + "')");
+              if (p.role >= Role::x && p.role <= Role::z) xyz[int(p.role) - int(Role::x)] = float(v);
+            } else {
+              int64_t v = 0;
+              if (!parse_int(tok, v))
+                return Status::error(what + ": " + quote_token(e.name) + " " + std::to_string(i) + " (line " +
+                                     std::to_string(tokens.line()) + ") has a value that is not an integer ('" +
+                                     quote_token(tok) + "')");
+              if (p.role >= Role::x && p.role <= Role::z) xyz[int(p.role) - int(Role::x)] = float(v);
+              if (p.role == Role::indices) raw.corners.push_back(v);
+            }
+          }
+        } else {
+          if (!p.is_list) {
+            const size_t s = type_size(p.type);
+            if (size - at < s) return truncated(i);
+            if (p.role >= Role::x && p.role <= Role::z) xyz[int(p.role) - int(Role::x)] = float(load_real(data + at, p.type, big));
+            at += s;
+            continue;
+          }
+          const size_t cs = type_size(p.count_type), s = type_size(p.type);
+          if (size - at < cs) return truncated(i);
+          const int64_t c = load_int(data + at, p.count_type, big);
+          at += cs;
+          if (c < 0)
+            return Status::error(what + ": " + quote_token(e.name) + " " + std::to_string(i) + " has a negative list length (" +
+                                 std::to_string(c) + ")");
+          if (uint64_t(c) > (size - at) / s) return truncated(i);
+          if (p.role == Role::indices)
+            for (int64_t k = 0; k < c; ++k) raw.corners.push_back(load_int(data + at + size_t(k) * s, p.type, big));
+          at += size_t(c) * s;
+        }
+      }
+      if (is_vertex) {
+        for (int k = 0; k < 3; ++k)
+          if (!std::isfinite(xyz[k]))
+            return Status::error(what + ": vertex " + std::to_string(i) +
+                                 (ascii ? " (line " + std::to_string(row_line) + ")" : std::string()) +
+                                 " has a non-finite coordinate (" + describe_nonfinite(xyz[k]) + ")");
+        raw.positions.insert(raw.positions.end(), xyz, xyz + 3);
+      }
+      if (is_face) {
+        if (raw.corners.size() > std::numeric_limits<uint32_t>::max())
+          return Status::error(what + ": more than 2^32-1 face corners");
+        raw.offsets.push_back(uint32_t(raw.corners.size()));
+      }
+    }
+    have_vertices |= is_vertex;
+    have_faces |= is_face;
+  }
+  return Status::success();
+}
+
+}  // namespace lod::detail
