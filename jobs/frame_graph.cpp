@@ -574,6 +574,16 @@ struct FrameGraph::Impl {
     f.morphing = 0;
     f.tris_morph_extra = 0;
     for (size_t c = 0; c < chunks; ++c) f.morphing += chunk_blend[c].morphing, f.tris_morph_extra += chunk_blend[c].extra_tris;
+    const SelectionParams& so = options.selection;
+    if (so.strict && so.count == BudgetCount::triangles && f.morphing > 0) {
+      const uint64_t room = selected.over_budget || selected.triangles >= so.budget ? 0 : so.budget - selected.triangles;
+      if (f.tris_morph_extra > room) {
+        const BlendTotals kept = fit_blends_to_room(f.morph, f.from_levels, f.objects, f.levels, f.models, state,
+                                                    set->models, room);
+        f.morphing = kept.morphing;
+        f.tris_morph_extra = kept.extra_tris;
+      }
+    }
     last_morph_extra = f.tris_morph_extra;
   }
 
@@ -822,7 +832,7 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      &Impl::node_selection},
     {Stage::entries, "handles, transforms, view masks of the entries, parallel", kEntries | kObjects | kVisibility,
      kPlacing, &Impl::node_entries},
-    {Stage::geomorph, "advance_level_blends, parallel", kEntries | kLevels | kHistory, kBlend, &Impl::node_geomorph},
+    {Stage::geomorph, "advance_level_blends, parallel; strict budgets: fit_blends_to_room, serial", kEntries | kLevels | kHistory, kBlend, &Impl::node_geomorph},
     {Stage::vdlod, "front_update per visible view-dependent object (view 0), parallel",
      kEntries | kPlacing | kLevels | kViews, kFronts, &Impl::node_vdlod},
     {Stage::vd_mesh, "vertex_morph_positions + compact meshes of vd objects, parallel", kEntries | kFronts, kVdMesh,

@@ -170,7 +170,7 @@ void read_run(const Reader& r, const toml::table& root, SceneConfig& c) {
 void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "budget", "budget");
   if (!t) return;
-  r.only_keys(*t, "budget", {"triangles", "count", "reserve_blends"});
+  r.only_keys(*t, "budget", {"triangles", "count", "reserve_blends", "strict"});
   if (auto v = r.integer(*t, "triangles", "budget.triangles")) {
     if (*v <= 0) r.fail("budget.triangles", "must be at least 1, got " + std::to_string(*v));
     c.selection.budget = static_cast<uint64_t>(*v);
@@ -188,6 +188,13 @@ void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
     if (!b) r.fail("budget.reserve_blends", "must be true or false");
     else c.selection.reserve_blends = b->get();
   }
+  if (const toml::node* n = t->get("strict")) {
+    const auto* b = n->as_boolean();
+    if (!b) r.fail("budget.strict", "must be true or false");
+    else c.selection.strict = b->get();
+  }
+  if (c.selection.strict && c.selection.count != BudgetCount::triangles)
+    r.fail("budget.strict", "needs count = \"triangles\" (blends are counted in triangles)");
 }
 
 void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {

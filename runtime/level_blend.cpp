@@ -39,4 +39,26 @@ BlendTotals advance_level_blends(std::span<float> morph, std::span<uint8_t> from
   return totals;
 }
 
+BlendTotals fit_blends_to_room(std::span<float> morph, std::span<uint8_t> from_level, std::span<const uint32_t> ids,
+                               std::span<const uint8_t> level, std::span<const uint32_t> model,
+                               const LevelBlendState& s, const ModelTable& models, uint64_t room) {
+  BlendTotals kept;
+  for (size_t k = 0; k < ids.size(); ++k) {
+    const uint8_t lv = level[k], from = from_level[k];
+    if (from == lv) continue;
+    const uint32_t first = models.first_level[model[k]];
+    const uint64_t extra = models.triangles[first + std::min(lv, from)] - models.triangles[first + lv];
+    if (kept.extra_tris + extra <= room) {
+      ++kept.morphing;
+      kept.extra_tris += extra;
+      continue;
+    }
+    from_level[k] = lv;  // dropped: settled at the new level from now on
+    morph[k] = 1;
+    s.morph_start[ids[k]] = -1e300;
+    s.morph_from[ids[k]] = lv;
+  }
+  return kept;
+}
+
 }  // namespace lod

@@ -32,4 +32,12 @@ BlendTotals advance_level_blends(std::span<float> morph, std::span<uint8_t> from
                                  std::span<const uint8_t> model_blends, const ModelTable& models, double now,
                                  float seconds);
 
+// Strict budgets: keeps blends, in entry order, while what they add to the selected
+// triangles fits `room` (M minus the selected triangles); every other blend is dropped (the
+// object shows its new level at once and is settled). Serial: the budget is global. Returns
+// the totals of the blends kept.
+BlendTotals fit_blends_to_room(std::span<float> morph, std::span<uint8_t> from_level, std::span<const uint32_t> ids,
+                               std::span<const uint8_t> level, std::span<const uint32_t> model,
+                               const LevelBlendState& state, const ModelTable& models, uint64_t room);
+
 }  // namespace lod

@@ -23,6 +23,9 @@ struct SelectionParams {
   // For the frame graph (triangle budgets): objects blending two levels draw the finer one,
   // so last frame's extra is held back from M (at most M / 2) to keep what is drawn near M.
   bool reserve_blends = true;
+  // Strict (triangle budgets): what is drawn, blends included, stays within M whenever the
+  // coarsest levels fit; a blend that does not fit is dropped (the level changes at once).
+  bool strict = false;
 };
 
 struct HeapEntry {

@@ -74,6 +74,7 @@ struct ServiceOptions {
   uint64_t budget = 2000000;         // M
   BudgetUnit budget_unit = BudgetUnit::triangles;
   bool reserve_blends = true;        // hold last frame's blend extra back from M
+  bool strict_budget = false;        // drawn triangles, blends included, <= M whenever the coarsest levels fit
   float pixel_error = 1.0f;          // screen-space error wanted before the budget applies
   float hysteresis = 0.25f;          // relative band against level flicker
   float blend_seconds = 0.25f;       // level changes, splits and collapses blend this long

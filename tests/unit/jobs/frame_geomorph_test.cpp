@@ -195,3 +195,42 @@ TEST(FrameGeomorph, NoGeomorphTimeMeansNothingBlends) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+// A budget cut makes many objects coarsen at once: their blends draw the finer level, which
+// takes what is drawn over M. Strict mode drops the blends that do not fit.
+TEST(FrameGeomorphStrict, WhatIsDrawnStaysWithinTheBudget) {
+  const Scene scene = test::synthetic_scene(3000, 250);
+  const CameraPath path = test::synthetic_config(3000, 250).camera;
+  for (bool strict : {false, true}) {
+    SCOPED_TRACE(strict ? "strict" : "not strict");
+    FrameGraphOptions o = still_levels_options();
+    o.selection.strict = strict;
+    FrameGraph g(scene, o);
+    Frame f;
+    g.run(view_at(path, 0), f);
+    const uint64_t budget = f.tris_selected / 3;
+    g.set_budget(budget);
+    uint64_t worst = 0, blends = 0;
+    for (uint32_t n = 1; n < 60; ++n) {
+      g.run(view_at(path, n), f);
+      ASSERT_FALSE(f.over_budget);
+      uint32_t morphing = 0;
+      EXPECT_EQ(extra_of(scene, f, &morphing), f.tris_morph_extra) << "the frame's own count of what blends add";
+      EXPECT_EQ(morphing, f.morphing);
+      worst = std::max(worst, f.tris_selected + f.tris_morph_extra);
+      blends += f.morphing;
+    }
+    if (strict) {
+      EXPECT_LE(worst, budget);
+      EXPECT_GT(blends, 0u) << "blends that fit still run";
+    } else {
+      EXPECT_GT(worst, budget) << "without strict mode this scene draws over M (else the test shows nothing)";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lod

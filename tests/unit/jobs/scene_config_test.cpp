@@ -454,3 +454,18 @@ TEST(SceneConfigMotion, RefusesBadMotion) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+TEST(SceneConfigStrict, ParsesAndRefusesBudgetStrict) {
+  ConfigDir d;
+  SceneConfig c;
+  ASSERT_TRUE(load(d, "[budget]\nstrict = true\n" + kModel + kInstances, c).ok);
+  EXPECT_TRUE(c.selection.strict);
+  expect_refused("[budget]\nstrict = 1\n" + kModel + kInstances, "budget.strict", "true or false");
+  expect_refused("[budget]\nstrict = true\ncount = \"levels\"\n" + kModel + kInstances, "budget.strict", "triangles");
+}
+
+}  // namespace
+}  // namespace lod
