@@ -236,7 +236,7 @@ Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, V
   take(t.inc_offsets, inner + 1);
   take(t.inc_faces, inc);
   std::string message;
-  if (!validate_vertex_tree(t, &message)) return refuse(what, "hierarchy: " + message);
+  if (!validate_vertex_tree(t, &message)) return refuse(what, "VHIE section: " + message);
   pack_vertex_bounds(t);
   out = std::move(t);
   return Status::success();
@@ -448,12 +448,16 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     get_words(p + mrph.offset, want, chain.morph_targets);
   }
   std::string message;
-  if (!validate_chain(chain, &message)) return refuse(what, message);
+  const char* section = "LEVL";
+  if (!validate_chain(chain, &message, &section)) return refuse(what, std::string(section) + " section: " + message);
   if (vhie.present) {
     if (Status st = get_hierarchy(p + vhie.offset, vhie.size, what, chain.hierarchy); !st) return st;
-    if (!chain.levels.empty() && chain.hierarchy.leaf_count != chain.levels[0].vertex_count)
-      return refuse(what, "hierarchy has " + std::to_string(chain.hierarchy.leaf_count) + " leaves but level 0 has " +
+    if (!chain.levels.empty() && chain.hierarchy.leaf_count != chain.levels[0].vertex_count) {
+      const std::string leaves = std::to_string(chain.hierarchy.leaf_count);
+      chain.hierarchy = VertexTree{};
+      return refuse(what, "VHIE section: hierarchy has " + leaves + " leaves but level 0 has " +
                               std::to_string(chain.levels[0].vertex_count) + " vertices");
+    }
   }
   out = std::move(chain);
   return Status::success();

@@ -24,9 +24,12 @@ bool fail(std::string* message, std::string text) {
   return false;
 }
 
+// Finite and far from float's limits (bounds are scaled, summed and squared downstream).
+bool finite_sane(float x) { return std::isfinite(x) && std::abs(x) <= kMaxTreeMagnitude; }
+
 bool all_finite(const std::vector<float>& values, size_t* bad) {
   for (size_t i = 0; i < values.size(); ++i) {
-    if (!std::isfinite(values[i])) {
+    if (!finite_sane(values[i])) {
       *bad = i;
       return false;
     }
@@ -36,22 +39,34 @@ bool all_finite(const std::vector<float>& values, size_t* bad) {
 
 }  // namespace
 
-bool validate_chain(const LodChain& chain, std::string* message) {
+bool validate_chain(const LodChain& chain, std::string* message, const char** section) {
+  // Which asset section the failing element lives in (for the asset reader's message).
+  auto in = [&](const char* tag) {
+    if (section) *section = tag;
+  };
+  in("LEVL");
   if (chain.levels.empty()) return fail(message, "chain has no levels");
   if (chain.levels.size() > kMaxLevels)
     return fail(message, "chain has " + std::to_string(chain.levels.size()) + " levels, at most " +
                              std::to_string(kMaxLevels) + " are supported");
+  in("POSN");
   if (chain.positions.size() % 3 != 0)
     return fail(message, "positions hold " + std::to_string(chain.positions.size()) +
                              " floats, not a multiple of 3");
+  in("NRML");
   if (!chain.normals.empty() && chain.normals.size() != chain.positions.size())
     return fail(message, "normals hold " + std::to_string(chain.normals.size()) + " floats but positions " +
                              std::to_string(chain.positions.size()));
   size_t bad = 0;
+  in("POSN");
   if (!all_finite(chain.positions, &bad))
-    return fail(message, "vertex " + std::to_string(bad / 3) + " has a non-finite position");
+    return fail(message, "vertex " + std::to_string(bad / 3) + " has a " +
+                             (std::isfinite(chain.positions[bad]) ? "huge (beyond 1e18)" : "non-finite") + " position");
+  in("NRML");
   if (!all_finite(chain.normals, &bad))
-    return fail(message, "vertex " + std::to_string(bad / 3) + " has a non-finite normal");
+    return fail(message, "vertex " + std::to_string(bad / 3) + " has a " +
+                             (std::isfinite(chain.normals[bad]) ? "huge (beyond 1e18)" : "non-finite") + " normal");
+  in("LEVL");
 
   const uint64_t vertex_total = chain.positions.size() / 3;
   const uint64_t index_total = chain.indices.size();
@@ -70,20 +85,22 @@ bool validate_chain(const LodChain& chain, std::string* message) {
                                ") exceed the " + std::to_string(vertex_total) + " stored");
     const uint32_t* idx = chain.indices.data() + lv.first_index;
     for (uint32_t i = 0; i < lv.index_count; ++i) {
-      if (idx[i] >= lv.vertex_count)
+      if (idx[i] >= lv.vertex_count) {
+        in("INDX");
         return fail(message, at + " index " + std::to_string(i) + " references vertex " +
                                  std::to_string(idx[i]) + " of " + std::to_string(lv.vertex_count));
+      }
     }
     if (lv.level != level_of_triangles(lv.triangles()))
       return fail(message, at + " says l = " + std::to_string(lv.level) + " but its " +
                                std::to_string(lv.triangles()) + " triangles give l = " +
                                std::to_string(level_of_triangles(lv.triangles())));
-    if (!std::isfinite(lv.error) || lv.error < 0 || !std::isfinite(lv.error_rms) || lv.error_rms < 0)
+    if (!finite_sane(lv.error) || lv.error < 0 || !finite_sane(lv.error_rms) || lv.error_rms < 0)
       return fail(message, at + " has an invalid error (" + std::to_string(lv.error) + ", rms " +
                                std::to_string(lv.error_rms) + ")");
     const Sphere& s = lv.bounds;
-    if (!std::isfinite(s.center[0]) || !std::isfinite(s.center[1]) || !std::isfinite(s.center[2]) ||
-        !std::isfinite(s.radius) || s.radius < 0)
+    if (!finite_sane(s.center[0]) || !finite_sane(s.center[1]) || !finite_sane(s.center[2]) ||
+        !finite_sane(s.radius) || s.radius < 0)
       return fail(message, at + " has an invalid bounding sphere");
     if (k > 0) {
       const LodLevel& finer = chain.levels[k - 1];
@@ -95,6 +112,7 @@ bool validate_chain(const LodChain& chain, std::string* message) {
                                  std::to_string(k - 1) + "'s " + std::to_string(finer.error));
     }
   }
+  in("MRPH");
   if (!chain.morph_targets.empty()) {
     const uint64_t want = morph_target_count(chain);
     if (chain.morph_targets.size() != want)

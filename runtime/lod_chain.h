@@ -55,7 +55,9 @@ int32_t level_of_triangles(uint64_t triangles);
 // vertex 90211 of 35947"); callers prefix the file.
 // With morph targets: one per vertex of every level but the last, each < the next level's
 // vertex_count ("level 2 vertex 17 morphs into vertex 900 of level 3's 812").
-bool validate_chain(const LodChain& chain, std::string* message);
+// Values must be finite and at most kMaxTreeMagnitude in size. `section`, when given, is set
+// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH") the failing element is in.
+bool validate_chain(const LodChain& chain, std::string* message, const char** section = nullptr);
 
 // Number of morph targets a chain with these levels stores: up to the end of the last
 // vertex range of the levels but the last (their vertex total when levels are back to back).

@@ -32,6 +32,100 @@ bool check_csr(const std::vector<uint32_t>& offsets, size_t rows, size_t values,
   return true;
 }
 
+// Replays the build's collapses in node order (a valid order by construction: children and
+// dependencies come first) and checks that every node's arrays are what that collapse makes:
+// its split faces are the faces on its edge, with one corner under each child and the third
+// at the wing; its incident faces are exactly the faces alive after the collapse with a corner
+// below it (each with exactly one such corner: front_update rewrites that corner alone); its
+// dependencies are exactly its neighbours then (the corners of those faces and the wings). So
+// every dependency is active when the node is made and its parent comes later, which bounds
+// force_split's climb (each forced split goes to a later node), and the split and collapse of
+// a front touch exactly the faces they must. Base faces keep three distinct roots. Union-find
+// over the collapses: linear in the arrays.
+bool check_collapse_order(const VertexTree& t, std::string* message) {
+  const uint32_t n = t.node_count(), leaves = t.leaf_count;
+  std::vector<uint32_t> rep(n);
+  for (uint32_t v = 0; v < n; ++v) rep[v] = v;
+  auto find = [&](uint32_t v) {
+    while (rep[v] != v) v = rep[v] = rep[rep[v]];
+    return v;
+  };
+  // Per active node: faces alive with a corner below it.
+  std::vector<uint32_t> alive(n, 0);
+  for (uint32_t l : t.face_leaves) ++alive[l];
+  std::vector<uint32_t> face_mark(t.face_count, kNoNode), near(n, kNoNode), dep_mark(n, kNoNode);
+  for (uint32_t v = leaves; v < n; ++v) {
+    const size_t i = v - leaves;
+    const uint32_t c1 = t.children[2 * i], c2 = t.children[2 * i + 1];
+    uint32_t made = 0;
+    for (int k = 0; k < 2; ++k) {
+      const uint32_t f = t.split_faces[2 * i + k];
+      if (f == kNoNode) continue;
+      ++made;
+      const uint32_t w = t.wings[2 * i + k];
+      uint32_t at_c1 = 0, at_c2 = 0, at_w = 0;
+      for (int j = 0; j < 3; ++j) {
+        const uint32_t r = find(t.face_leaves[3 * size_t(f) + j]);
+        at_c1 += r == c1, at_c2 += r == c2, at_w += r == w;
+      }
+      if (at_c1 != 1 || at_c2 != 1 || at_w != 1)
+        return fail(message, "node " + num(v) + " split face " + num(f) + " does not join its children " +
+                                 num(c1) + ", " + num(c2) + " and its wing " + num(w));
+      --alive[w];
+    }
+    rep[c1] = rep[c2] = v;
+    const uint64_t expect = uint64_t(alive[c1]) + alive[c2] - 2 * made;
+    const uint32_t lo = t.inc_offsets[i], hi = t.inc_offsets[i + 1];
+    if (hi - lo != expect)
+      return fail(message, "node " + num(v) + " lists " + num(hi - lo) + " incident faces but has " + num(expect));
+    alive[v] = static_cast<uint32_t>(expect);
+    uint32_t neighbours = 0;
+    auto meet = [&](uint32_t u) {
+      if (near[u] != v) near[u] = v, ++neighbours;
+    };
+    for (uint32_t k = lo; k < hi; ++k) {
+      const uint32_t f = t.inc_faces[k];
+      if (face_mark[f] == v) return fail(message, "node " + num(v) + " lists incident face " + num(f) + " twice");
+      face_mark[f] = v;
+      if (t.face_owner[f] != kNoNode && t.face_owner[f] <= v)
+        return fail(message, "node " + num(v) + " incident face " + num(f) + " is gone by then (made by node " +
+                                 num(t.face_owner[f]) + ")");
+      uint32_t below = 0;
+      for (int j = 0; j < 3; ++j) {
+        const uint32_t r = find(t.face_leaves[3 * size_t(f) + j]);
+        if (r == v)
+          ++below;
+        else
+          meet(r);
+      }
+      if (below != 1)
+        return fail(message, "node " + num(v) + " incident face " + num(f) + " has " + num(below) +
+                                 " corners below it, not 1");
+    }
+    for (int k = 0; k < 2; ++k)
+      if (t.wings[2 * i + k] != kNoNode) meet(t.wings[2 * i + k]);
+    const uint32_t dlo = t.dep_offsets[i], dhi = t.dep_offsets[i + 1];
+    for (uint32_t k = dlo; k < dhi; ++k) {
+      const uint32_t d = t.deps[k];
+      if (d >= n || near[d] != v)
+        return fail(message, "node " + num(v) + " dependency " + num(d) + " is not one of its neighbours");
+      if (dep_mark[d] == v) return fail(message, "node " + num(v) + " lists dependency " + num(d) + " twice");
+      dep_mark[d] = v;
+    }
+    if (dhi - dlo != neighbours)
+      return fail(message, "node " + num(v) + " lists " + num(dhi - dlo) + " dependencies but has " +
+                               num(neighbours) + " neighbours");
+  }
+  for (uint32_t f = 0; f < t.face_count; ++f) {
+    if (t.face_owner[f] != kNoNode) continue;
+    const uint32_t a = find(t.face_leaves[3 * size_t(f)]), b = find(t.face_leaves[3 * size_t(f) + 1]),
+                   c = find(t.face_leaves[3 * size_t(f) + 2]);
+    if (a == b || b == c || a == c)
+      return fail(message, "base face " + num(f) + " has two corners under one root");
+  }
+  return true;
+}
+
 }  // namespace
 
 bool validate_vertex_tree(const VertexTree& t, std::string* message) {
@@ -55,22 +149,31 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
   if (!check_csr(t.dep_offsets, inner, t.deps.size(), "dependency", message)) return false;
   if (!check_csr(t.inc_offsets, inner, t.inc_faces.size(), "incidence", message)) return false;
 
+  // Finite and far from float's limits: the front squares and sums these (its extent, reach
+  // and bucket indices must stay finite).
+  auto sane = [](float x) { return std::isfinite(x) && std::abs(x) <= kMaxTreeMagnitude; };
   for (size_t i = 0; i < 3 * n; ++i)
-    if (!std::isfinite(t.positions[i]) || !std::isfinite(t.cone_axis[i]))
-      return fail(message, "node " + num(i / 3) + " has a non-finite position or cone");
+    if (!sane(t.positions[i]) || !std::isfinite(t.cone_axis[i]))
+      return fail(message, "node " + num(i / 3) + " has a non-finite or huge position, or a non-finite cone");
   for (size_t v = 0; v < n; ++v) {
-    if (!std::isfinite(t.radius[v]) || !(t.radius[v] >= 0) || !std::isfinite(t.error[v]) ||
-        !(t.error[v] >= 0) || !std::isfinite(t.cone_cos[v]))
+    if (!sane(t.radius[v]) || !(t.radius[v] >= 0) || !sane(t.error[v]) || !(t.error[v] >= 0) ||
+        !std::isfinite(t.cone_cos[v]))
       return fail(message, "node " + num(v) + " has a bad radius, error or cone angle");
     const uint32_t p = t.parent[v];
     if (p != kNoNode && (p >= n || p <= v || p < t.leaf_count))
       return fail(message, "node " + num(v) + " has parent " + num(p) + " of " + num(n));
+    if (p != kNoNode && t.children[2 * size_t(p - t.leaf_count)] != v &&
+        t.children[2 * size_t(p - t.leaf_count) + 1] != v)
+      return fail(message, "node " + num(v) + " has parent " + num(p) + " which does not list it as a child");
     if (t.leaf_lo[v] > t.leaf_hi[v] || t.leaf_hi[v] > t.leaf_count)
       return fail(message, "node " + num(v) + " has leaf range [" + num(t.leaf_lo[v]) + ", " +
                                num(t.leaf_hi[v]) + ")");
   }
+  std::vector<uint8_t> rank_seen(t.leaf_count, 0);
   for (uint32_t l = 0; l < t.leaf_count; ++l) {
     if (t.leaf_rank[l] >= t.leaf_count) return fail(message, "leaf " + num(l) + " has rank out of range");
+    if (rank_seen[t.leaf_rank[l]]++)
+      return fail(message, "leaf " + num(l) + " has rank " + num(t.leaf_rank[l]) + " of another leaf");
     if (t.leaf_lo[l] != t.leaf_rank[l] || t.leaf_hi[l] != t.leaf_rank[l] + 1)
       return fail(message, "leaf " + num(l) + " range does not match its rank");
   }
@@ -90,6 +193,8 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
         return fail(message, "node " + num(v) + " wing " + num(w) + " of " + num(n) + " is out of range");
     }
     if (t.split_faces[2 * i] == kNoNode) return fail(message, "node " + num(v) + " creates no face");
+    if (t.split_faces[2 * i] == t.split_faces[2 * i + 1])
+      return fail(message, "node " + num(v) + " creates face " + num(t.split_faces[2 * i]) + " twice");
     const uint32_t a = t.children[2 * i], b = t.children[2 * i + 1];
     if (t.leaf_lo[v] != std::min(t.leaf_lo[a], t.leaf_lo[b]) ||
         t.leaf_hi[v] != std::max(t.leaf_hi[a], t.leaf_hi[b]) ||
@@ -108,6 +213,10 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
       if (t.face_leaves[3 * f + k] >= t.leaf_count)
         return fail(message, "face " + num(f) + " references vertex " + num(t.face_leaves[3 * f + k]) +
                                  " of " + num(t.leaf_count));
+    const uint32_t* l = &t.face_leaves[3 * f];
+    if (l[0] == l[1] || l[1] == l[2] || l[0] == l[2])
+      return fail(message, "face " + num(f) + " repeats a vertex (" + num(l[0]) + ", " + num(l[1]) + ", " +
+                               num(l[2]) + ")");
     const uint32_t o = t.face_owner[f];
     if (o != kNoNode && (o < t.leaf_count || o >= n))
       return fail(message, "face " + num(f) + " owner " + num(o) + " is not an interior node");
@@ -117,7 +226,7 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
         return fail(message, "face " + num(f) + " owner " + num(o) + " does not list it");
     }
   }
-  return true;
+  return check_collapse_order(t, message);
 }
 
 void pack_vertex_bounds(VertexTree& t) {

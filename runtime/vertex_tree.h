@@ -86,9 +86,16 @@ struct VertexTree {
   bool empty() const { return parent.empty(); }
 };
 
+// Largest magnitude of a node position, radius or error a tree may hold (the front sums and
+// squares them in float and double and must stay finite).
+inline constexpr float kMaxTreeMagnitude = 1e18f;
+
 // Checks sizes, id ranges, parent/child agreement, ids increasing towards the roots, leaf
-// intervals, split faces owned by their node and finite values. On failure `message` names
-// the element ("node 812 child 90211 of 35947"); callers prefix the file.
+// intervals (ranks a permutation), split faces owned by their node, finite values within
+// kMaxTreeMagnitude, and replays the collapses in node order: split faces, wings, incident
+// faces and dependencies must be exactly what each collapse makes (what front_update and its
+// forced splits rely on). Linear in the arrays. On failure `message` names the element
+// ("node 812 child 90211 of 35947"); callers prefix the file.
 bool validate_vertex_tree(const VertexTree& tree, std::string* message);
 
 // Fills tree.bounds from the per-node arrays. Builders and readers call it; fronts need it.

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -154,7 +155,7 @@ TEST(LodAsset, RefusesInvalidChainWithCorrectChecksumNamingTheElement) {
   LodChain out = sentinel();
   const Status st = decode_lod_asset(encode_lod_asset(c), "bunny.lod", out);
   ASSERT_FALSE(st);
-  EXPECT_EQ(st.message, "bunny.lod: level 1 index 4 references vertex 9 of 5");
+  EXPECT_EQ(st.message, "bunny.lod: INDX section: level 1 index 4 references vertex 9 of 5");
   EXPECT_EQ(out.name, "untouched");
 }
 
@@ -261,8 +262,51 @@ TEST(LodAsset, RefusesMorphTargetOutOfRangeNamingLevelAndVertex) {
   LodChain out = sentinel();
   const Status st = decode_lod_asset(encode_lod_asset(c), "bunny.lod", out);
   ASSERT_FALSE(st);
-  EXPECT_EQ(st.message, "bunny.lod: level 1 vertex 3 morphs into vertex 40 of level 2's 4");
+  EXPECT_EQ(st.message, "bunny.lod: MRPH section: level 1 vertex 3 morphs into vertex 40 of level 2's 4");
   EXPECT_EQ(out.name, "untouched");
+}
+
+
+// Checksum-valid hostile assets (encode checks nothing): each bad field is refused with a
+// message naming its section and the element.
+TEST(LodAsset, HostileFieldsAreRefusedNamingTheSection) {
+  struct Case {
+    const char* expect;
+    std::function<void(LodChain&)> edit;
+  };
+  const Case cases[] = {
+      {"POSN section: vertex 2 has a non-finite position", [](LodChain& c) { c.positions[7] = std::nanf(""); }},
+      {"POSN section: vertex 1 has a huge (beyond 1e18) position", [](LodChain& c) { c.positions[3] = 1e30f; }},
+      {"NRML section: vertex 0 has a non-finite normal", [](LodChain& c) { c.normals[0] = INFINITY; }},
+      {"INDX section: level 0 index 2 references vertex", [](LodChain& c) { c.indices[2] = 1000; }},
+      {"LEVL section: level 1 says l = 9", [](LodChain& c) { c.levels[1].level = 9; }},
+      {"LEVL section: level 2 has an invalid bounding sphere", [](LodChain& c) { c.levels[2].bounds.radius = 3e38f; }},
+      {"LEVL section: level 1 indices", [](LodChain& c) { c.levels[1].first_index = 1u << 30; }},
+      {"LEVL section: level 0 has an invalid error", [](LodChain& c) { c.levels[0].error = -1; }},
+      {"MRPH section: level 0 vertex 1 morphs into vertex", [](LodChain& c) { c.morph_targets[1] = 77; }},
+  };
+  for (const Case& k : cases) {
+    LodChain c = chain_with_targets();
+    k.edit(c);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(encode_lod_asset(c), "bunny.lod", out);
+    ASSERT_FALSE(st) << k.expect;
+    EXPECT_EQ(st.message.rfind(std::string("bunny.lod: ") + k.expect, 0), 0u) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+  // META's counts against the other sections' sizes (bytes edited, checksum fixed).
+  std::vector<uint8_t> bytes = encode_lod_asset(chain_with_targets());
+  uint64_t meta = 0;
+  std::memcpy(&meta, bytes.data() + 16 + 8, 8);
+  const uint64_t vertices = 1ull << 40;
+  std::memcpy(bytes.data() + meta + 16, &vertices, 8);
+  const uint64_t h = hash_bytes(bytes.data(), bytes.size() - 8);
+  std::memcpy(bytes.data() + bytes.size() - 8, &h, 8);
+  LodChain out = sentinel();
+  const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("POSN section is"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("META says 1099511627776"), std::string::npos) << st.message;
 }
 
 }  // namespace
