@@ -19,6 +19,18 @@ namespace {
 inline constexpr int kMaxWindowPixels = 16384;  // per side
 inline constexpr uint32_t kMaxThreads = 1024;
 inline constexpr uint64_t kMaxObjects = 10000000;  // all [[instances]] together
+// Float-fed values: squares and products of two stay finite and normal in float.
+inline constexpr double kMinFloatValue = 1e-15, kMaxFloatValue = 1e15;
+
+// The seed of an [[instances]] block without one: block 0 keeps 1 (as before); later blocks
+// mix their index in, so two blocks in one box do not stack their objects on each other.
+uint64_t default_seed(size_t block) {
+  if (block == 0) return 1;
+  uint64_t z = 1 + 0x9e3779b97f4a7c15ull * block;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return (z ^ (z >> 31)) & 0x7fffffffffffffffull;  // a value `seed = ...` could also give
+}
 
 // Thrown inside the parser only; load_scene_config turns it into a Status.
 struct ConfigError {
@@ -30,6 +42,8 @@ std::string number_text(double v) {
   s << v;
   return s.str();
 }
+
+enum class Fit { float32, any };
 
 class Reader {
  public:
@@ -77,7 +91,10 @@ class Reader {
     }
   }
 
-  std::optional<double> number(const toml::node& n, const std::string& key) const {
+  // A number; `as_float` (every key but run.rate_hz feeds a 32-bit float): also within what
+  // that float and the math on it hold, 0 or a magnitude in [kMinFloatValue, kMaxFloatValue]
+  // (near = 1e-50 would become 0, far = 1e39 infinity, and squares of 1e20 overflow).
+  std::optional<double> number(const toml::node& n, const std::string& key, Fit fit = Fit::float32) const {
     double v = 0;
     if (n.is_integer())
       v = static_cast<double>(n.as_integer()->get());
@@ -86,12 +103,16 @@ class Reader {
     else
       fail(key, "expected a number");
     if (!std::isfinite(v)) fail(key, "must be finite, got " + number_text(v));
+    if (fit == Fit::float32 && v != 0 && (std::abs(v) < kMinFloatValue || std::abs(v) > kMaxFloatValue))
+      fail(key, number_text(v) + " does not fit the 32-bit float it feeds (0 or a magnitude in [" +
+                    number_text(kMinFloatValue) + ", " + number_text(kMaxFloatValue) + "])");
     return v;
   }
-  std::optional<double> number(const toml::table& t, std::string_view name, const std::string& key) const {
+  std::optional<double> number(const toml::table& t, std::string_view name, const std::string& key,
+                               Fit fit = Fit::float32) const {
     const toml::node* n = t.get(name);
     if (!n) return std::nullopt;
-    return number(*n, key);
+    return number(*n, key, fit);
   }
 
   std::optional<std::string> string(const toml::table& t, std::string_view name,
@@ -160,7 +181,7 @@ void read_run(const Reader& r, const toml::table& root, SceneConfig& c) {
   r.only_keys(*t, "run", {"frames", "threads", "rate_hz"});
   r.integer_in(*t, "frames", "run.frames", 1, 100000000, c.frames);
   r.integer_in(*t, "threads", "run.threads", 0, kMaxThreads, c.threads);
-  if (auto v = r.number(*t, "rate_hz", "run.rate_hz")) {
+  if (auto v = r.number(*t, "rate_hz", "run.rate_hz", Fit::any)) {
     if (*v <= 0 || *v > 10000)
       r.fail("run.rate_hz", "must be in (0, 10000] frames per second, got " + number_text(*v));
     c.rate_hz = *v;
@@ -429,6 +450,7 @@ void read_instances(const Reader& r, const toml::table& root, bool required, Sce
       inst.scale_min = static_cast<float>(lo);
       inst.scale_max = static_cast<float>(hi);
     }
+    inst.seed = default_seed(i);
     r.integer_in(t, "seed", key + ".seed", 0, INT64_MAX, inst.seed);
     read_motion(r, t, key, inst);
     c.instances.push_back(inst);

@@ -30,7 +30,7 @@ struct InstanceConfig {
   float box_min[3] = {-500, 0, -500};
   float box_max[3] = {500, 0, 500};
   float scale_min = 1, scale_max = 1;
-  uint64_t seed = 1;
+  uint64_t seed = 1;            // absent: 1 for block 0, a mix of the block index for later ones
   MotionSpec motion;           // motion = "wander" / "orbit" with a speed: moved every frame
 };
 

@@ -68,13 +68,28 @@ View keyframe_view(const CameraPath& path, uint32_t frame) {
   return v;
 }
 
+// A view direction (nearly) parallel to the lens's up vector (a keyframe looking straight
+// down or up) has no basis: glm::lookAt gave NaN planes and Service::set_view refuses it, so
+// every frame saw 0 objects. Such views get the up vector front_view_of falls back to
+// (perpendicular to the view direction), the same on every frame.
+View with_stable_up(View v) {
+  const glm::dvec3 d = glm::dvec3(v.target) - glm::dvec3(v.eye);
+  const glm::dvec3 up(v.up);
+  if (glm::length(d) == 0 || glm::length(up) == 0) return v;
+  const glm::dvec3 f = glm::normalize(d);
+  if (glm::length(glm::cross(f, glm::normalize(up))) >= 1e-3) return v;
+  const glm::dvec3 right = glm::normalize(glm::cross(f, std::abs(f.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+  v.up = glm::vec3(glm::cross(right, f));
+  return v;
+}
+
 }  // namespace
 
 View view_at(const CameraPath& path, uint32_t frame) {
   switch (path.kind) {
-    case PathKind::orbit: return orbit_view(path, frame);
-    case PathKind::flythrough: return flythrough_view(path, frame);
-    case PathKind::keyframes: return keyframe_view(path, frame);
+    case PathKind::orbit: return with_stable_up(orbit_view(path, frame));
+    case PathKind::flythrough: return with_stable_up(flythrough_view(path, frame));
+    case PathKind::keyframes: return with_stable_up(keyframe_view(path, frame));
   }
   return path.lens;
 }

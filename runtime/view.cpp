@@ -8,7 +8,31 @@
 
 namespace lod {
 
-glm::mat4 view_matrix(const View& v) { return glm::lookAt(v.eye, v.target, v.up); }
+glm::mat4 view_matrix(const View& v) {
+  // glm::lookAt's basis, built in double with front_view_of's fallbacks: an up vector parallel
+  // to the view direction (a camera looking straight down with up = +y) or a zero one gives
+  // the basis front_view_of uses instead of NaNs (which culled every object), so the frustum
+  // and the view-dependent fronts agree.
+  using V = glm::dvec3;
+  const V eye(v.eye);
+  V fwd = V(v.target) - eye;
+  fwd = glm::length(fwd) > 0 ? glm::normalize(fwd) : V(0, 0, -1);
+  V right = glm::cross(fwd, V(v.up));
+  if (!(glm::length(right) >= 1e-12))
+    right = glm::cross(fwd, std::abs(fwd.y) < 0.9 ? V(0, 1, 0) : V(1, 0, 0));
+  right = glm::normalize(right);
+  const V up = glm::cross(right, fwd);
+  glm::dmat4 m(1);
+  for (int k = 0; k < 3; ++k) {
+    m[k][0] = right[k];
+    m[k][1] = up[k];
+    m[k][2] = -fwd[k];
+  }
+  m[3][0] = -glm::dot(right, eye);
+  m[3][1] = -glm::dot(up, eye);
+  m[3][2] = glm::dot(fwd, eye);
+  return glm::mat4(m);
+}
 
 glm::mat4 projection_matrix(const View& v) {
   const float aspect = static_cast<float>(v.width) / static_cast<float>(v.height > 0 ? v.height : 1);

@@ -419,6 +419,47 @@ TEST(SceneConfig, RefusesNegativeSeed) {
   expect_refused(kModel + kInstances + "seed = -1\n", "instances[0].seed");
 }
 
+// Finite as double but 0 or infinity as the float they feed (the old reader took them and
+// every frame then saw 0 objects): refused naming the key.
+TEST(SceneConfig, RefusesValuesThatDoNotFitTheirFloat) {
+  const std::string cam = "[camera]\n";
+  expect_refused(kModel + kInstances + cam + "near = 1e-50\n", "camera.near", "does not fit the 32-bit float");
+  expect_refused(kModel + kInstances + cam + "far = 1e39\n", "camera.far", "1e+39");
+  expect_refused(kModel + kInstances + cam + "radius = 1e39\n", "camera.radius");
+  expect_refused(kModel + kInstances + cam + "center = [0, 1e39, 0]\n", "camera.center[1]");
+  expect_refused(kModel + kInstances + "scale = 1e39\n", "instances[0].scale");
+  expect_refused(kModel + kInstances + "scale_range = [1e-40, 1.0]\n", "instances[0].scale_range[0]");
+  expect_refused(kModel + kInstances + "box_max = [1e20, 0, 1]\n", "instances[0].box_max[0]");
+  expect_refused("[lod]\npixel_error = 1e-30\n" + kModel + kInstances, "lod.pixel_error");
+  // Zero and ordinary values are fine.
+  ConfigDir d;
+  SceneConfig c;
+  ASSERT_TRUE(load(d, kModel + kInstances + "box_min = [-1e6, 0, -1e6]\nbox_max = [1e6, 0, 1e6]\n", c).ok);
+}
+
+// Blocks without a seed used to share seed 1: two blocks in one box put their objects on the
+// same spots. Block 0 keeps seed 1; later blocks get distinct ones; a given seed is kept.
+TEST(SceneConfig, InstanceBlocksWithoutASeedGetDistinctSeeds) {
+  ConfigDir d;
+  SceneConfig c;
+  const std::string text = kModel + kInstances + kInstances + kInstances + kInstances + "seed = 1\n";
+  const Status s = load(d, text, c);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(c.instances.size(), 4u);
+  EXPECT_EQ(c.instances[0].seed, 1u);
+  EXPECT_NE(c.instances[1].seed, c.instances[0].seed);
+  EXPECT_NE(c.instances[2].seed, c.instances[1].seed);
+  EXPECT_NE(c.instances[2].seed, c.instances[0].seed);
+  EXPECT_EQ(c.instances[3].seed, 1u);
+  SceneConfig again;
+  ASSERT_TRUE(load(d, text, again).ok);
+  EXPECT_EQ(again.instances[1].seed, c.instances[1].seed);  // deterministic
+}
+
+TEST(SceneConfig, RefusesRepeatedRatios) {
+  expect_refused(kModel + "ratios = [1.0, 0.5, 0.5]\n" + kInstances, "model[0].ratios[2]", "must decrease");
+}
+
 TEST(SceneConfig, DefaultDataDirIsTheCompiledInOne) { EXPECT_EQ(default_data_dir(), fs::path(LOD_DATA_DIR)); }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "runtime/camera_path.h"
 #include "runtime/view.h"
 
@@ -129,6 +131,40 @@ TEST(CameraPath, SingleKeyframeHoldsForever) {
   p.keyframes = {{5, {1, 2, 3}, {4, 5, 6}}};
   EXPECT_EQ(view_at(p, 0).eye, glm::vec3(1, 2, 3));
   EXPECT_EQ(view_at(p, 99).target, glm::vec3(4, 5, 6));
+}
+
+
+// A keyframe looking straight down (up = +y, parallel to the view direction): glm::lookAt gave
+// NaN planes and every object was culled. The basis falls back to front_view_of's.
+TEST(CameraPath, LookingStraightDownHasAStableFrustum) {
+  CameraPath p;
+  p.kind = PathKind::keyframes;
+  p.keyframes = {{0, {0, 100, 0}, {0, 0, 0}}};
+  const View v = view_at(p, 0);
+  // The path gives an up vector the service accepts (perpendicular to the view direction).
+  const char* why = nullptr;
+  EXPECT_TRUE(camera_valid(camera_of(v), &why)) << why;
+  EXPECT_NEAR(glm::dot(v.up, glm::normalize(v.target - v.eye)), 0.f, 1e-6f);
+  View raw = v;
+  raw.up = {0, 1, 0};  // and view_matrix itself copes with a parallel up
+  for (const glm::vec4& pl : frustum_of(raw).planes) EXPECT_GT(plane_distance(pl, {0, 0, 0}), 0.f);
+  const Frustum f = frustum_of(v);
+  for (const glm::vec4& pl : f.planes)
+    for (int k = 0; k < 4; ++k) ASSERT_TRUE(std::isfinite(pl[k]));
+  for (const glm::vec3 x : {glm::vec3(0, 0, 0), glm::vec3(5, 0, 5), glm::vec3(-5, 10, 3)})
+    for (const glm::vec4& pl : f.planes) EXPECT_GT(plane_distance(pl, x), 0.f) << x.x << " " << x.z;
+  EXPECT_LT(plane_distance(f.planes[4], {0, 101, 0}), 0.f);  // behind the eye
+  const glm::vec4 clip = projection_matrix(v) * view_matrix(v) * glm::vec4(v.target, 1.f);
+  EXPECT_NEAR(clip.x / clip.w, 0.f, 1e-5f);
+  EXPECT_NEAR(clip.y / clip.w, 0.f, 1e-5f);
+  // Looking straight up too, and the ordinary case is glm::lookAt's matrix.
+  View up = v;
+  up.eye = {0, -100, 0};
+  for (const glm::vec4& pl : frustum_of(up).planes) EXPECT_GT(plane_distance(pl, {0, 0, 0}), 0.f);
+  const View t = test_view();
+  const glm::mat4 a = view_matrix(t), b = glm::lookAt(t.eye, t.target, t.up);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(a[c][r], b[c][r], 1e-4f);
 }
 
 }  // namespace
