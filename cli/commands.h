@@ -31,9 +31,10 @@ struct BakeArgs {
   std::string out_dir;
   std::vector<float> ratios;
   std::string method = "auto";
-  uint32_t threads = 0;
+  int64_t threads = 0;
   bool measure = false;
   bool json = false;
+  bool quiet = false;  // nothing but errors (no progress, no table)
 };
 int bake_command(const BakeArgs& args);
 

@@ -4,18 +4,21 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/names.h"
 #include "preprocess/mesh_io.h"
 #include "runtime/lod_asset.h"
 
 namespace lod::cli {
 
 int inspect_command(const InspectArgs& args) {
+  const std::string shown_file = printable(args.file);
   LodChain chain;
   if (auto st = read_lod_asset(args.file, chain); !st) {
-    std::fprintf(stderr, "lod inspect: %s\n", st.message.c_str());
+    std::fprintf(stderr, "lod inspect: %s\n", printable(st.message).c_str());
     return 1;
   }
-  const auto bytes = std::filesystem::file_size(args.file);
+  std::error_code size_error;
+  const auto bytes = std::filesystem::file_size(args.file, size_error);
   const double full = chain.levels.empty() ? 1.0 : double(std::max(1u, chain.levels[0].triangles()));
   if (args.json) {
     nlohmann::json j;
@@ -41,9 +44,12 @@ int inspect_command(const InspectArgs& args) {
                              {"bounds", {l.bounds.center[0], l.bounds.center[1], l.bounds.center[2], l.bounds.radius}},
                              {"bytes", l.vertex_count * 24ull + l.index_count * 4ull}});
     }
-    std::printf("%s\n", j.dump(1).c_str());
+    // Names and paths are bytes: invalid UTF-8 is replaced (U+FFFD) rather than aborting the
+    // dump; JSON escapes control characters itself.
+    std::printf("%s\n", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
-    std::printf("%s: model '%s', asset v%u, %llu bytes, source hash %016llx\n", args.file.c_str(), chain.name.c_str(),
+    std::printf("%s: model '%s', asset v%u, %llu bytes, source hash %016llx\n", shown_file.c_str(),
+                printable(chain.name).c_str(),
                 kLodAssetVersion, (unsigned long long)bytes, (unsigned long long)chain.source_hash);
     std::printf("%5s %10s %9s %8s %4s %12s %12s %10s %10s\n", "level", "triangles", "vertices", "ratio", "l",
                 "error", "error_rms", "radius", "bytes");
@@ -63,16 +69,24 @@ int inspect_command(const InspectArgs& args) {
   if (!args.export_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(args.export_dir, ec);
+    if (ec || !std::filesystem::is_directory(args.export_dir)) {
+      std::fprintf(stderr, "lod inspect: --export %s: cannot create the folder%s%s\n", printable(args.export_dir).c_str(),
+                   ec ? ": " : " (a file is in the way)", ec ? ec.message().c_str() : "");
+      return 1;
+    }
+    // The model name is data from the asset, never a path: only a sanitised form of it names
+    // the files, and always directly inside the export folder.
+    const std::string stem = export_stem(chain.name);
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
-      const auto out = std::filesystem::path(args.export_dir) / (chain.name + "-level" + std::to_string(i) + ".ply");
+      const auto out = std::filesystem::path(args.export_dir) / (stem + "-level" + std::to_string(i) + ".ply");
       auto st = save_ply(out, chain.positions.data() + size_t(l.first_vertex) * 3, l.vertex_count,
                          chain.indices.data() + l.first_index, l.index_count);
       if (!st) {
-        std::fprintf(stderr, "lod inspect: %s\n", st.message.c_str());
+        std::fprintf(stderr, "lod inspect: %s\n", printable(st.message).c_str());
         return 1;
       }
-      if (!args.json) std::printf("exported %s\n", out.c_str());
+      if (!args.json) std::printf("exported %s\n", printable(out.string()).c_str());
     }
   }
   return 0;

@@ -10,8 +10,12 @@ int main(int argc, char** argv) {
   lod::cli::RunArgs run;
   auto* run_cmd = app.add_subcommand("run", "bake what the scene needs (cached), then run the LOD service headless");
   run_cmd->add_option("--config", run.config, "scene config (TOML)")->required();
-  run_cmd->add_option("--frames", run.frames, "frames along the camera path (default: config)");
-  run_cmd->add_option("--threads", run.threads, "worker threads, 0 = all cores (default: config)");
+  // Ranges checked here: -1 is only the internal "not given" (an explicit negative count is
+  // refused, not read as "use the config").
+  run_cmd->add_option("--frames", run.frames, "frames along the camera path (default: config)")
+      ->check(CLI::Range(int64_t{1}, int64_t{100000000}));
+  run_cmd->add_option("--threads", run.threads, "worker threads, 0 = all cores (default: config)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1024}));
   run_cmd->add_option("--data", run.data_dir, "mesh directory searched after the config's folder");
   run_cmd->add_option("--cache", run.cache_dir, "baked asset cache (default: $LOD_CACHE_DIR or <data>/../cache)");
   run_cmd->add_option("--json", run.json_file, "write per-frame figures and a summary as JSON");
@@ -32,9 +36,11 @@ int main(int argc, char** argv) {
   bake_cmd->add_option("--ratios", bake.ratios, "level ratios, 1.0 first (default: by size, as R0)");
   bake_cmd->add_option("--method", bake.method, "qem | extreme | auto")
       ->check(CLI::IsMember({"qem", "extreme", "auto"}));
-  bake_cmd->add_option("--threads", bake.threads, "worker threads, 0 = all cores");
+  bake_cmd->add_option("--threads", bake.threads, "worker threads, 0 = all cores")
+      ->check(CLI::Range(int64_t{0}, int64_t{1024}));
   bake_cmd->add_flag("--measure", bake.measure, "print each level's measured error");
   bake_cmd->add_flag("--json", bake.json, "print JSON");
+  bake_cmd->add_flag("--quiet", bake.quiet, "print nothing but errors");
 
   CLI11_PARSE(app, argc, argv);
   if (run_cmd->parsed()) return lod::cli::run_command(run);

@@ -20,6 +20,8 @@
 // The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
 #include "runtime/lod_asset.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -29,6 +31,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <new>
 #include <string_view>
 #include <system_error>
 
@@ -497,14 +500,39 @@ Status write_lod_asset(const std::filesystem::path& path, const LodChain& chain)
 }
 
 Status read_lod_asset(const std::filesystem::path& path, LodChain& out) {
-  std::ifstream f(path, std::ios::binary | std::ios::ate);
-  if (!f) return refuse(path.string(), std::string("cannot open: ") + std::strerror(errno));
-  const std::streamoff end = f.tellg();
-  if (end < 0) return refuse(path.string(), "cannot determine its size");
-  std::vector<uint8_t> bytes(static_cast<size_t>(end));
-  f.seekg(0);
-  if (!bytes.empty() && !f.read(reinterpret_cast<char*>(bytes.data()), end))
-    return refuse(path.string(), "read failed");
+  // Regular files only: opened without blocking (a FIFO named like an asset must not hang the
+  // reader) and checked on the open descriptor, so nothing can swap the file in between.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) return refuse(path.string(), std::string("cannot open: ") + std::strerror(errno));
+  struct FdCloser {
+    int fd;
+    ~FdCloser() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return refuse(path.string(), std::string("cannot stat: ") + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) {
+    const char* kind = S_ISDIR(st.st_mode)    ? "a directory"
+                       : S_ISFIFO(st.st_mode) ? "a FIFO"
+                       : S_ISSOCK(st.st_mode) ? "a socket"
+                       : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                                                                    : "not a regular file";
+    return refuse(path.string(), std::string("is ") + kind + ", not a .lod asset file");
+  }
+  std::vector<uint8_t> bytes;
+  try {
+    bytes.resize(static_cast<size_t>(st.st_size));
+  } catch (const std::bad_alloc&) {
+    return refuse(path.string(), "is " + std::to_string(st.st_size) + " bytes, too large to load");
+  }
+  size_t got = 0;
+  while (got < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return refuse(path.string(), std::string("read failed: ") + std::strerror(errno));
+    if (n == 0) break;  // shrank while reading: decode reports the truncation
+    got += static_cast<size_t>(n);
+  }
+  bytes.resize(got);
   return decode_lod_asset(bytes, path.string(), out);
 }
 

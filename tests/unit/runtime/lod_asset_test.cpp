@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <cmath>
@@ -169,6 +170,22 @@ TEST(LodAsset, ReadingMissingOrEmptyFileNamesIt) {
   st = read_lod_asset(dir / "empty.lod", out);
   ASSERT_FALSE(st);
   EXPECT_NE(st.message.find("empty.lod"), std::string::npos) << st.message;
+}
+
+// A directory used to abort with bad_alloc and a FIFO to hang the reader: both are refused
+// at once, saying what they are.
+TEST(LodAsset, ReadsRegularFilesOnly) {
+  const auto dir = test::temp_dir("asset-kinds");
+  std::filesystem::create_directories(dir / "folder.lod");
+  LodChain out = sentinel();
+  Status st = read_lod_asset(dir / "folder.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("folder.lod: is a directory"), std::string::npos) << st.message;
+  ASSERT_EQ(::mkfifo((dir / "pipe.lod").c_str(), 0600), 0);
+  st = read_lod_asset(dir / "pipe.lod", out);  // no writer: opening it blocking would hang
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("pipe.lod: is a FIFO"), std::string::npos) << st.message;
+  EXPECT_EQ(out.name, "untouched");
 }
 
 TEST(HashBytes, IsDeterministicAndSeeded) {
