@@ -33,6 +33,7 @@
 #include "runtime/derived_columns.h"
 #include "runtime/level_caps.h"
 #include "runtime/object_controls.h"
+#include "runtime/occlusion.h"
 #include "runtime/vd_share.h"
 #include "runtime/vertex_front.h"
 #include "runtime/view_masks.h"
@@ -146,6 +147,8 @@ struct FrameGraph::Impl {
   };
   std::vector<VdModel> vd_models;  // per model with a hierarchy (else default)
   std::vector<uint8_t> has_vd;      // per model: has a hierarchy
+  std::vector<int16_t> occluder_level;  // per model: the level occluders draw, -1 = none
+  std::vector<uint8_t> can_occlude;     // per model: occluder_level >= 0
   bool any_vd = false;
 
   // The fixed scene's objects (FrameGraph(scene)).
@@ -186,6 +189,11 @@ struct FrameGraph::Impl {
   static constexpr size_t kCountLanes = 4;  // interleaved per-level counters (no store chains)
   std::vector<uint32_t> level_counts;       // chunks x kCountLanes x level_total
   std::vector<BlendTotals> chunk_blend;
+  std::vector<std::vector<OccluderCandidate>> chunk_occluders;
+  std::vector<OccluderCandidate> occluders;
+  std::vector<uint32_t> chunk_occluded;
+  OcclusionBuffer occlusion_buffer;
+  OcclusionCamera occlusion_view{};
   uint32_t visible_total = 0;
   uint64_t last_morph_extra = 0;
   uint64_t morph_reserve = 0;
@@ -248,6 +256,17 @@ struct FrameGraph::Impl {
     vd_models.assign(m.model_count(), VdModel{});
     has_vd.assign(m.model_count(), 0);
     any_vd = false;
+    occluder_level.assign(m.model_count(), -1);
+    can_occlude.assign(m.model_count(), 0);
+    for (size_t i = 0; i < m.model_count(); ++i) {
+      const LodChain& chain = *set->chains[i];
+      for (size_t k = 0; k < chain.levels.size() && chain.positions.size() >= 9; ++k) {
+        if (chain.levels[k].triangles() > options.occlusion.occluder_triangles) continue;
+        occluder_level[i] = static_cast<int16_t>(k);
+        can_occlude[i] = 1;
+        break;
+      }
+    }
     for (size_t i = 0; i < m.model_count(); ++i) {
       const LodChain& chain = *set->chains[i];
       model_blends[i] = chain.hierarchy.empty() && can_morph_levels(chain);
@@ -299,6 +318,8 @@ struct FrameGraph::Impl {
     chunk_minima.resize(chunks * kMaxViews);
     chunk_totals.resize(chunks);
     chunk_blend.resize(chunks);
+    chunk_occluders.resize(chunks);
+    chunk_occluded.resize(chunks);
     selection_counts.resize(chunks * level_total);
     level_counts.resize(chunks * kCountLanes * level_total);
   }
@@ -414,6 +435,8 @@ struct FrameGraph::Impl {
       frusta[v] = frustum_of(views[v]);
       focal[v] = focal_pixels(views[v]);
     }
+    if (options.occlusion.enabled)
+      occlusion_view = occlusion_camera(views[0], options.occlusion.width, options.occlusion.height);
   }
 
   void node_visibility() {
@@ -426,13 +449,59 @@ struct FrameGraph::Impl {
       }
       chunk_visible[c] = static_cast<uint32_t>(
           combine_view_masks(sub(mask, b, e), std::span(vis.data(), view_count), sub(s.never_cull, b, e)));
+      if (options.occlusion.enabled) {
+        chunk_occluders[c].clear();
+        gather_occluders(chunk_occluders[c], options.occlusion.occluders, vis[0], sub(s.cx, b, e), sub(s.cy, b, e),
+                         sub(s.cz, b, e), sub(s.radius, b, e), sub(s.model, b, e), can_occlude, occlusion_view.eye,
+                         static_cast<uint32_t>(b));
+      }
     });
+    out->occluded = out->occluders = 0;
+    out->occluder_tris = 0;
+    if (options.occlusion.enabled) cull_occluded();
     // Exclusive prefix sum over the chunks: where each chunk's visible objects go.
     visible_total = 0;
     for (size_t c = 0; c < chunks; ++c) {
       chunk_offset[c] = visible_total;
       visible_total += chunk_visible[c];
     }
+  }
+
+  // Occlusion for view 0: the best occluders of all chunks rasterised (serial, in a fixed
+  // order), then every object view 0 sees tested against them, parallel over chunks.
+  void cull_occluded() {
+    const ObjectStore& s = *store;
+    occluders.clear();
+    for (size_t c = 0; c < chunks; ++c) occluders.insert(occluders.end(), chunk_occluders[c].begin(), chunk_occluders[c].end());
+    keep_best_occluders(occluders, options.occlusion.occluders);
+    occlusion_clear(occlusion_buffer, occlusion_view);
+    for (const OccluderCandidate& o : occluders) {
+      const LodChain& chain = *set->chains[s.model[o.object]];
+      const LodLevel& l = chain.levels[occluder_level[s.model[o.object]]];
+      rasterize_occluder(occlusion_buffer, occlusion_view,
+                         std::span(chain.positions.data() + 3 * size_t(l.first_vertex), 3 * size_t(l.vertex_count)),
+                         std::span(chain.indices.data() + l.first_index, l.index_count), s.transform[o.object]);
+    }
+    occlusion_finish(occlusion_buffer);
+    for_chunks(Stage::visibility, [&](size_t c, size_t b, size_t e) {
+      std::span<uint8_t> v0 = sub(per_view[0].visible, b, e);
+      // never_cull objects are seen whatever hides them: test only the others.
+      uint32_t culled = 0;
+      for (size_t i = b; i < e; ++i) {
+        if (!v0[i - b] || s.never_cull[i]) continue;
+        const float center[3] = {s.cx[i], s.cy[i], s.cz[i]};
+        if (!sphere_occluded(occlusion_buffer, occlusion_view, center, s.radius[i])) continue;
+        v0[i - b] = 0;
+        const uint8_t before = mask[i];
+        mask[i] = static_cast<uint8_t>(before & ~1u);
+        chunk_visible[c] -= mask[i] == 0;
+        ++culled;
+      }
+      chunk_occluded[c] = culled;
+    });
+    for (size_t c = 0; c < chunks; ++c) out->occluded += chunk_occluded[c];
+    out->occluders = static_cast<uint32_t>(occluders.size());
+    out->occluder_tris = occlusion_buffer.triangles;
   }
 
   void node_importance() {
@@ -822,7 +891,7 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      &Impl::node_commit},
     {Stage::bounds, "world_spheres + object_controls, parallel", kObjects, kBounds | kControls, &Impl::node_bounds},
     {Stage::view, "frustum planes, focal length per view", 0, kViews, &Impl::node_view},
-    {Stage::visibility, "cull_spheres per view + combine_view_masks, parallel", kBounds | kControls | kViews,
+    {Stage::visibility, "cull_spheres per view + combine_view_masks; occlusion: gather_occluders, rasterize_occluder, sphere_occluded; parallel", kBounds | kControls | kViews,
      kVisibility, &Impl::node_visibility},
     {Stage::importance,
      "measure_objects + minima, importance_weights + choose_initial_levels per view, combine_view_choice, "

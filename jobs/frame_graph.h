@@ -36,6 +36,14 @@ struct FrameGraphOptions {
   float geomorph_seconds = 0.25f;
   float frame_seconds = 1.0f / 60;
   float vd_hysteresis = 1.5f;      // FrontParams::hysteresis
+  // Occlusion culling for view 0 (runtime/occlusion.h): the `occluders` objects of largest
+  // angular size are rasterised at their finest level of at most `occluder_triangles`.
+  struct Occlusion {
+    bool enabled = false;
+    int width = 320, height = 180;     // depth buffer pixels
+    uint32_t occluders = 48;
+    uint32_t occluder_triangles = 3000;
+  } occlusion;
   // Called at the start of every stage, on the thread running it (tracing; tests inject
   // failures by throwing from it). Empty = no call.
   std::function<void(Stage)> stage_hook;

@@ -76,6 +76,10 @@ struct Frame {
   uint64_t coarsest_cost = 0;   // cost with all visible objects at their coarsest level
   bool over_budget = false;     // even the coarsest levels exceed M
   uint32_t lowered_steps = 0;   // heap pops in selection
+  // Occlusion culling (view 0): objects in the frustum found hidden, occluders rasterised.
+  uint32_t occluded = 0;
+  uint32_t occluders = 0;
+  uint64_t occluder_tris = 0;
   std::array<uint32_t, kHistogramLevels> level_histogram{};  // objects per l
 
   // View-dependent objects (models with view_dependent = true), visible ones only, in object

@@ -75,6 +75,7 @@ struct ServiceOptions {
   BudgetUnit budget_unit = BudgetUnit::triangles;
   bool reserve_blends = true;        // hold last frame's blend extra back from M
   bool strict_budget = false;        // drawn triangles, blends included, <= M whenever the coarsest levels fit
+  bool occlusion = false;            // cull objects hidden behind large nearby ones (view 0)
   float pixel_error = 1.0f;          // screen-space error wanted before the budget applies
   float hysteresis = 0.25f;          // relative band against level flicker
   float blend_seconds = 0.25f;       // level changes, splits and collapses blend this long

@@ -1,0 +1,222 @@
+// Occlusion culling: conservative rasterisation of occluders, a max-depth pyramid, sphere tests.
+#include "runtime/occlusion.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+#include "runtime/world_bounds.h"
+
+namespace lod {
+
+namespace {
+
+constexpr float kEmpty = std::numeric_limits<float>::infinity();
+
+struct V3 {
+  float x, y, z;
+};
+
+V3 to_view(const OcclusionCamera& c, const float p[3]) {
+  const float d[3] = {p[0] - c.eye[0], p[1] - c.eye[1], p[2] - c.eye[2]};
+  return {d[0] * c.right[0] + d[1] * c.right[1] + d[2] * c.right[2], d[0] * c.up[0] + d[1] * c.up[1] + d[2] * c.up[2],
+          d[0] * c.forward[0] + d[1] * c.forward[1] + d[2] * c.forward[2]};
+}
+
+// Image-plane coordinates (x / z, y / z) to pixels; y grows downwards.
+float px_of(const OcclusionCamera& c, float u) { return (u / c.tan_x * 0.5f + 0.5f) * float(c.width); }
+float py_of(const OcclusionCamera& c, float v) { return (0.5f - v / c.tan_y * 0.5f) * float(c.height); }
+
+// Edge a x + b y + c >= 0 inside; its smallest value over the pixel [x, x+1] x [y, y+1].
+struct Edge {
+  float a, b, c;
+  float min_over_pixel(float x, float y) const {
+    return a * (a < 0 ? x + 1 : x) + b * (b < 0 ? y + 1 : y) + c;
+  }
+};
+
+Edge edge_of(float x0, float y0, float x1, float y1) { return {y0 - y1, x1 - x0, x0 * y1 - x1 * y0}; }
+
+void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[3], float depth) {
+  // Ordered so that cross(p1 - p0, p2 - p0) > 0: then every edge function is >= 0 inside.
+  const float area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
+  if (!(std::abs(area) > 1e-6f)) return;
+  const int i1 = area > 0 ? 1 : 2, i2 = area > 0 ? 2 : 1;
+  const Edge e[3] = {edge_of(sx[0], sy[0], sx[i1], sy[i1]), edge_of(sx[i1], sy[i1], sx[i2], sy[i2]),
+                     edge_of(sx[i2], sy[i2], sx[0], sy[0])};
+  const int x0 = std::max(0, int(std::floor(std::min({sx[0], sx[1], sx[2]}))));
+  const int x1 = std::min(buf.width - 1, int(std::ceil(std::max({sx[0], sx[1], sx[2]}))));
+  const int y0 = std::max(0, int(std::floor(std::min({sy[0], sy[1], sy[2]}))));
+  const int y1 = std::min(buf.height - 1, int(std::ceil(std::max({sy[0], sy[1], sy[2]}))));
+  float* d = buf.levels[0].data();
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const float fx = float(x), fy = float(y);
+      // Covered when every edge stays >= 0 over the whole pixel (its worst corner).
+      const bool covered = e[0].min_over_pixel(fx, fy) >= 0 && e[1].min_over_pixel(fx, fy) >= 0 &&
+                           e[2].min_over_pixel(fx, fy) >= 0;
+      if (covered) d[size_t(y) * size_t(buf.width) + size_t(x)] = std::min(d[size_t(y) * size_t(buf.width) + size_t(x)], depth);
+    }
+  }
+}
+
+}  // namespace
+
+OcclusionCamera occlusion_camera(const View& view, int width, int height) {
+  OcclusionCamera c{};
+  glm::vec3 f = view.target - view.eye;
+  f = glm::length(f) > 0 ? glm::normalize(f) : glm::vec3(0, 0, -1);
+  glm::vec3 r = glm::cross(f, view.up);
+  if (glm::length(r) < 1e-6f) r = glm::cross(f, std::abs(f.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0));
+  r = glm::normalize(r);
+  const glm::vec3 u = glm::cross(r, f);
+  for (int k = 0; k < 3; ++k) c.eye[k] = view.eye[k], c.right[k] = r[k], c.up[k] = u[k], c.forward[k] = f[k];
+  c.tan_y = std::tan(0.5f * glm::radians(view.fov_y_deg));
+  c.tan_x = c.tan_y * float(view.width) / float(std::max(view.height, 1));
+  c.near_z = view.near_plane;
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
+void occlusion_clear(OcclusionBuffer& b, const OcclusionCamera& c) {
+  b.width = c.width;
+  b.height = c.height;
+  b.levels.resize(1);
+  b.levels[0].assign(size_t(c.width) * size_t(c.height), kEmpty);
+  b.level_width.assign(1, c.width);
+  b.level_height.assign(1, c.height);
+  b.triangles = 0;
+}
+
+void rasterize_occluder(OcclusionBuffer& buf, const OcclusionCamera& c, std::span<const float> positions,
+                        std::span<const uint32_t> indices, const Transform& t) {
+  const size_t vertices = positions.size() / 3;
+  const float len2 = t.rotation[0] * t.rotation[0] + t.rotation[1] * t.rotation[1] + t.rotation[2] * t.rotation[2] +
+                     t.rotation[3] * t.rotation[3];
+  if (!(len2 > 0)) return;
+  const float inv = 1.0f / std::sqrt(len2);
+  const float q[4] = {t.rotation[0] * inv, t.rotation[1] * inv, t.rotation[2] * inv, t.rotation[3] * inv};
+  for (size_t k = 0; k + 2 < indices.size(); k += 3) {
+    float sx[3], sy[3], far_z = 0;
+    bool ok = true;
+    for (int j = 0; j < 3 && ok; ++j) {
+      const uint32_t v = indices[k + j];
+      if (v >= vertices) {
+        ok = false;
+        break;
+      }
+      float w[3];
+      rotate_by_quaternion(q, &positions[3 * size_t(v)], w);
+      for (int a = 0; a < 3; ++a) w[a] = t.position[a] + t.scale * w[a];
+      const V3 p = to_view(c, w);
+      if (!(p.z > c.near_z)) ok = false;  // reaches in front of the near plane: not used
+      sx[j] = px_of(c, p.x / p.z);
+      sy[j] = py_of(c, p.y / p.z);
+      far_z = std::max(far_z, p.z);
+    }
+    if (!ok) continue;
+    rasterize_triangle(buf, sx, sy, far_z);
+    ++buf.triangles;
+  }
+}
+
+void occlusion_finish(OcclusionBuffer& b) {
+  b.levels.resize(1);
+  b.level_width.resize(1);
+  b.level_height.resize(1);
+  while (b.level_width.back() > 1 || b.level_height.back() > 1) {
+    const int pw = b.level_width.back(), ph = b.level_height.back();
+    const int w = (pw + 1) / 2, h = (ph + 1) / 2;
+    const std::vector<float>& src = b.levels.back();
+    std::vector<float> dst(size_t(w) * size_t(h));
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        float m = 0;
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx) {
+            const int sx = 2 * x + dx, sy = 2 * y + dy;
+            // A child past the edge is unknown: +infinity, so the parent never hides anything there.
+            m = std::max(m, sx < pw && sy < ph ? src[size_t(sy) * size_t(pw) + size_t(sx)] : kEmpty);
+          }
+        dst[size_t(y) * size_t(w) + size_t(x)] = m;
+      }
+    }
+    b.levels.push_back(std::move(dst));
+    b.level_width.push_back(w);
+    b.level_height.push_back(h);
+  }
+}
+
+bool sphere_occluded(const OcclusionBuffer& b, const OcclusionCamera& c, const float center[3], float radius) {
+  if (b.levels.empty() || b.triangles == 0) return false;
+  const V3 p = to_view(c, center);
+  const float nearest = p.z - radius;
+  if (!(nearest > c.near_z)) return false;
+  // x / z and y / z over the sphere's box are extreme at its corners (z > 0 throughout).
+  const float zs[2] = {p.z - radius, p.z + radius};
+  float u0 = kEmpty, u1 = -kEmpty, v0 = kEmpty, v1 = -kEmpty;
+  for (float z : zs) {
+    for (float x : {p.x - radius, p.x + radius}) u0 = std::min(u0, x / z), u1 = std::max(u1, x / z);
+    for (float y : {p.y - radius, p.y + radius}) v0 = std::min(v0, y / z), v1 = std::max(v1, y / z);
+  }
+  const int x0 = std::max(0, int(std::floor(px_of(c, u0)))), x1 = std::min(b.width - 1, int(std::floor(px_of(c, u1))));
+  const int y0 = std::max(0, int(std::floor(py_of(c, v1)))), y1 = std::min(b.height - 1, int(std::floor(py_of(c, v0))));
+  if (x0 > x1 || y0 > y1) return false;  // off screen: the frustum test decides
+  // The level where the rectangle spans at most 2 x 2 texels.
+  size_t level = 0;
+  while (level + 1 < b.levels.size() && ((x1 >> level) - (x0 >> level) > 1 || (y1 >> level) - (y0 >> level) > 1))
+    ++level;
+  const std::vector<float>& d = b.levels[level];
+  const int w = b.level_width[level];
+  for (int y = y0 >> level; y <= (y1 >> level); ++y)
+    for (int x = x0 >> level; x <= (x1 >> level); ++x)
+      if (!(d[size_t(y) * size_t(w) + size_t(x)] < nearest)) return false;
+  return true;
+}
+
+size_t occlusion_cull(std::span<uint8_t> visible, std::span<const float> cx, std::span<const float> cy,
+                      std::span<const float> cz, std::span<const float> radius, const OcclusionBuffer& buffer,
+                      const OcclusionCamera& camera) {
+  size_t culled = 0;
+  for (size_t i = 0; i < visible.size(); ++i) {
+    if (!visible[i]) continue;
+    const float c[3] = {cx[i], cy[i], cz[i]};
+    if (sphere_occluded(buffer, camera, c, radius[i])) {
+      visible[i] = 0;
+      ++culled;
+    }
+  }
+  return culled;
+}
+
+namespace {
+bool better(const OccluderCandidate& a, const OccluderCandidate& b) {
+  return a.score != b.score ? a.score > b.score : a.object < b.object;
+}
+}  // namespace
+
+void gather_occluders(std::vector<OccluderCandidate>& out, size_t k, std::span<const uint8_t> visible,
+                      std::span<const float> cx, std::span<const float> cy, std::span<const float> cz,
+                      std::span<const float> radius, std::span<const uint32_t> model, std::span<const uint8_t> usable,
+                      const float eye[3], uint32_t first_id) {
+  const size_t begin = out.size();
+  for (size_t i = 0; i < visible.size(); ++i) {
+    if (!visible[i] || !usable[model[i]]) continue;
+    const float dx = cx[i] - eye[0], dy = cy[i] - eye[1], dz = cz[i] - eye[2];
+    const float d = std::max(std::sqrt(dx * dx + dy * dy + dz * dz), 1e-6f);
+    out.push_back({radius[i] / d, first_id + static_cast<uint32_t>(i)});
+  }
+  if (out.size() - begin > k) {
+    std::nth_element(out.begin() + begin, out.begin() + begin + k, out.end(), better);
+    out.resize(begin + k);
+  }
+}
+
+void keep_best_occluders(std::vector<OccluderCandidate>& all, size_t k) {
+  std::sort(all.begin(), all.end(), better);
+  if (all.size() > k) all.resize(k);
+}
+
+}  // namespace lod
