@@ -1,6 +1,6 @@
-// Mesh loading (OBJ, PLY, OFF, STL) into flat arrays: PLY, OFF and STL by single-pass
-// readers of our own, OBJ by OpenMesh's reader behind a pre-check. Every failure names the
-// file and what is wrong; `out` is only written on success.
+// Mesh loading (OBJ, PLY, OFF, STL) into flat arrays by single-pass readers of our own
+// (OpenMesh's readers are not used). Every failure names the file and what is wrong; `out`
+// is only written on success.
 #pragma once
 #include <cstdint>
 #include <filesystem>

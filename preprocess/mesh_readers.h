@@ -32,6 +32,9 @@ struct RawPolygons {
 Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
 Status read_off(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
 Status read_stl(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
+// OBJ: corners are stored 0-based (positive v as v-1, negative resolved against the vertices
+// before the face); finish_polygons(..., obj_numbering=true) names them from 1 again.
+Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
 
 // Range-checks every corner (first bad one reported: "face F references vertex N of V",
 // N as the file wrote it) and fan-triangulates into `out` (positions moved out of `raw`).

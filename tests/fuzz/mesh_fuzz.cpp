@@ -8,22 +8,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <mutex>
 
 #include "preprocess/mesh_io.h"
 
 #ifndef LOD_FUZZ_EXT
 #error "build with -DLOD_FUZZ_EXT='\".ply\"' (or .off, .stl, .obj)"
 #endif
-
-namespace lod::detail {
-// The real one lives in decimater_chain.cpp, which this binary does not link (it would pull
-// in the decimater); mesh_io.cpp only needs a process-wide mutex for OpenMesh's readers.
-std::mutex& openmesh_global_mutex() {
-  static std::mutex m;
-  return m;
-}
-}  // namespace lod::detail
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   lod::MeshData mesh;

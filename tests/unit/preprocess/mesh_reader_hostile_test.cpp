@@ -85,6 +85,21 @@ TEST(MeshReaders, RefusesAMissingFileAndAFileUnderAFile) {
   expect_message(load_mesh(dir / "none.off", m), "none.off: no such file");
 }
 
+TEST(MeshReaders, ObjMtllibNamingAFifoDoesNotBlock) {
+  // OpenMesh's OBJ reader opened the file a "mtllib" line names (a FIFO there blocked the
+  // load); materials are not used, so lodkit's reader never follows the line.
+  const fs::path dir = test::temp_dir("rd-mtl");
+  const fs::path fifo = dir / "materials.mtl";
+  fs::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  const std::string text = "mtllib " + fifo.string() + "\n  mtllib " + fifo.string() +
+                           "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+  MeshData m;
+  const Status s = load_text("mtl.obj", ".obj", text, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(m.triangle_count(), 1u);
+}
+
 // ---- byte-order marks ---------------------------------------------------------------------
 
 TEST(MeshReaders, SkipsAUtf8BomBeforeAnObj) {
@@ -216,6 +231,38 @@ TEST(MeshReaders, UnknownPlyHeaderWordsAreSkippedOrRefusedNeverLooped) {
                  "malformed property");
   expect_message(load_text("w.ply", ".ply", "ply\nformat utf8 1.0\n" + rest, m), "unknown format 'utf8'");
   expect_message(load_text("w.ply", ".ply", "ply\n" + rest, m), "no 'format' line");
+}
+
+// ---- fuzzing findings (scripts/fuzz.sh), each kept as a regression test ------------------
+
+TEST(MeshReaders, FuzzObjCornerWithoutIndexAfterCarriageReturn) {
+  // fuzz_obj, crash-2aeb9546: "f\r/1" is a face for iostreams (CR ends the keyword), and
+  // OpenMesh's reader asserted (!vhandles.empty()) on the corner "/1": the process aborted.
+  const uint8_t crash[] = {0x76, 0x20, 0x30, 0x20, 0x31, 0x20, 0x30, 0x0d, 0x0d, 0x0a, 0x66, 0x20, 0x20, 0x2d, 0x31, 0x20,
+                           0x2d, 0x31, 0x2f, 0x0d, 0x0d, 0x0d, 0x0a, 0x66, 0x0d, 0x2f, 0x31, 0x0d, 0x31, 0x34, 0x0d, 0x12};
+  MeshData m;
+  const Status s = load_mesh_from_memory("crash.obj", ".obj", crash, sizeof crash, m);
+  expect_message(s, "face 1 (line 3) has a corner without a valid vertex index ('/1')");
+}
+
+TEST(MeshReaders, ObjKeywordsEndAtAnyBlankAndLinesContinue) {
+  MeshData m;
+  Status s = load_text("cr.obj", ".obj", "v\t0 0 0\nv\r1 0 0\nv 0\f1 0\nf\t1\r2 3\n", m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  s = load_text("cont.obj", ".obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 \\\n  3 \\  \n 4\nf 9\n", m);
+  expect_message(s, "face 1 references vertex 9 of 4");
+}
+
+TEST(MeshReaders, ObjRepeatedCornersOfAFaceAreDropped) {
+  // As OpenMesh's reader did: "f 1 2 3 4 1 2 3 4" is the quad 1 2 3 4 (2 triangles), also
+  // for a long face (the set path) and with relative indices.
+  MeshData m;
+  std::string longface = "f";
+  for (int r = 0; r < 10; ++r) longface += " 1 2 3 4";
+  const Status s = load_text("rep.obj", ".obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n" + longface + "\nf 1 -3 2 -1\n", m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 1, 3}));
 }
 
 // ---- formats the single-pass readers read ---------------------------------------------------
