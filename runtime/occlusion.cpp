@@ -28,35 +28,39 @@ V3 to_view(const OcclusionCamera& c, const float p[3]) {
 float px_of(const OcclusionCamera& c, float u) { return (u / c.tan_x * 0.5f + 0.5f) * float(c.width); }
 float py_of(const OcclusionCamera& c, float v) { return (0.5f - v / c.tan_y * 0.5f) * float(c.height); }
 
-// Edge a x + b y + c >= 0 inside; its smallest value over the pixel [x, x+1] x [y, y+1].
+// Edge function E(x, y) = a x + b y + c, >= 0 inside. Its smallest value over the pixel
+// [x, x+1] x [y, y+1] is E(x, y) + min(a, 0) + min(b, 0): a linear function of the pixel's
+// integer corner, so a row is one add per pixel.
 struct Edge {
   float a, b, c;
-  float min_over_pixel(float x, float y) const {
-    return a * (a < 0 ? x + 1 : x) + b * (b < 0 ? y + 1 : y) + c;
-  }
 };
 
-Edge edge_of(float x0, float y0, float x1, float y1) { return {y0 - y1, x1 - x0, x0 * y1 - x1 * y0}; }
+Edge pixel_edge(float x0, float y0, float x1, float y1) {
+  const float a = y0 - y1, b = x1 - x0;
+  return {a, b, x0 * y1 - x1 * y0 + std::min(a, 0.f) + std::min(b, 0.f)};
+}
 
 void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[3], float depth) {
   // Ordered so that cross(p1 - p0, p2 - p0) > 0: then every edge function is >= 0 inside.
   const float area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
   if (!(std::abs(area) > 1e-6f)) return;
   const int i1 = area > 0 ? 1 : 2, i2 = area > 0 ? 2 : 1;
-  const Edge e[3] = {edge_of(sx[0], sy[0], sx[i1], sy[i1]), edge_of(sx[i1], sy[i1], sx[i2], sy[i2]),
-                     edge_of(sx[i2], sy[i2], sx[0], sy[0])};
+  const Edge e0 = pixel_edge(sx[0], sy[0], sx[i1], sy[i1]);
+  const Edge e1 = pixel_edge(sx[i1], sy[i1], sx[i2], sy[i2]);
+  const Edge e2 = pixel_edge(sx[i2], sy[i2], sx[0], sy[0]);
   const int x0 = std::max(0, int(std::floor(std::min({sx[0], sx[1], sx[2]}))));
   const int x1 = std::min(buf.width - 1, int(std::ceil(std::max({sx[0], sx[1], sx[2]}))));
   const int y0 = std::max(0, int(std::floor(std::min({sy[0], sy[1], sy[2]}))));
   const int y1 = std::min(buf.height - 1, int(std::ceil(std::max({sy[0], sy[1], sy[2]}))));
-  float* d = buf.levels[0].data();
   for (int y = y0; y <= y1; ++y) {
+    float* __restrict row = buf.levels[0].data() + size_t(y) * size_t(buf.width);
+    const float fy = float(y);
+    const float w0 = e0.b * fy + e0.c, w1 = e1.b * fy + e1.c, w2 = e2.b * fy + e2.c;
+    // Branch-free over the row, so that it vectorizes.
     for (int x = x0; x <= x1; ++x) {
-      const float fx = float(x), fy = float(y);
-      // Covered when every edge stays >= 0 over the whole pixel (its worst corner).
-      const bool covered = e[0].min_over_pixel(fx, fy) >= 0 && e[1].min_over_pixel(fx, fy) >= 0 &&
-                           e[2].min_over_pixel(fx, fy) >= 0;
-      if (covered) d[size_t(y) * size_t(buf.width) + size_t(x)] = std::min(d[size_t(y) * size_t(buf.width) + size_t(x)], depth);
+      const float fx = float(x);
+      const bool covered = (e0.a * fx + w0 >= 0) & (e1.a * fx + w1 >= 0) & (e2.a * fx + w2 >= 0);
+      row[x] = covered ? std::min(row[x], depth) : row[x];
     }
   }
 }
