@@ -28,16 +28,24 @@ V3 to_view(const OcclusionCamera& c, const float p[3]) {
 float px_of(const OcclusionCamera& c, float u) { return (u / c.tan_x * 0.5f + 0.5f) * float(c.width); }
 float py_of(const OcclusionCamera& c, float v) { return (0.5f - v / c.tan_y * 0.5f) * float(c.height); }
 
-// Edge function E(x, y) = a x + b y + c, >= 0 inside. Its smallest value over the pixel
-// [x, x+1] x [y, y+1] is E(x, y) + min(a, 0) + min(b, 0): a linear function of the pixel's
-// integer corner, so a row is one add per pixel.
+// floor(v) clamped to [lo, hi] before the conversion (a float out of int's range, or NaN,
+// would be undefined behaviour to convert).
+int clamped_floor(float v, int lo, int hi) {
+  const float f = std::floor(v);
+  if (!(f >= float(lo))) return lo;
+  if (f > float(hi)) return hi;
+  return int(f);
+}
+
+// Edge function E(x, y) = a x + b y + c, >= 0 inside, evaluated at sample centres
+// (x + 0.5, y + 0.5): the half folded into c, so a row is one add per sample.
 struct Edge {
   float a, b, c;
 };
 
 Edge pixel_edge(float x0, float y0, float x1, float y1) {
   const float a = y0 - y1, b = x1 - x0;
-  return {a, b, x0 * y1 - x1 * y0 + std::min(a, 0.f) + std::min(b, 0.f)};
+  return {a, b, x0 * y1 - x1 * y0 + 0.5f * (a + b)};
 }
 
 void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[3], float depth) {
@@ -48,15 +56,18 @@ void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[
   const Edge e0 = pixel_edge(sx[0], sy[0], sx[i1], sy[i1]);
   const Edge e1 = pixel_edge(sx[i1], sy[i1], sx[i2], sy[i2]);
   const Edge e2 = pixel_edge(sx[i2], sy[i2], sx[0], sy[0]);
-  const int x0 = std::max(0, int(std::floor(std::min({sx[0], sx[1], sx[2]}))));
-  const int x1 = std::min(buf.width - 1, int(std::ceil(std::max({sx[0], sx[1], sx[2]}))));
-  const int y0 = std::max(0, int(std::floor(std::min({sy[0], sy[1], sy[2]}))));
-  const int y1 = std::min(buf.height - 1, int(std::ceil(std::max({sy[0], sy[1], sy[2]}))));
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(sx[k]) || !std::isfinite(sy[k])) return;
+  const int x0 = clamped_floor(std::min({sx[0], sx[1], sx[2]}), 0, buf.width - 1);
+  const int x1 = clamped_floor(std::max({sx[0], sx[1], sx[2]}) + 1, 0, buf.width - 1);
+  const int y0 = clamped_floor(std::min({sy[0], sy[1], sy[2]}), 0, buf.height - 1);
+  const int y1 = clamped_floor(std::max({sy[0], sy[1], sy[2]}) + 1, 0, buf.height - 1);
   for (int y = y0; y <= y1; ++y) {
     float* __restrict row = buf.levels[0].data() + size_t(y) * size_t(buf.width);
     const float fy = float(y);
     const float w0 = e0.b * fy + e0.c, w1 = e1.b * fy + e1.c, w2 = e2.b * fy + e2.c;
-    // Branch-free over the row, so that it vectorizes.
+    // Branch-free over the row, so that it vectorizes. A sample on an edge counts as inside
+    // for both triangles that share the edge, so meshes leave no cracks.
     for (int x = x0; x <= x1; ++x) {
       const float fx = float(x);
       const bool covered = (e0.a * fx + w0 >= 0) & (e1.a * fx + w1 >= 0) & (e2.a * fx + w2 >= 0);
@@ -165,9 +176,10 @@ bool sphere_occluded(const OcclusionBuffer& b, const OcclusionCamera& c, const f
     for (float x : {p.x - radius, p.x + radius}) u0 = std::min(u0, x / z), u1 = std::max(u1, x / z);
     for (float y : {p.y - radius, p.y + radius}) v0 = std::min(v0, y / z), v1 = std::max(v1, y / z);
   }
-  const int x0 = std::max(0, int(std::floor(px_of(c, u0)))), x1 = std::min(b.width - 1, int(std::floor(px_of(c, u1))));
-  const int y0 = std::max(0, int(std::floor(py_of(c, v1)))), y1 = std::min(b.height - 1, int(std::floor(py_of(c, v0))));
-  if (x0 > x1 || y0 > y1) return false;  // off screen: the frustum test decides
+  const float fx0 = px_of(c, u0), fx1 = px_of(c, u1), fy0 = py_of(c, v1), fy1 = py_of(c, v0);
+  if (!(fx1 >= 0 && fy1 >= 0 && fx0 < float(b.width) && fy0 < float(b.height))) return false;  // off screen, or NaN
+  const int x0 = clamped_floor(fx0, 0, b.width - 1), x1 = clamped_floor(fx1, 0, b.width - 1);
+  const int y0 = clamped_floor(fy0, 0, b.height - 1), y1 = clamped_floor(fy1, 0, b.height - 1);
   // The level where the rectangle spans at most 2 x 2 texels.
   size_t level = 0;
   while (level + 1 < b.levels.size() && ((x1 >> level) - (x0 >> level) > 1 || (y1 >> level) - (y0 >> level) > 1))

@@ -1,13 +1,15 @@
 // Occlusion culling against a small software depth buffer.
 //
-// Occluders (the coarse levels of large nearby objects) are rasterised conservatively: a pixel
-// is written only when the triangle covers all of it, and then with the triangle's farthest
-// depth, so every point of a written pixel lies behind the stored depth. A max-depth pyramid
-// over the buffer lets an object be tested with a few texels: it is occluded when the screen
-// rectangle of its bounding sphere (bounded through the corners of the sphere's box, so it
-// holds the whole sphere) lies behind the stored depth everywhere. Depth is the view-space
-// distance along the view direction. Whatever is not known (pixels no occluder covers fully,
-// spheres crossing the near plane) counts as visible, so nothing visible is ever culled.
+// Occluders (the coarse levels of large nearby objects) are point-sampled at the centre of
+// every buffer sample, each covered sample taking the triangle's farthest depth, so the
+// occluder surface at a sample is never behind the stored depth. A max-depth pyramid over the
+// buffer lets an object be tested with a few texels: it is occluded when the screen rectangle
+// of its bounding sphere (bounded through the corners of the sphere's box, so it holds the
+// whole sphere) lies behind the stored depth everywhere. Depth is the view-space distance
+// along the view direction. Whatever is not known (samples no occluder covers, spheres
+// crossing the near plane) counts as visible. So nothing that a ray through any sample centre
+// sees first is ever culled; what shows only between samples (thinner than a sample, through a
+// gap narrower than one) may be, as with any occlusion culling at a finite resolution.
 #pragma once
 #include <cstdint>
 #include <span>

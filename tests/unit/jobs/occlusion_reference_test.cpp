@@ -1,7 +1,8 @@
 // Occlusion culling never culls a visible object: a street of box buildings with props behind
-// them, seen from street level; the exact reference is Embree, a primary ray through every
-// pixel (and 4 samples within it) of the same view, and every object any ray hits first must
-// be in the frame. It also has to cull: most props behind the buildings are hidden.
+// them, seen from street level; the exact reference is Embree, a primary ray through the
+// centre of every pixel of the same view at the occlusion buffer's resolution, and every
+// object any ray hits first must be in the frame. It also has to cull: most props behind the
+// buildings are hidden.
 #include <embree3/rtcore.h>
 #include <gtest/gtest.h>
 
@@ -52,8 +53,8 @@ Street make_street() {
   return s;
 }
 
-// Objects hit first by a ray through 4 points of every pixel of `view`.
-std::set<uint32_t> reference_visible(const Street& s) {
+// Objects hit first by a ray through the centre of every pixel of a width x height frame.
+std::set<uint32_t> reference_visible(const Street& s, int width, int height) {
   RTCDevice device = rtcNewDevice(nullptr);
   RTCScene scene = rtcNewScene(device);
   const ObjectSet& o = s.scene.objects;
@@ -74,15 +75,15 @@ std::set<uint32_t> reference_visible(const Street& s) {
     rtcReleaseGeometry(g);
   }
   rtcCommitScene(scene);
-  const OcclusionCamera cam = occlusion_camera(s.view, s.view.width, s.view.height);
+  const OcclusionCamera cam = occlusion_camera(s.view, width, height);
   std::set<uint32_t> seen;
   RTCIntersectContext context;
-  for (int y = 0; y < s.view.height; ++y) {
-    for (int x = 0; x < s.view.width; ++x) {
-      for (float sy : {0.25f, 0.75f}) {
-        for (float sx : {0.25f, 0.75f}) {
-          const float u = ((float(x) + sx) / float(s.view.width) * 2 - 1) * cam.tan_x;
-          const float w = (1 - (float(y) + sy) / float(s.view.height) * 2) * cam.tan_y;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      {
+        {
+          const float u = ((float(x) + 0.5f) / float(width) * 2 - 1) * cam.tan_x;
+          const float w = (1 - (float(y) + 0.5f) / float(height) * 2) * cam.tan_y;
           RTCRayHit rh{};
           rh.ray.org_x = cam.eye[0], rh.ray.org_y = cam.eye[1], rh.ray.org_z = cam.eye[2];
           rh.ray.dir_x = cam.forward[0] + u * cam.right[0] + w * cam.up[0];
@@ -118,7 +119,8 @@ Frame run_frame(const Street& s, bool occlusion) {
 
 TEST(OcclusionReference, NoObjectAnyPrimaryRayHitsIsCulled) {
   const Street s = make_street();
-  const std::set<uint32_t> reference = reference_visible(s);
+  const FrameGraphOptions defaults;
+  const std::set<uint32_t> reference = reference_visible(s, defaults.occlusion.width, defaults.occlusion.height);
   ASSERT_GT(reference.size(), 20u);
   const Frame with = run_frame(s, true), without = run_frame(s, false);
   const std::set<uint32_t> kept(with.objects.begin(), with.objects.end());
