@@ -33,6 +33,18 @@ void expect_message(const Status& s, const std::string& needle) {
   EXPECT_NE(s.message.find(needle), std::string::npos) << s.message;
 }
 
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAsan = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAsan = true;
+#else
+constexpr bool kAsan = false;
+#endif
+#else
+constexpr bool kAsan = false;
+#endif
+
 long max_rss_kb() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -189,7 +201,7 @@ TEST(MeshReaders, TinyFilesWithHugeCountsAreRefusedWithoutAllocating) {
                  "truncated: the data ends inside face 0 of 1");
   expect_message(load_text("c.off", ".off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n", m),
                  "declares 4000000000 corners");
-  EXPECT_LT(max_rss_kb() - before, 64 * 1024);
+  EXPECT_LT(max_rss_kb() - before, (64 + (kAsan ? 256 : 0)) * 1024);
 }
 
 TEST(MeshReaders, PlyElementWithoutPropertiesAndAHugeCountIsSkippedAtOnce) {
@@ -472,7 +484,10 @@ TEST(MeshReaders, EverySmallHostileFileIsRefusedOrLoadedQuicklyInBoundedMemory) 
             << "); peak RSS growth " << growth_kb << " KB\n";
   EXPECT_GT(loaded, 0u);
   EXPECT_GT(refused, 0u);
-  EXPECT_LT(growth_kb, 64 * 1024);
+  // Peak RSS of the whole run bounds every single load's peak. AddressSanitizer keeps freed
+  // blocks in its quarantine (256 MB by default), so there the bound allows for it; the
+  // fuzz targets check single allocations against 64 MB under ASan (-malloc_limit_mb=64).
+  EXPECT_LT(growth_kb, (64 + (kAsan ? 256 : 0)) * 1024);
 }
 
 }  // namespace
