@@ -80,6 +80,12 @@ int inspect_command(const InspectArgs& args) {
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
       const auto out = std::filesystem::path(args.export_dir) / (stem + "-level" + std::to_string(i) + ".ply");
+      // Never written through a link planted under the export name (it could point anywhere).
+      if (std::filesystem::is_symlink(std::filesystem::symlink_status(out, ec))) {
+        std::fprintf(stderr, "lod inspect: %s is a symbolic link; not writing through it\n",
+                     printable(out.string()).c_str());
+        return 1;
+      }
       auto st = save_ply(out, chain.positions.data() + size_t(l.first_vertex) * 3, l.vertex_count,
                          chain.indices.data() + l.first_index, l.index_count);
       if (!st) {

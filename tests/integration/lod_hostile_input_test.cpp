@@ -73,6 +73,17 @@ TEST(LodInspectNames, ExportNamesStayInsideTheFolderWhateverTheModelName) {
   EXPECT_TRUE(fs::exists(dir / "export5" / "model-level0.ply"));        // nothing left: a default
 }
 
+TEST(LodInspectNames, ExportNeverWritesThroughAPlantedLink) {
+  const auto dir = lod::test::temp_dir("hostile-link");
+  const fs::path asset = write_named_asset(dir, "m.lod", "ball");
+  fs::create_directories(dir / "export");
+  fs::create_symlink(dir / "victim.ply", dir / "export" / "ball-level0.ply");
+  const auto r = run_lod("inspect " + asset.string() + " --export " + (dir / "export").string());
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("is a symbolic link"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "victim.ply"));
+}
+
 TEST(LodInspectNames, ControlCharactersAreEscapedAndJsonSurvivesNonUtf8) {
   const auto dir = lod::test::temp_dir("hostile-names");
   const fs::path esc = write_named_asset(dir, "esc.lod", "evil\x1b]0;title\x07\x9b\r\nname\xc2\x9b");
