@@ -121,6 +121,13 @@ Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out,
     return Status::error(what + ": has no triangles (" + std::to_string(nf) + " faces with fewer than 3 corners)");
   MeshData mesh;
   mesh.source = what;
+  if (triangles * 3 == raw.corners.size() && triangles == nf) {  // all triangles: copy and free
+    mesh.indices.assign(raw.corners.begin(), raw.corners.end());
+    std::vector<int64_t>().swap(raw.corners);
+    mesh.positions = std::move(raw.positions);
+    out = std::move(mesh);
+    return Status::success();
+  }
   mesh.indices.reserve(3 * triangles);
   for (size_t f = 0; f < nf; ++f) {
     const uint32_t begin = raw.offsets[f], end = raw.offsets[f + 1];
@@ -200,9 +207,12 @@ Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
 }  // namespace
 }  // namespace detail
 
-Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
-                             MeshData& out) {
-  using namespace detail;
+namespace detail {
+namespace {
+// Parses, then frees `owned` (the file's bytes, when load_mesh read them) before the
+// polygons are checked and triangulated, so the bytes and the triangles never coexist.
+Status parse_and_finish(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
+                        MeshData& out, std::vector<uint8_t>* owned) {
   static_assert(std::endian::native == std::endian::little, "the binary readers assume a little-endian host");
   const std::string ext = lower(extension);
   if (size == 0) return Status::error(name + ": file is empty");
@@ -216,10 +226,18 @@ Status load_mesh_from_memory(const std::string& name, const std::string& extensi
     else
       return Status::error(name + ": unknown mesh format '" + extension + "' (expected .obj, .ply, .off or .stl)");
     if (!s) return s;
+    if (owned) std::vector<uint8_t>().swap(*owned);
     return finish_polygons(name, raw, out, /*obj_numbering=*/ext == ".obj");
   } catch (const std::bad_alloc&) {
     return Status::error(name + ": not enough memory to load it (" + std::to_string(size) + " bytes)");
   }
+}
+}  // namespace
+}  // namespace detail
+
+Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
+                             MeshData& out) {
+  return detail::parse_and_finish(name, extension, data, size, out, nullptr);
 }
 
 Status load_mesh(const std::filesystem::path& path, MeshData& out) {
@@ -235,7 +253,7 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   std::vector<uint8_t> bytes;
   Status r = read_regular_file(path, bytes);
   if (!r) return r;
-  return load_mesh_from_memory(what, path.extension().string(), bytes.data(), bytes.size(), out);
+  return parse_and_finish(what, path.extension().string(), bytes.data(), bytes.size(), out, &bytes);
 }
 
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,
