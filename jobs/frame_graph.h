@@ -42,7 +42,7 @@ struct FrameGraphOptions {
     bool enabled = false;
     int width = 320, height = 180;     // depth buffer pixels
     uint32_t occluders = 48;
-    uint32_t occluder_triangles = 3000;
+    uint32_t occluder_triangles = 256;
   } occlusion;
   // Called at the start of every stage, on the thread running it (tracing; tests inject
   // failures by throwing from it). Empty = no call.

@@ -233,6 +233,20 @@ void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {
   }
 }
 
+// [visibility] occlusion = true: cull what large nearby objects hide (view 0); occluders =
+// how many objects are rasterised as occluders per frame.
+void read_visibility(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const toml::table* t = r.table(root, "visibility", "visibility");
+  if (!t) return;
+  r.only_keys(*t, "visibility", {"occlusion", "occluders"});
+  if (const toml::node* n = t->get("occlusion")) {
+    const auto* b = n->as_boolean();
+    if (!b) r.fail("visibility.occlusion", "must be true or false");
+    else c.occlusion = b->get();
+  }
+  r.integer_in(*t, "occluders", "visibility.occluders", 1, 4096, c.occluders);
+}
+
 void read_camera(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "camera", "camera");
   if (!t) return;
@@ -476,10 +490,11 @@ Status load_scene_config(const std::filesystem::path& file, const std::filesyste
   c.file = file;
   const Reader r(name);
   try {
-    r.only_keys(root, "", {"run", "budget", "lod", "camera", "model", "instances"});
+    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "model", "instances"});
     read_run(r, root, c);
     read_budget(r, root, c);
     read_lod(r, root, c);
+    read_visibility(r, root, c);
     read_camera(r, root, c);
     const std::filesystem::path dir =
         file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");

@@ -42,6 +42,8 @@ struct SceneConfig {
   SelectionParams selection;
   float pixel_error = 1.0f;          // [lod] pixel_error: screen-space threshold of initial levels
   float hysteresis = 0.25f;          // [lod] hysteresis
+  bool occlusion = false;            // [visibility] occlusion
+  uint32_t occluders = 48;           // [visibility] occluders
   CameraPath camera;
   std::vector<ModelConfig> models;
   std::vector<InstanceConfig> instances;

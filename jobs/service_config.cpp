@@ -28,6 +28,8 @@ FrameGraphOptions frame_graph_options(const SceneConfig& config) {
   g.selection = config.selection;
   g.pixel_error = config.pixel_error;
   g.hysteresis = config.hysteresis;
+  g.occlusion.enabled = config.occlusion;
+  g.occlusion.occluders = config.occluders;
   return g;
 }
 

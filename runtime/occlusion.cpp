@@ -48,14 +48,32 @@ Edge pixel_edge(float x0, float y0, float x1, float y1) {
   return {a, b, x0 * y1 - x1 * y0 + 0.5f * (a + b)};
 }
 
+// The samples of row y (centres at x + 0.5) inside every edge: [lo, hi], empty when lo > hi.
+bool row_span(const Edge (&e)[3], float fy, int x0, int x1, int* lo, int* hi) {
+  float a = float(x0), b = float(x1);
+  for (const Edge& g : e) {
+    const float w = g.b * fy + g.c;  // E = g.a * x + w at sample x
+    if (g.a > 0)
+      a = std::max(a, std::ceil(-w / g.a));
+    else if (g.a < 0)
+      b = std::min(b, std::floor(-w / g.a));
+    else if (w < 0)
+      return false;
+  }
+  if (!(a <= b)) return false;
+  *lo = int(a), *hi = int(b);
+  return true;
+}
+
 void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[3], float depth) {
-  // Ordered so that cross(p1 - p0, p2 - p0) > 0: then every edge function is >= 0 inside.
+  // Screen y grows downwards, so a face turned towards the eye (counter-clockwise seen from
+  // outside) has a negative signed area here. Back faces are skipped: on a closed mesh they
+  // are behind its front faces, and leaving out an occluder's triangles only hides less.
   const float area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
-  if (!(std::abs(area) > 1e-6f)) return;
-  const int i1 = area > 0 ? 1 : 2, i2 = area > 0 ? 2 : 1;
-  const Edge e0 = pixel_edge(sx[0], sy[0], sx[i1], sy[i1]);
-  const Edge e1 = pixel_edge(sx[i1], sy[i1], sx[i2], sy[i2]);
-  const Edge e2 = pixel_edge(sx[i2], sy[i2], sx[0], sy[0]);
+  if (!(area < -1e-6f)) return;
+  // Ordered so that cross(p1 - p0, p2 - p0) > 0: then every edge function is >= 0 inside.
+  const Edge e[3] = {pixel_edge(sx[0], sy[0], sx[2], sy[2]), pixel_edge(sx[2], sy[2], sx[1], sy[1]),
+                     pixel_edge(sx[1], sy[1], sx[0], sy[0])};
   for (int k = 0; k < 3; ++k)
     if (!std::isfinite(sx[k]) || !std::isfinite(sy[k])) return;
   const int x0 = clamped_floor(std::min({sx[0], sx[1], sx[2]}), 0, buf.width - 1);
@@ -63,16 +81,12 @@ void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[
   const int y0 = clamped_floor(std::min({sy[0], sy[1], sy[2]}), 0, buf.height - 1);
   const int y1 = clamped_floor(std::max({sy[0], sy[1], sy[2]}) + 1, 0, buf.height - 1);
   for (int y = y0; y <= y1; ++y) {
+    int lo, hi;
+    if (!row_span(e, float(y), x0, x1, &lo, &hi)) continue;
     float* __restrict row = buf.levels[0].data() + size_t(y) * size_t(buf.width);
-    const float fy = float(y);
-    const float w0 = e0.b * fy + e0.c, w1 = e1.b * fy + e1.c, w2 = e2.b * fy + e2.c;
-    // Branch-free over the row, so that it vectorizes. A sample on an edge counts as inside
-    // for both triangles that share the edge, so meshes leave no cracks.
-    for (int x = x0; x <= x1; ++x) {
-      const float fx = float(x);
-      const bool covered = (e0.a * fx + w0 >= 0) & (e1.a * fx + w1 >= 0) & (e2.a * fx + w2 >= 0);
-      row[x] = covered ? std::min(row[x], depth) : row[x];
-    }
+    // Every sample of the span is inside; a sample on an edge counts for both triangles that
+    // share the edge, so meshes leave no cracks.
+    for (int x = lo; x <= hi; ++x) row[x] = std::min(row[x], depth);
   }
 }
 

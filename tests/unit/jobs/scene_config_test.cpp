@@ -1,6 +1,7 @@
 // SceneConfig: a good config parses into every field; each absurd value is refused with
 // "file: key: why".
 #include "jobs/scene_config.h"
+#include "jobs/service.h"
 
 #include <gtest/gtest.h>
 
@@ -506,6 +507,24 @@ TEST(SceneConfigStrict, ParsesAndRefusesBudgetStrict) {
   EXPECT_TRUE(c.selection.strict);
   expect_refused("[budget]\nstrict = 1\n" + kModel + kInstances, "budget.strict", "true or false");
   expect_refused("[budget]\nstrict = true\ncount = \"levels\"\n" + kModel + kInstances, "budget.strict", "triangles");
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+TEST(SceneConfigVisibility, ParsesAndRefusesOcclusionKeys) {
+  ConfigDir d;
+  SceneConfig c;
+  ASSERT_TRUE(load(d, "[visibility]\nocclusion = true\noccluders = 12\n" + kModel + kInstances, c).ok);
+  EXPECT_TRUE(c.occlusion);
+  EXPECT_EQ(c.occluders, 12u);
+  EXPECT_TRUE(frame_graph_options(c).occlusion.enabled);
+  expect_refused("[visibility]\nocclusion = \"yes\"\n" + kModel + kInstances, "visibility.occlusion");
+  expect_refused("[visibility]\noccluders = 0\n" + kModel + kInstances, "visibility.occluders");
+  expect_refused("[visibility]\nhiz = 1\n" + kModel + kInstances, "visibility.hiz", "unknown key");
 }
 
 }  // namespace
