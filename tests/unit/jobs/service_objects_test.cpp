@@ -269,7 +269,7 @@ TEST(ServiceObjects, ChurnOfAMillionKeepsHandlesHonestAndMemoryFlat) {
   std::vector<ObjectHandle> dead;
   constexpr int kChurn = 1000000;
   for (int i = 0; i < kChurn; ++i) {
-    if (live.size() < 256 && (live.empty() || (i * 7919) % 3 != 0)) {
+    if (live.size() < 256 && (live.empty() || (uint64_t(i) * 7919u) % 3 != 0)) {
       live.push_back(s.create(uint32_t(i % 3), placed(float(i % 20) - 10, 0, -float(i % 13))));
       ASSERT_NE(live.back(), 0u);
     } else {
