@@ -58,6 +58,8 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"morphing", r.morphing},
           {"tris_morph_extra", r.tris_morph_extra},
           {"budget_morph_reserve", r.budget_morph_reserve},
+          {"tick", r.tick},
+          {"occluded", r.occluded},
           {"ms", ms}};
 }
 
@@ -83,6 +85,8 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"mean_tris_selected", s.mean_tris_selected},
           {"mean_tris_drawn", s.mean_tris_drawn},
           {"max_drawn_over_budget", s.max_drawn_over_budget},
+          {"frames_drawn_over_budget", s.frames_drawn_over_budget},
+          {"mean_occluded", s.mean_occluded},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
           {"cached_models", s.cached_models},
@@ -112,6 +116,8 @@ FrameRecord record_of(const Frame& f) {
   r.morphing = f.morphing;
   r.tris_morph_extra = f.tris_morph_extra;
   r.budget_morph_reserve = f.budget_morph_reserve;
+  r.tick = f.tick;
+  r.occluded = f.occluded;
   return r;
 }
 
@@ -121,8 +127,9 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.binding_frames = 0;
   std::vector<double> total;
   std::array<std::vector<double>, kStageCount> stage;
-  double vis = 0, inview = 0, sel = 0, drawn = 0;
+  double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0;
   s.max_drawn_over_budget = 0;
+  s.frames_drawn_over_budget = 0;
   for (const auto& r : records) {
     s.over_budget_frames += r.over_budget;
     s.binding_frames += (r.lowered_steps > 0 || r.over_budget);
@@ -134,6 +141,8 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     const double d = double(r.tris_selected + r.tris_morph_extra);
     drawn += d;
     if (r.budget > 0) s.max_drawn_over_budget = std::max(s.max_drawn_over_budget, d / double(r.budget));
+    s.frames_drawn_over_budget += d > double(r.budget);
+    occluded += r.occluded;
   }
   const double n = std::max<double>(1, double(records.size()));
   s.median_ms = percentile(total, 0.5);
@@ -147,6 +156,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.mean_tris_in_view = inview / n;
   s.mean_tris_selected = sel / n;
   s.mean_tris_drawn = drawn / n;
+  s.mean_occluded = occluded / n;
 }
 
 std::string table_header() {
@@ -182,12 +192,18 @@ std::string summary_text(const RunSummary& s) {
   std::snprintf(buf, sizeof buf,
                 " ms\n  budget bound on %zu of %zu frames; over budget (coarsest levels exceed M) on %zu frames\n"
                 "  mean visible %.0f, mean triangles in view %.0f at full detail, %.0f selected (%.1fx fewer)\n"
-                "  drawn with level blends: mean %.0f, worst frame %.3f x M\n"
+                "  drawn with level blends: mean %.0f, worst frame %.3f x M, %zu frames drawn over M\n"
                 "  bake: %.0f ms, %zu models baked, %zu from cache; wall %.1f s\n",
                 s.binding_frames, s.frames, s.over_budget_frames, s.mean_visible, s.mean_tris_in_view,
                 s.mean_tris_selected, s.mean_tris_selected > 0 ? s.mean_tris_in_view / s.mean_tris_selected : 0.0,
-                s.mean_tris_drawn, s.max_drawn_over_budget, s.bake_ms, s.baked_models, s.cached_models, s.wall_s);
+                s.mean_tris_drawn, s.max_drawn_over_budget, s.frames_drawn_over_budget, s.bake_ms, s.baked_models,
+                s.cached_models, s.wall_s);
   o << buf;
+  if (s.mean_occluded > 0) {
+    std::snprintf(buf, sizeof buf, "  occlusion: mean %.0f objects in the frustum culled as hidden per frame\n",
+                  s.mean_occluded);
+    o << buf;
+  }
   return o.str();
 }
 

@@ -25,6 +25,8 @@ struct FrameRecord {
   uint32_t morphing = 0;             // objects blending two levels (drawn at the finer one)
   uint64_t tris_morph_extra = 0;     // what that adds to tris_selected
   uint64_t budget_morph_reserve = 0; // held back from M for last frame's blends
+  uint64_t tick = 0;                 // the commit the frame was computed from
+  uint32_t occluded = 0;             // frustum-visible objects occlusion culled
 };
 
 FrameRecord record_of(const Frame& frame);
@@ -41,6 +43,8 @@ struct RunSummary {
   double mean_visible = 0, mean_tris_in_view = 0, mean_tris_selected = 0;
   // Drawn = selected + what blends add (triangle budgets): the mean and the worst frame vs M.
   double mean_tris_drawn = 0, max_drawn_over_budget = 0;
+  size_t frames_drawn_over_budget = 0;  // drawn (blends included) > M
+  double mean_occluded = 0;             // objects occlusion culled per frame
   double bake_ms = 0;
   size_t baked_models = 0, cached_models = 0;
   double wall_s = 0;
