@@ -53,14 +53,12 @@ ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>
       objects.z[o] = p[2];
       objects.yaw[o] = yaw;
       objects.scale[o] = scale;
-      // World sphere: rotate the object-space centre about +y (as glm::rotate(yaw, y) does),
-      // scale it, then move it to the position.
-      const float c = std::cos(yaw), s = std::sin(yaw);
-      const float* sc = sphere.center;
-      objects.cx[o] = p[0] + scale * (c * sc[0] + s * sc[2]);
-      objects.cy[o] = p[1] + scale * sc[1];
-      objects.cz[o] = p[2] + scale * (-s * sc[0] + c * sc[2]);
-      objects.radius[o] = sphere.radius * scale;
+      // The world sphere as every frame computes it (runtime/world_bounds.h).
+      const Sphere w = world_sphere(transform_of(objects, o), sphere);
+      objects.cx[o] = w.center[0];
+      objects.cy[o] = w.center[1];
+      objects.cz[o] = w.center[2];
+      objects.radius[o] = w.radius;
     }
   }
   return objects;

@@ -26,20 +26,6 @@ ObjectControl control_of(const ObjectOptions& o, float scale, uint32_t model, co
   return c;
 }
 
-void object_controls(std::span<uint32_t> row, std::span<uint8_t> min_level, std::span<float> error_scale,
-                     std::span<float> inv_priority, std::span<uint8_t> never_cull,
-                     std::span<const ObjectOptions> options, std::span<const Transform> transform,
-                     std::span<const uint32_t> model, const LevelCaps& caps) {
-  const size_t n = options.size();
-  assert(row.size() == n && min_level.size() == n && error_scale.size() == n && inv_priority.size() == n &&
-         never_cull.size() == n && transform.size() == n && model.size() == n);
-  for (size_t i = 0; i < n; ++i) {
-    const ObjectControl c = control_of(options[i], transform[i].scale, model[i], caps);
-    row[i] = c.row, min_level[i] = c.min_level, error_scale[i] = c.error_scale;
-    inv_priority[i] = c.inv_priority, never_cull[i] = c.never_cull;
-  }
-}
-
 void apply_object_controls(std::span<uint8_t> level, std::span<float> weight, std::span<const uint8_t> visible,
                            std::span<const uint8_t> min_level, std::span<const float> inv_priority) {
   const size_t n = visible.size();

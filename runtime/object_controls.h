@@ -25,12 +25,6 @@ struct ObjectControl {
 // One object's controls; clamps what it reads, so any option values give valid columns.
 ObjectControl control_of(const ObjectOptions& o, float scale, uint32_t model, const LevelCaps& caps);
 
-// The same over columns. Sub-range safe.
-void object_controls(std::span<uint32_t> row, std::span<uint8_t> min_level, std::span<float> error_scale,
-                     std::span<float> inv_priority, std::span<uint8_t> never_cull,
-                     std::span<const ObjectOptions> options, std::span<const Transform> transform,
-                     std::span<const uint32_t> model, const LevelCaps& caps);
-
 // level[i] = max(level[i], min_level[i]) and weight[i] *= inv_priority[i], for every object
 // (an invisible one's values are not read), so that the loop vectorizes. Sub-range safe.
 void apply_object_controls(std::span<uint8_t> level, std::span<float> weight, std::span<const uint8_t> visible,

@@ -122,11 +122,8 @@ void occlusion_clear(OcclusionBuffer& b, const OcclusionCamera& c) {
 void rasterize_occluder(OcclusionBuffer& buf, const OcclusionCamera& c, std::span<const float> positions,
                         std::span<const uint32_t> indices, const Transform& t) {
   const size_t vertices = positions.size() / 3;
-  const float len2 = t.rotation[0] * t.rotation[0] + t.rotation[1] * t.rotation[1] + t.rotation[2] * t.rotation[2] +
-                     t.rotation[3] * t.rotation[3];
-  if (!(len2 > 0)) return;
-  const float inv = 1.0f / std::sqrt(len2);
-  const float q[4] = {t.rotation[0] * inv, t.rotation[1] * inv, t.rotation[2] * inv, t.rotation[3] * inv};
+  float q[4];
+  normalized_rotation(t, q);
   for (size_t k = 0; k + 2 < indices.size(); k += 3) {
     float sx[3], sy[3], far_z = 0;
     bool ok = true;

@@ -31,30 +31,23 @@ void rotate_by_quaternion(const float q[4], const float v[3], float out[3]) {
   out[2] = v[2] + w * tz + (ux * ty - uy * tx);
 }
 
-Sphere world_sphere(const Transform& t, const Sphere& s) {
+void normalized_rotation(const Transform& t, float q[4]) {
   const float len2 = t.rotation[0] * t.rotation[0] + t.rotation[1] * t.rotation[1] + t.rotation[2] * t.rotation[2] +
                      t.rotation[3] * t.rotation[3];
   const float inv = len2 > 0 ? 1.0f / std::sqrt(len2) : 0.0f;
-  const float q[4] = {t.rotation[0] * inv, t.rotation[1] * inv, t.rotation[2] * inv,
-                      len2 > 0 ? t.rotation[3] * inv : 1.0f};
+  for (int k = 0; k < 3; ++k) q[k] = t.rotation[k] * inv;
+  q[3] = len2 > 0 ? t.rotation[3] * inv : 1.0f;
+}
+
+Sphere world_sphere(const Transform& t, const Sphere& s) {
+  float q[4];
+  normalized_rotation(t, q);
   float c[3];
   rotate_by_quaternion(q, s.center, c);
   Sphere w;
   for (int k = 0; k < 3; ++k) w.center[k] = t.position[k] + t.scale * c[k];
   w.radius = s.radius * t.scale;
   return w;
-}
-
-void world_spheres(std::span<float> cx, std::span<float> cy, std::span<float> cz, std::span<float> radius,
-                   std::span<const Transform> transform, std::span<const uint32_t> model,
-                   std::span<const Sphere> model_sphere) {
-  const size_t n = transform.size();
-  assert(cx.size() == n && cy.size() == n && cz.size() == n && radius.size() == n && model.size() == n);
-  for (size_t i = 0; i < n; ++i) {
-    assert(model[i] < model_sphere.size());
-    const Sphere w = world_sphere(transform[i], model_sphere[model[i]]);
-    cx[i] = w.center[0], cy[i] = w.center[1], cz[i] = w.center[2], radius[i] = w.radius;
-  }
 }
 
 }  // namespace lod

@@ -3,7 +3,6 @@
 // q normalised here (a zero quaternion counts as no rotation).
 #pragma once
 #include <cstdint>
-#include <span>
 
 #include "lodkit/types.hpp"
 #include "runtime/lod_chain.h"
@@ -16,12 +15,10 @@ Sphere chain_sphere(const LodChain& chain);
 // rotate(q, v) for a unit quaternion q = x y z w.
 void rotate_by_quaternion(const float q[4], const float v[3], float out[3]);
 
+// The transform's rotation as a unit quaternion (a zero quaternion counts as no rotation).
+void normalized_rotation(const Transform& t, float q[4]);
+
 // One object's world sphere.
 Sphere world_sphere(const Transform& t, const Sphere& model_sphere);
-
-// Sub-range safe: run it on chunks.
-void world_spheres(std::span<float> cx, std::span<float> cy, std::span<float> cz, std::span<float> radius,
-                   std::span<const Transform> transform, std::span<const uint32_t> model,
-                   std::span<const Sphere> model_sphere);
 
 }  // namespace lod
