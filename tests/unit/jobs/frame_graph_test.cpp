@@ -208,13 +208,13 @@ TEST(FrameGraph, StageTimesAreFilledAndBoundedByTheTotal) {
   FrameGraph g(scene, options_with(2, 100000));
   Frame f;
   g.run(view_at(test::synthetic_config(2000, 200).camera, 0), f);
-  double sum = 0;
+  // Independent nodes run at the same time, so the stages' sum may pass the frame's wall
+  // time; no single stage can.
   for (double ms : f.stage_ms) {
     EXPECT_GE(ms, 0.0);
-    sum += ms;
+    EXPECT_LE(ms, f.total_ms);
   }
   EXPECT_GT(f.stage_ms[static_cast<size_t>(Stage::visibility)], 0.0);
-  EXPECT_LE(sum, f.total_ms);
 }
 
 // The data dependencies of the node table: each node starts after the nodes it reads from.

@@ -20,6 +20,8 @@ extern "C" const char* __tsan_default_suppressions() {
   return "race_top:/oneapi/tbb/\n"
          "race:tbb::detail::d1::fold_tree\n"          // parallel_for's partition tree
          "race:tbb::detail::d1::tree_node::\n"
+         "race:tbb::detail::d1::wait_node\n"          // ... its root, on the spawning task's stack
+         "race:tbb::detail::d1::node::node\n"
          "race:tbb::detail::d1::wait_context::\n"     // completion counters
          "race:tbb::detail::d1::broadcast_cache\n"    // flow-graph successor lists
          "race:tbb::detail::d1::spin_rw_mutex\n";
