@@ -33,7 +33,7 @@ echo "== AddressSanitizer + UBSan: runtime, preprocess, jobs, integration =="
 cmake --build build-asan -j "$JOBS" --target test_runtime test_preprocess test_jobs test_c_api test_integration
 ASAN_OPTIONS="detect_leaks=1" UBSAN_OPTIONS="print_stacktrace=1" \
   ./scripts/ctest-all.sh build-asan -j "$JOBS" --timeout 900 -L 'unit|integration'
-# ---- fuzzing (mesh readers): each libFuzzer target for a bounded time; a crash, sanitizer
+# ---- fuzzing (mesh readers, .lod assets, scene configs): each libFuzzer target for a bounded time; a crash, sanitizer
 # report, hang or > 64 MB allocation fails the suite (scripts/fuzz.sh SECONDS runs longer).
 echo "== libFuzzer + ASan/UBSan: mesh readers, ${LOD_FUZZ_SECONDS:-20} s per format =="
 ./scripts/fuzz.sh "${LOD_FUZZ_SECONDS:-20}"
