@@ -35,6 +35,6 @@ ASAN_OPTIONS="detect_leaks=1" UBSAN_OPTIONS="print_stacktrace=1" \
   ./scripts/ctest-all.sh build-asan -j "$JOBS" --timeout 900 -L 'unit|integration'
 # ---- fuzzing (mesh readers, .lod assets, scene configs): each libFuzzer target for a bounded time; a crash, sanitizer
 # report, hang or > 64 MB allocation fails the suite (scripts/fuzz.sh SECONDS runs longer).
-echo "== libFuzzer + ASan/UBSan: mesh readers, ${LOD_FUZZ_SECONDS:-20} s per format =="
+echo "== libFuzzer + ASan/UBSan: every reader, ${LOD_FUZZ_SECONDS:-20} s per target =="
 ./scripts/fuzz.sh "${LOD_FUZZ_SECONDS:-20}"
 echo "== all tests passed =="
