@@ -11,7 +11,8 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. scripts/fuzz.sh 20   or  scripts/fuzz.sh 180 ply lod
 # Env: LOD_FUZZ_BUILD (default build-fuzz), LOD_FUZZ_JOBS (parallel targets; default nproc),
-#      LOD_FUZZ_MAX_LEN (default 4096 bytes; 16384 for lod, whose seeds are larger).
+#      LOD_FUZZ_MAX_LEN (default 4096 bytes; 16384 for lod, whose seeds are larger),
+#      LOD_FUZZ_TIMEOUT (seconds per input, default 5; more on a loaded or niced run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
@@ -94,7 +95,7 @@ run_one() {  # runs in a background subshell; reports by its exit status
   # -malloc_limit_mb=64: the figure "every file under 1 KB loads in < 64 MB" (inputs here are
   # up to MAX_LEN bytes, so this is stricter); -timeout=5: a hang is a finding.
   ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-    "$OUT/fuzz_$fmt" -max_total_time="$SECONDS_EACH" -timeout=5 -malloc_limit_mb=64 -rss_limit_mb=1024 \
+    "$OUT/fuzz_$fmt" -max_total_time="$SECONDS_EACH" -timeout="${LOD_FUZZ_TIMEOUT:-5}" -malloc_limit_mb=64 -rss_limit_mb=1024 \
       -max_len="$max_len" -dict="tests/fuzz/$fmt.dict" -artifact_prefix="$dir/" -print_final_stats=1 \
       "$dir/corpus" "tests/fuzz/corpus/$fmt" >"$dir/log.txt" 2>&1 || rc=$?
   local execs rate cov
