@@ -186,14 +186,14 @@ std::vector<float> sample_surface(const TriangleMeshView& view, size_t count, ui
 }
 
 // Distances from every sample to `mesh`: updates max and the sum of squares.
-void query_distances(const std::vector<float>& samples, const QueryMesh& mesh, double& max_d, double& sum_sq,
-                     size_t& n) {
+void query_distances(const float* samples, size_t sample_floats, const QueryMesh& mesh, double& max_d,
+                     double& sum_sq, size_t& n) {
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   constexpr float kInf = std::numeric_limits<float>::infinity();
   Vec3 prev{0, 0, 0};
   double prev_d = kInf;
-  for (size_t i = 0; i + 2 < samples.size(); i += 3) {
+  for (size_t i = 0; i + 2 < sample_floats; i += 3) {
     QueryState st{&mesh, load(&samples[i]), kInf};
     RTCPointQuery q;
     q.x = st.point.x;
@@ -265,14 +265,79 @@ Status SurfaceErrorMeter::measure(const TriangleMeshView& mesh, SurfaceError& ou
   const std::vector<float> samples = sample_surface(mesh, m.settings.surface_samples, m.settings.seed + 1);
   double max_d = 0, sum_sq = 0;
   size_t n = 0;
-  query_distances(samples, m.reference, max_d, sum_sq, n);
-  query_distances(m.reference_samples, other, max_d, sum_sq, n);
+  query_distances(samples.data(), samples.size(), m.reference, max_d, sum_sq, n);
+  query_distances(m.reference_samples.data(), m.reference_samples.size(), other, max_d, sum_sq, n);
   if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
     return Status::error(m.what + ": Embree point query failed (" + device_error_text(m.device) + ")");
   out.max = float(max_d);
   out.rms = n ? float(std::sqrt(sum_sq / double(n))) : 0.0f;
   out.samples = n;
   return Status::success();
+}
+
+struct SurfaceDistance::Impl {
+  RTCDevice device = nullptr;
+  QueryMesh surface;
+  std::string what;
+  bool ready = false;
+
+  ~Impl() {
+    surface.release();
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+SurfaceDistance::SurfaceDistance() : impl_(std::make_unique<Impl>()) {}
+SurfaceDistance::~SurfaceDistance() = default;
+
+Status SurfaceDistance::set_surface(const TriangleMeshView& surface, const std::string& what) {
+  Impl& m = *impl_;
+  m.ready = false;
+  m.what = what;
+  if (!m.device) {
+    m.device = rtcNewDevice(nullptr);
+    if (!m.device) return Status::error(what + ": Embree device could not be created");
+  }
+  if (Status s = build_query_mesh(m.device, surface, what, m.surface); !s) return s;
+  m.ready = true;
+  return Status::success();
+}
+
+namespace {
+SurfaceError distance_summary(double max_d, double sum_sq, size_t n) {
+  SurfaceError e;
+  e.max = float(max_d);
+  e.rms = n ? float(std::sqrt(sum_sq / double(n))) : 0.0f;
+  e.samples = n;
+  return e;
+}
+}  // namespace
+
+Status SurfaceDistance::from_points(const float* points, size_t count, SurfaceError& out) const {
+  const Impl& m = *impl_;
+  if (!m.ready) return Status::error("surface distance: no surface set");
+  double max_d = 0, sum_sq = 0;
+  size_t n = 0;
+  query_distances(points, 3 * count, m.surface, max_d, sum_sq, n);
+  out = distance_summary(max_d, sum_sq, n);
+  return Status::success();
+}
+
+Status SurfaceDistance::from_points_to(const TriangleMeshView& mesh, const float* points, size_t count,
+                                       SurfaceError& out) const {
+  const Impl& m = *impl_;
+  if (!m.ready) return Status::error("surface distance: no surface set");
+  QueryMesh other;
+  if (Status s = build_query_mesh(m.device, mesh, m.what + " (layer)", other); !s) return s;
+  double max_d = 0, sum_sq = 0;
+  size_t n = 0;
+  query_distances(points, 3 * count, other, max_d, sum_sq, n);
+  out = distance_summary(max_d, sum_sq, n);
+  return Status::success();
+}
+
+std::vector<float> surface_sample_points(const TriangleMeshView& mesh, size_t count, uint64_t seed) {
+  return sample_surface(mesh, count, seed);
 }
 
 Status measure_surface_error(const TriangleMeshView& a, const TriangleMeshView& b,

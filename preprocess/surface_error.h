@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "runtime/status.h"
 
@@ -50,6 +51,33 @@ class SurfaceErrorMeter {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// One surface held for closest-point queries from many threads at once (HLOD builds measure
+// every node's layers against one original). The const members are thread-safe.
+class SurfaceDistance {
+ public:
+  SurfaceDistance();
+  ~SurfaceDistance();
+  SurfaceDistance(const SurfaceDistance&) = delete;
+  SurfaceDistance& operator=(const SurfaceDistance&) = delete;
+
+  // Copies `surface` into a BVH. `what` names it in messages.
+  Status set_surface(const TriangleMeshView& surface, const std::string& what);
+  // Distance from each of `count` points (xyz) to the held surface: max into out.max,
+  // RMS into out.rms (samples = count).
+  Status from_points(const float* points, size_t count, SurfaceError& out) const;
+  // The same to `mesh` instead, whose BVH is built on the held surface's Embree device for
+  // this call only (a small layer measured from the original's samples).
+  Status from_points_to(const TriangleMeshView& mesh, const float* points, size_t count, SurfaceError& out) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The sample points SurfaceErrorMeter uses: every vertex some triangle uses, then `count`
+// seeded area-weighted points on the triangles (xyz each).
+std::vector<float> surface_sample_points(const TriangleMeshView& mesh, size_t count, uint64_t seed);
 
 // One-off convenience: symmetric distance between a and b.
 Status measure_surface_error(const TriangleMeshView& a, const TriangleMeshView& b,
