@@ -44,7 +44,7 @@ struct BuildNode {
   uint8_t child_mask = 0;
   std::vector<uint32_t> patch;      // original triangles across the children
   std::vector<Layer> layers;        // finest first
-  std::vector<float> reference;     // original points of the node's region, thinned
+  std::vector<uint32_t> reference;  // original vertices of the node's region, thinned
   Sphere bounds;
   Status status;
   bool leaf() const { return child_mask == 0; }
@@ -191,45 +191,83 @@ void simplify_layers(Context& c, BuildNode& n) {
   }
 }
 
-// `points` evenly thinned to at most `cap` (xyz each), in order.
-std::vector<float> thinned(const std::vector<float>& points, size_t cap) {
-  const size_t n = points.size() / 3;
-  if (n <= cap) return points;
-  std::vector<float> out(3 * cap);
-  for (size_t k = 0; k < cap; ++k) {
-    const size_t i = k * n / cap;
-    for (int j = 0; j < 3; ++j) out[3 * k + j] = points[3 * i + j];
-  }
+// `ids` evenly thinned to at most `cap`, in order.
+std::vector<uint32_t> thinned(std::vector<uint32_t> ids, size_t cap) {
+  const size_t n = ids.size();
+  if (n <= cap) return ids;
+  std::vector<uint32_t> out(cap);
+  for (size_t k = 0; k < cap; ++k) out[k] = ids[k * n / cap];
   return out;
 }
 
 // The node's original region, sampled: a leaf's own vertices; an inner node's children's
 // samples and its patch's vertices.
 void gather_reference(Context& c, BuildNode& n) {
-  std::vector<float> points;
+  std::vector<uint32_t> ids;
   if (n.leaf()) {
-    points = n.layers[0].positions;
+    ids = n.layers[0].source;
   } else {
     for (const auto& child : n.children)
-      if (child) points.insert(points.end(), child->reference.begin(), child->reference.end());
+      if (child) ids.insert(ids.end(), child->reference.begin(), child->reference.end());
     for (uint32_t t : n.patch)
-      for (int k = 0; k < 3; ++k) {
-        const float* p = c.positions + 3 * size_t(c.indices[3 * size_t(t) + k]);
-        points.insert(points.end(), p, p + 3);
-      }
+      for (int k = 0; k < 3; ++k) ids.push_back(c.indices[3 * size_t(t) + k]);
   }
-  n.reference = thinned(points, c.options.reference_samples);
+  n.reference = thinned(std::move(ids), c.options.reference_samples);
+}
+
+float distance_to_original(const Context& c, const float* p, uint32_t v) {
+  const float* o = c.positions + 3 * size_t(v);
+  const double dx = p[0] - o[0], dy = p[1] - o[1], dz = p[2] - o[2];
+  return float(std::sqrt(dx * dx + dy * dy + dz * dz));
+}
+
+// The node's original samples, each with a distance the layer is known to be within: to the
+// layer vertex descended from it, when it survived into the layer.
+void reference_samples(Context& c, const BuildNode& n, const Layer& layer, std::vector<float>& points,
+                       std::vector<float>& known) {
+  const uint32_t s = c.new_stamp();
+  for (uint32_t i = 0; i < layer.vertices(); ++i) c.stamp[layer.source[i]] = s, c.local[layer.source[i]] = i;
+  points.resize(3 * n.reference.size());
+  known.resize(n.reference.size());
+  for (size_t k = 0; k < n.reference.size(); ++k) {
+    const uint32_t v = n.reference[k];
+    for (int j = 0; j < 3; ++j) points[3 * k + j] = c.positions[3 * size_t(v) + j];
+    known[k] = c.stamp[v] == s ? distance_to_original(c, &layer.positions[3 * size_t(c.local[v])], v) : INFINITY;
+  }
+}
+
+// A layer's own samples: every vertex, then the centroids of an even subset of its triangles.
+// Each comes with a distance the original surface is known to be within (to the original
+// vertex it, or its triangle's nearest corner, descends from), so that its closest-point
+// query starts small.
+void layer_samples(const Context& c, const Layer& layer, std::vector<float>& points, std::vector<float>& known) {
+  points = layer.positions;
+  known.resize(layer.vertices());
+  for (size_t i = 0; i < layer.vertices(); ++i) known[i] = distance_to_original(c, &layer.positions[3 * i], layer.source[i]);
+  const size_t tris = layer.triangles();
+  const auto centroids = std::min(tris, size_t(std::ceil(double(c.options.layer_samples_per_triangle) * double(tris))));
+  for (size_t k = 0; k < centroids; ++k) {
+    const uint32_t* f = &layer.indices[3 * (k * tris / centroids)];
+    float p[3];
+    for (int j = 0; j < 3; ++j)
+      p[j] = (layer.positions[3 * size_t(f[0]) + j] + layer.positions[3 * size_t(f[1]) + j] + layer.positions[3 * size_t(f[2]) + j]) / 3;
+    points.insert(points.end(), p, p + 3);
+    float bound = INFINITY;
+    for (int j = 0; j < 3; ++j) bound = std::min(bound, distance_to_original(c, p, layer.source[f[j]]));
+    known.push_back(bound);
+  }
 }
 
 // Symmetric distance between a layer and the original: the layer's samples to the whole
 // original surface, the node's original samples to the layer.
 Status measure_layer(Context& c, const BuildNode& n, const Layer& layer, float& error) {
   const TriangleMeshView view{layer.positions.data(), layer.vertices(), layer.indices.data(), layer.indices.size()};
-  const auto area = size_t(std::ceil(double(c.options.layer_samples_per_triangle) * double(layer.triangles())));
-  const std::vector<float> samples = surface_sample_points(view, area, c.options.seed);
+  std::vector<float> samples, known;
+  layer_samples(c, layer, samples, known);
   SurfaceError to_original, from_original;
-  if (Status s = c.original.from_points(samples.data(), samples.size() / 3, to_original); !s) return s;
-  if (Status s = c.original.from_points_to(view, n.reference.data(), n.reference.size() / 3, from_original); !s)
+  if (Status s = c.original.from_points(samples.data(), samples.size() / 3, known.data(), to_original); !s) return s;
+  reference_samples(c, n, layer, samples, known);
+  if (Status s = c.original.from_points_to(view, samples.data(), samples.size() / 3, known.data(), from_original); !s)
     return s;
   error = std::max(to_original.max, from_original.max);
   return Status::success();

@@ -33,13 +33,12 @@ using HlodBuildProgress = std::function<void(float fraction)>;
 
 struct HlodBuildOptions {
   uint32_t min_verts = 1000;  // a cell with more vertices splits (R1 Table I: 500-1000)
-  // Error measurement, per layer. The layer side: every vertex plus this many area samples
-  // per triangle, against the whole original. The original side: the node's own original
-  // vertices (its region of the mesh: leaves, patches below it), evenly thinned to at most
-  // reference_samples, against the layer.
-  float layer_samples_per_triangle = 1.0f;
-  uint32_t reference_samples = 2048;
-  uint64_t seed = 1;
+  // Error measurement, per layer. The layer side: every vertex plus the centroids of this
+  // fraction of its triangles (evenly spread), against the whole original. The original side:
+  // the node's own original vertices (its region of the mesh: its leaves and the patches
+  // below it), evenly thinned to at most reference_samples, against the layer.
+  float layer_samples_per_triangle = 0.25f;
+  uint32_t reference_samples = 1024;
   ParallelFor parallel_for;     // optional; independent subtrees and children in parallel
   HlodBuildProgress progress;   // optional
 };

@@ -186,8 +186,8 @@ std::vector<float> sample_surface(const TriangleMeshView& view, size_t count, ui
 }
 
 // Distances from every sample to `mesh`: updates max and the sum of squares.
-void query_distances(const float* samples, size_t sample_floats, const QueryMesh& mesh, double& max_d,
-                     double& sum_sq, size_t& n) {
+void query_distances(const float* samples, size_t sample_floats, const float* known, const QueryMesh& mesh,
+                     double& max_d, double& sum_sq, size_t& n) {
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -204,7 +204,8 @@ void query_distances(const float* samples, size_t sample_floats, const QueryMesh
     // plus the step between the samples. Starting the query with that radius prunes most of
     // the BVH; the margin covers float rounding, and a miss falls back to an open query.
     const Vec3 step = st.point - prev;
-    const double bound = prev_d + std::sqrt(double(dot(step, step)));
+    double bound = prev_d + std::sqrt(double(dot(step, step)));
+    if (known) bound = std::min(bound, double(known[i / 3]));  // the caller's own bound, when tighter
     q.radius = float(bound * 1.0001 + 1e-12);
     rtcPointQuery(mesh.scene, &q, &context, closest_point_callback, &st);
     if (st.best_sq == kInf) {
@@ -265,8 +266,8 @@ Status SurfaceErrorMeter::measure(const TriangleMeshView& mesh, SurfaceError& ou
   const std::vector<float> samples = sample_surface(mesh, m.settings.surface_samples, m.settings.seed + 1);
   double max_d = 0, sum_sq = 0;
   size_t n = 0;
-  query_distances(samples.data(), samples.size(), m.reference, max_d, sum_sq, n);
-  query_distances(m.reference_samples.data(), m.reference_samples.size(), other, max_d, sum_sq, n);
+  query_distances(samples.data(), samples.size(), nullptr, m.reference, max_d, sum_sq, n);
+  query_distances(m.reference_samples.data(), m.reference_samples.size(), nullptr, other, max_d, sum_sq, n);
   if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
     return Status::error(m.what + ": Embree point query failed (" + device_error_text(m.device) + ")");
   out.max = float(max_d);
@@ -313,31 +314,27 @@ SurfaceError distance_summary(double max_d, double sum_sq, size_t n) {
 }
 }  // namespace
 
-Status SurfaceDistance::from_points(const float* points, size_t count, SurfaceError& out) const {
+Status SurfaceDistance::from_points(const float* points, size_t count, const float* known, SurfaceError& out) const {
   const Impl& m = *impl_;
   if (!m.ready) return Status::error("surface distance: no surface set");
   double max_d = 0, sum_sq = 0;
   size_t n = 0;
-  query_distances(points, 3 * count, m.surface, max_d, sum_sq, n);
+  query_distances(points, 3 * count, known, m.surface, max_d, sum_sq, n);
   out = distance_summary(max_d, sum_sq, n);
   return Status::success();
 }
 
 Status SurfaceDistance::from_points_to(const TriangleMeshView& mesh, const float* points, size_t count,
-                                       SurfaceError& out) const {
+                                       const float* known, SurfaceError& out) const {
   const Impl& m = *impl_;
   if (!m.ready) return Status::error("surface distance: no surface set");
   QueryMesh other;
   if (Status s = build_query_mesh(m.device, mesh, m.what + " (layer)", other); !s) return s;
   double max_d = 0, sum_sq = 0;
   size_t n = 0;
-  query_distances(points, 3 * count, other, max_d, sum_sq, n);
+  query_distances(points, 3 * count, known, other, max_d, sum_sq, n);
   out = distance_summary(max_d, sum_sq, n);
   return Status::success();
-}
-
-std::vector<float> surface_sample_points(const TriangleMeshView& mesh, size_t count, uint64_t seed) {
-  return sample_surface(mesh, count, seed);
 }
 
 Status measure_surface_error(const TriangleMeshView& a, const TriangleMeshView& b,

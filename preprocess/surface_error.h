@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "runtime/status.h"
 
@@ -64,20 +63,19 @@ class SurfaceDistance {
   // Copies `surface` into a BVH. `what` names it in messages.
   Status set_surface(const TriangleMeshView& surface, const std::string& what);
   // Distance from each of `count` points (xyz) to the held surface: max into out.max,
-  // RMS into out.rms (samples = count).
-  Status from_points(const float* points, size_t count, SurfaceError& out) const;
+  // RMS into out.rms (samples = count). `known` (optional, one per point): a distance the
+  // surface is known to be within (e.g. to a surface vertex the point came from), so the
+  // query starts small; +inf where nothing is known.
+  Status from_points(const float* points, size_t count, const float* known, SurfaceError& out) const;
   // The same to `mesh` instead, whose BVH is built on the held surface's Embree device for
   // this call only (a small layer measured from the original's samples).
-  Status from_points_to(const TriangleMeshView& mesh, const float* points, size_t count, SurfaceError& out) const;
+  Status from_points_to(const TriangleMeshView& mesh, const float* points, size_t count, const float* known,
+                        SurfaceError& out) const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// The sample points SurfaceErrorMeter uses: every vertex some triangle uses, then `count`
-// seeded area-weighted points on the triangles (xyz each).
-std::vector<float> surface_sample_points(const TriangleMeshView& mesh, size_t count, uint64_t seed);
 
 // One-off convenience: symmetric distance between a and b.
 Status measure_surface_error(const TriangleMeshView& a, const TriangleMeshView& b,
