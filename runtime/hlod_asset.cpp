@@ -11,7 +11,7 @@
 //     node records: 64 bytes each (see put_record), breadth-first
 //     offset table: u64 offset, u64 size per node
 //   u64 head checksum = hash_bytes(bytes [0, H))
-//   payloads, one per node in node order, each 8-aligned: per layer positions (3 f32 per
+//   payloads, one per node in node order, back to back up to the end of the file: per layer positions (3 f32 per
 //   vertex), normals (same), indices (3 u32 per triangle, layer-local), then the boundary
 //   patch the same way, then u64 checksum = hash_bytes(the payload before it)
 //
@@ -310,7 +310,6 @@ std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const Hlo
   w.patch_u32(12, uint32_t(head));
   w.u64(0);  // head checksum, once the offsets are in
   for (uint32_t i = 0; i < count; ++i) {
-    w.align();
     const size_t begin = w.bytes.size();
     const HlodPayload& p = payloads[i];
     auto put_range = [&](const LodLevel& r) {
@@ -384,10 +383,10 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
                              std::to_string(n.payload_size) + ")";
     if (n.payload_size != want)
       return refuse(what, name + " should be " + std::to_string(want) + " bytes for its counts");
-    if (n.payload_offset % 8 != 0 || n.payload_offset < end || n.payload_offset > file_size ||
-        n.payload_size > file_size - n.payload_offset)
-      return refuse(what, name + " lies outside the file's " + std::to_string(file_size) +
-                              " bytes or overlaps the head or the payload before it");
+    if (n.payload_offset != end || n.payload_offset > file_size || n.payload_size > file_size - n.payload_offset)
+      return refuse(what, name + " does not follow the " + (i ? "payload before it" : "head") + " at " +
+                              std::to_string(end) + " (it overlaps it or leaves a gap) or lies outside the file's " +
+                              std::to_string(file_size) + " bytes");
     end = n.payload_offset + n.payload_size;
     uint64_t own = n.boundary_vertices;
     for (uint32_t k = 0; k < n.layer_count; ++k) own += n.layers[k].vertices;
@@ -396,6 +395,8 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
     boundary += n.boundary_triangles;
     n.resident_bytes = hlod_resident_bytes(n);
   }
+  if (end != file_size)
+    return refuse(what, "the payloads end at " + std::to_string(end) + ", the file at " + std::to_string(file_size));
   if (vertices != load_u64(p + 48) || boundary != load_u64(p + 56))
     return refuse(what, "header counts " + std::to_string(load_u64(p + 48)) + " vertices, " +
                             std::to_string(load_u64(p + 56)) + " boundary triangles; the nodes hold " +
