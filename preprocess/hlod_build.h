@@ -33,6 +33,10 @@ using HlodBuildProgress = std::function<void(float fraction)>;
 
 struct HlodBuildOptions {
   uint32_t min_verts = 1000;  // a cell with more vertices splits (R1 Table I: 500-1000)
+  // A layer stops above its half rather than make a collapse whose QEM error exceeds this
+  // fraction of the node's cell edge: errors then grow with cell size, as the octree's
+  // selection expects. 0 = always halve.
+  float max_error_per_cell = 0.01f;
   // Error measurement, per layer. The layer side: every vertex plus the centroids of this
   // fraction of its triangles (evenly spread), against the whole original. The original side:
   // the node's own original vertices (its region of the mesh: its leaves and the patches

@@ -281,7 +281,7 @@ TEST(HlodBuild, ProgressRisesToOne) {
 }
 
 TEST(HlodBuild, SmallMeshIsOneLeaf) {
-  const HlodModel m = build(test::vd_sphere(8, 10), 1000);
+  const HlodModel m = build(test::vd_sphere(20, 24), 1000);
   ASSERT_EQ(m.tree.nodes.size(), 1u);
   EXPECT_TRUE(m.tree.nodes[0].leaf());
   EXPECT_EQ(m.tree.nodes[0].layer_count, 3);
