@@ -195,6 +195,12 @@ void query_distances(const float* samples, size_t sample_floats, const float* kn
   double prev_d = kInf;
   for (size_t i = 0; i + 2 < sample_floats; i += 3) {
     QueryState st{&mesh, load(&samples[i]), kInf};
+    if (known && known[i / 3] == 0) {  // a point of the surface itself: nothing to look up
+      prev = st.point;
+      prev_d = 0;
+      ++n;
+      continue;
+    }
     RTCPointQuery q;
     q.x = st.point.x;
     q.y = st.point.y;

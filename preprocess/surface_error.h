@@ -65,7 +65,7 @@ class SurfaceDistance {
   // Distance from each of `count` points (xyz) to the held surface: max into out.max,
   // RMS into out.rms (samples = count). `known` (optional, one per point): a distance the
   // surface is known to be within (e.g. to a surface vertex the point came from), so the
-  // query starts small; +inf where nothing is known.
+  // query starts small; +inf where nothing is known, 0 for a point of the surface itself.
   Status from_points(const float* points, size_t count, const float* known, SurfaceError& out) const;
   // The same to `mesh` instead, whose BVH is built on the held surface's Embree device for
   // this call only (a small layer measured from the original's samples).
