@@ -14,6 +14,14 @@ int bake_hlod_command(const BakeArgs& args) {
     std::fprintf(stderr, "lod bake: --ratios and --method do not apply to --hlod (its layers halve, by QEM)\n");
     return 1;
   }
+  for (size_t a = 0; a < args.models.size(); ++a)
+    for (size_t b = 0; b < a; ++b)
+      if (std::filesystem::path(args.models[a]).stem() == std::filesystem::path(args.models[b]).stem()) {
+        std::fprintf(stderr, "lod bake: two models named '%s' (%s, %s) would write one .hlod file\n",
+                     printable(std::filesystem::path(args.models[a]).stem().string()).c_str(),
+                     printable(args.models[b]).c_str(), printable(args.models[a]).c_str());
+        return 1;
+      }
   nlohmann::json j = nlohmann::json::array();
   for (const auto& file : args.models) {
     const std::string name = std::filesystem::path(file).stem().string();

@@ -61,6 +61,10 @@ void print_tree_top(const HlodTree& tree, size_t i, uint32_t max_depth) {
 }  // namespace
 
 bool is_hlod_file(const std::string& file) {
+  // Regular files only: opening a FIFO to peek at it would block (the .lod reader then says
+  // what the path is).
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return false;
   std::ifstream f(file, std::ios::binary);
   char magic[8] = {};
   return f.read(magic, 8) && std::memcmp(magic, "LODHLOD\n", 8) == 0;
