@@ -51,6 +51,21 @@ TEST(LodHlodCli, BakesWithProgressAndInspectsAsJson) {
   }
 }
 
+// Subtrees run as tbb tasks: the file must not depend on how many threads ran them.
+TEST(LodHlodCli, SameFileAtOneAndTwoThreads) {
+  const fs::path dir = lod::test::temp_dir("hlod_cli_threads");
+  const fs::path mesh = dir / "ball.off";
+  lod::test::write_text(mesh, lod::test::sphere_off(90, 120));
+  for (const char* threads : {"1", "2"})
+    ASSERT_EQ(run_lod("bake " + mesh.string() + " -o " + (dir / threads).string() + " --hlod --min-verts 200 --quiet --threads " +
+                      threads)
+                  .code,
+              0);
+  const auto one = lod::test::read_bytes(dir / "1" / "ball.hlod");
+  ASSERT_GT(one.size(), 100000u);
+  EXPECT_TRUE(one == lod::test::read_bytes(dir / "2" / "ball.hlod"));
+}
+
 TEST(LodHlodCli, RefusesACorruptedFileNamingIt) {
   const fs::path dir = lod::test::temp_dir("hlod_cli_bad");
   const fs::path mesh = dir / "ball.off";
