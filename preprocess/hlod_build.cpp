@@ -356,12 +356,14 @@ void build_node(Context& c, BuildNode& n) {
 // Per-vertex normals of a layer from its own triangles, except where the vertex is an
 // original one shared with a neighbour (locked): there the original normal, so both sides
 // shade alike.
-void layer_normals(const Context& c, const BuildNode& n, const Layer& l, bool all_original, std::vector<float>& out) {
+enum class Normals : uint8_t { own_except_locked, original };  // a leaf's layer 0 is the original
+
+void layer_normals(const Context& c, const BuildNode& n, const Layer& l, Normals which, std::vector<float>& out) {
   const size_t base = out.size();
   out.resize(base + l.positions.size());
   compute_vertex_normals(l.positions.data(), l.vertices(), l.indices.data(), l.indices.size(), out.data() + base);
   for (size_t i = 0; i < l.vertices(); ++i)
-    if (all_original || c.patch_depth[l.source[i]] < n.depth)
+    if (which == Normals::original || c.patch_depth[l.source[i]] < n.depth)
       for (int k = 0; k < 3; ++k) out[base + 3 * i + k] = c.normals[3 * size_t(l.source[i]) + k];
 }
 
@@ -384,7 +386,7 @@ HlodPayload make_payload(Context& c, const BuildNode& n) {
     append_range(p, l.positions, l.indices, range);
     range.error = l.error;
     range.bounds = n.bounds;
-    layer_normals(c, n, l, n.leaf() && k == 0, p.normals);
+    layer_normals(c, n, l, n.leaf() && k == 0 ? Normals::original : Normals::own_except_locked, p.normals);
     p.layers.push_back(range);
   }
   Layer patch;  // the patch with vertices of its own, originals
