@@ -10,6 +10,7 @@
 namespace lod::cli {
 
 int bake_command(const BakeArgs& args) {
+  if (args.hlod) return bake_hlod_command(args);
   // The config's rules for ratios: 1 first, each in (0, 1], strictly decreasing, at most 16
   // (a repeated ratio used to drop a level silently).
   if (!args.ratios.empty()) {

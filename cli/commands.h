@@ -25,6 +25,10 @@ struct InspectArgs {
   std::string export_dir;
 };
 int inspect_command(const InspectArgs& args);
+// The .hlod side of `lod inspect` (cli/inspect_hlod.cpp): true when `file` starts with the
+// .hlod magic bytes.
+bool is_hlod_file(const std::string& file);
+int inspect_hlod_command(const InspectArgs& args);
 
 struct BakeArgs {
   std::vector<std::string> models;
@@ -35,8 +39,11 @@ struct BakeArgs {
   bool measure = false;
   bool json = false;
   bool quiet = false;  // nothing but errors (no progress, no table)
+  bool hlod = false;   // write DIR/<name>.hlod (R1's model HLOD) instead of .lod chains
+  int64_t min_verts = 1000;
 };
 int bake_command(const BakeArgs& args);
+int bake_hlod_command(const BakeArgs& args);  // cli/bake_hlod.cpp
 
 // Where baked assets are cached: $LOD_CACHE_DIR, else next to the data directory.
 std::string default_cache_dir(const std::string& data_dir);

@@ -11,6 +11,7 @@
 namespace lod::cli {
 
 int inspect_command(const InspectArgs& args) {
+  if (is_hlod_file(args.file)) return inspect_hlod_command(args);
   const std::string shown_file = printable(args.file);
   LodChain chain;
   if (auto st = read_lod_asset(args.file, chain); !st) {

@@ -24,8 +24,8 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--quiet", run.quiet, "no per-frame table");
 
   lod::cli::InspectArgs inspect;
-  auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels");
-  inspect_cmd->add_option("file", inspect.file, ".lod file")->required();
+  auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels or an .hlod file's tree");
+  inspect_cmd->add_option("file", inspect.file, ".lod or .hlod file")->required();
   inspect_cmd->add_flag("--json", inspect.json, "print JSON");
   inspect_cmd->add_option("--export", inspect.export_dir, "write every level as PLY into this directory");
 
@@ -41,6 +41,9 @@ int main(int argc, char** argv) {
   bake_cmd->add_flag("--measure", bake.measure, "print each level's measured error");
   bake_cmd->add_flag("--json", bake.json, "print JSON");
   bake_cmd->add_flag("--quiet", bake.quiet, "print nothing but errors");
+  bake_cmd->add_flag("--hlod", bake.hlod, "write an .hlod octree (R1 model HLOD) per mesh instead of a .lod chain");
+  bake_cmd->add_option("--min-verts", bake.min_verts, "--hlod: a cell with more vertices splits (default 1000)")
+      ->check(CLI::Range(int64_t{3}, int64_t{100000000}));
 
   CLI11_PARSE(app, argc, argv);
   if (run_cmd->parsed()) return lod::cli::run_command(run);

@@ -186,15 +186,21 @@ std::vector<float> sample_surface(const TriangleMeshView& view, size_t count, ui
 }
 
 // Distances from every sample to `mesh`: updates max and the sum of squares.
-void query_distances(const std::vector<float>& samples, const QueryMesh& mesh, double& max_d, double& sum_sq,
-                     size_t& n) {
+void query_distances(const float* samples, size_t sample_floats, const float* known, const QueryMesh& mesh,
+                     double& max_d, double& sum_sq, size_t& n) {
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   constexpr float kInf = std::numeric_limits<float>::infinity();
   Vec3 prev{0, 0, 0};
   double prev_d = kInf;
-  for (size_t i = 0; i + 2 < samples.size(); i += 3) {
+  for (size_t i = 0; i + 2 < sample_floats; i += 3) {
     QueryState st{&mesh, load(&samples[i]), kInf};
+    if (known && known[i / 3] == 0) {  // a point of the surface itself: nothing to look up
+      prev = st.point;
+      prev_d = 0;
+      ++n;
+      continue;
+    }
     RTCPointQuery q;
     q.x = st.point.x;
     q.y = st.point.y;
@@ -204,7 +210,8 @@ void query_distances(const std::vector<float>& samples, const QueryMesh& mesh, d
     // plus the step between the samples. Starting the query with that radius prunes most of
     // the BVH; the margin covers float rounding, and a miss falls back to an open query.
     const Vec3 step = st.point - prev;
-    const double bound = prev_d + std::sqrt(double(dot(step, step)));
+    double bound = prev_d + std::sqrt(double(dot(step, step)));
+    if (known) bound = std::min(bound, double(known[i / 3]));  // the caller's own bound, when tighter
     q.radius = float(bound * 1.0001 + 1e-12);
     rtcPointQuery(mesh.scene, &q, &context, closest_point_callback, &st);
     if (st.best_sq == kInf) {
@@ -265,13 +272,74 @@ Status SurfaceErrorMeter::measure(const TriangleMeshView& mesh, SurfaceError& ou
   const std::vector<float> samples = sample_surface(mesh, m.settings.surface_samples, m.settings.seed + 1);
   double max_d = 0, sum_sq = 0;
   size_t n = 0;
-  query_distances(samples, m.reference, max_d, sum_sq, n);
-  query_distances(m.reference_samples, other, max_d, sum_sq, n);
+  query_distances(samples.data(), samples.size(), nullptr, m.reference, max_d, sum_sq, n);
+  query_distances(m.reference_samples.data(), m.reference_samples.size(), nullptr, other, max_d, sum_sq, n);
   if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
     return Status::error(m.what + ": Embree point query failed (" + device_error_text(m.device) + ")");
   out.max = float(max_d);
   out.rms = n ? float(std::sqrt(sum_sq / double(n))) : 0.0f;
   out.samples = n;
+  return Status::success();
+}
+
+struct SurfaceDistance::Impl {
+  RTCDevice device = nullptr;
+  QueryMesh surface;
+  std::string what;
+  bool ready = false;
+
+  ~Impl() {
+    surface.release();
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+SurfaceDistance::SurfaceDistance() : impl_(std::make_unique<Impl>()) {}
+SurfaceDistance::~SurfaceDistance() = default;
+
+Status SurfaceDistance::set_surface(const TriangleMeshView& surface, const std::string& what) {
+  Impl& m = *impl_;
+  m.ready = false;
+  m.what = what;
+  if (!m.device) {
+    m.device = rtcNewDevice(nullptr);
+    if (!m.device) return Status::error(what + ": Embree device could not be created");
+  }
+  if (Status s = build_query_mesh(m.device, surface, what, m.surface); !s) return s;
+  m.ready = true;
+  return Status::success();
+}
+
+namespace {
+SurfaceError distance_summary(double max_d, double sum_sq, size_t n) {
+  SurfaceError e;
+  e.max = float(max_d);
+  e.rms = n ? float(std::sqrt(sum_sq / double(n))) : 0.0f;
+  e.samples = n;
+  return e;
+}
+}  // namespace
+
+Status SurfaceDistance::from_points(const float* points, size_t count, const float* known, SurfaceError& out) const {
+  const Impl& m = *impl_;
+  if (!m.ready) return Status::error("surface distance: no surface set");
+  double max_d = 0, sum_sq = 0;
+  size_t n = 0;
+  query_distances(points, 3 * count, known, m.surface, max_d, sum_sq, n);
+  out = distance_summary(max_d, sum_sq, n);
+  return Status::success();
+}
+
+Status SurfaceDistance::from_points_to(const TriangleMeshView& mesh, const float* points, size_t count,
+                                       const float* known, SurfaceError& out) const {
+  const Impl& m = *impl_;
+  if (!m.ready) return Status::error("surface distance: no surface set");
+  QueryMesh other;
+  if (Status s = build_query_mesh(m.device, mesh, m.what + " (layer)", other); !s) return s;
+  double max_d = 0, sum_sq = 0;
+  size_t n = 0;
+  query_distances(points, 3 * count, known, other, max_d, sum_sq, n);
+  out = distance_summary(max_d, sum_sq, n);
   return Status::success();
 }
 

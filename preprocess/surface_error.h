@@ -51,6 +51,32 @@ class SurfaceErrorMeter {
   std::unique_ptr<Impl> impl_;
 };
 
+// One surface held for closest-point queries from many threads at once (HLOD builds measure
+// every node's layers against one original). The const members are thread-safe.
+class SurfaceDistance {
+ public:
+  SurfaceDistance();
+  ~SurfaceDistance();
+  SurfaceDistance(const SurfaceDistance&) = delete;
+  SurfaceDistance& operator=(const SurfaceDistance&) = delete;
+
+  // Copies `surface` into a BVH. `what` names it in messages.
+  Status set_surface(const TriangleMeshView& surface, const std::string& what);
+  // Distance from each of `count` points (xyz) to the held surface: max into out.max,
+  // RMS into out.rms (samples = count). `known` (optional, one per point): a distance the
+  // surface is known to be within (e.g. to a surface vertex the point came from), so the
+  // query starts small; +inf where nothing is known, 0 for a point of the surface itself.
+  Status from_points(const float* points, size_t count, const float* known, SurfaceError& out) const;
+  // The same to `mesh` instead, whose BVH is built on the held surface's Embree device for
+  // this call only (a small layer measured from the original's samples).
+  Status from_points_to(const TriangleMeshView& mesh, const float* points, size_t count, const float* known,
+                        SurfaceError& out) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // One-off convenience: symmetric distance between a and b.
 Status measure_surface_error(const TriangleMeshView& a, const TriangleMeshView& b,
                              const SurfaceErrorSettings& settings, SurfaceError& out);

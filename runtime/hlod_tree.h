@@ -41,6 +41,7 @@ struct HlodNode {
   float box_half = 0;                // half its edge (cells are cubes)
   Sphere bounds;                     // of everything the node or its subtree draws
   uint32_t boundary_triangles = 0;   // patch between the children (0 at a leaf)
+  uint32_t boundary_vertices = 0;    // the patch's own vertices (originals, never moved)
   HlodLayerInfo layers[kHlodMaxLayers];
 
   // Where the node's payload is in its .hlod file, and its size in memory once loaded

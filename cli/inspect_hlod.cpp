@@ -1,0 +1,115 @@
+// lod inspect FILE.hlod: the tree, per depth and node by node (--json: every node).
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.h"
+#include "cli/names.h"
+#include "runtime/hlod_asset.h"
+
+namespace lod::cli {
+namespace {
+
+// Outside programs read these names: id, parent, depth, leaf, boundary_triangles, layers
+// (triangles, error). Keep them.
+nlohmann::json node_json(const HlodTree& tree, size_t i) {
+  const HlodNode& n = tree.nodes[i];
+  nlohmann::json layers = nlohmann::json::array();
+  for (uint32_t k = 0; k < n.layer_count; ++k) layers.push_back({{"triangles", n.layers[k].triangles}, {"error", n.layers[k].error}});
+  return {{"id", i},      {"parent", n.parent},
+          {"depth", n.depth}, {"leaf", n.leaf()},
+          {"boundary_triangles", n.boundary_triangles}, {"layers", layers}};
+}
+
+void print_depth_table(const HlodTree& tree) {
+  uint32_t deepest = 0;
+  for (const HlodNode& n : tree.nodes) deepest = std::max<uint32_t>(deepest, n.depth);
+  std::printf("%5s %7s %7s %12s %12s %10s %12s %12s\n", "depth", "nodes", "leaves", "finest tris", "coarsest tris",
+              "boundary", "max error", "payload MB");
+  for (uint32_t d = 0; d <= deepest; ++d) {
+    size_t nodes = 0, leaves = 0;
+    uint64_t finest = 0, coarsest = 0, boundary = 0, bytes = 0;
+    float error = 0;
+    for (const HlodNode& n : tree.nodes) {
+      if (n.depth != d) continue;
+      ++nodes, leaves += n.leaf();
+      finest += n.layers[0].triangles;
+      coarsest += n.layers[n.layer_count - 1].triangles;
+      boundary += n.boundary_triangles;
+      bytes += n.payload_size;
+      error = std::max(error, n.layers[n.layer_count - 1].error);
+    }
+    std::printf("%5u %7zu %7zu %12llu %12llu %10llu %12.6g %12.3f\n", d, nodes, leaves, (unsigned long long)finest,
+                (unsigned long long)coarsest, (unsigned long long)boundary, error, double(bytes) / 1e6);
+  }
+}
+
+// The top of the tree, indented (the whole tree would be thousands of lines).
+void print_tree_top(const HlodTree& tree, size_t i, uint32_t max_depth) {
+  const HlodNode& n = tree.nodes[i];
+  std::printf("%*snode %zu%s: layers", 2 * int(n.depth), "", i, n.leaf() ? " (leaf)" : "");
+  for (uint32_t k = 0; k < n.layer_count; ++k) std::printf(" %u/%.3g", n.layers[k].triangles, n.layers[k].error);
+  if (!n.leaf()) std::printf(", boundary %u, %u children", n.boundary_triangles, n.child_count);
+  std::printf("\n");
+  if (n.depth >= max_depth) return;
+  for (uint32_t c = 0; c < n.child_count; ++c) print_tree_top(tree, n.first_child + c, max_depth);
+}
+
+}  // namespace
+
+bool is_hlod_file(const std::string& file) {
+  // Regular files only: opening a FIFO to peek at it would block (the .lod reader then says
+  // what the path is).
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return false;
+  std::ifstream f(file, std::ios::binary);
+  char magic[8] = {};
+  return f.read(magic, 8) && std::memcmp(magic, "LODHLOD\n", 8) == 0;
+}
+
+int inspect_hlod_command(const InspectArgs& args) {
+  if (!args.export_dir.empty()) {
+    std::fprintf(stderr, "lod inspect: --export writes .lod levels; %s is an .hlod file\n", printable(args.file).c_str());
+    return 1;
+  }
+  HlodTree tree;
+  if (Status st = read_hlod_tree(args.file, tree); !st) {
+    std::fprintf(stderr, "lod inspect: %s\n", printable(st.message).c_str());
+    return 1;
+  }
+  std::error_code size_error;
+  const auto bytes = std::filesystem::file_size(args.file, size_error);
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "%016llx", (unsigned long long)tree.source_hash);
+  if (args.json) {
+    nlohmann::json j;
+    j["file"] = args.file;
+    j["name"] = tree.name;
+    j["version"] = kHlodAssetVersion;
+    j["bytes"] = bytes;
+    j["source_hash"] = hash;
+    j["source_triangles"] = tree.source_triangles;
+    j["min_verts"] = tree.min_verts;
+    j["box"] = {{"center", {tree.box_center[0], tree.box_center[1], tree.box_center[2]}}, {"half", tree.box_half}};
+    j["nodes"] = nlohmann::json::array();
+    for (size_t i = 0; i < tree.nodes.size(); ++i) j["nodes"].push_back(node_json(tree, i));
+    std::printf("%s\n", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+    return 0;
+  }
+  size_t leaves = 0;
+  for (const HlodNode& n : tree.nodes) leaves += n.leaf();
+  std::printf("%s: model '%s', hlod v%u, %llu bytes, source hash %s, %llu source triangles, min_verts %u\n",
+              printable(args.file).c_str(), printable(tree.name).c_str(), kHlodAssetVersion, (unsigned long long)bytes,
+              hash, (unsigned long long)tree.source_triangles, tree.min_verts);
+  std::printf("%zu nodes, %zu leaves; root cube centre (%g, %g, %g), half size %g\n", tree.nodes.size(), leaves,
+              tree.box_center[0], tree.box_center[1], tree.box_center[2], tree.box_half);
+  print_depth_table(tree);
+  std::printf("top of the tree (layers: triangles/error):\n");
+  print_tree_top(tree, 0, 2);
+  return 0;
+}
+
+}  // namespace lod::cli

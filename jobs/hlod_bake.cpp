@@ -1,0 +1,105 @@
+// HLOD bake job: load -> clean -> build (subtrees as tbb tasks in an arena of the requested
+// size) -> write. Progress lines every 10 %.
+#include "jobs/hlod_bake.h"
+
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <iterator>
+#include <mutex>
+#include <vector>
+
+#include "preprocess/mesh_clean.h"
+#include "preprocess/mesh_io.h"
+#include "runtime/file_write.h"
+#include "runtime/hlod_asset.h"
+#include "runtime/lod_asset.h"  // hash_bytes
+
+namespace lod {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Content hash of the mesh file's bytes, mixed with what else decides the output.
+Status source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out) {
+  std::ifstream f(file, std::ios::binary);
+  if (!f) return Status::error(file.string() + ": cannot be opened for reading");
+  const std::vector<char> bytes{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+  if (f.bad()) return Status::error(file.string() + ": read error");
+  const uint64_t settings[2] = {1 /* build version */, min_verts};
+  out = hash_bytes(settings, sizeof settings, hash_bytes(bytes.data(), bytes.size()));
+  return Status::success();
+}
+
+}  // namespace
+
+ParallelFor tbb_parallel_for() {
+  return [](size_t count, const std::function<void(size_t)>& body) {
+    tbb::parallel_for(size_t(0), count, [&](size_t i) { body(i); });
+  };
+}
+
+Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string& name,
+                      const std::filesystem::path& out_dir, const HlodBakeSettings& settings, const HlodBakeLog& log,
+                      HlodBakeResult* result) {
+  HlodBakeResult r;
+  auto t0 = std::chrono::steady_clock::now();
+  MeshData mesh;
+  if (Status s = load_mesh(mesh_file, mesh); !s) return s;
+  r.input_triangles = mesh.triangle_count();
+  clean_mesh(mesh);
+  HlodModel model;
+  if (Status s = source_hash(mesh_file, settings.min_verts, model.tree.source_hash); !s) return s;
+  const uint64_t hash = model.tree.source_hash;
+  r.load_seconds = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  std::mutex log_mutex;
+  std::atomic<int> last_decile{0};
+  HlodBuildOptions options;
+  options.min_verts = settings.min_verts;
+  options.parallel_for = tbb_parallel_for();
+  options.progress = [&](float fraction) {
+    const int decile = int(std::clamp(fraction, 0.f, 1.f) * 10);
+    int seen = last_decile.load();
+    do {
+      if (decile <= seen) return;
+    } while (!last_decile.compare_exchange_weak(seen, decile));
+    if (!log) return;
+    std::lock_guard lock(log_mutex);
+    log("hlod " + name + " " + std::to_string(decile * 10) + "%");
+  };
+  Status built;
+  tbb::task_arena arena(settings.threads == 0 ? tbb::task_arena::automatic : int(settings.threads));
+  arena.execute([&] {
+    try {
+      built = build_hlod(model, mesh, options, &r.report);
+    } catch (const std::exception& e) {  // bad_alloc on a huge mesh: a status, not a crash
+      built = Status::error(mesh_file.string() + ": " + e.what());
+    }
+  });
+  if (!built) return built;
+  model.tree.name = name;
+  model.tree.source_hash = hash;
+  r.build_seconds = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return Status::error(out_dir.string() + ": cannot create the output directory: " + ec.message());
+  r.file = out_dir / (name + ".hlod");
+  const std::vector<uint8_t> bytes = encode_hlod_asset(model.tree, model.payloads);
+  if (Status s = write_file_atomic(r.file, bytes); !s) return s;
+  r.bytes = bytes.size();
+  r.write_seconds = seconds_since(t0);
+  if (result) *result = std::move(r);
+  return Status::success();
+}
+
+}  // namespace lod

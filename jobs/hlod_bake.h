@@ -1,0 +1,38 @@
+// HLOD bake job: load a mesh, clean it, build its HLOD on oneTBB, write DIR/<name>.hlod.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "preprocess/hlod_build.h"
+#include "runtime/status.h"
+
+namespace lod {
+
+struct HlodBakeSettings {
+  uint32_t min_verts = 1000;
+  uint32_t threads = 0;  // 0 = all cores
+};
+
+struct HlodBakeResult {
+  std::filesystem::path file;  // what was written
+  HlodBuildReport report;
+  size_t input_triangles = 0;
+  double load_seconds = 0, build_seconds = 0, write_seconds = 0;
+  uint64_t bytes = 0;
+};
+
+// Lines like "hlod dragon 40%" (every 10 %), from one thread at a time.
+using HlodBakeLog = std::function<void(const std::string&)>;
+
+// The tbb parallel_for the builder's subtrees run on (inside the caller's arena).
+ParallelFor tbb_parallel_for();
+
+// Builds and writes `out_dir/<name>.hlod`; source_hash is the mesh file's content hash mixed
+// with min_verts. On failure the status names the file; nothing is written.
+Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string& name,
+                      const std::filesystem::path& out_dir, const HlodBakeSettings& settings, const HlodBakeLog& log,
+                      HlodBakeResult* result);
+
+}  // namespace lod

@@ -1,0 +1,514 @@
+// Model HLOD build (R1 3.1) as passes per node, run bottom-up over the octree:
+//
+//   count -> split (children + patch) -> [children, in parallel] -> layer 0 (leaf geometry,
+//   or children's coarsest welded to the patch) -> two QEM halvings with ancestors' patch
+//   vertices locked -> measure each layer -> bounds -> breadth-first flattening at the end.
+//
+// Per-vertex scratch arrays are shared by all tasks without locks: every vertex lies in
+// exactly one cell per depth, tasks run on disjoint subtrees, and a node only touches its own
+// cell's vertices after its children have finished, so no two tasks ever touch one vertex.
+#include "preprocess/hlod_build.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "preprocess/decimater_chain.h"  // compute_vertex_normals
+#include "preprocess/surface_error.h"
+#include "runtime/lod_chain.h"
+
+namespace lod {
+namespace {
+
+constexpr uint8_t kNoPatch = 0xff;
+
+struct Layer {
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  std::vector<uint32_t> source;  // original vertex each vertex descends from
+  float error = 0;
+  size_t triangles() const { return indices.size() / 3; }
+  size_t vertices() const { return source.size(); }
+};
+
+struct BuildNode {
+  uint8_t depth = 0;
+  float center[3] = {0, 0, 0};
+  float half = 0;
+  std::vector<uint32_t> triangles;  // original triangles in the cell and in no ancestor's patch
+  std::unique_ptr<BuildNode> children[8];
+  uint8_t child_mask = 0;
+  std::vector<uint32_t> patch;      // original triangles across the children
+  std::vector<Layer> layers;        // finest first
+  std::vector<uint32_t> reference;  // original vertices of the node's region, thinned
+  Sphere bounds;
+  Status status;
+  bool leaf() const { return child_mask == 0; }
+};
+
+struct Context {
+  const HlodBuildOptions& options;
+  const float* positions = nullptr;
+  const uint32_t* indices = nullptr;
+  std::vector<float> normals;          // of the original, per vertex
+  std::vector<uint8_t> patch_depth;    // shallowest depth whose patch holds the vertex
+  std::vector<uint32_t> stamp;         // per vertex: which node last visited it
+  std::vector<uint32_t> local;         // per vertex: its index in that node's arrays
+  std::atomic<uint32_t> next_stamp{1};
+  SurfaceDistance original;
+  uint64_t total_triangles = 0;
+  std::atomic<uint64_t> done_triangles{0};
+  std::atomic<size_t> short_layers{0};
+  std::atomic<size_t> oversized_leaves{0};
+
+  explicit Context(const HlodBuildOptions& o) : options(o) {}
+  uint32_t new_stamp() { return next_stamp.fetch_add(1, std::memory_order_relaxed); }
+};
+
+int octant(const Context& c, const BuildNode& n, uint32_t v) {
+  const float* p = c.positions + 3 * size_t(v);
+  return (p[0] >= n.center[0] ? 1 : 0) | (p[1] >= n.center[1] ? 2 : 0) | (p[2] >= n.center[2] ? 4 : 0);
+}
+
+size_t count_vertices(Context& c, const std::vector<uint32_t>& triangles) {
+  const uint32_t s = c.new_stamp();
+  size_t count = 0;
+  for (uint32_t t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = c.indices[3 * size_t(t) + k];
+      if (c.stamp[v] != s) c.stamp[v] = s, ++count;
+    }
+  return count;
+}
+
+// Triangles within one octant go to that child, the others to the patch. false (nothing
+// changed) when every triangle crosses octants: the node stays a leaf.
+bool split_node(Context& c, BuildNode& n) {
+  std::vector<uint32_t> part[8];
+  std::vector<uint32_t> patch;
+  for (uint32_t t : n.triangles) {
+    const uint32_t* f = c.indices + 3 * size_t(t);
+    const int o = octant(c, n, f[0]);
+    if (octant(c, n, f[1]) == o && octant(c, n, f[2]) == o) part[o].push_back(t);
+    else patch.push_back(t);
+  }
+  if (patch.size() == n.triangles.size()) return false;
+  for (int o = 0; o < 8; ++o) {
+    if (part[o].empty()) continue;
+    auto child = std::make_unique<BuildNode>();
+    child->depth = uint8_t(n.depth + 1);
+    child->half = n.half / 2;
+    for (int k = 0; k < 3; ++k) child->center[k] = n.center[k] + ((o >> k) & 1 ? child->half : -child->half);
+    child->triangles = std::move(part[o]);
+    n.children[o] = std::move(child);
+    n.child_mask |= uint8_t(1u << o);
+  }
+  for (uint32_t t : patch)
+    for (int k = 0; k < 3; ++k) {
+      uint8_t& d = c.patch_depth[c.indices[3 * size_t(t) + k]];
+      d = std::min(d, n.depth);
+    }
+  n.patch = std::move(patch);
+  n.triangles.clear();
+  n.triangles.shrink_to_fit();
+  return true;
+}
+
+// Original vertex v appended to `layer` once per stamp `s`; returns its index there.
+uint32_t take_original(Context& c, Layer& layer, uint32_t v, uint32_t s) {
+  if (c.stamp[v] == s) return c.local[v];
+  c.stamp[v] = s;
+  c.local[v] = uint32_t(layer.vertices());
+  layer.positions.insert(layer.positions.end(), c.positions + 3 * size_t(v), c.positions + 3 * size_t(v) + 3);
+  layer.source.push_back(v);
+  return c.local[v];
+}
+
+Layer leaf_geometry(Context& c, const BuildNode& n) {
+  Layer layer;
+  const uint32_t s = c.new_stamp();
+  layer.indices.reserve(3 * n.triangles.size());
+  for (uint32_t t : n.triangles)
+    for (int k = 0; k < 3; ++k) layer.indices.push_back(take_original(c, layer, c.indices[3 * size_t(t) + k], s));
+  return layer;
+}
+
+// The children's coarsest layers side by side, welded to the patch through the patch's
+// vertices (locked in every child, so still at their original positions there).
+Layer merged_children(Context& c, const BuildNode& n) {
+  Layer layer;
+  const uint32_t s = c.new_stamp();
+  for (const auto& child : n.children) {
+    if (!child) continue;
+    const Layer& coarse = child->layers.back();
+    const uint32_t base = uint32_t(layer.vertices());
+    layer.positions.insert(layer.positions.end(), coarse.positions.begin(), coarse.positions.end());
+    layer.source.insert(layer.source.end(), coarse.source.begin(), coarse.source.end());
+    for (uint32_t i : coarse.indices) layer.indices.push_back(base + i);
+    for (uint32_t i = 0; i < coarse.vertices(); ++i) {
+      c.stamp[coarse.source[i]] = s;
+      c.local[coarse.source[i]] = base + i;
+    }
+  }
+  for (uint32_t t : n.patch)
+    for (int k = 0; k < 3; ++k) layer.indices.push_back(take_original(c, layer, c.indices[3 * size_t(t) + k], s));
+  return layer;
+}
+
+// Two halvings of layers[0] with every ancestor's patch vertex locked; a layer no smaller than
+// the one before is dropped.
+void simplify_layers(Context& c, BuildNode& n) {
+  n.layers.reserve(3);  // `finest` stays valid while the coarser layers are appended
+  const Layer& finest = n.layers[0];
+  const size_t t0 = finest.triangles();
+  if (t0 < 2) return;
+  std::vector<uint8_t> lock(finest.vertices());
+  for (size_t i = 0; i < lock.size(); ++i) lock[i] = c.patch_depth[finest.source[i]] < n.depth;
+  QemOptions options;
+  options.lock_border = true;  // the mesh's own holes keep their outline in every layer
+  options.vertex_lock = lock.data();
+  // Heavily locked cells otherwise reach their halves by ruinous collapses (on the bunny at
+  // min_verts 500, one layer 10 % of the model off its surface, which the monotonic errors
+  // then carry to the root).
+  options.max_error = c.options.max_error_per_cell * 2 * n.half;
+  const size_t targets[2] = {t0 / 2, t0 / 4};
+  ChainLevelOut out[2];
+  const size_t made = qem_simplify_chain(out, finest.positions.data(), finest.vertices(), finest.indices.data(),
+                                         finest.indices.size(), targets, targets[1] > 0 ? 2 : 1, options);
+  for (size_t k = 0; k < made; ++k) {
+    const size_t tris = out[k].triangle_count();
+    if (tris == 0 || tris >= n.layers.back().triangles()) {
+      c.short_layers.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    Layer layer;
+    layer.positions = std::move(out[k].positions);
+    layer.indices = std::move(out[k].indices);
+    layer.source.resize(out[k].source_vertex.size());
+    const Layer& from = n.layers[0];
+    for (size_t i = 0; i < layer.source.size(); ++i) layer.source[i] = from.source[out[k].source_vertex[i]];
+    n.layers.push_back(std::move(layer));
+  }
+}
+
+// `ids` evenly thinned to at most `cap`, in order.
+std::vector<uint32_t> thinned(std::vector<uint32_t> ids, size_t cap) {
+  const size_t n = ids.size();
+  if (n <= cap) return ids;
+  std::vector<uint32_t> out(cap);
+  for (size_t k = 0; k < cap; ++k) out[k] = ids[k * n / cap];
+  return out;
+}
+
+// The node's original region, sampled: a leaf's own vertices; an inner node's children's
+// samples and its patch's vertices.
+void gather_reference(Context& c, BuildNode& n) {
+  std::vector<uint32_t> ids;
+  if (n.leaf()) {
+    ids = n.layers[0].source;
+  } else {
+    for (const auto& child : n.children)
+      if (child) ids.insert(ids.end(), child->reference.begin(), child->reference.end());
+    for (uint32_t t : n.patch)
+      for (int k = 0; k < 3; ++k) ids.push_back(c.indices[3 * size_t(t) + k]);
+  }
+  n.reference = thinned(std::move(ids), c.options.reference_samples);
+}
+
+float distance_to_original(const Context& c, const float* p, uint32_t v) {
+  const float* o = c.positions + 3 * size_t(v);
+  const double dx = p[0] - o[0], dy = p[1] - o[1], dz = p[2] - o[2];
+  return float(std::sqrt(dx * dx + dy * dy + dz * dz));
+}
+
+// The node's original samples, each with a distance the layer is known to be within: to the
+// layer vertex descended from it, when it survived into the layer.
+void reference_samples(Context& c, const BuildNode& n, const Layer& layer, std::vector<float>& points,
+                       std::vector<float>& known) {
+  const uint32_t s = c.new_stamp();
+  for (uint32_t i = 0; i < layer.vertices(); ++i) c.stamp[layer.source[i]] = s, c.local[layer.source[i]] = i;
+  points.resize(3 * n.reference.size());
+  known.resize(n.reference.size());
+  for (size_t k = 0; k < n.reference.size(); ++k) {
+    const uint32_t v = n.reference[k];
+    for (int j = 0; j < 3; ++j) points[3 * k + j] = c.positions[3 * size_t(v) + j];
+    known[k] = c.stamp[v] == s ? distance_to_original(c, &layer.positions[3 * size_t(c.local[v])], v) : INFINITY;
+  }
+}
+
+// A layer's own samples: every vertex, then the centroids of an even subset of its triangles.
+// Each comes with a distance the original surface is known to be within (to the original
+// vertex it, or its triangle's nearest corner, descends from), so that its closest-point
+// query starts small.
+void layer_samples(const Context& c, const Layer& layer, std::vector<float>& points, std::vector<float>& known) {
+  points = layer.positions;
+  known.resize(layer.vertices());
+  for (size_t i = 0; i < layer.vertices(); ++i) known[i] = distance_to_original(c, &layer.positions[3 * i], layer.source[i]);
+  const size_t tris = layer.triangles();
+  const auto centroids = std::min(tris, size_t(std::ceil(double(c.options.layer_samples_per_triangle) * double(tris))));
+  for (size_t k = 0; k < centroids; ++k) {
+    const uint32_t* f = &layer.indices[3 * (k * tris / centroids)];
+    float p[3];
+    for (int j = 0; j < 3; ++j)
+      p[j] = (layer.positions[3 * size_t(f[0]) + j] + layer.positions[3 * size_t(f[1]) + j] + layer.positions[3 * size_t(f[2]) + j]) / 3;
+    points.insert(points.end(), p, p + 3);
+    float bound = INFINITY;
+    for (int j = 0; j < 3; ++j) bound = std::min(bound, distance_to_original(c, p, layer.source[f[j]]));
+    known.push_back(bound);
+  }
+}
+
+// Symmetric distance between a layer and the original: the layer's samples to the whole
+// original surface, the node's original samples to the layer.
+Status measure_layer(Context& c, const BuildNode& n, const Layer& layer, float& error) {
+  const TriangleMeshView view{layer.positions.data(), layer.vertices(), layer.indices.data(), layer.indices.size()};
+  std::vector<float> samples, known;
+  layer_samples(c, layer, samples, known);
+  SurfaceError to_original, from_original;
+  if (Status s = c.original.from_points(samples.data(), samples.size() / 3, known.data(), to_original); !s) return s;
+  reference_samples(c, n, layer, samples, known);
+  if (Status s = c.original.from_points_to(view, samples.data(), samples.size() / 3, known.data(), from_original); !s)
+    return s;
+  error = std::max(to_original.max, from_original.max);
+  return Status::success();
+}
+
+Status measure_layers(Context& c, BuildNode& n) {
+  float floor = 0;  // an inner node never reports less than any child's coarsest layer
+  for (const auto& child : n.children)
+    if (child) floor = std::max(floor, child->layers.back().error);
+  for (size_t k = 0; k < n.layers.size(); ++k) {
+    Layer& layer = n.layers[k];
+    if (n.leaf() && k == 0) {
+      layer.error = 0;  // the original itself
+      continue;
+    }
+    if (Status s = measure_layer(c, n, layer, layer.error); !s) return s;
+    layer.error = std::max(layer.error, k == 0 ? floor : n.layers[k - 1].error);
+  }
+  return Status::success();
+}
+
+// A sphere around every vertex the node draws, grown over its children's spheres.
+Sphere node_bounds(const BuildNode& n) {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (const Layer& l : n.layers)
+    for (size_t i = 0; i < l.positions.size(); i += 3)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], l.positions[i + k]), hi[k] = std::max(hi[k], l.positions[i + k]);
+  Sphere s;
+  for (int k = 0; k < 3; ++k) s.center[k] = 0.5f * (lo[k] + hi[k]);
+  double r2 = 0;
+  for (const Layer& l : n.layers)
+    for (size_t i = 0; i < l.positions.size(); i += 3) {
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += double(l.positions[i + k] - s.center[k]) * (l.positions[i + k] - s.center[k]);
+      r2 = std::max(r2, d2);
+    }
+  double r = std::sqrt(r2);
+  for (const auto& child : n.children) {
+    if (!child) continue;
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) d2 += double(child->bounds.center[k] - s.center[k]) * (child->bounds.center[k] - s.center[k]);
+    r = std::max(r, std::sqrt(d2) + child->bounds.radius);
+  }
+  s.radius = float(r * (1 + 1e-6));
+  return s;
+}
+
+void report_done(Context& c, const BuildNode& n) {
+  const uint64_t mine = n.leaf() ? n.layers[0].triangles() : n.patch.size();
+  const uint64_t done = c.done_triangles.fetch_add(mine, std::memory_order_relaxed) + mine;
+  if (c.options.progress) c.options.progress(float(double(done) / double(std::max<uint64_t>(1, c.total_triangles))));
+}
+
+void build_node(Context& c, BuildNode& n) {
+  const size_t vertices = count_vertices(c, n.triangles);
+  const bool splits = vertices > c.options.min_verts && n.depth < kHlodMaxDepth && split_node(c, n);
+  if (!splits) {
+    if (vertices > c.options.min_verts) c.oversized_leaves.fetch_add(1, std::memory_order_relaxed);
+    n.layers.push_back(leaf_geometry(c, n));
+  } else {
+    BuildNode* kids[8];
+    size_t count = 0;
+    for (auto& child : n.children)
+      if (child) kids[count++] = child.get();
+    auto body = [&](size_t i) { build_node(c, *kids[i]); };
+    if (c.options.parallel_for && count > 1) c.options.parallel_for(count, body);
+    else for (size_t i = 0; i < count; ++i) body(i);
+    for (size_t i = 0; i < count; ++i)
+      if (!kids[i]->status) {
+        n.status = kids[i]->status;
+        return;
+      }
+    n.layers.push_back(merged_children(c, n));
+  }
+  simplify_layers(c, n);
+  gather_reference(c, n);
+  n.status = measure_layers(c, n);
+  n.bounds = node_bounds(n);
+  report_done(c, n);
+}
+
+// Per-vertex normals of a layer from its own triangles, except where the vertex is an
+// original one shared with a neighbour (locked): there the original normal, so both sides
+// shade alike.
+enum class Normals : uint8_t { own_except_locked, original };  // a leaf's layer 0 is the original
+
+void layer_normals(const Context& c, const BuildNode& n, const Layer& l, Normals which, std::vector<float>& out) {
+  const size_t base = out.size();
+  out.resize(base + l.positions.size());
+  compute_vertex_normals(l.positions.data(), l.vertices(), l.indices.data(), l.indices.size(), out.data() + base);
+  for (size_t i = 0; i < l.vertices(); ++i)
+    if (which == Normals::original || c.patch_depth[l.source[i]] < n.depth)
+      for (int k = 0; k < 3; ++k) out[base + 3 * i + k] = c.normals[3 * size_t(l.source[i]) + k];
+}
+
+void append_range(HlodPayload& p, const std::vector<float>& positions, const std::vector<uint32_t>& indices,
+                  LodLevel& range) {
+  range.first_index = uint32_t(p.indices.size());
+  range.index_count = uint32_t(indices.size());
+  range.first_vertex = uint32_t(p.positions.size() / 3);
+  range.vertex_count = uint32_t(positions.size() / 3);
+  range.level = level_of_triangles(indices.size() / 3);
+  p.positions.insert(p.positions.end(), positions.begin(), positions.end());
+  p.indices.insert(p.indices.end(), indices.begin(), indices.end());
+}
+
+HlodPayload make_payload(Context& c, const BuildNode& n) {
+  HlodPayload p;
+  for (size_t k = 0; k < n.layers.size(); ++k) {
+    const Layer& l = n.layers[k];
+    LodLevel range;
+    append_range(p, l.positions, l.indices, range);
+    range.error = l.error;
+    range.bounds = n.bounds;
+    layer_normals(c, n, l, n.leaf() && k == 0 ? Normals::original : Normals::own_except_locked, p.normals);
+    p.layers.push_back(range);
+  }
+  Layer patch;  // the patch with vertices of its own, originals
+  const uint32_t s = c.new_stamp();
+  for (uint32_t t : n.patch)
+    for (int k = 0; k < 3; ++k) patch.indices.push_back(take_original(c, patch, c.indices[3 * size_t(t) + k], s));
+  append_range(p, patch.positions, patch.indices, p.boundary);
+  p.boundary.bounds = n.bounds;
+  for (uint32_t v : patch.source) p.normals.insert(p.normals.end(), &c.normals[3 * size_t(v)], &c.normals[3 * size_t(v)] + 3);
+  return p;
+}
+
+// Breadth-first order (children of one node contiguous, in octant order), as the file stores it.
+void flatten(Context& c, const BuildNode& root, HlodModel& out, HlodBuildReport& report) {
+  std::vector<const BuildNode*> order{&root};
+  out.tree.nodes.clear();
+  out.tree.nodes.emplace_back();
+  for (size_t i = 0; i < order.size(); ++i) {
+    const BuildNode& b = *order[i];
+    HlodNode h = out.tree.nodes[i];  // parent already set
+    h.depth = b.depth;
+    for (int k = 0; k < 3; ++k) h.box_center[k] = b.center[k];
+    h.box_half = b.half;
+    h.bounds = b.bounds;
+    h.child_mask = b.child_mask;
+    h.boundary_triangles = uint32_t(b.patch.size());
+    h.layer_count = uint8_t(b.layers.size());
+    for (size_t k = 0; k < b.layers.size(); ++k)
+      h.layers[k] = {uint32_t(b.layers[k].triangles()), uint32_t(b.layers[k].vertices()), b.layers[k].error};
+    if (!b.leaf()) h.first_child = uint32_t(order.size());
+    for (const auto& child : b.children) {
+      if (!child) continue;
+      order.push_back(child.get());
+      HlodNode kid;
+      kid.parent = int32_t(i);
+      out.tree.nodes.push_back(kid);
+      ++h.child_count;
+    }
+    HlodPayload payload = make_payload(c, b);
+    h.boundary_vertices = payload.boundary.vertex_count;
+    h.resident_bytes = 4 * (payload.positions.size() + payload.normals.size() + payload.indices.size());
+    out.tree.nodes[i] = h;
+    out.payloads.push_back(std::move(payload));
+    report.leaves += b.leaf();
+    report.depth = std::max<uint32_t>(report.depth, b.depth);
+    report.boundary_triangles += b.patch.size();
+  }
+  report.nodes = order.size();
+}
+
+Status check_input(const MeshData& mesh) {
+  const std::string what = mesh.source.empty() ? std::string("mesh") : mesh.source;
+  if (mesh.vertex_count() >= UINT32_MAX) return Status::error(what + ": more than 2^32 - 1 vertices");
+  if (mesh.indices.size() % 3 != 0) return Status::error(what + ": index count is not a multiple of 3");
+  for (size_t i = 0; i < mesh.positions.size(); ++i)
+    if (!std::isfinite(mesh.positions[i]))
+      return Status::error(what + ": vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+  for (size_t i = 0; i < mesh.indices.size(); ++i)
+    if (mesh.indices[i] >= mesh.vertex_count())
+      return Status::error(what + ": face " + std::to_string(i / 3) + " references vertex " +
+                           std::to_string(mesh.indices[i]) + " of " + std::to_string(mesh.vertex_count()));
+  return Status::success();
+}
+
+// The root cell: the cube around the used vertices' box.
+void root_cell(const MeshData& mesh, const std::vector<uint32_t>& triangles, BuildNode& root) {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (uint32_t t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const float* p = &mesh.positions[3 * size_t(mesh.indices[3 * size_t(t) + k])];
+      for (int j = 0; j < 3; ++j) lo[j] = std::min(lo[j], p[j]), hi[j] = std::max(hi[j], p[j]);
+    }
+  float extent = 0;
+  for (int j = 0; j < 3; ++j) root.center[j] = 0.5f * (lo[j] + hi[j]), extent = std::max(extent, hi[j] - lo[j]);
+  root.half = extent > 0 ? 0.5f * extent * (1 + 1e-5f) : 1.0f;
+}
+
+}  // namespace
+
+Status build_hlod(HlodModel& out, const MeshData& mesh, const HlodBuildOptions& options, HlodBuildReport* report_out) {
+  if (Status s = check_input(mesh); !s) return s;
+  const std::string what = mesh.source.empty() ? std::string("mesh") : mesh.source;
+  HlodBuildReport report;
+  auto root = std::make_unique<BuildNode>();
+  for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const uint32_t* f = &mesh.indices[3 * size_t(t)];
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) ++report.dropped_triangles;
+    else root->triangles.push_back(t);
+  }
+  if (root->triangles.empty()) return Status::error(what + ": no triangles to build an HLOD from");
+  root_cell(mesh, root->triangles, *root);
+
+  Context c(options);
+  c.positions = mesh.positions.data();
+  c.indices = mesh.indices.data();
+  c.total_triangles = root->triangles.size();
+  c.patch_depth.assign(mesh.vertex_count(), kNoPatch);
+  c.stamp.assign(mesh.vertex_count(), 0);
+  c.local.assign(mesh.vertex_count(), 0);
+  c.normals.resize(mesh.positions.size());
+  compute_vertex_normals(mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size(),
+                         c.normals.data());
+  if (Status s = c.original.set_surface({mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
+                                         mesh.indices.size()},
+                                        what);
+      !s)
+    return s;
+
+  build_node(c, *root);
+  if (!root->status) return root->status;
+
+  HlodModel model;
+  model.tree.min_verts = options.min_verts;
+  for (int k = 0; k < 3; ++k) model.tree.box_center[k] = root->center[k];
+  model.tree.box_half = root->half;
+  model.tree.source_triangles = mesh.triangle_count();
+  flatten(c, *root, model, report);
+  report.short_layers = c.short_layers.load();
+  report.oversized_leaves = c.oversized_leaves.load();
+  out = std::move(model);
+  if (report_out) *report_out = report;
+  return Status::success();
+}
+
+}  // namespace lod

@@ -1,0 +1,542 @@
+// The .hlod file, version 1. All integers and floats little-endian; sections 8-byte aligned.
+//
+//   head:
+//     magic "LODHLOD\n" (8) | u32 version | u32 head bytes H (everything before the head checksum)
+//     u64 source_hash | u64 source_triangles | f32 box centre xyz, f32 box half (the root cube)
+//     u64 vertices (all nodes' layers and patches) | u64 boundary triangles (all patches)
+//     u32 materials (0 in version 1) | u32 min_verts | u32 node count | u32 inner node count
+//     u32 name bytes | u32 0 | name
+//     OctreeCode: one byte per inner node, breadth-first: bit i = octant i is non-empty
+//     NodeDescription: one bit per node but the root, breadth-first: 1 = leaf, 0 = inner
+//     node records: 64 bytes each (see put_record), breadth-first
+//     offset table: u64 offset, u64 size per node
+//   u64 head checksum = hash_bytes(bytes [0, H))
+//   payloads, one per node in node order, back to back up to the end of the file: per layer positions (3 f32 per
+//   vertex), normals (same), indices (3 u32 per triangle, layer-local), then the boundary
+//   patch the same way, then u64 checksum = hash_bytes(the payload before it)
+//
+// The tree's structure (parents, child ranges, depths, cells) is not stored: it follows from
+// the bits and the root cube, as R1 rebuilds its octree from OctreeCode and NodeDescription.
+#include "runtime/hlod_asset.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+#include "runtime/file_write.h"
+#include "runtime/lod_asset.h"  // hash_bytes
+#include "runtime/lod_chain.h"
+#include "runtime/vertex_tree.h"  // kMaxTreeMagnitude
+
+namespace lod {
+namespace {
+
+constexpr char kMagic[8] = {'L', 'O', 'D', 'H', 'L', 'O', 'D', '\n'};
+constexpr uint64_t kFixedBytes = 88;
+constexpr uint64_t kRecordBytes = 64;
+constexpr uint64_t kOffsetBytes = 16;
+constexpr uint64_t kChecksumBytes = 8;
+
+uint64_t align8(uint64_t v) { return (v + 7) & ~uint64_t{7}; }
+
+inline uint64_t load_u64(const uint8_t* p) {
+  uint64_t v;
+  std::memcpy(&v, p, 8);
+  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap64(v);
+  return v;
+}
+inline uint32_t load_u32(const uint8_t* p) {
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap32(v);
+  return v;
+}
+inline float load_f32(const uint8_t* p) { return std::bit_cast<float>(load_u32(p)); }
+
+struct Writer {
+  std::vector<uint8_t> bytes;
+  void u8(uint8_t v) { bytes.push_back(v); }
+  void u32(uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void u64(uint64_t v) {
+    for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
+  template <class T>
+  void words(const T* v, size_t count) {
+    static_assert(sizeof(T) == 4);
+    for (size_t i = 0; i < count; ++i) u32(std::bit_cast<uint32_t>(v[i]));
+  }
+  void align() {
+    while (bytes.size() % 8 != 0) bytes.push_back(0);
+  }
+  void patch_u32(size_t at, uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<uint8_t>(v >> (8 * i));
+  }
+  void patch_u64(size_t at, uint64_t v) {
+    for (int i = 0; i < 8; ++i) bytes[at + i] = static_cast<uint8_t>(v >> (8 * i));
+  }
+};
+
+Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
+
+// The head's size from its counts (all u32, so no overflow in u64).
+uint64_t head_bytes(uint64_t name_bytes, uint64_t nodes, uint64_t inner) {
+  const uint64_t description = nodes > 0 ? (nodes - 1 + 7) / 8 : 0;
+  return align8(kFixedBytes + name_bytes) + align8(inner) + align8(description) + nodes * (kRecordBytes + kOffsetBytes);
+}
+
+// A payload holds exactly what it takes in memory, plus its checksum.
+uint64_t payload_data_bytes(const HlodNode& n) { return hlod_resident_bytes(n); }
+
+void put_record(Writer& w, const HlodNode& n) {
+  w.u8(n.layer_count);
+  w.u8(0), w.u8(0), w.u8(0);
+  w.u32(n.boundary_triangles);
+  w.u32(n.boundary_vertices);
+  w.f32(n.bounds.center[0]), w.f32(n.bounds.center[1]), w.f32(n.bounds.center[2]), w.f32(n.bounds.radius);
+  for (uint32_t k = 0; k < kHlodMaxLayers; ++k) {
+    const bool used = k < n.layer_count;
+    w.u32(used ? n.layers[k].triangles : 0);
+    w.u32(used ? n.layers[k].vertices : 0);
+    w.f32(used ? n.layers[k].error : 0.0f);
+  }
+}
+
+bool finite_in_range(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxTreeMagnitude; }
+
+// One record's own fields; "node N: ..." on failure.
+bool get_record(const uint8_t* p, HlodNode& n, std::string& why) {
+  n.layer_count = p[0];
+  if (p[1] || p[2] || p[3]) return why = "reserved bytes are not zero", false;
+  n.boundary_triangles = load_u32(p + 4);
+  n.boundary_vertices = load_u32(p + 8);
+  for (int k = 0; k < 3; ++k) n.bounds.center[k] = load_f32(p + 12 + 4 * k);
+  n.bounds.radius = load_f32(p + 24);
+  if (n.layer_count < 1 || n.layer_count > kHlodMaxLayers)
+    return why = "layer count " + std::to_string(n.layer_count) + " is outside 1.." + std::to_string(kHlodMaxLayers), false;
+  for (uint32_t k = 0; k < kHlodMaxLayers; ++k) {
+    const uint8_t* l = p + 28 + 12 * k;
+    HlodLayerInfo& info = n.layers[k];
+    info.triangles = load_u32(l);
+    info.vertices = load_u32(l + 4);
+    info.error = load_f32(l + 8);
+    const std::string name = "layer " + std::to_string(k);
+    if (k >= n.layer_count) {
+      if (info.triangles || info.vertices || std::bit_cast<uint32_t>(info.error))
+        return why = name + " is beyond the layer count but not empty", false;
+      continue;
+    }
+    if (info.triangles == 0) return why = name + " has no triangles", false;
+    if (info.vertices == 0 || info.vertices > 3ull * info.triangles)
+      return why = name + " has " + std::to_string(info.vertices) + " vertices for " + std::to_string(info.triangles) +
+                   " triangles",
+             false;
+    if (!finite_in_range(info.error) || info.error < 0)
+      return why = name + " error " + std::to_string(info.error) + " is not a finite distance", false;
+    if (k > 0 && !(info.triangles < n.layers[k - 1].triangles))
+      return why = name + " has " + std::to_string(info.triangles) + " triangles, not fewer than the layer before", false;
+    if (k > 0 && info.error < n.layers[k - 1].error) return why = name + " error is below the finer layer's", false;
+  }
+  if (n.boundary_vertices > 3ull * n.boundary_triangles || (n.boundary_triangles > 0 && n.boundary_vertices == 0))
+    return why = "boundary has " + std::to_string(n.boundary_vertices) + " vertices for " +
+                 std::to_string(n.boundary_triangles) + " triangles",
+           false;
+  for (int k = 0; k < 3; ++k)
+    if (!finite_in_range(n.bounds.center[k])) return why = "bounding sphere centre is not finite", false;
+  if (!finite_in_range(n.bounds.radius) || n.bounds.radius < 0) return why = "bounding sphere radius is invalid", false;
+  return true;
+}
+
+// Parents, child ranges, depths and cells from the bits, breadth-first (R1's rebuild).
+bool rebuild_structure(const uint8_t* code, uint32_t inner, const uint8_t* description, HlodTree& t, std::string& why) {
+  const uint32_t count = uint32_t(t.nodes.size());
+  HlodNode& root = t.nodes[0];
+  root.parent = -1;
+  root.depth = 0;
+  for (int k = 0; k < 3; ++k) root.box_center[k] = t.box_center[k];
+  root.box_half = t.box_half;
+  std::vector<uint8_t> is_inner(count, 0);
+  is_inner[0] = inner > 0;
+  uint32_t next = 1, codes = 0, described = 0, inner_seen = is_inner[0];
+  for (uint32_t i = 0; i < count; ++i) {
+    if (i >= next) return why = "node " + std::to_string(i) + " is not reached from the root", false;
+    HlodNode& n = t.nodes[i];
+    if (!is_inner[i]) continue;
+    if (codes >= inner) return why = "more inner nodes than OctreeCode bytes", false;
+    const uint8_t mask = code[codes++];
+    if (mask == 0) return why = "node " + std::to_string(i) + " is inner but its OctreeCode has no child", false;
+    if (n.depth >= kHlodMaxDepth)
+      return why = "node " + std::to_string(i) + " has children below depth " + std::to_string(kHlodMaxDepth), false;
+    n.child_mask = mask;
+    n.first_child = next;
+    n.child_count = uint8_t(std::popcount(mask));
+    for (int o = 0; o < 8; ++o) {
+      if (!((mask >> o) & 1)) continue;
+      if (next >= count) return why = "OctreeCode names more children than the " + std::to_string(count) + " nodes", false;
+      HlodNode& c = t.nodes[next];
+      c.parent = int32_t(i);
+      c.depth = uint8_t(n.depth + 1);
+      c.box_half = n.box_half / 2;
+      for (int k = 0; k < 3; ++k) c.box_center[k] = n.box_center[k] + ((o >> k) & 1 ? c.box_half : -c.box_half);
+      const bool leaf = (description[described / 8] >> (described % 8)) & 1;
+      ++described;
+      is_inner[next] = !leaf;
+      inner_seen += !leaf;
+      ++next;
+    }
+  }
+  if (next != count || codes != inner || inner_seen != inner)
+    return why = "OctreeCode and NodeDescription describe " + std::to_string(next) + " nodes and " +
+                 std::to_string(inner_seen) + " inner ones, the header " + std::to_string(count) + " and " +
+                 std::to_string(inner),
+           false;
+  const uint64_t description_bytes = (count - 1 + 7) / 8;
+  for (uint64_t b = described; b < 8 * description_bytes; ++b)
+    if ((description[b / 8] >> (b % 8)) & 1) return why = "NodeDescription padding bits are not zero", false;
+  for (uint32_t i = 0; i < count; ++i)
+    if (!is_inner[i]) t.nodes[i].first_child = 0, t.nodes[i].child_count = 0, t.nodes[i].child_mask = 0;
+  return true;
+}
+
+// What the tree says of itself beyond one record: leaves have no patch, errors grow upwards.
+bool check_tree(const HlodTree& t, std::string& why) {
+  for (size_t i = 1; i < t.nodes.size(); ++i) {
+    const HlodNode& n = t.nodes[i];
+    const HlodNode& p = t.nodes[size_t(n.parent)];
+    if (p.layers[0].error < n.layers[n.layer_count - 1].error)
+      return why = "node " + std::to_string(i) + ": coarsest error " + std::to_string(n.layers[n.layer_count - 1].error) +
+                   " exceeds its parent's finest " + std::to_string(p.layers[0].error) + " (errors must grow upwards)",
+             false;
+  }
+  for (size_t i = 0; i < t.nodes.size(); ++i)
+    if (t.nodes[i].leaf() && (t.nodes[i].boundary_triangles || t.nodes[i].boundary_vertices))
+      return why = "node " + std::to_string(i) + " is a leaf with a boundary patch", false;
+  return true;
+}
+
+template <class T>
+void get_words(const uint8_t* p, size_t count, T* out) {
+  static_assert(sizeof(T) == 4);
+  if constexpr (std::endian::native == std::endian::little) {
+    if (count) std::memcpy(out, p, count * 4);
+  } else {
+    for (size_t i = 0; i < count; ++i) out[i] = std::bit_cast<T>(load_u32(p + 4 * i));
+  }
+}
+
+// One range (a layer or the patch): positions, normals, indices, each checked.
+bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, HlodPayload& out, LodLevel& range,
+               std::string& why) {
+  range.first_vertex = uint32_t(out.positions.size() / 3);
+  range.vertex_count = vertices;
+  range.first_index = uint32_t(out.indices.size());
+  range.index_count = 3 * triangles;
+  range.level = level_of_triangles(triangles);
+  const size_t v0 = out.positions.size(), i0 = out.indices.size();
+  out.positions.resize(v0 + 3 * size_t(vertices));
+  out.normals.resize(v0 + 3 * size_t(vertices));
+  out.indices.resize(i0 + 3 * size_t(triangles));
+  get_words(p, 3 * size_t(vertices), out.positions.data() + v0);
+  p += 12 * size_t(vertices);
+  get_words(p, 3 * size_t(vertices), out.normals.data() + v0);
+  p += 12 * size_t(vertices);
+  get_words(p, 3 * size_t(triangles), out.indices.data() + i0);
+  p += 12 * size_t(triangles);
+  for (size_t i = v0; i < out.positions.size(); ++i)
+    if (!finite_in_range(out.positions[i]) || !finite_in_range(out.normals[i]))
+      return why = "vertex " + std::to_string((i - v0) / 3) + " is not finite", false;
+  for (size_t i = i0; i < out.indices.size(); ++i)
+    if (out.indices[i] >= vertices)
+      return why = "triangle " + std::to_string((i - i0) / 3) + " references vertex " + std::to_string(out.indices[i]) +
+                   " of " + std::to_string(vertices),
+             false;
+  return true;
+}
+
+}  // namespace
+
+uint64_t hlod_resident_bytes(const HlodNode& n) {
+  uint64_t b = 0;
+  for (uint32_t k = 0; k < n.layer_count && k < kHlodMaxLayers; ++k) b += 24ull * n.layers[k].vertices + 12ull * n.layers[k].triangles;
+  return b + 24ull * n.boundary_vertices + 12ull * n.boundary_triangles;
+}
+
+std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads) {
+  Writer w;
+  const uint32_t count = uint32_t(tree.nodes.size());
+  uint32_t inner = 0;
+  uint64_t vertices = 0, boundary = 0;
+  for (const HlodNode& n : tree.nodes) {
+    inner += !n.leaf();
+    for (uint32_t k = 0; k < n.layer_count; ++k) vertices += n.layers[k].vertices;
+    vertices += n.boundary_vertices;
+    boundary += n.boundary_triangles;
+  }
+  for (char c : kMagic) w.u8(uint8_t(c));
+  w.u32(kHlodAssetVersion);
+  w.u32(0);  // head bytes, patched below
+  w.u64(tree.source_hash);
+  w.u64(tree.source_triangles);
+  w.f32(tree.box_center[0]), w.f32(tree.box_center[1]), w.f32(tree.box_center[2]), w.f32(tree.box_half);
+  w.u64(vertices);
+  w.u64(boundary);
+  w.u32(0);  // materials
+  w.u32(tree.min_verts);
+  w.u32(count);
+  w.u32(inner);
+  w.u32(uint32_t(tree.name.size()));
+  w.u32(0);
+  w.bytes.insert(w.bytes.end(), tree.name.begin(), tree.name.end());
+  w.align();
+  for (const HlodNode& n : tree.nodes)
+    if (!n.leaf()) w.u8(n.child_mask);
+  w.align();
+  std::vector<uint8_t> description((count > 0 ? count - 1 + 7 : 0) / 8, 0);
+  for (uint32_t i = 1; i < count; ++i)
+    if (tree.nodes[i].leaf()) description[(i - 1) / 8] |= uint8_t(1u << ((i - 1) % 8));
+  w.bytes.insert(w.bytes.end(), description.begin(), description.end());
+  w.align();
+  for (const HlodNode& n : tree.nodes) put_record(w, n);
+  const size_t table = w.bytes.size();
+  w.bytes.resize(table + kOffsetBytes * count, 0);
+  const uint64_t head = w.bytes.size();
+  w.patch_u32(12, uint32_t(head));
+  w.u64(0);  // head checksum, once the offsets are in
+  for (uint32_t i = 0; i < count; ++i) {
+    const size_t begin = w.bytes.size();
+    const HlodPayload& p = payloads[i];
+    auto put_range = [&](const LodLevel& r) {
+      w.words(p.positions.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
+      w.words(p.normals.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
+      w.words(p.indices.data() + r.first_index, r.index_count);
+    };
+    for (const LodLevel& r : p.layers) put_range(r);
+    put_range(p.boundary);
+    w.u64(hash_bytes(w.bytes.data() + begin, w.bytes.size() - begin));
+    w.patch_u64(table + kOffsetBytes * i, begin);
+    w.patch_u64(table + kOffsetBytes * i + 8, w.bytes.size() - begin);
+  }
+  w.patch_u64(head, hash_bytes(w.bytes.data(), head));
+  return std::move(w.bytes);
+}
+
+Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, const std::string& what, HlodTree& out) {
+  const uint8_t* p = bytes.data();
+  if (bytes.size() < kFixedBytes || file_size < kFixedBytes + kChecksumBytes)
+    return refuse(what, "file is " + std::to_string(std::min<uint64_t>(bytes.size(), file_size)) +
+                            " bytes, too short for an .hlod file (truncated?)");
+  if (std::memcmp(p, kMagic, 8) != 0) return refuse(what, "not an .hlod file (bad magic bytes)");
+  const uint32_t version = load_u32(p + 8);
+  if (version != kHlodAssetVersion)
+    return refuse(what, "hlod version " + std::to_string(version) + " is not supported (this build reads version " +
+                            std::to_string(kHlodAssetVersion) + "); re-bake it");
+  const uint64_t head = load_u32(p + 12);
+  const uint32_t materials = load_u32(p + 64), min_verts = load_u32(p + 68);
+  const uint32_t count = load_u32(p + 72), inner = load_u32(p + 76), name_bytes = load_u32(p + 80);
+  // Counts against the head size before anything is allocated.
+  if (head + kChecksumBytes > file_size || head + kChecksumBytes > bytes.size())
+    return refuse(what, "truncated: the head needs " + std::to_string(head + kChecksumBytes) + " bytes, the file has " +
+                            std::to_string(file_size));
+  if (count == 0 || inner >= count || head != head_bytes(name_bytes, count, inner))
+    return refuse(what, "head of " + std::to_string(head) + " bytes does not match its counts (" + std::to_string(count) +
+                            " nodes, " + std::to_string(inner) + " inner, name of " + std::to_string(name_bytes) + ")");
+  if (load_u64(p + head) != hash_bytes(p, head)) return refuse(what, "head checksum mismatch (file is corrupted)");
+  if (materials != 0) return refuse(what, std::to_string(materials) + " materials: version 1 stores none");
+  if (min_verts == 0 || load_u32(p + 84) != 0) return refuse(what, "header fields min_verts / reserved are invalid");
+
+  HlodTree t;
+  t.source_hash = load_u64(p + 16);
+  t.source_triangles = load_u64(p + 24);
+  for (int k = 0; k < 3; ++k) t.box_center[k] = load_f32(p + 32 + 4 * k);
+  t.box_half = load_f32(p + 44);
+  t.min_verts = min_verts;
+  for (int k = 0; k < 3; ++k)
+    if (!finite_in_range(t.box_center[k])) return refuse(what, "root box centre is not finite");
+  if (!finite_in_range(t.box_half) || !(t.box_half > 0)) return refuse(what, "root box size is not positive");
+  t.name.assign(reinterpret_cast<const char*>(p + kFixedBytes), name_bytes);
+  const uint64_t code_at = align8(kFixedBytes + name_bytes);
+  const uint64_t description_at = code_at + align8(inner);
+  const uint64_t records_at = description_at + align8((uint64_t(count) - 1 + 7) / 8);
+  const uint64_t table_at = records_at + kRecordBytes * count;
+  t.nodes.resize(count);
+  std::string why;
+  for (uint32_t i = 0; i < count; ++i)
+    if (!get_record(p + records_at + kRecordBytes * i, t.nodes[i], why))
+      return refuse(what, "node " + std::to_string(i) + ": " + why);
+  if (!rebuild_structure(p + code_at, inner, p + description_at, t, why)) return refuse(what, "octree: " + why);
+  if (!check_tree(t, why)) return refuse(what, why);
+
+  uint64_t vertices = 0, boundary = 0, end = head + kChecksumBytes;
+  for (uint32_t i = 0; i < count; ++i) {
+    HlodNode& n = t.nodes[i];
+    n.payload_offset = load_u64(p + table_at + kOffsetBytes * i);
+    n.payload_size = load_u64(p + table_at + kOffsetBytes * i + 8);
+    const uint64_t want = payload_data_bytes(n) + kChecksumBytes;
+    const std::string name = "node " + std::to_string(i) + " payload [" + std::to_string(n.payload_offset) + ", +" +
+                             std::to_string(n.payload_size) + ")";
+    if (n.payload_size != want)
+      return refuse(what, name + " should be " + std::to_string(want) + " bytes for its counts");
+    if (n.payload_offset != end || n.payload_offset > file_size || n.payload_size > file_size - n.payload_offset)
+      return refuse(what, name + " does not follow the " + (i ? "payload before it" : "head") + " at " +
+                              std::to_string(end) + " (it overlaps it or leaves a gap) or lies outside the file's " +
+                              std::to_string(file_size) + " bytes");
+    end = n.payload_offset + n.payload_size;
+    uint64_t own = n.boundary_vertices;
+    for (uint32_t k = 0; k < n.layer_count; ++k) own += n.layers[k].vertices;
+    if (own > UINT32_MAX / 3) return refuse(what, "node " + std::to_string(i) + " has too many vertices");
+    vertices += own;
+    boundary += n.boundary_triangles;
+    n.resident_bytes = hlod_resident_bytes(n);
+  }
+  if (end != file_size)
+    return refuse(what, "the payloads end at " + std::to_string(end) + ", the file at " + std::to_string(file_size));
+  if (vertices != load_u64(p + 48) || boundary != load_u64(p + 56))
+    return refuse(what, "header counts " + std::to_string(load_u64(p + 48)) + " vertices, " +
+                            std::to_string(load_u64(p + 56)) + " boundary triangles; the nodes hold " +
+                            std::to_string(vertices) + " and " + std::to_string(boundary));
+  out = std::move(t);
+  return Status::success();
+}
+
+Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node, const std::string& what,
+                           HlodPayload& out) {
+  if (bytes.size() != node.payload_size || bytes.size() != payload_data_bytes(node) + kChecksumBytes)
+    return refuse(what, "node payload is " + std::to_string(bytes.size()) + " bytes, its counts need " +
+                            std::to_string(payload_data_bytes(node) + kChecksumBytes) + " (truncated?)");
+  const uint64_t body = bytes.size() - kChecksumBytes;
+  if (load_u64(bytes.data() + body) != hash_bytes(bytes.data(), body))
+    return refuse(what, "node payload checksum mismatch (file is corrupted)");
+  HlodPayload p;
+  const uint8_t* q = bytes.data();
+  std::string why;
+  for (uint32_t k = 0; k < node.layer_count; ++k) {
+    LodLevel range;
+    if (!get_range(q, node.layers[k].vertices, node.layers[k].triangles, p, range, why))
+      return refuse(what, "layer " + std::to_string(k) + ": " + why);
+    range.error = node.layers[k].error;
+    range.bounds = node.bounds;
+    p.layers.push_back(range);
+  }
+  if (!get_range(q, node.boundary_vertices, node.boundary_triangles, p, p.boundary, why))
+    return refuse(what, "boundary: " + why);
+  p.boundary.bounds = node.bounds;
+  out = std::move(p);
+  return Status::success();
+}
+
+Status decode_hlod_asset(std::span<const uint8_t> file, const std::string& what, HlodTree& tree,
+                         std::vector<HlodPayload>& payloads) {
+  HlodTree t;
+  if (Status s = decode_hlod_tree(file, file.size(), what, t); !s) return s;
+  std::vector<HlodPayload> all(t.nodes.size());
+  for (size_t i = 0; i < t.nodes.size(); ++i) {
+    const HlodNode& n = t.nodes[i];
+    if (Status s = decode_hlod_payload(file.subspan(n.payload_offset, n.payload_size), n,
+                                       what + ": node " + std::to_string(i), all[i]);
+        !s)
+      return s;
+  }
+  tree = std::move(t);
+  payloads = std::move(all);
+  return Status::success();
+}
+
+Status write_hlod_asset(const std::filesystem::path& path, const HlodTree& tree, std::span<const HlodPayload> payloads) {
+  const std::vector<uint8_t> bytes = encode_hlod_asset(tree, payloads);
+  return write_file_atomic(path, bytes);
+}
+
+// ---- reading from a file -----------------------------------------------------------------
+
+namespace {
+
+Status read_exactly(int fd, uint64_t offset, uint64_t size, std::vector<uint8_t>& out, const std::string& what) {
+  out.resize(size_t(size));
+  uint64_t got = 0;
+  while (got < size) {
+    const ssize_t n = ::pread(fd, out.data() + got, size_t(size - got), off_t(offset + got));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return refuse(what, std::string("read failed: ") + std::strerror(errno));
+    if (n == 0) return refuse(what, "truncated: " + std::to_string(got) + " of " + std::to_string(size) +
+                                        " bytes at offset " + std::to_string(offset));
+    got += uint64_t(n);
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+HlodFile::~HlodFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+HlodFile::HlodFile(HlodFile&& other) noexcept : fd_(other.fd_), size_(other.size_), path_(std::move(other.path_)) {
+  other.fd_ = -1;
+}
+HlodFile& HlodFile::operator=(HlodFile&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = other.fd_, size_ = other.size_, path_ = std::move(other.path_);
+    other.fd_ = -1;
+  }
+  return *this;
+}
+
+Status HlodFile::open(const std::filesystem::path& path, HlodTree& tree) {
+  const std::string what = path.string();
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) return refuse(what, std::string("cannot open: ") + std::strerror(errno));
+  HlodFile f;
+  f.fd_ = fd;
+  f.path_ = what;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return refuse(what, std::string("cannot stat: ") + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) return refuse(what, "is not a regular file, not an .hlod file");
+  f.size_ = uint64_t(st.st_size);
+  if (f.size_ < kFixedBytes + kChecksumBytes)
+    return refuse(what, "file is " + std::to_string(f.size_) + " bytes, too short for an .hlod file (truncated?)");
+  std::vector<uint8_t> fixed;
+  if (Status s = read_exactly(fd, 0, kFixedBytes, fixed, what); !s) return s;
+  // The head's size as the file states it, bounded by the file before it is allocated.
+  const uint64_t head = std::memcmp(fixed.data(), kMagic, 8) == 0 ? load_u32(fixed.data() + 12) : 0;
+  std::vector<uint8_t> bytes;
+  if (head + kChecksumBytes <= f.size_ && head >= kFixedBytes) {
+    if (Status s = read_exactly(fd, 0, head + kChecksumBytes, bytes, what); !s) return s;
+  } else {
+    bytes = std::move(fixed);  // decode names what is wrong with it
+  }
+  HlodTree t;
+  if (Status s = decode_hlod_tree(bytes, f.size_, what, t); !s) return s;
+  tree = std::move(t);
+  *this = std::move(f);
+  return Status::success();
+}
+
+Status HlodFile::read_node(const HlodNode& node, HlodPayload& out) const {
+  if (fd_ < 0) return Status::error("hlod: no file open");
+  if (node.payload_offset > size_ || node.payload_size > size_ - node.payload_offset)
+    return refuse(path_, "node payload lies outside the file");
+  std::vector<uint8_t> bytes;
+  if (Status s = read_exactly(fd_, node.payload_offset, node.payload_size, bytes, path_); !s) return s;
+  return decode_hlod_payload(bytes, node, path_, out);
+}
+
+Status read_hlod_tree(const std::filesystem::path& path, HlodTree& out) {
+  HlodFile f;
+  return f.open(path, out);
+}
+
+Status read_hlod_node(const std::filesystem::path& path, const HlodNode& node, HlodPayload& out) {
+  HlodFile f;
+  HlodTree tree;
+  if (Status s = f.open(path, tree); !s) return s;
+  return f.read_node(node, out);
+}
+
+}  // namespace lod

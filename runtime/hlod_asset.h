@@ -1,0 +1,74 @@
+// The .hlod file (R1 Fig. 6): a header, the octree as breadth-first OctreeCode and
+// NodeDescription bits, per-node metadata and a per-node offset table (all checksummed
+// together: the "head"), then each node's payload with a checksum of its own, so that one
+// node can be read and verified without reading the rest.
+//
+// Nothing in a file is trusted: every count is checked against the sizes before anything is
+// allocated, every offset and index before it is used, the tree against its bits (parents,
+// child ranges, depth <= kHlodMaxDepth), values for finiteness and errors for monotonicity.
+// A refused file leaves the output untouched.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "runtime/hlod_tree.h"
+#include "runtime/status.h"
+
+namespace lod {
+
+inline constexpr uint32_t kHlodAssetVersion = 1;
+
+// The whole file. Offsets and sizes in the written file are computed here (tree's own
+// payload_offset / payload_size are ignored); payloads[i] is node i's geometry.
+std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads);
+
+// The tree from the file's first bytes (`head`: at least the head, possibly the whole file);
+// `file_size` is the whole file's, so that every payload range can be checked. `what` names
+// the source in messages.
+Status decode_hlod_tree(std::span<const uint8_t> head, uint64_t file_size, const std::string& what, HlodTree& out);
+// One node's payload from its own bytes (exactly node.payload_size of them, read at
+// node.payload_offset), checked against `node` (a node of a tree decode_hlod_tree accepted).
+Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node, const std::string& what,
+                           HlodPayload& out);
+// Everything, from the whole file in memory.
+Status decode_hlod_asset(std::span<const uint8_t> file, const std::string& what, HlodTree& tree,
+                         std::vector<HlodPayload>& payloads);
+
+// Temporary file + rename, as .lod assets.
+Status write_hlod_asset(const std::filesystem::path& path, const HlodTree& tree, std::span<const HlodPayload> payloads);
+
+// An open .hlod file: the head is read and checked once, nodes are read one at a time.
+// read_node may be called from several threads at once (positioned reads on one descriptor).
+class HlodFile {
+ public:
+  HlodFile() = default;
+  ~HlodFile();
+  HlodFile(HlodFile&& other) noexcept;
+  HlodFile& operator=(HlodFile&& other) noexcept;
+  HlodFile(const HlodFile&) = delete;
+  HlodFile& operator=(const HlodFile&) = delete;
+
+  // Regular files only (a FIFO never blocks the reader). Reads the head, not the payloads.
+  Status open(const std::filesystem::path& path, HlodTree& tree);
+  Status read_node(const HlodNode& node, HlodPayload& out) const;
+  bool is_open() const { return fd_ >= 0; }
+
+ private:
+  int fd_ = -1;
+  uint64_t size_ = 0;
+  std::string path_;
+};
+
+// Header + tree + offsets only.
+Status read_hlod_tree(const std::filesystem::path& path, HlodTree& out);
+// One node of the file at `path` (the node from read_hlod_tree of the same file).
+Status read_hlod_node(const std::filesystem::path& path, const HlodNode& node, HlodPayload& out);
+
+// Bytes a payload with these counts takes in memory (positions, normals, indices), as
+// HlodNode::resident_bytes counts them.
+uint64_t hlod_resident_bytes(const HlodNode& node);
+
+}  // namespace lod

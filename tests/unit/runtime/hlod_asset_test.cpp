@@ -1,0 +1,352 @@
+// The .hlod file: round trips, one node read alone, and every truncation and flipped byte
+// refused (by the checksums, or by validation when the checksum is recomputed).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <thread>
+
+#include "runtime/hlod_asset.h"
+#include "runtime/lod_asset.h"  // hash_bytes
+#include "test_support.h"
+
+namespace lod {
+namespace {
+
+// `triangles` fan triangles around vertex 0 of a range with triangles + 2 vertices.
+LodLevel add_fan(HlodPayload& p, uint32_t triangles, float shift) {
+  LodLevel r;
+  r.first_vertex = uint32_t(p.positions.size() / 3);
+  r.vertex_count = triangles + 2;
+  r.first_index = uint32_t(p.indices.size());
+  r.index_count = 3 * triangles;
+  r.level = level_of_triangles(triangles);
+  for (uint32_t v = 0; v < triangles + 2; ++v) {
+    const float a = 0.25f * float(v) + shift;
+    p.positions.insert(p.positions.end(), {a, 1 - a, a * a});
+    p.normals.insert(p.normals.end(), {0, 1, -0.0f});
+  }
+  for (uint32_t f = 0; f < triangles; ++f) p.indices.insert(p.indices.end(), {0u, f + 1, f + 2});
+  return r;
+}
+
+// A node with fan layers of `tris` triangles, errors `errors`, and a patch of `patch` triangles.
+void add_node(HlodTree& t, std::vector<HlodPayload>& payloads, std::vector<uint32_t> tris, std::vector<float> errors,
+              uint32_t patch) {
+  HlodNode n;
+  HlodPayload p;
+  n.layer_count = uint8_t(tris.size());
+  for (size_t k = 0; k < tris.size(); ++k) {
+    LodLevel r = add_fan(p, tris[k], 0.01f * float(k));
+    r.error = errors[k];
+    p.layers.push_back(r);
+    n.layers[k] = {tris[k], tris[k] + 2, errors[k]};
+  }
+  p.boundary = add_fan(p, patch, 0.5f);
+  n.boundary_triangles = patch;
+  n.boundary_vertices = patch ? patch + 2 : 0;
+  if (!patch) {  // an empty range has no vertices
+    p.positions.resize(3 * size_t(p.boundary.first_vertex));
+    p.normals.resize(p.positions.size());
+    p.boundary.vertex_count = 0;
+  }
+  n.bounds = {{0.5f, 0.25f, -1}, 3};
+  n.resident_bytes = 4 * (p.positions.size() + p.normals.size() + p.indices.size());
+  t.nodes.push_back(n);
+  payloads.push_back(std::move(p));
+}
+
+// Root (inner: octants 0 and 6) -> a leaf and an inner node (octant 3) -> a leaf.
+struct Sample {
+  HlodTree tree;
+  std::vector<HlodPayload> payloads;
+};
+Sample sample() {
+  Sample s;
+  s.tree.name = "bunny";
+  s.tree.source_hash = 0x0123456789abcdefull;
+  s.tree.min_verts = 12;
+  s.tree.source_triangles = 40;
+  s.tree.box_center[0] = 0.5f, s.tree.box_center[1] = -2, s.tree.box_center[2] = 1e-40f;  // a denormal
+  s.tree.box_half = 4;
+  add_node(s.tree, s.payloads, {6, 3, 1}, {0.5f, 0.75f, 1.0f}, 3);
+  add_node(s.tree, s.payloads, {5, 2}, {0, 0.25f}, 0);
+  add_node(s.tree, s.payloads, {4, 2, 1}, {0.25f, 0.25f, 0.5f}, 2);
+  add_node(s.tree, s.payloads, {7, 3, 1}, {0, 0.125f, 0.25f}, 0);
+  HlodTree& t = s.tree;
+  t.nodes[0].child_mask = 0b01000001, t.nodes[0].child_count = 2, t.nodes[0].first_child = 1;
+  t.nodes[1].parent = 0, t.nodes[1].depth = 1;
+  t.nodes[2].parent = 0, t.nodes[2].depth = 1;
+  t.nodes[2].child_mask = 0b00001000, t.nodes[2].child_count = 1, t.nodes[2].first_child = 3;
+  t.nodes[3].parent = 2, t.nodes[3].depth = 2;
+  return s;
+}
+
+HlodTree sentinel() {
+  HlodTree t;
+  t.name = "untouched";
+  return t;
+}
+
+void expect_same(const Sample& a, const HlodTree& t, const std::vector<HlodPayload>& p) {
+  EXPECT_EQ(t.name, a.tree.name);
+  EXPECT_EQ(t.source_hash, a.tree.source_hash);
+  EXPECT_EQ(t.min_verts, a.tree.min_verts);
+  EXPECT_EQ(t.source_triangles, a.tree.source_triangles);
+  EXPECT_EQ(std::memcmp(t.box_center, a.tree.box_center, sizeof t.box_center), 0);
+  ASSERT_EQ(t.nodes.size(), a.tree.nodes.size());
+  for (size_t i = 0; i < t.nodes.size(); ++i) {
+    const HlodNode &x = t.nodes[i], &y = a.tree.nodes[i];
+    EXPECT_EQ(x.parent, y.parent) << i;
+    EXPECT_EQ(x.first_child, y.first_child) << i;
+    EXPECT_EQ(x.child_count, y.child_count) << i;
+    EXPECT_EQ(x.child_mask, y.child_mask) << i;
+    EXPECT_EQ(x.depth, y.depth) << i;
+    EXPECT_EQ(x.layer_count, y.layer_count) << i;
+    EXPECT_EQ(x.boundary_triangles, y.boundary_triangles) << i;
+    EXPECT_EQ(x.boundary_vertices, y.boundary_vertices) << i;
+    EXPECT_EQ(x.resident_bytes, y.resident_bytes) << i;
+    for (uint32_t k = 0; k < x.layer_count; ++k) {
+      EXPECT_EQ(x.layers[k].triangles, y.layers[k].triangles);
+      EXPECT_EQ(x.layers[k].error, y.layers[k].error);
+    }
+    ASSERT_EQ(p[i].layers.size(), a.payloads[i].layers.size());
+    EXPECT_EQ(std::memcmp(p[i].positions.data(), a.payloads[i].positions.data(), 4 * p[i].positions.size()), 0);
+    EXPECT_EQ(std::memcmp(p[i].normals.data(), a.payloads[i].normals.data(), 4 * p[i].normals.size()), 0);
+    EXPECT_EQ(p[i].indices, a.payloads[i].indices);
+    EXPECT_EQ(p[i].boundary.index_count, a.payloads[i].boundary.index_count);
+  }
+}
+
+TEST(HlodAsset, RoundTripIsBitExact) {
+  const Sample s = sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  HlodTree t;
+  std::vector<HlodPayload> p;
+  const Status st = decode_hlod_asset(bytes, "bunny.hlod", t, p);
+  ASSERT_TRUE(st) << st.message;
+  expect_same(s, t, p);
+  EXPECT_EQ(t.nodes[3].box_half, 1.0f) << "cells follow from the root cube and the bits";
+  EXPECT_EQ(t.nodes[3].box_center[0], 0.5f - 2 + 1);  // octant 6 of the root, then octant 3
+  EXPECT_EQ(t.nodes[3].box_center[1], -2.0f + 2 + 1);
+  EXPECT_EQ(encode_hlod_asset(t, p), bytes);
+}
+
+TEST(HlodAsset, ReadsTheTreeThenOneNodeAtATime) {
+  const Sample s = sample();
+  const auto dir = test::temp_dir("hlod_asset");
+  const auto file = dir / "bunny.hlod";
+  ASSERT_TRUE(write_hlod_asset(file, s.tree, s.payloads));
+  HlodTree t;
+  ASSERT_TRUE(read_hlod_tree(file, t));
+  std::vector<HlodPayload> p(t.nodes.size());
+  for (size_t i = t.nodes.size(); i-- > 0;) {
+    const Status st = read_hlod_node(file, t.nodes[i], p[i]);
+    ASSERT_TRUE(st) << st.message;
+  }
+  expect_same(s, t, p);
+  // One open file, several readers at once.
+  HlodFile f;
+  HlodTree again;
+  ASSERT_TRUE(f.open(file, again));
+  std::vector<HlodPayload> q(again.nodes.size());
+  std::vector<std::thread> readers;
+  for (size_t i = 0; i < again.nodes.size(); ++i)
+    readers.emplace_back([&, i] { EXPECT_TRUE(f.read_node(again.nodes[i], q[i])); });
+  for (auto& r : readers) r.join();
+  expect_same(s, again, q);
+}
+
+TEST(HlodAsset, RefusesTruncationAtEveryLength) {
+  const Sample s = sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  const auto dir = test::temp_dir("hlod_trunc");
+  for (size_t len = 0; len < bytes.size(); ++len) {
+    const std::span<const uint8_t> cut = std::span(bytes).first(len);
+    HlodTree t = sentinel();
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(cut, "bunny.hlod", t, p);
+    ASSERT_FALSE(st) << "accepted a file cut to " << len << " of " << bytes.size() << " bytes";
+    EXPECT_EQ(st.message.rfind("bunny.hlod: ", 0), 0u) << st.message;
+    EXPECT_EQ(t.name, "untouched");
+    // From disk: the tree alone is refused too, since its payloads would lie outside the file
+    // (every length up to just past the head, then a sample: files are slow).
+    if (len > 512 && len % 29 != 0) continue;
+    const auto file = dir / "cut.hlod";
+    test::write_bytes(file, std::vector<uint8_t>(cut.begin(), cut.end()));
+    HlodTree u = sentinel();
+    ASSERT_FALSE(read_hlod_tree(file, u)) << len;
+    EXPECT_EQ(u.name, "untouched");
+  }
+}
+
+TEST(HlodAsset, RefusesEverySingleFlippedByte) {
+  const Sample s = sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  for (size_t at = 0; at < bytes.size(); ++at)
+    for (uint8_t mask : {0x01, 0x80, 0xff}) {
+      std::vector<uint8_t> bad = bytes;
+      bad[at] ^= mask;
+      HlodTree t = sentinel();
+      std::vector<HlodPayload> p;
+      ASSERT_FALSE(decode_hlod_asset(bad, "bunny.hlod", t, p)) << "byte " << at << " ^ " << int(mask);
+      EXPECT_EQ(t.name, "untouched");
+    }
+}
+
+// Where each checksum sits and what it covers, so a test can forge it.
+struct Layout {
+  uint64_t head = 0;  // head bytes; its checksum follows
+  std::vector<std::pair<uint64_t, uint64_t>> payloads;  // offset, size (checksum last 8)
+};
+Layout layout_of(const std::vector<uint8_t>& bytes) {
+  Layout l;
+  HlodTree t;
+  EXPECT_TRUE(decode_hlod_tree(bytes, bytes.size(), "x", t));
+  std::memcpy(&l.head, bytes.data() + 12, 4);
+  for (const HlodNode& n : t.nodes) l.payloads.push_back({n.payload_offset, n.payload_size});
+  return l;
+}
+void put_u64(std::vector<uint8_t>& b, uint64_t at, uint64_t v) { std::memcpy(b.data() + at, &v, 8); }
+// Recomputes whichever checksum covers byte `at` (the head's, or that payload's).
+void forge_checksum(std::vector<uint8_t>& b, const Layout& l, uint64_t at) {
+  if (at < l.head) {
+    put_u64(b, l.head, hash_bytes(b.data(), l.head));
+    return;
+  }
+  for (const auto& [off, size] : l.payloads)
+    if (at >= off && at < off + size - 8) put_u64(b, off + size - 8, hash_bytes(b.data() + off, size - 8));
+}
+
+// Checksums forged after every single flip: validation alone must stand. Every outcome is a
+// clean refusal or a file that decodes into something valid (a flipped mantissa bit of a
+// position is still a position); nothing crashes or allocates wildly (ASan in CI).
+TEST(HlodAsset, ValidatesEveryFlippedByteUnderAForgedChecksum) {
+  const Sample s = sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  const Layout l = layout_of(bytes);
+  size_t refused = 0, accepted = 0;
+  const uint64_t table = l.head - 16 * l.payloads.size();
+  for (size_t at = 0; at < bytes.size(); ++at)
+    for (uint8_t mask : {0x01, 0x10, 0x80, 0xff}) {
+      // Node and inner-node counts and the offset table: no flip there is harmless.
+      const bool structural = (at >= 72 && at < 80) || (at >= table && at < l.head);
+      std::vector<uint8_t> bad = bytes;
+      bad[at] ^= mask;
+      forge_checksum(bad, l, at);
+      HlodTree t = sentinel();
+      std::vector<HlodPayload> p;
+      const Status st = decode_hlod_asset(bad, "bunny.hlod", t, p);
+      EXPECT_TRUE(!st || !structural) << "byte " << at << " ^ " << int(mask) << " accepted";
+      if (!st) {
+        ++refused;
+        EXPECT_EQ(t.name, "untouched");
+        EXPECT_EQ(st.message.rfind("bunny.hlod", 0), 0u) << st.message;
+        continue;
+      }
+      ++accepted;
+      // Accepted: every index in range, every value finite, the tree consistent.
+      ASSERT_EQ(p.size(), t.nodes.size());
+      for (size_t i = 0; i < t.nodes.size(); ++i) {
+        const HlodNode& n = t.nodes[i];
+        ASSERT_LE(n.depth, kHlodMaxDepth);
+        if (n.parent >= 0) {
+          ASSERT_LT(size_t(n.parent), i);
+          const HlodNode& par = t.nodes[size_t(n.parent)];
+          ASSERT_GE(i, par.first_child);
+          ASSERT_LT(i, par.first_child + par.child_count);
+          ASSERT_GE(par.layers[0].error, n.layers[n.layer_count - 1].error);
+        }
+        for (const LodLevel& r : p[i].layers)
+          for (uint32_t k = 0; k < r.index_count; ++k) ASSERT_LT(p[i].indices[r.first_index + k], r.vertex_count);
+        for (float v : p[i].positions) ASSERT_TRUE(std::isfinite(v));
+      }
+    }
+  EXPECT_GT(refused, 0u);
+  EXPECT_GT(accepted, 0u) << "flipped position bits are still positions: the forged checksums took";
+}
+
+TEST(HlodAsset, RefusesHostileFieldsNamingThem) {
+  const Sample s = sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  const Layout l = layout_of(bytes);
+  auto refuse = [&](auto&& edit, const char* expected) {
+    std::vector<uint8_t> bad = bytes;
+    const uint64_t at = edit(bad);
+    forge_checksum(bad, l, at);
+    HlodTree t = sentinel();
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(bad, "bunny.hlod", t, p);
+    ASSERT_FALSE(st) << expected;
+    EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
+  };
+  // An index out of range in node 1's first layer (its indices follow 2 x 7 vertices x 12 bytes).
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t at = l.payloads[1].first + 2 * 7 * 12;
+    const uint32_t v = 1000;
+    std::memcpy(b.data() + at, &v, 4);
+    return at;
+  }, "references vertex 1000 of 7");
+  // A payload offset pointing into the head.
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t table = l.head - 16 * l.payloads.size();
+    put_u64(b, table + 16, 8);
+    return table + 16;
+  }, "does not follow the payload before it");
+  // A node count of 2^32 - 1: refused by the head's size, before any allocation.
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint32_t v = 0xffffffffu;
+    std::memcpy(b.data() + 72, &v, 4);
+    return uint64_t{72};
+  }, "does not match its counts");
+  // A NaN error.
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t records = l.head - 16 * l.payloads.size() - 64 * l.payloads.size();
+    const float nan = NAN;
+    std::memcpy(b.data() + records + 64 * 2 + 28 + 8, &nan, 4);
+    return records;
+  }, "not a finite distance");
+  // A child coarser than its parent (node 3's coarsest error above node 2's finest).
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t records = l.head - 16 * l.payloads.size() - 64 * l.payloads.size();
+    const float big = 0.4f;
+    std::memcpy(b.data() + records + 64 * 3 + 28 + 24 + 8, &big, 4);
+    return records;
+  }, "errors must grow upwards");
+  // An OctreeCode naming more children than there are nodes.
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t code = 88 + 8;  // after the name "bunny", 8-aligned
+    b[code] = 0xff;
+    return code;
+  }, "octree");
+}
+
+TEST(HlodAsset, RefusesWrongMagicAndVersionSayingSo) {
+  const Sample s = sample();
+  std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  HlodTree t;
+  std::vector<HlodPayload> p;
+  std::vector<uint8_t> bad = bytes;
+  bad[0] = 'X';
+  Status st = decode_hlod_asset(bad, "a.hlod", t, p);
+  EXPECT_NE(st.message.find("bad magic"), std::string::npos) << st.message;
+  bad = bytes;
+  bad[8] = 9;
+  st = decode_hlod_asset(bad, "a.hlod", t, p);
+  EXPECT_NE(st.message.find("version 9 is not supported"), std::string::npos) << st.message;
+}
+
+TEST(HlodAsset, ReadsRegularFilesOnlyAndNamesMissingOnes) {
+  const auto dir = test::temp_dir("hlod_files");
+  HlodTree t;
+  Status st = read_hlod_tree(dir / "none.hlod", t);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("none.hlod: cannot open"), std::string::npos) << st.message;
+  st = read_hlod_tree(dir, t);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("not a regular file"), std::string::npos) << st.message;
+}
+
+}  // namespace
+}  // namespace lod
