@@ -1,0 +1,276 @@
+// HLOD cut selection (R1 3.3): one breadth-first visit of the wanted cut, one pass deciding
+// which wanted openings the children's residency allows, one top-down pass emitting the cut,
+// then R0-style undoing under the budget with a min-heap of screen-space errors.
+#include "runtime/hlod_select.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+#include "runtime/world_bounds.h"
+
+namespace lod {
+namespace {
+
+constexpr float kHuge = std::numeric_limits<float>::max();
+
+// Low bits: what the visit decided; high bits: where the node stands in the emitted cut.
+enum : uint8_t {
+  kCulled = 1,
+  kMissing = 2,    // visible, not resident: requested
+  kDraw = 3,       // drawn at scratch.layer (if in the cut)
+  kWantOpen = 4,   // no layer is fine enough; resolved to kOpened or kDraw
+  kOpened = 5,
+  kKindMask = 0x0f,
+  kInCut = 0x10,     // its parent is opened and in the cut (or it is the root)
+  kCovered = 0x20,   // some ancestor is drawn in the cut
+};
+
+uint8_t kind(uint8_t s) { return s & kKindMask; }
+bool in_cut(uint8_t s) { return (s & kInCut) != 0; }
+
+bool outside(const Frustum& f, const float c[3], float r) {
+  for (const glm::vec4& p : f.planes) {
+    if (p.x * c[0] + p.y * c[1] + p.z * c[2] + p.w < -r) return true;
+  }
+  return false;
+}
+
+// The coarsest layer whose scaled error meets E at this distance, or -1.
+int wanted_layer(const HlodNode& n, float scale, float distance, const HlodView& view, float pixel_error) {
+  const float threshold = hlod_error_threshold(distance, pixel_error, view.focal_px);
+  for (int l = int(n.layer_count) - 1; l >= 0; --l) {
+    if (n.layers[l].error * scale <= threshold) return l;
+  }
+  return -1;
+}
+
+float sse_of(const HlodCutScratch& s, const HlodNode& n, uint32_t id, uint32_t layer) {
+  return n.layers[layer].error * s.error_scale[id];
+}
+
+// Breadth-first from the root: measure, cull, choose the wanted layer, queue wanted children.
+void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<const uint8_t> resident,
+           const Transform& transform, const HlodView& view, const HlodSelectParams& params) {
+  float q[4];
+  normalized_rotation(transform, q);
+  s.queue.clear();
+  s.queue.push_back(0);
+  for (size_t head = 0; head < s.queue.size(); ++head) {
+    const uint32_t id = s.queue[head];
+    const HlodNode& n = tree.nodes[id];
+    float c[3];
+    rotate_by_quaternion(q, n.bounds.center, c);
+    for (int k = 0; k < 3; ++k) c[k] = transform.position[k] + transform.scale * c[k];
+    const float r = n.bounds.radius * transform.scale;
+    if (view.cull && outside(view.frustum, c, r)) {
+      s.state[id] = kCulled;
+      cut.culled.push_back(id);
+      continue;
+    }
+    const float dx = c[0] - view.eye.x, dy = c[1] - view.eye.y, dz = c[2] - view.eye.z;
+    const float d = std::max(0.0f, std::sqrt(dx * dx + dy * dy + dz * dz) - r);
+    s.distance[id] = d;
+    s.error_scale[id] = d > 0 ? view.focal_px * transform.scale / d : kHuge;
+    if (!resident[id]) {
+      s.state[id] = kMissing;
+      continue;
+    }
+    cut.kept.push_back(id);
+    const int l = wanted_layer(n, transform.scale, d, view, params.pixel_error);
+    s.layer[id] = static_cast<uint8_t>(std::max(l, 0));
+    if (l >= 0 || n.leaf()) {
+      s.state[id] = kDraw;
+      continue;
+    }
+    s.state[id] = kWantOpen;
+    for (uint32_t k = 0; k < n.child_count; ++k) s.queue.push_back(n.first_child + k);
+  }
+}
+
+// Never a hole: an opening is honoured only when every visible child is resident; otherwise
+// the node stays drawn at its finest layer.
+void resolve_openings(HlodCutScratch& s, const HlodTree& tree) {
+  for (uint32_t id : s.queue) {
+    if (kind(s.state[id]) != kWantOpen) continue;
+    const HlodNode& n = tree.nodes[id];
+    bool all_there = true;
+    for (uint32_t k = 0; k < n.child_count; ++k) all_there &= kind(s.state[n.first_child + k]) != kMissing;
+    s.state[id] = all_there ? kOpened : kDraw;
+  }
+}
+
+// Top-down in visiting order (parents first): which nodes are in the cut, the triangles, the
+// requests and the holes.
+void emit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, const HlodSelectParams& params) {
+  for (uint32_t id : s.queue) {
+    const HlodNode& n = tree.nodes[id];
+    uint8_t st = s.state[id];
+    if (n.parent < 0) {
+      st |= kInCut;
+    } else {
+      const uint8_t ps = s.state[n.parent];
+      if (in_cut(ps) && kind(ps) == kOpened) st |= kInCut;
+      if ((ps & kCovered) || (in_cut(ps) && kind(ps) == kDraw)) st |= kCovered;
+    }
+    s.state[id] = st;
+    if (kind(st) == kMissing) {
+      const float deficit =
+          n.parent < 0 ? kHuge : sse_of(s, tree.nodes[n.parent], uint32_t(n.parent), 0) - params.pixel_error;
+      cut.requests.push_back({id, deficit, s.distance[id]});
+      if (!(st & kCovered)) ++cut.holes;
+    }
+    if (!in_cut(st)) continue;
+    if (kind(st) == kDraw) cut.triangles += n.layers[s.layer[id]].triangles;
+    if (kind(st) == kOpened) cut.triangles += n.boundary_triangles;
+  }
+}
+
+// Min-heap order: the smallest error first, then the deeper (larger id) node.
+bool undo_after(const HlodCutScratch::Undo& a, const HlodCutScratch::Undo& b) {
+  return a.sse != b.sse ? a.sse > b.sse : a.node < b.node;
+}
+
+void push_undo(HlodCutScratch& s, float sse, uint32_t id) {
+  s.heap.push_back({sse, id});
+  std::push_heap(s.heap.begin(), s.heap.end(), undo_after);
+}
+
+uint32_t opened_children(const HlodCutScratch& s, const HlodNode& n) {
+  uint32_t count = 0;
+  for (uint32_t k = 0; k < n.child_count; ++k) count += kind(s.state[n.first_child + k]) == kOpened;
+  return count;
+}
+
+// The undo an in-cut node offers now: one layer coarser when drawn, closing when opened with
+// no opened child. False when it offers none.
+bool next_undo(const HlodCutScratch& s, const HlodTree& tree, uint32_t id, float* sse) {
+  const HlodNode& n = tree.nodes[id];
+  const uint8_t st = s.state[id];
+  if (!in_cut(st)) return false;
+  if (kind(st) == kDraw && s.layer[id] + 1u < n.layer_count) {
+    *sse = sse_of(s, n, id, s.layer[id] + 1u);
+    return true;
+  }
+  if (kind(st) == kOpened && s.open_children[id] == 0) {
+    *sse = sse_of(s, n, id, 0);
+    return true;
+  }
+  return false;
+}
+
+void offer_undo(HlodCutScratch& s, const HlodTree& tree, uint32_t id) {
+  float sse;
+  if (next_undo(s, tree, id, &sse)) push_undo(s, sse, id);
+}
+
+// Applies one undo; returns the triangles it changed (signed: a closed node may cost more).
+int64_t apply_undo(HlodCutScratch& s, const HlodTree& tree, uint32_t id) {
+  const HlodNode& n = tree.nodes[id];
+  if (kind(s.state[id]) == kDraw) {
+    const uint8_t l = s.layer[id]++;
+    return int64_t(n.layers[l + 1].triangles) - int64_t(n.layers[l].triangles);
+  }
+  int64_t delta = int64_t(n.layers[0].triangles) - int64_t(n.boundary_triangles);
+  for (uint32_t k = 0; k < n.child_count; ++k) {
+    const uint32_t c = n.first_child + k;
+    if (in_cut(s.state[c]) && kind(s.state[c]) == kDraw) delta -= tree.nodes[c].layers[s.layer[c]].triangles;
+    s.state[c] &= uint8_t(~kInCut);
+  }
+  s.state[id] = uint8_t((s.state[id] & ~kKindMask) | kDraw);
+  s.layer[id] = 0;
+  if (n.parent >= 0) --s.open_children[n.parent];
+  return delta;
+}
+
+void fit_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uint64_t budget) {
+  s.heap.clear();
+  for (uint32_t id : s.queue) {
+    if (kind(s.state[id]) == kOpened) s.open_children[id] = uint8_t(opened_children(s, tree.nodes[id]));
+  }
+  for (uint32_t id : s.queue) offer_undo(s, tree, id);
+  int64_t triangles = int64_t(cut.triangles);
+  while (triangles > int64_t(budget) && !s.heap.empty()) {
+    std::pop_heap(s.heap.begin(), s.heap.end(), undo_after);
+    const HlodCutScratch::Undo u = s.heap.back();
+    s.heap.pop_back();
+    float sse;
+    // Entries go stale when a node leaves the cut or changes; only the current offer counts.
+    if (!next_undo(s, tree, u.node, &sse) || sse != u.sse) continue;
+    const bool closing = kind(s.state[u.node]) == kOpened;
+    triangles += apply_undo(s, tree, u.node);
+    ++cut.undone;
+    offer_undo(s, tree, u.node);
+    // Closing the last opened child lets the parent close in turn.
+    const int32_t p = tree.nodes[u.node].parent;
+    if (closing && p >= 0) offer_undo(s, tree, uint32_t(p));
+  }
+  cut.triangles = uint64_t(triangles);
+  cut.over_budget = triangles > int64_t(budget);
+}
+
+void list_cut(HlodCut& cut, const HlodCutScratch& s) {
+  cut.drawn.clear();
+  cut.opened.clear();
+  for (uint32_t id : s.queue) {
+    const uint8_t st = s.state[id];
+    if (!in_cut(st)) continue;
+    if (kind(st) == kDraw) cut.drawn.push_back({id, s.layer[id]});
+    if (kind(st) == kOpened) cut.opened.push_back(id);
+  }
+}
+
+}  // namespace
+
+HlodView hlod_view_of(const View& v) {
+  HlodView h;
+  h.eye = v.eye;
+  h.focal_px = focal_pixels(v);
+  h.frustum = frustum_of(v);
+  return h;
+}
+
+bool request_before(const HlodRequest& a, const HlodRequest& b) {
+  if (a.deficit != b.deficit) return a.deficit > b.deficit;
+  if (a.distance != b.distance) return a.distance < b.distance;
+  return a.node < b.node;
+}
+
+void prepare_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree) {
+  const size_t n = tree.nodes.size();
+  s.distance.assign(n, 0);
+  s.error_scale.assign(n, 0);
+  s.state.assign(n, 0);
+  s.layer.assign(n, 0);
+  s.open_children.assign(n, 0);
+  s.queue.reserve(n);
+  s.heap.reserve(7 * n);  // an offer per node, two per undo, at most three undos per node
+  for (auto* v : {&cut.opened, &cut.culled, &cut.kept}) v->reserve(n);
+  cut.drawn.reserve(n);
+  cut.requests.reserve(n);
+}
+
+uint32_t select_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<const uint8_t> resident,
+                         const Transform& transform, const HlodView& view, const HlodSelectParams& params) {
+  cut.drawn.clear();
+  cut.opened.clear();
+  cut.culled.clear();
+  cut.requests.clear();
+  cut.kept.clear();
+  cut.triangles = cut.wanted_triangles = 0;
+  cut.undone = cut.holes = 0;
+  cut.over_budget = false;
+  if (tree.nodes.empty()) return 0;
+  assert(resident.size() == tree.nodes.size() && s.state.size() == tree.nodes.size());
+  visit(cut, s, tree, resident, transform, view, params);
+  resolve_openings(s, tree);
+  emit(cut, s, tree, params);
+  cut.wanted_triangles = cut.triangles;
+  if (cut.triangles > params.triangle_budget) fit_budget(cut, s, tree, params.triangle_budget);
+  list_cut(cut, s);
+  std::sort(cut.requests.begin(), cut.requests.end(), request_before);
+  return uint32_t(cut.drawn.size());
+}
+
+}  // namespace lod
