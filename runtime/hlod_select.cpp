@@ -30,18 +30,11 @@ enum : uint8_t {
 uint8_t kind(uint8_t s) { return s & kKindMask; }
 bool in_cut(uint8_t s) { return (s & kInCut) != 0; }
 
-bool outside(const Frustum& f, const float c[3], float r) {
-  for (const glm::vec4& p : f.planes) {
-    if (p.x * c[0] + p.y * c[1] + p.z * c[2] + p.w < -r) return true;
-  }
-  return false;
-}
-
-// The coarsest layer whose scaled error meets E at this distance, or -1.
-int wanted_layer(const HlodNode& n, float scale, float distance, const HlodView& view, float pixel_error) {
+// The coarsest layer whose error meets E at this (object-space) distance, or -1.
+int wanted_layer(const HlodNode& n, float distance, const HlodView& view, float pixel_error) {
   const float threshold = hlod_error_threshold(distance, pixel_error, view.focal_px);
   for (int l = int(n.layer_count) - 1; l >= 0; --l) {
-    if (n.layers[l].error * scale <= threshold) return l;
+    if (n.layers[l].error <= threshold) return l;
   }
   return -1;
 }
@@ -50,35 +43,65 @@ float sse_of(const HlodCutScratch& s, const HlodNode& n, uint32_t id, uint32_t l
   return n.layers[layer].error * s.error_scale[id];
 }
 
-// Breadth-first from the root: measure, cull, choose the wanted layer, queue wanted children.
-void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<const uint8_t> resident,
-           const Transform& transform, const HlodView& view, const HlodSelectParams& params) {
+// The view in the tree's object space, so that no node is transformed: with world =
+// position + scale * R(object), a world plane (n, w) is (R^T n, (n . position + w) / scale)
+// over object-space spheres, distances shrink by the scale and so do the errors they meet.
+struct ObjectView {
+  glm::vec3 eye;
+  glm::vec4 planes[6];
+  float scale;
+};
+
+ObjectView object_view(const Transform& transform, const HlodView& view) {
   float q[4];
   normalized_rotation(transform, q);
+  const float inverse[4] = {-q[0], -q[1], -q[2], q[3]};
+  const glm::vec3 position(transform.position[0], transform.position[1], transform.position[2]);
+  ObjectView o;
+  o.scale = transform.scale;
+  const glm::vec3 rel = (view.eye - position) / transform.scale;
+  rotate_by_quaternion(inverse, &rel.x, &o.eye.x);
+  for (int k = 0; k < 6; ++k) {
+    const glm::vec4& p = view.frustum.planes[k];
+    glm::vec3 n;
+    rotate_by_quaternion(inverse, &p.x, &n.x);
+    // Culling off: planes every sphere is inside of.
+    o.planes[k] = view.cull ? glm::vec4(n, (glm::dot(glm::vec3(p), position) + p.w) / transform.scale)
+                            : glm::vec4(0, 0, 0, 1);
+  }
+  return o;
+}
+
+bool outside(const ObjectView& o, const Sphere& b) {
+  for (const glm::vec4& p : o.planes) {
+    if (p.x * b.center[0] + p.y * b.center[1] + p.z * b.center[2] + p.w < -b.radius) return true;
+  }
+  return false;
+}
+
+// Breadth-first from the root: measure, cull, choose the wanted layer, queue wanted children.
+void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<const uint8_t> resident,
+           const ObjectView& o, const HlodView& view, const HlodSelectParams& params) {
   s.queue.clear();
   s.queue.push_back(0);
   for (size_t head = 0; head < s.queue.size(); ++head) {
     const uint32_t id = s.queue[head];
     const HlodNode& n = tree.nodes[id];
-    float c[3];
-    rotate_by_quaternion(q, n.bounds.center, c);
-    for (int k = 0; k < 3; ++k) c[k] = transform.position[k] + transform.scale * c[k];
-    const float r = n.bounds.radius * transform.scale;
-    if (view.cull && outside(view.frustum, c, r)) {
+    if (outside(o, n.bounds)) {
       s.state[id] = kCulled;
       cut.culled.push_back(id);
       continue;
     }
-    const float dx = c[0] - view.eye.x, dy = c[1] - view.eye.y, dz = c[2] - view.eye.z;
-    const float d = std::max(0.0f, std::sqrt(dx * dx + dy * dy + dz * dz) - r);
-    s.distance[id] = d;
-    s.error_scale[id] = d > 0 ? view.focal_px * transform.scale / d : kHuge;
+    const float dx = n.bounds.center[0] - o.eye.x, dy = n.bounds.center[1] - o.eye.y, dz = n.bounds.center[2] - o.eye.z;
+    const float d = std::max(0.0f, std::sqrt(dx * dx + dy * dy + dz * dz) - n.bounds.radius);  // object space
+    s.distance[id] = d * o.scale;
+    s.error_scale[id] = d > 0 ? view.focal_px / d : kHuge;
     if (!resident[id]) {
       s.state[id] = kMissing;
       continue;
     }
     cut.kept.push_back(id);
-    const int l = wanted_layer(n, transform.scale, d, view, params.pixel_error);
+    const int l = wanted_layer(n, d, view, params.pixel_error);
     s.layer[id] = static_cast<uint8_t>(std::max(l, 0));
     if (l >= 0 || n.leaf()) {
       s.state[id] = kDraw;
@@ -127,10 +150,14 @@ void emit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, const HlodSelec
   }
 }
 
-// Min-heap order: the smallest error first, then the deeper (larger id) node.
-bool undo_after(const HlodCutScratch::Undo& a, const HlodCutScratch::Undo& b) {
-  return a.sse != b.sse ? a.sse > b.sse : a.node < b.node;
-}
+// Min-heap order: the smallest error first, then the deeper (larger id) node. A function
+// object, so the heap algorithms inline it.
+struct UndoAfter {
+  bool operator()(const HlodCutScratch::Undo& a, const HlodCutScratch::Undo& b) const {
+    return a.sse != b.sse ? a.sse > b.sse : a.node < b.node;
+  }
+};
+constexpr UndoAfter undo_after{};
 
 void push_undo(HlodCutScratch& s, float sse, uint32_t id) {
   s.heap.push_back({sse, id});
@@ -263,7 +290,7 @@ uint32_t select_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, 
   cut.over_budget = false;
   if (tree.nodes.empty()) return 0;
   assert(resident.size() == tree.nodes.size() && s.state.size() == tree.nodes.size());
-  visit(cut, s, tree, resident, transform, view, params);
+  visit(cut, s, tree, resident, object_view(transform, view), view, params);
   resolve_openings(s, tree);
   emit(cut, s, tree, params);
   cut.wanted_triangles = cut.triangles;

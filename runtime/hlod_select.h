@@ -89,7 +89,7 @@ struct HlodCut {
 // Per-node scratch, reused frame to frame.
 struct HlodCutScratch {
   std::vector<float> distance;        // world
-  std::vector<float> error_scale;     // focal * scale / d (sse = e * error_scale), inf inside
+  std::vector<float> error_scale;     // sse = e * error_scale: focal * scale / d, huge inside
   std::vector<uint8_t> state;         // detail::HlodNodeState
   std::vector<uint8_t> layer;         // drawn layer
   std::vector<uint8_t> open_children; // opened children of an opened node
