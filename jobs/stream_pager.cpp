@@ -135,7 +135,8 @@ void StreamPager::requeue(uint64_t frame, std::span<const HlodRequest> wanted) {
     // This frame's priorities: the best (lowest rank) at the back, where loaders take.
     std::sort(sh.queue.begin(), sh.queue.end(), [&](uint32_t a, uint32_t b) { return state_.rank[a] > state_.rank[b]; });
   }
-  if (!update_.issued.empty()) sh.wake.notify_all();
+  // One loader per new node: waking them all would only have them compete for the cores.
+  for (size_t i = 0; i < update_.issued.size(); ++i) sh.wake.notify_one();
   for (uint32_t n : update_.evicted) payloads_[n].reset();
   for (uint32_t n : too_large_) {
     update_.failures.push_back({n, node_message(n, "needs " + std::to_string(state_.bytes[n]) +

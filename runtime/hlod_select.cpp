@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <limits>
 
 #include "runtime/world_bounds.h"
@@ -23,8 +25,9 @@ enum : uint8_t {
   kWantOpen = 4,   // no layer is fine enough; resolved to kOpened or kDraw
   kOpened = 5,
   kKindMask = 0x0f,
-  kInCut = 0x10,     // its parent is opened and in the cut (or it is the root)
-  kCovered = 0x20,   // some ancestor is drawn in the cut
+  kInCut = 0x10,       // its parent is opened and in the cut (or it is the root)
+  kCovered = 0x20,     // some ancestor is drawn in the cut
+  kWantedOpen = 0x40,  // opened in the cut before the budget (the refining pass's target)
 };
 
 uint8_t kind(uint8_t s) { return s & kKindMask; }
@@ -150,17 +153,26 @@ void emit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, const HlodSelec
   }
 }
 
-// Min-heap order: the smallest error first, then the deeper (larger id) node. A function
-// object, so the heap algorithms inline it.
-struct UndoAfter {
-  bool operator()(const HlodCutScratch::Undo& a, const HlodCutScratch::Undo& b) const {
-    return a.sse != b.sse ? a.sse > b.sse : a.node < b.node;
-  }
-};
-constexpr UndoAfter undo_after{};
+// Heap entries are one integer: the error's bits (a float >= 0 orders as its bits) above the
+// complemented node id, so one comparison orders by error, then by id: a min-heap pops the
+// smallest error, then the deeper (larger id) node; a max-heap the largest, then the
+// shallower. Branch-free compares: the heap is the budget passes' whole cost.
+uint64_t heap_key(float sse, uint32_t id) {
+  uint32_t bits;
+  std::memcpy(&bits, &sse, sizeof bits);
+  return uint64_t(bits) << 32 | uint32_t(~id);
+}
+float key_sse(uint64_t key) {
+  const uint32_t bits = uint32_t(key >> 32);
+  float sse;
+  std::memcpy(&sse, &bits, sizeof sse);
+  return sse;
+}
+uint32_t key_node(uint64_t key) { return ~uint32_t(key); }
+constexpr std::greater<uint64_t> undo_after{};
 
 void push_undo(HlodCutScratch& s, float sse, uint32_t id) {
-  s.heap.push_back({sse, id});
+  s.heap.push_back(heap_key(sse, id));
   std::push_heap(s.heap.begin(), s.heap.end(), undo_after);
 }
 
@@ -211,7 +223,8 @@ int64_t apply_undo(HlodCutScratch& s, const HlodTree& tree, uint32_t id) {
   return delta;
 }
 
-void fit_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uint64_t budget) {
+// Undoing from the wanted cut: cheap when the cut is a little over the budget.
+void undo_to_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uint64_t budget) {
   s.heap.clear();
   for (uint32_t id : s.queue) {
     if (kind(s.state[id]) == kOpened) s.open_children[id] = uint8_t(opened_children(s, tree.nodes[id]));
@@ -220,8 +233,12 @@ void fit_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uint64_t 
   int64_t triangles = int64_t(cut.triangles);
   while (triangles > int64_t(budget) && !s.heap.empty()) {
     std::pop_heap(s.heap.begin(), s.heap.end(), undo_after);
-    const HlodCutScratch::Undo u = s.heap.back();
+    const uint64_t key = s.heap.back();
     s.heap.pop_back();
+    const struct {
+      float sse;
+      uint32_t node;
+    } u{key_sse(key), key_node(key)};
     float sse;
     // Entries go stale when a node leaves the cut or changes; only the current offer counts.
     if (!next_undo(s, tree, u.node, &sse) || sse != u.sse) continue;
@@ -234,6 +251,90 @@ void fit_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uint64_t 
     if (closing && p >= 0) offer_undo(s, tree, uint32_t(p));
   }
   cut.triangles = uint64_t(triangles);
+  cut.over_budget = triangles > int64_t(budget);
+}
+
+// Refining from the root towards the wanted cut, the largest error first, until the next
+// step would not fit: the same steps in reverse order, so the same cut when every undo
+// lowers the triangles (errors and triangle counts monotonic up the tree); cheap when the
+// wanted cut is far over the budget, since only the budgeted cut is walked.
+using RefineBefore = std::less<uint64_t>;  // max-heap: the largest error, then the smaller id
+
+uint64_t coarsest_triangles(const HlodNode& n) { return n.layers[n.layer_count - 1].triangles; }
+
+// The refinement a drawn node offers: one layer finer towards its wanted layer, then opening.
+bool next_refine(const HlodCutScratch& s, const HlodTree& tree, uint32_t id, float* sse, int64_t* delta) {
+  const HlodNode& n = tree.nodes[id];
+  const uint8_t l = s.layer[id];
+  if (l > s.wanted_layer[id]) {
+    *sse = sse_of(s, n, id, l);
+    *delta = int64_t(n.layers[l - 1].triangles) - int64_t(n.layers[l].triangles);
+    return true;
+  }
+  if (l != 0 || !(s.state[id] & kWantedOpen) || kind(s.state[id]) != kDraw) return false;
+  *sse = sse_of(s, n, id, 0);
+  *delta = int64_t(n.boundary_triangles) - int64_t(n.layers[0].triangles);
+  for (uint32_t k = 0; k < n.child_count; ++k) {
+    const uint32_t c = n.first_child + k;
+    if (kind(s.state[c]) != kCulled) *delta += int64_t(coarsest_triangles(tree.nodes[c]));
+  }
+  return true;
+}
+
+void offer_refine(HlodCutScratch& s, const HlodTree& tree, uint32_t id) {
+  float sse;
+  int64_t delta;
+  if (!next_refine(s, tree, id, &sse, &delta)) return;
+  s.heap.push_back(heap_key(sse, id));
+  std::push_heap(s.heap.begin(), s.heap.end(), RefineBefore{});
+}
+
+// A node starts drawn at its coarsest layer (culled ones stay culled).
+void start_coarsest(HlodCutScratch& s, const HlodTree& tree, uint32_t id) {
+  s.state[id] |= kInCut;
+  if (kind(s.state[id]) == kCulled) return;
+  s.state[id] = uint8_t((s.state[id] & ~kKindMask) | kDraw);
+  s.layer[id] = uint8_t(tree.nodes[id].layer_count - 1);
+}
+
+void refine_to_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uint64_t budget) {
+  uint32_t wanted_steps = 0;
+  for (uint32_t id : s.queue) {
+    uint8_t& st = s.state[id];
+    if (in_cut(st) && kind(st) == kDraw) wanted_steps += tree.nodes[id].layer_count - 1u - s.layer[id];
+    if (in_cut(st) && kind(st) == kOpened) wanted_steps += tree.nodes[id].layer_count, st |= kWantedOpen;
+    s.wanted_layer[id] = s.layer[id];
+    st &= uint8_t(~kInCut);
+  }
+  s.heap.clear();
+  start_coarsest(s, tree, 0);
+  int64_t triangles = kind(s.state[0]) == kCulled ? 0 : int64_t(coarsest_triangles(tree.nodes[0]));
+  offer_refine(s, tree, 0);
+  uint32_t steps = 0;
+  while (!s.heap.empty()) {
+    const uint32_t id = key_node(s.heap.front());
+    float sse = 0;
+    int64_t delta = 0;
+    next_refine(s, tree, id, &sse, &delta);  // always true: one live entry per node
+    if (triangles + delta > int64_t(budget)) break;  // the undoing pass would stop here too
+    std::pop_heap(s.heap.begin(), s.heap.end(), RefineBefore{});
+    s.heap.pop_back();
+    triangles += delta;
+    ++steps;
+    if (s.layer[id] > s.wanted_layer[id]) {
+      --s.layer[id];
+      offer_refine(s, tree, id);
+      continue;
+    }
+    s.state[id] = uint8_t((s.state[id] & ~kKindMask) | kOpened);
+    const HlodNode& n = tree.nodes[id];
+    for (uint32_t k = 0; k < n.child_count; ++k) {
+      start_coarsest(s, tree, n.first_child + k);
+      offer_refine(s, tree, n.first_child + k);
+    }
+  }
+  cut.triangles = uint64_t(triangles);
+  cut.undone = wanted_steps - steps;
   cut.over_budget = triangles > int64_t(budget);
 }
 
@@ -270,6 +371,7 @@ void prepare_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree) {
   s.error_scale.assign(n, 0);
   s.state.assign(n, 0);
   s.layer.assign(n, 0);
+  s.wanted_layer.assign(n, 0);
   s.open_children.assign(n, 0);
   s.queue.reserve(n);
   s.heap.reserve(7 * n);  // an offer per node, two per undo, at most three undos per node
@@ -294,7 +396,16 @@ uint32_t select_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, 
   resolve_openings(s, tree);
   emit(cut, s, tree, params);
   cut.wanted_triangles = cut.triangles;
-  if (cut.triangles > params.triangle_budget) fit_budget(cut, s, tree, params.triangle_budget);
+  if (cut.triangles > params.triangle_budget) {
+    // The pass with fewer steps: undo when the cut is less than twice the budget.
+    const bool refine = params.budget_pass == HlodBudgetPass::refine ||
+                        (params.budget_pass == HlodBudgetPass::automatic && cut.triangles / 2 > params.triangle_budget);
+    if (refine) {
+      refine_to_budget(cut, s, tree, params.triangle_budget);
+    } else {
+      undo_to_budget(cut, s, tree, params.triangle_budget);
+    }
+  }
   list_cut(cut, s);
   std::sort(cut.requests.begin(), cut.requests.end(), request_before);
   return uint32_t(cut.drawn.size());

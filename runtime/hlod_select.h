@@ -29,6 +29,8 @@
 // the smallest screen-space error first: a drawn node one layer coarser, or an opened node
 // whose visible children are all drawn closed again (drawn at its finest layer). It stops when
 // the cut fits or the root is drawn at its coarsest layer (the smallest cut; `over_budget`).
+// Far over the budget the same steps are taken the other way round (HlodBudgetPass): from
+// the root at its coarsest, largest error first, until the next step would not fit.
 //
 // Not sub-range safe: one call selects one tree's whole cut. No threads, clocks or I/O; after
 // prepare_hlod_cut no allocation either (the outputs and scratch keep their capacity).
@@ -51,9 +53,19 @@ struct HlodView {
 };
 HlodView hlod_view_of(const View& v);
 
+// How the budget is met. Both passes take the same steps in opposite orders, so they give the
+// same cut whenever every undo lowers the triangle count (errors and triangle counts
+// monotonic up the tree); `automatic` takes the one with fewer steps.
+enum class HlodBudgetPass : uint8_t {
+  automatic,  // undo when the wanted cut is under twice the budget, else refine
+  undo,       // from the wanted cut, undo the smallest-error refinement first
+  refine,     // from the root at its coarsest, refine the largest-error step first
+};
+
 struct HlodSelectParams {
   float pixel_error = 1;                   // P, pixels
   uint64_t triangle_budget = UINT64_MAX;   // this cut's share of M
+  HlodBudgetPass budget_pass = HlodBudgetPass::automatic;
 };
 
 struct HlodDraw {
@@ -92,13 +104,10 @@ struct HlodCutScratch {
   std::vector<float> error_scale;     // sse = e * error_scale: focal * scale / d, huge inside
   std::vector<uint8_t> state;         // detail::HlodNodeState
   std::vector<uint8_t> layer;         // drawn layer
+  std::vector<uint8_t> wanted_layer;  // before the budget (refine pass)
   std::vector<uint8_t> open_children; // opened children of an opened node
   std::vector<uint32_t> queue;        // breadth-first visiting order
-  struct Undo {
-    float sse;       // screen-space error once undone
-    uint32_t node;
-  };
-  std::vector<Undo> heap;
+  std::vector<uint64_t> heap;         // budget steps: error bits << 32 | ~node
 };
 
 // Sizes the outputs and the scratch for `tree` (the only allocation).

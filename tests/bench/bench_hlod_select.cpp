@@ -58,7 +58,7 @@ void run_cut(benchmark::State& state, float radius, float pixel_error, uint32_t 
   HlodCutScratch scratch;
   prepare_hlod_cut(cut, scratch, t);
   const Transform tr = placed();
-  size_t frame = 0, visited = 0, drawn = 0, requests = 0, undone = 0;
+  size_t frame = 0, visited = 0, drawn = 0, requests = 0, undone = 0, wanted = 0, triangles = 0;
   for (auto _ : state) {
     select_hlod_cut(cut, scratch, t, resident, tr, hviews[frame++ % hviews.size()], {pixel_error, budget});
     benchmark::DoNotOptimize(cut.triangles);
@@ -66,6 +66,8 @@ void run_cut(benchmark::State& state, float radius, float pixel_error, uint32_t 
     drawn += cut.drawn.size();
     requests += cut.requests.size();
     undone += cut.undone;
+    wanted += cut.wanted_triangles;
+    triangles += cut.triangles;
   }
   const double n = double(state.iterations());
   state.counters["nodes"] = double(t.nodes.size());
@@ -73,14 +75,20 @@ void run_cut(benchmark::State& state, float radius, float pixel_error, uint32_t 
   state.counters["drawn"] = double(drawn) / n;
   state.counters["requests"] = double(requests) / n;
   state.counters["undone"] = double(undone) / n;
+  state.counters["wanted_tris"] = double(wanted) / n;
+  state.counters["tris"] = double(triangles) / n;
 }
 
 void BM_HlodCutResident(benchmark::State& state) { run_cut(state, 150, 1.0f, 100, UINT64_MAX); }
 void BM_HlodCutPartlyResident(benchmark::State& state) { run_cut(state, 150, 1.0f, 70, UINT64_MAX); }
-void BM_HlodCutUnderBudget(benchmark::State& state) { run_cut(state, 150, 0.5f, 100, 200000); }
+// Budgets at 60 % of the wanted cut (the undoing pass) and at 25 % (the refining pass).
+void BM_HlodCutUnderBudgetUndo(benchmark::State& state) { run_cut(state, 150, 0.5f, 100, 90000); }
+void BM_HlodCutUnderBudgetRefine(benchmark::State& state) { run_cut(state, 150, 0.5f, 100, 35000); }
 // P so small that every node wants to open: the cut visits all 10,000 nodes.
 void BM_HlodCutEveryNode(benchmark::State& state) { run_cut(state, 150, 1e-4f, 100, UINT64_MAX); }
 void BM_HlodCutEveryNodeUnderBudget(benchmark::State& state) { run_cut(state, 150, 1e-4f, 100, 100000); }
+// The undoing pass's worst case: every node visited, 40 % of the wanted cut to undo.
+void BM_HlodCutEveryNodeUndoing40Percent(benchmark::State& state) { run_cut(state, 150, 1e-4f, 100, 4700000); }
 
 // Baseline: transform and cull every node's sphere, nothing else.
 void BM_SphereCullEveryNode(benchmark::State& state) {
@@ -106,9 +114,11 @@ void BM_SphereCullEveryNode(benchmark::State& state) {
 
 BENCHMARK(BM_HlodCutResident)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_HlodCutPartlyResident)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_HlodCutUnderBudget)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_HlodCutUnderBudgetUndo)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_HlodCutUnderBudgetRefine)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_HlodCutEveryNode)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_HlodCutEveryNodeUnderBudget)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_HlodCutEveryNodeUndoing40Percent)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SphereCullEveryNode)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

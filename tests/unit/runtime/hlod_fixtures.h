@@ -42,8 +42,9 @@ inline void set_payload(HlodNode& n, uint64_t bytes_per_triangle) {
 }
 
 // A full octree over a cube centred at the origin, breadth-first; a node at depth k has
-// layer errors root_error * 2^-k * {1/4, 1/2, 1} (leaves: {0, ...}), so every node's
-// finest error equals its children's coarsest (monotonic up the tree).
+// layer errors root_error * 2^-k * {1/2, 3/4, 1} (leaves: {0, ...}), so every node's
+// finest error equals its children's coarsest (monotonic up the tree). Children's bounds
+// nest in their parent's.
 inline HlodTree full_octree(const OctreeSpec& spec) {
   HlodTree t;
   t.name = "octree";
@@ -66,7 +67,7 @@ inline HlodTree full_octree(const OctreeSpec& spec) {
   }
   for (HlodNode& n : t.nodes) {
     const float e = spec.root_error / float(1u << n.depth);
-    const float errors[3] = {n.leaf() ? 0.0f : e / 4, e / 2, e};
+    const float errors[3] = {n.leaf() ? 0.0f : e / 2, 3 * e / 4, e};
     set_layers(n, spec.triangles, errors, 3);
     n.boundary_triangles = n.leaf() ? 0 : spec.triangles / 8;
     set_payload(n, spec.bytes_per_triangle);

@@ -116,10 +116,11 @@ struct Selector {
   HlodCutScratch scratch;
   explicit Selector(const HlodTree& t) { prepare_hlod_cut(cut, scratch, t); }
   const HlodCut& run(const HlodTree& t, const std::vector<uint8_t>& resident, const Transform& tr, const View& v,
-                     float pixel_error, bool cull = true, uint64_t budget = UINT64_MAX) {
+                     float pixel_error, bool cull = true, uint64_t budget = UINT64_MAX,
+                     HlodBudgetPass pass = HlodBudgetPass::automatic) {
     HlodView hv = hlod_view_of(v);
     hv.cull = cull;
-    select_hlod_cut(cut, scratch, t, resident, tr, hv, {pixel_error, budget});
+    select_hlod_cut(cut, scratch, t, resident, tr, hv, {pixel_error, budget, pass});
     return cut;
   }
 };
@@ -399,7 +400,7 @@ TEST(HlodSelect, TransformActsAsTheInverseOnTheEye) {
   }
 }
 
-TEST(HlodSelect, BudgetNeverExceededWhenTheSmallestCutFits) {
+void budget_never_exceeded(HlodBudgetPass pass) {
   std::mt19937 rng(3);
   uint64_t undone = 0;
   for (uint32_t seed = 1; seed <= 30; ++seed) {
@@ -414,7 +415,7 @@ TEST(HlodSelect, BudgetNeverExceededWhenTheSmallestCutFits) {
       const uint64_t wanted = sel.run(t, resident, tr, v, 0.5f).wanted_triangles;
       const uint64_t smallest = root.layers[root.layer_count - 1].triangles;
       const uint64_t budget = smallest + uint64_t(rng() % (wanted + 1));
-      const HlodCut& cut = sel.run(t, resident, tr, v, 0.5f, true, budget);
+      const HlodCut& cut = sel.run(t, resident, tr, v, 0.5f, true, budget, pass);
       EXPECT_EQ(cut.wanted_triangles, wanted);
       EXPECT_LE(cut.triangles, budget) << "seed " << seed << " view " << k;
       EXPECT_FALSE(cut.over_budget);
@@ -429,6 +430,42 @@ TEST(HlodSelect, BudgetNeverExceededWhenTheSmallestCutFits) {
   }
   EXPECT_GT(undone, 1000u);  // the budgets really bite
   std::printf("%llu refinements undone\n", (unsigned long long)undone);
+}
+
+TEST(HlodSelect, BudgetNeverExceededWhenTheSmallestCutFits) { budget_never_exceeded(HlodBudgetPass::automatic); }
+TEST(HlodSelect, BudgetNeverExceededByTheUndoingPass) { budget_never_exceeded(HlodBudgetPass::undo); }
+TEST(HlodSelect, BudgetNeverExceededByTheRefiningPass) { budget_never_exceeded(HlodBudgetPass::refine); }
+
+TEST(HlodSelect, RefiningAndUndoingPassesAgreeOnMonotonicTrees) {
+  // Full octrees: errors and triangle counts monotonic up the tree, bounds nested, so both
+  // passes take the same steps in opposite orders and stop at the same cut. Without culling:
+  // closing a node most of whose children are culled adds triangles (then they may differ).
+  std::mt19937 rng(8);
+  int compared = 0, undone = 0;
+  for (uint32_t depth = 2; depth <= 4; ++depth) {
+    const HlodTree t = test::full_octree({.depth = depth});
+    Selector a(t), b(t);
+    for (int k = 0; k < 60; ++k) {
+      const auto resident = random_residency(t.nodes.size(), rng, k % 2 ? 100 : 90);
+      const View v = random_view(rng);
+      const uint64_t wanted = a.run(t, resident, {}, v, 0.25f, false).wanted_triangles;
+      const uint64_t budget = 250 + uint64_t(rng() % (wanted + 1));
+      const HlodCut& u = a.run(t, resident, {}, v, 0.25f, false, budget, HlodBudgetPass::undo);
+      const HlodCut& r = b.run(t, resident, {}, v, 0.25f, false, budget, HlodBudgetPass::refine);
+      ASSERT_EQ(u.drawn.size(), r.drawn.size()) << "depth " << depth << " view " << k;
+      for (size_t i = 0; i < u.drawn.size(); ++i) {
+        ASSERT_EQ(u.drawn[i].node, r.drawn[i].node);
+        ASSERT_EQ(u.drawn[i].layer, r.drawn[i].layer);
+      }
+      EXPECT_EQ(u.opened, r.opened);
+      EXPECT_EQ(u.triangles, r.triangles);
+      EXPECT_EQ(u.undone, r.undone);
+      ++compared;
+      undone += int(u.undone);
+    }
+  }
+  EXPECT_EQ(compared, 180);
+  EXPECT_GT(undone, 500);
 }
 
 TEST(HlodSelect, BudgetUndoesTheFarRefinementFirst) {
