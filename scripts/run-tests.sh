@@ -25,7 +25,7 @@ echo "== ThreadSanitizer: frame pool, service (simulation + consumers), frame gr
       -DLOD_BUILD_BENCH=OFF -DLOD_BUILD_VIEWER=OFF
 cmake --build build-tsan -j "$JOBS" --target test_jobs
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
-  ./scripts/ctest-all.sh build-tsan -j "$JOBS" --timeout 900 -R '^(FramePool|Service|ServiceObjects|ServiceThreads|FrameGraph|FrameGraphVd|FrameGeomorph|StreamPager)\.'
+  ./scripts/ctest-all.sh build-tsan -j "$JOBS" --timeout 900 -R '^(FramePool|Service|ServiceObjects|ServiceThreads|FrameGraph|FrameGraphVd|FrameGeomorph|StreamPager|HlodStream)\.'
 
 echo "== AddressSanitizer + UBSan: runtime, preprocess, jobs, integration =="
 ./scripts/configure.sh build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=address \
