@@ -61,6 +61,12 @@ void loader_loop(StreamPager::Shared& sh) {
 
 std::string node_message(uint32_t node, const std::string& why) { return "node " + std::to_string(node) + ": " + why; }
 
+// What a payload takes in memory, counted as HlodNode::resident_bytes counts it (positions,
+// normals, indices).
+uint64_t payload_bytes(const HlodPayload& p) {
+  return 4ull * (p.positions.size() + p.normals.size() + p.indices.size());
+}
+
 }  // namespace
 
 StreamPager::StreamPager(const HlodTree& tree, const StreamPagerConfig& config, NodeLoader load)
@@ -101,6 +107,12 @@ void StreamPager::take_completions(uint64_t frame) {
     std::swap(sh.done, sh.taken);
   }
   for (Completion& c : sh.taken) {
+    // The budget reserved what the tree says; a payload that takes more (a lying or corrupt
+    // source) would break it, so it is refused like any bad node.
+    if (c.status.ok && payload_bytes(*c.payload) > state_.bytes[c.node]) {
+      c.status = Status::error("its payload takes " + std::to_string(payload_bytes(*c.payload)) +
+                               " bytes, more than the " + std::to_string(state_.bytes[c.node]) + " its node records");
+    }
     if (c.status.ok) {
       stream_loaded(state_, c.node, frame);
       payloads_[c.node] = std::move(c.payload);

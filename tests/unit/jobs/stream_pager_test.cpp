@@ -196,6 +196,32 @@ TEST(StreamPager, FailuresAreReportedOnceNeverRetriedAndTheParentStaysDrawn) {
   EXPECT_EQ(pager.reserved_bytes(), pager.resident_bytes());
 }
 
+TEST(StreamPager, PayloadLargerThanItsNodeRecordsIsRefused) {
+  const HlodTree t = test::full_octree({.depth = 1});
+  StreamPager pager(t, {.loader_threads = 1, .budget_bytes = 1ull << 30, .max_in_flight = 2},
+                    [&](uint32_t n, HlodPayload& out) {
+                      synthetic_payload(t, n, out);
+                      if (n == 2) out.indices.resize(t.nodes[n].resident_bytes / 4 + 1);  // one index too many
+                      return Status::success();
+                    });
+  uint64_t frame = 0;
+  const auto wanted = requests_for({1, 2});
+  std::vector<StreamFailure> failures;
+  for (int i = 0; i < 20000 && !(pager.residency()[1] && !failures.empty()); ++i) {
+    for (const StreamFailure& f : pager.update(++frame, wanted, {}).failures) failures.push_back(f);
+    std::this_thread::sleep_for(200us);
+  }
+  for (int i = 0; i < 20; ++i) {  // and never again
+    for (const StreamFailure& f : pager.update(++frame, wanted, {}).failures) failures.push_back(f);
+  }
+  ASSERT_EQ(failures.size(), 1u);
+  EXPECT_EQ(failures[0].node, 2u);
+  EXPECT_NE(failures[0].message.find("node 2: its payload takes"), std::string::npos) << failures[0].message;
+  EXPECT_FALSE(pager.residency()[2]);
+  EXPECT_FALSE(pager.payload(2));
+  EXPECT_EQ(pager.reserved_bytes(), pager.resident_bytes());
+}
+
 TEST(StreamPager, NodeLargerThanTheBudgetFailsOnceUnread) {
   const HlodTree t = test::full_octree({.depth = 1});
   ReadLog log;
