@@ -34,16 +34,18 @@ uint8_t kind(uint8_t s) { return s & kKindMask; }
 bool in_cut(uint8_t s) { return (s & kInCut) != 0; }
 
 // The coarsest layer whose error meets E at this (object-space) distance, or -1.
-int wanted_layer(const HlodNode& n, float distance, const HlodView& view, float pixel_error) {
-  const float threshold = hlod_error_threshold(distance, pixel_error, view.focal_px);
+int wanted_layer(const HlodNode& n, float distance, float error_per_distance) {
+  const float threshold = distance * error_per_distance;  // hlod_error_threshold, one multiply
   for (int l = int(n.layer_count) - 1; l >= 0; --l) {
     if (n.layers[l].error <= threshold) return l;
   }
   return -1;
 }
 
+// Screen-space error, pixels: e * scale * focal / d (world distance); huge inside the bounds.
 float sse_of(const HlodCutScratch& s, const HlodNode& n, uint32_t id, uint32_t layer) {
-  return n.layers[layer].error * s.error_scale[id];
+  const float d = s.distance[id];
+  return d > 0 ? n.layers[layer].error * s.sse_numerator / d : n.layers[layer].error * kHuge;
 }
 
 // The view in the tree's object space, so that no node is transformed: with world =
@@ -85,6 +87,8 @@ bool outside(const ObjectView& o, const Sphere& b) {
 // Breadth-first from the root: measure, cull, choose the wanted layer, queue wanted children.
 void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<const uint8_t> resident,
            const ObjectView& o, const HlodView& view, const HlodSelectParams& params) {
+  const float error_per_distance = params.pixel_error / view.focal_px;  // E = d * P / focal
+  s.sse_numerator = view.focal_px * o.scale;
   s.queue.clear();
   s.queue.push_back(0);
   for (size_t head = 0; head < s.queue.size(); ++head) {
@@ -98,13 +102,12 @@ void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<cons
     const float dx = n.bounds.center[0] - o.eye.x, dy = n.bounds.center[1] - o.eye.y, dz = n.bounds.center[2] - o.eye.z;
     const float d = std::max(0.0f, std::sqrt(dx * dx + dy * dy + dz * dz) - n.bounds.radius);  // object space
     s.distance[id] = d * o.scale;
-    s.error_scale[id] = d > 0 ? view.focal_px / d : kHuge;
     if (!resident[id]) {
       s.state[id] = kMissing;
       continue;
     }
     cut.kept.push_back(id);
-    const int l = wanted_layer(n, d, view, params.pixel_error);
+    const int l = wanted_layer(n, d, error_per_distance);
     s.layer[id] = static_cast<uint8_t>(std::max(l, 0));
     if (l >= 0 || n.leaf()) {
       s.state[id] = kDraw;
@@ -368,7 +371,6 @@ bool request_before(const HlodRequest& a, const HlodRequest& b) {
 void prepare_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree) {
   const size_t n = tree.nodes.size();
   s.distance.assign(n, 0);
-  s.error_scale.assign(n, 0);
   s.state.assign(n, 0);
   s.layer.assign(n, 0);
   s.wanted_layer.assign(n, 0);

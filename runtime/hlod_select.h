@@ -101,7 +101,7 @@ struct HlodCut {
 // Per-node scratch, reused frame to frame.
 struct HlodCutScratch {
   std::vector<float> distance;        // world
-  std::vector<float> error_scale;     // sse = e * error_scale: focal * scale / d, huge inside
+  float sse_numerator = 0;            // focal * scale: sse = e * sse_numerator / distance
   std::vector<uint8_t> state;         // detail::HlodNodeState
   std::vector<uint8_t> layer;         // drawn layer
   std::vector<uint8_t> wanted_layer;  // before the budget (refine pass)
