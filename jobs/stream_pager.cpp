@@ -70,11 +70,14 @@ uint64_t payload_bytes(const HlodPayload& p) {
 }  // namespace
 
 StreamPager::StreamPager(const HlodTree& tree, const StreamPagerConfig& config, NodeLoader load)
-    : tree_(tree), config_(config), shared_(std::make_unique<Shared>()) {
+    : StreamPager(node_bytes_of(tree), config, std::move(load)) {}
+
+StreamPager::StreamPager(std::span<const uint64_t> node_bytes, const StreamPagerConfig& config, NodeLoader load)
+    : config_(config), shared_(std::make_unique<Shared>()) {
   config_.loader_threads = std::max(config_.loader_threads, 1u);
   config_.max_in_flight = std::max(config_.max_in_flight, 1u);
-  init_stream_residency(state_, tree, config_.budget_bytes);
-  const size_t n = tree.nodes.size();
+  init_stream_residency(state_, node_bytes, config_.budget_bytes);
+  const size_t n = node_bytes.size();
   payloads_.resize(n);
   update_.loaded.reserve(n);
   update_.evicted.reserve(n);

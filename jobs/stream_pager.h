@@ -1,4 +1,5 @@
-// StreamPager: the out-of-core loader of one HLOD tree. A few loader threads read node payloads
+// StreamPager: the out-of-core loader of HLOD nodes (one tree's, or several trees' numbered one
+// after another, sharing one budget: jobs/hlod_stream). A few loader threads read node payloads
 // through a callback, in the cut's priority order, under a byte budget; the per-frame side
 // (update) never waits on I/O: it takes in what finished, drops what is no longer wanted,
 // evicts least-recently-used nodes the cut does not use, and hands out new reads.
@@ -58,7 +59,10 @@ struct StreamUpdate {
 
 class StreamPager {
  public:
-  // `tree` must outlive the pager. Starts the loader threads.
+  // Nodes 0..node_bytes.size() - 1, each taking node_bytes[i] once resident (its
+  // HlodNode::resident_bytes). Starts the loader threads.
+  StreamPager(std::span<const uint64_t> node_bytes, const StreamPagerConfig& config, NodeLoader load);
+  // One tree's nodes.
   StreamPager(const HlodTree& tree, const StreamPagerConfig& config, NodeLoader load);
   // Stops the loaders; waits for reads in progress (their results are discarded).
   ~StreamPager();
@@ -84,7 +88,6 @@ class StreamPager {
   void take_completions(uint64_t frame);
   void requeue(uint64_t frame, std::span<const HlodRequest> wanted);
 
-  const HlodTree& tree_;
   StreamPagerConfig config_;
   StreamResidency state_;
   std::vector<std::shared_ptr<const HlodPayload>> payloads_;

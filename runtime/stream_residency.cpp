@@ -46,12 +46,21 @@ void end_loading(StreamResidency& s, Node n, NodeLoad to) {
 
 }  // namespace
 
+std::vector<uint64_t> node_bytes_of(const HlodTree& tree) {
+  std::vector<uint64_t> b(tree.nodes.size());
+  for (size_t i = 0; i < b.size(); ++i) b[i] = tree.nodes[i].resident_bytes;
+  return b;
+}
+
 void init_stream_residency(StreamResidency& s, const HlodTree& tree, uint64_t budget_bytes) {
-  const size_t n = tree.nodes.size();
+  init_stream_residency(s, node_bytes_of(tree), budget_bytes);
+}
+
+void init_stream_residency(StreamResidency& s, std::span<const uint64_t> node_bytes, uint64_t budget_bytes) {
+  const size_t n = node_bytes.size();
   s.resident.assign(n, 0);
   s.load.assign(n, uint8_t(NodeLoad::absent));
-  s.bytes.resize(n);
-  for (size_t i = 0; i < n; ++i) s.bytes[i] = tree.nodes[i].resident_bytes;
+  s.bytes.assign(node_bytes.begin(), node_bytes.end());
   s.last_used.assign(n, UINT64_MAX);
   s.wanted_in.assign(n, UINT64_MAX);
   s.rank.assign(n, 0);

@@ -53,7 +53,13 @@ struct StreamResidency {
   static constexpr uint32_t kNone = UINT32_MAX;
 };
 
+// Over any flat node space: one entry of `node_bytes` per node (several trees can share one
+// residency, their nodes numbered one after another).
+void init_stream_residency(StreamResidency& s, std::span<const uint64_t> node_bytes, uint64_t budget_bytes);
 void init_stream_residency(StreamResidency& s, const HlodTree& tree, uint64_t budget_bytes);
+
+// The nodes' resident_bytes, by id.
+std::vector<uint64_t> node_bytes_of(const HlodTree& tree);
 
 // Marks this frame: `in_use` nodes move to the most-recently-used end, `wanted` nodes get
 // their rank (index) for this frame.
