@@ -1,6 +1,7 @@
 // HLOD cut selection (R1 3.3): one breadth-first visit of the wanted cut, one pass deciding
 // which wanted openings the children's residency allows, one top-down pass emitting the cut,
-// then R0-style undoing under the budget with a min-heap of screen-space errors.
+// then, over the budget, R0-style undoing (a min-heap of screen-space errors) or the same
+// steps refining from the root (a max-heap).
 #include "runtime/hlod_select.h"
 
 #include <algorithm>
@@ -27,7 +28,7 @@ enum : uint8_t {
   kKindMask = 0x0f,
   kInCut = 0x10,       // its parent is opened and in the cut (or it is the root)
   kCovered = 0x20,     // some ancestor is drawn in the cut
-  kWantedOpen = 0x40,  // opened in the cut before the budget (the refining pass's target)
+  kOpenBeforeBudget = 0x40,  // opened in the wanted cut (the refining pass's target)
 };
 
 uint8_t kind(uint8_t s) { return s & kKindMask; }
@@ -274,7 +275,7 @@ bool next_refine(const HlodCutScratch& s, const HlodTree& tree, uint32_t id, flo
     *delta = int64_t(n.layers[l - 1].triangles) - int64_t(n.layers[l].triangles);
     return true;
   }
-  if (l != 0 || !(s.state[id] & kWantedOpen) || kind(s.state[id]) != kDraw) return false;
+  if (l != 0 || !(s.state[id] & kOpenBeforeBudget) || kind(s.state[id]) != kDraw) return false;
   *sse = sse_of(s, n, id, 0);
   *delta = int64_t(n.boundary_triangles) - int64_t(n.layers[0].triangles);
   for (uint32_t k = 0; k < n.child_count; ++k) {
@@ -305,7 +306,7 @@ void refine_to_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uin
   for (uint32_t id : s.queue) {
     uint8_t& st = s.state[id];
     if (in_cut(st) && kind(st) == kDraw) wanted_steps += tree.nodes[id].layer_count - 1u - s.layer[id];
-    if (in_cut(st) && kind(st) == kOpened) wanted_steps += tree.nodes[id].layer_count, st |= kWantedOpen;
+    if (in_cut(st) && kind(st) == kOpened) wanted_steps += tree.nodes[id].layer_count, st |= kOpenBeforeBudget;
     s.wanted_layer[id] = s.layer[id];
     st &= uint8_t(~kInCut);
   }
