@@ -29,6 +29,7 @@ enum : uint8_t {
   kInCut = 0x10,       // its parent is opened and in the cut (or it is the root)
   kCovered = 0x20,     // some ancestor is drawn in the cut
   kOpenBeforeBudget = 0x40,  // opened in the wanted cut (the refining pass's target)
+  kOutside = 0x80,           // outside the frustum, covered (HlodCulledNodes::cover)
 };
 
 uint8_t kind(uint8_t s) { return s & kKindMask; }
@@ -95,7 +96,8 @@ void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<cons
   for (size_t head = 0; head < s.queue.size(); ++head) {
     const uint32_t id = s.queue[head];
     const HlodNode& n = tree.nodes[id];
-    if (outside(o, n.bounds)) {
+    const bool out = outside(o, n.bounds);
+    if (out && (id == 0 || params.culled == HlodCulledNodes::skip)) {
       s.state[id] = kCulled;
       cut.culled.push_back(id);
       continue;
@@ -103,6 +105,12 @@ void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<cons
     const float dx = n.bounds.center[0] - o.eye.x, dy = n.bounds.center[1] - o.eye.y, dz = n.bounds.center[2] - o.eye.z;
     const float d = std::max(0.0f, std::sqrt(dx * dx + dy * dy + dz * dz) - n.bounds.radius);  // object space
     s.distance[id] = d * o.scale;
+    if (out) {  // covered: drawn at its coarsest, never opened; requested last when missing
+      s.state[id] = resident[id] ? uint8_t(kDraw | kOutside) : uint8_t(kMissing | kOutside);
+      s.layer[id] = uint8_t(n.layer_count - 1);
+      if (resident[id]) cut.kept.push_back(id);
+      continue;
+    }
     if (!resident[id]) {
       s.state[id] = kMissing;
       continue;
@@ -146,8 +154,9 @@ void emit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, const HlodSelec
     }
     s.state[id] = st;
     if (kind(st) == kMissing) {
-      const float deficit =
-          n.parent < 0 ? kHuge : sse_of(s, tree.nodes[n.parent], uint32_t(n.parent), 0) - params.pixel_error;
+      const float deficit = n.parent < 0   ? kHuge
+                            : st & kOutside ? -kHuge  // invisible: after every visible request
+                                            : sse_of(s, tree.nodes[n.parent], uint32_t(n.parent), 0) - params.pixel_error;
       cut.requests.push_back({id, deficit, s.distance[id]});
       if (!(st & kCovered)) ++cut.holes;
     }

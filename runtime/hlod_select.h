@@ -16,6 +16,8 @@
 //   - a node outside the frustum is *culled*: nothing of it is drawn, requested or opened
 //     (Cesium does the same). Its bounds lie wholly outside one frustum plane, so no visible
 //     pixel is left uncovered; `culled` lists them for validators that check closed cuts.
+//     With HlodCulledNodes::cover a non-root node outside is instead drawn at its coarsest
+//     layer, requested last, and waited for like a visible child: a closed cut.
 //   - a visible node that is not resident is *requested*; its parent stays drawn.
 //   - a visible resident node *wants* its coarsest layer with e <= E; a leaf with none wants
 //     its finest; an inner node with none wants to open. It is *opened* only when every
@@ -62,10 +64,21 @@ enum class HlodBudgetPass : uint8_t {
   refine,     // from the root at its coarsest, refine the largest-error step first
 };
 
+// What becomes of a non-root node outside the frustum.
+enum class HlodCulledNodes : uint8_t {
+  skip,   // culled: nothing drawn or requested, no opening waits for it (Cesium)
+  // Covered: drawn at its coarsest layer (never opened), requested after every visible node
+  // when missing, and its parent opens only once it is resident, like a visible child. The
+  // whole cut stays closed (every boundary edge shared by two drawn triangles), for
+  // validation, shadow views or a camera that turns fast, at the price of invisible triangles.
+  cover,
+};
+
 struct HlodSelectParams {
   float pixel_error = 1;                   // P, pixels
   uint64_t triangle_budget = UINT64_MAX;   // this cut's share of M
   HlodBudgetPass budget_pass = HlodBudgetPass::automatic;
+  HlodCulledNodes culled = HlodCulledNodes::skip;
 };
 
 struct HlodDraw {
@@ -77,7 +90,8 @@ struct HlodDraw {
 // then the nearest.
 struct HlodRequest {
   uint32_t node;
-  float deficit;    // pixels: screen-space error shown in its place (its parent's finest layer) - P
+  float deficit;    // pixels: screen-space error shown in its place (its parent's finest layer) - P;
+                    // -FLT_MAX for a covered node outside the frustum, FLT_MAX for the root
   float distance;   // eye to its world bounds
 };
 // True when a is loaded before b (larger deficit, then nearer, then lower id).
@@ -86,7 +100,7 @@ bool request_before(const HlodRequest& a, const HlodRequest& b);
 struct HlodCut {
   std::vector<HlodDraw> drawn;        // breadth-first order
   std::vector<uint32_t> opened;       // their boundary patches are drawn
-  std::vector<uint32_t> culled;       // visited and outside the frustum
+  std::vector<uint32_t> culled;       // visited, outside the frustum, not covered
   std::vector<HlodRequest> requests;  // sorted by request_before
   // Resident nodes the cut visited (drawn, opened, or waiting for a sibling): what streaming
   // must keep. Ids in visiting order.

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -31,6 +32,7 @@ struct RefInputs {
   View view;
   float pixel_error;
   bool cull;
+  HlodCulledNodes culled = HlodCulledNodes::skip;
 };
 
 glm::vec3 ref_world_center(const RefInputs& in, const HlodNode& n) {
@@ -81,7 +83,13 @@ int ref_wanted_layer(const RefInputs& in, const HlodNode& n, bool* borderline) {
 void ref_visit(const RefInputs& in, uint32_t id, bool in_cut, RefCut& out) {
   const HlodNode& n = in.tree.nodes[id];
   if (!ref_visible(in, n, &out.borderline)) {
-    out.culled.insert(id);
+    if (id == 0 || in.culled == HlodCulledNodes::skip) {
+      out.culled.insert(id);
+    } else if (!in.resident[id]) {
+      out.requested.insert(id);
+    } else if (in_cut) {
+      out.drawn[id] = n.layer_count - 1u;  // covered at its coarsest
+    }
     return;
   }
   if (!in.resident[id]) {
@@ -96,7 +104,8 @@ void ref_visit(const RefInputs& in, uint32_t id, bool in_cut, RefCut& out) {
   bool can_open = true;
   for (uint32_t k = 0; k < n.child_count; ++k) {
     const uint32_t c = n.first_child + k;
-    if (ref_visible(in, in.tree.nodes[c], &out.borderline) && !in.resident[c]) can_open = false;
+    const bool counts = in.culled == HlodCulledNodes::cover || ref_visible(in, in.tree.nodes[c], &out.borderline);
+    if (counts && !in.resident[c]) can_open = false;
   }
   for (uint32_t k = 0; k < n.child_count; ++k) ref_visit(in, n.first_child + k, in_cut && can_open, out);
   if (in_cut && can_open) out.opened.insert(id);
@@ -117,10 +126,10 @@ struct Selector {
   explicit Selector(const HlodTree& t) { prepare_hlod_cut(cut, scratch, t); }
   const HlodCut& run(const HlodTree& t, const std::vector<uint8_t>& resident, const Transform& tr, const View& v,
                      float pixel_error, bool cull = true, uint64_t budget = UINT64_MAX,
-                     HlodBudgetPass pass = HlodBudgetPass::automatic) {
+                     HlodBudgetPass pass = HlodBudgetPass::automatic, HlodCulledNodes culled = HlodCulledNodes::skip) {
     HlodView hv = hlod_view_of(v);
     hv.cull = cull;
-    select_hlod_cut(cut, scratch, t, resident, tr, hv, {pixel_error, budget, pass});
+    select_hlod_cut(cut, scratch, t, resident, tr, hv, {pixel_error, budget, pass, culled});
     return cut;
   }
 };
@@ -237,8 +246,9 @@ TEST(HlodSelect, EqualsRecursiveReferenceOnRandomTreesAndViews) {
       const auto resident = random_residency(t.nodes.size(), rng, k % 3 == 0 ? 100 : 85);
       const float p = 0.5f + float(rng() % 8);
       const bool cull = k % 4 != 0;
-      const HlodCut& cut = sel.run(t, resident, tr, v, p, cull);
-      const RefCut ref = reference_cut({t, resident, tr, v, p, cull});
+      const HlodCulledNodes culled = k % 2 ? HlodCulledNodes::cover : HlodCulledNodes::skip;
+      const HlodCut& cut = sel.run(t, resident, tr, v, p, cull, UINT64_MAX, HlodBudgetPass::automatic, culled);
+      const RefCut ref = reference_cut({t, resident, tr, v, p, cull, culled});
       if (ref.borderline) continue;
       ++compared;
       opened += ref.opened.size();
@@ -259,7 +269,7 @@ TEST(HlodSelect, EqualsRecursiveReferenceOnRandomTreesAndViews) {
   // The views open, request and cull a fair share (the comparison is not between empty cuts).
   EXPECT_GT(opened, size_t(compared) * 3);
   EXPECT_GT(requested_total, size_t(compared));
-  EXPECT_GT(culled_total, size_t(compared));
+  EXPECT_GT(culled_total, size_t(compared) / 4);  // skip-mode views only
   std::printf("compared %d cuts: %zu opened, %zu requested, %zu culled\n", compared, opened, requested_total, culled_total);
 }
 
@@ -274,6 +284,59 @@ TEST(HlodSelect, NeverAHoleWithRandomResidency) {
       const HlodCut& cut = sel.run(t, resident, random_transform(rng), random_view(rng), 1.0f, k % 2 == 0);
       EXPECT_EQ(cut.holes, 0u);
       expect_closed_cut(t, cut, resident);
+    }
+  }
+}
+
+TEST(HlodSelect, CoverModeKeepsTheWholeCutClosed) {
+  // Every root-to-leaf path ends at a drawn node (none at a culled one) once the root is in
+  // view, whatever is resident: the cut a crack checker can test edge by edge.
+  std::mt19937 rng(17);
+  int with_outside = 0;
+  for (uint32_t seed = 1; seed <= 30; ++seed) {
+    const HlodTree t = test::random_octree(seed + 500);
+    Selector sel(t);
+    for (int k = 0; k < 20; ++k) {
+      auto resident = random_residency(t.nodes.size(), rng, 30 + 10 * uint32_t(k % 7));
+      resident[0] = 1;
+      const HlodCut& cut = sel.run(t, resident, random_transform(rng), random_view(rng), 1.0f, true, UINT64_MAX,
+                                   HlodBudgetPass::automatic, HlodCulledNodes::cover);
+      if (!cut.culled.empty()) {
+        EXPECT_EQ(cut.culled, std::vector<uint32_t>{0});  // only a root out of view is culled
+        continue;
+      }
+      EXPECT_EQ(cut.holes, 0u);
+      expect_closed_cut(t, cut, resident);
+      for (size_t i = 1; i < cut.requests.size(); ++i) EXPECT_TRUE(request_before(cut.requests[i - 1], cut.requests[i]));
+      with_outside += std::any_of(cut.requests.begin(), cut.requests.end(), [](auto& r) { return r.deficit < -1e30f; });
+    }
+  }
+  EXPECT_GT(with_outside, 20);  // covered nodes outside the view were requested, last
+}
+
+TEST(HlodSelect, CoverModeWaitsForChildrenOutsideTheView) {
+  const HlodTree t = test::full_octree({.depth = 1});
+  Selector sel(t);
+  std::vector<uint8_t> resident(t.nodes.size(), 1);
+  View v = looking_at({40, 0, 0}, {200, 0, 0});  // the -x children (ids 1, 3, 5, 7) are behind
+  v.fov_y_deg = 20;
+  v.near_plane = 1;
+  resident[3] = 0;
+  const HlodCut& waiting = sel.run(t, resident, {}, v, 0.01f, true, UINT64_MAX, HlodBudgetPass::automatic,
+                                   HlodCulledNodes::cover);
+  ASSERT_EQ(waiting.drawn.size(), 1u);  // the root, until node 3 is in
+  EXPECT_EQ(waiting.drawn[0].node, 0u);
+  ASSERT_EQ(waiting.requests.size(), 1u);
+  EXPECT_EQ(waiting.requests[0].node, 3u);
+  resident[3] = 1;
+  const HlodCut& cut = sel.run(t, resident, {}, v, 0.01f, true, UINT64_MAX, HlodBudgetPass::automatic,
+                               HlodCulledNodes::cover);
+  EXPECT_EQ(cut.opened.size(), 1u);
+  EXPECT_EQ(cut.drawn.size(), 8u);
+  EXPECT_TRUE(cut.culled.empty());
+  for (const HlodDraw& d : cut.drawn) {
+    if ((d.node - 1) % 2 == 0) {
+      EXPECT_EQ(d.layer, 2u) << "behind, drawn coarsest: " << d.node;
     }
   }
 }
@@ -412,10 +475,12 @@ void budget_never_exceeded(HlodBudgetPass pass) {
       resident[0] = 1;
       const View v = random_view(rng);
       const Transform tr = random_transform(rng);
-      const uint64_t wanted = sel.run(t, resident, tr, v, 0.5f).wanted_triangles;
+      const HlodCulledNodes culled = k % 2 ? HlodCulledNodes::cover : HlodCulledNodes::skip;
+      const uint64_t wanted =
+          sel.run(t, resident, tr, v, 0.5f, true, UINT64_MAX, HlodBudgetPass::automatic, culled).wanted_triangles;
       const uint64_t smallest = root.layers[root.layer_count - 1].triangles;
       const uint64_t budget = smallest + uint64_t(rng() % (wanted + 1));
-      const HlodCut& cut = sel.run(t, resident, tr, v, 0.5f, true, budget, pass);
+      const HlodCut& cut = sel.run(t, resident, tr, v, 0.5f, true, budget, pass, culled);
       EXPECT_EQ(cut.wanted_triangles, wanted);
       EXPECT_LE(cut.triangles, budget) << "seed " << seed << " view " << k;
       EXPECT_FALSE(cut.over_budget);
