@@ -41,18 +41,21 @@ HlodStream::HlodStream(std::vector<HlodTree> trees, const StreamPagerConfig& con
         return of;
       }()),
       load_(std::move(load)),
-      pager_(bytes_of(models_), config, [this](uint32_t node, HlodPayload& out) { return load_node(node, out); }) {
+      pager_(bytes_of(models_), config,
+             [this](uint32_t node, HlodPayload& out) { return load_node(node, out); }) {
   wanted_.reserve(model_of_.size());
   in_use_.reserve(model_of_.size());
 }
 
 HlodStream::HlodStream(HlodTree tree, const StreamPagerConfig& config, NodeLoader load)
-    : HlodStream([&] {
-        std::vector<HlodTree> one;
-        one.push_back(std::move(tree));
-        return one;
-      }(),
-                 config, [load = std::move(load)](uint32_t, uint32_t node, HlodPayload& out) { return load(node, out); }) {}
+    : HlodStream(
+          [&] {
+            std::vector<HlodTree> one;
+            one.push_back(std::move(tree));
+            return one;
+          }(),
+          config,
+          [load = std::move(load)](uint32_t, uint32_t node, HlodPayload& out) { return load(node, out); }) {}
 
 std::span<const uint8_t> HlodStream::residency(uint32_t model) const {
   return pager_.residency().subspan(models_[model].first, models_[model].tree.nodes.size());
@@ -64,8 +67,10 @@ void HlodStream::frame(uint64_t frame, const HlodView& view, std::span<const Hlo
   in_use_.clear();
   for (uint32_t m = 0; m < models_.size(); ++m) {
     Model& model = models_[m];
-    select_hlod_cut(model.cut, model.scratch, model.tree, residency(m), inputs[m].transform, view, inputs[m].params);
-    for (const HlodRequest& r : model.cut.requests) wanted_.push_back({r.node + model.first, r.deficit, r.distance});
+    select_hlod_cut(model.cut, model.scratch, model.tree, residency(m), inputs[m].transform, view,
+                    inputs[m].params);
+    for (const HlodRequest& r : model.cut.requests)
+      wanted_.push_back({r.node + model.first, r.deficit, r.distance});
     for (const uint32_t k : model.cut.kept) in_use_.push_back(k + model.first);
   }
   // One priority order across models (each cut's requests are already in it).

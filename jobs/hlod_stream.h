@@ -34,14 +34,14 @@ struct HlodModelInput {
 // The figures `lod run --json` reports per frame, summed over the models.
 struct HlodStreamFigures {
   uint32_t hlod_nodes_drawn = 0;
-  uint64_t hlod_triangles = 0;   // drawn layers + opened boundaries
+  uint64_t hlod_triangles = 0;  // drawn layers + opened boundaries
   uint64_t resident_bytes = 0;
   uint64_t stream_requests = 0;  // loads issued so far
   uint64_t stream_loads = 0;     // completed so far
   uint64_t stream_failures = 0;
   uint64_t stream_evictions = 0;
-  uint32_t holes = 0;            // requested nodes with no drawn ancestor (only missing roots)
-  uint32_t wanted = 0;           // this frame's requests
+  uint32_t holes = 0;   // requested nodes with no drawn ancestor (only missing roots)
+  uint32_t wanted = 0;  // this frame's requests
 };
 
 class HlodStream {

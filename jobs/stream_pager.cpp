@@ -25,9 +25,9 @@ struct StreamPager::Shared {
   NodeLoader load;
   std::mutex mutex;
   std::condition_variable wake;
-  std::vector<uint32_t> queue;   // issued, unread; back() is the most important
-  std::vector<Completion> done;  // filled by the loaders, swapped out by update
-  std::vector<Completion> taken; // the frame thread's side of the swap (keeps its capacity)
+  std::vector<uint32_t> queue;    // issued, unread; back() is the most important
+  std::vector<Completion> done;   // filled by the loaders, swapped out by update
+  std::vector<Completion> taken;  // the frame thread's side of the swap (keeps its capacity)
   bool stop = false;
   std::vector<std::thread> threads;
 };
@@ -59,7 +59,9 @@ void loader_loop(StreamPager::Shared& sh) {
   }
 }
 
-std::string node_message(uint32_t node, const std::string& why) { return "node " + std::to_string(node) + ": " + why; }
+std::string node_message(uint32_t node, const std::string& why) {
+  return "node " + std::to_string(node) + ": " + why;
+}
 
 // What a payload takes in memory, counted as HlodNode::resident_bytes counts it (positions,
 // normals, indices).
@@ -72,7 +74,8 @@ uint64_t payload_bytes(const HlodPayload& p) {
 StreamPager::StreamPager(const HlodTree& tree, const StreamPagerConfig& config, NodeLoader load)
     : StreamPager(node_bytes_of(tree), config, std::move(load)) {}
 
-StreamPager::StreamPager(std::span<const uint64_t> node_bytes, const StreamPagerConfig& config, NodeLoader load)
+StreamPager::StreamPager(std::span<const uint64_t> node_bytes, const StreamPagerConfig& config,
+                         NodeLoader load)
     : config_(config), shared_(std::make_unique<Shared>()) {
   config_.loader_threads = std::max(config_.loader_threads, 1u);
   config_.max_in_flight = std::max(config_.max_in_flight, 1u);
@@ -91,7 +94,8 @@ StreamPager::StreamPager(std::span<const uint64_t> node_bytes, const StreamPager
   shared_->queue.reserve(config_.max_in_flight);
   shared_->done.reserve(config_.max_in_flight);
   shared_->taken.reserve(config_.max_in_flight);
-  for (uint32_t i = 0; i < config_.loader_threads; ++i) shared_->threads.emplace_back(loader_loop, std::ref(*shared_));
+  for (uint32_t i = 0; i < config_.loader_threads; ++i)
+    shared_->threads.emplace_back(loader_loop, std::ref(*shared_));
 }
 
 StreamPager::~StreamPager() {
@@ -114,7 +118,8 @@ void StreamPager::take_completions(uint64_t frame) {
     // source) would break it, so it is refused like any bad node.
     if (c.status.ok && payload_bytes(*c.payload) > state_.bytes[c.node]) {
       c.status = Status::error("its payload takes " + std::to_string(payload_bytes(*c.payload)) +
-                               " bytes, more than the " + std::to_string(state_.bytes[c.node]) + " its node records");
+                               " bytes, more than the " + std::to_string(state_.bytes[c.node]) +
+                               " its node records");
     }
     if (c.status.ok) {
       stream_loaded(state_, c.node, frame);
@@ -148,15 +153,16 @@ void StreamPager::requeue(uint64_t frame, std::span<const HlodRequest> wanted) {
     too_large_.assign(too_large_buf_.begin(), too_large_buf_.begin() + plan.too_large);
     sh.queue.insert(sh.queue.end(), update_.issued.begin(), update_.issued.end());
     // This frame's priorities: the best (lowest rank) at the back, where loaders take.
-    std::sort(sh.queue.begin(), sh.queue.end(), [&](uint32_t a, uint32_t b) { return state_.rank[a] > state_.rank[b]; });
+    std::sort(sh.queue.begin(), sh.queue.end(),
+              [&](uint32_t a, uint32_t b) { return state_.rank[a] > state_.rank[b]; });
   }
   // One loader per new node: waking them all would only have them compete for the cores.
   for (size_t i = 0; i < update_.issued.size(); ++i) sh.wake.notify_one();
   for (uint32_t n : update_.evicted) payloads_[n].reset();
   for (uint32_t n : too_large_) {
-    update_.failures.push_back({n, node_message(n, "needs " + std::to_string(state_.bytes[n]) +
-                                                       " bytes, more than the stream budget of " +
-                                                       std::to_string(state_.budget))});
+    update_.failures.push_back(
+        {n, node_message(n, "needs " + std::to_string(state_.bytes[n]) +
+                                " bytes, more than the stream budget of " + std::to_string(state_.budget))});
   }
 }
 

@@ -30,9 +30,9 @@
 namespace lod {
 
 struct StreamPagerConfig {
-  uint32_t loader_threads = 2;              // [stream] loader_threads
-  uint64_t budget_bytes = 64ull << 20;      // [stream] budget_mb
-  uint32_t max_in_flight = 8;               // queued + being read
+  uint32_t loader_threads = 2;          // [stream] loader_threads
+  uint64_t budget_bytes = 64ull << 20;  // [stream] budget_mb
+  uint32_t max_in_flight = 8;           // queued + being read
 };
 
 // Reads one node's payload (any source: a .hlod file, memory, the network). Called on the
@@ -50,10 +50,10 @@ struct StreamFailure {
 
 // What one update changed; valid until the next update.
 struct StreamUpdate {
-  std::vector<uint32_t> loaded;     // now resident
-  std::vector<uint32_t> evicted;    // no longer resident
-  std::vector<uint32_t> dropped;    // queued, no longer wanted, never read
-  std::vector<uint32_t> issued;     // handed to the loaders
+  std::vector<uint32_t> loaded;         // now resident
+  std::vector<uint32_t> evicted;        // no longer resident
+  std::vector<uint32_t> dropped;        // queued, no longer wanted, never read
+  std::vector<uint32_t> issued;         // handed to the loaders
   std::vector<StreamFailure> failures;  // each failing node once, ever
 };
 
@@ -71,7 +71,8 @@ class StreamPager {
 
   // Once per frame, after the cut: `wanted` = cut.requests (priority order), `in_use` =
   // cut.kept (never evicted this frame). Frames must increase.
-  const StreamUpdate& update(uint64_t frame, std::span<const HlodRequest> wanted, std::span<const uint32_t> in_use);
+  const StreamUpdate& update(uint64_t frame, std::span<const HlodRequest> wanted,
+                             std::span<const uint32_t> in_use);
 
   // Frame-thread views, changed only by update.
   std::span<const uint8_t> residency() const { return state_.resident; }

@@ -21,13 +21,13 @@ constexpr float kHuge = std::numeric_limits<float>::max();
 // Low bits: what the visit decided; high bits: where the node stands in the emitted cut.
 enum : uint8_t {
   kCulled = 1,
-  kMissing = 2,    // visible, not resident: requested
-  kDraw = 3,       // drawn at scratch.layer (if in the cut)
-  kWantOpen = 4,   // no layer is fine enough; resolved to kOpened or kDraw
+  kMissing = 2,   // visible, not resident: requested
+  kDraw = 3,      // drawn at scratch.layer (if in the cut)
+  kWantOpen = 4,  // no layer is fine enough; resolved to kOpened or kDraw
   kOpened = 5,
   kKindMask = 0x0f,
-  kInCut = 0x10,       // its parent is opened and in the cut (or it is the root)
-  kCovered = 0x20,     // some ancestor is drawn in the cut
+  kInCut = 0x10,             // its parent is opened and in the cut (or it is the root)
+  kCovered = 0x20,           // some ancestor is drawn in the cut
   kOpenBeforeBudget = 0x40,  // opened in the wanted cut (the refining pass's target)
   kOutside = 0x80,           // outside the frustum, covered (HlodCulledNodes::cover)
 };
@@ -102,7 +102,8 @@ void visit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<cons
       cut.culled.push_back(id);
       continue;
     }
-    const float dx = n.bounds.center[0] - o.eye.x, dy = n.bounds.center[1] - o.eye.y, dz = n.bounds.center[2] - o.eye.z;
+    const float dx = n.bounds.center[0] - o.eye.x, dy = n.bounds.center[1] - o.eye.y,
+                dz = n.bounds.center[2] - o.eye.z;
     const float d = std::max(0.0f, std::sqrt(dx * dx + dy * dy + dz * dz) - n.bounds.radius);  // object space
     s.distance[id] = d * o.scale;
     if (out) {  // covered: drawn at its coarsest, never opened; requested last when missing
@@ -154,9 +155,10 @@ void emit(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, const HlodSelec
     }
     s.state[id] = st;
     if (kind(st) == kMissing) {
-      const float deficit = n.parent < 0   ? kHuge
-                            : st & kOutside ? -kHuge  // invisible: after every visible request
-                                            : sse_of(s, tree.nodes[n.parent], uint32_t(n.parent), 0) - params.pixel_error;
+      const float deficit = n.parent < 0 ? kHuge
+                            : st & kOutside
+                                ? -kHuge  // invisible: after every visible request
+                                : sse_of(s, tree.nodes[n.parent], uint32_t(n.parent), 0) - params.pixel_error;
       cut.requests.push_back({id, deficit, s.distance[id]});
       if (!(st & kCovered)) ++cut.holes;
     }
@@ -315,7 +317,8 @@ void refine_to_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uin
   for (uint32_t id : s.queue) {
     uint8_t& st = s.state[id];
     if (in_cut(st) && kind(st) == kDraw) wanted_steps += tree.nodes[id].layer_count - 1u - s.layer[id];
-    if (in_cut(st) && kind(st) == kOpened) wanted_steps += tree.nodes[id].layer_count, st |= kOpenBeforeBudget;
+    if (in_cut(st) && kind(st) == kOpened)
+      wanted_steps += tree.nodes[id].layer_count, st |= kOpenBeforeBudget;
     s.wanted_layer[id] = s.layer[id];
     st &= uint8_t(~kInCut);
   }
@@ -328,7 +331,7 @@ void refine_to_budget(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, uin
     const uint32_t id = key_node(s.heap.front());
     float sse = 0;
     int64_t delta = 0;
-    next_refine(s, tree, id, &sse, &delta);  // always true: one live entry per node
+    next_refine(s, tree, id, &sse, &delta);          // always true: one live entry per node
     if (triangles + delta > int64_t(budget)) break;  // the undoing pass would stop here too
     std::pop_heap(s.heap.begin(), s.heap.end(), RefineBefore{});
     s.heap.pop_back();
@@ -392,8 +395,9 @@ void prepare_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree) {
   cut.requests.reserve(n);
 }
 
-uint32_t select_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, std::span<const uint8_t> resident,
-                         const Transform& transform, const HlodView& view, const HlodSelectParams& params) {
+uint32_t select_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree,
+                         std::span<const uint8_t> resident, const Transform& transform, const HlodView& view,
+                         const HlodSelectParams& params) {
   cut.drawn.clear();
   cut.opened.clear();
   cut.culled.clear();
@@ -410,8 +414,9 @@ uint32_t select_hlod_cut(HlodCut& cut, HlodCutScratch& s, const HlodTree& tree, 
   cut.wanted_triangles = cut.triangles;
   if (cut.triangles > params.triangle_budget) {
     // The pass with fewer steps: undo when the cut is less than twice the budget.
-    const bool refine = params.budget_pass == HlodBudgetPass::refine ||
-                        (params.budget_pass == HlodBudgetPass::automatic && cut.triangles / 2 > params.triangle_budget);
+    const bool refine =
+        params.budget_pass == HlodBudgetPass::refine ||
+        (params.budget_pass == HlodBudgetPass::automatic && cut.triangles / 2 > params.triangle_budget);
     if (refine) {
       refine_to_budget(cut, s, tree, params.triangle_budget);
     } else {

@@ -49,9 +49,9 @@ namespace lod {
 
 struct HlodView {
   glm::vec3 eye{0, 0, 0};
-  float focal_px = 1;   // (H / 2) / tan(fovy / 2), focal_pixels(view)
+  float focal_px = 1;  // (H / 2) / tan(fovy / 2), focal_pixels(view)
   Frustum frustum{};
-  bool cull = true;     // false: every node counts as inside the frustum
+  bool cull = true;  // false: every node counts as inside the frustum
 };
 HlodView hlod_view_of(const View& v);
 
@@ -66,7 +66,7 @@ enum class HlodBudgetPass : uint8_t {
 
 // What becomes of a non-root node outside the frustum.
 enum class HlodCulledNodes : uint8_t {
-  skip,   // culled: nothing drawn or requested, no opening waits for it (Cesium)
+  skip,  // culled: nothing drawn or requested, no opening waits for it (Cesium)
   // Covered: drawn at its coarsest layer (never opened), requested after every visible node
   // when missing, and its parent opens only once it is resident, like a visible child. The
   // whole cut stays closed (every boundary edge shared by two drawn triangles), for
@@ -75,8 +75,8 @@ enum class HlodCulledNodes : uint8_t {
 };
 
 struct HlodSelectParams {
-  float pixel_error = 1;                   // P, pixels
-  uint64_t triangle_budget = UINT64_MAX;   // this cut's share of M
+  float pixel_error = 1;                  // P, pixels
+  uint64_t triangle_budget = UINT64_MAX;  // this cut's share of M
   HlodBudgetPass budget_pass = HlodBudgetPass::automatic;
   HlodCulledNodes culled = HlodCulledNodes::skip;
 };
@@ -90,9 +90,9 @@ struct HlodDraw {
 // then the nearest.
 struct HlodRequest {
   uint32_t node;
-  float deficit;    // pixels: screen-space error shown in its place (its parent's finest layer) - P;
-                    // -FLT_MAX for a covered node outside the frustum, FLT_MAX for the root
-  float distance;   // eye to its world bounds
+  float deficit;   // pixels: screen-space error shown in its place (its parent's finest layer) - P;
+                   // -FLT_MAX for a covered node outside the frustum, FLT_MAX for the root
+  float distance;  // eye to its world bounds
 };
 // True when a is loaded before b (larger deficit, then nearer, then lower id).
 bool request_before(const HlodRequest& a, const HlodRequest& b);
@@ -105,23 +105,23 @@ struct HlodCut {
   // Resident nodes the cut visited (drawn, opened, or waiting for a sibling): what streaming
   // must keep. Ids in visiting order.
   std::vector<uint32_t> kept;
-  uint64_t triangles = 0;             // drawn layers + opened boundaries, after the budget
-  uint64_t wanted_triangles = 0;      // the same before the budget
-  uint32_t undone = 0;                // refinements the budget undid
-  uint32_t holes = 0;                 // requested nodes with no drawn ancestor (only a missing root)
-  bool over_budget = false;           // the smallest cut still exceeds the budget
+  uint64_t triangles = 0;         // drawn layers + opened boundaries, after the budget
+  uint64_t wanted_triangles = 0;  // the same before the budget
+  uint32_t undone = 0;            // refinements the budget undid
+  uint32_t holes = 0;             // requested nodes with no drawn ancestor (only a missing root)
+  bool over_budget = false;       // the smallest cut still exceeds the budget
 };
 
 // Per-node scratch, reused frame to frame.
 struct HlodCutScratch {
-  std::vector<float> distance;        // world
-  float sse_numerator = 0;            // focal * scale: sse = e * sse_numerator / distance
-  std::vector<uint8_t> state;         // detail::HlodNodeState
-  std::vector<uint8_t> layer;         // drawn layer
-  std::vector<uint8_t> wanted_layer;  // before the budget (refine pass)
-  std::vector<uint8_t> open_children; // opened children of an opened node
-  std::vector<uint32_t> queue;        // breadth-first visiting order
-  std::vector<uint64_t> heap;         // budget steps: error bits << 32 | ~node
+  std::vector<float> distance;         // world
+  float sse_numerator = 0;             // focal * scale: sse = e * sse_numerator / distance
+  std::vector<uint8_t> state;          // detail::HlodNodeState
+  std::vector<uint8_t> layer;          // drawn layer
+  std::vector<uint8_t> wanted_layer;   // before the budget (refine pass)
+  std::vector<uint8_t> open_children;  // opened children of an opened node
+  std::vector<uint32_t> queue;         // breadth-first visiting order
+  std::vector<uint64_t> heap;          // budget steps: error bits << 32 | ~node
 };
 
 // Sizes the outputs and the scratch for `tree` (the only allocation).
@@ -129,8 +129,8 @@ void prepare_hlod_cut(HlodCut& cut, HlodCutScratch& scratch, const HlodTree& tre
 
 // `resident[i]` != 0 when node i's payload is loaded. Returns the number of nodes drawn.
 uint32_t select_hlod_cut(HlodCut& cut, HlodCutScratch& scratch, const HlodTree& tree,
-                         std::span<const uint8_t> resident, const Transform& transform,
-                         const HlodView& view, const HlodSelectParams& params);
+                         std::span<const uint8_t> resident, const Transform& transform, const HlodView& view,
+                         const HlodSelectParams& params);
 
 // E = d * P / focal (see above): the largest object-space error (times scale) drawable at d.
 inline float hlod_error_threshold(float distance, float pixel_error, float focal_px) {

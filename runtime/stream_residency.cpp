@@ -88,9 +88,9 @@ void mark_stream_frame(StreamResidency& s, uint64_t frame, std::span<const HlodR
   }
 }
 
-StreamPlan plan_stream_loads(std::span<uint32_t> issue, std::span<uint32_t> evicted, std::span<uint32_t> too_large,
-                             StreamResidency& s, uint64_t frame, std::span<const HlodRequest> wanted,
-                             uint32_t max_in_flight) {
+StreamPlan plan_stream_loads(std::span<uint32_t> issue, std::span<uint32_t> evicted,
+                             std::span<uint32_t> too_large, StreamResidency& s, uint64_t frame,
+                             std::span<const HlodRequest> wanted, uint32_t max_in_flight) {
   StreamPlan plan;
   for (const HlodRequest& r : wanted) {
     if (s.in_flight >= max_in_flight) break;

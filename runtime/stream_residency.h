@@ -25,11 +25,11 @@ namespace lod {
 enum class NodeLoad : uint8_t { absent, loading, resident, failed };
 
 struct StreamCounters {
-  uint64_t requests = 0;    // loads issued (bytes reserved)
-  uint64_t loads = 0;       // completed
-  uint64_t failures = 0;    // completed with an error, or larger than the whole budget
+  uint64_t requests = 0;  // loads issued (bytes reserved)
+  uint64_t loads = 0;     // completed
+  uint64_t failures = 0;  // completed with an error, or larger than the whole budget
   uint64_t evictions = 0;
-  uint64_t dropped = 0;     // issued, no longer wanted, dropped before they were read
+  uint64_t dropped = 0;  // issued, no longer wanted, dropped before they were read
 };
 
 struct StreamResidency {
@@ -46,8 +46,8 @@ struct StreamResidency {
 
   uint64_t budget = 0;
   uint64_t resident_bytes = 0;
-  uint64_t reserved_bytes = 0;      // resident + loading: never above budget
-  uint32_t in_flight = 0;           // loading
+  uint64_t reserved_bytes = 0;  // resident + loading: never above budget
+  uint32_t in_flight = 0;       // loading
   StreamCounters counters;
 
   static constexpr uint32_t kNone = UINT32_MAX;
@@ -79,9 +79,9 @@ struct StreamPlan {
 
 // Issues loads for `wanted` (in its order) that are absent, evicting as needed. `issue` needs
 // room for max_in_flight, `evicted` for every node, `too_large` for wanted.size().
-StreamPlan plan_stream_loads(std::span<uint32_t> issue, std::span<uint32_t> evicted, std::span<uint32_t> too_large,
-                             StreamResidency& s, uint64_t frame, std::span<const HlodRequest> wanted,
-                             uint32_t max_in_flight);
+StreamPlan plan_stream_loads(std::span<uint32_t> issue, std::span<uint32_t> evicted,
+                             std::span<uint32_t> too_large, StreamResidency& s, uint64_t frame,
+                             std::span<const HlodRequest> wanted, uint32_t max_in_flight);
 
 // A load issued by plan_stream_loads ended: loaded (counted as used in `frame`, the one whose
 // update takes it in, so it is not evicted before the cut has seen it), failed (reservation

@@ -46,7 +46,8 @@ Transform placed() {
   return t;
 }
 
-void run_cut(benchmark::State& state, float radius, float pixel_error, uint32_t resident_percent, uint64_t budget) {
+void run_cut(benchmark::State& state, float radius, float pixel_error, uint32_t resident_percent,
+             uint64_t budget) {
   const HlodTree& t = tree_10k();
   std::mt19937 rng(1);
   std::vector<uint8_t> resident(t.nodes.size(), 1);
@@ -88,7 +89,9 @@ void BM_HlodCutUnderBudgetRefine(benchmark::State& state) { run_cut(state, 150, 
 void BM_HlodCutEveryNode(benchmark::State& state) { run_cut(state, 150, 1e-4f, 100, UINT64_MAX); }
 void BM_HlodCutEveryNodeUnderBudget(benchmark::State& state) { run_cut(state, 150, 1e-4f, 100, 100000); }
 // The undoing pass's worst case: every node visited, 40 % of the wanted cut to undo.
-void BM_HlodCutEveryNodeUndoing40Percent(benchmark::State& state) { run_cut(state, 150, 1e-4f, 100, 4700000); }
+void BM_HlodCutEveryNodeUndoing40Percent(benchmark::State& state) {
+  run_cut(state, 150, 1e-4f, 100, 4700000);
+}
 
 // Baseline: transform and cull every node's sphere, nothing else.
 void BM_SphereCullEveryNode(benchmark::State& state) {
@@ -104,7 +107,8 @@ void BM_SphereCullEveryNode(benchmark::State& state) {
     for (const HlodNode& n : t.nodes) {
       const Sphere s = world_sphere(tr, n.bounds);
       bool in = true;
-      for (const glm::vec4& p : f.planes) in &= p.x * s.center[0] + p.y * s.center[1] + p.z * s.center[2] + p.w >= -s.radius;
+      for (const glm::vec4& p : f.planes)
+        in &= p.x * s.center[0] + p.y * s.center[1] + p.z * s.center[2] + p.w >= -s.radius;
       inside += in;
     }
     benchmark::DoNotOptimize(inside);

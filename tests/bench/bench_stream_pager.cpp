@@ -6,14 +6,13 @@
 // more loads (and evict more) per frame, so the like-for-like figure is `quiet`: frames that
 // took in and evicted nothing, where waiting on a read would show.
 #include <benchmark/benchmark.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <thread>
 #include <vector>
-
-#include <time.h>
 
 #include "jobs/stream_pager.h"
 #include "runtime/hlod_select.h"
@@ -32,7 +31,8 @@ const HlodTree& tree() {
 HlodView view_at(int frame) {
   const float a = float(frame) * 0.01f;
   View v;
-  v.eye = glm::vec3(150 * std::cos(a), 30 * std::sin(3 * a), 150 * std::sin(a)) * (0.6f + 0.4f * std::cos(0.5f * a));
+  v.eye = glm::vec3(150 * std::cos(a), 30 * std::sin(3 * a), 150 * std::sin(a)) *
+          (0.6f + 0.4f * std::cos(0.5f * a));
   v.far_plane = 1e4f;
   return hlod_view_of(v);
 }

@@ -1,4 +1,6 @@
 // HlodStream: select + page as one node, on a synthetic in-memory model.
+#include "jobs/hlod_stream.h"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -6,7 +8,6 @@
 #include <cmath>
 #include <thread>
 
-#include "jobs/hlod_stream.h"
 #include "unit/runtime/hlod_fixtures.h"
 
 namespace lod {
@@ -90,7 +91,9 @@ TEST(HlodStream, ModelsShareOneBudgetAndOnePriorityOrder) {
     inputs[m].params = {1.0f, 150000};
   }
   std::vector<uint8_t> seen_root(3, 0);
-  auto enough = [&] { return seen_root == std::vector<uint8_t>(3, 1) && stream.figures().stream_evictions > 0; };
+  auto enough = [&] {
+    return seen_root == std::vector<uint8_t>(3, 1) && stream.figures().stream_evictions > 0;
+  };
   for (int f = 0; f < 300 || (!enough() && f < 40000); ++f) {
     std::vector<uint8_t> root_resident(3);
     for (uint32_t m = 0; m < 3; ++m) root_resident[m] = stream.residency(m)[0];

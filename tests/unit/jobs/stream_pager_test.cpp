@@ -1,5 +1,7 @@
 // StreamPager: loader threads, the byte budget, LRU eviction, stale drops, failures, and
 // select + update on a moving camera (run under ThreadSanitizer: scripts/run-tests.sh).
+#include "jobs/stream_pager.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,7 +16,6 @@
 #include <stdexcept>
 #include <thread>
 
-#include "jobs/stream_pager.h"
 #include "runtime/hlod_select.h"
 #include "unit/runtime/hlod_fixtures.h"
 
@@ -57,8 +58,8 @@ struct ReadLog {
 
 // Calls update on increasing frames until `done` holds (or 10 s pass).
 template <class Done>
-bool pump(StreamPager& pager, uint64_t& frame, std::span<const HlodRequest> wanted, std::span<const uint32_t> in_use,
-          Done done) {
+bool pump(StreamPager& pager, uint64_t& frame, std::span<const HlodRequest> wanted,
+          std::span<const uint32_t> in_use, Done done) {
   const auto until = std::chrono::steady_clock::now() + 10s;
   while (std::chrono::steady_clock::now() < until) {
     pager.update(++frame, wanted, in_use);
@@ -203,7 +204,8 @@ TEST(StreamPager, PayloadLargerThanItsNodeRecordsIsRefused) {
   StreamPager pager(t, {.loader_threads = 1, .budget_bytes = 1ull << 30, .max_in_flight = 2},
                     [&](uint32_t n, HlodPayload& out) {
                       synthetic_payload(t, n, out);
-                      if (n == 2) out.indices.resize(t.nodes[n].resident_bytes / 4 + 1);  // one index too many
+                      if (n == 2)
+                        out.indices.resize(t.nodes[n].resident_bytes / 4 + 1);  // one index too many
                       return Status::success();
                     });
   uint64_t frame = 0;
@@ -227,7 +229,8 @@ TEST(StreamPager, PayloadLargerThanItsNodeRecordsIsRefused) {
 TEST(StreamPager, NodeLargerThanTheBudgetFailsOnceUnread) {
   const HlodTree t = test::full_octree({.depth = 1});
   ReadLog log;
-  StreamPager pager(t, {.loader_threads = 1, .budget_bytes = t.nodes[1].resident_bytes - 1, .max_in_flight = 2},
+  StreamPager pager(t,
+                    {.loader_threads = 1, .budget_bytes = t.nodes[1].resident_bytes - 1, .max_in_flight = 2},
                     [&](uint32_t n, HlodPayload& out) {
                       log.add(n);
                       return synthetic_payload(t, n, out);
@@ -262,7 +265,8 @@ TEST(StreamPager, ResidentBytesNeverExceedTheBudget) {
   std::vector<uint32_t> in_use;
   // 400 frames at least, and on until the budget has made it evict and requests were dropped
   // (how soon depends on how much CPU the loaders get, not on the pager).
-  for (int i = 0; i < 400 || ((pager.counters().evictions <= 20 || pager.counters().dropped == 0) && i < 40000); ++i) {
+  for (int i = 0;
+       i < 400 || ((pager.counters().evictions <= 20 || pager.counters().dropped == 0) && i < 40000); ++i) {
     wanted.clear();
     in_use.clear();
     for (uint32_t k = 0, m = rng() % 40; k < m; ++k) {
@@ -274,7 +278,8 @@ TEST(StreamPager, ResidentBytesNeverExceedTheBudget) {
     for (uint32_t n = 0; n < t.nodes.size(); ++n)
       if (pager.residency()[n] && rng() % 4 == 0) in_use.push_back(n);
     const StreamUpdate& u = pager.update(++frame, wanted, in_use);
-    for (uint32_t e : u.evicted) EXPECT_EQ(std::count(in_use.begin(), in_use.end(), e), 0) << "evicted in use";
+    for (uint32_t e : u.evicted)
+      EXPECT_EQ(std::count(in_use.begin(), in_use.end(), e), 0) << "evicted in use";
     ASSERT_LE(pager.reserved_bytes(), budget);
     ASSERT_LE(pager.resident_bytes(), pager.reserved_bytes());
     ASSERT_LE(pager.in_flight(), 6u);
@@ -298,12 +303,13 @@ void fly_through(uint32_t loader_threads) {
   for (const HlodNode& n : t.nodes) total += n.resident_bytes;
   const uint64_t budget = total / 6;
   std::atomic<uint64_t> reads{0};
-  StreamPager pager(t, {.loader_threads = loader_threads, .budget_bytes = budget, .max_in_flight = 2 * loader_threads},
-                    [&](uint32_t n, HlodPayload& out) {
-                      ++reads;
-                      std::this_thread::sleep_for(std::chrono::microseconds(100 + n % 5 * 100));
-                      return synthetic_payload(t, n, out);
-                    });
+  StreamPager pager(
+      t, {.loader_threads = loader_threads, .budget_bytes = budget, .max_in_flight = 2 * loader_threads},
+      [&](uint32_t n, HlodPayload& out) {
+        ++reads;
+        std::this_thread::sleep_for(std::chrono::microseconds(100 + n % 5 * 100));
+        return synthetic_payload(t, n, out);
+      });
   HlodCut cut;
   HlodCutScratch scratch;
   prepare_hlod_cut(cut, scratch, t);
@@ -311,11 +317,14 @@ void fly_through(uint32_t loader_threads) {
   uint64_t drawn_total = 0, opened_total = 0;
   // 600 frames at least, and on until enough has been loaded and evicted (how soon depends
   // on how much CPU the loaders get).
-  auto enough = [&] { return pager.counters().loads > 50 && pager.counters().evictions > 0 && opened_total > 0; };
+  auto enough = [&] {
+    return pager.counters().loads > 50 && pager.counters().evictions > 0 && opened_total > 0;
+  };
   for (int i = 0; i < 600 || (!enough() && i < 40000); ++i) {
     const float a = float(i) * 0.02f;
     View v;
-    v.eye = glm::vec3(150 * std::cos(a), 30 * std::sin(3 * a), 150 * std::sin(a)) * (0.6f + 0.4f * std::cos(0.5f * a));
+    v.eye = glm::vec3(150 * std::cos(a), 30 * std::sin(3 * a), 150 * std::sin(a)) *
+            (0.6f + 0.4f * std::cos(0.5f * a));
     v.target = glm::vec3(0, 0, 0);
     v.far_plane = 1e4f;
     select_hlod_cut(cut, scratch, t, pager.residency(), {}, hlod_view_of(v), {1.0f, UINT64_MAX});

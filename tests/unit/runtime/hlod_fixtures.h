@@ -11,10 +11,10 @@
 namespace lod::test {
 
 struct OctreeSpec {
-  uint32_t depth = 4;            // levels below the root
-  float half = 64;               // root cell half edge
-  float root_error = 8;          // the root's coarsest error; halves per depth
-  uint32_t triangles = 1000;     // finest layer of every node; then 1/2, 1/4
+  uint32_t depth = 4;         // levels below the root
+  float half = 64;            // root cell half edge
+  float root_error = 8;       // the root's coarsest error; halves per depth
+  uint32_t triangles = 1000;  // finest layer of every node; then 1/2, 1/4
   uint64_t bytes_per_triangle = 64;
 };
 
@@ -29,7 +29,8 @@ inline void set_layers(HlodNode& n, uint32_t triangles, const float errors[3], u
 
 inline void place_child(HlodNode& c, const HlodNode& p, uint32_t octant) {
   c.box_half = p.box_half / 2;
-  for (int k = 0; k < 3; ++k) c.box_center[k] = p.box_center[k] + ((octant >> k) & 1 ? c.box_half : -c.box_half);
+  for (int k = 0; k < 3; ++k)
+    c.box_center[k] = p.box_center[k] + ((octant >> k) & 1 ? c.box_half : -c.box_half);
   for (int k = 0; k < 3; ++k) c.bounds.center[k] = c.box_center[k];
   c.bounds.radius = c.box_half * std::sqrt(3.0f);
   c.depth = uint8_t(p.depth + 1);
@@ -90,7 +91,8 @@ inline HlodTree random_octree(uint32_t seed, uint32_t max_nodes = 800, uint32_t 
   std::vector<float> finest{4 + 8 * u(rng)};  // the finest error each node allows its children
   for (size_t i = 0; i < t.nodes.size(); ++i) {
     HlodNode& n = t.nodes[i];
-    const bool split = n.depth < max_depth && t.nodes.size() + 8 < max_nodes && (n.depth < 2 || u(rng) < 0.6f);
+    const bool split =
+        n.depth < max_depth && t.nodes.size() + 8 < max_nodes && (n.depth < 2 || u(rng) < 0.6f);
     uint32_t count = 1 + rng() % 3;
     float errors[3];
     float e = finest[i] * (0.3f + 0.7f * u(rng));

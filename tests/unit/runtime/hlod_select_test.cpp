@@ -1,15 +1,15 @@
+#include "runtime/hlod_select.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <glm/gtc/quaternion.hpp>
 #include <map>
 #include <random>
 #include <set>
 
-#include <glm/gtc/quaternion.hpp>
-
-#include "runtime/hlod_select.h"
 #include "unit/runtime/hlod_fixtures.h"
 
 namespace lod {
@@ -58,7 +58,8 @@ bool ref_visible(const RefInputs& in, const HlodNode& n, bool* borderline) {
 }
 
 double ref_distance(const RefInputs& in, const HlodNode& n) {
-  const double d = glm::length(ref_world_center(in, n) - in.view.eye) - double(n.bounds.radius) * in.transform.scale;
+  const double d =
+      glm::length(ref_world_center(in, n) - in.view.eye) - double(n.bounds.radius) * in.transform.scale;
   return d > 0 ? d : 0;
 }
 
@@ -104,7 +105,8 @@ void ref_visit(const RefInputs& in, uint32_t id, bool in_cut, RefCut& out) {
   bool can_open = true;
   for (uint32_t k = 0; k < n.child_count; ++k) {
     const uint32_t c = n.first_child + k;
-    const bool counts = in.culled == HlodCulledNodes::cover || ref_visible(in, in.tree.nodes[c], &out.borderline);
+    const bool counts =
+        in.culled == HlodCulledNodes::cover || ref_visible(in, in.tree.nodes[c], &out.borderline);
     if (counts && !in.resident[c]) can_open = false;
   }
   for (uint32_t k = 0; k < n.child_count; ++k) ref_visit(in, n.first_child + k, in_cut && can_open, out);
@@ -124,9 +126,10 @@ struct Selector {
   HlodCut cut;
   HlodCutScratch scratch;
   explicit Selector(const HlodTree& t) { prepare_hlod_cut(cut, scratch, t); }
-  const HlodCut& run(const HlodTree& t, const std::vector<uint8_t>& resident, const Transform& tr, const View& v,
-                     float pixel_error, bool cull = true, uint64_t budget = UINT64_MAX,
-                     HlodBudgetPass pass = HlodBudgetPass::automatic, HlodCulledNodes culled = HlodCulledNodes::skip) {
+  const HlodCut& run(const HlodTree& t, const std::vector<uint8_t>& resident, const Transform& tr,
+                     const View& v, float pixel_error, bool cull = true, uint64_t budget = UINT64_MAX,
+                     HlodBudgetPass pass = HlodBudgetPass::automatic,
+                     HlodCulledNodes culled = HlodCulledNodes::skip) {
     HlodView hv = hlod_view_of(v);
     hv.cull = cull;
     select_hlod_cut(cut, scratch, t, resident, tr, hv, {pixel_error, budget, pass, culled});
@@ -247,7 +250,8 @@ TEST(HlodSelect, EqualsRecursiveReferenceOnRandomTreesAndViews) {
       const float p = 0.5f + float(rng() % 8);
       const bool cull = k % 4 != 0;
       const HlodCulledNodes culled = k % 2 ? HlodCulledNodes::cover : HlodCulledNodes::skip;
-      const HlodCut& cut = sel.run(t, resident, tr, v, p, cull, UINT64_MAX, HlodBudgetPass::automatic, culled);
+      const HlodCut& cut =
+          sel.run(t, resident, tr, v, p, cull, UINT64_MAX, HlodBudgetPass::automatic, culled);
       const RefCut ref = reference_cut({t, resident, tr, v, p, cull, culled});
       if (ref.borderline) continue;
       ++compared;
@@ -270,7 +274,8 @@ TEST(HlodSelect, EqualsRecursiveReferenceOnRandomTreesAndViews) {
   EXPECT_GT(opened, size_t(compared) * 3);
   EXPECT_GT(requested_total, size_t(compared));
   EXPECT_GT(culled_total, size_t(compared) / 4);  // skip-mode views only
-  std::printf("compared %d cuts: %zu opened, %zu requested, %zu culled\n", compared, opened, requested_total, culled_total);
+  std::printf("compared %d cuts: %zu opened, %zu requested, %zu culled\n", compared, opened, requested_total,
+              culled_total);
 }
 
 TEST(HlodSelect, NeverAHoleWithRandomResidency) {
@@ -299,16 +304,18 @@ TEST(HlodSelect, CoverModeKeepsTheWholeCutClosed) {
     for (int k = 0; k < 20; ++k) {
       auto resident = random_residency(t.nodes.size(), rng, 30 + 10 * uint32_t(k % 7));
       resident[0] = 1;
-      const HlodCut& cut = sel.run(t, resident, random_transform(rng), random_view(rng), 1.0f, true, UINT64_MAX,
-                                   HlodBudgetPass::automatic, HlodCulledNodes::cover);
+      const HlodCut& cut = sel.run(t, resident, random_transform(rng), random_view(rng), 1.0f, true,
+                                   UINT64_MAX, HlodBudgetPass::automatic, HlodCulledNodes::cover);
       if (!cut.culled.empty()) {
         EXPECT_EQ(cut.culled, std::vector<uint32_t>{0});  // only a root out of view is culled
         continue;
       }
       EXPECT_EQ(cut.holes, 0u);
       expect_closed_cut(t, cut, resident);
-      for (size_t i = 1; i < cut.requests.size(); ++i) EXPECT_TRUE(request_before(cut.requests[i - 1], cut.requests[i]));
-      with_outside += std::any_of(cut.requests.begin(), cut.requests.end(), [](auto& r) { return r.deficit < -1e30f; });
+      for (size_t i = 1; i < cut.requests.size(); ++i)
+        EXPECT_TRUE(request_before(cut.requests[i - 1], cut.requests[i]));
+      with_outside +=
+          std::any_of(cut.requests.begin(), cut.requests.end(), [](auto& r) { return r.deficit < -1e30f; });
     }
   }
   EXPECT_GT(with_outside, 20);  // covered nodes outside the view were requested, last
@@ -322,15 +329,15 @@ TEST(HlodSelect, CoverModeWaitsForChildrenOutsideTheView) {
   v.fov_y_deg = 20;
   v.near_plane = 1;
   resident[3] = 0;
-  const HlodCut& waiting = sel.run(t, resident, {}, v, 0.01f, true, UINT64_MAX, HlodBudgetPass::automatic,
-                                   HlodCulledNodes::cover);
+  const HlodCut& waiting =
+      sel.run(t, resident, {}, v, 0.01f, true, UINT64_MAX, HlodBudgetPass::automatic, HlodCulledNodes::cover);
   ASSERT_EQ(waiting.drawn.size(), 1u);  // the root, until node 3 is in
   EXPECT_EQ(waiting.drawn[0].node, 0u);
   ASSERT_EQ(waiting.requests.size(), 1u);
   EXPECT_EQ(waiting.requests[0].node, 3u);
   resident[3] = 1;
-  const HlodCut& cut = sel.run(t, resident, {}, v, 0.01f, true, UINT64_MAX, HlodBudgetPass::automatic,
-                               HlodCulledNodes::cover);
+  const HlodCut& cut =
+      sel.run(t, resident, {}, v, 0.01f, true, UINT64_MAX, HlodBudgetPass::automatic, HlodCulledNodes::cover);
   EXPECT_EQ(cut.opened.size(), 1u);
   EXPECT_EQ(cut.drawn.size(), 8u);
   EXPECT_TRUE(cut.culled.empty());
@@ -401,8 +408,10 @@ TEST(HlodSelect, CoarserAndShallowerWithDistanceAndPixelError) {
   const HlodCut& far = sel.run(t, resident, {}, looking_at({0, 0, 1e4f}, {0, 0, 0}), 1.0f);
   ASSERT_EQ(far.drawn.size(), 1u);
   EXPECT_EQ(far.drawn[0].layer, 2u);
-  const uint64_t near_triangles = sel.run(t, resident, {}, looking_at({0, 0, 200}, {0, 0, 0}), 1.0f).triangles;
-  const uint64_t loose_triangles = sel.run(t, resident, {}, looking_at({0, 0, 200}, {0, 0, 0}), 8.0f).triangles;
+  const uint64_t near_triangles =
+      sel.run(t, resident, {}, looking_at({0, 0, 200}, {0, 0, 0}), 1.0f).triangles;
+  const uint64_t loose_triangles =
+      sel.run(t, resident, {}, looking_at({0, 0, 200}, {0, 0, 0}), 8.0f).triangles;
   EXPECT_GT(near_triangles, far.triangles);
   EXPECT_LT(loose_triangles, near_triangles);
 }
@@ -410,7 +419,8 @@ TEST(HlodSelect, CoarserAndShallowerWithDistanceAndPixelError) {
 // The finer the covering node of a leaf, the higher: depth first, then the layer.
 int refinement_rank(const HlodTree& t, const HlodCut& cut, uint32_t leaf, const std::vector<int>& layer_of) {
   for (int32_t a = int32_t(leaf); a >= 0; a = t.nodes[a].parent)
-    if (layer_of[a] >= 0) return int(t.nodes[a].depth) * int(kHlodMaxLayers) + int(kHlodMaxLayers) - 1 - layer_of[a];
+    if (layer_of[a] >= 0)
+      return int(t.nodes[a].depth) * int(kHlodMaxLayers) + int(kHlodMaxLayers) - 1 - layer_of[a];
   (void)cut;
   return -1;
 }
@@ -425,7 +435,9 @@ TEST(HlodSelect, RefinesMonotonicallyAsTheCameraApproaches) {
     const glm::vec3 dir = glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
     // Beyond every node's bounds centre, distances to them all shrink as the eye moves in.
     float root_r = t.nodes[0].bounds.radius;
-    for (const HlodNode& n : t.nodes) root_r = std::max(root_r, glm::length(glm::vec3(n.bounds.center[0], n.bounds.center[1], n.bounds.center[2])));
+    for (const HlodNode& n : t.nodes)
+      root_r = std::max(root_r,
+                        glm::length(glm::vec3(n.bounds.center[0], n.bounds.center[1], n.bounds.center[2])));
     std::vector<int> last(t.nodes.size(), -1);
     for (float dist = 40 * root_r; dist > 1.05f * root_r; dist *= 0.97f) {
       const HlodCut& cut = sel.run(t, resident, {}, looking_at(dir * dist, {0, 0, 0}), 1.0f, false);
@@ -450,9 +462,11 @@ TEST(HlodSelect, TransformActsAsTheInverseOnTheEye) {
     std::mt19937 rng(seed);
     const std::vector<uint8_t> resident(t.nodes.size(), 1);
     Transform tr = random_transform(rng);
-    const glm::quat q = glm::normalize(glm::quat(tr.rotation[3], tr.rotation[0], tr.rotation[1], tr.rotation[2]));
+    const glm::quat q =
+        glm::normalize(glm::quat(tr.rotation[3], tr.rotation[0], tr.rotation[1], tr.rotation[2]));
     const glm::vec3 eye(150, 40, -90);
-    const glm::vec3 local = glm::inverse(q) * (eye - glm::vec3(tr.position[0], tr.position[1], tr.position[2])) / tr.scale;
+    const glm::vec3 local =
+        glm::inverse(q) * (eye - glm::vec3(tr.position[0], tr.position[1], tr.position[2])) / tr.scale;
     const HlodCut& world = a.run(t, resident, tr, looking_at(eye, {0, 0, 0}), 1.0f, false);
     const HlodCut& object = b.run(t, resident, {}, looking_at(local, {0, 0, 0}), 1.0f, false);
     ASSERT_EQ(world.drawn.size(), object.drawn.size()) << seed;
@@ -477,7 +491,8 @@ void budget_never_exceeded(HlodBudgetPass pass) {
       const Transform tr = random_transform(rng);
       const HlodCulledNodes culled = k % 2 ? HlodCulledNodes::cover : HlodCulledNodes::skip;
       const uint64_t wanted =
-          sel.run(t, resident, tr, v, 0.5f, true, UINT64_MAX, HlodBudgetPass::automatic, culled).wanted_triangles;
+          sel.run(t, resident, tr, v, 0.5f, true, UINT64_MAX, HlodBudgetPass::automatic, culled)
+              .wanted_triangles;
       const uint64_t smallest = root.layers[root.layer_count - 1].triangles;
       const uint64_t budget = smallest + uint64_t(rng() % (wanted + 1));
       const HlodCut& cut = sel.run(t, resident, tr, v, 0.5f, true, budget, pass, culled);
@@ -497,7 +512,9 @@ void budget_never_exceeded(HlodBudgetPass pass) {
   std::printf("%llu refinements undone\n", (unsigned long long)undone);
 }
 
-TEST(HlodSelect, BudgetNeverExceededWhenTheSmallestCutFits) { budget_never_exceeded(HlodBudgetPass::automatic); }
+TEST(HlodSelect, BudgetNeverExceededWhenTheSmallestCutFits) {
+  budget_never_exceeded(HlodBudgetPass::automatic);
+}
 TEST(HlodSelect, BudgetNeverExceededByTheUndoingPass) { budget_never_exceeded(HlodBudgetPass::undo); }
 TEST(HlodSelect, BudgetNeverExceededByTheRefiningPass) { budget_never_exceeded(HlodBudgetPass::refine); }
 
@@ -571,7 +588,8 @@ TEST(HlodSelect, RequestsLargestDeficitFirstThenNearest) {
   for (uint32_t i = 0; i <= 8; ++i) resident[i] = 1;  // root and children; no grandchild
   const HlodCut& cut = sel.run(t, resident, {}, looking_at({10, 20, 90}, {0, 0, 0}), 0.25f, false);
   ASSERT_GT(cut.requests.size(), 8u);
-  for (size_t i = 1; i < cut.requests.size(); ++i) EXPECT_TRUE(request_before(cut.requests[i - 1], cut.requests[i]));
+  for (size_t i = 1; i < cut.requests.size(); ++i)
+    EXPECT_TRUE(request_before(cut.requests[i - 1], cut.requests[i]));
   for (const HlodRequest& r : cut.requests) EXPECT_GE(t.nodes[r.node].depth, 2u);
 }
 
@@ -581,8 +599,8 @@ TEST(HlodSelect, SteadyStateKeepsItsBuffers) {
   Selector sel(t);
   std::mt19937 rng(1);
   auto storage = [&] {
-    return std::vector<const void*>{sel.cut.drawn.data(), sel.cut.opened.data(), sel.cut.culled.data(),
-                                    sel.cut.requests.data(), sel.cut.kept.data(), sel.scratch.queue.data(),
+    return std::vector<const void*>{sel.cut.drawn.data(),    sel.cut.opened.data(), sel.cut.culled.data(),
+                                    sel.cut.requests.data(), sel.cut.kept.data(),   sel.scratch.queue.data(),
                                     sel.scratch.heap.data()};
   };
   const auto before = storage();

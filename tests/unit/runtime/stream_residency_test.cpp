@@ -1,10 +1,11 @@
 // Stream residency without threads: the reservation, the in-flight cap, the priority order,
 // LRU eviction and what is never evicted.
+#include "runtime/stream_residency.h"
+
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "runtime/stream_residency.h"
 #include "unit/runtime/hlod_fixtures.h"
 
 namespace lod {
