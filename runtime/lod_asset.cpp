@@ -20,12 +20,9 @@
 // The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
 #include "runtime/lod_asset.h"
 
-#include "runtime/file_write.h"
-
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
 
 #include <algorithm>
 #include <bit>
