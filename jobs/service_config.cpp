@@ -28,6 +28,7 @@ FrameGraphOptions frame_graph_options(const SceneConfig& config) {
   g.selection = config.selection;
   g.pixel_error = config.pixel_error;
   g.hysteresis = config.hysteresis;
+  g.max_distance = config.max_distance;
   g.occlusion.enabled = config.occlusion;
   g.occlusion.occluders = config.occluders;
   return g;

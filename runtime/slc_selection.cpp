@@ -175,39 +175,72 @@ Gathered gather_direct(const Columns& c, const ModelTable& models, HeapEntry* he
 }
 
 
-// Pass 3: lower the top one level at a time until the budget holds. The coarsest levels fit,
-// so the heap cannot run dry first (and placeholders, ranked below every real entry, are
-// never reached). Returns the steps taken.
-uint32_t lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std::span<const float> weight,
-                         std::span<const uint32_t> model, const ModelTable& models, bool by_triangles,
-                         uint64_t budget, uint64_t& cost, uint64_t& tri_sum, uint64_t& lev_sum) {
+// The runner-up's rank: the best of the root's children (0 when the root has none).
+inline uint64_t runner_up_rank(const HeapEntry* h, size_t size) {
+  uint64_t best = 0;
+  for (size_t c = 1; c < std::min(size, kArity + 1); ++c) best = std::max(best, rank(h[c]));
+  return best;
+}
+
+struct LowerParams {
+  bool by_triangles = true;
+  uint64_t budget = 0;
+  Selector selector = Selector::greedy;
+  float slack = 1;  // greedy_multi
+};
+
+struct Lowered {
+  uint32_t pops = 0, levels = 0;
+};
+
+// Pass 3: lower the top until the budget holds (greedy: one level per pop; greedy_multi: while
+// its next key, divided by the slack, still ranks above the runner-up). The coarsest levels fit,
+// so the heap cannot run dry first (and placeholders, ranked below every real entry, are never
+// reached).
+Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std::span<const float> weight,
+                        std::span<const uint32_t> model, const ModelTable& models, const LowerParams& p,
+                        uint64_t& cost, uint64_t& tri_sum, uint64_t& lev_sum) {
   const uint32_t* first = models.first_level.data();
   const uint8_t* counts = models.level_count.data();
   const uint32_t* tris = models.triangles.data();
   const int32_t* ls = models.level_l.data();
-  uint32_t steps = 0;
-  while (cost > budget) {
+  const bool multi = p.selector == Selector::greedy_multi;
+  assert(!multi || (p.slack > 0 && p.slack <= 1));
+  Lowered done;
+  while (cost > p.budget) {
     assert(size > 0 && h[0].object != kPlaceholder);
     const uint32_t obj = h[0].object;
     const uint32_t m = model[obj];
-    const uint32_t cur = level[obj];
-    const uint32_t at = first[m] + cur;
-    const uint64_t tri_drop = tris[at] - tris[at + 1];
-    const uint64_t lev_drop = pow2(ls[at]) - pow2(ls[at + 1]);
-    tri_sum -= tri_drop;
-    lev_sum -= lev_drop;
-    cost -= by_triangles ? tri_drop : lev_drop;
-    level[obj] = static_cast<uint8_t>(cur + 1u);
-    ++steps;
-    if (cur + 2u < counts[m]) {
+    const uint64_t runner_up = multi ? runner_up_rank(h, size) : 0;
+    ++done.pops;
+    for (;;) {
+      const uint32_t cur = level[obj];
+      const uint32_t at = first[m] + cur;
+      const uint64_t tri_drop = tris[at] - tris[at + 1];
+      const uint64_t lev_drop = pow2(ls[at]) - pow2(ls[at + 1]);
+      tri_sum -= tri_drop;
+      lev_sum -= lev_drop;
+      cost -= p.by_triangles ? tri_drop : lev_drop;
+      level[obj] = static_cast<uint8_t>(cur + 1u);
+      ++done.levels;
+      if (cur + 2u >= counts[m]) {  // at its coarsest: out of the heap
+        --size;
+        if (size > 0) sift_down(h, size, 0, h[size]);
+        break;
+      }
       const HeapEntry next{weight[obj] * static_cast<float>(span_of_level_changed(ls[at + 1], ls[at + 2])), obj};
-      sift_down(h, size, 0, next);
-    } else {
-      --size;
-      if (size > 0) sift_down(h, size, 0, h[size]);
+      const bool again = multi && cost > p.budget && rank(HeapEntry{next.key / p.slack, obj}) > runner_up;
+      if (!again) {
+        sift_down(h, size, 0, next);
+        break;
+      }
     }
   }
-  return steps;
+  return done;
+}
+
+LowerParams lower_params_of(const SelectionParams& p) {
+  return {p.count == BudgetCount::triangles, p.budget, p.selector, p.multi_level_slack};
 }
 
 }  // namespace
@@ -255,8 +288,10 @@ SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const ui
     // Pass 2: heapify, O(m).
     assert(g.heap_size <= heap.size() && "heap scratch needs room for every visible object");
     make_heap(h, g.heap_size);
-    r.lowered_steps = lower_from_heap(h, g.heap_size, level, weight, model, models, by_triangles, params.budget,
-                                      cost, tri_sum, lev_sum);
+    const Lowered l = lower_from_heap(h, g.heap_size, level, weight, model, models, lower_params_of(params), cost,
+                                      tri_sum, lev_sum);
+    r.lowered_steps = l.pops;
+    r.levels_lowered = l.levels;
   }
   r.cost = cost;
   r.triangles = tri_sum;
@@ -343,8 +378,10 @@ SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uin
   uint64_t cost = by_triangles ? tri_sum : lev_sum;
   if (cost > params.budget) {
     make_heap(heap.data(), n);
-    r.lowered_steps = lower_from_heap(heap.data(), n, level, weight, model, models, by_triangles, params.budget, cost,
-                                      tri_sum, lev_sum);
+    const Lowered l =
+        lower_from_heap(heap.data(), n, level, weight, model, models, lower_params_of(params), cost, tri_sum, lev_sum);
+    r.lowered_steps = l.pops;
+    r.levels_lowered = l.levels;
   }
   r.cost = cost;
   r.triangles = tri_sum;
