@@ -186,7 +186,8 @@ struct LowerParams {
   bool by_triangles = true;
   uint64_t budget = 0;
   Selector selector = Selector::greedy;
-  float slack = 1;  // greedy_multi
+  float slack = 1;         // greedy_multi
+  float exact_tail = 0;    // greedy_multi: share of the excess lowered with slack 1
 };
 
 struct Lowered {
@@ -206,6 +207,8 @@ Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std
   const int32_t* ls = models.level_l.data();
   const bool multi = p.selector == Selector::greedy_multi;
   assert(!multi || (p.slack > 0 && p.slack <= 1));
+  // Below `relaxed_until` only the steps greedy itself would take next are taken in a row.
+  const uint64_t relaxed_until = p.budget + uint64_t(double(cost - p.budget) * p.exact_tail);
   Lowered done;
   while (cost > p.budget) {
     assert(size > 0 && h[0].object != kPlaceholder);
@@ -229,7 +232,8 @@ Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std
         break;
       }
       const HeapEntry next{weight[obj] * static_cast<float>(span_of_level_changed(ls[at + 1], ls[at + 2])), obj};
-      const bool again = multi && cost > p.budget && rank(HeapEntry{next.key / p.slack, obj}) > runner_up;
+      const float slack = cost > relaxed_until ? p.slack : 1.0f;
+      const bool again = multi && cost > p.budget && rank(HeapEntry{next.key / slack, obj}) > runner_up;
       if (!again) {
         sift_down(h, size, 0, next);
         break;
@@ -240,7 +244,7 @@ Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std
 }
 
 LowerParams lower_params_of(const SelectionParams& p) {
-  return {p.count == BudgetCount::triangles, p.budget, p.selector, p.multi_level_slack};
+  return {p.count == BudgetCount::triangles, p.budget, p.selector, p.multi_level_slack, p.multi_exact_tail};
 }
 
 }  // namespace

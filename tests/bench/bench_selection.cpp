@@ -72,7 +72,7 @@ ModelTable bunny_like_table() {
 }
 
 // arg 0: budget as per mille of the way from the coarsest to the finest levels; arg 1:
-// greedy_multi's slack in percent (50 is the default).
+// greedy_multi's slack in percent (default 50); arg 2: its exact tail in percent (default 5).
 void BM_SelectorsColdStart(benchmark::State& state) {
   const ModelTable t = bunny_like_table();
   constexpr size_t n = 100000;
@@ -92,6 +92,7 @@ void BM_SelectorsColdStart(benchmark::State& state) {
   SelectionParams p;
   p.budget = coarsest + (finest - coarsest) * uint64_t(state.range(0)) / 1000;
   p.multi_level_slack = float(state.range(1)) / 100.f;
+  p.multi_exact_tail = float(state.range(2)) / 100.f;
   double ms[2] = {0, 0};
   uint64_t pops[2] = {0, 0}, levels[2] = {0, 0};
   for (auto _ : state) {
@@ -116,10 +117,10 @@ void BM_SelectorsColdStart(benchmark::State& state) {
   state.counters["multi_levels_per_pop"] = double(levels[1]) / double(pops[1]);
 }
 BENCHMARK(BM_SelectorsColdStart)
-    ->Args({20, 50})
-    ->Args({300, 50})
-    ->Args({20, 90})
-    ->Args({300, 90})
+    ->Args({20, 50, 5})   // the defaults
+    ->Args({300, 50, 5})
+    ->Args({20, 50, 0})   // no exact tail
+    ->Args({20, 90, 5})   // a timid slack
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
