@@ -62,6 +62,14 @@ void make_heap(HeapEntry* heap, size_t size) {
 
 inline uint64_t pow2(int32_t l) { return uint64_t{1} << l; }
 
+// SLC of lowering from chain level `at` to `at + 1`. The culled level (0 triangles, l = 0)
+// counts as one level below the one before it: culling saves about what such a step saves,
+// and R0's l_i^2 span would make the heap cull objects before it lowers finer ones.
+inline float step_slc(const int32_t* ls, const uint32_t* tris, uint32_t at) {
+  const int32_t to = tris[at + 1] == 0 ? ls[at] - 1 : ls[at + 1];
+  return static_cast<float>(span_of_level_changed(ls[at], to));
+}
+
 // gather_selection's entry for an object that cannot be lowered: rank 0, below every real
 // entry (a real one has ~object > 0), so it sinks to the bottom and is never popped.
 constexpr uint32_t kPlaceholder = 0xffffffffu;
@@ -98,7 +106,7 @@ Gathered gather_by_slots(const Columns& c, const ModelTable& models, HeapEntry* 
   const int32_t* ls = models.level_l.data();
   for (size_t m = 0; m < models.model_count(); ++m) {
     for (uint32_t k = first[m]; k + 1 < first[m] + models.level_count[m]; ++k) {
-      slc_next[k] = static_cast<float>(span_of_level_changed(ls[k], ls[k + 1]));
+      slc_next[k] = step_slc(ls, models.triangles.data(), k);
       lowerable[k] = 1;
     }
   }
@@ -164,8 +172,7 @@ Gathered gather_direct(const Columns& c, const ModelTable& models, HeapEntry* he
     g.lev_sum += pow2(ls[at]) & keep;
     g.tri_coarse += tris[coarse] & keep;
     g.lev_coarse += pow2(ls[coarse]) & keep;
-    const HeapEntry e{c.weight[i] * static_cast<float>(span_of_level_changed(ls[at], ls[at + lowerable])),
-                      static_cast<uint32_t>(i)};
+    const HeapEntry e{lowerable ? c.weight[i] * step_slc(ls, tris, at) : 0.f, static_cast<uint32_t>(i)};
     assert(!(lowerable && keep) || e.key >= 0.f);
     if (size < capacity) heap[size] = e;
     size += lowerable & keep;
@@ -231,7 +238,7 @@ Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std
         if (size > 0) sift_down(h, size, 0, h[size]);
         break;
       }
-      const HeapEntry next{weight[obj] * static_cast<float>(span_of_level_changed(ls[at + 1], ls[at + 2])), obj};
+      const HeapEntry next{weight[obj] * step_slc(ls, tris, at + 1), obj};
       const float slack = cost > relaxed_until ? p.slack : 1.0f;
       const bool again = multi && cost > p.budget && rank(HeapEntry{next.key / slack, obj}) > runner_up;
       if (!again) {
@@ -312,7 +319,7 @@ SelectionTables build_selection_tables(const ModelTable& models) {
   for (size_t m = 0; m < models.model_count(); ++m) {
     const uint32_t first = models.first_level[m];
     for (uint32_t k = first; k + 1 < first + models.level_count[m]; ++k) {
-      t.slc_next[k] = static_cast<float>(span_of_level_changed(models.level_l[k], models.level_l[k + 1]));
+      t.slc_next[k] = step_slc(models.level_l.data(), models.triangles.data(), k);
       t.lowerable[k] = 1;
     }
   }

@@ -3,6 +3,7 @@
 // selector against R0's heap and the exact optimum; the per-frame benefit and pixel error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "runtime/initial_levels.h"
@@ -147,6 +148,27 @@ TEST(CulledLevel, SelectionLowersIntoTheCulledLevelLikeAnyOther) {
   for (uint8_t l : level) culled += l == 2;
   EXPECT_GE(culled, 5u);
   EXPECT_EQ(r.coarsest_cost, 0u);
+}
+
+// R0's span from l = 11 to the culled level's l = 0 would be 121, so the heap would cull small
+// objects before it lowers a 65k-triangle one; culling counts as one more level instead.
+TEST(CulledLevel, CullingWeighsLikeOneMoreLevel) {
+  const ModelTable t = test::table_of({{{65536, 0}, {32768, 1}}, {{2048, 0}, {0, 5}}});
+  std::vector<uint8_t> level(11, 0), visible(11, 1);
+  std::vector<float> weight(11, 1.f);
+  std::vector<uint32_t> model(11, 1);
+  model[0] = 0;
+  std::vector<HeapEntry> heap(11);
+  SelectionParams p;
+  p.budget = 65536 - 32768 + 10 * 2048;  // one step of object 0 is enough
+  for (Selector s : {Selector::greedy, Selector::greedy_multi}) {
+    p.selector = s;
+    std::vector<uint8_t> l = level;
+    const SelectionResult r = select_under_budget(l, visible, weight, model, t, p, heap);
+    EXPECT_EQ(r.triangles, p.budget);
+    EXPECT_EQ(l[0], 1) << "SLC 16 (l 16 -> 15) beats SLC 11 (l 11 -> culled)";
+    EXPECT_EQ(std::count(l.begin() + 1, l.end(), uint8_t{1}), 0) << "nothing culled";
+  }
 }
 
 TEST(MaxDistance, CullsSpheresWhoseNearestPointIsFarther) {
