@@ -35,21 +35,23 @@ std::string ratio_text(double r) {
 
 }  // namespace
 
-BudgetShortfall budget_shortfall(const Frame& f, const ModelTable& models) {
+BudgetShortfall budget_shortfall(const Frame& f, const ModelTable& models, BudgetCount unit) {
   BudgetShortfall s;
   s.budget = f.budget;
+  s.count = unit;
   std::map<std::pair<uint32_t, uint8_t>, uint32_t> count;
   for (size_t k = 0; k < f.models.size(); ++k) ++count[{f.models[k], f.levels[k]}];
   uint64_t full = 0;  // the frame's objects at full detail
   for (const auto& [key, n] : count) {
     const uint32_t first = models.first_level[key.first];
-    const ShortfallGroup g{key.first, key.second, n, models.triangles[first + key.second]};
+    const ShortfallGroup g{key.first, key.second, n, models.triangles[first + key.second],
+                           level_cost(models, key.first, key.second, unit)};
     s.groups.push_back(g);
-    s.need += uint64_t{n} * g.triangles;
-    full += uint64_t{n} * models.triangles[first];
+    s.need += uint64_t{n} * g.cost;
+    full += uint64_t{n} * level_cost(models, key.first, 0, unit);
   }
   std::stable_sort(s.groups.begin(), s.groups.end(), [](const ShortfallGroup& a, const ShortfallGroup& b) {
-    return uint64_t{a.objects} * a.triangles > uint64_t{b.objects} * b.triangles;
+    return uint64_t{a.objects} * a.cost > uint64_t{b.objects} * b.cost;
   });
   s.fitting_ratio = full > 0 ? floor_two_digits(double(s.budget) / double(full)) : 0;
   return s;
@@ -57,19 +59,21 @@ BudgetShortfall budget_shortfall(const Frame& f, const ModelTable& models) {
 
 std::string shortfall_text(const BudgetShortfall& s, const std::vector<std::string>& names) {
   constexpr size_t kNamed = 3;
-  std::string t = "budget " + thousands(s.budget) + " triangles cannot be met: ";
+  const bool tris = s.count == BudgetCount::triangles;
+  std::string t = "budget " + thousands(s.budget) + (tris ? " triangles" : " (sum of 2^l)") + " cannot be met: ";
   uint64_t rest = 0;
   size_t rest_objects = 0;
   for (size_t i = 0; i < s.groups.size(); ++i) {
     const ShortfallGroup& g = s.groups[i];
-    const uint64_t total = uint64_t{g.objects} * g.triangles;
+    const uint64_t total = uint64_t{g.objects} * g.cost;
     if (i >= kNamed) {
       rest += total, rest_objects += g.objects;
       continue;
     }
     const std::string name = g.model < names.size() ? printable(names[g.model]) : std::to_string(g.model);
     t += (i ? "; " : "") + thousands(g.objects) + " objects of model '" + name + "' at their coarsest level " +
-         std::to_string(g.level) + " (" + thousands(g.triangles) + " triangles each) need " + thousands(total);
+         std::to_string(g.level) + " (" + thousands(g.triangles) + " triangles each" +
+         (tris ? "" : ", 2^l = " + thousands(g.cost)) + ") need " + thousands(total);
   }
   if (rest_objects > 0) t += "; " + thousands(rest_objects) + " more objects need " + thousands(rest);
   if (s.groups.size() > 1) t += " (" + thousands(s.need) + " in all)";

@@ -204,7 +204,7 @@ int run_command(const RunArgs& args) {
     if (frame.over_budget && !told_shortfall) {
       told_shortfall = true;
       std::fprintf(stderr, "lod run: frame %u: %s\n", n,
-                   shortfall_text(budget_shortfall(frame, scene.models), model_names).c_str());
+                   shortfall_text(budget_shortfall(frame, scene.models, config.selection.count), model_names).c_str());
     }
     records.push_back(record_of(frame));
     if (!args.quiet && (n % every == 0 || n + 1 == config.frames))
