@@ -60,7 +60,8 @@ BudgetShortfall budget_shortfall(const Frame& f, const ModelTable& models, Budge
 std::string shortfall_text(const BudgetShortfall& s, const std::vector<std::string>& names) {
   constexpr size_t kNamed = 3;
   const bool tris = s.count == BudgetCount::triangles;
-  std::string t = "budget " + thousands(s.budget) + (tris ? " triangles" : " (sum of 2^l)") + " cannot be met: ";
+  std::string t =
+      "budget " + thousands(s.budget) + (tris ? " triangles" : " (sum of 2^l)") + " cannot be met: ";
   uint64_t rest = 0;
   size_t rest_objects = 0;
   for (size_t i = 0; i < s.groups.size(); ++i) {
@@ -71,9 +72,9 @@ std::string shortfall_text(const BudgetShortfall& s, const std::vector<std::stri
       continue;
     }
     const std::string name = g.model < names.size() ? printable(names[g.model]) : std::to_string(g.model);
-    t += (i ? "; " : "") + thousands(g.objects) + " objects of model '" + name + "' at their coarsest level " +
-         std::to_string(g.level) + " (" + thousands(g.triangles) + " triangles each" +
-         (tris ? "" : ", 2^l = " + thousands(g.cost)) + ") need " + thousands(total);
+    t += (i ? "; " : "") + thousands(g.objects) + " objects of model '" + name +
+         "' at their coarsest level " + std::to_string(g.level) + " (" + thousands(g.triangles) +
+         " triangles each" + (tris ? "" : ", 2^l = " + thousands(g.cost)) + ") need " + thousands(total);
   }
   if (rest_objects > 0) t += "; " + thousands(rest_objects) + " more objects need " + thousands(rest);
   if (s.groups.size() > 1) t += " (" + thousands(s.need) + " in all)";

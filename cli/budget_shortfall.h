@@ -13,10 +13,10 @@ namespace lod::cli {
 
 struct ShortfallGroup {
   uint32_t model = 0;
-  uint8_t level = 0;        // the coarsest level the frame used for these objects
+  uint8_t level = 0;  // the coarsest level the frame used for these objects
   uint32_t objects = 0;
-  uint32_t triangles = 0;   // each
-  uint64_t cost = 0;        // each, in the budget's unit (triangles, or 2^l)
+  uint32_t triangles = 0;  // each
+  uint64_t cost = 0;       // each, in the budget's unit (triangles, or 2^l)
 };
 
 struct BudgetShortfall {

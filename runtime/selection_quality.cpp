@@ -7,8 +7,9 @@
 namespace lod {
 
 SelectionQuality measure_selection_quality(std::span<const uint32_t> ids, std::span<const uint8_t> level,
-                                           std::span<const uint32_t> model, std::span<const uint8_t> view_mask,
-                                           uint8_t view_bit, std::span<const float> distance, std::span<const float> area,
+                                           std::span<const uint32_t> model,
+                                           std::span<const uint8_t> view_mask, uint8_t view_bit,
+                                           std::span<const float> distance, std::span<const float> area,
                                            std::span<const float> error_scale, const ModelTable& models,
                                            float focal_px) {
   const size_t n = ids.size();
@@ -30,8 +31,8 @@ SelectionQuality measure_selection_quality(std::span<const uint32_t> ids, std::s
 }
 
 SelectionQuality merge_quality(const SelectionQuality& a, const SelectionQuality& b) {
-  return {a.benefit + b.benefit, a.pixel_error_sum + b.pixel_error_sum, std::max(a.pixel_error_max, b.pixel_error_max),
-          a.measured + b.measured};
+  return {a.benefit + b.benefit, a.pixel_error_sum + b.pixel_error_sum,
+          std::max(a.pixel_error_max, b.pixel_error_max), a.measured + b.measured};
 }
 
 }  // namespace lod

@@ -24,8 +24,9 @@ struct SelectionQuality {
 // of level[k] of model[k]. `distance`, `area` and `error_scale` are per object (importance's
 // measure_objects and the object controls).
 SelectionQuality measure_selection_quality(std::span<const uint32_t> ids, std::span<const uint8_t> level,
-                                           std::span<const uint32_t> model, std::span<const uint8_t> view_mask,
-                                           uint8_t view_bit, std::span<const float> distance, std::span<const float> area,
+                                           std::span<const uint32_t> model,
+                                           std::span<const uint8_t> view_mask, uint8_t view_bit,
+                                           std::span<const float> distance, std::span<const float> area,
                                            std::span<const float> error_scale, const ModelTable& models,
                                            float focal_px);
 

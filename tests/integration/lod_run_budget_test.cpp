@@ -16,8 +16,8 @@ namespace {
 using lod::test::run_lod;
 
 // 300 balls (6,240 triangles) and 100 pebbles (528); `ball_ratios` and `extra` TOML vary it.
-std::filesystem::path budget_scene(const std::filesystem::path& dir, uint64_t budget, const std::string& ball_ratios,
-                                   const std::string& extra = "") {
+std::filesystem::path budget_scene(const std::filesystem::path& dir, uint64_t budget,
+                                   const std::string& ball_ratios, const std::string& extra = "") {
   lod::test::write_text(dir / "ball.off", lod::test::sphere_off(40, 80));
   lod::test::write_text(dir / "pebble.off", lod::test::sphere_off(12, 24));
   const auto cfg = dir / "scene.toml";
@@ -27,7 +27,8 @@ frames = 24
 threads = 2
 
 [budget]
-triangles = )" + std::to_string(budget) + R"(
+triangles = )" + std::to_string(budget) +
+                                 R"(
 
 [camera]
 path = "orbit"
@@ -86,12 +87,14 @@ size_t count_of(const std::string& text, const std::string& part) {
 TEST(LodRunBudget, ExplainsOnceWhatKeepsTheCoarsestLevelsOverBudget) {
   const auto dir = lod::test::temp_dir("lodrun-shortfall");
   const auto cfg = budget_scene(dir, 20000, "[1.0, 0.5, 0.25, 0.12, 0.06]");
-  const std::string base = "run --config " + cfg.string() + " --cache " + (dir / "cache").string() + " --quiet";
+  const std::string base =
+      "run --config " + cfg.string() + " --cache " + (dir / "cache").string() + " --quiet";
   auto r = run_lod(base + " --json " + (dir / "o.json").string());
   ASSERT_EQ(r.code, 0) << "without --strict-exit an over-budget run still succeeds\n" << r.out;
   EXPECT_EQ(count_of(r.out, "cannot be met"), 1u) << r.out;
   EXPECT_NE(r.out.find("budget 20,000 triangles cannot be met"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("of model 'ball' at their coarsest level 4 (374 triangles each)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("of model 'ball' at their coarsest level 4 (374 triangles each)"), std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("model 'pebble' at their coarsest level 2"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("a last ratio of 0.0"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("or culling, ratios ending in 0"), std::string::npos) << r.out;
@@ -169,7 +172,8 @@ TEST(LodRunBudget, BothSelectorsMeetTheBudgetAndTheReportShowsTheSelection) {
       EXPECT_TRUE(std::filesystem::exists(report / file)) << file;
     const std::string csv = read_text(report / "frames.csv");
     const std::string header = csv.substr(0, csv.find('\n'));
-    for (const char* column : {"tris_drawn", "tris_blend_extra", "benefit", "pixel_error_max", "level_changes"})
+    for (const char* column :
+         {"tris_drawn", "tris_blend_extra", "benefit", "pixel_error_max", "level_changes"})
       EXPECT_NE(header.find(column), std::string::npos) << column;
     ++k;
   }

@@ -66,7 +66,8 @@ TEST(FrameBudgetModes, CulledEntriesDrawNothingAreCountedAndNeverBlend) {
       culled += to;
       if (f.from_levels[k] != f.levels[k]) {
         ++blends;
-        EXPECT_FALSE(to || from) << "frame " << n << " entry " << k << ": a blend into or out of the culled level";
+        EXPECT_FALSE(to || from) << "frame " << n << " entry " << k
+                                 << ": a blend into or out of the culled level";
       }
     }
     EXPECT_EQ(f.culled, culled) << "frame " << n;

@@ -65,7 +65,8 @@ TEST(CulledLevel, MorphTargetsStopBeforeTheCulledLevel) {
   std::string why;
   EXPECT_TRUE(validate_chain(c, &why)) << why;
   EXPECT_TRUE(can_morph_levels(c));
-  EXPECT_FALSE(can_morph_levels(with_culled_level(test::fan_chain("one", {4})))) << "one drawn level: nothing to blend";
+  EXPECT_FALSE(can_morph_levels(with_culled_level(test::fan_chain("one", {4}))))
+      << "one drawn level: nothing to blend";
 }
 
 TEST(CulledLevel, AssetRoundTripsAndRefusesAnEmptyMiddleLevel) {
@@ -99,8 +100,8 @@ struct OneObjectBlend {
 
   BlendTotals run(uint8_t new_level, double now) {
     level[0] = new_level;
-    const BlendTotals t = advance_level_blends(morph, from_level, ids, level, model, {start, from, prev, was}, blends,
-                                               models, now, 1.0f);
+    const BlendTotals t = advance_level_blends(morph, from_level, ids, level, model, {start, from, prev, was},
+                                               blends, models, now, 1.0f);
     prev[0] = new_level;
     was[0] = 1;
     return t;
@@ -180,8 +181,8 @@ TEST(MaxDistance, CullsSpheresWhoseNearestPointIsFarther) {
   EXPECT_EQ(cleared, 1u) << "only visible ones count";
   // Sub-ranges give the same result.
   std::vector<uint8_t> a = {1, 1, 1, 0};
-  cull_beyond_distance(std::span(a).first(2), std::span(cx).first(2), std::span(cy).first(2), std::span(cz).first(2),
-                       std::span(r).first(2), glm::vec3(0), 100.f);
+  cull_beyond_distance(std::span(a).first(2), std::span(cx).first(2), std::span(cy).first(2),
+                       std::span(cz).first(2), std::span(r).first(2), glm::vec3(0), 100.f);
   cull_beyond_distance(std::span(a).subspan(2), std::span(cx).subspan(2), std::span(cy).subspan(2),
                        std::span(cz).subspan(2), std::span(r).subspan(2), glm::vec3(0), 100.f);
   EXPECT_EQ(a, visible);
@@ -208,7 +209,8 @@ struct ColdStart {
   std::vector<uint32_t> model;
   std::vector<HeapEntry> heap;
   uint64_t coarsest = 0;
-  ColdStart(const ModelTable& t, size_t n, uint32_t seed) : level(n, 0), visible(n, 1), weight(n), model(n), heap(n) {
+  ColdStart(const ModelTable& t, size_t n, uint32_t seed)
+      : level(n, 0), visible(n, 1), weight(n), model(n), heap(n) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> w(0.001f, 1.f);
     for (size_t i = 0; i < n; ++i) {
@@ -303,8 +305,8 @@ TEST(SelectionQuality, BenefitIsTheOraclesAndPixelErrorTheProjectedError) {
   // Parts merge to the whole.
   const auto part = [&](size_t b, size_t e) {
     return measure_selection_quality(std::span(ids).subspan(b, e - b), std::span(chosen).subspan(b, e - b),
-                                     std::span(s.model).subspan(b, e - b), mask, 1, s.distance, s.area, s.scale,
-                                     s.models, 1000.f);
+                                     std::span(s.model).subspan(b, e - b), mask, 1, s.distance, s.area,
+                                     s.scale, s.models, 1000.f);
   };
   const SelectionQuality merged = merge_quality(part(0, 17), part(17, 40));
   EXPECT_NEAR(merged.benefit, q.benefit, 1e-9 * q.benefit);
