@@ -706,8 +706,10 @@ struct FrameGraph::Impl {
     vd_visible.clear();
     vd_tasks.clear();
     if (!any_vd) return;
+    const ModelTable& m = set->models;
     for (uint32_t k = 0; k < visible_total; ++k) {
       if (!has_vd[f.models[k]]) continue;
+      if (m.triangles[m.first_level[f.models[k]] + f.levels[k]] == 0) continue;  // culled: no front drawn
       VdObject& o = vd_state(f.handles[k], f.models[k]);
       o.entry = k;
       vd_visible.push_back(&o);
