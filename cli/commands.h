@@ -16,6 +16,7 @@ struct RunArgs {
   int64_t threads = -1;      // -1 = config
   bool validate = false;
   bool quiet = false;
+  bool strict_exit = false;  // exit 5 when any frame's coarsest levels exceed M
 };
 int run_command(const RunArgs& args);
 

@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--report", run.report_dir, "write frames.csv, summary.json, graph.dot and SVG plots here");
   run_cmd->add_flag("--validate", run.validate, "check every frame's invariants; fail on the first bad one");
   run_cmd->add_flag("--quiet", run.quiet, "no per-frame table");
+  run_cmd->add_flag("--strict-exit", run.strict_exit,
+                    "exit with code 5 when the coarsest levels exceed the budget on any frame");
 
   lod::cli::InspectArgs inspect;
   auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels or an .hlod file's tree");

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "cli/budget_shortfall.h"
 #include "cli/commands.h"
 #include "cli/run_report.h"
 #include "jobs/bake_jobs.h"
@@ -167,10 +168,14 @@ int run_command(const RunArgs& args) {
   summary.baked_models = bake.baked;
   summary.cached_models = bake.cached;
 
+  std::vector<std::string> model_names;
+  for (const ModelConfig& m : config.models) model_names.push_back(m.name);
+  bool told_shortfall = false;  // the first over-budget frame is explained, the summary counts them all
+
   std::vector<FrameRecord> records;
   records.reserve(config.frames);
   const uint32_t every = config.frames <= 40 ? 1 : (config.frames + 29) / 30;
-  if (!args.quiet) std::printf("%s\n", table_header().c_str());
+  if (!args.quiet) std::printf("%s\n%s\n", table_header().c_str(), table_legend().c_str());
   for (uint32_t n = 0; n < config.frames; ++n) {
     if (motion.moving() > 0) {
       motion.stage(service, (n + 1) * dt);
@@ -196,6 +201,11 @@ int run_command(const RunArgs& args) {
         return 3;
       }
     }
+    if (frame.over_budget && !told_shortfall) {
+      told_shortfall = true;
+      std::fprintf(stderr, "lod run: frame %u: %s\n", n,
+                   shortfall_text(budget_shortfall(frame, scene.models, config.selection.count), model_names).c_str());
+    }
     records.push_back(record_of(frame));
     if (!args.quiet && (n % every == 0 || n + 1 == config.frames))
       std::printf("%s\n", table_row(records.back()).c_str());
@@ -219,10 +229,17 @@ int run_command(const RunArgs& args) {
       std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
       return 1;
     }
-    std::printf("  report: %s/{frames.csv,summary.json,triangles.svg,stage_ms.svg,graph.dot}\n",
+    std::printf("  report: %s/{frames.csv,summary.json,triangles.svg,drawn.svg,levels.svg,level_changes.svg,"
+                "pixel_error.svg,stage_ms.svg,graph.dot}\n",
                 args.report_dir.c_str());
   }
-  return stats.errors ? 4 : 0;
+  if (stats.errors) return 4;
+  if (args.strict_exit && summary.over_budget_frames > 0) {
+    std::fprintf(stderr, "lod run --strict-exit: the coarsest levels exceeded the budget on %zu of %zu frames\n",
+                 summary.over_budget_frames, summary.frames);
+    return 5;
+  }
+  return 0;
 }
 
 }  // namespace lod::cli

@@ -50,6 +50,13 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"budget_morph_reserve", r.budget_morph_reserve},
           {"tick", r.tick},
           {"occluded", r.occluded},
+          {"levels_lowered", r.levels_lowered},
+          {"culled", r.culled},
+          {"level_changes", r.level_changes},
+          {"benefit", r.benefit},
+          {"pixel_error_max", r.pixel_error_max},
+          {"pixel_error_mean", r.pixel_error_mean},
+          {"tris_drawn", r.drawn()},
           {"ms", ms}};
 }
 
@@ -77,6 +84,11 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"max_drawn_over_budget", s.max_drawn_over_budget},
           {"frames_drawn_over_budget", s.frames_drawn_over_budget},
           {"mean_occluded", s.mean_occluded},
+          {"mean_culled", s.mean_culled},
+          {"mean_benefit", s.mean_benefit},
+          {"mean_level_changes", s.mean_level_changes},
+          {"mean_pixel_error", s.mean_pixel_error},
+          {"max_pixel_error", s.max_pixel_error},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
           {"cached_models", s.cached_models},
@@ -108,6 +120,13 @@ FrameRecord record_of(const Frame& f) {
   r.budget_morph_reserve = f.budget_morph_reserve;
   r.tick = f.tick;
   r.occluded = f.occluded;
+  r.levels_lowered = f.levels_lowered;
+  r.culled = f.culled;
+  r.level_changes = f.level_changes;
+  r.benefit = f.benefit;
+  r.pixel_error_max = f.pixel_error_max;
+  r.pixel_error_mean = f.pixel_error_mean;
+  for (uint8_t l : f.levels) ++r.chain_levels[std::min<size_t>(l, kMaxLevels - 1)];
   return r;
 }
 
@@ -117,7 +136,8 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.binding_frames = 0;
   std::vector<double> total;
   std::array<std::vector<double>, kStageCount> stage;
-  double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0;
+  double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0, culled = 0, benefit = 0, changes = 0, px = 0;
+  s.max_pixel_error = 0;
   s.max_drawn_over_budget = 0;
   s.frames_drawn_over_budget = 0;
   for (const auto& r : records) {
@@ -133,6 +153,11 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     if (r.budget > 0) s.max_drawn_over_budget = std::max(s.max_drawn_over_budget, d / double(r.budget));
     s.frames_drawn_over_budget += d > double(r.budget);
     occluded += r.occluded;
+    culled += r.culled;
+    benefit += r.benefit;
+    changes += r.level_changes;
+    px += r.pixel_error_mean;
+    s.max_pixel_error = std::max(s.max_pixel_error, double(r.pixel_error_max));
   }
   const double n = std::max<double>(1, double(records.size()));
   s.median_ms = percentile(total, 0.5);
@@ -147,6 +172,16 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.mean_tris_selected = sel / n;
   s.mean_tris_drawn = drawn / n;
   s.mean_occluded = occluded / n;
+  s.mean_culled = culled / n;
+  s.mean_benefit = benefit / n;
+  s.mean_level_changes = changes / n;
+  s.mean_pixel_error = px / n;
+}
+
+std::string table_legend() {
+  return "  (tris_in_view: the visible objects at full detail; selected: triangles of the chosen levels; budget: M;\n"
+         "   over: YES when even the coarsest levels exceed M; lowered: heap pops of selection; *_ms: visibility,\n"
+         "   importance and selection stages and the whole frame graph, in milliseconds)";
 }
 
 std::string table_header() {
@@ -189,6 +224,16 @@ std::string summary_text(const RunSummary& s) {
                 s.mean_tris_drawn, s.max_drawn_over_budget, s.frames_drawn_over_budget, s.bake_ms, s.baked_models,
                 s.cached_models, s.wall_s);
   o << buf;
+  std::snprintf(buf, sizeof buf,
+                "  selection: mean benefit %.4g, %.1f level changes per frame; screen-space error left: mean %.2f px, "
+                "worst %.2f px\n",
+                s.mean_benefit, s.mean_level_changes, s.mean_pixel_error, s.max_pixel_error);
+  o << buf;
+  if (s.mean_culled > 0) {
+    std::snprintf(buf, sizeof buf, "  culled (culled level or beyond lod.max_distance): mean %.0f objects per frame\n",
+                  s.mean_culled);
+    o << buf;
+  }
   if (s.mean_occluded > 0) {
     std::snprintf(buf, sizeof buf, "  occlusion: mean %.0f objects in the frustum culled as hidden per frame\n",
                   s.mean_occluded);
@@ -209,6 +254,55 @@ Status write_json(const std::filesystem::path& file, const std::vector<FrameReco
   return write_file(file, j.dump(1) + "\n");
 }
 
+namespace {
+
+// The plots of what selection did: drawn vs M (linear), objects per level, level changes and
+// the pixel error left.
+Status write_selection_plots(const std::filesystem::path& dir, const std::vector<FrameRecord>& records,
+                             const RunSummary& s) {
+  PlotSeries drawn{"drawn (selected + blends)", "#d62728", {}}, selected{"selected", "#1f77b4", {}},
+      budget{"budget M", "#2ca02c", {}, true};
+  PlotSeries changes{"level changes", "#9467bd", {}}, culled{"culled", "#7f7f7f", {}, true};
+  PlotSeries px_max{"worst", "#d62728", {}}, px_mean{"mean", "#1f77b4", {}};
+  size_t levels_used = 1;
+  for (const auto& r : records) {
+    drawn.values.push_back(double(r.drawn()));
+    selected.values.push_back(double(r.tris_selected));
+    budget.values.push_back(double(r.budget));
+    changes.values.push_back(r.level_changes);
+    culled.values.push_back(r.culled);
+    px_max.values.push_back(r.pixel_error_max);
+    px_mean.values.push_back(r.pixel_error_mean);
+    for (size_t l = 0; l < kMaxLevels; ++l)
+      if (r.chain_levels[l]) levels_used = std::max(levels_used, l + 1);
+  }
+  PlotOptions o;
+  o.title = "Drawn triangles (with level blends) vs the budget (" + s.config + ")";
+  o.y_label = "triangles";
+  if (auto st = write_file(dir / "drawn.svg", svg_line_plot({drawn, selected, budget}, o)); !st) return st;
+
+  static const char* colors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
+                                 "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+  std::vector<PlotSeries> per_level;
+  for (size_t l = 0; l < levels_used; ++l) {
+    PlotSeries ps{"level " + std::to_string(l), colors[l % 10], {}};
+    for (const auto& r : records) ps.values.push_back(r.chain_levels[l]);
+    per_level.push_back(std::move(ps));
+  }
+  per_level.push_back(culled);
+  o.title = "Objects per chain level (0 = full detail; culled: not drawn)";
+  o.y_label = "objects";
+  if (auto st = write_file(dir / "levels.svg", svg_line_plot(per_level, o)); !st) return st;
+  o.title = "Level changes per frame (objects visible last frame at another level)";
+  o.y_label = "objects";
+  if (auto st = write_file(dir / "level_changes.svg", svg_line_plot({changes}, o)); !st) return st;
+  o.title = "Screen-space error left by the selected levels (view 0)";
+  o.y_label = "pixels";
+  return write_file(dir / "pixel_error.svg", svg_line_plot({px_max, px_mean}, o));
+}
+
+}  // namespace
+
 Status write_report(const std::filesystem::path& dir, const std::vector<FrameRecord>& records, const RunSummary& s,
                     const std::string& graph_dot) {
   std::error_code ec;
@@ -216,13 +310,15 @@ Status write_report(const std::filesystem::path& dir, const std::vector<FrameRec
   if (ec) return Status::error(dir.string() + ": cannot create report directory: " + ec.message());
 
   std::ostringstream csv;
-  csv << "frame,objects,visible,tris_in_view,tris_selected,level_cost,budget,coarsest_cost,over_budget,lowered_steps";
+  csv << "frame,objects,visible,tris_in_view,tris_selected,tris_drawn,tris_blend_extra,level_cost,budget,coarsest_cost,"
+         "over_budget,lowered_steps,levels_lowered,culled,level_changes,benefit,pixel_error_max,pixel_error_mean";
   for (size_t i = 0; i < kStageCount; ++i) csv << "," << kStageNames[i] << "_ms";
   csv << ",total_ms\n";
   for (const auto& r : records) {
     csv << r.frame << "," << r.objects << "," << r.visible << "," << r.tris_in_view << "," << r.tris_selected << ","
-        << r.level_cost << "," << r.budget << "," << r.coarsest_cost << "," << (r.over_budget ? 1 : 0) << ","
-        << r.lowered_steps;
+        << r.drawn() << "," << r.tris_morph_extra << "," << r.level_cost << "," << r.budget << "," << r.coarsest_cost
+        << "," << (r.over_budget ? 1 : 0) << "," << r.lowered_steps << "," << r.levels_lowered << "," << r.culled << ","
+        << r.level_changes << "," << r.benefit << "," << r.pixel_error_max << "," << r.pixel_error_mean;
     for (size_t i = 0; i < kStageCount; ++i) csv << "," << r.stage_ms[i];
     csv << "," << r.total_ms << "\n";
   }
@@ -242,6 +338,7 @@ Status write_report(const std::filesystem::path& dir, const std::vector<FrameRec
   tri_opt.y_label = "triangles (log)";
   tri_opt.log_y = true;
   if (auto st = write_file(dir / "triangles.svg", svg_line_plot({in_view, selected, budget}, tri_opt)); !st) return st;
+  if (auto st = write_selection_plots(dir, records, s); !st) return st;
 
   static const char* colors[] = {"#7f7f7f", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"};
   std::vector<PlotSeries> stages;

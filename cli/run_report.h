@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "runtime/frame.h"
+#include "runtime/model_table.h"
 #include "runtime/status.h"
 
 namespace lod::cli {
@@ -27,6 +28,14 @@ struct FrameRecord {
   uint64_t budget_morph_reserve = 0; // held back from M for last frame's blends
   uint64_t tick = 0;                 // the commit the frame was computed from
   uint32_t occluded = 0;             // frustum-visible objects occlusion culled
+  uint32_t levels_lowered = 0;       // levels selection lowered (lowered_steps counts heap pops)
+  uint32_t culled = 0;               // at a culled level, or beyond lod.max_distance
+  uint32_t level_changes = 0;        // entries at another level than last frame
+  double benefit = 0;                // the oracle's benefit of the selected levels (view 0)
+  float pixel_error_max = 0, pixel_error_mean = 0;  // screen-space error left (view 0)
+  std::array<uint32_t, kMaxLevels> chain_levels{};  // objects per chain level index
+
+  uint64_t drawn() const { return tris_selected + tris_morph_extra; }  // with blends
 };
 
 FrameRecord record_of(const Frame& frame);
@@ -45,6 +54,9 @@ struct RunSummary {
   double mean_tris_drawn = 0, max_drawn_over_budget = 0;
   size_t frames_drawn_over_budget = 0;  // drawn (blends included) > M
   double mean_occluded = 0;             // objects occlusion culled per frame
+  double mean_culled = 0;               // culled level or beyond lod.max_distance, per frame
+  double mean_benefit = 0, mean_level_changes = 0;
+  double mean_pixel_error = 0, max_pixel_error = 0;
   double bake_ms = 0;
   size_t baked_models = 0, cached_models = 0;
   double wall_s = 0;
@@ -53,14 +65,18 @@ struct RunSummary {
 // Fills the timing and mean fields of `summary` from the records.
 void summarize(const std::vector<FrameRecord>& records, RunSummary& summary);
 
+// What the per-frame table's columns mean (printed under its header).
+std::string table_legend();
 std::string table_header();
 std::string table_row(const FrameRecord& r);
 std::string summary_text(const RunSummary& s);
 
 Status write_json(const std::filesystem::path& file, const std::vector<FrameRecord>& records,
                   const RunSummary& summary);
-// frames.csv, summary.json, triangles.svg (R0's Fig. 4: in view, selected, budget),
-// stage_ms.svg (per-stage milliseconds), graph.dot.
+// frames.csv, summary.json, graph.dot and the plots: triangles.svg (R0's Fig. 4: in view,
+// selected, budget; log scale), drawn.svg (drawn with blends vs M, linear), levels.svg
+// (objects per chain level), level_changes.svg, pixel_error.svg (worst and mean error left)
+// and stage_ms.svg (per-stage milliseconds).
 Status write_report(const std::filesystem::path& dir, const std::vector<FrameRecord>& records,
                     const RunSummary& summary, const std::string& graph_dot);
 

@@ -34,6 +34,7 @@
 #include "runtime/level_caps.h"
 #include "runtime/object_controls.h"
 #include "runtime/occlusion.h"
+#include "runtime/selection_quality.h"
 #include "runtime/vd_share.h"
 #include "runtime/vertex_front.h"
 #include "runtime/view_masks.h"
@@ -86,6 +87,9 @@ struct ChunkTotals {
   uint64_t tris_in_view = 0;
   uint64_t tris_selected = 0;
   uint64_t level_cost = 0;
+  uint32_t culled = 0;         // entries at a culled level (0 triangles)
+  uint32_t level_changes = 0;  // entries visible last frame at another level
+  SelectionQuality quality;
   std::array<uint32_t, kHistogramLevels> histogram{};
 };
 
@@ -194,6 +198,7 @@ struct FrameGraph::Impl {
   std::vector<std::vector<OccluderCandidate>> chunk_occluders;
   std::vector<OccluderCandidate> occluders;
   std::vector<uint32_t> chunk_occluded;
+  std::vector<uint32_t> chunk_far;         // view 0's frustum, beyond max_distance
   OcclusionBuffer occlusion_buffer;
   OcclusionCamera occlusion_view{};
   uint32_t visible_total = 0;
@@ -269,7 +274,8 @@ struct FrameGraph::Impl {
     for (size_t i = 0; i < m.model_count(); ++i) {
       const LodChain& chain = *set->chains[i];
       for (size_t k = 0; k < chain.levels.size() && chain.positions.size() >= 9; ++k) {
-        if (chain.levels[k].triangles() > options.occlusion.occluder_triangles) continue;
+        const uint32_t tris = chain.levels[k].triangles();
+        if (tris > options.occlusion.occluder_triangles || tris == 0) continue;  // 0: the culled level
         occluder_level[i] = static_cast<int16_t>(k);
         can_occlude[i] = 1;
         break;
@@ -328,6 +334,7 @@ struct FrameGraph::Impl {
     chunk_blend.resize(chunks);
     chunk_occluders.resize(chunks);
     chunk_occluded.resize(chunks);
+    chunk_far.resize(chunks);
     selection_counts.resize(chunks * level_total);
     level_counts.resize(chunks * kCountLanes * level_total);
   }
@@ -459,7 +466,12 @@ struct FrameGraph::Impl {
       for (uint32_t v = 0; v < view_count; ++v) {
         vis[v] = sub(per_view[v].visible, b, e);
         cull_spheres(vis[v], sub(s.cx, b, e), sub(s.cy, b, e), sub(s.cz, b, e), sub(s.radius, b, e), frusta[v]);
+        if (options.max_distance <= 0) continue;
+        const size_t far = cull_beyond_distance(vis[v], sub(s.cx, b, e), sub(s.cy, b, e), sub(s.cz, b, e),
+                                                sub(s.radius, b, e), views[v].eye, options.max_distance);
+        if (v == 0) chunk_far[c] = static_cast<uint32_t>(far);
       }
+      if (options.max_distance <= 0) chunk_far[c] = 0;
       chunk_visible[c] = static_cast<uint32_t>(
           combine_view_masks(sub(mask, b, e), std::span(vis.data(), view_count), sub(s.never_cull, b, e)));
       if (options.occlusion.enabled) {
@@ -707,8 +719,10 @@ struct FrameGraph::Impl {
     vd_visible.clear();
     vd_tasks.clear();
     if (!any_vd) return;
+    const ModelTable& m = set->models;
     for (uint32_t k = 0; k < visible_total; ++k) {
       if (!has_vd[f.models[k]]) continue;
+      if (m.triangles[m.first_level[f.models[k]] + f.levels[k]] == 0) continue;  // culled: no front drawn
       VdObject& o = vd_state(f.handles[k], f.models[k]);
       o.entry = k;
       vd_visible.push_back(&o);
@@ -802,25 +816,41 @@ struct FrameGraph::Impl {
     const ModelTable& rows = caps.rows;
     const PerView& p0 = per_view[0];
     for_chunks(Stage::publish, [&](size_t c, size_t b, size_t e) {
-      // Temporal state for the next frame: who was visible, at which level.
-      std::copy(p0.visible.begin() + b, p0.visible.begin() + e, s.was_visible.begin() + b);
       uint32_t* counts = level_counts.data() + c * kCountLanes * level_total;
       std::fill(counts, counts + kCountLanes * level_total, 0u);
       const uint32_t first_slot = chunk_offset[c], end_slot = first_slot + chunk_visible[c];
       const uint32_t* first_level = rows.first_level.data();
+      const size_t n = end_slot - first_slot;
+      // Measured before the history is overwritten (the entries of chunk c are its objects).
+      const SelectionQuality quality = measure_selection_quality(
+          std::span(f.objects.data() + first_slot, n), std::span(f.levels.data() + first_slot, n),
+          std::span(f.models.data() + first_slot, n), mask, uint8_t{1}, p0.distance, p0.area, s.error_scale,
+          set->models, focal[0]);
+      uint32_t changes = 0;
       for (uint32_t k = first_slot; k < end_slot; ++k) {
         const uint8_t level = f.levels[k];
-        s.prev_level[f.objects[k]] = level;
+        const uint32_t id = f.objects[k];
+        changes += s.was_visible[id] && s.prev_level[id] != level;
+        s.prev_level[id] = level;
         ++counts[(k % kCountLanes) * level_total + first_level[visible_row[k]] + level];
       }
+      // Temporal state for the next frame: who was visible, at which level.
+      std::copy(p0.visible.begin() + b, p0.visible.begin() + e, s.was_visible.begin() + b);
       chunk_totals[c] = sum_counts(counts);
+      chunk_totals[c].level_changes = changes;
+      chunk_totals[c].quality = quality;
     });
     f.object_count = static_cast<uint32_t>(count);
     f.visible = visible_total;
     f.tris_in_view = f.tris_selected = f.level_cost = 0;
     f.level_histogram.fill(0);
+    f.culled = f.level_changes = 0;
+    SelectionQuality quality;
     for (size_t c = 0; c < chunks; ++c) {
       const ChunkTotals& t = chunk_totals[c];
+      f.culled += t.culled + chunk_far[c];
+      f.level_changes += t.level_changes;
+      quality = merge_quality(quality, t.quality);
       f.tris_in_view += t.tris_in_view;
       f.tris_selected += t.tris_selected;
       f.level_cost += t.level_cost;
@@ -831,6 +861,10 @@ struct FrameGraph::Impl {
     f.coarsest_cost = selected.coarsest_cost;
     f.over_budget = selected.over_budget;
     f.lowered_steps = selected.lowered_steps;
+    f.levels_lowered = selected.levels_lowered;
+    f.benefit = quality.benefit;
+    f.pixel_error_max = quality.pixel_error_max;
+    f.pixel_error_mean = quality.measured ? float(quality.pixel_error_sum / quality.measured) : 0.f;
   }
 
   ChunkTotals sum_counts(const uint32_t* counts) const {
@@ -843,6 +877,7 @@ struct FrameGraph::Impl {
       const int32_t l = rows.level_l[at];
       t.tris_in_view += n * full_triangles[at];
       t.tris_selected += n * rows.triangles[at];
+      t.culled += rows.triangles[at] == 0 ? static_cast<uint32_t>(n) : 0u;
       t.level_cost += n << std::clamp(l, 0, 63);
       t.histogram[static_cast<size_t>(std::clamp<int32_t>(l, 0, kHistogramLevels - 1))] += static_cast<uint32_t>(n);
     }
@@ -914,13 +949,13 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      &Impl::node_commit},
     {Stage::bounds, "world_spheres + object_controls, parallel", kObjects, kBounds | kControls, &Impl::node_bounds},
     {Stage::view, "frustum planes, focal length per view", 0, kViews, &Impl::node_view},
-    {Stage::visibility, "cull_spheres per view + combine_view_masks; occlusion: gather_occluders, rasterize_occluder, sphere_occluded; parallel", kBounds | kControls | kViews,
+    {Stage::visibility, "cull_spheres (+ cull_beyond_distance) per view + combine_view_masks; occlusion: gather_occluders, rasterize_occluder, sphere_occluded; parallel", kBounds | kControls | kViews,
      kVisibility, &Impl::node_visibility},
     {Stage::importance,
      "measure_objects + minima, importance_weights + choose_initial_levels per view, combine_view_choice, "
      "apply_object_controls, compaction, gather_selection, parallel",
      kObjects | kBounds | kControls | kViews | kVisibility | kHistory, kEntries | kLevels, &Impl::node_importance},
-    {Stage::selection, "lower_under_budget: heap over the visible set, serial", kEntries | kLevels, kLevels,
+    {Stage::selection, "lower_under_budget (greedy or greedy_multi): heap over the visible set, serial", kEntries | kLevels, kLevels,
      &Impl::node_selection},
     {Stage::entries, "handles, transforms, view masks of the entries, parallel", kEntries | kObjects | kVisibility,
      kPlacing, &Impl::node_entries},
@@ -929,7 +964,7 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      kEntries | kPlacing | kLevels | kViews, kFronts, &Impl::node_vdlod},
     {Stage::vd_mesh, "vertex_morph_positions + compact meshes of vd objects, parallel", kEntries | kFronts, kVdMesh,
      &Impl::node_vd_mesh},
-    {Stage::publish, "totals, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend,
+    {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend,
      kTotals | kHistory, &Impl::node_publish},
 };
 

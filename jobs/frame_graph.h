@@ -30,6 +30,7 @@ struct FrameGraphOptions {
   SelectionParams selection;
   float pixel_error = 1.0f;
   float hysteresis = 0.25f;
+  float max_distance = 0;          // objects whose sphere lies farther are not drawn; 0 = no limit
   uint32_t grain = 2048;           // objects per parallel chunk
   // View-dependent objects and geomorphing: a level change, split or collapse blends over
   // geomorph_seconds (0 = none). run(view, out) steps the clock by frame_seconds.

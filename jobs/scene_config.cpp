@@ -192,7 +192,7 @@ void read_run(const Reader& r, const toml::table& root, SceneConfig& c) {
 void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "budget", "budget");
   if (!t) return;
-  r.only_keys(*t, "budget", {"triangles", "count", "reserve_blends", "strict"});
+  r.only_keys(*t, "budget", {"triangles", "count", "reserve_blends", "strict", "selector"});
   if (auto v = r.integer(*t, "triangles", "budget.triangles")) {
     if (*v <= 0) r.fail("budget.triangles", "must be at least 1, got " + std::to_string(*v));
     c.selection.budget = static_cast<uint64_t>(*v);
@@ -215,6 +215,14 @@ void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
     if (!b) r.fail("budget.strict", "must be true or false");
     else c.selection.strict = b->get();
   }
+  if (auto v = r.string(*t, "selector", "budget.selector")) {
+    if (*v == "greedy")
+      c.selection.selector = Selector::greedy;
+    else if (*v == "greedy_multi")
+      c.selection.selector = Selector::greedy_multi;
+    else
+      r.fail("budget.selector", "must be \"greedy\" or \"greedy_multi\", got \"" + *v + "\"");
+  }
   if (c.selection.strict && c.selection.count != BudgetCount::triangles)
     r.fail("budget.strict", "needs count = \"triangles\" (blends are counted in triangles)");
 }
@@ -222,7 +230,7 @@ void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
 void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "lod", "lod");
   if (!t) return;
-  r.only_keys(*t, "lod", {"pixel_error", "hysteresis"});
+  r.only_keys(*t, "lod", {"pixel_error", "hysteresis", "max_distance"});
   if (auto v = r.number(*t, "pixel_error", "lod.pixel_error")) {
     if (*v <= 0 || *v > 10000)
       r.fail("lod.pixel_error", "must be in (0, 10000] pixels, got " + number_text(*v));
@@ -231,6 +239,10 @@ void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {
   if (auto v = r.number(*t, "hysteresis", "lod.hysteresis")) {
     if (*v < 0 || *v > 10) r.fail("lod.hysteresis", "must be in [0, 10], got " + number_text(*v));
     c.hysteresis = static_cast<float>(*v);
+  }
+  if (auto v = r.number(*t, "max_distance", "lod.max_distance")) {
+    if (!(*v > 0)) r.fail("lod.max_distance", "must be > 0 world units, got " + number_text(*v));
+    c.max_distance = static_cast<float>(*v);
   }
 }
 
@@ -360,7 +372,10 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
       for (size_t j = 0; j < a->size(); ++j) {
         const std::string rk = indexed(key + ".ratios", j);
         const double v = *r.number(*a->get(j), rk);
-        if (!(v > 0 && v <= 1)) r.fail(rk, "must be in (0, 1], got " + number_text(v));
+        // A last ratio of 0 is the culled level: the object is not drawn there.
+        const bool culled = v == 0 && j > 0 && j + 1 == a->size();
+        if (!culled && !(v > 0 && v <= 1))
+          r.fail(rk, v == 0 ? "0 (the culled level) may only be the last ratio" : "must be in (0, 1], got " + number_text(v));
         if (j == 0 && v != 1) r.fail(rk, "must be 1.0: level 0 is the full mesh, got " + number_text(v));
         if (j > 0 && !(v < m.bake.ratios.back()))
           r.fail(rk, "ratios must decrease, but " + number_text(v) + " follows " +
@@ -385,6 +400,8 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
       m.view_dependent = b->get();
     }
     r.integer_in(t, "vd_parts", key + ".vd_parts", 1, 64, m.vd_parts);
+    if (m.view_dependent && !m.bake.ratios.empty() && m.bake.ratios.back() == 0)
+      r.fail(key + ".ratios", "a culled level (last ratio 0) needs view_dependent = false");
     if (m.vd_parts > 1 && !m.view_dependent) r.fail(key + ".vd_parts", "needs view_dependent = true");
     c.models.push_back(std::move(m));
   }

@@ -43,6 +43,7 @@ struct SceneConfig {
   SelectionParams selection;
   float pixel_error = 1.0f;          // [lod] pixel_error: screen-space threshold of initial levels
   float hysteresis = 0.25f;          // [lod] hysteresis
+  float max_distance = 0;            // [lod] max_distance: objects farther are not drawn; 0 = no limit
   bool occlusion = false;            // [visibility] occlusion
   uint32_t occluders = 48;           // [visibility] occluders
   CameraPath camera;

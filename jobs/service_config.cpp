@@ -28,6 +28,7 @@ FrameGraphOptions frame_graph_options(const SceneConfig& config) {
   g.selection = config.selection;
   g.pixel_error = config.pixel_error;
   g.hysteresis = config.hysteresis;
+  g.max_distance = config.max_distance;
   g.occlusion.enabled = config.occlusion;
   g.occlusion.occluders = config.occluders;
   return g;
@@ -37,8 +38,10 @@ ModelBaker mesh_baker(std::vector<float> ratios) {
   return [ratios](const std::filesystem::path& mesh, const std::filesystem::path& cache_dir,
                   std::vector<uint8_t>& asset, std::string& error) {
     for (size_t i = 0; i < ratios.size(); ++i) {
-      if (!(ratios[i] > 0 && ratios[i] <= 1) || (i == 0 && ratios[i] != 1) || (i > 0 && !(ratios[i] < ratios[i - 1]))) {
-        error = mesh.string() + ": baker ratios must start at 1 and decrease within (0, 1]";
+      const bool culled = i > 0 && i + 1 == ratios.size() && ratios[i] == 0;  // the culled level
+      if (!(culled || (ratios[i] > 0 && ratios[i] <= 1)) || (i == 0 && ratios[i] != 1) ||
+          (i > 0 && !(ratios[i] < ratios[i - 1]))) {
+        error = mesh.string() + ": baker ratios must start at 1 and decrease within (0, 1] (a last 0 culls)";
         return false;
       }
     }

@@ -66,6 +66,22 @@ Sphere bounding_sphere(const float* p, size_t n) {
   return s;
 }
 
+// The culled level: no vertices, no triangles. Its error is level 0's bounding diameter (the
+// most any drawn point can be away from nothing that a viewer can tell), at least the error
+// of the level before, so initial levels cull an object once its diameter projects within the
+// pixel threshold. Its ranges start at the ends of the buffers.
+LodLevel culled_level(const LodChain& chain) {
+  LodLevel l;
+  l.first_index = uint32_t(chain.indices.size());
+  l.first_vertex = uint32_t(chain.positions.size() / 3);
+  l.level = level_of_triangles(0);
+  const LodLevel& full = chain.levels.front();
+  l.error = std::max(2 * full.bounds.radius, chain.levels.back().error);
+  l.error_rms = std::max(2 * full.bounds.radius, chain.levels.back().error_rms);
+  l.bounds = full.bounds;
+  return l;
+}
+
 const char* method_name(SimplifyMethod m) {
   switch (m) {
     case SimplifyMethod::qem: return "qem";
@@ -75,13 +91,16 @@ const char* method_name(SimplifyMethod m) {
   return "?";
 }
 
-// Ratios as given (or defaults), checked; sorted from fine to coarse, 1.0 first, unique.
+// Ratios as given (or defaults), checked; sorted from fine to coarse, 1.0 first, unique. A
+// last ratio of 0 (the culled level) is taken off and reported through `culled`.
 Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std::string& what,
-                      std::vector<float>& out) {
+                      std::vector<float>& out, bool& culled) {
   out = settings.ratios.empty() ? default_ratios(triangles) : settings.ratios;
+  culled = out.size() > 1 && out.back() == 0.0f;
+  if (culled) out.pop_back();
   for (float r : out)
     if (!(r > 0.0f && r <= 1.0f))
-      return Status::error(what + ": LOD ratio " + std::to_string(r) + " is outside (0, 1]");
+      return Status::error(what + ": LOD ratio " + std::to_string(r) + " is outside (0, 1] (0 only as the last)");
   out.push_back(1.0f);
   std::sort(out.begin(), out.end(), std::greater<float>());
   out.erase(std::unique(out.begin(), out.end()), out.end());
@@ -205,7 +224,8 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
     return Status::error(mesh_file.string() + ": no triangles left after cleaning (all degenerate)");
 
   std::vector<float> ratios;
-  s = resolve_ratios(settings, mesh.triangle_count(), what, ratios);
+  bool culled = false;
+  s = resolve_ratios(settings, mesh.triangle_count(), what, ratios, culled);
   if (!s) return s;
 
   SimplifyMethod method = settings.method;
@@ -322,6 +342,7 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
                                " triangles land on no level " + std::to_string(k + 1) +
                                " triangle when fully morphed (a blend there is approximate)");
   }
+  if (culled) chain.levels.push_back(culled_level(chain));
   std::string problem;
   if (!validate_chain(chain, &problem)) return Status::error(what + ": baked chain is invalid: " + problem);
 

@@ -28,10 +28,14 @@ BlendTotals advance_level_blends(std::span<float> morph, std::span<uint8_t> from
     if (!s.was_visible[id]) s.morph_start[id] = -1e300;
     morph[k] = morph_factor(now, s.morph_start[id], seconds);
     const uint32_t m = model[k];
-    const bool blends = morph[k] < 1 && model_blends[m] && s.morph_from[id] != lv;
+    const uint32_t first = models.first_level[m];
+    // Into or out of the culled level (no triangles): no targets to morph to, the object
+    // disappears or appears at once.
+    const uint8_t from = s.morph_from[id];
+    const bool blends = morph[k] < 1 && model_blends[m] && from != lv && from < models.level_count[m] &&
+                        models.triangles[first + lv] > 0 && models.triangles[first + from] > 0;
     from_level[k] = blends ? s.morph_from[id] : lv;
     if (blends) {
-      const uint32_t first = models.first_level[m];
       ++totals.morphing;
       totals.extra_tris += models.triangles[first + std::min(lv, s.morph_from[id])] - models.triangles[first + lv];
     }

@@ -4,7 +4,8 @@
 //     level it was leaving, mid-blend, runs the same blend backwards from where it is;
 //   - an object not visible last frame appears settled;
 //   - morph[k] = elapsed / seconds in [0, 1], from_level[k] = the level it blends from (its own
-//     level when settled or when its model cannot blend).
+//     level when settled or when its model cannot blend);
+//   - a change into or out of a culled level (0 triangles) never blends: nothing to morph to.
 // Sub-range safe over entries (each entry touches only its own object's state).
 #pragma once
 #include <cstdint>

@@ -102,6 +102,12 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
     if (!finite_sane(s.center[0]) || !finite_sane(s.center[1]) || !finite_sane(s.center[2]) ||
         !finite_sane(s.radius) || s.radius < 0)
       return fail(message, at + " has an invalid bounding sphere");
+    // The culled level (a last ratio of 0): empty, and only as the last of two or more.
+    if (lv.index_count == 0 && (k == 0 || k + 1 != chain.levels.size()))
+      return fail(message, at + " has no triangles; only a last level after level 0 may be empty (the culled level)");
+    if (lv.index_count == 0 && lv.vertex_count != 0)
+      return fail(message, at + " is the culled level (no triangles) but has " + std::to_string(lv.vertex_count) +
+                               " vertices");
     if (k > 0) {
       const LodLevel& finer = chain.levels[k - 1];
       if (lv.triangles() > finer.triangles())
@@ -118,7 +124,7 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
     if (chain.morph_targets.size() != want)
       return fail(message, "morph targets hold " + std::to_string(chain.morph_targets.size()) +
                                " entries, the levels but the last have " + std::to_string(want) + " vertices");
-    for (size_t k = 0; k + 1 < chain.levels.size(); ++k) {
+    for (size_t k = 0; k + 1 < drawn_levels(chain); ++k) {
       const LodLevel& lv = chain.levels[k];
       const uint32_t next = chain.levels[k + 1].vertex_count;
       // Ranges were checked above; targets of level k start where its vertices do.
@@ -133,19 +139,25 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
   return true;
 }
 
+bool has_culled_level(const LodChain& chain) {
+  return chain.levels.size() > 1 && chain.levels.back().index_count == 0;
+}
+
+size_t drawn_levels(const LodChain& chain) { return chain.levels.size() - (has_culled_level(chain) ? 1 : 0); }
+
 uint64_t morph_target_count(const LodChain& chain) {
   uint64_t end = 0;
-  for (size_t k = 0; k + 1 < chain.levels.size(); ++k)
+  for (size_t k = 0; k + 1 < drawn_levels(chain); ++k)
     end = std::max(end, uint64_t{chain.levels[k].first_vertex} + chain.levels[k].vertex_count);
   return end;
 }
 
 bool can_morph_levels(const LodChain& chain) {
-  return chain.levels.size() > 1 && chain.morph_targets.size() == morph_target_count(chain);
+  return drawn_levels(chain) > 1 && chain.morph_targets.size() == morph_target_count(chain);
 }
 
 void compose_morph_targets(std::span<uint32_t> out, const LodChain& chain, uint32_t fine, uint32_t coarse) {
-  assert(fine <= coarse && coarse < chain.levels.size());
+  assert(fine <= coarse && coarse < drawn_levels(chain));
   assert(out.size() == chain.levels[fine].vertex_count);
   assert(fine == coarse || chain.morph_targets.size() == morph_target_count(chain));
   for (uint32_t v = 0; v < out.size(); ++v) {

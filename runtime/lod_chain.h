@@ -53,21 +53,31 @@ int32_t level_of_triangles(uint64_t triangles);
 // non-increasing, errors non-decreasing, l = level_of_triangles, finite values, at most
 // kMaxLevels levels. On failure `message` names the element ("level 3 index 812 references
 // vertex 90211 of 35947"); callers prefix the file.
-// With morph targets: one per vertex of every level but the last, each < the next level's
+// The culled level: an empty last level (0 triangles, 0 vertices) after level 0; no other level
+// may be empty.
+// With morph targets: one per vertex of every drawn level but the last, each < the next level's
 // vertex_count ("level 2 vertex 17 morphs into vertex 900 of level 3's 812").
 // Values must be finite and at most kMaxTreeMagnitude in size. `section`, when given, is set
 // to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH") the failing element is in.
 bool validate_chain(const LodChain& chain, std::string* message, const char** section = nullptr);
 
+// The culled level (a last ratio of 0): a last level, after level 0, with no triangles and no
+// vertices; an object there is not drawn. validate_chain accepts no other empty level.
+bool has_culled_level(const LodChain& chain);
+// Levels with triangles: all of them but the culled level.
+size_t drawn_levels(const LodChain& chain);
+
 // Number of morph targets a chain with these levels stores: up to the end of the last
-// vertex range of the levels but the last (their vertex total when levels are back to back).
+// vertex range of the drawn levels but the last (their vertex total when levels are back to
+// back). The culled level has no vertices to morph into, so the level before it has none.
 uint64_t morph_target_count(const LodChain& chain);
 
-// True when level changes can blend: every vertex of every level but the last has a morph
-// target (vacuously so for chains without vertices).
+// True when level changes can blend: every vertex of every drawn level but the last has a
+// morph target (vacuously so for chains without vertices). Changes into or out of the culled
+// level never blend: the object appears or disappears at once.
 bool can_morph_levels(const LodChain& chain);
 
-// Composed morph targets of level `fine` into the coarser level `coarse` (fine < coarse):
+// Composed morph targets of level `fine` into the coarser drawn level `coarse` (fine < coarse):
 // out[v] = t_{coarse-1}(...t_fine(v)), level-local indices of `coarse`, out sized for the fine
 // level's vertices. `fine == coarse` gives the identity. The chain must have morph targets.
 void compose_morph_targets(std::span<uint32_t> out, const LodChain& chain, uint32_t fine, uint32_t coarse);

@@ -62,6 +62,14 @@ void make_heap(HeapEntry* heap, size_t size) {
 
 inline uint64_t pow2(int32_t l) { return uint64_t{1} << l; }
 
+// SLC of lowering from chain level `at` to `at + 1`. The culled level (0 triangles, l = 0)
+// counts as one level below the one before it: culling saves about what such a step saves,
+// and R0's l_i^2 span would make the heap cull objects before it lowers finer ones.
+inline float step_slc(const int32_t* ls, const uint32_t* tris, uint32_t at) {
+  const int32_t to = tris[at + 1] == 0 ? ls[at] - 1 : ls[at + 1];
+  return static_cast<float>(span_of_level_changed(ls[at], to));
+}
+
 // gather_selection's entry for an object that cannot be lowered: rank 0, below every real
 // entry (a real one has ~object > 0), so it sinks to the bottom and is never popped.
 constexpr uint32_t kPlaceholder = 0xffffffffu;
@@ -98,7 +106,7 @@ Gathered gather_by_slots(const Columns& c, const ModelTable& models, HeapEntry* 
   const int32_t* ls = models.level_l.data();
   for (size_t m = 0; m < models.model_count(); ++m) {
     for (uint32_t k = first[m]; k + 1 < first[m] + models.level_count[m]; ++k) {
-      slc_next[k] = static_cast<float>(span_of_level_changed(ls[k], ls[k + 1]));
+      slc_next[k] = step_slc(ls, models.triangles.data(), k);
       lowerable[k] = 1;
     }
   }
@@ -164,8 +172,7 @@ Gathered gather_direct(const Columns& c, const ModelTable& models, HeapEntry* he
     g.lev_sum += pow2(ls[at]) & keep;
     g.tri_coarse += tris[coarse] & keep;
     g.lev_coarse += pow2(ls[coarse]) & keep;
-    const HeapEntry e{c.weight[i] * static_cast<float>(span_of_level_changed(ls[at], ls[at + lowerable])),
-                      static_cast<uint32_t>(i)};
+    const HeapEntry e{lowerable ? c.weight[i] * step_slc(ls, tris, at) : 0.f, static_cast<uint32_t>(i)};
     assert(!(lowerable && keep) || e.key >= 0.f);
     if (size < capacity) heap[size] = e;
     size += lowerable & keep;
@@ -175,39 +182,76 @@ Gathered gather_direct(const Columns& c, const ModelTable& models, HeapEntry* he
 }
 
 
-// Pass 3: lower the top one level at a time until the budget holds. The coarsest levels fit,
-// so the heap cannot run dry first (and placeholders, ranked below every real entry, are
-// never reached). Returns the steps taken.
-uint32_t lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std::span<const float> weight,
-                         std::span<const uint32_t> model, const ModelTable& models, bool by_triangles,
-                         uint64_t budget, uint64_t& cost, uint64_t& tri_sum, uint64_t& lev_sum) {
+// The runner-up's rank: the best of the root's children (0 when the root has none).
+inline uint64_t runner_up_rank(const HeapEntry* h, size_t size) {
+  uint64_t best = 0;
+  for (size_t c = 1; c < std::min(size, kArity + 1); ++c) best = std::max(best, rank(h[c]));
+  return best;
+}
+
+struct LowerParams {
+  bool by_triangles = true;
+  uint64_t budget = 0;
+  Selector selector = Selector::greedy;
+  float slack = 1;         // greedy_multi
+  float exact_tail = 0;    // greedy_multi: share of the excess lowered with slack 1
+};
+
+struct Lowered {
+  uint32_t pops = 0, levels = 0;
+};
+
+// Pass 3: lower the top until the budget holds (greedy: one level per pop; greedy_multi: while
+// its next key, divided by the slack, still ranks above the runner-up). The coarsest levels fit,
+// so the heap cannot run dry first (and placeholders, ranked below every real entry, are never
+// reached).
+Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std::span<const float> weight,
+                        std::span<const uint32_t> model, const ModelTable& models, const LowerParams& p,
+                        uint64_t& cost, uint64_t& tri_sum, uint64_t& lev_sum) {
   const uint32_t* first = models.first_level.data();
   const uint8_t* counts = models.level_count.data();
   const uint32_t* tris = models.triangles.data();
   const int32_t* ls = models.level_l.data();
-  uint32_t steps = 0;
-  while (cost > budget) {
+  const bool multi = p.selector == Selector::greedy_multi;
+  assert(!multi || (p.slack > 0 && p.slack <= 1));
+  // Below `relaxed_until` only the steps greedy itself would take next are taken in a row.
+  const uint64_t relaxed_until = p.budget + uint64_t(double(cost - p.budget) * p.exact_tail);
+  Lowered done;
+  while (cost > p.budget) {
     assert(size > 0 && h[0].object != kPlaceholder);
     const uint32_t obj = h[0].object;
     const uint32_t m = model[obj];
-    const uint32_t cur = level[obj];
-    const uint32_t at = first[m] + cur;
-    const uint64_t tri_drop = tris[at] - tris[at + 1];
-    const uint64_t lev_drop = pow2(ls[at]) - pow2(ls[at + 1]);
-    tri_sum -= tri_drop;
-    lev_sum -= lev_drop;
-    cost -= by_triangles ? tri_drop : lev_drop;
-    level[obj] = static_cast<uint8_t>(cur + 1u);
-    ++steps;
-    if (cur + 2u < counts[m]) {
-      const HeapEntry next{weight[obj] * static_cast<float>(span_of_level_changed(ls[at + 1], ls[at + 2])), obj};
-      sift_down(h, size, 0, next);
-    } else {
-      --size;
-      if (size > 0) sift_down(h, size, 0, h[size]);
+    const uint64_t runner_up = multi ? runner_up_rank(h, size) : 0;
+    ++done.pops;
+    for (;;) {
+      const uint32_t cur = level[obj];
+      const uint32_t at = first[m] + cur;
+      const uint64_t tri_drop = tris[at] - tris[at + 1];
+      const uint64_t lev_drop = pow2(ls[at]) - pow2(ls[at + 1]);
+      tri_sum -= tri_drop;
+      lev_sum -= lev_drop;
+      cost -= p.by_triangles ? tri_drop : lev_drop;
+      level[obj] = static_cast<uint8_t>(cur + 1u);
+      ++done.levels;
+      if (cur + 2u >= counts[m]) {  // at its coarsest: out of the heap
+        --size;
+        if (size > 0) sift_down(h, size, 0, h[size]);
+        break;
+      }
+      const HeapEntry next{weight[obj] * step_slc(ls, tris, at + 1), obj};
+      const float slack = cost > relaxed_until ? p.slack : 1.0f;
+      const bool again = multi && cost > p.budget && rank(HeapEntry{next.key / slack, obj}) > runner_up;
+      if (!again) {
+        sift_down(h, size, 0, next);
+        break;
+      }
     }
   }
-  return steps;
+  return done;
+}
+
+LowerParams lower_params_of(const SelectionParams& p) {
+  return {p.count == BudgetCount::triangles, p.budget, p.selector, p.multi_level_slack, p.multi_exact_tail};
 }
 
 }  // namespace
@@ -255,8 +299,10 @@ SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const ui
     // Pass 2: heapify, O(m).
     assert(g.heap_size <= heap.size() && "heap scratch needs room for every visible object");
     make_heap(h, g.heap_size);
-    r.lowered_steps = lower_from_heap(h, g.heap_size, level, weight, model, models, by_triangles, params.budget,
-                                      cost, tri_sum, lev_sum);
+    const Lowered l = lower_from_heap(h, g.heap_size, level, weight, model, models, lower_params_of(params), cost,
+                                      tri_sum, lev_sum);
+    r.lowered_steps = l.pops;
+    r.levels_lowered = l.levels;
   }
   r.cost = cost;
   r.triangles = tri_sum;
@@ -273,7 +319,7 @@ SelectionTables build_selection_tables(const ModelTable& models) {
   for (size_t m = 0; m < models.model_count(); ++m) {
     const uint32_t first = models.first_level[m];
     for (uint32_t k = first; k + 1 < first + models.level_count[m]; ++k) {
-      t.slc_next[k] = static_cast<float>(span_of_level_changed(models.level_l[k], models.level_l[k + 1]));
+      t.slc_next[k] = step_slc(models.level_l.data(), models.triangles.data(), k);
       t.lowerable[k] = 1;
     }
   }
@@ -343,8 +389,10 @@ SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uin
   uint64_t cost = by_triangles ? tri_sum : lev_sum;
   if (cost > params.budget) {
     make_heap(heap.data(), n);
-    r.lowered_steps = lower_from_heap(heap.data(), n, level, weight, model, models, by_triangles, params.budget, cost,
-                                      tri_sum, lev_sum);
+    const Lowered l =
+        lower_from_heap(heap.data(), n, level, weight, model, models, lower_params_of(params), cost, tri_sum, lev_sum);
+    r.lowered_steps = l.pops;
+    r.levels_lowered = l.levels;
   }
   r.cost = cost;
   r.triangles = tri_sum;

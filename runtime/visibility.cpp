@@ -41,4 +41,21 @@ size_t cull_spheres(std::span<uint8_t> visible, std::span<const float> cx, std::
   return count;
 }
 
+size_t cull_beyond_distance(std::span<uint8_t> visible, std::span<const float> cx, std::span<const float> cy,
+                            std::span<const float> cz, std::span<const float> radius, const glm::vec3& eye,
+                            float max_distance) {
+  const size_t n = visible.size();
+  assert(cx.size() == n && cy.size() == n && cz.size() == n && radius.size() == n && max_distance > 0);
+  size_t cleared = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const float dx = cx[i] - eye.x, dy = cy[i] - eye.y, dz = cz[i] - eye.z;
+    // |c - eye| - r > D  <=>  |c - eye| > D + r (both sides >= 0): no square root.
+    const float reach = max_distance + radius[i];
+    const bool far = dx * dx + dy * dy + dz * dz > reach * reach;
+    cleared += visible[i] & far;
+    visible[i] = static_cast<uint8_t>(visible[i] & !far);
+  }
+  return cleared;
+}
+
 }  // namespace lod

@@ -6,7 +6,7 @@ namespace lod::viewer {
 int64_t MorphStreams::offset_of(uint32_t model, uint32_t fine, uint32_t coarse) {
   if (model >= chains_.size() || fine >= coarse) return -1;
   const LodChain& chain = chains_[model];
-  if (coarse >= chain.levels.size() || !can_morph_levels(chain)) return -1;
+  if (coarse >= drawn_levels(chain) || !can_morph_levels(chain)) return -1;  // none into the culled level
   const uint64_t key = uint64_t(model) << 16 | uint64_t(fine) << 8 | coarse;  // levels < kMaxLevels
   if (auto it = offsets_.find(key); it != offsets_.end()) return it->second;
   const LodLevel& f = chain.levels[fine];

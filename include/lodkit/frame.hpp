@@ -50,7 +50,8 @@ struct Frame {
   std::vector<Transform> transforms;   // the transform this frame was computed with
   std::vector<uint8_t> view_masks;     // bit v set: view v sees it (never_cull: every view)
   std::vector<uint32_t> objects;       // its dense index in the service at this frame
-  std::vector<uint8_t> levels;    // chain level index (0 = full detail)
+  std::vector<uint8_t> levels;    // chain level index (0 = full detail); a chain's culled level
+                                  // (a last ratio of 0, no triangles) means: not drawn
   std::vector<float> morph;       // geomorph factor in [0, 1] towards `levels` (1 = settled)
   // Level each object morphs FROM (equal to `levels` once settled, and always for view-dependent
   // objects, which draw their active mesh, and for chains without morph targets). To blend, a renderer draws the FINER of (from, to)
@@ -76,6 +77,16 @@ struct Frame {
   uint64_t coarsest_cost = 0;   // cost with all visible objects at their coarsest level
   bool over_budget = false;     // even the coarsest levels exceed M
   uint32_t lowered_steps = 0;   // heap pops in selection
+  uint32_t levels_lowered = 0;  // levels lowered by selection (= lowered_steps for one level per pop)
+  // Not drawn: entries at their chain's culled level, plus objects in view 0's frustum beyond
+  // lod.max_distance (those have no entry).
+  uint32_t culled = 0;
+  uint32_t level_changes = 0;   // entries visible last frame at another level
+  // Selection quality for view 0 (runtime/selection_quality.h): the summed benefit of the
+  // selected levels, and the screen-space error in pixels they leave, worst and mean.
+  double benefit = 0;
+  float pixel_error_max = 0;
+  float pixel_error_mean = 0;
   // Occlusion culling (view 0): objects in the frustum found hidden, occluders rasterised.
   uint32_t occluded = 0;
   uint32_t occluders = 0;

@@ -58,6 +58,12 @@ enum class BudgetUnit : uint8_t {
   levels,     // R0's sum of 2^l <= M
 };
 
+// Which selector lowers levels under the budget (both meet the same M):
+enum class BudgetSelector : uint8_t {
+  greedy,        // R0's max-heap, one level per pop
+  greedy_multi,  // several levels per pop: far fewer pops on a cold start, about the same benefit
+};
+
 // Turns a mesh file into the bytes of a baked .lod asset (cached in cache_dir when not empty).
 // lod::mesh_baker() (in lodkit::lodkit) is lodkit's own; lodkit::engine alone has none and
 // loads .lod assets only.
@@ -75,6 +81,8 @@ struct ServiceOptions {
   BudgetUnit budget_unit = BudgetUnit::triangles;
   bool reserve_blends = true;        // hold last frame's blend extra back from M
   bool strict_budget = false;        // drawn triangles, blends included, <= M whenever the coarsest levels fit
+  BudgetSelector selector = BudgetSelector::greedy;
+  float max_distance = 0;            // objects farther from the camera are not drawn; 0 = no limit
   bool occlusion = false;            // cull objects hidden behind large nearby ones (view 0)
   float pixel_error = 1.0f;          // screen-space error wanted before the budget applies
   float hysteresis = 0.25f;          // relative band against level flicker

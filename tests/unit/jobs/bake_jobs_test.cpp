@@ -189,3 +189,38 @@ TEST(BakeJobs, UnwritableCacheDirectoryIsRefused) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+// ratios = [1, 0.5, 0.25, 0]: the bake appends the culled level (empty), the chain validates
+// and morphs between its drawn levels, and the cached asset gives the same chain back.
+TEST(BakeJobsCulledLevel, ARatioOfZeroBakesAnEmptyLastLevel) {
+  BakeDir d;
+  std::vector<ModelConfig> models = {d.models[0]};
+  models[0].bake.ratios = {1.0f, 0.5f, 0.25f, 0.0f};
+  std::vector<LodChain> chains;
+  BakeSummary first, second;
+  Status s = bake_scene_models(models, d.cache, 2, chains, first, d.log);
+  ASSERT_TRUE(s.ok) << s.message;
+  const LodChain& c = chains.at(0);
+  ASSERT_EQ(c.levels.size(), 4u);
+  EXPECT_TRUE(has_culled_level(c));
+  EXPECT_EQ(c.levels[3].triangles(), 0u);
+  EXPECT_EQ(c.levels[3].vertex_count, 0u);
+  EXPECT_GT(c.levels[2].triangles(), 0u);
+  EXPECT_GE(c.levels[3].error, 2 * c.levels[0].bounds.radius * 0.999f) << "culled: the object's size is the error";
+  EXPECT_GE(c.levels[3].error, c.levels[2].error);
+  std::string why;
+  EXPECT_TRUE(validate_chain(c, &why)) << why;
+  EXPECT_TRUE(can_morph_levels(c)) << "the drawn levels keep their morph targets";
+
+  std::vector<LodChain> again;
+  s = bake_scene_models(models, d.cache, 2, again, second, d.log);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(second.cached, 1u);
+  EXPECT_EQ(encode_lod_asset(again.at(0)), encode_lod_asset(c));
+}
+
+}  // namespace
+}  // namespace lod

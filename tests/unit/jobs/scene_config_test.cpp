@@ -352,8 +352,9 @@ TEST(SceneConfig, RefusesDuplicateModelNames) {
 TEST(SceneConfig, RefusesRatioAboveOne) {
   expect_refused(kModel + "ratios = [1.0, 1.5]\n" + kInstances, "model[0].ratios[1]");
 }
-TEST(SceneConfig, RefusesZeroRatio) {
-  expect_refused(kModel + "ratios = [1.0, 0.5, 0.0]\n" + kInstances, "model[0].ratios[2]");
+TEST(SceneConfig, RefusesZeroRatioBeforeTheLast) {
+  expect_refused(kModel + "ratios = [1.0, 0.0, 0.25]\n" + kInstances, "model[0].ratios[1]", "only be the last");
+  expect_refused(kModel + "ratios = [0.0]\n" + kInstances, "model[0].ratios[0]");
 }
 TEST(SceneConfig, RefusesNegativeRatio) {
   expect_refused(kModel + "ratios = [1.0, -0.5]\n" + kInstances, "model[0].ratios[1]");
@@ -567,6 +568,39 @@ TEST(SceneConfigFiles, FuzzFindingsAreRefusedWithAPosition) {
     ASSERT_FALSE(s.ok) << text;
     EXPECT_EQ(s.message.rfind("fuzzed.toml:1:", 0), 0u) << s.message;
   }
+TEST(SceneConfigBudgetModes, AcceptsACulledLastLevel) {
+  ConfigDir d;
+  SceneConfig c;
+  ASSERT_TRUE(load(d, kModel + "ratios = [1.0, 0.5, 0.0]\n" + kInstances, c).ok);
+  ASSERT_EQ(c.models[0].bake.ratios.size(), 3u);
+  EXPECT_EQ(c.models[0].bake.ratios.back(), 0.0f);
+  expect_refused(kModel + "ratios = [1.0, 0.5, 0.0]\nview_dependent = true\n" + kInstances, "model[0].ratios",
+                 "view_dependent");
+}
+
+TEST(SceneConfigBudgetModes, ParsesAndRefusesMaxDistance) {
+  ConfigDir d;
+  SceneConfig c;
+  ASSERT_TRUE(load(d, "[lod]\nmax_distance = 250\n" + kModel + kInstances, c).ok);
+  EXPECT_EQ(c.max_distance, 250.f);
+  EXPECT_EQ(frame_graph_options(c).max_distance, 250.f);
+  SceneConfig none;
+  ASSERT_TRUE(load(d, kModel + kInstances, none).ok);
+  EXPECT_EQ(none.max_distance, 0.f) << "absent: no limit";
+  expect_refused("[lod]\nmax_distance = 0\n" + kModel + kInstances, "lod.max_distance");
+  expect_refused("[lod]\nmax_distance = -3\n" + kModel + kInstances, "lod.max_distance");
+}
+
+TEST(SceneConfigBudgetModes, ParsesAndRefusesSelector) {
+  ConfigDir d;
+  SceneConfig c;
+  EXPECT_EQ(c.selection.selector, Selector::greedy) << "default";
+  ASSERT_TRUE(load(d, "[budget]\nselector = \"greedy_multi\"\n" + kModel + kInstances, c).ok);
+  EXPECT_EQ(c.selection.selector, Selector::greedy_multi);
+  EXPECT_EQ(frame_graph_options(c).selection.selector, Selector::greedy_multi);
+  ASSERT_TRUE(load(d, "[budget]\nselector = \"greedy\"\n" + kModel + kInstances, c).ok);
+  EXPECT_EQ(c.selection.selector, Selector::greedy);
+  expect_refused("[budget]\nselector = \"optimal\"\n" + kModel + kInstances, "budget.selector", "greedy_multi");
 }
 
 }  // namespace

@@ -52,13 +52,16 @@ struct RandomScene {
     if (problem.capacity < coarsest) problem.capacity += 10;
   }
 
-  // R0's heap from every object at full detail (the selection's cold start).
-  std::vector<uint8_t> heap_choice() const {
+  // R0's heap from every object at full detail (the selection's cold start), with either
+  // selector; `pops` gets the heap pops it took.
+  std::vector<uint8_t> heap_choice(Selector selector = Selector::greedy, uint32_t* pops = nullptr) const {
     std::vector<uint8_t> levels(model.size(), 0), visible(model.size(), 1);
     std::vector<HeapEntry> heap(model.size());
     SelectionParams p;
     p.budget = problem.capacity;
-    select_under_budget(levels, visible, weight, model, models, p, heap);
+    p.selector = selector;
+    const SelectionResult r = select_under_budget(levels, visible, weight, model, models, p, heap);
+    if (pops) *pops = r.lowered_steps;
     return levels;
   }
 };
