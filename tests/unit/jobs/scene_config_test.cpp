@@ -568,6 +568,8 @@ TEST(SceneConfigFiles, FuzzFindingsAreRefusedWithAPosition) {
     ASSERT_FALSE(s.ok) << text;
     EXPECT_EQ(s.message.rfind("fuzzed.toml:1:", 0), 0u) << s.message;
   }
+}
+
 TEST(SceneConfigBudgetModes, AcceptsACulledLastLevel) {
   ConfigDir d;
   SceneConfig c;
