@@ -46,7 +46,12 @@ namespace {
 std::filesystem::path temporary_beside(const std::filesystem::path& path) {
   static std::atomic<uint64_t> serial{0};
   std::filesystem::path tmp = path;
-  tmp += "." + std::to_string(::getpid()) + "-" + std::to_string(serial++) + ".tmp";
+  std::string suffix = ".";  // appended piecewise: GCC 12 warns (-Wrestrict) on "." + to_string
+  suffix += std::to_string(::getpid());
+  suffix += '-';
+  suffix += std::to_string(serial++);
+  suffix += ".tmp";
+  tmp += suffix;
   return tmp;
 }
 
