@@ -24,16 +24,16 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <atomic>
 
 #include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <new>
 #include <string_view>
 #include <system_error>
+
+#include "runtime/file_write.h"
 
 namespace lod {
 
@@ -467,36 +467,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
 }
 
 Status write_lod_asset(const std::filesystem::path& path, const LodChain& chain) {
-  const std::vector<uint8_t> bytes = encode_lod_asset(chain);
-  // A temporary name of its own per process and call: runs sharing a cache folder may write the
-  // same asset at once, and each rename then replaces the file whole (last one wins).
-  static std::atomic<uint64_t> serial{0};
-  std::filesystem::path tmp = path;
-  std::string suffix = ".";
-  suffix += std::to_string(::getpid());
-  suffix += '-';
-  suffix += std::to_string(serial++);
-  suffix += ".tmp";
-  tmp += suffix;
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) return refuse(path.string(), std::string("cannot create ") + tmp.string() + ": " + std::strerror(errno));
-    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    f.flush();
-    if (!f) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      return refuse(path.string(), "write failed after " + std::to_string(bytes.size()) + " bytes requested");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    return refuse(path.string(), "cannot rename " + tmp.string() + ": " + ec.message());
-  }
-  return Status::success();
+  return write_file_atomic(path, encode_lod_asset(chain));
 }
 
 Status read_lod_asset(const std::filesystem::path& path, LodChain& out) {
