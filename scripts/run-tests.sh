@@ -20,7 +20,7 @@ for label in unit integration stress viewer package; do
 done
 ./scripts/ctest-all.sh build -j "$JOBS" --timeout 900
 
-echo "== ThreadSanitizer: frame pool, service (simulation + consumers), frame graph, stream pager =="
+echo "== ThreadSanitizer: frame pool, service (simulation + consumers), frame graph, soak, stream pager =="
 ./scripts/configure.sh build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=thread \
       -DLOD_BUILD_BENCH=OFF -DLOD_BUILD_VIEWER=OFF
 cmake --build build-tsan -j "$JOBS" --target test_jobs test_stress
