@@ -822,10 +822,13 @@ struct FrameGraph::Impl {
       const uint32_t* first_level = rows.first_level.data();
       const size_t n = end_slot - first_slot;
       // Measured before the history is overwritten (the entries of chunk c are its objects).
-      const SelectionQuality quality = measure_selection_quality(
-          std::span(f.objects.data() + first_slot, n), std::span(f.levels.data() + first_slot, n),
-          std::span(f.models.data() + first_slot, n), mask, uint8_t{1}, p0.distance, p0.area, s.error_scale,
-          set->models, focal[0]);
+      const SelectionQuality quality =
+          options.measure_quality
+              ? measure_selection_quality(std::span(f.objects.data() + first_slot, n),
+                                          std::span(f.levels.data() + first_slot, n),
+                                          std::span(f.models.data() + first_slot, n), mask, uint8_t{1},
+                                          p0.distance, p0.area, s.error_scale, set->models, focal[0])
+              : SelectionQuality{};
       uint32_t changes = 0;
       for (uint32_t k = first_slot; k < end_slot; ++k) {
         const uint8_t level = f.levels[k];

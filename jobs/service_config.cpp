@@ -29,6 +29,7 @@ FrameGraphOptions frame_graph_options(const SceneConfig& config) {
   g.pixel_error = config.pixel_error;
   g.hysteresis = config.hysteresis;
   g.max_distance = config.max_distance;
+  g.measure_quality = true;  // services from configs (lod run) report benefit and pixel error
   g.occlusion.enabled = config.occlusion;
   g.occlusion.occluders = config.occluders;
   return g;

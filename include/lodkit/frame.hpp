@@ -83,7 +83,8 @@ struct Frame {
   uint32_t culled = 0;
   uint32_t level_changes = 0;   // entries visible last frame at another level
   // Selection quality for view 0 (runtime/selection_quality.h): the summed benefit of the
-  // selected levels, and the screen-space error in pixels they leave, worst and mean.
+  // selected levels, and the screen-space error in pixels they leave, worst and mean. Measured
+  // for services made from a config (Service::from_config, lod run); 0 otherwise.
   double benefit = 0;
   float pixel_error_max = 0;
   float pixel_error_mean = 0;

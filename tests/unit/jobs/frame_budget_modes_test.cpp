@@ -131,6 +131,7 @@ TEST(FrameBudgetModes, BenefitPixelErrorAndLevelChangesFollowTheBudget) {
   const View view = view_at(test::synthetic_config(3000, 250).camera, 0);
   FrameGraphOptions o = options();
   o.selection.budget = UINT64_MAX;
+  o.measure_quality = true;
   FrameGraph g(scene, o);
   Frame f;
   g.run(view, f);
@@ -152,6 +153,28 @@ TEST(FrameBudgetModes, BenefitPixelErrorAndLevelChangesFollowTheBudget) {
   EXPECT_GT(f.pixel_error_max, o.pixel_error) << "a binding budget leaves more error than the threshold";
   g.run(view, f);
   EXPECT_EQ(f.level_changes, 0u) << "same view, same budget: levels hold";
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+TEST(FrameBudgetModes, QualityIsMeasuredOnlyWhenAsked) {
+  const Scene scene = test::synthetic_scene(500, 100);
+  const View view = view_at(test::synthetic_config(500, 100).camera, 0);
+  FrameGraphOptions o = options();
+  FrameGraph quiet(scene, o);
+  Frame f;
+  quiet.run(view, f);
+  ASSERT_GT(f.visible, 0u);
+  EXPECT_EQ(f.benefit, 0.0);
+  EXPECT_EQ(f.pixel_error_max, 0.f);
+  o.measure_quality = true;
+  FrameGraph asked(scene, o);
+  asked.run(view, f);
+  EXPECT_GT(f.pixel_error_max, 0.f);
 }
 
 }  // namespace
