@@ -275,7 +275,7 @@ TEST(HlodBuild, ProgressRisesToOne) {
   options.progress = [&](float f) { seen.push_back(f); };
   HlodModel m;
   ASSERT_TRUE(build_hlod(m, sphere_mesh(), options));
-  ASSERT_EQ(seen.size(), m.tree.nodes.size()) << "once per node";
+  ASSERT_EQ(seen.size(), 2 * m.tree.nodes.size()) << "once per node built, once per node measured";
   EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
   EXPECT_FLOAT_EQ(seen.back(), 1.0f);
 }
