@@ -16,8 +16,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <deque>
-#include <limits>
 #include <memory>
 #include <string>
 
