@@ -1,10 +1,14 @@
-// Model HLOD build (R1 3.1) as passes per node, run bottom-up over the octree:
+// Model HLOD build (R1 3.1) in three passes:
 //
-//   count -> split (children + patch) -> [children, in parallel] -> layer 0 (leaf geometry,
-//   or children's coarsest welded to the patch) -> two QEM halvings with ancestors' patch
-//   vertices locked -> measure each layer -> bounds -> breadth-first flattening at the end.
+//   1. per node, bottom-up over the octree (subtrees in parallel): count -> split (children +
+//      patch) -> [children] -> layer 0 (leaf geometry, or children's coarsest welded to the
+//      patch) -> two QEM halvings with ancestors' patch vertices locked -> reference samples,
+//      bounds; beside it, the original's BVH for pass 2
+//   2. every node at once: each layer's distance to the original
+//   3. children before parents: errors made monotonic
+//   then breadth-first flattening into the tree and its payloads.
 //
-// Per-vertex scratch arrays are shared by all tasks without locks: every vertex lies in
+// Per-vertex scratch arrays are shared by pass 1's tasks without locks: every vertex lies in
 // exactly one cell per depth, tasks run on disjoint subtrees, and a node only touches its own
 // cell's vertices after its children have finished, so no two tasks ever touch one vertex.
 #include "preprocess/hlod_build.h"
@@ -12,8 +16,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <deque>
-#include <limits>
 #include <memory>
 #include <string>
 
@@ -46,7 +48,6 @@ struct BuildNode {
   std::vector<Layer> layers;        // finest first
   std::vector<uint32_t> reference;  // original vertices of the node's region, thinned
   Sphere bounds;
-  Status status;
   bool leaf() const { return child_mask == 0; }
 };
 
@@ -170,6 +171,9 @@ void simplify_layers(Context& c, BuildNode& n) {
   for (size_t i = 0; i < lock.size(); ++i) lock[i] = c.patch_depth[finest.source[i]] < n.depth;
   QemOptions options;
   options.lock_border = true;  // the mesh's own holes keep their outline in every layer
+  // Non-manifold vertices stay too: moving one can open an edge that a patch or a neighbour
+  // meets (Stanford's buddha: 80-150 open edges per cut otherwise).
+  options.move_nonmanifold = false;
   options.vertex_lock = lock.data();
   // Heavily locked cells otherwise reach their halves by ruinous collapses (on the bunny at
   // min_verts 500, one layer 10 % of the model off its surface, which the monotonic errors
@@ -226,17 +230,22 @@ float distance_to_original(const Context& c, const float* p, uint32_t v) {
 }
 
 // The node's original samples, each with a distance the layer is known to be within: to the
-// layer vertex descended from it, when it survived into the layer.
-void reference_samples(Context& c, const BuildNode& n, const Layer& layer, std::vector<float>& points,
+// layer vertex descended from it, when it survived into the layer. (A sorted lookup, not the
+// per-vertex scratch: nodes are measured in any order, ancestors beside descendants.)
+void reference_samples(const Context& c, const BuildNode& n, const Layer& layer, std::vector<float>& points,
                        std::vector<float>& known) {
-  const uint32_t s = c.new_stamp();
-  for (uint32_t i = 0; i < layer.vertices(); ++i) c.stamp[layer.source[i]] = s, c.local[layer.source[i]] = i;
+  std::vector<std::pair<uint32_t, uint32_t>> by_source(layer.vertices());
+  for (uint32_t i = 0; i < layer.vertices(); ++i) by_source[i] = {layer.source[i], i};
+  std::sort(by_source.begin(), by_source.end());
   points.resize(3 * n.reference.size());
   known.resize(n.reference.size());
   for (size_t k = 0; k < n.reference.size(); ++k) {
     const uint32_t v = n.reference[k];
     for (int j = 0; j < 3; ++j) points[3 * k + j] = c.positions[3 * size_t(v) + j];
-    known[k] = c.stamp[v] == s ? distance_to_original(c, &layer.positions[3 * size_t(c.local[v])], v) : INFINITY;
+    const auto it = std::lower_bound(by_source.begin(), by_source.end(), std::make_pair(v, 0u));
+    known[k] = it != by_source.end() && it->first == v
+                   ? distance_to_original(c, &layer.positions[3 * size_t(it->second)], v)
+                   : INFINITY;
   }
 }
 
@@ -264,7 +273,7 @@ void layer_samples(const Context& c, const Layer& layer, std::vector<float>& poi
 
 // Symmetric distance between a layer and the original: the layer's samples to the whole
 // original surface, the node's original samples to the layer.
-Status measure_layer(Context& c, const BuildNode& n, const Layer& layer, float& error) {
+Status measure_layer(const Context& c, const BuildNode& n, const Layer& layer, float& error) {
   const TriangleMeshView view{layer.positions.data(), layer.vertices(), layer.indices.data(), layer.indices.size()};
   std::vector<float> samples, known;
   layer_samples(c, layer, samples, known);
@@ -277,20 +286,32 @@ Status measure_layer(Context& c, const BuildNode& n, const Layer& layer, float& 
   return Status::success();
 }
 
+void report_done(Context& c, const BuildNode& n) {
+  const uint64_t mine = n.leaf() ? n.layers[0].triangles() : n.patch.size();
+  const uint64_t done = c.done_triangles.fetch_add(mine, std::memory_order_relaxed) + mine;
+  // Every node reports twice (built, measured): the fraction counts both passes.
+  if (c.options.progress) c.options.progress(float(double(done) / double(std::max<uint64_t>(1, 2 * c.total_triangles))));
+}
+
+// Pass 2, any node in any order: each layer's own distance to the original (a leaf's layer 0
+// is the original itself).
 Status measure_layers(Context& c, BuildNode& n) {
-  float floor = 0;  // an inner node never reports less than any child's coarsest layer
-  for (const auto& child : n.children)
-    if (child) floor = std::max(floor, child->layers.back().error);
-  for (size_t k = 0; k < n.layers.size(); ++k) {
-    Layer& layer = n.layers[k];
-    if (n.leaf() && k == 0) {
-      layer.error = 0;  // the original itself
-      continue;
-    }
-    if (Status s = measure_layer(c, n, layer, layer.error); !s) return s;
-    layer.error = std::max(layer.error, k == 0 ? floor : n.layers[k - 1].error);
-  }
+  for (size_t k = n.leaf() ? 1 : 0; k < n.layers.size(); ++k)
+    if (Status s = measure_layer(c, n, n.layers[k], n.layers[k].error); !s) return s;
+  report_done(c, n);
   return Status::success();
+}
+
+// Pass 3, children before parents: never below the finer layer, and an inner node never
+// below any child's coarsest layer.
+void make_errors_monotonic(const std::vector<BuildNode*>& breadth_first) {
+  for (size_t i = breadth_first.size(); i-- > 0;) {
+    BuildNode& n = *breadth_first[i];
+    float floor = 0;
+    for (const auto& child : n.children)
+      if (child) floor = std::max(floor, child->layers.back().error);
+    for (Layer& layer : n.layers) floor = layer.error = std::max(layer.error, floor);
+  }
 }
 
 // A sphere around every vertex the node draws, grown over its children's spheres.
@@ -319,12 +340,6 @@ Sphere node_bounds(const BuildNode& n) {
   return s;
 }
 
-void report_done(Context& c, const BuildNode& n) {
-  const uint64_t mine = n.leaf() ? n.layers[0].triangles() : n.patch.size();
-  const uint64_t done = c.done_triangles.fetch_add(mine, std::memory_order_relaxed) + mine;
-  if (c.options.progress) c.options.progress(float(double(done) / double(std::max<uint64_t>(1, c.total_triangles))));
-}
-
 void build_node(Context& c, BuildNode& n) {
   const size_t vertices = count_vertices(c, n.triangles);
   const bool splits = vertices > c.options.min_verts && n.depth < kHlodMaxDepth && split_node(c, n);
@@ -339,18 +354,43 @@ void build_node(Context& c, BuildNode& n) {
     auto body = [&](size_t i) { build_node(c, *kids[i]); };
     if (c.options.parallel_for && count > 1) c.options.parallel_for(count, body);
     else for (size_t i = 0; i < count; ++i) body(i);
-    for (size_t i = 0; i < count; ++i)
-      if (!kids[i]->status) {
-        n.status = kids[i]->status;
-        return;
-      }
     n.layers.push_back(merged_children(c, n));
   }
   simplify_layers(c, n);
   gather_reference(c, n);
-  n.status = measure_layers(c, n);
   n.bounds = node_bounds(n);
   report_done(c, n);
+}
+
+std::vector<BuildNode*> breadth_first(BuildNode& root) {
+  std::vector<BuildNode*> order{&root};
+  for (size_t i = 0; i < order.size(); ++i)
+    for (auto& child : order[i]->children)
+      if (child) order.push_back(child.get());
+  return order;
+}
+
+// Pass 1 (the octree and every layer, bottom-up) beside the original's BVH, which only pass 2
+// needs; then pass 2 over all nodes at once, then pass 3.
+Status build_passes(Context& c, BuildNode& root, const TriangleMeshView& original, const std::string& what) {
+  Status surface;
+  auto first = [&](size_t i) {
+    if (i == 0) surface = c.original.set_surface(original, what);
+    else build_node(c, root);
+  };
+  const ParallelFor& parallel_for = c.options.parallel_for;
+  if (parallel_for) parallel_for(2, first);
+  else first(0), first(1);
+  if (!surface) return surface;
+  const std::vector<BuildNode*> order = breadth_first(root);
+  std::vector<Status> measured(order.size());
+  auto second = [&](size_t i) { measured[i] = measure_layers(c, *order[i]); };
+  if (parallel_for) parallel_for(order.size(), second);
+  else for (size_t i = 0; i < order.size(); ++i) second(i);
+  for (const Status& s : measured)
+    if (!s) return s;
+  make_errors_monotonic(order);
+  return Status::success();
 }
 
 // Per-vertex normals of a layer from its own triangles, except where the vertex is an
@@ -489,14 +529,8 @@ Status build_hlod(HlodModel& out, const MeshData& mesh, const HlodBuildOptions& 
   c.normals.resize(mesh.positions.size());
   compute_vertex_normals(mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size(),
                          c.normals.data());
-  if (Status s = c.original.set_surface({mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
-                                         mesh.indices.size()},
-                                        what);
-      !s)
-    return s;
-
-  build_node(c, *root);
-  if (!root->status) return root->status;
+  const TriangleMeshView original{mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
+  if (Status s = build_passes(c, *root, original, what); !s) return s;
 
   HlodModel model;
   model.tree.min_verts = options.min_verts;

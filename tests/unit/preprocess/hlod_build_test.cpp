@@ -195,6 +195,33 @@ TEST(HlodBuild, StanfordBunnyHasEveryProperty) {
   expect_all_properties(mesh, 1000, 30);
 }
 
+// Stanford's decimated buddha: 2,151 non-manifold edges, fins, 1,423 open edges. Its
+// non-manifold vertices are locked (moving them opened 80-150 edges per cut), so its layers
+// shrink less than half. Known limit, left visible here: where a valence-3 vertex sits over a
+// triangle that is itself a face (a tetrahedron glued into the surface), QEM's link condition
+// lets the collapse through and one of the doubled faces goes, opening one edge: a few per
+// cut, never more than 1 in 1,000 of the drawn edges.
+TEST(HlodBuild, NonManifoldBuddhaKeepsItsPropertiesAndAlmostAllEdges) {
+  LOD_REQUIRE_SHARED_MESH(file, "happy-buddha-res3.ply");
+  MeshData mesh;
+  ASSERT_TRUE(load_mesh(file, mesh));
+  clean_mesh(mesh);
+  const HlodModel m = build(mesh, 500, kSequential);
+  expect_leaves_within(m, 500);
+  expect_partition(mesh, m);
+  expect_monotonic_errors(m);
+  const auto payloads = pointers(m);
+  const HlodCutReference ref = hlod_cut_reference(m.tree, payloads);
+  std::mt19937 rng(7);
+  for (int k = 0; k < 20; ++k) {
+    const std::vector<int8_t> cut = random_cut(m.tree, rng, 0.7);
+    size_t edges = 0;
+    for (size_t i = 0; i < cut.size(); ++i)
+      if (cut[i] >= 0) edges += 3 * m.tree.nodes[i].layers[cut[i]].triangles / 2;
+    EXPECT_LT(count_cut_gaps(m.tree, payloads, cut, ref), edges / 1000 + 1) << "cut " << k;
+  }
+}
+
 TEST(HlodBuild, TreeIsBreadthFirstWithCellsHalving) {
   const HlodModel m = build(sphere_mesh(), 300);
   const HlodTree& t = m.tree;
@@ -275,7 +302,7 @@ TEST(HlodBuild, ProgressRisesToOne) {
   options.progress = [&](float f) { seen.push_back(f); };
   HlodModel m;
   ASSERT_TRUE(build_hlod(m, sphere_mesh(), options));
-  ASSERT_EQ(seen.size(), m.tree.nodes.size()) << "once per node";
+  ASSERT_EQ(seen.size(), 2 * m.tree.nodes.size()) << "once per node built, once per node measured";
   EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
   EXPECT_FLOAT_EQ(seen.back(), 1.0f);
 }
