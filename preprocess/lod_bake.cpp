@@ -66,6 +66,16 @@ Sphere bounding_sphere(const float* p, size_t n) {
   return s;
 }
 
+// The levels hold positions and normals only: say what the input had that they lose.
+void note_dropped_attributes(const MeshData& mesh, std::vector<std::string>& notes) {
+  for (const std::string& w : mesh.warnings) notes.push_back("import: " + w);
+  if (!mesh.uvs.empty())
+    notes.push_back("texture coordinates of " + mesh.source + " are not kept in the levels (positions and normals only)");
+  if (mesh.materials.size() > 1 || mesh.submeshes.size() > 1)
+    notes.push_back(std::to_string(mesh.materials.size()) + " materials / " + std::to_string(mesh.submeshes.size()) +
+                    " submeshes of " + mesh.source + " are not kept in the levels (one surface)");
+}
+
 const char* method_name(SimplifyMethod m) {
   switch (m) {
     case SimplifyMethod::qem: return "qem";
@@ -198,6 +208,7 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   Status s = load_mesh(mesh_file, mesh);
   if (!s) return s;
   report.input_triangles = mesh.triangle_count();
+  note_dropped_attributes(mesh, report.notes);
 
   say(0.04f, "clean");
   report.cleaned = clean_mesh(mesh);
