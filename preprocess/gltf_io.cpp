@@ -176,13 +176,11 @@ Status parse_with_tinygltf(const GltfSource& src, bool binary, const uint8_t* da
 Status check_extensions(const std::string& what, const tinygltf::Model& m, std::vector<std::string>& warnings) {
   for (const std::string& ext : m.extensionsRequired) {
     if (is_compression(ext)) return compression_refusal(what, ext);
-    if (ext != "KHR_mesh_quantization")
+    if (ext != "KHR_mesh_quantization" && ext != "KHR_texture_transform")
       warnings.push_back(what + ": requires extension " + ext + ", which is not applied (geometry imported as is)");
   }
   for (const std::string& ext : m.extensionsUsed) {
-    if (ext == "KHR_texture_transform")
-      warnings.push_back(what + ": KHR_texture_transform is not applied to the texture coordinates");
-    else if (is_compression(ext))
+    if (is_compression(ext))
       warnings.push_back(what + ": " + ext + " is optional here; the uncompressed fallback data is imported");
   }
   return Status::success();
@@ -413,7 +411,41 @@ uint32_t read_index(const AccessorView& a, size_t i) {
 
 // ---- planning: every primitive checked and counted before anything is allocated ------------
 
+// uv' = (m[0] u + m[1] v + m[2], m[3] u + m[4] v + m[5]): KHR_texture_transform's T * R * S.
+struct UvTransform {
+  double m[6] = {1, 0, 0, 0, 1, 0};
+  bool identity = true;
+};
+
+// The base colour texture's KHR_texture_transform, when it maps TEXCOORD_0 (gltfpack stores
+// quantized UVs this way). Other textures' transforms do not change the one uv per vertex.
+UvTransform uv_transform_of(const tinygltf::Model& m, int material) {
+  UvTransform t;
+  if (material < 0 || size_t(material) >= m.materials.size()) return t;
+  const tinygltf::TextureInfo& info = m.materials[size_t(material)].pbrMetallicRoughness.baseColorTexture;
+  const auto it = info.extensions.find("KHR_texture_transform");
+  if (info.index < 0 || info.texCoord != 0 || it == info.extensions.end() || !it->second.IsObject()) return t;
+  const tinygltf::Value& v = it->second;
+  auto number = [](const tinygltf::Value& x, int i, double fallback) {
+    if (!x.IsArray() || int(x.ArrayLen()) <= i || !x.Get(i).IsNumber()) return fallback;
+    const double d = x.Get(i).GetNumberAsDouble();
+    return std::isfinite(d) ? d : fallback;
+  };
+  if (v.Get("texCoord").IsNumber() && v.Get("texCoord").GetNumberAsDouble() != 0) return t;
+  const double ox = number(v.Get("offset"), 0, 0), oy = number(v.Get("offset"), 1, 0);
+  const double sx = number(v.Get("scale"), 0, 1), sy = number(v.Get("scale"), 1, 1);
+  const double r = v.Get("rotation").IsNumber() && std::isfinite(v.Get("rotation").GetNumberAsDouble())
+                       ? v.Get("rotation").GetNumberAsDouble()
+                       : 0.0;
+  const double c = std::cos(r), s = std::sin(r);
+  const double mat[6] = {c * sx, s * sy, ox, -s * sx, c * sy, oy};
+  std::copy(mat, mat + 6, t.m);
+  t.identity = false;
+  return t;
+}
+
 struct PrimitivePlan {
+  UvTransform uv_transform;
   int mesh = -1, primitive = -1;
   int mode = TINYGLTF_MODE_TRIANGLES;
   int material = -1;
@@ -465,6 +497,7 @@ Status plan_mesh(const std::string& what, const tinygltf::Model& m, int mesh, st
     if (plan.material >= 0 && size_t(plan.material) >= m.materials.size())
       return Status::error(where + ": material " + std::to_string(plan.material) + " of " +
                            std::to_string(m.materials.size()));
+    plan.uv_transform = uv_transform_of(m, plan.material);
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) return Status::error(where + ": has no POSITION attribute");
     for (const auto& [name, accessor] : prim.attributes) {
@@ -507,15 +540,15 @@ Status plan_mesh(const std::string& what, const tinygltf::Model& m, int mesh, st
 }
 
 // Instancing can make a small file flatten into a huge mesh: refuse output beyond 256 times
-// the bytes the file (and its buffers) hold, with 64 MiB always allowed, and beyond what
-// 32-bit indices address.
+// the bytes the file (and its buffers) hold, with 16 MiB always allowed (below the fuzzer's
+// 64 MB allocation limit), and beyond what 32-bit indices address.
 Status check_budget(const std::string& what, size_t input_bytes, uint64_t vertices, uint64_t triangles,
                     uint64_t bytes_per_vertex) {
   if (vertices > std::numeric_limits<uint32_t>::max() || triangles > std::numeric_limits<uint32_t>::max() / 3)
     return Status::error(what + ": flattens to " + std::to_string(vertices) + " vertices and " + std::to_string(triangles) +
                          " triangles, beyond 32-bit indices");
   const uint64_t bytes = vertices * bytes_per_vertex + triangles * 12;
-  const uint64_t budget = std::max<uint64_t>(uint64_t(64) << 20, uint64_t(input_bytes) * 256);
+  const uint64_t budget = std::max<uint64_t>(uint64_t(16) << 20, uint64_t(input_bytes) * 256);
   if (bytes > budget)
     return Status::error(what + ": the scene flattens (nodes instancing meshes) to " + std::to_string(triangles) +
                          " triangles, " + std::to_string(bytes >> 20) + " MiB from a " + std::to_string(input_bytes) +
@@ -560,6 +593,12 @@ Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const 
     if (cols.uvs) {
       float uv[2] = {0, 0};
       if (plan.has_uv) read_element(plan.uv, v, uv);
+      if (!plan.uv_transform.identity) {
+        const double* t = plan.uv_transform.m;
+        const double u0 = uv[0], v0 = uv[1];
+        uv[0] = float(t[0] * u0 + t[1] * v0 + t[2]);
+        uv[1] = float(t[3] * u0 + t[4] * v0 + t[5]);
+      }
       if (!std::isfinite(uv[0]) || !std::isfinite(uv[1]))
         return Status::error(where + ": vertex " + std::to_string(v) + " has a non-finite TEXCOORD_0");
       out.uvs.insert(out.uvs.end(), {uv[0], uv[1]});
@@ -757,6 +796,32 @@ Status load_gltf_from_memory(const std::string& name, const std::string& extensi
   while (src.base_dir.size() > 1 && src.base_dir.back() == '/') src.base_dir.pop_back();
   src.file_bytes = size;
   return detail::load_gltf_bytes(src, extension, data, size, out);
+}
+
+std::vector<std::filesystem::path> gltf_external_files(const std::filesystem::path& path) {
+  std::vector<uint8_t> bytes;
+  if (!detail::read_regular_file(path, bytes)) return {};
+  size_t begin = 0, size = bytes.size();
+  if (size >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) {
+    if (!detail::check_glb_container(path.string(), bytes.data(), size)) return {};
+    begin = 20;
+    size = detail::read_u32(bytes.data() + 12);
+  }
+  const auto j = nlohmann::json::parse(bytes.begin() + std::ptrdiff_t(begin), bytes.begin() + std::ptrdiff_t(begin + size),
+                                       nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object()) return {};
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::vector<std::filesystem::path> out;
+  for (const char* list : {"buffers", "images"}) {
+    const auto it = j.find(list);
+    if (it == j.end() || !it->is_array()) continue;
+    for (const auto& item : *it) {
+      if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+      const std::string uri = item["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) != 0) out.push_back(dir / detail::decode_uri(uri));
+    }
+  }
+  return out;
 }
 
 Status load_gltf(const std::filesystem::path& path, MeshData& out) {

@@ -6,7 +6,8 @@
 // mirroring transform flips the winding back). TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN,
 // indexed (u8/u16/u32) or not; POSITION, NORMAL and TEXCOORD_0 as float, normalized
 // (u)int8/(u)int16 or, as KHR_mesh_quantization allows, plain (u)int8/(u)int16; byte strides
-// honoured. Materials (metallic-roughness factors, base colour texture URI, alpha mode,
+// honoured; the base colour texture's KHR_texture_transform is applied to TEXCOORD_0 (so
+// gltfpack's quantized UVs come out in texture space). Materials (metallic-roughness factors, base colour texture URI, alpha mode,
 // double-sided) become MeshData::materials, each primitive a Submesh.
 //
 // Refused, with the file and the element named: Draco / meshopt compression when required,
@@ -21,6 +22,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "preprocess/mesh.h"
 #include "runtime/status.h"
@@ -37,5 +39,10 @@ Status load_gltf(const std::filesystem::path& path, MeshData& out);
 // past `size`.
 Status load_gltf_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
                              const std::filesystem::path& base_dir, MeshData& out);
+
+// The files a .gltf or .glb names by URI (external buffers and images, resolved next to it,
+// percent-decoded; data URIs excluded), so a cache key can cover them too. Empty when the
+// file cannot be read or parsed: the load itself then says why.
+std::vector<std::filesystem::path> gltf_external_files(const std::filesystem::path& path);
 
 }  // namespace lod

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -12,6 +13,7 @@
 
 #include "preprocess/cluster_simplifier.h"
 #include "preprocess/decimater_chain.h"
+#include "preprocess/gltf_io.h"
 #include "preprocess/mesh_io.h"
 #include "preprocess/qem_simplifier.h"
 #include "preprocess/surface_error.h"
@@ -176,7 +178,16 @@ uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& se
     if (status) *status = Status::error(mesh_file.string() + ": read error");
     return 0;
   }
-  const uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  // A .gltf's geometry may live in the files it names: they are part of the content.
+  std::string ext = mesh_file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".gltf" || ext == ".glb")
+    for (const auto& file : gltf_external_files(mesh_file)) {
+      std::ifstream g(file, std::ios::binary);
+      const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
+      content = hash_bytes(more.data(), more.size(), content);
+    }
   // Settings as explicit little records, so padding never enters the hash.
   std::vector<uint8_t> s;
   auto put = [&s](const void* p, size_t n) {

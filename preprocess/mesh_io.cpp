@@ -285,4 +285,40 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
   return Status::success();
 }
 
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
+                const uint32_t* indices, size_t index_count) {
+  const std::string what = path.string();
+  if (index_count % 3 != 0) return Status::error(what + ": index count " + std::to_string(index_count) + " is not a multiple of 3");
+  for (size_t i = 0; i < index_count; ++i)
+    if (indices[i] >= vertex_count)
+      return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
+                           std::to_string(indices[i]) + " of " + std::to_string(vertex_count));
+  std::ofstream f(path, std::ios::trunc);
+  if (!f) return Status::error(what + ": cannot be opened for writing");
+  char line[160];
+  f << "# lodkit\n";
+  for (size_t v = 0; v < vertex_count; ++v) {
+    const float* p = positions + 3 * v;
+    std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+    f << line;
+  }
+  if (normals)
+    for (size_t v = 0; v < vertex_count; ++v) {
+      const float* n = normals + 3 * v;
+      std::snprintf(line, sizeof line, "vn %.6g %.6g %.6g\n", n[0], n[1], n[2]);
+      f << line;
+    }
+  for (size_t t = 0; t < index_count / 3; ++t) {
+    const unsigned long a = indices[3 * t] + 1ul, b = indices[3 * t + 1] + 1ul, c = indices[3 * t + 2] + 1ul;
+    if (normals)
+      std::snprintf(line, sizeof line, "f %lu//%lu %lu//%lu %lu//%lu\n", a, a, b, b, c, c);
+    else
+      std::snprintf(line, sizeof line, "f %lu %lu %lu\n", a, b, c);
+    f << line;
+  }
+  f.flush();
+  if (!f) return Status::error(what + ": write failed (disk full?)");
+  return Status::success();
+}
+
 }  // namespace lod

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# libFuzzer over the mesh readers: one target per format (PLY, OFF, STL, OBJ), built with
+# libFuzzer over the mesh readers: one target per format (PLY, OFF, STL, OBJ, GLB), built with
 # Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each run for SECONDS
 # (default 600) from the seeds in tests/fuzz/corpus/<format>/ with tests/fuzz/<format>.dict.
 # A crash, sanitizer report, timeout (> 5 s on one input) or single allocation over 64 MB
@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
 FORMATS=("$@")
-[ ${#FORMATS[@]} -gt 0 ] || FORMATS=(ply off stl obj)
+[ ${#FORMATS[@]} -gt 0 ] || FORMATS=(ply off stl obj glb)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
 MAX_LEN=${LOD_FUZZ_MAX_LEN:-4096}
@@ -27,8 +27,8 @@ mkdir -p "$OUT/obj"
 FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
        -I. -D_USE_MATH_DEFINES)
 SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
-         preprocess/obj_reader.cpp)
-HEADERS=(preprocess/mesh_io.h preprocess/mesh_readers.h preprocess/mesh.h runtime/status.h)
+         preprocess/obj_reader.cpp preprocess/gltf_io.cpp)  # gltf_io.cpp compiles tinygltf in (instrumented too)
+HEADERS=(preprocess/mesh_io.h preprocess/mesh_readers.h preprocess/mesh.h preprocess/gltf_io.h runtime/status.h)
 newest_header=$(ls -t "${HEADERS[@]}" | head -1)
 objs=()
 pids=()

@@ -10,6 +10,7 @@
 
 #include "gltf_fixture.h"
 #include "preprocess/gltf_io.h"
+#include "preprocess/lod_bake.h"
 #include "preprocess/mesh_io.h"
 #include "test_support.h"
 
@@ -296,6 +297,24 @@ TEST(GltfImport, RefusesAMissingExternalBuffer) {
   expect_refused(s, "quad.bin");
 }
 
+// The bake cache key covers the .bin a .gltf names: new geometry there is a new bake.
+TEST(GltfImport, BakeKeyCoversTheFilesAGltfNames) {
+  const fs::path dir = test::temp_dir("gltf-key");
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  place_meshes(f);
+  f.j["images"] = json::array({{{"uri", "my%20tex.png"}}, {{"uri", "data:image/png;base64,AAAA"}}});
+  const fs::path file = f.write_gltf_with_bin(dir, "quad");
+  EXPECT_EQ(gltf_external_files(file), (std::vector<fs::path>{dir / "quad.bin", dir / "my tex.png"}));
+  Status st;
+  const uint64_t before = bake_key(file, BakeSettings{}, &st);
+  ASSERT_TRUE(st.ok) << st.message;
+  std::vector<uint8_t> bin = test::read_bytes(dir / "quad.bin");
+  bin[4] ^= 0x40;
+  test::write_bytes(dir / "quad.bin", bin);
+  EXPECT_NE(bake_key(file, BakeSettings{}, &st), before);
+}
+
 TEST(GltfImport, InMemoryInputNeverReadsExternalFiles) {
   GltfFixture f;
   f.add_float_mesh(kQuad, kQuadIndices);
@@ -348,6 +367,78 @@ TEST(GltfImport, ReadsMaterialsAsSubmeshes) {
   // The same file without its image is refused, naming the image.
   fs::remove(dir / "bark texture.png");
   expect_refused(load_mesh(file, m), "image 0 'bark%20texture.png' not found");
+}
+
+TEST(GltfImport, AppliesTheBaseColourTextureTransformToTexcoords) {
+  GltfFixture f;
+  const int pos = f.add_accessor(f.add_view(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), kFloat, 3, "VEC3");
+  const int tex = f.add_accessor(f.add_view(std::vector<float>{0, 0, 1, 0, 1, 1}), kFloat, 3, "VEC2");
+  f.add_mesh({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", tex}}}, {"material", 0}}});
+  f.j["images"] = json::array({{{"uri", "a.png"}}});
+  f.j["textures"] = json::array({{{"source", 0}}});
+  f.j["materials"] = json::array({{{"pbrMetallicRoughness",
+                                    {{"baseColorTexture",
+                                      {{"index", 0},
+                                       {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0.25}}, {"scale", {2, 4}}}}}}}}}}}});
+  f.j["extensionsUsed"] = {"KHR_texture_transform"};
+  f.j["extensionsRequired"] = {"KHR_texture_transform"};
+  place_meshes(f);
+  MeshData m;
+  const Status s = load_glb(f, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(m.uvs, (std::vector<float>{0.5f, 0.25f, 2.5f, 0.25f, 2.5f, 4.25f}));
+  EXPECT_FALSE(has_warning(m, "KHR_texture_transform"));
+}
+
+// ../shared's spot.obj with its texture, converted at test time by Debian's gltfpack: once
+// quantized (KHR_mesh_quantization, UVs through KHR_texture_transform, texture embedded in
+// the GLB) and once not (.gltf + .bin, texture by URI). Both give the OBJ's triangles, bounds
+// and the same UV range.
+TEST(GltfShared, ImportsSpotConvertedByGltfpackWithItsTexture) {
+  LOD_REQUIRE_SHARED_MESH(obj, "spot.obj");
+  const fs::path texture = test::shared_meshes() / "spot_texture.png";
+  if (!fs::exists(texture)) GTEST_SKIP() << "needs ../shared/data/meshes/spot_texture.png (absent on this machine)";
+  ASSERT_EQ(std::system("command -v gltfpack >/dev/null 2>&1"), 0) << "gltfpack missing: run scripts/install-deps.sh";
+  const fs::path dir = test::temp_dir("gltf-spot");
+  const std::vector<uint8_t> original = test::read_bytes(obj);
+  std::vector<uint8_t> with_material;
+  for (char c : std::string("mtllib spot.mtl\nusemtl spot\n")) with_material.push_back(uint8_t(c));
+  with_material.insert(with_material.end(), original.begin(), original.end());
+  test::write_bytes(dir / "spot.obj", with_material);
+  test::write_text(dir / "spot.mtl", "newmtl spot\nKd 1 1 1\nmap_Kd spot_texture.png\n");
+  fs::copy_file(texture, dir / "spot_texture.png");
+  const std::string in = " -i " + (dir / "spot.obj").string();
+  ASSERT_EQ(std::system(("gltfpack" + in + " -o " + (dir / "spot.glb").string() + " >/dev/null 2>&1").c_str()), 0);
+  ASSERT_EQ(std::system(("gltfpack -noq" + in + " -o " + (dir / "spot-noq.gltf").string() + " >/dev/null 2>&1").c_str()), 0);
+
+  MeshData reference, packed, plain;
+  ASSERT_TRUE(load_mesh(obj, reference).ok);
+  Status s = load_mesh(dir / "spot.glb", packed);
+  ASSERT_TRUE(s.ok) << s.message;
+  s = load_mesh(dir / "spot-noq.gltf", plain);
+  ASSERT_TRUE(s.ok) << s.message;
+  auto range = [](const std::vector<float>& v, size_t stride, size_t c) {
+    float lo = 1e30f, hi = -1e30f;
+    for (size_t i = c; i < v.size(); i += stride) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]);
+    return std::pair{lo, hi};
+  };
+  for (const MeshData* m : {&packed, &plain}) {
+    EXPECT_EQ(m->triangle_count(), reference.triangle_count());
+    EXPECT_EQ(m->uvs.size(), 2 * m->vertex_count());
+    EXPECT_TRUE(m->normals.empty());  // spot.obj has no vn lines
+    ASSERT_EQ(m->materials.size(), 1u);
+    for (size_t c = 0; c < 3; ++c) {  // 16-bit positions: within 1e-3 of the OBJ's box
+      EXPECT_NEAR(range(m->positions, 3, c).first, range(reference.positions, 3, c).first, 1e-3);
+      EXPECT_NEAR(range(m->positions, 3, c).second, range(reference.positions, 3, c).second, 1e-3);
+    }
+    for (size_t c = 0; c < 2; ++c) {
+      EXPECT_NEAR(range(m->uvs, 2, c).first, range(plain.uvs, 2, c).first, 2e-3);
+      EXPECT_NEAR(range(m->uvs, 2, c).second, range(plain.uvs, 2, c).second, 2e-3);
+    }
+  }
+  EXPECT_TRUE(packed.materials[0].base_color_texture_embedded);
+  EXPECT_EQ(plain.materials[0].base_color_texture, "spot_texture.png");
+  EXPECT_GT(range(plain.uvs, 2, 0).second - range(plain.uvs, 2, 0).first, 0.5f);  // spans the texture
 }
 
 // ---- skipped content ----------------------------------------------------------------------------
