@@ -562,72 +562,140 @@ struct Columns {
   bool normals = false, uvs = false;
 };
 
-// Appends one primitive under one node's transform; index values are checked here, against
-// the primitive's own vertex count, before any triangle refers to them.
+// Every element of an accessor into out[0, count * components): floats copied as they are,
+// integers converted (read_component); no buffer view reads as zeros.
+void decode_elements(const AccessorView& a, float* out) {
+  const size_t n = a.count, k = size_t(a.components);
+  if (!a.data) {
+    std::fill(out, out + n * k, 0.0f);
+  } else if (a.component_type == TINYGLTF_COMPONENT_TYPE_FLOAT && a.stride == 4 * k) {
+    std::memcpy(out, a.data, 4 * k * n);
+  } else if (a.component_type == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+    for (size_t i = 0; i < n; ++i) std::memcpy(out + i * k, a.data + i * a.stride, 4 * k);
+  } else {
+    for (size_t i = 0; i < n; ++i) read_element(a, i, out + i * k);
+  }
+}
+
+bool is_identity(const glm::dmat4& m) { return m == glm::dmat4(1.0); }
+
+void transform_positions(const glm::dmat4& world, float* p, size_t n) {
+  for (size_t v = 0; v < n; ++v, p += 3) {
+    const glm::dvec4 w = world * glm::dvec4(p[0], p[1], p[2], 1.0);
+    p[0] = float(w.x), p[1] = float(w.y), p[2] = float(w.z);
+  }
+}
+
+// Normals go through the inverse transpose and are renormalized (a zero one stays zero).
+void transform_normals(const glm::dmat4& world, float* p, size_t n) {
+  const glm::dmat3 m = glm::transpose(glm::inverse(glm::dmat3(world)));
+  for (size_t v = 0; v < n; ++v, p += 3) {
+    glm::dvec3 t = m * glm::dvec3(p[0], p[1], p[2]);
+    const double len = glm::length(t);
+    if (len > 0) t /= len;
+    p[0] = float(t.x), p[1] = float(t.y), p[2] = float(t.z);
+  }
+}
+
+void transform_uvs(const UvTransform& t, float* p, size_t n) {
+  for (size_t v = 0; v < n; ++v, p += 2) {
+    const double u = p[0], w = p[1];
+    p[0] = float(t.m[0] * u + t.m[1] * w + t.m[2]);
+    p[1] = float(t.m[3] * u + t.m[4] * w + t.m[5]);
+  }
+}
+
+// Index of the first non-finite value in p[0, n), or n.
+size_t first_nonfinite(const float* p, size_t n) {
+  for (size_t i = 0; i < n; ++i)
+    if (!std::isfinite(p[i])) return i;
+  return n;
+}
+
+// The primitive's corners (its indices, or 0..n-1 without), each checked against its vertices.
+Status read_corners(const std::string& where, const PrimitivePlan& plan, uint32_t* out) {
+  if (!plan.indexed) {
+    for (size_t i = 0; i < plan.vertices(); ++i) out[i] = uint32_t(i);
+    return Status::success();
+  }
+  const AccessorView& a = plan.indices;
+  if (a.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) std::memcpy(out, a.data, 4 * a.count);  // tight: no stride
+  else
+    for (size_t i = 0; i < a.count; ++i) out[i] = read_index(a, i);
+  uint32_t largest = 0;
+  for (size_t i = 0; i < a.count; ++i) largest = std::max(largest, out[i]);
+  if (largest < plan.vertices()) return Status::success();
+  for (size_t i = 0; i < a.count; ++i)
+    if (out[i] >= plan.vertices())
+      return Status::error(where + ": index " + std::to_string(i) + " references vertex " + std::to_string(out[i]) +
+                           " of " + std::to_string(plan.vertices()));
+  return Status::success();
+}
+
+// Corners to triangles (spec 3.7.2.1: strips alternate their winding, fans turn about corner
+// 0), offset by `base`; a mirroring transform swaps two corners to keep the front face.
+void triangles_from_corners(int mode, const uint32_t* c, size_t triangles, uint32_t base, bool mirrored, uint32_t* out) {
+  for (size_t t = 0; t < triangles; ++t, out += 3) {
+    if (mode == TINYGLTF_MODE_TRIANGLES) out[0] = c[3 * t], out[1] = c[3 * t + 1], out[2] = c[3 * t + 2];
+    else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) out[0] = c[t], out[1] = c[t + 1 + t % 2], out[2] = c[t + 2 - t % 2];
+    else out[0] = c[t + 1], out[1] = c[t + 2], out[2] = c[0];
+    if (mirrored) std::swap(out[1], out[2]);
+    out[0] += base, out[1] += base, out[2] += base;
+  }
+}
+
+// Appends one primitive under one node's transform, as passes over its new ranges: decode,
+// transform, check finite, then corners -> triangles.
 Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const Instance& inst, Columns cols,
-                      MeshData& out) {
+                      std::vector<uint32_t>& scratch, MeshData& out) {
   const std::string where = what + ": mesh " + std::to_string(plan.mesh) + " primitive " + std::to_string(plan.primitive);
-  const size_t base = out.vertex_count();
-  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(inst.world)));
+  const size_t base = out.vertex_count(), n = plan.vertices();
+  const bool moved = !is_identity(inst.world);
+
+  out.positions.resize(3 * (base + n));
+  float* p = out.positions.data() + 3 * base;
+  decode_elements(plan.position, p);
+  if (moved) transform_positions(inst.world, p, n);
+  if (const size_t bad = first_nonfinite(p, 3 * n); bad < 3 * n)
+    return Status::error(where + ": vertex " + std::to_string(bad / 3) + " has a non-finite position (" +
+                         describe_nonfinite(p[bad]) + ")");
+  if (cols.normals) {
+    out.normals.resize(3 * (base + n));
+    float* q = out.normals.data() + 3 * base;
+    decode_elements(plan.normal, q);
+    if (moved) transform_normals(inst.world, q, n);
+    if (const size_t bad = first_nonfinite(q, 3 * n); bad < 3 * n)
+      return Status::error(where + ": vertex " + std::to_string(bad / 3) + " has a non-finite normal");
+  }
+  if (cols.uvs) {
+    out.uvs.resize(2 * (base + n), 0.0f);  // (0, 0) for a primitive without TEXCOORD_0
+    float* q = out.uvs.data() + 2 * base;
+    if (plan.has_uv) decode_elements(plan.uv, q);
+    if (plan.has_uv && !plan.uv_transform.identity) transform_uvs(plan.uv_transform, q, n);
+    if (const size_t bad = first_nonfinite(q, 2 * n); bad < 2 * n)
+      return Status::error(where + ": vertex " + std::to_string(bad / 2) + " has a non-finite TEXCOORD_0");
+  }
+
+  const size_t first = out.triangle_count();
   const bool mirrored = glm::determinant(glm::dmat3(inst.world)) < 0;
-  for (size_t v = 0; v < plan.vertices(); ++v) {
-    float p[3];
-    read_element(plan.position, v, p);
-    const glm::dvec4 w = inst.world * glm::dvec4(p[0], p[1], p[2], 1.0);
-    for (int c = 0; c < 3; ++c) {
-      const float f = float(w[c]);
-      if (!std::isfinite(f))
-        return Status::error(where + ": vertex " + std::to_string(v) + " has a non-finite position (" +
-                             describe_nonfinite(f) + ")");
-      out.positions.push_back(f);
-    }
-    if (cols.normals) {
-      float n[3];
-      read_element(plan.normal, v, n);
-      glm::dvec3 t = normal_matrix * glm::dvec3(n[0], n[1], n[2]);
-      const double len = glm::length(t);
-      if (!std::isfinite(len)) return Status::error(where + ": vertex " + std::to_string(v) + " has a non-finite normal");
-      t = len > 0 ? t / len : t;
-      out.normals.insert(out.normals.end(), {float(t.x), float(t.y), float(t.z)});
-    }
-    if (cols.uvs) {
-      float uv[2] = {0, 0};
-      if (plan.has_uv) read_element(plan.uv, v, uv);
-      if (!plan.uv_transform.identity) {
-        const double* t = plan.uv_transform.m;
-        const double u0 = uv[0], v0 = uv[1];
-        uv[0] = float(t[0] * u0 + t[1] * v0 + t[2]);
-        uv[1] = float(t[3] * u0 + t[4] * v0 + t[5]);
-      }
-      if (!std::isfinite(uv[0]) || !std::isfinite(uv[1]))
-        return Status::error(where + ": vertex " + std::to_string(v) + " has a non-finite TEXCOORD_0");
-      out.uvs.insert(out.uvs.end(), {uv[0], uv[1]});
-    }
+  const size_t corners = plan.indexed ? plan.indices.count : n;
+  if (plan.mode == TINYGLTF_MODE_TRIANGLES && !mirrored) {  // the common case: corners are the triangles
+    out.indices.resize(3 * first + corners);
+    if (Status s = read_corners(where, plan, out.indices.data() + 3 * first); !s) return s;
+    out.indices.resize(3 * (first + plan.triangles));  // a stray last corner or two
+    for (size_t i = 3 * first; i < out.indices.size(); ++i) out.indices[i] += uint32_t(base);
+  } else {
+    scratch.resize(corners);
+    if (Status s = read_corners(where, plan, scratch.data()); !s) return s;
+    out.indices.resize(3 * (first + plan.triangles));
+    triangles_from_corners(plan.mode, scratch.data(), plan.triangles, uint32_t(base), mirrored,
+                           out.indices.data() + 3 * first);
   }
-  const size_t corners = plan.indexed ? plan.indices.count : plan.vertices();
-  auto corner = [&](size_t i) -> uint32_t { return plan.indexed ? read_index(plan.indices, i) : uint32_t(i); };
-  if (plan.indexed)
-    for (size_t i = 0; i < corners; ++i)
-      if (const uint32_t c = corner(i); c >= plan.vertices())
-        return Status::error(where + ": index " + std::to_string(i) + " references vertex " + std::to_string(c) + " of " +
-                             std::to_string(plan.vertices()));
-  for (size_t t = 0; t < plan.triangles; ++t) {
-    uint32_t tri[3];
-    if (plan.mode == TINYGLTF_MODE_TRIANGLES) {
-      tri[0] = corner(3 * t), tri[1] = corner(3 * t + 1), tri[2] = corner(3 * t + 2);
-    } else if (plan.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {  // odd triangles swap to keep the winding
-      tri[0] = corner(t), tri[1] = corner(t + 1 + t % 2), tri[2] = corner(t + 2 - t % 2);
-    } else {  // fan around the first corner
-      tri[0] = corner(t + 1), tri[1] = corner(t + 2), tri[2] = corner(0);
-    }
-    if (mirrored) std::swap(tri[1], tri[2]);
-    for (uint32_t c : tri) out.indices.push_back(uint32_t(base + c));
-  }
-  const uint32_t first = uint32_t(out.triangle_count() - plan.triangles);
+
   if (!out.submeshes.empty() && out.submeshes.back().material == plan.material)
     out.submeshes.back().triangle_count += uint32_t(plan.triangles);
   else
-    out.submeshes.push_back({first, uint32_t(plan.triangles), plan.material});
+    out.submeshes.push_back({uint32_t(first), uint32_t(plan.triangles), plan.material});
   return Status::success();
 }
 
@@ -743,9 +811,10 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
   if (cols.uvs) mesh.uvs.reserve(2 * vertices);
   mesh.indices.reserve(3 * triangles);
   std::string missing_normals, missing_uvs;
+  std::vector<uint32_t> scratch;
   for (const Instance& inst : instances)
     for (const PrimitivePlan& p : plans[inst.mesh]) {
-      if (Status s = emit_primitive(what, p, inst, cols, mesh); !s) return s;
+      if (Status s = emit_primitive(what, p, inst, cols, scratch, mesh); !s) return s;
       const std::string name = "mesh " + std::to_string(p.mesh) + " primitive " + std::to_string(p.primitive);
       if (!p.has_normal && missing_normals.empty()) missing_normals = name;
       if (cols.uvs && !p.has_uv && missing_uvs.empty()) missing_uvs = name;
