@@ -293,20 +293,18 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
     if (indices[i] >= vertex_count)
       return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
                            std::to_string(indices[i]) + " of " + std::to_string(vertex_count));
-  std::ofstream f(path, std::ios::trunc);
-  if (!f) return Status::error(what + ": cannot be opened for writing");
+  std::string text = "# lodkit\n";
   char line[160];
-  f << "# lodkit\n";
   for (size_t v = 0; v < vertex_count; ++v) {
     const float* p = positions + 3 * v;
     std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
-    f << line;
+    text += line;
   }
   if (normals)
     for (size_t v = 0; v < vertex_count; ++v) {
       const float* n = normals + 3 * v;
       std::snprintf(line, sizeof line, "vn %.6g %.6g %.6g\n", n[0], n[1], n[2]);
-      f << line;
+      text += line;
     }
   for (size_t t = 0; t < index_count / 3; ++t) {
     const unsigned long a = indices[3 * t] + 1ul, b = indices[3 * t + 1] + 1ul, c = indices[3 * t + 2] + 1ul;
@@ -314,11 +312,9 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
       std::snprintf(line, sizeof line, "f %lu//%lu %lu//%lu %lu//%lu\n", a, a, b, b, c, c);
     else
       std::snprintf(line, sizeof line, "f %lu %lu %lu\n", a, b, c);
-    f << line;
+    text += line;
   }
-  f.flush();
-  if (!f) return Status::error(what + ": write failed (disk full?)");
-  return Status::success();
+  return write_file_atomic(path, text);
 }
 
 }  // namespace lod
