@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "cli/svg_plot.h"
+#include "runtime/file_write.h"
 
 namespace lod::cli {
 namespace {
@@ -21,17 +21,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 Status write_file(const std::filesystem::path& file, const std::string& text) {
-  const auto tmp = file.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) return Status::error(file.string() + ": cannot open for writing");
-    f << text;
-    if (!f) return Status::error(file.string() + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) return Status::error(file.string() + ": " + ec.message());
-  return Status::success();
+  return write_file_atomic(file, text);
 }
 
 nlohmann::json frame_json(const FrameRecord& r) {

@@ -77,9 +77,12 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
 
 // "model NAME (FILE): message", without naming the file twice when preprocess/ already did.
 std::string model_error(const ModelConfig& model, const std::string& message) {
+  // Messages from the bake already name the file, or the model and the file: name each once.
   const std::string file = model.file.string();
+  const std::string both = model.name + " (" + file + ")";
+  if (message.compare(0, both.size(), both) == 0) return "model " + message;
   if (message.compare(0, file.size(), file) == 0) return "model " + model.name + ": " + message;
-  return "model " + model.name + " (" + file + "): " + message;
+  return "model " + both + ": " + message;
 }
 
 void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, LogLines& log,
@@ -147,7 +150,7 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
   }
   const Status written = write_lod_asset(asset, chain);
   if (!written) {
-    task.status = Status::error("model " + model.name + ": cannot write cache " + asset.string() + ": " + written.message);
+    task.status = Status::error("model " + model.name + ": cannot write its cache: " + written.message);
     return;
   }
   task.result.levels = chain.levels.size();

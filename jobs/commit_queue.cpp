@@ -113,6 +113,8 @@ void CommitQueue::commit(uint64_t tick) {
   if (!spare_.empty()) {  // a recycled buffer keeps its capacity for the next batch
     staged_.swap(spare_.back());
     spare_.pop_back();
+  } else {
+    buffers_.fetch_add(1, std::memory_order_relaxed);  // the new staging buffer grows from empty
   }
 }
 

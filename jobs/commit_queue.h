@@ -5,6 +5,7 @@
 // the buffers back for reuse. Neither side ever holds a lock while the other works on a frame,
 // and a steady rate of updates allocates nothing.
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <span>
@@ -33,6 +34,9 @@ class CommitQueue {
   uint64_t live_count() const;
   uint64_t slots() const;
   uint64_t commits() const;
+  // Staging buffers made so far (each grows to the largest batch it carried): 1 + the most
+  // batches ever pending or in use at once, when commits outpace frames.
+  uint64_t buffers() const { return buffers_.load(std::memory_order_relaxed); }
   void commit(uint64_t tick);
 
   // LOD side (one thread): every batch committed so far, oldest first, swapped into `out`
@@ -45,6 +49,7 @@ class CommitQueue {
   std::vector<ObjectCommand> staged_;
   HandleTable handles_;
   uint64_t commits_ = 0;
+  std::atomic<uint64_t> buffers_{1};
 
   std::mutex pending_mutex_;  // pending_, spare_
   std::vector<Batch> pending_;

@@ -49,10 +49,12 @@ using Clock = std::chrono::steady_clock;
 using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 
 // ThreadSanitizer cannot see the synchronisation inside libtbb (a library not built with it),
-// so these mark the edges TBB guarantees: what precedes a spawn happens before the task runs,
-// and what a task does happens before the wait that joins it (and before the tasks TBB runs
-// after it: range splits and successor nodes happen inside TBB). One address for every graph,
-// since a task must acquire before it reads even its own captures. No-ops in other builds.
+// so the graph marks the hand-overs TBB guarantees, each on an address of its own (SyncPoints):
+// a node acquires what each of its predecessors released when it finished (or, at a root,
+// what the frame's caller released before starting it); a parallel loop's chunks acquire
+// what their node released before the loop and release what it acquires after the join.
+// Data that crosses between two nodes without an edge of the table is therefore reported.
+// No-ops in other builds.
 #if defined(__SANITIZE_THREAD__)
 #define LOD_TSAN 1
 #elif defined(__has_feature)
@@ -60,19 +62,19 @@ using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 #define LOD_TSAN 1
 #endif
 #endif
+// A node's body must acquire before it reads even its own captures (written when the graph
+// was built), so it first acquires the one address every frame's caller releases: graphs are
+// ordered after every caller, a node never after another node without an edge.
 #ifdef LOD_TSAN
 extern "C" void __tsan_acquire(void* addr);
 extern "C" void __tsan_release(void* addr);
-char tbb_edge;
-void before_spawn() { __tsan_release(&tbb_edge); }
-void task_begins() { __tsan_acquire(&tbb_edge); }
-void task_ends() { __tsan_release(&tbb_edge); }
-void after_join() { __tsan_acquire(&tbb_edge); }
+char tsan_any_frame_start;
+void tsan_acquire(char& at) { __tsan_acquire(&at); }
+void tsan_release(char& at) { __tsan_release(&at); }
 #else
-inline void before_spawn() {}
-inline void task_begins() {}
-inline void task_ends() {}
-inline void after_join() {}
+[[maybe_unused]] char tsan_any_frame_start;
+inline void tsan_acquire(char&) {}
+inline void tsan_release(char&) {}
 #endif
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
@@ -199,6 +201,12 @@ struct FrameGraph::Impl {
   uint64_t morph_reserve = 0;
   SelectionResult selected;
   std::array<double, kStageCount> stage_ms{};
+  // ThreadSanitizer's view of the graph's edges (see tsan_acquire); one byte per hand-over.
+  struct SyncPoints {
+    char start = 0, finish = 0;
+    std::array<char, kNodeCount> done{};
+    std::array<char, kStageCount> spawn{}, join{};
+  } sync;
   uint64_t frame_index = 0;
   std::vector<uint32_t> freed_slots;
 
@@ -355,19 +363,20 @@ struct FrameGraph::Impl {
     const auto pred = reduced_predecessors();
     nodes.reserve(kNodeCount);
     for (size_t i = 0; i < kNodeCount; ++i) {
-        nodes.push_back(std::make_unique<Node>(*graph, [this, i](const tbb::flow::continue_msg&) {
-        task_begins();
+      nodes.push_back(std::make_unique<Node>(*graph, [this, i, preds = pred[i]](const tbb::flow::continue_msg&) {
+        tsan_acquire(tsan_any_frame_start);
+        for (uint32_t p = preds; p; p &= p - 1) tsan_acquire(sync.done[std::countr_zero(p)]);
         const NodeSpec& spec = kNodes[i];
         const auto t0 = Clock::now();
         try {
           if (options.stage_hook) options.stage_hook(spec.stage);
           (this->*spec.run)();
         } catch (...) {
-          task_ends();
+          tsan_release(sync.done[i]);
           throw;
         }
         stage_ms[static_cast<size_t>(spec.stage)] = ms_between(t0, Clock::now());
-        task_ends();
+        tsan_release(sync.done[i]);
       }));
     }
     for (size_t j = 0; j < kNodeCount; ++j) {
@@ -378,29 +387,33 @@ struct FrameGraph::Impl {
 
   // Runs body(chunk, begin, end) for every chunk; one task per chunk.
   template <class Body>
-  void for_chunks(Stage, const Body& body) {
-    before_spawn();
+  void for_chunks(Stage stage, const Body& body) {
+    char& spawn = sync.spawn[static_cast<size_t>(stage)];
+    char& join = sync.join[static_cast<size_t>(stage)];
+    tsan_release(spawn);
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, chunks, 1),
         [&](const tbb::blocked_range<size_t>& r) {
-          task_begins();
+          tsan_acquire(spawn);
           for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
-          task_ends();
+          tsan_release(join);
         },
         tbb::simple_partitioner());
-    after_join();
+    tsan_acquire(join);
   }
 
   template <class Body>
-  void for_items(Stage, size_t n, const Body& body) {
+  void for_items(Stage stage, size_t n, const Body& body) {
     if (n == 0) return;
-    before_spawn();
+    char& spawn = sync.spawn[static_cast<size_t>(stage)];
+    char& join = sync.join[static_cast<size_t>(stage)];
+    tsan_release(spawn);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& r) {
-      task_begins();
+      tsan_acquire(spawn);
       for (size_t j = r.begin(); j != r.end(); ++j) body(j);
-      task_ends();
+      tsan_release(join);
     });
-    after_join();
+    tsan_acquire(join);
   }
 
   // ---- nodes ------------------------------------------------------------------------------
@@ -858,23 +871,33 @@ struct FrameGraph::Impl {
     stage_ms.fill(0);
     f.index = ++frame_index;
     f.time_s = time;
-    before_spawn();
+    tsan_release(sync.start);
+    tsan_release(tsan_any_frame_start);
+    auto join_nodes = [this] {
+      for (char& d : sync.done) tsan_acquire(d);
+      tsan_release(sync.finish);
+    };
     try {
       arena.execute([&] {  // may run on a worker when the arena has no free slot
-        task_begins();
+        tsan_acquire(sync.start);
         start->try_put(tbb::flow::continue_msg());
-        graph->wait_for_all();
-        task_ends();
+        try {
+          graph->wait_for_all();
+        } catch (...) {
+          join_nodes();
+          throw;
+        }
+        join_nodes();
       });
     } catch (...) {
-      after_join();
+      tsan_acquire(sync.finish);
       graph->reset();
       reset_temporal_state();
       out = nullptr;
       f.tick = tick;
       throw;
     }
-    after_join();
+    tsan_acquire(sync.finish);
     out = nullptr;
     input = nullptr;
     f.tick = tick;

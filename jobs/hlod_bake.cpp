@@ -15,7 +15,7 @@
 
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
-#include "runtime/atomic_file.h"
+#include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 
@@ -95,7 +95,7 @@ Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string&
   if (ec) return Status::error(out_dir.string() + ": cannot create the output directory: " + ec.message());
   r.file = out_dir / (name + ".hlod");
   const std::vector<uint8_t> bytes = encode_hlod_asset(model.tree, model.payloads);
-  if (Status s = write_file_atomically(r.file, bytes); !s) return s;
+  if (Status s = write_file_atomic(r.file, bytes); !s) return s;
   r.bytes = bytes.size();
   r.write_seconds = seconds_since(t0);
   if (result) *result = std::move(r);

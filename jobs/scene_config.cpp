@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <initializer_list>
 #include <optional>
 #include <sstream>
@@ -477,10 +478,26 @@ Status load_scene_config(const std::filesystem::path& file, const std::filesyste
                          SceneConfig& out, bool objects_optional) {
   const std::string name = file.string();
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) return Status::error(name + ": config file not found");
+  const auto kind = std::filesystem::status(file, ec).type();
+  if (kind == std::filesystem::file_type::not_found) return Status::error(name + ": config file not found");
+  if (kind != std::filesystem::file_type::regular) return Status::error(name + ": not a regular file");
+  const uintmax_t size = std::filesystem::file_size(file, ec);
+  if (ec) return Status::error(name + ": cannot read its size: " + ec.message());
+  if (size > kMaxConfigBytes)
+    return Status::error(name + ": " + std::to_string(size) + " bytes; a scene config is at most " +
+                         std::to_string(kMaxConfigBytes) + " bytes");
+  std::ifstream f(file, std::ios::binary);
+  std::string text(size_t(size), '\0');
+  if (!f.read(text.data(), std::streamsize(size))) return Status::error(name + ": cannot be read");
+  return parse_scene_config(text, file, data_dir, out, objects_optional);
+}
+
+Status parse_scene_config(std::string_view text, const std::filesystem::path& file,
+                          const std::filesystem::path& data_dir, SceneConfig& out, bool objects_optional) {
+  const std::string name = file.string();
   toml::table root;
   try {
-    root = toml::parse_file(name);
+    root = toml::parse(text, name);
   } catch (const toml::parse_error& e) {
     const auto& at = e.source().begin;
     return Status::error(name + ":" + std::to_string(at.line) + ":" + std::to_string(at.column) + ": " +

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "preprocess/lod_bake.h"
@@ -56,6 +57,12 @@ struct SceneConfig {
 // program fills itself); `lod run` and the viewer need both.
 Status load_scene_config(const std::filesystem::path& file, const std::filesystem::path& data_dir,
                          SceneConfig& out, bool objects_optional = false);
+
+// The same over a config's text; `file` names it in messages and is where relative mesh paths
+// start. Configs are small: load_scene_config refuses files over kMaxConfigBytes unread.
+inline constexpr uint64_t kMaxConfigBytes = 16u << 20;
+Status parse_scene_config(std::string_view text, const std::filesystem::path& file,
+                          const std::filesystem::path& data_dir, SceneConfig& out, bool objects_optional = false);
 
 // The data directory the set-up fills (Debian's CGAL meshes), compiled in.
 std::filesystem::path default_data_dir();

@@ -203,6 +203,7 @@ ServiceStats Service::stats() const {
   s.commits = impl_->queue.commits();
   s.live_objects = impl_->queue.live_count();
   s.handle_slots = impl_->queue.slots();
+  s.commit_buffers = impl_->queue.buffers();
   return s;
 }
 

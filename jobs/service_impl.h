@@ -128,6 +128,7 @@ struct Service::Impl {
     }
     const double ms = back.total_ms;
     pool.publish();
+    stats.frame_slots = pool.slots();
     ++stats.frames;
     stats.last_ms = ms;
     stats.mean_ms += (ms - stats.mean_ms) / static_cast<double>(stats.frames);

@@ -7,6 +7,7 @@
 #include "preprocess/mesh_io.h"
 
 #include "preprocess/mesh_readers.h"
+#include "runtime/file_write.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -21,7 +22,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <mutex>
 #include <new>
@@ -264,22 +264,22 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
     if (indices[i] >= vertex_count)
       return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
                            std::to_string(indices[i]) + " of " + std::to_string(vertex_count));
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) return Status::error(what + ": cannot be opened for writing");
-  f << "ply\nformat binary_little_endian 1.0\ncomment lodkit\nelement vertex " << vertex_count
-    << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << index_count / 3
-    << "\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string header = "ply\nformat binary_little_endian 1.0\ncomment lodkit\nelement vertex " +
+                             std::to_string(vertex_count) +
+                             "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                             std::to_string(index_count / 3) +
+                             "\nproperty list uchar int vertex_indices\nend_header\n";
   static_assert(std::endian::native == std::endian::little, "save_ply writes host-order floats");
-  f.write(reinterpret_cast<const char*>(positions), std::streamsize(vertex_count * 3 * sizeof(float)));
-  std::vector<char> face(13);
-  face[0] = 3;
-  for (size_t t = 0; t < index_count / 3; ++t) {
-    std::memcpy(&face[1], indices + 3 * t, 12);
-    f.write(face.data(), 13);
+  std::vector<uint8_t> bytes(header.begin(), header.end());
+  const size_t body = header.size();
+  bytes.resize(body + vertex_count * 12 + index_count / 3 * 13);
+  std::memcpy(bytes.data() + body, positions, vertex_count * 12);
+  uint8_t* face = bytes.data() + body + vertex_count * 12;
+  for (size_t t = 0; t < index_count / 3; ++t, face += 13) {
+    face[0] = 3;
+    std::memcpy(face + 1, indices + 3 * t, 12);
   }
-  f.flush();
-  if (!f) return Status::error(what + ": write failed (disk full?)");
-  return Status::success();
+  return write_file_atomic(path, bytes);
 }
 
 }  // namespace lod

@@ -28,7 +28,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "runtime/atomic_file.h"
+#include "runtime/file_write.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/lod_chain.h"
 #include "runtime/vertex_tree.h"  // kMaxTreeMagnitude
@@ -450,7 +450,7 @@ Status decode_hlod_asset(std::span<const uint8_t> file, const std::string& what,
 
 Status write_hlod_asset(const std::filesystem::path& path, const HlodTree& tree, std::span<const HlodPayload> payloads) {
   const std::vector<uint8_t> bytes = encode_hlod_asset(tree, payloads);
-  return write_file_atomically(path, bytes);
+  return write_file_atomic(path, bytes);
 }
 
 // ---- reading from a file -----------------------------------------------------------------

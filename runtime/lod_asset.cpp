@@ -20,22 +20,20 @@
 // The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
 #include "runtime/lod_asset.h"
 
-#include "runtime/atomic_file.h"
-
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <atomic>
 
 #include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <new>
 #include <string_view>
 #include <system_error>
+
+#include "runtime/file_write.h"
 
 namespace lod {
 
@@ -469,8 +467,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
 }
 
 Status write_lod_asset(const std::filesystem::path& path, const LodChain& chain) {
-  const std::vector<uint8_t> bytes = encode_lod_asset(chain);
-  return write_file_atomically(path, bytes);
+  return write_file_atomic(path, encode_lod_asset(chain));
 }
 
 Status read_lod_asset(const std::filesystem::path& path, LodChain& out) {

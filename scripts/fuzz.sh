@@ -1,65 +1,102 @@
 #!/usr/bin/env bash
-# libFuzzer over the mesh readers: one target per format (PLY, OFF, STL, OBJ), built with
-# Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each run for SECONDS
-# (default 600) from the seeds in tests/fuzz/corpus/<format>/ with tests/fuzz/<format>.dict.
-# A crash, sanitizer report, timeout (> 5 s on one input) or single allocation over 64 MB
-# fails the run; the input is kept in $OUT/<format>/ (crash-*, timeout-*, oom-*) and the
-# script exits non-zero. Every finding must become a regression test in
-# tests/unit/preprocess/mesh_reader_hostile_test.cpp.
+# libFuzzer over every reader: one target per mesh format (PLY, OFF, STL, OBJ), the .lod asset
+# reader (`lod`, with a mutator that keeps the checksum valid) and the scene config reader
+# (`scene`), built with Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each
+# run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with
+# tests/fuzz/<target>.dict. A crash, sanitizer report, timeout (> 5 s on one input) or single
+# allocation over 64 MB fails the run; the input is kept in $OUT/<target>/ (crash-*, timeout-*,
+# oom-*) and the script exits non-zero. Every finding must become a regression test
+# (tests/unit/preprocess/mesh_reader_hostile_test.cpp, tests/unit/runtime/lod_asset_test.cpp,
+# tests/unit/jobs/scene_config_test.cpp).
 #
-#   scripts/fuzz.sh [SECONDS] [FORMAT...]      e.g. scripts/fuzz.sh 20   or  scripts/fuzz.sh 180 ply
+#   scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. scripts/fuzz.sh 20   or  scripts/fuzz.sh 180 ply lod
 # Env: LOD_FUZZ_BUILD (default build-fuzz), LOD_FUZZ_JOBS (parallel targets; default nproc),
-#      LOD_FUZZ_MAX_LEN (default 4096 bytes).
+#      LOD_FUZZ_MAX_LEN (default 4096 bytes; 16384 for lod, whose seeds are larger),
+#      LOD_FUZZ_TIMEOUT (seconds per input, default 5; more on a loaded or niced run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
-FORMATS=("$@")
-[ ${#FORMATS[@]} -gt 0 ] || FORMATS=(ply off stl obj)
+TARGETS=("$@")
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj lod scene)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
-MAX_LEN=${LOD_FUZZ_MAX_LEN:-4096}
 CXX=${LOD_FUZZ_CXX:-clang++}
 command -v "$CXX" >/dev/null || { echo "[fuzz] $CXX not found (apt-get install clang libclang-rt-14-dev)" >&2; exit 1; }
 mkdir -p "$OUT/obj"
 
 # ---- build (objects shared by the targets; rebuilt when a source or header is newer) ----
 FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
-       -I. -D_USE_MATH_DEFINES)
-SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
-         preprocess/obj_reader.cpp)
-HEADERS=(preprocess/mesh_io.h preprocess/mesh_readers.h preprocess/mesh.h runtime/status.h)
-newest_header=$(ls -t "${HEADERS[@]}" | head -1)
-objs=()
+       -I. -Iinclude -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
+MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
+              preprocess/obj_reader.cpp runtime/file_write.cpp)
+LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/vertex_front.cpp
+             runtime/file_write.cpp runtime/model_table.cpp runtime/view.cpp)
+SCENE_SOURCES=(jobs/scene_config.cpp)
+# The scene reader links Debian's toml++ library as lodkit does (its header-only mode has debug
+# asserts that the shipped, NDEBUG library does not: "[[[a]]" asserts there, is refused here).
+SCENE_FLAGS=(-DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1)
+newest_header=$(ls -t preprocess/*.h runtime/*.h jobs/scene_config.h include/lodkit/*.hpp | head -1)
+declare -A built=()
 pids=()
-for src in "${SOURCES[@]}"; do
-  o="$OUT/obj/$(basename "$src" .cpp).o"
-  objs+=("$o")
-  if [ ! -f "$o" ] || [ "$src" -nt "$o" ] || [ "$newest_header" -nt "$o" ]; then
-    "$CXX" "${FLAGS[@]}" -fsanitize=fuzzer-no-link -c "$src" -o "$o" & pids+=($!)
-  fi
+object_of() { echo "$OUT/obj/$(echo "$1" | tr / _ | sed 's/\.cpp$/.o/')"; }
+compile() {  # compiles each source once per run, in the background
+  for src in "$@"; do
+    local o
+    o=$(object_of "$src")
+    [ -n "${built[$o]:-}" ] && continue
+    built[$o]=1
+    if [ ! -f "$o" ] || [ "$src" -nt "$o" ] || [ "$newest_header" -nt "$o" ]; then
+      local own=()
+      [[ " ${SCENE_SOURCES[*]} tests/fuzz/scene_fuzz.cpp " == *" $src "* ]] && own=("${SCENE_FLAGS[@]}")
+      "$CXX" "${FLAGS[@]}" "${own[@]}" -fsanitize=fuzzer-no-link -c "$src" -o "$o" & pids+=($!)
+    fi
+  done
+}
+sources_of() {
+  case $1 in
+    lod) echo "${LOD_SOURCES[@]}" ;;
+    scene) echo "${SCENE_SOURCES[@]}" ;;
+    *) echo "${MESH_SOURCES[@]}" ;;
+  esac
+}
+for t in "${TARGETS[@]}"; do
+  case $t in ply|off|stl|obj|lod|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj lod scene)" >&2; exit 2 ;; esac
+  # shellcheck disable=SC2046
+  compile $(sources_of "$t")
 done
 for p in "${pids[@]}"; do wait "$p"; done
-for fmt in "${FORMATS[@]}"; do
-  bin="$OUT/fuzz_$fmt"
-  if [ ! -x "$bin" ] || [ tests/fuzz/mesh_fuzz.cpp -nt "$bin" ] || [ -n "$(find "${objs[@]}" -newer "$bin")" ]; then
-    "$CXX" "${FLAGS[@]}" -fsanitize=fuzzer "-DLOD_FUZZ_EXT=\".$fmt\"" tests/fuzz/mesh_fuzz.cpp "${objs[@]}" -o "$bin"
+for t in "${TARGETS[@]}"; do
+  bin="$OUT/fuzz_$t"
+  objs=()
+  for src in $(sources_of "$t"); do objs+=("$(object_of "$src")"); done
+  case $t in
+    lod) main=tests/fuzz/asset_fuzz.cpp; extra=() ;;
+    scene) main=tests/fuzz/scene_fuzz.cpp; extra=("${SCENE_FLAGS[@]}" -ltomlplusplus) ;;
+    *) main=tests/fuzz/mesh_fuzz.cpp; extra=("-DLOD_FUZZ_EXT=\".$t\"") ;;
+  esac
+  if [ ! -x "$bin" ] || [ "$main" -nt "$bin" ] || [ -n "$(find "${objs[@]}" -newer "$bin")" ]; then
+    libs=(); defs=()
+    for e in "${extra[@]}"; do case $e in -l*) libs+=("$e") ;; *) defs+=("$e") ;; esac; done
+    "$CXX" "${FLAGS[@]}" -fsanitize=fuzzer "${defs[@]}" "$main" "${objs[@]}" "${libs[@]}" -o "$bin"
   fi
 done
-echo "[fuzz] built ${FORMATS[*]} in $OUT/; ${SECONDS_EACH} s per target, $JOBS at a time"
+echo "[fuzz] built ${TARGETS[*]} in $OUT/; ${SECONDS_EACH} s per target, $JOBS at a time"
 
 # ---- run ---------------------------------------------------------------------------------
 run_one() {  # runs in a background subshell; reports by its exit status
   set +e +o pipefail
   local fmt=$1 dir="$OUT/$1"
+  local max_len=${LOD_FUZZ_MAX_LEN:-4096}
+  [ "$fmt" = lod ] && max_len=${LOD_FUZZ_MAX_LEN:-16384}
   mkdir -p "$dir/corpus"
   rm -f "$dir"/crash-* "$dir"/timeout-* "$dir"/oom-* "$dir"/leak-*
   local rc=0
   # -malloc_limit_mb=64: the figure "every file under 1 KB loads in < 64 MB" (inputs here are
   # up to MAX_LEN bytes, so this is stricter); -timeout=5: a hang is a finding.
   ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-    "$OUT/fuzz_$fmt" -max_total_time="$SECONDS_EACH" -timeout=5 -malloc_limit_mb=64 -rss_limit_mb=1024 \
-      -max_len="$MAX_LEN" -dict="tests/fuzz/$fmt.dict" -artifact_prefix="$dir/" -print_final_stats=1 \
+    "$OUT/fuzz_$fmt" -max_total_time="$SECONDS_EACH" -timeout="${LOD_FUZZ_TIMEOUT:-5}" -malloc_limit_mb=64 -rss_limit_mb=1024 \
+      -max_len="$max_len" -dict="tests/fuzz/$fmt.dict" -artifact_prefix="$dir/" -print_final_stats=1 \
       "$dir/corpus" "tests/fuzz/corpus/$fmt" >"$dir/log.txt" 2>&1 || rc=$?
   local execs rate cov
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/log.txt" | tail -1)
@@ -77,7 +114,7 @@ run_one() {  # runs in a background subshell; reports by its exit status
 failed=0
 running=0
 declare -A pid_of
-for fmt in "${FORMATS[@]}"; do
+for fmt in "${TARGETS[@]}"; do
   run_one "$fmt" & pid_of[$fmt]=$!
   running=$((running + 1))
   if [ "$running" -ge "$JOBS" ]; then
@@ -93,4 +130,4 @@ if [ "$failed" -ne 0 ]; then
   echo "[fuzz] FAILED: findings above (inputs kept in $OUT/<format>/)" >&2
   exit 1
 fi
-echo "[fuzz] all ${#FORMATS[@]} targets clean"
+echo "[fuzz] all ${#TARGETS[@]} targets clean"

@@ -23,9 +23,9 @@ done
 echo "== ThreadSanitizer: frame pool, service (simulation + consumers), frame graph =="
 ./scripts/configure.sh build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=thread \
       -DLOD_BUILD_BENCH=OFF -DLOD_BUILD_VIEWER=OFF
-cmake --build build-tsan -j "$JOBS" --target test_jobs
-TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
-  ./scripts/ctest-all.sh build-tsan -j "$JOBS" --timeout 900 -R '^(FramePool|Service|ServiceObjects|ServiceThreads|FrameGraph|FrameGraphVd|FrameGeomorph)\.'
+cmake --build build-tsan -j "$JOBS" --target test_jobs test_stress
+TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" LOD_SOAK_SECONDS=${LOD_TSAN_SOAK_SECONDS:-15} \
+  ./scripts/ctest-all.sh build-tsan -j "$JOBS" --timeout 900 -R '^(FramePool|Service|ServiceObjects|ServiceThreads|FrameGraph|FrameGraphVd|FrameGeomorph|Soak)\.'
 
 echo "== AddressSanitizer + UBSan: runtime, preprocess, jobs, integration =="
 ./scripts/configure.sh build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=address \
@@ -33,8 +33,8 @@ echo "== AddressSanitizer + UBSan: runtime, preprocess, jobs, integration =="
 cmake --build build-asan -j "$JOBS" --target test_runtime test_preprocess test_jobs test_c_api test_integration
 ASAN_OPTIONS="detect_leaks=1" UBSAN_OPTIONS="print_stacktrace=1" \
   ./scripts/ctest-all.sh build-asan -j "$JOBS" --timeout 900 -L 'unit|integration'
-# ---- fuzzing (mesh readers): each libFuzzer target for a bounded time; a crash, sanitizer
+# ---- fuzzing (mesh readers, .lod assets, scene configs): each libFuzzer target for a bounded time; a crash, sanitizer
 # report, hang or > 64 MB allocation fails the suite (scripts/fuzz.sh SECONDS runs longer).
-echo "== libFuzzer + ASan/UBSan: mesh readers, ${LOD_FUZZ_SECONDS:-20} s per format =="
+echo "== libFuzzer + ASan/UBSan: every reader, ${LOD_FUZZ_SECONDS:-20} s per target =="
 ./scripts/fuzz.sh "${LOD_FUZZ_SECONDS:-20}"
 echo "== all tests passed =="

@@ -91,6 +91,11 @@ struct ServiceStats {
   uint64_t commits = 0;       // commit() calls
   uint64_t live_objects = 0;  // objects created and not destroyed (as staged)
   uint64_t handle_slots = 0;  // slots the handle table holds: its peak of live objects
+  // Frames the pool holds: one more than the most ever held at once by consumers, plus the
+  // one being written (each as large as the largest frame it held).
+  uint64_t frame_slots = 0;
+  // Commit buffers made: 1 + the most committed batches ever waiting for a frame at once.
+  uint64_t commit_buffers = 0;
 };
 
 class Service {

@@ -155,6 +155,19 @@ TEST(BakeJobs, BrokenMeshNamesModelAndFileAndWritesNothingForIt) {
   for (const fs::path& p : d.cache_files()) EXPECT_NE(p.filename().string().rfind("c-", 0), 0u) << p;
 }
 
+TEST(BakeJobs, BakeErrorsNameTheModelAndTheFileOnce) {
+  // The bake's own message already says "c (file)"; the job must not say it again.
+  BakeDir d;
+  d.models[2].bake.ratios = {1.0f, 1.5f};
+  std::vector<LodChain> chains;
+  BakeSummary summary;
+  const Status s = bake_scene_models(d.models, d.cache, 2, chains, summary, d.log);
+  ASSERT_FALSE(s.ok);
+  EXPECT_EQ(s.message.rfind("model c (", 0), 0u) << s.message;
+  EXPECT_EQ(s.message.find("c.off"), s.message.rfind("c.off")) << "the file is named once: " << s.message;
+  EXPECT_NE(s.message.find("ratio 1.5"), std::string::npos) << s.message;
+}
+
 TEST(BakeJobs, NoModelsIsAnEmptySuccess) {
   BakeDir d;
   std::vector<LodChain> chains(2);

@@ -529,3 +529,45 @@ TEST(SceneConfigVisibility, ParsesAndRefusesOcclusionKeys) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+TEST(SceneConfigFiles, DirectoryOrFifoIsNotARegularFile) {
+  ConfigDir d;
+  SceneConfig c;
+  const Status s = load_scene_config(d.dir, d.data, c);
+  ASSERT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("not a regular file"), std::string::npos) << s.message;
+  const fs::path missing = d.dir / "missing.toml";
+  const Status m = load_scene_config(missing, d.data, c);
+  ASSERT_FALSE(m.ok);
+  EXPECT_NE(m.message.find(missing.string() + ": config file not found"), std::string::npos) << m.message;
+}
+
+TEST(SceneConfigFiles, ParsesTextLikeTheFile) {
+  ConfigDir d;
+  SceneConfig from_file, from_text;
+  const std::string text = kModel + kInstances + "[budget]\ntriangles = 12345\n";
+  ASSERT_TRUE(load_scene_config(d.write(text), d.data, from_file).ok);
+  const Status s = parse_scene_config(text, d.dir / "scene.toml", d.data, from_text);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(from_text.selection.budget, 12345u);
+  ASSERT_EQ(from_text.models.size(), 1u);
+  EXPECT_EQ(from_text.models[0].file, from_file.models[0].file) << "mesh paths start at the config's folder";
+}
+
+// Found by the scene fuzz target: nested array-of-table brackets (an assert inside toml++'s
+// header-only parser; the library lodkit links refuses them).
+TEST(SceneConfigFiles, FuzzFindingsAreRefusedWithAPosition) {
+  ConfigDir d;
+  for (const char* text : {"[[[a]]", "[[[", "\xef\xbb\xbf[[[[#x\n"}) {
+    SceneConfig c;
+    const Status s = parse_scene_config(text, "fuzzed.toml", d.data, c);
+    ASSERT_FALSE(s.ok) << text;
+    EXPECT_EQ(s.message.rfind("fuzzed.toml:1:", 0), 0u) << s.message;
+  }
+}
+
+}  // namespace
+}  // namespace lod

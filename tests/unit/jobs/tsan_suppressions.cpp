@@ -1,4 +1,4 @@
-// ThreadSanitizer suppressions compiled into test_jobs (the sanitizer asks for them at start).
+// ThreadSanitizer suppressions compiled into test_jobs and test_stress (the sanitizer asks for them at start).
 //
 // Debian's libtbb is not built with ThreadSanitizer, so the synchronisation of its scheduler
 // (work stealing, task hand-over, waiting) is invisible, and TSan reports TBB's own task and

@@ -1,0 +1,87 @@
+// write_file_atomic: temporary + fsync + rename, as the header says.
+#include "runtime/file_write.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+
+namespace lod {
+
+std::string describe_write_errno(int err) {
+  switch (err) {
+    case ENOSPC: return "the disk is full (no space left on device)";
+    case EDQUOT: return "the disk quota is exceeded";
+    case EROFS: return "the file system is read-only";
+    case EACCES:
+    case EPERM: return "permission denied";
+    case EFBIG: return "the file is too large for this file system";
+    case EIO: return "an I/O error occurred on the device";
+    default: return std::strerror(err);
+  }
+}
+
+Status write_all(int fd, std::span<const uint8_t> bytes, const std::string& what) {
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : EIO;
+      return Status::error(what + ": " + describe_write_errno(err) + " after writing " + std::to_string(done) +
+                           " of " + std::to_string(bytes.size()) + " bytes");
+    }
+    done += size_t(n);
+  }
+  return Status::success();
+}
+
+namespace {
+
+// A name of its own per process and call: runs sharing a folder may write the same file at
+// once, and each rename then replaces it whole (last one wins).
+std::filesystem::path temporary_beside(const std::filesystem::path& path) {
+  static std::atomic<uint64_t> serial{0};
+  std::filesystem::path tmp = path;
+  std::string suffix = ".";  // appended piecewise: GCC 12 warns (-Wrestrict) on "." + to_string
+  suffix += std::to_string(::getpid());
+  suffix += '-';
+  suffix += std::to_string(serial++);
+  suffix += ".tmp";
+  tmp += suffix;
+  return tmp;
+}
+
+Status write_and_sync(const std::filesystem::path& tmp, std::span<const uint8_t> bytes, const std::string& what) {
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return Status::error(what + ": cannot create " + tmp.string() + ": " + describe_write_errno(errno));
+  Status st = write_all(fd, bytes, what);
+  // Delayed allocation can report a full disk only here.
+  if (st && ::fsync(fd) != 0) st = Status::error(what + ": " + describe_write_errno(errno) + " while flushing to disk");
+  if (::close(fd) != 0 && st) st = Status::error(what + ": " + describe_write_errno(errno) + " while closing");
+  return st;
+}
+
+}  // namespace
+
+Status write_file_atomic(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+  const std::string what = path.string();
+  const std::filesystem::path tmp = temporary_beside(path);
+  Status st = write_and_sync(tmp, bytes, what);
+  std::error_code ec;
+  if (st) {
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) st = Status::error(what + ": cannot rename " + tmp.string() + " into place: " + ec.message());
+  }
+  if (!st) std::filesystem::remove(tmp, ec);
+  return st;
+}
+
+Status write_file_atomic(const std::filesystem::path& path, const std::string& text) {
+  return write_file_atomic(path, std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+}
+
+}  // namespace lod

@@ -1,0 +1,79 @@
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "runtime/file_write.h"
+#include "test_support.h"
+
+namespace {
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+size_t leftover_temporaries(const std::filesystem::path& dir) {
+  size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".tmp") ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST(FileWrite, FullDiskSaysSoInPlainWords) {
+  // /dev/full fails every write with ENOSPC, as a full file system does.
+  const int fd = ::open("/dev/full", O_WRONLY | O_CLOEXEC);
+  if (fd < 0) GTEST_SKIP() << "/dev/full is not available here";
+  const std::vector<uint8_t> bytes(9000, 7);
+  const lod::Status st = lod::write_all(fd, bytes, "cache/bunny.lod");
+  ::close(fd);
+  ASSERT_FALSE(st.ok);
+  EXPECT_NE(st.message.find("cache/bunny.lod: the disk is full"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("after writing 0 of 9000 bytes"), std::string::npos) << st.message;
+}
+
+TEST(FileWrite, ErrnoWordsForTheCommonFailures) {
+  EXPECT_EQ(lod::describe_write_errno(ENOSPC), "the disk is full (no space left on device)");
+  EXPECT_EQ(lod::describe_write_errno(EROFS), "the file system is read-only");
+  EXPECT_EQ(lod::describe_write_errno(EACCES), "permission denied");
+  EXPECT_FALSE(lod::describe_write_errno(ENOENT).empty());
+}
+
+TEST(FileWrite, ReplacesTheFileWholeAndLeavesNoTemporary) {
+  const auto dir = lod::test::temp_dir("file_write_replace");
+  const auto file = dir / "out.txt";
+  ASSERT_TRUE(lod::write_file_atomic(file, std::string("first version, longer")).ok);
+  ASSERT_TRUE(lod::write_file_atomic(file, std::string("second")).ok);
+  EXPECT_EQ(read_text(file), "second");
+  EXPECT_EQ(leftover_temporaries(dir), 0u);
+}
+
+TEST(FileWrite, MissingFolderIsRefusedNamingTheFile) {
+  const auto dir = lod::test::temp_dir("file_write_missing");
+  const auto file = dir / "no-such-folder" / "out.lod";
+  const lod::Status st = lod::write_file_atomic(file, std::string("x"));
+  ASSERT_FALSE(st.ok);
+  EXPECT_EQ(st.message.rfind(file.string(), 0), 0u) << st.message;
+  EXPECT_FALSE(std::filesystem::exists(file));
+}
+
+TEST(FileWrite, FailedRenameKeepsWhatWasThereAndRemovesTheTemporary) {
+  // The target is a non-empty folder: the rename fails after the bytes were written.
+  const auto dir = lod::test::temp_dir("file_write_rename");
+  const auto target = dir / "taken";
+  std::filesystem::create_directories(target / "inside");
+  const lod::Status st = lod::write_file_atomic(target, std::string("payload"));
+  ASSERT_FALSE(st.ok);
+  EXPECT_NE(st.message.find("cannot rename"), std::string::npos) << st.message;
+  EXPECT_TRUE(std::filesystem::is_directory(target / "inside"));
+  EXPECT_EQ(leftover_temporaries(dir), 0u);
+}
