@@ -173,24 +173,21 @@ void lock_tetrahedron_tips(const Layer& l, std::vector<uint8_t>& lock) {
   std::vector<uint32_t> fill(first.begin(), first.end() - 1), faces(3 * nt);
   for (uint32_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) faces[fill[l.indices[3 * t + k]]++] = t;
-  std::vector<std::array<uint32_t, 3>> sorted(nt);
-  for (size_t t = 0; t < nt; ++t) {
-    sorted[t] = {l.indices[3 * t], l.indices[3 * t + 1], l.indices[3 * t + 2]};
-    std::sort(sorted[t].begin(), sorted[t].end());
-  }
-  std::vector<std::array<uint32_t, 3>> set = sorted;
-  std::sort(set.begin(), set.end());
+  auto has_corner = [&](uint32_t t, uint32_t w) {
+    return l.indices[3 * t] == w || l.indices[3 * t + 1] == w || l.indices[3 * t + 2] == w;
+  };
   for (size_t v = 0; v < nv; ++v) {
     if (first[v + 1] - first[v] != 3 || lock[v]) continue;
     std::array<uint32_t, 9> around;
     size_t n = 0;
     for (uint32_t i = first[v]; i < first[v + 1]; ++i)
-      for (uint32_t w : sorted[faces[i]])
-        if (w != v) around[n++] = w;
+      for (int k = 0; k < 3; ++k)
+        if (const uint32_t w = l.indices[3 * faces[i] + k]; w != v) around[n++] = w;
     std::sort(around.begin(), around.begin() + n);
-    const size_t distinct = size_t(std::unique(around.begin(), around.begin() + n) - around.begin());
-    if (distinct == 3 && std::binary_search(set.begin(), set.end(), std::array<uint32_t, 3>{around[0], around[1], around[2]}))
-      lock[v] = 1;
+    if (std::unique(around.begin(), around.begin() + n) - around.begin() != 3) continue;
+    // Is (a, b, c) a face? Look among a's faces.
+    for (uint32_t i = first[around[0]]; i < first[around[0] + 1]; ++i)
+      if (has_corner(faces[i], around[1]) && has_corner(faces[i], around[2])) lock[v] = 1;
   }
 }
 
