@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # libFuzzer over every reader: one target per mesh format (PLY, OFF, STL, OBJ, GLB), the .lod asset
-# reader (`lod`, with a mutator that keeps the checksum valid) and the scene config reader
+# reader (`lod`, with a mutator that keeps the checksum valid), the .hlod reader (`hlod`, the
+# same for its head and payload checksums) and the scene config reader
 # (`scene`), built with Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each
 # run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with
 # tests/fuzz/<target>.dict. A crash, sanitizer report, timeout (> 5 s on one input) or single
@@ -11,14 +12,14 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. scripts/fuzz.sh 20   or  scripts/fuzz.sh 180 ply lod
 # Env: LOD_FUZZ_BUILD (default build-fuzz), LOD_FUZZ_JOBS (parallel targets; default nproc),
-#      LOD_FUZZ_MAX_LEN (default 4096 bytes; 16384 for lod, whose seeds are larger),
+#      LOD_FUZZ_MAX_LEN (default 4096 bytes; 16384 for lod and 32768 for hlod, whose seeds are larger),
 #      LOD_FUZZ_TIMEOUT (seconds per input, default 5; more on a loaded or niced run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod scene)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod scene)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
 CXX=${LOD_FUZZ_CXX:-clang++}
@@ -32,6 +33,9 @@ MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_re
               preprocess/obj_reader.cpp preprocess/gltf_io.cpp runtime/file_write.cpp)  # gltf_io compiles tinygltf in
 LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/vertex_front.cpp
              runtime/file_write.cpp runtime/model_table.cpp runtime/view.cpp)
+HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp
+              runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/file_write.cpp runtime/model_table.cpp
+              runtime/view.cpp runtime/world_bounds.cpp)
 SCENE_SOURCES=(jobs/scene_config.cpp)
 # The scene reader links Debian's toml++ library as lodkit does (its header-only mode has debug
 # asserts that the shipped, NDEBUG library does not: "[[[a]]" asserts there, is refused here).
@@ -56,12 +60,13 @@ compile() {  # compiles each source once per run, in the background
 sources_of() {
   case $1 in
     lod) echo "${LOD_SOURCES[@]}" ;;
+    hlod) echo "${HLOD_SOURCES[@]}" ;;
     scene) echo "${SCENE_SOURCES[@]}" ;;
     *) echo "${MESH_SOURCES[@]}" ;;
   esac
 }
 for t in "${TARGETS[@]}"; do
-  case $t in ply|off|stl|obj|glb|lod|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod scene)" >&2; exit 2 ;; esac
+  case $t in ply|off|stl|obj|glb|lod|hlod|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod scene)" >&2; exit 2 ;; esac
   # shellcheck disable=SC2046
   compile $(sources_of "$t")
 done
@@ -72,6 +77,7 @@ for t in "${TARGETS[@]}"; do
   for src in $(sources_of "$t"); do objs+=("$(object_of "$src")"); done
   case $t in
     lod) main=tests/fuzz/asset_fuzz.cpp; extra=() ;;
+    hlod) main=tests/fuzz/hlod_fuzz.cpp; extra=() ;;
     scene) main=tests/fuzz/scene_fuzz.cpp; extra=("${SCENE_FLAGS[@]}" -ltomlplusplus) ;;
     *) main=tests/fuzz/mesh_fuzz.cpp; extra=("-DLOD_FUZZ_EXT=\".$t\"") ;;
   esac
@@ -89,6 +95,7 @@ run_one() {  # runs in a background subshell; reports by its exit status
   local fmt=$1 dir="$OUT/$1"
   local max_len=${LOD_FUZZ_MAX_LEN:-4096}
   [ "$fmt" = lod ] && max_len=${LOD_FUZZ_MAX_LEN:-16384}
+  [ "$fmt" = hlod ] && max_len=${LOD_FUZZ_MAX_LEN:-32768}
   mkdir -p "$dir/corpus"
   rm -f "$dir"/crash-* "$dir"/timeout-* "$dir"/oom-* "$dir"/leak-*
   local rc=0
