@@ -770,6 +770,15 @@ Status check_images(const GltfSource& src, const tinygltf::Model& m) {
   return Status::success();
 }
 
+// A file with thousands of skipped primitives says so in a few lines, not thousands.
+void cap_warnings(std::vector<std::string>& warnings) {
+  constexpr size_t kShown = 16;
+  if (warnings.size() <= kShown) return;
+  const size_t more = warnings.size() - kShown;
+  warnings.resize(kShown);
+  warnings.push_back("... and " + std::to_string(more) + " more warnings like these");
+}
+
 // ---- the pipeline ------------------------------------------------------------------------
 
 Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& out) {
@@ -829,6 +838,7 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
   if (!missing_uvs.empty()) warnings.push_back(what + ": " + missing_uvs + " has no TEXCOORD_0; its vertices get (0, 0)");
   if (Status s = read_materials(what, m, mesh.materials); !s) return s;
   if (Status s = check_images(src, m); !s) return s;
+  cap_warnings(mesh.warnings);
   out = std::move(mesh);
   return Status::success();
 }

@@ -499,6 +499,20 @@ TEST(GltfImport, SkipsLinesPointsMorphTargetsAndSkinsWithWarnings) {
   EXPECT_TRUE(has_warning(m, "node 0: skin 0 is not applied"));
 }
 
+TEST(GltfImport, ManySkippedPrimitivesGiveAFewWarningLines) {
+  GltfFixture f;
+  const int pos = f.add_accessor(f.add_view(kQuad), kFloat, 4, "VEC3");
+  std::vector<json> prims(40, json{{"attributes", {{"POSITION", pos}}}, {"mode", 3}});
+  prims.push_back({{"attributes", {{"POSITION", pos}}}, {"mode", 6}});
+  f.add_mesh(prims);
+  place_meshes(f);
+  MeshData m;
+  ASSERT_TRUE(load_glb(f, m).ok);
+  ASSERT_EQ(m.warnings.size(), 17u);
+  EXPECT_EQ(m.warnings.back(), "... and 24 more warnings like these");
+  EXPECT_EQ(m.triangle_count(), 2u);
+}
+
 TEST(GltfImport, RefusesAFileWithOnlyLines) {
   GltfFixture f;
   f.add_float_mesh(kQuad, {}, 1);
