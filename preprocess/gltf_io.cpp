@@ -632,14 +632,17 @@ Status read_corners(const std::string& where, const PrimitivePlan& plan, uint32_
   return Status::success();
 }
 
+enum class Winding : uint8_t { keep, flip };
+
 // Corners to triangles (spec 3.7.2.1: strips alternate their winding, fans turn about corner
-// 0), offset by `base`; a mirroring transform swaps two corners to keep the front face.
-void triangles_from_corners(int mode, const uint32_t* c, size_t triangles, uint32_t base, bool mirrored, uint32_t* out) {
+// 0), offset by `base`; under a mirroring transform the winding flips to keep the front face.
+void triangles_from_corners(int mode, const uint32_t* c, size_t triangles, uint32_t base, Winding winding,
+                            uint32_t* out) {
   for (size_t t = 0; t < triangles; ++t, out += 3) {
     if (mode == TINYGLTF_MODE_TRIANGLES) out[0] = c[3 * t], out[1] = c[3 * t + 1], out[2] = c[3 * t + 2];
     else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) out[0] = c[t], out[1] = c[t + 1 + t % 2], out[2] = c[t + 2 - t % 2];
     else out[0] = c[t + 1], out[1] = c[t + 2], out[2] = c[0];
-    if (mirrored) std::swap(out[1], out[2]);
+    if (winding == Winding::flip) std::swap(out[1], out[2]);
     out[0] += base, out[1] += base, out[2] += base;
   }
 }
@@ -688,8 +691,8 @@ Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const 
     scratch.resize(corners);
     if (Status s = read_corners(where, plan, scratch.data()); !s) return s;
     out.indices.resize(3 * (first + plan.triangles));
-    triangles_from_corners(plan.mode, scratch.data(), plan.triangles, uint32_t(base), mirrored,
-                           out.indices.data() + 3 * first);
+    triangles_from_corners(plan.mode, scratch.data(), plan.triangles, uint32_t(base),
+                           mirrored ? Winding::flip : Winding::keep, out.indices.data() + 3 * first);
   }
 
   if (!out.submeshes.empty() && out.submeshes.back().material == plan.material)
@@ -767,6 +770,15 @@ Status check_images(const GltfSource& src, const tinygltf::Model& m) {
   return Status::success();
 }
 
+// A file with thousands of skipped primitives says so in a few lines, not thousands.
+void cap_warnings(std::vector<std::string>& warnings) {
+  constexpr size_t kShown = 16;
+  if (warnings.size() <= kShown) return;
+  const size_t more = warnings.size() - kShown;
+  warnings.resize(kShown);
+  warnings.push_back("... and " + std::to_string(more) + " more warnings like these");
+}
+
 // ---- the pipeline ------------------------------------------------------------------------
 
 Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& out) {
@@ -826,6 +838,7 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
   if (!missing_uvs.empty()) warnings.push_back(what + ": " + missing_uvs + " has no TEXCOORD_0; its vertices get (0, 0)");
   if (Status s = read_materials(what, m, mesh.materials); !s) return s;
   if (Status s = check_images(src, m); !s) return s;
+  cap_warnings(mesh.warnings);
   out = std::move(mesh);
   return Status::success();
 }

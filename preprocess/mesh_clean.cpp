@@ -87,12 +87,14 @@ CleanReport clean_mesh(MeshData& mesh) {
   // Pass 2: faces, in order; degenerate ones first, then repeats of an earlier vertex set.
   std::vector<uint32_t> kept;
   kept.reserve(mesh.indices.size());
-  std::vector<uint32_t> kept_before(mesh.triangle_count() + 1, 0);  // kept triangles before t: re-ranges submeshes
+  // Kept triangles before triangle t, to re-range submeshes (only when there are some).
+  const bool has_submeshes = !mesh.submeshes.empty();
+  std::vector<uint32_t> kept_before(has_submeshes ? mesh.triangle_count() + 1 : 0, 0);
   {
     std::unordered_map<FaceKey, uint32_t, FaceKeyHash> seen;
     seen.reserve(mesh.triangle_count());
     for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-      kept_before[t] = uint32_t(kept.size() / 3);
+      if (has_submeshes) kept_before[t] = uint32_t(kept.size() / 3);
       const uint32_t a = weld[mesh.indices[3 * t]], b = weld[mesh.indices[3 * t + 1]], c = weld[mesh.indices[3 * t + 2]];
       if (a == b || b == c || a == c ||
           zero_area(&mesh.positions[3 * a], &mesh.positions[3 * b], &mesh.positions[3 * c])) {
@@ -107,7 +109,7 @@ CleanReport clean_mesh(MeshData& mesh) {
       }
       kept.insert(kept.end(), {a, b, c});
     }
-    kept_before[mesh.triangle_count()] = uint32_t(kept.size() / 3);
+    if (has_submeshes) kept_before[mesh.triangle_count()] = uint32_t(kept.size() / 3);
   }
 
   // Pass 3: compact to the referenced vertices, in their original order. Vertices welded
@@ -137,7 +139,7 @@ CleanReport clean_mesh(MeshData& mesh) {
   mesh.normals = has_normals ? std::move(normals) : std::vector<float>{};
   mesh.uvs = has_uvs ? std::move(uvs) : std::vector<float>{};
   mesh.indices = std::move(kept);
-  resubmesh(mesh.submeshes, kept_before);
+  if (has_submeshes) resubmesh(mesh.submeshes, kept_before);
   return report;
 }
 

@@ -284,6 +284,42 @@ TEST(GltfImport, ReadsDataUriAndExternalBuffers) {
   EXPECT_EQ(e.source, file.string());
 }
 
+TEST(GltfImport, ReadsAGlbWithAnExternalBufferAndMemoryWithABaseDir) {
+  const fs::path dir = test::temp_dir("gltf-glb-external");
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  place_meshes(f);
+  const fs::path gltf = f.write_gltf_with_bin(dir, "quad");  // also writes quad.bin
+  // The same JSON as a GLB without a BIN chunk, its buffer still named by URI.
+  std::string text_chunk = f.j.dump();
+  while (text_chunk.size() % 4) text_chunk += ' ';
+  std::vector<uint8_t> glb = {'g', 'l', 'T', 'F', 2, 0, 0, 0};
+  const uint32_t total = uint32_t(20 + text_chunk.size()), length = uint32_t(text_chunk.size()), kind = 0x4E4F534A;
+  for (uint32_t v : {total, length, kind})
+    for (int b = 0; b < 4; ++b) glb.push_back(uint8_t(v >> (8 * b)));
+  glb.insert(glb.end(), text_chunk.begin(), text_chunk.end());
+  test::write_bytes(dir / "quad.glb", glb);
+  MeshData m;
+  Status s = load_mesh(dir / "quad.glb", m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(m.indices, kQuadIndices);
+  const std::vector<uint8_t> text = test::read_bytes(gltf);
+  s = load_gltf_from_memory("mem.gltf", ".gltf", text.data(), text.size(), dir, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(m.positions, kQuad);
+}
+
+TEST(GltfImport, RefusesADataUriOfTheWrongLength) {
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  place_meshes(f);
+  const std::string text = f.gltf_data_uri();
+  json j = json::parse(text);
+  j["buffers"][0]["byteLength"] = j["buffers"][0]["byteLength"].get<size_t>() + 4;
+  MeshData m;
+  expect_refused(load_gltf_text(j.dump(), m), "t.gltf: not valid glTF");
+}
+
 TEST(GltfImport, RefusesAMissingExternalBuffer) {
   const fs::path dir = test::temp_dir("gltf-missing-bin");
   GltfFixture f;
@@ -461,6 +497,20 @@ TEST(GltfImport, SkipsLinesPointsMorphTargetsAndSkinsWithWarnings) {
   EXPECT_TRUE(has_warning(m, "mesh 0 primitive 1: mode POINTS"));
   EXPECT_TRUE(has_warning(m, "morph targets not applied"));
   EXPECT_TRUE(has_warning(m, "node 0: skin 0 is not applied"));
+}
+
+TEST(GltfImport, ManySkippedPrimitivesGiveAFewWarningLines) {
+  GltfFixture f;
+  const int pos = f.add_accessor(f.add_view(kQuad), kFloat, 4, "VEC3");
+  std::vector<json> prims(40, json{{"attributes", {{"POSITION", pos}}}, {"mode", 3}});
+  prims.push_back({{"attributes", {{"POSITION", pos}}}, {"mode", 6}});
+  f.add_mesh(prims);
+  place_meshes(f);
+  MeshData m;
+  ASSERT_TRUE(load_glb(f, m).ok);
+  ASSERT_EQ(m.warnings.size(), 17u);
+  EXPECT_EQ(m.warnings.back(), "... and 24 more warnings like these");
+  EXPECT_EQ(m.triangle_count(), 2u);
 }
 
 TEST(GltfImport, RefusesAFileWithOnlyLines) {

@@ -21,6 +21,25 @@ TEST(MeshClean, LeavesACleanMeshAlone) {
   EXPECT_EQ(m.indices, before.indices);
 }
 
+// glTF's optional attributes survive cleaning: a welded vertex keeps its first uv, and each
+// submesh keeps exactly its surviving triangles (an emptied one goes).
+TEST(MeshClean, KeepsUvsAndReRangesSubmeshes) {
+  // Vertex 4 repeats vertex 1's position (welded); triangle 1 is degenerate, triangle 3 repeats 0.
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0},
+                    {0, 1, 2, 0, 0, 1, 1, 3, 2, 2, 0, 4, 4, 3, 2});
+  m.uvs = {0, 0, 0.1f, 0, 0, 1, 1, 1, 0.9f, 0};
+  m.submeshes = {{0, 2, 0}, {2, 2, 1}, {4, 1, 0}};
+  clean_mesh(m);
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
+  EXPECT_EQ(m.uvs, (std::vector<float>{0, 0, 0.1f, 0, 0, 1, 1, 1}));
+  ASSERT_EQ(m.submeshes.size(), 2u);  // kept: triangle 0 | triangle 2 | none (4 repeats 2)
+  EXPECT_EQ(m.submeshes[0].first_triangle, 0u);
+  EXPECT_EQ(m.submeshes[0].triangle_count, 1u);
+  EXPECT_EQ(m.submeshes[1].first_triangle, 1u);
+  EXPECT_EQ(m.submeshes[1].triangle_count, 1u);
+  EXPECT_EQ(m.submeshes[1].material, 1);
+}
+
 TEST(MeshClean, DropsFacesWithARepeatedIndex) {
   MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2, 0, 0, 1, 2, 1, 2});
   const CleanReport r = clean_mesh(m);
