@@ -280,7 +280,9 @@ TEST(ServiceObjects, ChurnOfAMillionKeepsHandlesHonestAndMemoryFlat) {
       live.pop_back();
     }
     if (i % 1000 == 999) s.commit(uint64_t(i));
-    if (i % 20000 == 19999) ASSERT_TRUE(s.step(0.01));
+    if (i % 20000 == 19999) {
+      ASSERT_TRUE(s.step(0.01));
+    }
   }
   s.commit(kChurn);
   ASSERT_TRUE(s.step(0.01));
