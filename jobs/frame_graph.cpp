@@ -63,17 +63,20 @@ using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 #define LOD_TSAN 1
 #endif
 #endif
-// A node's body must acquire before it reads even its own captures (written when the graph
-// was built), so it first acquires the one address every frame's caller releases: graphs are
-// ordered after every caller, a node never after another node without an edge.
+// A task must acquire before it reads even its own captures (a node's were written when the
+// graph was built, a loop chunk's live on the spawning thread's stack), so each first acquires
+// one shared address: every frame's caller and every loop's spawner release it. Nodes are thus
+// ordered after every caller (never after another node without an edge); loop chunks after
+// every spawn so far, so a missing edge is still reported for what a node's own body reads,
+// not for what only its chunks read of another node's pre-loop writes.
 #ifdef LOD_TSAN
 extern "C" void __tsan_acquire(void* addr);
 extern "C" void __tsan_release(void* addr);
-char tsan_any_frame_start;
+char tsan_any_frame_start, tsan_any_spawn;
 void tsan_acquire(char& at) { __tsan_acquire(&at); }
 void tsan_release(char& at) { __tsan_release(&at); }
 #else
-[[maybe_unused]] char tsan_any_frame_start;
+[[maybe_unused]] char tsan_any_frame_start, tsan_any_spawn;
 inline void tsan_acquire(char&) {}
 inline void tsan_release(char&) {}
 #endif
@@ -398,9 +401,11 @@ struct FrameGraph::Impl {
     char& spawn = sync.spawn[static_cast<size_t>(stage)];
     char& join = sync.join[static_cast<size_t>(stage)];
     tsan_release(spawn);
+    tsan_release(tsan_any_spawn);
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, chunks, 1),
         [&](const tbb::blocked_range<size_t>& r) {
+          tsan_acquire(tsan_any_spawn);
           tsan_acquire(spawn);
           for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
           tsan_release(join);
@@ -415,7 +420,9 @@ struct FrameGraph::Impl {
     char& spawn = sync.spawn[static_cast<size_t>(stage)];
     char& join = sync.join[static_cast<size_t>(stage)];
     tsan_release(spawn);
+    tsan_release(tsan_any_spawn);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& r) {
+      tsan_acquire(tsan_any_spawn);
       tsan_acquire(spawn);
       for (size_t j = r.begin(); j != r.end(); ++j) body(j);
       tsan_release(join);
