@@ -8,8 +8,10 @@
 
 #include "cli/budget_shortfall.h"
 #include "cli/commands.h"
+#include "cli/hlod_check.h"
 #include "cli/run_report.h"
 #include "jobs/bake_jobs.h"
+#include "jobs/hlod_scene.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "jobs/scene_motion.h"
@@ -94,8 +96,9 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
     }
     tris += scene.models.triangles[scene.models.first_level[m] + f.levels[i]];
   }
+  tris += f.hlod_tris;  // HLOD cuts count in the same budget
   if (tris != f.tris_selected) {
-    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels add up to %llu",
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels and hlod cuts add up to %llu",
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     *why = buf;
     return false;
@@ -134,18 +137,37 @@ int run_command(const RunArgs& args) {
   }
 
   const std::string cache_dir = args.cache_dir.empty() ? default_cache_dir(data_dir) : args.cache_dir;
+  auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  // hlod = true models stream through the hlod node; the rest are discrete objects.
+  auto hlod = std::make_shared<HlodModels>();
+  size_t hlod_baked = 0, hlod_cached = 0;
+  if (auto st = bake_hlod_models(config, cache_dir, log, *hlod, &hlod_baked, &hlod_cached); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  HlodCheck hlod_check;
+  if (args.validate && !hlod->empty()) {
+    hlod->culled = HlodCulledNodes::cover;  // closed cuts, so every boundary edge can be checked
+    if (auto st = hlod_check.load(*hlod); !st) {
+      std::fprintf(stderr, "lod run --validate: %s\n", st.message.c_str());
+      return 1;
+    }
+  }
+  config = discrete_part(config);
   std::vector<LodChain> chains;
   BakeSummary bake;
-  auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   if (auto st = bake_scene_models(config.models, cache_dir, config.threads, chains, bake, log); !st) {
     std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
     return 1;
   }
-  std::fprintf(stderr, "bake: %zu models (%zu baked, %zu from cache %s) in %.0f ms\n", chains.size(), bake.baked,
-               bake.cached, cache_dir.c_str(), bake.ms);
+  bake.baked += hlod_baked;
+  bake.cached += hlod_cached;
+  std::fprintf(stderr, "bake: %zu models (%zu baked, %zu from cache %s) in %.0f ms\n", chains.size() + hlod->trees.size(),
+               bake.baked, bake.cached, cache_dir.c_str(), bake.ms);
 
   Scene scene = make_scene(config, std::move(chains));
-  const FrameGraphOptions options = frame_graph_options(config);
+  FrameGraphOptions options = frame_graph_options(config);
+  if (!hlod->empty()) options.hlod = hlod;
   std::vector<ObjectHandle> handles;
   std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);
   Service& service = *owned;
@@ -160,7 +182,9 @@ int run_command(const RunArgs& args) {
   RunSummary summary;
   summary.config = std::filesystem::path(args.config).filename().string();
   summary.objects = scene.objects.size();
-  summary.models = scene.chains.size();
+  summary.models = scene.chains.size() + hlod->trees.size();
+  summary.hlod_models = hlod->trees.size();
+  summary.stream_budget = hlod->empty() ? 0 : hlod->stream.budget_bytes;
   summary.threads = config.threads;
   summary.budget = config.selection.budget;
   summary.budget_count = config.selection.count == BudgetCount::levels ? "levels" : "triangles";
@@ -191,6 +215,10 @@ int run_command(const RunArgs& args) {
     if (args.validate) {
       std::string why;
       if (!validate_frame(frame, scene, records.empty() ? frame.index : records.back().frame + 1, &why)) {
+        std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
+        return 3;
+      }
+      if (!hlod_check.check(frame, &why)) {
         std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
         return 3;
       }
