@@ -98,6 +98,8 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"stream_budget", s.stream_budget},
           {"max_resident_bytes", s.max_resident_bytes},
           {"total_holes", s.total_holes},
+          {"stream_loads", s.stream_loads},
+          {"stream_evictions", s.stream_evictions},
           {"mean_hlod_nodes_drawn", s.mean_hlod_nodes_drawn},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
@@ -143,6 +145,7 @@ FrameRecord record_of(const Frame& f) {
   r.resident_bytes = f.resident_bytes;
   r.stream_requests = f.stream_requests;
   r.stream_loads = f.stream_loads;
+  r.stream_evictions = f.stream_evictions;
   return r;
 }
 
@@ -179,6 +182,8 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     s.max_resident_bytes = std::max(s.max_resident_bytes, r.resident_bytes);
     s.total_holes += r.holes;
     hlod_nodes += r.hlod_nodes_drawn;
+    s.stream_loads = std::max(s.stream_loads, r.stream_loads);  // counters: the last frame's
+    s.stream_evictions = std::max(s.stream_evictions, r.stream_evictions);
   }
   s.mean_hlod_nodes_drawn = hlod_nodes / std::max<double>(1, double(records.size()));
   const double n = std::max<double>(1, double(records.size()));
@@ -259,9 +264,10 @@ std::string summary_text(const RunSummary& s) {
   if (s.hlod_models > 0) {
     std::snprintf(buf, sizeof buf,
                   "  hlod: %zu models, mean %.1f nodes drawn; resident max %.2f MB of the %.2f MB stream budget; "
-                  "%llu holes\n",
+                  "%llu loads, %llu evictions; %llu holes\n",
                   s.hlod_models, s.mean_hlod_nodes_drawn, double(s.max_resident_bytes) / (1 << 20),
-                  double(s.stream_budget) / (1 << 20), (unsigned long long)s.total_holes);
+                  double(s.stream_budget) / (1 << 20), (unsigned long long)s.stream_loads,
+                  (unsigned long long)s.stream_evictions, (unsigned long long)s.total_holes);
     o << buf;
   }
   if (s.mean_occluded > 0) {
