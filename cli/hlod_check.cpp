@@ -5,19 +5,21 @@
 
 namespace lod::cli {
 
-Status HlodCheck::load(const HlodModels& h) {
+void HlodCheck::load(const HlodModels& h) {
   models_.clear();
   models_.resize(h.trees.size());
   for (size_t m = 0; m < h.trees.size(); ++m) {
     Model& model = models_[m];
     model.tree = &h.trees[m];
     model.payloads.resize(model.tree->nodes.size());
-    for (size_t n = 0; n < model.payloads.size(); ++n)
-      if (Status s = read_hlod_node(h.files[m], model.tree->nodes[n], model.payloads[n]); !s) return s;
-    for (const HlodPayload& p : model.payloads) model.pointers.push_back(&p);
+    // A node that cannot be read stays without geometry: the pager cannot load it either, so
+    // the frames must never draw it (if one did, its edges would count as gaps).
+    for (size_t n = 0; n < model.payloads.size(); ++n) {
+      const bool read = read_hlod_node(h.files[m], model.tree->nodes[n], model.payloads[n]).ok;
+      model.pointers.push_back(read ? &model.payloads[n] : nullptr);
+    }
     model.reference = hlod_cut_reference(*model.tree, model.pointers);
   }
-  return Status::success();
 }
 
 bool HlodCheck::check_cut(const Frame& f, uint32_t m, std::string* why) const {

@@ -9,13 +9,13 @@
 #include "jobs/hlod_models.h"
 #include "runtime/frame.h"
 #include "runtime/hlod_cut_check.h"
-#include "runtime/status.h"
 
 namespace lod::cli {
 
 class HlodCheck {
  public:
-  Status load(const HlodModels& models);
+  // Reads every node of every model (a node that cannot be read stays empty).
+  void load(const HlodModels& models);
   // False with `why` at the first fault of `f`.
   bool check(const Frame& f, std::string* why) const;
 

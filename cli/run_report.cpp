@@ -100,6 +100,7 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"total_holes", s.total_holes},
           {"stream_loads", s.stream_loads},
           {"stream_evictions", s.stream_evictions},
+          {"stream_failures", s.stream_failures},
           {"mean_hlod_nodes_drawn", s.mean_hlod_nodes_drawn},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
@@ -146,6 +147,7 @@ FrameRecord record_of(const Frame& f) {
   r.stream_requests = f.stream_requests;
   r.stream_loads = f.stream_loads;
   r.stream_evictions = f.stream_evictions;
+  r.stream_failures = f.stream_failures;
   return r;
 }
 
@@ -184,6 +186,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     hlod_nodes += r.hlod_nodes_drawn;
     s.stream_loads = std::max(s.stream_loads, r.stream_loads);  // counters: the last frame's
     s.stream_evictions = std::max(s.stream_evictions, r.stream_evictions);
+    s.stream_failures = std::max(s.stream_failures, r.stream_failures);
   }
   s.mean_hlod_nodes_drawn = hlod_nodes / std::max<double>(1, double(records.size()));
   const double n = std::max<double>(1, double(records.size()));
@@ -264,10 +267,11 @@ std::string summary_text(const RunSummary& s) {
   if (s.hlod_models > 0) {
     std::snprintf(buf, sizeof buf,
                   "  hlod: %zu models, mean %.1f nodes drawn; resident max %.2f MB of the %.2f MB stream budget; "
-                  "%llu loads, %llu evictions; %llu holes\n",
+                  "%llu loads, %llu evictions, %llu failed reads; %llu holes\n",
                   s.hlod_models, s.mean_hlod_nodes_drawn, double(s.max_resident_bytes) / (1 << 20),
                   double(s.stream_budget) / (1 << 20), (unsigned long long)s.stream_loads,
-                  (unsigned long long)s.stream_evictions, (unsigned long long)s.total_holes);
+                  (unsigned long long)s.stream_evictions, (unsigned long long)s.stream_failures,
+                  (unsigned long long)s.total_holes);
     o << buf;
   }
   if (s.mean_occluded > 0) {

@@ -847,7 +847,7 @@ struct FrameGraph::Impl {
     f.hlod_opened.clear();
     hlod_over_budget = false;
     f.hlod_nodes_drawn = 0;
-    f.hlod_tris = f.resident_bytes = f.stream_requests = f.stream_loads = f.stream_evictions = f.stream_budget = 0;
+    f.hlod_tris = f.resident_bytes = f.stream_requests = f.stream_loads = f.stream_evictions = f.stream_failures = f.stream_budget = 0;
     f.holes = 0;
     if (!hlod_stream) return;
     const uint64_t share = hlod_share();
@@ -871,6 +871,7 @@ struct FrameGraph::Impl {
     f.stream_requests = fig.stream_requests;
     f.stream_loads = fig.stream_loads;
     f.stream_evictions = fig.stream_evictions;
+    f.stream_failures = fig.stream_failures;
     f.holes = fig.holes;
   }
 

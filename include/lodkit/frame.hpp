@@ -126,6 +126,7 @@ struct Frame {
   uint64_t stream_requests = 0;               // loads issued so far
   uint64_t stream_loads = 0;                  // loads completed so far
   uint64_t stream_evictions = 0;              // nodes evicted so far (least recently used)
+  uint64_t stream_failures = 0;               // node reads failed so far (each node once; parent stays drawn)
   uint32_t holes = 0;                         // wanted, not drawable, no drawn ancestor: must be 0
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds

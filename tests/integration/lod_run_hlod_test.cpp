@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "runtime/hlod_asset.h"
 #include "run_cli.h"
 #include "test_support.h"
 
@@ -131,6 +132,44 @@ TEST(LodRunHlod, RefusesAnHlodBlockOfTwoObjects) {
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("instances[1].count"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("count = 1"), std::string::npos) << r.out;
+}
+
+// A corrupted root payload in the cache: every frame reports the hole (nothing can be drawn),
+// the failed read is counted, nothing crashes; --validate fails the run.
+TEST(LodRunHlod, CorruptedRootIsAHoleThatValidateRefuses) {
+  const auto dir = lod::test::temp_dir("lodrun-hlod-corrupt");
+  const auto cfg = write_mixed_scene(dir, "count = 1\nscale = 10.0\n");
+  const auto cache = dir / "cache";
+  ASSERT_EQ(run_lod("run --config " + cfg.string() + " --frames 1 --quiet --cache " + cache.string()).code, 0);
+  std::filesystem::path file;
+  for (const auto& e : std::filesystem::directory_iterator(cache))
+    if (e.path().extension() == ".hlod") file = e.path();
+  ASSERT_FALSE(file.empty());
+  lod::HlodTree tree;
+  ASSERT_TRUE(lod::read_hlod_tree(file, tree).ok);
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(std::streamoff(tree.nodes[0].payload_offset + tree.nodes[0].payload_size / 2));
+    char c = 0;
+    f.read(&c, 1);
+    c = char(c ^ 0x5a);
+    f.seekp(std::streamoff(tree.nodes[0].payload_offset + tree.nodes[0].payload_size / 2));
+    f.write(&c, 1);
+  }
+  const auto r = run_lod("run --config " + cfg.string() + " --frames 5 --quiet --cache " + cache.string() + " --json " +
+                         (dir / "run.json").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("hlod node reads failed"), std::string::npos) << r.out;
+  const auto j = read_json(dir / "run.json");
+  for (const auto& f : j["frames"]) {
+    EXPECT_EQ(f["holes"].get<uint64_t>(), 1u);
+    EXPECT_EQ(f["hlod_nodes_drawn"].get<uint64_t>(), 0u);
+  }
+  EXPECT_EQ(j["summary"]["stream_failures"].get<uint64_t>(), 1u);
+  EXPECT_EQ(j["summary"]["total_holes"].get<uint64_t>(), 5u);
+  const auto v = run_lod("run --config " + cfg.string() + " --frames 5 --validate --quiet --cache " + cache.string());
+  EXPECT_EQ(v.code, 3) << v.out;
+  EXPECT_NE(v.out.find("1 hlod holes"), std::string::npos) << v.out;
 }
 
 }  // namespace
