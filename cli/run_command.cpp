@@ -198,7 +198,12 @@ int run_command(const RunArgs& args) {
   records.reserve(config.frames);
   const uint32_t every = config.frames <= 40 ? 1 : (config.frames + 29) / 30;
   if (!args.quiet) std::printf("%s\n%s\n", table_header().c_str(), table_legend().c_str());
+  // Streaming scenes run at rate_hz in wall time: the loader threads get a frame's time per
+  // frame, as under a renderer (back to back, frames take microseconds and loads trail far behind).
+  const bool paced = !hlod->empty();
+  const auto paced_start = std::chrono::steady_clock::now();
   for (uint32_t n = 0; n < config.frames; ++n) {
+    if (paced) std::this_thread::sleep_until(paced_start + std::chrono::duration<double>(n * dt));
     if (motion.moving() > 0) {
       motion.stage(service, (n + 1) * dt);
       service.commit(n + 1);
