@@ -1,5 +1,6 @@
 // lod run: the main job. Bake (cached) what the scene needs, then drive lod::Service frame by
 // frame along the config's camera path and report what every frame did.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -234,8 +235,15 @@ int run_command(const RunArgs& args) {
     }
     if (frame.over_budget && !told_shortfall) {
       told_shortfall = true;
-      std::fprintf(stderr, "lod run: frame %u: %s\n", n,
-                   shortfall_text(budget_shortfall(frame, scene.models, config.selection.count), model_names).c_str());
+      if (frame.coarsest_cost <= frame.budget && frame.hlod_tris > 0)  // the discrete levels fit: HLOD did not
+        std::fprintf(stderr,
+                     "lod run: frame %u: budget %llu cannot be met: the hlod models' smallest cuts (%llu triangles) "
+                     "exceed what the discrete objects leave of M (%llu)\n",
+                     n, (unsigned long long)frame.budget, (unsigned long long)frame.hlod_tris,
+                     (unsigned long long)(frame.budget - std::min(frame.budget, frame.tris_selected - frame.hlod_tris)));
+      else
+        std::fprintf(stderr, "lod run: frame %u: %s\n", n,
+                     shortfall_text(budget_shortfall(frame, scene.models, config.selection.count), model_names).c_str());
     }
     if (frame.stream_failures > told_failures) {
       std::fprintf(stderr, "lod run: frame %u: %llu hlod node reads failed so far (their parents stay drawn)\n", n,
