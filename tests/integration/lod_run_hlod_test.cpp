@@ -125,6 +125,19 @@ TEST(LodRunHlod, MixedSceneCountsHlodTrianglesInTheBudget) {
   EXPECT_NE(again.out.find("bake big: cached"), std::string::npos) << again.out;
 }
 
+// Behind the camera all the way: nothing of it drawn or wanted, no hole, and --validate passes.
+TEST(LodRunHlod, ModelOutOfViewDrawsNothingAndValidates) {
+  const auto dir = lod::test::temp_dir("lodrun-hlod-behind");
+  const auto cfg = write_mixed_scene(dir, "count = 1\nbox_min = [0, 0, 3000]\nbox_max = [0, 0, 3000]\nscale = 10.0\n");
+  const auto r = run_lod("run --config " + cfg.string() + " --frames 10 --validate --quiet --cache " +
+                         (dir / "cache").string() + " --json " + (dir / "run.json").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const auto& f : read_json(dir / "run.json")["frames"]) {
+    EXPECT_EQ(f["hlod_nodes_drawn"].get<uint64_t>(), 0u);
+    EXPECT_EQ(f["holes"].get<uint64_t>(), 0u);
+  }
+}
+
 TEST(LodRunHlod, RefusesAnHlodBlockOfTwoObjects) {
   const auto dir = lod::test::temp_dir("lodrun-hlod-two");
   const auto cfg = write_mixed_scene(dir, "count = 2\n");
