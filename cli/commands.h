@@ -24,6 +24,7 @@ struct InspectArgs {
   std::string file;
   bool json = false;
   std::string export_dir;
+  std::string format = "ply";  // of --export: ply | obj | glb | gltf
 };
 int inspect_command(const InspectArgs& args);
 // The .hlod side of `lod inspect` (cli/inspect_hlod.cpp): true when `file` starts with the

@@ -1,14 +1,42 @@
-// lod inspect: what a .lod asset holds, level by level; --export writes each level as PLY.
+// lod inspect: what a .lod asset holds, level by level; --export writes each level as PLY
+// (default), OBJ, GLB or glTF (--format).
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "cli/commands.h"
 #include "cli/names.h"
+#include "preprocess/gltf_write.h"
 #include "preprocess/mesh_io.h"
 #include "runtime/lod_asset.h"
 
 namespace lod::cli {
+namespace {
+
+// One level in the chosen format: positions and triangles, plus normals where the format
+// has them (the chain stores one per vertex).
+Status export_level(const std::filesystem::path& out, const std::string& format, const LodChain& chain,
+                    const LodLevel& l, const std::string& name) {
+  const float* positions = chain.positions.data() + size_t(l.first_vertex) * 3;
+  const float* normals = chain.normals.size() == chain.positions.size() ? chain.normals.data() + size_t(l.first_vertex) * 3
+                                                                        : nullptr;
+  const uint32_t* indices = chain.indices.data() + l.first_index;
+  if (format == "obj") return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count);
+  if (format == "glb" || format == "gltf") {
+    GltfMeshView view;
+    view.name = name;
+    view.positions = positions;
+    view.normals = normals;
+    view.vertex_count = l.vertex_count;
+    view.indices = indices;
+    view.index_count = l.index_count;
+    return save_gltf(out, view);
+  }
+  return save_ply(out, positions, l.vertex_count, indices, l.index_count);
+}
+
+}  // namespace
 
 int inspect_command(const InspectArgs& args) {
   if (is_hlod_file(args.file)) return inspect_hlod_command(args);
@@ -80,15 +108,18 @@ int inspect_command(const InspectArgs& args) {
     const std::string stem = export_stem(chain.name);
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
-      const auto out = std::filesystem::path(args.export_dir) / (stem + "-level" + std::to_string(i) + ".ply");
-      // Never written through a link planted under the export name (it could point anywhere).
-      if (std::filesystem::is_symlink(std::filesystem::symlink_status(out, ec))) {
-        std::fprintf(stderr, "lod inspect: %s is a symbolic link; not writing through it\n",
-                     printable(out.string()).c_str());
-        return 1;
-      }
-      auto st = save_ply(out, chain.positions.data() + size_t(l.first_vertex) * 3, l.vertex_count,
-                         chain.indices.data() + l.first_index, l.index_count);
+      const auto out = std::filesystem::path(args.export_dir) / (stem + "-level" + std::to_string(i) + "." + args.format);
+      // Never written through a link planted under the export name (it could point anywhere);
+      // a .gltf also writes its .bin.
+      auto bin = out;
+      bin.replace_extension(".bin");
+      for (const auto& written : args.format == "gltf" ? std::vector{out, bin} : std::vector{out})
+        if (std::filesystem::is_symlink(std::filesystem::symlink_status(written, ec))) {
+          std::fprintf(stderr, "lod inspect: %s is a symbolic link; not writing through it\n",
+                       printable(written.string()).c_str());
+          return 1;
+        }
+      const Status st = export_level(out, args.format, chain, l, stem + "-level" + std::to_string(i));
       if (!st) {
         std::fprintf(stderr, "lod inspect: %s\n", printable(st.message).c_str());
         return 1;

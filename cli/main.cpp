@@ -29,11 +29,13 @@ int main(int argc, char** argv) {
   auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels or an .hlod file's tree");
   inspect_cmd->add_option("file", inspect.file, ".lod or .hlod file")->required();
   inspect_cmd->add_flag("--json", inspect.json, "print JSON");
-  inspect_cmd->add_option("--export", inspect.export_dir, "write every level as PLY into this directory");
+  inspect_cmd->add_option("--export", inspect.export_dir, "write every level into this directory (as --format)");
+  inspect_cmd->add_option("--format", inspect.format, "format of --export: ply (default) | obj | glb | gltf")
+      ->check(CLI::IsMember({"ply", "obj", "glb", "gltf"}));
 
   lod::cli::BakeArgs bake;
   auto* bake_cmd = app.add_subcommand("bake", "bake meshes into .lod assets");
-  bake_cmd->add_option("models", bake.models, "mesh files (OBJ, PLY, OFF, STL)")->required();
+  bake_cmd->add_option("models", bake.models, "mesh files (OBJ, PLY, OFF, STL, glTF: .gltf/.glb)")->required();
   bake_cmd->add_option("-o,--out", bake.out_dir, "output directory")->required();
   bake_cmd->add_option("--ratios", bake.ratios, "level ratios, 1.0 first (default: by size, as R0)");
   bake_cmd->add_option("--method", bake.method, "qem | extreme | auto")

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <mutex>
@@ -85,10 +86,39 @@ std::string model_error(const ModelConfig& model, const std::string& message) {
   return "model " + both + ": " + message;
 }
 
+bool names_lod_asset(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".lod";
+}
+
+// A model whose file is an asset already baked: read as it is, never rebaked or cached (its
+// own bake settings decided its levels). Counted with the cached ones: nothing was baked.
+void load_baked_asset(const ModelConfig& model, LogLines& log, BakeTask& task) {
+  const auto t0 = std::chrono::steady_clock::now();
+  LodChain chain;
+  if (Status s = read_lod_asset(model.file, chain); !s) {
+    task.status = Status::error(model_error(model, s.message));
+    return;
+  }
+  if (Status h = ensure_hierarchy(model, nullptr, log, chain); !h) {
+    task.status = Status::error(model_error(model, h.message));
+    return;
+  }
+  chain.name = model.name;  // the scene's name for it, as for every other model
+  task.chain = std::move(chain);
+  task.result.from_cache = true;
+  task.result.levels = task.chain.levels.size();
+  task.result.input_triangles = task.chain.levels.empty() ? 0 : task.chain.levels[0].triangles();
+  task.result.ms = ms_since(t0);
+  log.line("bake " + model.name + ": baked asset " + model.file.string() + " loaded as is");
+}
+
 void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, LogLines& log,
               BakeTask& task) {
   const auto t0 = std::chrono::steady_clock::now();
   task.result.model = model.name;
+  if (names_lod_asset(model.file)) return load_baked_asset(model, log, task);
 
   Status key_status;
   const uint64_t key = bake_key(model.file, model.bake, &key_status);

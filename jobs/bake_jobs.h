@@ -32,7 +32,8 @@ struct BakeSummary {
 // Progress lines ("bake bunny 40% simplify") go to `log` from one thread at a time.
 using ProgressLog = std::function<void(const std::string&)>;
 
-// Loads `cache_dir/<name>-<key>.lod` when present and valid, otherwise bakes and writes it.
+// Loads `cache_dir/<name>-<key>.lod` when present and valid, otherwise bakes and writes it; a
+// model whose file is a .lod asset is read as it is (counted as cached).
 // `threads` = 0 uses all cores. On failure the status names the model and file; nothing
 // is written for a model that failed.
 Status bake_scene_models(const std::vector<ModelConfig>& models, const std::filesystem::path& cache_dir,

@@ -14,6 +14,7 @@
 #include "preprocess/hlod_build.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -160,6 +161,36 @@ Layer merged_children(Context& c, const BuildNode& n) {
   return layer;
 }
 
+// Locks the tip of every tetrahedron glued into the surface: a vertex on exactly three faces
+// whose three neighbours also form a face. QEM's link condition lets its collapse through,
+// and the two faces it doubles are merged into one, opening an edge (non-manifold scans such
+// as Stanford's buddha have them).
+void lock_tetrahedron_tips(const Layer& l, std::vector<uint8_t>& lock) {
+  const size_t nv = l.vertices(), nt = l.triangles();
+  std::vector<uint32_t> first(nv + 1, 0);
+  for (uint32_t i : l.indices) ++first[i + 1];
+  for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+  std::vector<uint32_t> fill(first.begin(), first.end() - 1), faces(3 * nt);
+  for (uint32_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) faces[fill[l.indices[3 * t + k]]++] = t;
+  auto has_corner = [&](uint32_t t, uint32_t w) {
+    return l.indices[3 * t] == w || l.indices[3 * t + 1] == w || l.indices[3 * t + 2] == w;
+  };
+  for (size_t v = 0; v < nv; ++v) {
+    if (first[v + 1] - first[v] != 3 || lock[v]) continue;
+    std::array<uint32_t, 9> around;
+    size_t n = 0;
+    for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k)
+        if (const uint32_t w = l.indices[3 * faces[i] + k]; w != v) around[n++] = w;
+    std::sort(around.begin(), around.begin() + n);
+    if (std::unique(around.begin(), around.begin() + n) - around.begin() != 3) continue;
+    // Is (a, b, c) a face? Look among a's faces.
+    for (uint32_t i = first[around[0]]; i < first[around[0] + 1]; ++i)
+      if (has_corner(faces[i], around[1]) && has_corner(faces[i], around[2])) lock[v] = 1;
+  }
+}
+
 // Two halvings of layers[0] with every ancestor's patch vertex locked; a layer no smaller than
 // the one before is dropped.
 void simplify_layers(Context& c, BuildNode& n) {
@@ -169,6 +200,7 @@ void simplify_layers(Context& c, BuildNode& n) {
   if (t0 < 2) return;
   std::vector<uint8_t> lock(finest.vertices());
   for (size_t i = 0; i < lock.size(); ++i) lock[i] = c.patch_depth[finest.source[i]] < n.depth;
+  lock_tetrahedron_tips(finest, lock);
   QemOptions options;
   options.lock_border = true;  // the mesh's own holes keep their outline in every layer
   // Non-manifold vertices stay too: moving one can open an edge that a patch or a neighbour

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -12,6 +13,7 @@
 
 #include "preprocess/cluster_simplifier.h"
 #include "preprocess/decimater_chain.h"
+#include "preprocess/gltf_io.h"
 #include "preprocess/mesh_io.h"
 #include "preprocess/qem_simplifier.h"
 #include "preprocess/surface_error.h"
@@ -80,6 +82,16 @@ LodLevel culled_level(const LodChain& chain) {
   l.error_rms = std::max(2 * full.bounds.radius, chain.levels.back().error_rms);
   l.bounds = full.bounds;
   return l;
+}
+
+// The levels hold positions and normals only: say what the input had that they lose.
+void note_dropped_attributes(const MeshData& mesh, std::vector<std::string>& notes) {
+  for (const std::string& w : mesh.warnings) notes.push_back("import: " + w);
+  if (!mesh.uvs.empty())
+    notes.push_back("texture coordinates of " + mesh.source + " are not kept in the levels (positions and normals only)");
+  if (mesh.materials.size() > 1 || mesh.submeshes.size() > 1)
+    notes.push_back(std::to_string(mesh.materials.size()) + " materials / " + std::to_string(mesh.submeshes.size()) +
+                    " submeshes of " + mesh.source + " are not kept in the levels (one surface)");
 }
 
 const char* method_name(SimplifyMethod m) {
@@ -185,7 +197,16 @@ uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& se
     if (status) *status = Status::error(mesh_file.string() + ": read error");
     return 0;
   }
-  const uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  // A .gltf's geometry may live in the files it names: they are part of the content.
+  std::string ext = mesh_file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".gltf" || ext == ".glb")
+    for (const auto& file : gltf_external_files(mesh_file)) {
+      std::ifstream g(file, std::ios::binary);
+      const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
+      content = hash_bytes(more.data(), more.size(), content);
+    }
   // Settings as explicit little records, so padding never enters the hash.
   std::vector<uint8_t> s;
   auto put = [&s](const void* p, size_t n) {
@@ -217,6 +238,7 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   Status s = load_mesh(mesh_file, mesh);
   if (!s) return s;
   report.input_triangles = mesh.triangle_count();
+  note_dropped_attributes(mesh, report.notes);
 
   say(0.04f, "clean");
   report.cleaned = clean_mesh(mesh);

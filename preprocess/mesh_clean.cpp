@@ -52,12 +52,25 @@ bool zero_area(const float* a, const float* b, const float* c) {
   return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
 }
 
+// Submesh ranges after faces were dropped: each keeps its surviving triangles, in order; an
+// emptied one goes.
+void resubmesh(std::vector<Submesh>& submeshes, const std::vector<uint32_t>& kept_before) {
+  std::vector<Submesh> out;
+  for (const Submesh& s : submeshes) {
+    const size_t end = std::min<size_t>(size_t(s.first_triangle) + s.triangle_count, kept_before.size() - 1);
+    const uint32_t first = kept_before[std::min<size_t>(s.first_triangle, end)], last = kept_before[end];
+    if (last > first) out.push_back({first, last - first, s.material});
+  }
+  submeshes = std::move(out);
+}
+
 }  // namespace
 
 CleanReport clean_mesh(MeshData& mesh) {
   CleanReport report;
   const size_t nv = mesh.vertex_count();
   const bool has_normals = mesh.normals.size() == mesh.positions.size();
+  const bool has_uvs = mesh.uvs.size() == 2 * nv;
 
   // Pass 1: weld exactly duplicated positions onto their first occurrence.
   std::vector<uint32_t> weld(nv);
@@ -74,10 +87,12 @@ CleanReport clean_mesh(MeshData& mesh) {
   // Pass 2: faces, in order; degenerate ones first, then repeats of an earlier vertex set.
   std::vector<uint32_t> kept;
   kept.reserve(mesh.indices.size());
+  std::vector<uint32_t> kept_before(mesh.triangle_count() + 1, 0);  // kept triangles before t: re-ranges submeshes
   {
     std::unordered_map<FaceKey, uint32_t, FaceKeyHash> seen;
     seen.reserve(mesh.triangle_count());
     for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+      kept_before[t] = uint32_t(kept.size() / 3);
       const uint32_t a = weld[mesh.indices[3 * t]], b = weld[mesh.indices[3 * t + 1]], c = weld[mesh.indices[3 * t + 2]];
       if (a == b || b == c || a == c ||
           zero_area(&mesh.positions[3 * a], &mesh.positions[3 * b], &mesh.positions[3 * c])) {
@@ -92,6 +107,7 @@ CleanReport clean_mesh(MeshData& mesh) {
       }
       kept.insert(kept.end(), {a, b, c});
     }
+    kept_before[mesh.triangle_count()] = uint32_t(kept.size() / 3);
   }
 
   // Pass 3: compact to the referenced vertices, in their original order. Vertices welded
@@ -99,9 +115,10 @@ CleanReport clean_mesh(MeshData& mesh) {
   std::vector<uint8_t> used(nv, 0);
   for (uint32_t v : kept) used[v] = 1;
   std::vector<uint32_t> remap(nv, UINT32_MAX);
-  std::vector<float> positions, normals;
+  std::vector<float> positions, normals, uvs;
   positions.reserve(mesh.positions.size());
   if (has_normals) normals.reserve(mesh.normals.size());
+  if (has_uvs) uvs.reserve(mesh.uvs.size());
   uint32_t next = 0;
   for (size_t v = 0; v < nv; ++v) {
     if (weld[v] != v) continue;
@@ -112,12 +129,15 @@ CleanReport clean_mesh(MeshData& mesh) {
     remap[v] = next++;
     positions.insert(positions.end(), &mesh.positions[3 * v], &mesh.positions[3 * v] + 3);
     if (has_normals) normals.insert(normals.end(), &mesh.normals[3 * v], &mesh.normals[3 * v] + 3);
+    if (has_uvs) uvs.insert(uvs.end(), &mesh.uvs[2 * v], &mesh.uvs[2 * v] + 2);
   }
   for (uint32_t& v : kept) v = remap[v];
 
   mesh.positions = std::move(positions);
   mesh.normals = has_normals ? std::move(normals) : std::vector<float>{};
+  mesh.uvs = has_uvs ? std::move(uvs) : std::vector<float>{};
   mesh.indices = std::move(kept);
+  resubmesh(mesh.submeshes, kept_before);
   return report;
 }
 

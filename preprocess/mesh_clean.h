@@ -16,7 +16,8 @@ struct CleanReport {
   }
 };
 
-// Cleans in place; deterministic; keeps the first occurrence of everything.
+// Cleans in place; deterministic; keeps the first occurrence of everything (a welded vertex
+// keeps its first normal and uv: seams are not kept). Submeshes keep their surviving triangles.
 CleanReport clean_mesh(MeshData& mesh);
 
 }  // namespace lod

@@ -6,6 +6,7 @@
 // and opens the files "mtllib" names, and its STL reader took a BOM for a binary header.
 #include "preprocess/mesh_io.h"
 
+#include "preprocess/gltf_io.h"
 #include "preprocess/mesh_readers.h"
 #include "runtime/file_write.h"
 
@@ -144,12 +145,13 @@ Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out,
 namespace {
 
 namespace fs = std::filesystem;
+constexpr const char* kMeshFormats = ".obj, .ply, .off, .stl, .gltf or .glb";
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
 }
 
-// ---- OBJ -------------------------------------------------------------------------------
+}  // namespace
 
 // Reads a regular file whole. stat first (a directory, FIFO, socket or device is refused by
 // name without opening it), then open with O_NONBLOCK (a FIFO swapped in meanwhile does not
@@ -204,7 +206,6 @@ Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
   return Status::success();
 }
 
-}  // namespace
 }  // namespace detail
 
 namespace detail {
@@ -223,8 +224,9 @@ Status parse_and_finish(const std::string& name, const std::string& extension, c
     else if (ext == ".ply") s = read_ply(name, data, size, raw);
     else if (ext == ".off") s = read_off(name, data, size, raw);
     else if (ext == ".stl") s = read_stl(name, data, size, raw);
+    else if (ext == ".gltf" || ext == ".glb") return load_gltf_from_memory(name, ext, data, size, {}, out);
     else
-      return Status::error(name + ": unknown mesh format '" + extension + "' (expected .obj, .ply, .off or .stl)");
+      return Status::error(name + ": unknown mesh format '" + extension + "' (expected " + kMeshFormats + ")");
     if (!s) return s;
     if (owned) std::vector<uint8_t>().swap(*owned);
     return finish_polygons(name, raw, out, /*obj_numbering=*/ext == ".obj");
@@ -245,11 +247,12 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   const std::string what = path.string();
   const std::string ext = lower(path.extension().string());
   if (ext == ".gz" || ext == ".zip" || ext == ".bz2" || ext == ".xz")
-    return Status::error(what + ": is compressed ('" + path.extension().string() +
-                         "'); decompress it first (.obj, .ply, .off or .stl)");
+    return Status::error(what + ": is compressed ('" + path.extension().string() + "'); decompress it first (" +
+                         kMeshFormats + ")");
+  if (ext == ".gltf" || ext == ".glb") return load_gltf(path, out);
   if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl")
-    return Status::error(what + ": unknown mesh format '" + path.extension().string() +
-                         "' (expected .obj, .ply, .off or .stl)");
+    return Status::error(what + ": unknown mesh format '" + path.extension().string() + "' (expected " + kMeshFormats +
+                         ")");
   std::vector<uint8_t> bytes;
   Status r = read_regular_file(path, bytes);
   if (!r) return r;
@@ -280,6 +283,38 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
     std::memcpy(face + 1, indices + 3 * t, 12);
   }
   return write_file_atomic(path, bytes);
+}
+
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
+                const uint32_t* indices, size_t index_count) {
+  const std::string what = path.string();
+  if (index_count % 3 != 0) return Status::error(what + ": index count " + std::to_string(index_count) + " is not a multiple of 3");
+  for (size_t i = 0; i < index_count; ++i)
+    if (indices[i] >= vertex_count)
+      return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
+                           std::to_string(indices[i]) + " of " + std::to_string(vertex_count));
+  std::string text = "# lodkit\n";
+  char line[160];
+  for (size_t v = 0; v < vertex_count; ++v) {
+    const float* p = positions + 3 * v;
+    std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+    text += line;
+  }
+  if (normals)
+    for (size_t v = 0; v < vertex_count; ++v) {
+      const float* n = normals + 3 * v;
+      std::snprintf(line, sizeof line, "vn %.6g %.6g %.6g\n", n[0], n[1], n[2]);
+      text += line;
+    }
+  for (size_t t = 0; t < index_count / 3; ++t) {
+    const unsigned long a = indices[3 * t] + 1ul, b = indices[3 * t + 1] + 1ul, c = indices[3 * t + 2] + 1ul;
+    if (normals)
+      std::snprintf(line, sizeof line, "f %lu//%lu %lu//%lu %lu//%lu\n", a, a, b, b, c, c);
+    else
+      std::snprintf(line, sizeof line, "f %lu %lu %lu\n", a, b, c);
+    text += line;
+  }
+  return write_file_atomic(path, text);
 }
 
 }  // namespace lod

@@ -1,5 +1,5 @@
 // Mesh loading (OBJ, PLY, OFF, STL) into flat arrays by single-pass readers of our own
-// (OpenMesh's readers are not used). Every failure names the file and what is wrong; `out`
+// (OpenMesh's readers are not used); glTF 2.0 (.gltf, .glb) through preprocess/gltf_io.h. Every failure names the file and what is wrong; `out`
 // is only written on success.
 #pragma once
 #include <cstdint>
@@ -20,12 +20,18 @@ namespace lod {
 Status load_mesh(const std::filesystem::path& path, MeshData& out);
 
 // The same readers over bytes already in memory; `extension` picks the format (".ply",
-// ".off", ".stl", ".obj"; any case), `name` is used in messages. Never reads past `size`.
+// ".off", ".stl", ".obj", ".gltf", ".glb"; any case), `name` is used in messages. Never reads
+// past `size`; a glTF naming an external buffer is refused (nothing is read from disk).
 Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
                              MeshData& out);
 
 // Writes positions + triangles as binary PLY (for --export and outside tools).
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,
+                const uint32_t* indices, size_t index_count);
+
+// Writes positions (+ normals when given, else null) + triangles as Wavefront OBJ text
+// ("v", "vn", "f a//a ..." numbered from 1).
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
                 const uint32_t* indices, size_t index_count);
 
 }  // namespace lod

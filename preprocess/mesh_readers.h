@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,6 +42,10 @@ Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPo
 // With `obj_numbering` the corners are 0-based handles of a file that numbers from 1, and
 // the message adds 1 back.
 Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out, bool obj_numbering = false);
+
+// Reads a regular file whole (a directory, FIFO, socket or device is refused by name and
+// never blocks); the message names the file.
+Status read_regular_file(const std::filesystem::path& path, std::vector<uint8_t>& bytes);
 
 // ---- helpers shared by the text readers ------------------------------------------------
 

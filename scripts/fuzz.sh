@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# libFuzzer over every reader: one target per mesh format (PLY, OFF, STL, OBJ), the .lod asset
+# libFuzzer over every reader: one target per mesh format (PLY, OFF, STL, OBJ, GLB), the .lod asset
 # reader (`lod`, with a mutator that keeps the checksum valid) and the scene config reader
 # (`scene`), built with Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each
 # run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with
@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj lod scene)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod scene)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
 CXX=${LOD_FUZZ_CXX:-clang++}
@@ -29,7 +29,7 @@ mkdir -p "$OUT/obj"
 FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
        -I. -Iinclude -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
-              preprocess/obj_reader.cpp runtime/file_write.cpp)
+              preprocess/obj_reader.cpp preprocess/gltf_io.cpp runtime/file_write.cpp)  # gltf_io compiles tinygltf in
 LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/vertex_front.cpp
              runtime/file_write.cpp runtime/model_table.cpp runtime/view.cpp)
 SCENE_SOURCES=(jobs/scene_config.cpp)
@@ -61,7 +61,7 @@ sources_of() {
   esac
 }
 for t in "${TARGETS[@]}"; do
-  case $t in ply|off|stl|obj|lod|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj lod scene)" >&2; exit 2 ;; esac
+  case $t in ply|off|stl|obj|glb|lod|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod scene)" >&2; exit 2 ;; esac
   # shellcheck disable=SC2046
   compile $(sources_of "$t")
 done

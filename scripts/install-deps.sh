@@ -6,6 +6,7 @@ PKGS=(build-essential cmake ninja-build ccache pkg-config
       libglfw3-dev libepoxy-dev libimgui-dev libstb-dev
       libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
       libgtest-dev libgmock-dev libbenchmark-dev libmeshoptimizer-dev
+      libtinygltf-dev gltfpack
       libcgal-demo xvfb xauth libgl1-mesa-dri
       clang libclang-rt-14-dev)  # clang: libFuzzer targets (scripts/fuzz.sh)
 missing=()

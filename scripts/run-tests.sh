@@ -7,6 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
+./scripts/install-node-tools.sh  # the glTF validator the export tests run
 JOBS=$(nproc)
 
 echo "== Release build + ctest =="

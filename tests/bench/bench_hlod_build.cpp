@@ -5,13 +5,15 @@
 //
 //   BM_HlodBuild/threads:N   build_hlod only (the mesh is loaded and cleaned beforehand), in a
 //                            tbb arena of N threads; counters: nodes, leaves, depth, cpu_s
-//                            (process CPU seconds per build, all threads)
+//                            (process CPU seconds per build, all threads), best_s (the
+//                            quietest iteration's wall time: the machine is shared)
 //
 // R1 built the 847k-triangle dragon in 2,212 s. Target (issue 11): < 3 s on 2 threads; 14M < 60 s.
 // Wall times on a shared machine are noisy: cpu_s says how much of a run was ours.
 #include <benchmark/benchmark.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -70,12 +72,14 @@ void run_build(benchmark::State& state, const MeshData* mesh) {
   HlodBuildOptions options;
   options.parallel_for = tbb_parallel_for();
   HlodBuildReport report;
-  double cpu = 0;
+  double cpu = 0, best = 1e30;
   for (auto _ : state) {
     HlodModel model;
     Status built;
     const double c0 = process_cpu_seconds();
+    const auto t0 = std::chrono::steady_clock::now();
     arena.execute([&] { built = build_hlod(model, *mesh, options, &report); });
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     cpu += process_cpu_seconds() - c0;
     if (!built) {
       state.SkipWithError(built.message.c_str());
@@ -88,12 +92,13 @@ void run_build(benchmark::State& state, const MeshData* mesh) {
   state.counters["depth"] = double(report.depth);
   state.counters["triangles"] = double(mesh->triangle_count());
   state.counters["cpu_s"] = cpu / double(state.iterations());
+  state.counters["best_s"] = best;  // the shared machine's quietest iteration
 }
 
 void BM_HlodBuild(benchmark::State& state) { run_build(state, dragon()); }
 void BM_HlodBuild14M(benchmark::State& state) { run_build(state, dragon_14m()); }
 
-BENCHMARK(BM_HlodBuild)->ArgName("threads")->Arg(1)->Arg(2)->Iterations(3)->UseRealTime()->Unit(benchmark::kSecond);
+BENCHMARK(BM_HlodBuild)->ArgName("threads")->Arg(1)->Arg(2)->Iterations(5)->UseRealTime()->Unit(benchmark::kSecond);
 BENCHMARK(BM_HlodBuild14M)->ArgName("threads")->Arg(2)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
 
 // Console output as usual, then the 2-vs-1-thread ratio and the ratio to R1's 2,212 s.
@@ -102,18 +107,24 @@ class RatioReporter : public benchmark::ConsoleReporter {
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& r : runs)
-      if (r.run_type == Run::RT_Iteration && !r.error_occurred) seconds_[r.benchmark_name()] = r.GetAdjustedRealTime();
+      if (r.run_type == Run::RT_Iteration && !r.error_occurred) {
+        const auto best = r.counters.find("best_s");
+        seconds_[r.benchmark_name()] = {r.GetAdjustedRealTime(), best == r.counters.end() ? 0.0 : double(best->second)};
+      }
   }
   void print_ratios() const {
-    const auto one = seconds_.find("BM_HlodBuild/threads:1/iterations:3/real_time");
-    const auto two = seconds_.find("BM_HlodBuild/threads:2/iterations:3/real_time");
-    if (one != seconds_.end() && two != seconds_.end())
-      std::printf("dragon HLOD build: 1 thread %.2f s, 2 threads %.2f s: 2 vs 1 thread %.2fx; R1 2,212 s / 2 threads = %.0fx\n",
-                  one->second, two->second, one->second / two->second, 2212.0 / two->second);
+    const auto one = seconds_.find("BM_HlodBuild/threads:1/iterations:5/real_time");
+    const auto two = seconds_.find("BM_HlodBuild/threads:2/iterations:5/real_time");
+    if (one == seconds_.end() || two == seconds_.end()) return;
+    const auto [mean1, best1] = one->second;
+    const auto [mean2, best2] = two->second;
+    std::printf("dragon HLOD build, mean: 1 thread %.2f s, 2 threads %.2f s (2 vs 1: %.2fx); best: %.2f s, %.2f s (%.2fx); "
+                "R1's 2,212 s / best 2-thread = %.0fx\n",
+                mean1, mean2, mean1 / mean2, best1, best2, best1 / best2, 2212.0 / best2);
   }
 
  private:
-  std::map<std::string, double> seconds_;
+  std::map<std::string, std::pair<double, double>> seconds_;  // mean, best
 };
 
 }  // namespace

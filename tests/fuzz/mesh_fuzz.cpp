@@ -1,6 +1,6 @@
 // libFuzzer target for one mesh format reader: the bytes go through load_mesh_from_memory
 // (the same code load_mesh runs after reading a file), built once per format with
-// -DLOD_FUZZ_EXT='".ply"' (".off", ".stl", ".obj") by scripts/fuzz.sh.
+// -DLOD_FUZZ_EXT='".ply"' (".off", ".stl", ".obj", ".glb") by scripts/fuzz.sh.
 //
 // Checks beyond the sanitizers: a load either fails with a message naming the input, or
 // gives a mesh whose indices are in range and whose coordinates are finite.
@@ -12,7 +12,7 @@
 #include "preprocess/mesh_io.h"
 
 #ifndef LOD_FUZZ_EXT
-#error "build with -DLOD_FUZZ_EXT='\".ply\"' (or .off, .stl, .obj)"
+#error "build with -DLOD_FUZZ_EXT='\".ply\"' (or .off, .stl, .obj, .glb)"
 #endif
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -77,6 +77,39 @@ TEST(BakeJobs, BakesEveryModelThenServesThemFromTheCache) {
   }
 }
 
+// A scene's `file` may name a baked asset (issue 12): it is read as is, never rebaked or
+// written to the cache, and a broken one is refused naming the model and the file.
+TEST(BakeJobs, ReadsAModelWhoseFileIsALodAssetAsIs) {
+  BakeDir d;
+  std::vector<LodChain> chains;
+  BakeSummary first;
+  ASSERT_TRUE(bake_scene_models(d.models, d.cache, 2, chains, first, d.log).ok);
+  const fs::path asset = d.meshes / "b-prebaked.LOD";
+  ASSERT_TRUE(write_lod_asset(asset, chains[1]).ok);
+  const fs::path fresh_cache = test::temp_dir("bake-cache-lod");
+  std::vector<ModelConfig> models = {ModelConfig{"tree", asset, {}}};
+  models[0].bake.ratios = {1.0f, 0.1f};  // ignored: the asset's own levels are kept
+  std::vector<LodChain> loaded;
+  BakeSummary summary;
+  const Status s = bake_scene_models(models, fresh_cache, 1, loaded, summary, d.log);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(loaded.size(), 1u);
+  EXPECT_EQ(loaded[0].name, "tree");
+  EXPECT_EQ(loaded[0].levels.size(), chains[1].levels.size());
+  EXPECT_EQ(loaded[0].indices, chains[1].indices);
+  EXPECT_EQ(loaded[0].positions, chains[1].positions);
+  EXPECT_EQ(summary.baked, 0u);
+  EXPECT_EQ(summary.cached, 1u);
+  EXPECT_TRUE(fs::is_empty(fresh_cache));
+  EXPECT_EQ(d.lines_with("loaded as is"), 1u);
+
+  test::write_bytes(asset, {'n', 'o', 't', ' ', 'a', 's', 's', 'e', 't'});
+  const Status bad = bake_scene_models(models, fresh_cache, 1, loaded, summary, d.log);
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.message.find("model tree"), std::string::npos) << bad.message;
+  EXPECT_NE(bad.message.find(asset.string()), std::string::npos) << bad.message;
+}
+
 TEST(BakeJobs, CacheFileIsNamedByModelAndKey) {
   BakeDir d;
   d.models.resize(1);

@@ -197,10 +197,11 @@ TEST(HlodBuild, StanfordBunnyHasEveryProperty) {
 
 // Stanford's decimated buddha: 2,151 non-manifold edges, fins, 1,423 open edges. Its
 // non-manifold vertices are locked (moving them opened 80-150 edges per cut), so its layers
-// shrink less than half. Known limit, left visible here: where a valence-3 vertex sits over a
-// triangle that is itself a face (a tetrahedron glued into the surface), QEM's link condition
-// lets the collapse through and one of the doubled faces goes, opening one edge: a few per
-// cut, never more than 1 in 1,000 of the drawn edges.
+// shrink less than half. Known limit, left visible here: QEM's link condition lets a valence-3
+// vertex over a triangle that is itself a face (a tetrahedron glued into the surface) collapse,
+// and one of the doubled faces goes, opening an edge. Tips there when a node's simplification
+// starts are locked (3-11 open edges per cut before); tips the simplification itself makes still
+// open a few (0-3 per cut), never more than 1 in 1,000 of the drawn edges.
 TEST(HlodBuild, NonManifoldBuddhaKeepsItsPropertiesAndAlmostAllEdges) {
   LOD_REQUIRE_SHARED_MESH(file, "happy-buddha-res3.ply");
   MeshData mesh;

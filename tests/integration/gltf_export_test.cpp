@@ -1,0 +1,246 @@
+// glTF through the `lod` command (issue 12): `lod inspect --export DIR --format glb|gltf|obj|ply`
+// writes every level; each GLB / glTF passes the Khronos glTF validator (npm gltf-validator,
+// installed by scripts/install-node-tools.sh, run through node) with 0 errors; import -> bake
+// -> export -> import keeps triangle counts and bounds; a scene may name .glb and .lod files.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "gltf_fixture.h"
+#include "preprocess/mesh_io.h"
+#include "run_cli.h"
+#include "test_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lod::test::run_lod;
+
+struct Box {
+  std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+};
+
+Box bounds_of(const lod::MeshData& m) {
+  Box b;
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      b.lo[size_t(c)] = std::min(b.lo[size_t(c)], m.positions[3 * v + size_t(c)]);
+      b.hi[size_t(c)] = std::max(b.hi[size_t(c)], m.positions[3 * v + size_t(c)]);
+    }
+  return b;
+}
+
+// The validator on `files`: its exit code and output. Not installed is a failure, not a skip:
+// scripts/run-tests.sh installs it before any test runs.
+lod::test::CliResult run_validator(const std::vector<fs::path>& files) {
+  const fs::path validator = fs::path(LOD_NODE_TOOLS) / "node_modules" / "gltf-validator";
+  lod::test::CliResult r;
+  if (!fs::exists(LOD_NODE_EXECUTABLE) || !fs::exists(validator / "package.json")) {
+    r.out = "gltf-validator is not installed (node '" LOD_NODE_EXECUTABLE "', validator " + validator.string() +
+            "): run scripts/install-node-tools.sh";
+    return r;
+  }
+  std::string cmd = std::string(LOD_NODE_EXECUTABLE) + " " + LOD_SOURCE_DIR "/tests/integration/validate_gltf.js " +
+                    validator.string();
+  for (const fs::path& f : files) cmd += " '" + f.string() + "'";
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+fs::path baked_asset(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".lod") return e.path();
+  return {};
+}
+
+// A sphere as GLB: the OFF sphere's arrays, under a node that moves it to (5, 0, -2).
+fs::path write_sphere_glb(const fs::path& dir, const std::string& name, int rings, int segments) {
+  const std::string off = lod::test::sphere_off(rings, segments);
+  lod::MeshData m;
+  EXPECT_TRUE(lod::load_mesh_from_memory("s.off", ".off", reinterpret_cast<const uint8_t*>(off.data()), off.size(), m).ok);
+  lod::test::GltfFixture f;
+  f.add_float_mesh(m.positions, m.indices);
+  f.set_scene({f.add_node({{"mesh", 0}, {"translation", {5, 0, -2}}})});
+  const fs::path file = dir / (name + ".glb");
+  lod::test::write_bytes(file, f.glb());
+  return file;
+}
+
+TEST(GltfExport, EveryExportedLevelPassesTheKhronosValidator) {
+  const fs::path dir = lod::test::temp_dir("gltf-validate");
+  std::vector<fs::path> meshes = {dir / "ball.off"};
+  lod::test::write_text(meshes[0], lod::test::sphere_off(40, 80));
+  if (!lod::test::data_dir().empty() && fs::exists(lod::test::data_dir() / "cow.off"))
+    meshes.push_back(lod::test::data_dir() / "cow.off");  // a scanned-style mesh, when the build extracted it
+  std::vector<fs::path> exported;
+  for (const fs::path& mesh : meshes) {
+    const fs::path out = dir / ("out-" + mesh.stem().string());
+    auto r = run_lod("bake " + mesh.string() + " -o " + out.string() + " --quiet");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const fs::path asset = baked_asset(out);
+    ASSERT_FALSE(asset.empty());
+    for (const char* format : {"glb", "gltf"}) {
+      const fs::path to = dir / (mesh.stem().string() + "-" + format);
+      r = run_lod("inspect " + asset.string() + " --json --export " + to.string() + " --format " + format);
+      ASSERT_EQ(r.code, 0) << r.out;
+      const auto j = nlohmann::json::parse(r.out);
+      ASSERT_GE(j["levels"].size(), 3u);
+      for (size_t i = 0; i < j["levels"].size(); ++i) {
+        const fs::path level = to / (mesh.stem().string() + "-level" + std::to_string(i) + "." + format);
+        ASSERT_TRUE(fs::exists(level)) << level;
+        if (std::string(format) == "gltf") {
+          EXPECT_TRUE(fs::exists(fs::path(level).replace_extension(".bin")));
+        }
+        exported.push_back(level);
+      }
+    }
+  }
+  const auto v = run_validator(exported);
+  EXPECT_EQ(v.code, 0) << v.out;
+  for (const fs::path& f : exported) EXPECT_NE(v.out.find(f.string() + ": errors 0 "), std::string::npos) << v.out;
+  std::printf("%s", v.out.c_str());
+}
+
+// The validator itself must catch a broken file, or the test above proves nothing.
+TEST(GltfExport, TheValidatorReportsABrokenFile) {
+  const fs::path dir = lod::test::temp_dir("gltf-validate-broken");
+  lod::test::GltfFixture f;
+  f.add_float_mesh({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 7});  // index past the vertices, no min/max
+  f.set_scene({f.add_node({{"mesh", 0}})});
+  lod::test::write_bytes(dir / "broken.glb", f.glb());
+  const auto v = run_validator({dir / "broken.glb"});
+  EXPECT_EQ(v.code, 1) << v.out;
+  EXPECT_EQ(v.out.find("errors 0 "), std::string::npos) << v.out;
+}
+
+TEST(GltfExport, RoundTripKeepsTriangleCountsAndBounds) {
+  const fs::path dir = lod::test::temp_dir("gltf-roundtrip");
+  const fs::path glb = write_sphere_glb(dir, "globe", 30, 60);
+  lod::MeshData original;
+  ASSERT_TRUE(lod::load_mesh(glb, original).ok);
+  const Box want = bounds_of(original);
+  EXPECT_NEAR(want.lo[0], 4.0f, 1e-5);  // the node's translation was applied
+  auto r = run_lod("bake " + glb.string() + " -o " + (dir / "out").string() + " --ratios 1 0.5 0.25 0.1 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path asset = baked_asset(dir / "out");
+  r = run_lod("inspect " + asset.string() + " --json --export " + (dir / "glb").string() + " --format glb");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["levels"].size(), 4u);
+  EXPECT_EQ(j["levels"][0]["triangles"].get<size_t>(), original.triangle_count());
+  for (size_t i = 0; i < 4; ++i) {
+    lod::MeshData back;
+    const fs::path level = dir / "glb" / ("globe-level" + std::to_string(i) + ".glb");
+    const lod::Status s = lod::load_mesh(level, back);
+    ASSERT_TRUE(s.ok) << s.message;
+    EXPECT_EQ(back.triangle_count(), j["levels"][i]["triangles"].get<size_t>()) << i;
+    EXPECT_EQ(back.normals.size(), back.positions.size()) << "normals exported";
+    const Box got = bounds_of(back);
+    for (size_t c = 0; c < 3; ++c) {
+      if (i == 0) {
+        EXPECT_FLOAT_EQ(got.lo[c], want.lo[c]);
+        EXPECT_FLOAT_EQ(got.hi[c], want.hi[c]);
+      } else {  // coarser levels stay near the original's box
+        EXPECT_GE(got.lo[c], want.lo[c] - 0.05f) << i;
+        EXPECT_LE(got.hi[c], want.hi[c] + 0.05f) << i;
+        EXPECT_LE(got.lo[c], want.lo[c] + 0.25f) << i;
+        EXPECT_GE(got.hi[c], want.hi[c] - 0.25f) << i;
+      }
+    }
+  }
+}
+
+TEST(GltfExport, ObjAndDefaultPlyExportsKeepTheirCounts) {
+  const fs::path dir = lod::test::temp_dir("gltf-obj");
+  lod::test::write_text(dir / "ball.off", lod::test::sphere_off(20, 40));
+  auto r = run_lod("bake " + (dir / "ball.off").string() + " -o " + (dir / "out").string() + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path asset = baked_asset(dir / "out");
+  r = run_lod("inspect " + asset.string() + " --json --export " + (dir / "obj").string() + " --format obj");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  r = run_lod("inspect " + asset.string() + " --export " + (dir / "ply").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (size_t i = 0; i < j["levels"].size(); ++i) {
+    for (const char* ext : {"obj", "ply"}) {
+      lod::MeshData m;
+      const fs::path f = dir / ext / ("ball-level" + std::to_string(i) + "." + ext);
+      const lod::Status s = lod::load_mesh(f, m);
+      ASSERT_TRUE(s.ok) << s.message;
+      EXPECT_EQ(m.triangle_count(), j["levels"][i]["triangles"].get<size_t>()) << f;
+    }
+  }
+  r = run_lod("inspect " + asset.string() + " --export " + (dir / "x").string() + " --format fbx");
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("--format"), std::string::npos) << r.out;
+}
+
+// A scene's models may name a .glb (imported and baked) and a .lod (read as it is).
+TEST(GltfScene, RunsASceneNamingGlbAndLodFiles) {
+  const fs::path dir = lod::test::temp_dir("gltf-scene");
+  write_sphere_glb(dir, "ball", 20, 40);
+  lod::test::write_text(dir / "pebble.off", lod::test::sphere_off(10, 20));
+  auto r = run_lod("bake " + (dir / "pebble.off").string() + " -o " + (dir / "pre").string() + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  fs::copy_file(baked_asset(dir / "pre"), dir / "pebble.lod");
+  lod::test::write_text(dir / "scene.toml", R"([run]
+frames = 4
+threads = 2
+
+[budget]
+triangles = 20000
+
+[camera]
+path = "orbit"
+center = [0, 0, 0]
+radius = 60.0
+height_above = 10.0
+period_frames = 4
+width = 320
+height = 200
+
+[[model]]
+name = "ball"
+file = "ball.glb"
+
+[[model]]
+name = "pebble"
+file = "pebble.lod"
+
+[[instances]]
+model = "ball"
+count = 20
+box_min = [-30, 0, -30]
+box_max = [30, 0, 30]
+seed = 3
+
+[[instances]]
+model = "pebble"
+count = 20
+box_min = [-30, 0, -30]
+box_max = [30, 0, 30]
+seed = 4
+)");
+  r = run_lod("run --config " + (dir / "scene.toml").string() + " --cache " + (dir / "cache").string() +
+              " --json " + (dir / "run.json").string() + " --validate");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("pebble.lod loaded as is"), std::string::npos) << r.out;
+  std::ifstream f(dir / "run.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["frames"].size(), 4u);
+  EXPECT_EQ(j["summary"]["baked_models"], 1);  // the .glb; the .lod was not baked
+}
+
+}  // namespace
