@@ -262,9 +262,11 @@ struct FrameGraph::Impl {
 
   // Reads run on the pager's threads, several at once: read_hlod_node opens the file per read.
   void make_hlod_stream(std::shared_ptr<const HlodModels> h) {
-    auto load = [h](uint32_t model, uint32_t node, HlodPayload& out) {
-      return read_hlod_node(h->files[model], h->trees[model].nodes[node], out);
-    };
+    ModelNodeLoader load = h->load;
+    if (!load)
+      load = [h](uint32_t model, uint32_t node, HlodPayload& out) {
+        return read_hlod_node(h->files[model], h->trees[model].nodes[node], out);
+      };
     hlod_stream = std::make_unique<HlodStream>(h->trees, h->stream, load);
     hlod_inputs.resize(h->trees.size());
     for (size_t m = 0; m < hlod_inputs.size(); ++m) hlod_inputs[m].transform = h->transforms[m];

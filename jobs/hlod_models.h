@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "jobs/hlod_stream.h"  // ModelNodeLoader
 #include "jobs/stream_pager.h"
 #include "lodkit/types.hpp"
 #include "runtime/hlod_select.h"
@@ -22,6 +23,9 @@ struct HlodModels {
   // skip: what the camera does not see is neither drawn nor loaded (Cesium). cover: a closed
   // cut (lod run --validate checks every boundary edge; hlod_select.h).
   HlodCulledNodes culled = HlodCulledNodes::skip;
+  // Reads one node (on the loader threads, several at once); empty: read_hlod_node on `files`.
+  // Tests inject slow or failing storage here.
+  ModelNodeLoader load;
   bool empty() const { return trees.empty(); }
 };
 

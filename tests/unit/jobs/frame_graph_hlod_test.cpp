@@ -2,6 +2,7 @@
 // objects, within what the discrete selection leaves of M, never with a hole.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -105,6 +106,36 @@ TEST(FrameGraphHlod, NoShareLeftDrawsTheSmallestCut) {
     EXPECT_EQ(f.hlod_tris, root.layers[root.layer_count - 1].triangles);
     EXPECT_EQ(f.holes, 0u);
   }
+}
+
+// Storage that takes 20 ms per node: the hlod node never waits for it (loads finish on the
+// loader threads while frames go on), so its time stays far below one read.
+TEST(FrameGraphHlod, SlowReadsNeverStallTheNode) {
+  const Scene scene = test::synthetic_scene(300, 150);
+  FrameGraphOptions o;
+  o.threads = 2;
+  o.selection.budget = 20000000;
+  auto h = sphere_hlod("fg-hlod-slow", 64ull << 20);
+  h->load = [files = h->files, trees = h->trees](uint32_t m, uint32_t node, HlodPayload& out) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return read_hlod_node(files[m], trees[m].nodes[node], out);
+  };
+  o.hlod = h;
+  FrameGraph g(scene, o);
+  Frame f;
+  std::vector<double> ms;
+  uint64_t loads_at_start = 0;
+  for (uint32_t n = 0; n < 100; ++n) {
+    g.run(near_origin(n), f);
+    if (n == 0) loads_at_start = f.stream_loads;
+    ASSERT_EQ(f.holes, 0u);
+    ms.push_back(f.stage_ms[size_t(Stage::hlod)]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_GT(f.stream_loads, loads_at_start + 2) << "loads completed while frames ran";
+  std::sort(ms.begin(), ms.end());
+  EXPECT_LT(ms[ms.size() / 2], 2.0) << "median hlod node ms";
+  EXPECT_LT(ms[ms.size() * 9 / 10], 10.0) << "p90 hlod node ms: a wait would take 20";
 }
 
 TEST(FrameGraphHlod, WithoutHlodModelsTheNodeDrawsNothing) {
