@@ -1,5 +1,6 @@
 // lod run: the main job. Bake (cached) what the scene needs, then drive lod::Service frame by
 // frame along the config's camera path and report what every frame did.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -8,8 +9,10 @@
 
 #include "cli/budget_shortfall.h"
 #include "cli/commands.h"
+#include "cli/hlod_check.h"
 #include "cli/run_report.h"
 #include "jobs/bake_jobs.h"
+#include "jobs/hlod_scene.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "jobs/scene_motion.h"
@@ -94,8 +97,9 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
     }
     tris += scene.models.triangles[scene.models.first_level[m] + f.levels[i]];
   }
+  tris += f.hlod_tris;  // HLOD cuts count in the same budget
   if (tris != f.tris_selected) {
-    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels add up to %llu",
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels and hlod cuts add up to %llu",
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     *why = buf;
     return false;
@@ -134,18 +138,34 @@ int run_command(const RunArgs& args) {
   }
 
   const std::string cache_dir = args.cache_dir.empty() ? default_cache_dir(data_dir) : args.cache_dir;
+  auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  // hlod = true models stream through the hlod node; the rest are discrete objects.
+  auto hlod = std::make_shared<HlodModels>();
+  size_t hlod_baked = 0, hlod_cached = 0;
+  if (auto st = bake_hlod_models(config, cache_dir, log, *hlod, &hlod_baked, &hlod_cached); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  HlodCheck hlod_check;
+  if (args.validate && !hlod->empty()) {
+    hlod->culled = HlodCulledNodes::cover;  // closed cuts, so every boundary edge can be checked
+    hlod_check.load(*hlod);
+  }
+  config = discrete_part(config);
   std::vector<LodChain> chains;
   BakeSummary bake;
-  auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   if (auto st = bake_scene_models(config.models, cache_dir, config.threads, chains, bake, log); !st) {
     std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
     return 1;
   }
-  std::fprintf(stderr, "bake: %zu models (%zu baked, %zu from cache %s) in %.0f ms\n", chains.size(), bake.baked,
-               bake.cached, cache_dir.c_str(), bake.ms);
+  bake.baked += hlod_baked;
+  bake.cached += hlod_cached;
+  std::fprintf(stderr, "bake: %zu models (%zu baked, %zu from cache %s) in %.0f ms\n", chains.size() + hlod->trees.size(),
+               bake.baked, bake.cached, cache_dir.c_str(), bake.ms);
 
   Scene scene = make_scene(config, std::move(chains));
-  const FrameGraphOptions options = frame_graph_options(config);
+  FrameGraphOptions options = frame_graph_options(config);
+  if (!hlod->empty()) options.hlod = hlod;
   std::vector<ObjectHandle> handles;
   std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);
   Service& service = *owned;
@@ -160,7 +180,9 @@ int run_command(const RunArgs& args) {
   RunSummary summary;
   summary.config = std::filesystem::path(args.config).filename().string();
   summary.objects = scene.objects.size();
-  summary.models = scene.chains.size();
+  summary.models = scene.chains.size() + hlod->trees.size();
+  summary.hlod_models = hlod->trees.size();
+  summary.stream_budget = hlod->empty() ? 0 : hlod->stream.budget_bytes;
   summary.threads = config.threads;
   summary.budget = config.selection.budget;
   summary.budget_count = config.selection.count == BudgetCount::levels ? "levels" : "triangles";
@@ -170,13 +192,19 @@ int run_command(const RunArgs& args) {
 
   std::vector<std::string> model_names;
   for (const ModelConfig& m : config.models) model_names.push_back(m.name);
-  bool told_shortfall = false;  // the first over-budget frame is explained, the summary counts them all
+  bool told_shortfall = false;
+  uint64_t told_failures = 0;  // HLOD node reads that failed, each told once  // the first over-budget frame is explained, the summary counts them all
 
   std::vector<FrameRecord> records;
   records.reserve(config.frames);
   const uint32_t every = config.frames <= 40 ? 1 : (config.frames + 29) / 30;
   if (!args.quiet) std::printf("%s\n%s\n", table_header().c_str(), table_legend().c_str());
+  // Streaming scenes run at rate_hz in wall time: the loader threads get a frame's time per
+  // frame, as under a renderer (back to back, frames take microseconds and loads trail far behind).
+  const bool paced = !hlod->empty();
+  const auto paced_start = std::chrono::steady_clock::now();
   for (uint32_t n = 0; n < config.frames; ++n) {
+    if (paced) std::this_thread::sleep_until(paced_start + std::chrono::duration<double>(n * dt));
     if (motion.moving() > 0) {
       motion.stage(service, (n + 1) * dt);
       service.commit(n + 1);
@@ -194,6 +222,10 @@ int run_command(const RunArgs& args) {
         std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
         return 3;
       }
+      if (!hlod_check.check(frame, &why)) {
+        std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
+        return 3;
+      }
       const uint64_t cost = config.selection.count == BudgetCount::levels ? frame.level_cost : frame.tris_selected;
       if (!frame.over_budget && cost > frame.budget) {
         std::fprintf(stderr, "lod run --validate: frame %u: cost %llu exceeds budget %llu without over_budget\n", n,
@@ -203,8 +235,20 @@ int run_command(const RunArgs& args) {
     }
     if (frame.over_budget && !told_shortfall) {
       told_shortfall = true;
-      std::fprintf(stderr, "lod run: frame %u: %s\n", n,
-                   shortfall_text(budget_shortfall(frame, scene.models, config.selection.count), model_names).c_str());
+      if (frame.coarsest_cost <= frame.budget && frame.hlod_tris > 0)  // the discrete levels fit: HLOD did not
+        std::fprintf(stderr,
+                     "lod run: frame %u: budget %llu cannot be met: the hlod models' smallest cuts (%llu triangles) "
+                     "exceed what the discrete objects leave of M (%llu)\n",
+                     n, (unsigned long long)frame.budget, (unsigned long long)frame.hlod_tris,
+                     (unsigned long long)(frame.budget - std::min(frame.budget, frame.tris_selected - frame.hlod_tris)));
+      else
+        std::fprintf(stderr, "lod run: frame %u: %s\n", n,
+                     shortfall_text(budget_shortfall(frame, scene.models, config.selection.count), model_names).c_str());
+    }
+    if (frame.stream_failures > told_failures) {
+      std::fprintf(stderr, "lod run: frame %u: %llu hlod node reads failed so far (their parents stay drawn)\n", n,
+                   (unsigned long long)frame.stream_failures);
+      told_failures = frame.stream_failures;
     }
     records.push_back(record_of(frame));
     if (!args.quiet && (n % every == 0 || n + 1 == config.frames))

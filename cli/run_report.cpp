@@ -57,6 +57,11 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"pixel_error_max", r.pixel_error_max},
           {"pixel_error_mean", r.pixel_error_mean},
           {"tris_drawn", r.drawn()},
+          {"hlod_nodes_drawn", r.hlod_nodes_drawn},
+          {"resident_bytes", r.resident_bytes},
+          {"stream_requests", r.stream_requests},
+          {"stream_loads", r.stream_loads},
+          {"holes", r.holes},
           {"ms", ms}};
 }
 
@@ -89,6 +94,14 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"mean_level_changes", s.mean_level_changes},
           {"mean_pixel_error", s.mean_pixel_error},
           {"max_pixel_error", s.max_pixel_error},
+          {"hlod_models", s.hlod_models},
+          {"stream_budget", s.stream_budget},
+          {"max_resident_bytes", s.max_resident_bytes},
+          {"total_holes", s.total_holes},
+          {"stream_loads", s.stream_loads},
+          {"stream_evictions", s.stream_evictions},
+          {"stream_failures", s.stream_failures},
+          {"mean_hlod_nodes_drawn", s.mean_hlod_nodes_drawn},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
           {"cached_models", s.cached_models},
@@ -127,6 +140,14 @@ FrameRecord record_of(const Frame& f) {
   r.pixel_error_max = f.pixel_error_max;
   r.pixel_error_mean = f.pixel_error_mean;
   for (uint8_t l : f.levels) ++r.chain_levels[std::min<size_t>(l, kMaxLevels - 1)];
+  r.hlod_nodes_drawn = f.hlod_nodes_drawn;
+  r.holes = f.holes;
+  r.hlod_tris = f.hlod_tris;
+  r.resident_bytes = f.resident_bytes;
+  r.stream_requests = f.stream_requests;
+  r.stream_loads = f.stream_loads;
+  r.stream_evictions = f.stream_evictions;
+  r.stream_failures = f.stream_failures;
   return r;
 }
 
@@ -138,6 +159,8 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   std::array<std::vector<double>, kStageCount> stage;
   double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0, culled = 0, benefit = 0, changes = 0, px = 0;
   s.max_pixel_error = 0;
+  s.max_resident_bytes = s.total_holes = 0;
+  double hlod_nodes = 0;
   s.max_drawn_over_budget = 0;
   s.frames_drawn_over_budget = 0;
   for (const auto& r : records) {
@@ -158,7 +181,14 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     changes += r.level_changes;
     px += r.pixel_error_mean;
     s.max_pixel_error = std::max(s.max_pixel_error, double(r.pixel_error_max));
+    s.max_resident_bytes = std::max(s.max_resident_bytes, r.resident_bytes);
+    s.total_holes += r.holes;
+    hlod_nodes += r.hlod_nodes_drawn;
+    s.stream_loads = std::max(s.stream_loads, r.stream_loads);  // counters: the last frame's
+    s.stream_evictions = std::max(s.stream_evictions, r.stream_evictions);
+    s.stream_failures = std::max(s.stream_failures, r.stream_failures);
   }
+  s.mean_hlod_nodes_drawn = hlod_nodes / std::max<double>(1, double(records.size()));
   const double n = std::max<double>(1, double(records.size()));
   s.median_ms = percentile(total, 0.5);
   s.p99_ms = percentile(total, 0.99);
@@ -232,6 +262,16 @@ std::string summary_text(const RunSummary& s) {
   if (s.mean_culled > 0) {
     std::snprintf(buf, sizeof buf, "  culled (culled level or beyond lod.max_distance): mean %.0f objects per frame\n",
                   s.mean_culled);
+    o << buf;
+  }
+  if (s.hlod_models > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "  hlod: %zu models, mean %.1f nodes drawn; resident max %.2f MB of the %.2f MB stream budget; "
+                  "%llu loads, %llu evictions, %llu failed reads; %llu holes\n",
+                  s.hlod_models, s.mean_hlod_nodes_drawn, double(s.max_resident_bytes) / (1 << 20),
+                  double(s.stream_budget) / (1 << 20), (unsigned long long)s.stream_loads,
+                  (unsigned long long)s.stream_evictions, (unsigned long long)s.stream_failures,
+                  (unsigned long long)s.total_holes);
     o << buf;
   }
   if (s.mean_occluded > 0) {

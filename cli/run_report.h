@@ -34,6 +34,10 @@ struct FrameRecord {
   double benefit = 0;                // the oracle's benefit of the selected levels (view 0)
   float pixel_error_max = 0, pixel_error_mean = 0;  // screen-space error left (view 0)
   std::array<uint32_t, kMaxLevels> chain_levels{};  // objects per chain level index
+  // HLOD models (the hlod node): nodes drawn, pager bytes and counters, holes (must be 0).
+  uint32_t hlod_nodes_drawn = 0, holes = 0;
+  uint64_t hlod_tris = 0, resident_bytes = 0, stream_requests = 0, stream_loads = 0, stream_evictions = 0,
+           stream_failures = 0;
 
   uint64_t drawn() const { return tris_selected + tris_morph_extra; }  // with blends
 };
@@ -57,6 +61,11 @@ struct RunSummary {
   double mean_culled = 0;               // culled level or beyond lod.max_distance, per frame
   double mean_benefit = 0, mean_level_changes = 0;
   double mean_pixel_error = 0, max_pixel_error = 0;
+  // HLOD models: the most bytes resident on any frame against [stream] budget_mb, holes summed.
+  size_t hlod_models = 0;
+  uint64_t stream_budget = 0, max_resident_bytes = 0, total_holes = 0, stream_loads = 0, stream_evictions = 0,
+           stream_failures = 0;
+  double mean_hlod_nodes_drawn = 0;
   double bake_ms = 0;
   size_t baked_models = 0, cached_models = 0;
   double wall_s = 0;

@@ -27,7 +27,9 @@
 #include <optional>
 #include <span>
 
+#include "jobs/hlod_stream.h"
 #include "runtime/geomorph.h"
+#include "runtime/hlod_asset.h"
 #include "runtime/importance.h"
 #include "runtime/level_blend.h"
 #include "runtime/derived_columns.h"
@@ -120,9 +122,11 @@ enum Column : uint32_t {
   kTotals = 1u << 10,     // the frame's totals
   kHistory = 1u << 11,    // the store's last-frame levels and visibility
   kPlacing = 1u << 12,    // the frame's handles, transforms and view masks per entry
+  kHlod = 1u << 13,       // HLOD cuts and the pager, the frame's hlod columns
 };
 constexpr const char* kColumnNames[] = {"objects", "bounds", "controls", "views",  "visibility", "entries", "levels",
-                                        "blend",   "fronts", "vd_mesh",  "totals", "history",    "placing"};
+                                        "blend",   "fronts", "vd_mesh",  "totals", "history",    "placing",
+                                        "hlod"};
 
 }  // namespace
 
@@ -239,6 +243,11 @@ struct FrameGraph::Impl {
   };
   std::vector<VdTask> vd_tasks;
 
+  // HLOD models (options.hlod): one stream for all of them; its loader threads are its own.
+  std::unique_ptr<HlodStream> hlod_stream;
+  std::vector<HlodModelInput> hlod_inputs;
+  bool hlod_over_budget = false;
+
   tbb::task_arena arena;
   std::optional<tbb::flow::graph> graph;
   std::optional<tbb::flow::broadcast_node<tbb::flow::continue_msg>> start;
@@ -249,8 +258,23 @@ struct FrameGraph::Impl {
         grain(std::max<uint32_t>(1, o.grain)),
         arena(o.threads == 0 ? tbb::task_arena::automatic : static_cast<int>(o.threads)) {
     set_models(std::move(models));
+    if (o.hlod && !o.hlod->empty()) make_hlod_stream(o.hlod);
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
+  }
+
+  // Reads run on the pager's threads, several at once: read_hlod_node opens the file per read.
+  void make_hlod_stream(std::shared_ptr<const HlodModels> h) {
+    ModelNodeLoader load = h->load;
+    if (!load)
+      load = [h](uint32_t model, uint32_t node, HlodPayload& out) {
+        return read_hlod_node(h->files[model], h->trees[model].nodes[node], out);
+      };
+    hlod_stream = std::make_unique<HlodStream>(h->trees, h->stream, load);
+    hlod_inputs.resize(h->trees.size());
+    for (size_t m = 0; m < hlod_inputs.size(); ++m) hlod_inputs[m].transform = h->transforms[m];
+    // Set-up, not a frame: the roots are there before frame 1, so no frame has a hole.
+    hlod_stream->load_roots(30.0);
   }
 
   // ---- the model set ----------------------------------------------------------------------
@@ -817,6 +841,49 @@ struct FrameGraph::Impl {
     });
   }
 
+  // The triangles M leaves after the discrete selection, split evenly over the HLOD models.
+  uint64_t hlod_share() const {
+    const SelectionParams& sp = options.selection;
+    if (sp.count != BudgetCount::triangles) return UINT64_MAX;
+    const uint64_t left = sp.budget > selected.triangles ? sp.budget - selected.triangles : 0;
+    return left / std::max<size_t>(1, hlod_inputs.size());
+  }
+
+  // View 0's cut of every HLOD model, then the pager's update (no I/O here).
+  void node_hlod() {
+    Frame& f = *out;
+    f.hlod_drawn.clear();
+    f.hlod_opened.clear();
+    hlod_over_budget = false;
+    f.hlod_nodes_drawn = 0;
+    f.hlod_tris = f.resident_bytes = f.stream_requests = f.stream_loads = f.stream_evictions = f.stream_failures = f.stream_budget = 0;
+    f.holes = 0;
+    if (!hlod_stream) return;
+    const uint64_t share = hlod_share();
+    for (HlodModelInput& in : hlod_inputs) {
+      in.params.pixel_error = options.pixel_error;
+      in.params.triangle_budget = share;
+      in.params.culled = options.hlod->culled;
+    }
+    hlod_stream->frame(frame_index, hlod_view_of(views[0]), hlod_inputs);
+    for (uint32_t m = 0; m < hlod_stream->model_count(); ++m) {
+      const HlodCut& cut = hlod_stream->cut(m);
+      for (const HlodDraw& d : cut.drawn) f.hlod_drawn.push_back({m, d.node, d.layer});
+      for (const uint32_t n : cut.opened) f.hlod_opened.push_back({m, n});
+      hlod_over_budget |= cut.over_budget;
+    }
+    const HlodStreamFigures fig = hlod_stream->figures();
+    f.hlod_nodes_drawn = fig.hlod_nodes_drawn;
+    f.hlod_tris = fig.hlod_triangles;
+    f.resident_bytes = fig.resident_bytes;
+    f.stream_budget = options.hlod->stream.budget_bytes;
+    f.stream_requests = fig.stream_requests;
+    f.stream_loads = fig.stream_loads;
+    f.stream_evictions = fig.stream_evictions;
+    f.stream_failures = fig.stream_failures;
+    f.holes = fig.holes;
+  }
+
   void node_publish() {
     Frame& f = *out;
     ObjectStore& s = *store;
@@ -866,10 +933,11 @@ struct FrameGraph::Impl {
       f.level_cost += t.level_cost;
       for (size_t l = 0; l < kHistogramLevels; ++l) f.level_histogram[l] += t.histogram[l];
     }
+    f.tris_selected += f.hlod_tris;  // HLOD cuts draw within the same M
     f.budget = options.selection.budget;
     f.budget_morph_reserve = morph_reserve;
     f.coarsest_cost = selected.coarsest_cost;
-    f.over_budget = selected.over_budget;
+    f.over_budget = selected.over_budget || hlod_over_budget;
     f.lowered_steps = selected.lowered_steps;
     f.levels_lowered = selected.levels_lowered;
     f.benefit = quality.benefit;
@@ -974,7 +1042,9 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      kEntries | kPlacing | kLevels | kViews, kFronts, &Impl::node_vdlod},
     {Stage::vd_mesh, "vertex_morph_positions + compact meshes of vd objects, parallel", kEntries | kFronts, kVdMesh,
      &Impl::node_vd_mesh},
-    {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend,
+    {Stage::hlod, "select_hlod_cut per HLOD model (view 0, M minus the discrete selection) + pager update, serial",
+     kLevels | kViews, kHlod, &Impl::node_hlod},
+    {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend | kHlod,
      kTotals | kHistory, &Impl::node_publish},
 };
 

@@ -6,7 +6,12 @@
 //   commit -> bounds --+
 //   view --------------+-> visibility -> importance -> selection -+-> geomorph -> publish
 //                                                                  +-> vdlod -> vd_mesh
+//                                                                  +-> hlod ------------+
 //
+// hlod (HLOD models, jobs/hlod_stream): view 0's cut of every model from what is resident, then
+// the pager's update (never waits on I/O; loader threads read the .hlod files). Its share of M
+// is what the discrete selection left: triangle_budget = M - selected triangles (at least 0),
+// split evenly over the models, the first form of "one budget" (levels budgets: no cap).
 // The flow-graph headers stay in frame_graph.cpp.
 #pragma once
 #include <functional>
@@ -15,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "jobs/hlod_models.h"
 #include "jobs/scene.h"
 #include "runtime/frame.h"
 #include "runtime/initial_levels.h"
@@ -52,6 +58,8 @@ struct FrameGraphOptions {
   // Called at the start of every stage, on the thread running it (tracing; tests inject
   // failures by throwing from it). Empty = no call.
   std::function<void(Stage)> stage_hook;
+  // Streamed HLOD models drawn by the hlod node (none: the node does nothing).
+  std::shared_ptr<const HlodModels> hlod;
 };
 
 // The models a graph draws from: chains shared (adding a model copies none), plus the tables

@@ -26,8 +26,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+}  // namespace
+
 // Content hash of the mesh file's bytes, mixed with what else decides the output.
-Status source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out) {
+Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out) {
   std::ifstream f(file, std::ios::binary);
   if (!f) return Status::error(file.string() + ": cannot be opened for reading");
   const std::vector<char> bytes{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
@@ -36,8 +38,6 @@ Status source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64
   out = hash_bytes(settings, sizeof settings, hash_bytes(bytes.data(), bytes.size()));
   return Status::success();
 }
-
-}  // namespace
 
 ParallelFor tbb_parallel_for() {
   return [](size_t count, const std::function<void(size_t)>& body) {
@@ -55,7 +55,7 @@ Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string&
   r.input_triangles = mesh.triangle_count();
   clean_mesh(mesh);
   HlodModel model;
-  if (Status s = source_hash(mesh_file, settings.min_verts, model.tree.source_hash); !s) return s;
+  if (Status s = hlod_source_hash(mesh_file, settings.min_verts, model.tree.source_hash); !s) return s;
   const uint64_t hash = model.tree.source_hash;
   r.load_seconds = seconds_since(t0);
 

@@ -29,6 +29,10 @@ using HlodBakeLog = std::function<void(const std::string&)>;
 // The tbb parallel_for the builder's subtrees run on (inside the caller's arena).
 ParallelFor tbb_parallel_for();
 
+// The content hash of a mesh file's bytes mixed with min_verts (and the build's version):
+// the source_hash of what bake_hlod_file writes, so a cached .hlod with it is current.
+Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out);
+
 // Builds and writes `out_dir/<name>.hlod`; source_hash is the mesh file's content hash mixed
 // with min_verts. On failure the status names the file; nothing is written.
 Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string& name,

@@ -2,7 +2,10 @@
 #include "jobs/hlod_stream.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cassert>
+#include <chrono>
+#include <thread>
 #include <utility>
 
 namespace lod {
@@ -75,7 +78,25 @@ void HlodStream::frame(uint64_t frame, const HlodView& view, std::span<const Hlo
   }
   // One priority order across models (each cut's requests are already in it).
   if (models_.size() > 1) std::sort(wanted_.begin(), wanted_.end(), request_before);
-  update_ = &pager_.update(frame, wanted_, in_use_);
+  update_ = &pager_.update(frame + frame_offset_, wanted_, in_use_);
+}
+
+bool HlodStream::load_roots(double timeout_s) {
+  std::vector<HlodRequest> roots;
+  std::vector<uint32_t> keep;
+  for (const Model& m : models_) {
+    roots.push_back({m.first, FLT_MAX, 0});
+    keep.push_back(m.first);
+  }
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    const StreamUpdate& u = pager_.update(++frame_offset_, roots, keep);
+    if (!u.failures.empty()) return false;
+    const bool all = std::all_of(keep.begin(), keep.end(), [&](uint32_t n) { return pager_.residency()[n] != 0; });
+    if (all) return true;
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
 }
 
 const HlodCut& HlodStream::frame(uint64_t frame_index, const Transform& transform, const HlodView& view,

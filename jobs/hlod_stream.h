@@ -56,6 +56,11 @@ class HlodStream {
   const HlodCut& frame(uint64_t frame, const Transform& transform, const HlodView& view,
                        const HlodSelectParams& params);
 
+  // Set-up, before the first frame (the per-frame calls never wait): loads every model's root
+  // and waits for them, so that no frame starts with a hole. False when a root failed or
+  // `timeout_s` passed; frames then show the hole until the pager loads it.
+  bool load_roots(double timeout_s);
+
   uint32_t model_count() const { return uint32_t(models_.size()); }
   const HlodTree& tree(uint32_t model) const { return models_[model].tree; }
   const HlodCut& cut(uint32_t model) const { return models_[model].cut; }
@@ -87,6 +92,7 @@ class HlodStream {
   std::vector<uint32_t> in_use_;
   StreamUpdate none_;
   const StreamUpdate* update_ = &none_;
+  uint64_t frame_offset_ = 0;  // pager frames load_roots used
 };
 
 }  // namespace lod

@@ -19,6 +19,37 @@ float lerp(float a, float b, double t) { return static_cast<float>(a + (static_c
 
 }  // namespace
 
+std::vector<Placement> place_block(const InstanceConfig& inst) {
+  std::vector<Placement> out(inst.count);
+  std::mt19937_64 rng(inst.seed);
+  // Grid: ceil(sqrt(n)) columns along x, as many rows along z as needed, one object per
+  // cell centre; y at the middle of the box.
+  const uint32_t cols = std::max<uint32_t>(1, static_cast<uint32_t>(std::ceil(std::sqrt(double(inst.count)))));
+  const uint32_t rows = std::max<uint32_t>(1, (inst.count + cols - 1) / cols);
+  for (uint32_t i = 0; i < inst.count; ++i) {
+    Placement& p = out[i];
+    if (inst.grid) {
+      p.position[0] = lerp(inst.box_min[0], inst.box_max[0], (i % cols + 0.5) / cols);
+      p.position[1] = lerp(inst.box_min[1], inst.box_max[1], 0.5);
+      p.position[2] = lerp(inst.box_min[2], inst.box_max[2], (i / cols + 0.5) / rows);
+    } else {
+      for (int a = 0; a < 3; ++a) p.position[a] = lerp(inst.box_min[a], inst.box_max[a], unit(rng));
+    }
+    p.yaw = static_cast<float>(2 * std::numbers::pi * unit(rng));
+    p.scale = lerp(inst.scale_min, inst.scale_max, unit(rng));
+  }
+  return out;
+}
+
+Transform transform_of(const Placement& p) {
+  Transform t;
+  for (int a = 0; a < 3; ++a) t.position[a] = p.position[a];
+  t.rotation[1] = std::sin(0.5f * p.yaw);
+  t.rotation[3] = std::cos(0.5f * p.yaw);
+  t.scale = p.scale;
+  return t;
+}
+
 ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>& chains) {
   size_t total = 0;
   for (const InstanceConfig& inst : config.instances) total += inst.count;
@@ -29,36 +60,20 @@ ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>
   for (const InstanceConfig& inst : config.instances) {
     assert(inst.model < chains.size());
     const Sphere sphere = chain_sphere(chains[inst.model]);
-    std::mt19937_64 rng(inst.seed);
-    // Grid: ceil(sqrt(n)) columns along x, as many rows along z as needed, one object per
-    // cell centre; y at the middle of the box.
-    const uint32_t cols =
-        std::max<uint32_t>(1, static_cast<uint32_t>(std::ceil(std::sqrt(double(inst.count)))));
-    const uint32_t rows = std::max<uint32_t>(1, (inst.count + cols - 1) / cols);
-    for (uint32_t i = 0; i < inst.count; ++i, ++o) {
-      float p[3];
-      if (inst.grid) {
-        p[0] = lerp(inst.box_min[0], inst.box_max[0], (i % cols + 0.5) / cols);
-        p[1] = lerp(inst.box_min[1], inst.box_max[1], 0.5);
-        p[2] = lerp(inst.box_min[2], inst.box_max[2], (i / cols + 0.5) / rows);
-      } else {
-        for (int a = 0; a < 3; ++a) p[a] = lerp(inst.box_min[a], inst.box_max[a], unit(rng));
-      }
-      const float yaw = static_cast<float>(2 * std::numbers::pi * unit(rng));
-      const float scale = lerp(inst.scale_min, inst.scale_max, unit(rng));
-
+    for (const Placement& p : place_block(inst)) {
       objects.model[o] = inst.model;
-      objects.x[o] = p[0];
-      objects.y[o] = p[1];
-      objects.z[o] = p[2];
-      objects.yaw[o] = yaw;
-      objects.scale[o] = scale;
+      objects.x[o] = p.position[0];
+      objects.y[o] = p.position[1];
+      objects.z[o] = p.position[2];
+      objects.yaw[o] = p.yaw;
+      objects.scale[o] = p.scale;
       // The world sphere as every frame computes it (runtime/world_bounds.h).
       const Sphere w = world_sphere(transform_of(objects, o), sphere);
       objects.cx[o] = w.center[0];
       objects.cy[o] = w.center[1];
       objects.cz[o] = w.center[2];
       objects.radius[o] = w.radius;
+      ++o;
     }
   }
   return objects;

@@ -16,6 +16,16 @@ struct Scene {
   ObjectSet objects;
 };
 
+// One object of an [[instances]] block: where it stands, turned about y, scaled.
+struct Placement {
+  float position[3] = {0, 0, 0};
+  float yaw = 0;
+  float scale = 1;
+};
+// The block's objects in order (seeded random in its box, or a grid filling it). Deterministic.
+std::vector<Placement> place_block(const InstanceConfig& inst);
+Transform transform_of(const Placement& p);  // as transform_of(ObjectSet) gives it
+
 // Places every [[instances]] block (seeded random in its box, or a grid filling it) and
 // fills the world bounding spheres from each chain's level-0 sphere. Deterministic.
 ObjectSet place_instances(const SceneConfig& config, const std::vector<LodChain>& chains);

@@ -345,6 +345,27 @@ std::filesystem::path resolve_mesh(const Reader& r, const std::string& key, cons
   r.fail(key, "mesh file \"" + file + "\" not found; tried " + tried);
 }
 
+// hlod = true (drawn through its HLOD tree) and its leaf size.
+void read_hlod_model(const Reader& r, const toml::table& t, const std::string& key, ModelConfig& m) {
+  if (const toml::node* n = t.get("hlod")) {
+    const auto* b = n->as_boolean();
+    if (!b) r.fail(key + ".hlod", "must be true or false");
+    m.hlod = b->get();
+  }
+  r.integer_in(t, "min_verts", key + ".min_verts", 3, 100000000, m.min_verts);
+  if (t.contains("min_verts") && !m.hlod) r.fail(key + ".min_verts", "needs hlod = true");
+  if (m.hlod && m.view_dependent) r.fail(key + ".hlod", "a model is either hlod or view_dependent, not both");
+}
+
+// [stream]: the HLOD pager's byte budget and loader threads.
+void read_stream(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const toml::table* t = r.table(root, "stream", "stream");
+  if (!t) return;
+  r.only_keys(*t, "stream", {"budget_mb", "loader_threads"});
+  r.integer_in(*t, "budget_mb", "stream.budget_mb", 1, 1 << 20, c.stream.budget_mb);
+  r.integer_in(*t, "loader_threads", "stream.loader_threads", 1, 64, c.stream.loader_threads);
+}
+
 void read_models(const Reader& r, const toml::table& root, const std::filesystem::path& config_dir,
                  const std::filesystem::path& data_dir, bool required, SceneConfig& c) {
   const auto models = r.tables(root, "model", "model");
@@ -352,7 +373,9 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
   for (size_t i = 0; i < models.size(); ++i) {
     const toml::table& t = *models[i];
     const std::string key = indexed("model", i);
-    r.only_keys(t, key, {"name", "file", "ratios", "method", "extreme_threshold", "view_dependent", "vd_parts"});
+    r.only_keys(t, key,
+                {"name", "file", "ratios", "method", "extreme_threshold", "view_dependent", "vd_parts", "hlod",
+                 "min_verts"});
     ModelConfig m;
     auto name = r.string(t, "name", key + ".name");
     if (!name) r.fail(key + ".name", "missing");
@@ -403,6 +426,7 @@ void read_models(const Reader& r, const toml::table& root, const std::filesystem
     if (m.view_dependent && !m.bake.ratios.empty() && m.bake.ratios.back() == 0)
       r.fail(key + ".ratios", "a culled level (last ratio 0) needs view_dependent = false");
     if (m.vd_parts > 1 && !m.view_dependent) r.fail(key + ".vd_parts", "needs view_dependent = true");
+    read_hlod_model(r, t, key, m);
     c.models.push_back(std::move(m));
   }
 }
@@ -443,6 +467,8 @@ void read_instances(const Reader& r, const toml::table& root, bool required, Sce
     if (it == c.models.end())
       r.fail(key + ".model", "unknown model \"" + *model + "\" (no [[model]] has that name)");
     inst.model = static_cast<uint32_t>(it - c.models.begin());
+    if (it->hlod && r.integer(t, "count", key + ".count").value_or(0) != 1)
+      r.fail(key + ".count", "model \"" + *model + "\" is hlod = true: its block places exactly one object (count = 1)");
 
     if (!r.integer(t, "count", key + ".count")) r.fail(key + ".count", "missing");
     r.integer_in(t, "count", key + ".count", 1, static_cast<int64_t>(kMaxObjects), inst.count);
@@ -524,12 +550,13 @@ Status parse_scene_config(std::string_view text, const std::filesystem::path& fi
   c.file = file;
   const Reader r(name);
   try {
-    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "model", "instances"});
+    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "stream", "model", "instances"});
     read_run(r, root, c);
     read_budget(r, root, c);
     read_lod(r, root, c);
     read_visibility(r, root, c);
     read_camera(r, root, c);
+    read_stream(r, root, c);
     const std::filesystem::path dir =
         file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
     read_models(r, root, dir, data_dir, !objects_optional, c);

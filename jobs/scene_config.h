@@ -22,6 +22,16 @@ struct ModelConfig {
   // vd_parts = N: the hierarchy is cut into N spatial parts (seams kept at full detail) whose
   // fronts update on separate threads; 1 = one front per object.
   uint32_t vd_parts = 1;
+  // hlod = true: baked to a .hlod (R1's octree of layered nodes) and drawn through its tree,
+  // streamed under [stream]; its [[instances]] block places exactly one object.
+  bool hlod = false;
+  uint32_t min_verts = 1000;    // min_verts: the HLOD build's leaf size (R1 Table I)
+};
+
+// [stream]: the HLOD node pager (jobs/stream_pager.h).
+struct StreamConfig {
+  uint32_t budget_mb = 256;     // budget_mb: resident node payloads, MiB
+  uint32_t loader_threads = 2;  // loader_threads
 };
 
 struct InstanceConfig {
@@ -47,6 +57,7 @@ struct SceneConfig {
   bool occlusion = false;            // [visibility] occlusion
   uint32_t occluders = 48;           // [visibility] occluders
   CameraPath camera;
+  StreamConfig stream;
   std::vector<ModelConfig> models;
   std::vector<InstanceConfig> instances;
 };

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "jobs/bake_jobs.h"
+#include "jobs/hlod_scene.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "jobs/service.h"
@@ -74,12 +75,17 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
   SceneConfig sc;
   if (auto st = load_scene_config(config, data, sc, /*objects_optional=*/true); !st) return failed(st.message);
   const std::filesystem::path cache = cache_dir_for(cache_dir, data);
+  auto hlod = std::make_shared<HlodModels>();
+  if (auto st = bake_hlod_models(sc, cache, nullptr, *hlod); !st) return failed(st.message);
+  sc = discrete_part(sc);  // hlod models are drawn by the hlod node, not as objects
   std::vector<LodChain> chains;
   BakeSummary summary;
   if (auto st = bake_scene_models(sc.models, cache, sc.threads, chains, summary, nullptr); !st)
     return failed(st.message);
   Scene scene = make_scene(sc, std::move(chains));
-  std::unique_ptr<Service> s = make_service(scene, frame_graph_options(sc), sc.rate_hz);
+  FrameGraphOptions options = frame_graph_options(sc);
+  if (!hlod->empty()) options.hlod = hlod;
+  std::unique_ptr<Service> s = make_service(scene, options, sc.rate_hz);
   Impl& m = s->impl();
   m.options.cache_dir = cache;
   m.options.baker = mesh_baker();

@@ -12,10 +12,10 @@ namespace lod {
 
 // The frame graph's nodes (FrameGraph::dot() shows their edges); Frame::stage_ms per node.
 enum class Stage : uint8_t {
-  commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, publish, count
+  commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, hlod, publish, count
 };
-inline constexpr const char* kStageNames[] = {"commit",    "bounds",  "view",     "visibility", "importance", "selection",
-                                              "entries",   "geomorph", "vdlod",   "vd_mesh",    "publish"};
+inline constexpr const char* kStageNames[] = {"commit",   "bounds",   "view",  "visibility", "importance", "selection",
+                                              "entries",  "geomorph", "vdlod", "vd_mesh",    "hlod",       "publish"};
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::count);
 inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 
@@ -34,6 +34,19 @@ struct VdObjectFrame {
   float threshold = 0;        // pixel threshold after this frame's feedback
   bool closed = false;        // the object's full mesh is closed (every edge in two faces)
   bool oriented = false;      // ... consistently oriented (each directed edge once)
+};
+
+// One node of an HLOD model's cut (models with hlod = true, numbered in config order among
+// them): draw layer `layer` of node `node` (HlodTree order), placed by the model's transform.
+struct HlodDrawFrame {
+  uint32_t model = 0;
+  uint32_t node = 0;
+  uint8_t layer = 0;  // 0 = the node's finest
+};
+// A node of the cut replaced by its children: draw its boundary patch.
+struct HlodOpenedFrame {
+  uint32_t model = 0;
+  uint32_t node = 0;
 };
 
 struct Frame {
@@ -102,6 +115,19 @@ struct Frame {
   uint64_t vd_active_tris = 0;
   uint64_t vd_splits = 0;
   uint64_t vd_collapses = 0;
+
+  // HLOD models (streamed; view 0's cut): what is drawn, what the pager holds and has done.
+  std::vector<HlodDrawFrame> hlod_drawn;      // per model, breadth-first
+  std::vector<HlodOpenedFrame> hlod_opened;   // their boundary patches are drawn too
+  uint32_t hlod_nodes_drawn = 0;              // hlod_drawn.size()
+  uint64_t hlod_tris = 0;                     // drawn layers + opened patches (in tris_selected)
+  uint64_t resident_bytes = 0;                // node payloads resident, against the stream budget
+  uint64_t stream_budget = 0;                 // [stream] budget_mb in bytes (0: no HLOD models)
+  uint64_t stream_requests = 0;               // loads issued so far
+  uint64_t stream_loads = 0;                  // loads completed so far
+  uint64_t stream_evictions = 0;              // nodes evicted so far (least recently used)
+  uint64_t stream_failures = 0;               // node reads failed so far (each node once; parent stays drawn)
+  uint32_t holes = 0;                         // wanted, not drawable, no drawn ancestor: must be 0
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds
   double total_ms = 0;

@@ -605,5 +605,54 @@ TEST(SceneConfigBudgetModes, ParsesAndRefusesSelector) {
   expect_refused("[budget]\nselector = \"optimal\"\n" + kModel + kInstances, "budget.selector", "greedy_multi");
 }
 
+
+// HLOD models and the stream pager ([stream], hlod = true, min_verts).
+const std::string kHlodModel = "[[model]]\nname = \"ball\"\nfile = \"ball.off\"\nhlod = true\n";
+const std::string kOneInstance = "[[instances]]\nmodel = \"ball\"\ncount = 1\n";
+
+TEST(SceneConfig, ParsesHlodModelAndStream) {
+  ConfigDir d;
+  SceneConfig c;
+  const Status s = load(d, "[stream]\nbudget_mb = 3\nloader_threads = 4\n" + kHlodModel + "min_verts = 500\n" + kOneInstance, c);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(c.models.size(), 1u);
+  EXPECT_TRUE(c.models[0].hlod);
+  EXPECT_EQ(c.models[0].min_verts, 500u);
+  EXPECT_EQ(c.stream.budget_mb, 3u);
+  EXPECT_EQ(c.stream.loader_threads, 4u);
+}
+TEST(SceneConfig, HlodAndStreamDefaults) {
+  ConfigDir d;
+  SceneConfig c;
+  ASSERT_TRUE(load(d, kHlodModel + kOneInstance, c).ok);
+  EXPECT_EQ(c.models[0].min_verts, 1000u);
+  EXPECT_EQ(c.stream.budget_mb, 256u);
+  EXPECT_EQ(c.stream.loader_threads, 2u);
+  SceneConfig plain;
+  ASSERT_TRUE(load(d, kModel + kInstances, plain).ok);
+  EXPECT_FALSE(plain.models[0].hlod);
+}
+TEST(SceneConfig, RefusesHlodThatIsNotABoolean) {
+  expect_refused(kModel + "hlod = 1\n" + kOneInstance, "model[0].hlod", "true or false");
+}
+TEST(SceneConfig, RefusesMinVertsWithoutHlod) { expect_refused(kModel + "min_verts = 500\n" + kInstances, "model[0].min_verts", "hlod"); }
+TEST(SceneConfig, RefusesTinyMinVerts) { expect_refused(kHlodModel + "min_verts = 0\n" + kOneInstance, "model[0].min_verts"); }
+TEST(SceneConfig, RefusesHlodViewDependentModel) {
+  expect_refused(kHlodModel + "view_dependent = true\n" + kOneInstance, "model[0].hlod");
+}
+TEST(SceneConfig, RefusesHlodInstancesOfMoreThanOne) {
+  expect_refused(kHlodModel + kInstances, "instances[0].count", "count = 1");
+}
+TEST(SceneConfig, RefusesZeroStreamBudget) { expect_refused("[stream]\nbudget_mb = 0\n" + kModel + kInstances, "stream.budget_mb"); }
+TEST(SceneConfig, RefusesNegativeStreamBudget) {
+  expect_refused("[stream]\nbudget_mb = -5\n" + kModel + kInstances, "stream.budget_mb");
+}
+TEST(SceneConfig, RefusesZeroLoaderThreads) {
+  expect_refused("[stream]\nloader_threads = 0\n" + kModel + kInstances, "stream.loader_threads");
+}
+TEST(SceneConfig, RefusesUnknownStreamKey) {
+  expect_refused("[stream]\nbudget = 5\n" + kModel + kInstances, "stream.budget", "unknown key");
+}
+
 }  // namespace
 }  // namespace lod
