@@ -166,8 +166,9 @@ Status read_height_field_text(const std::filesystem::path& path, HeightField& ou
                               const HeightFieldTextOptions& options) {
   const std::string name = path.string();
   if (path.extension() == ".gz")
-    return Status::error(name + ": gzip'd text is not read; decompress it first (gzip -dc, or "
-                                "scripts/fetch-topography.sh, which writes topography.txt)");
+    return Status::error(name +
+                         ": gzip'd text is not read; decompress it first (gzip -dc, or "
+                         "scripts/fetch-topography.sh, which writes topography.txt)");
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::error(name + ": cannot open");
   std::ostringstream text;

@@ -37,7 +37,7 @@ struct HeightFieldTextOptions {
   GridCoordinates coordinates = GridCoordinates::metres;
   float vertical_scale = 1;
   double no_data_value = std::numeric_limits<double>::quiet_NaN();  // NaN: none
-  size_t max_samples = size_t(1) << 28;  // 1 GiB of floats
+  size_t max_samples = size_t(1) << 28;                             // 1 GiB of floats
 };
 
 // `name` labels messages (the file name). On error `out` is unchanged.

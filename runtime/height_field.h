@@ -10,11 +10,11 @@
 namespace lod {
 
 struct HeightField {
-  uint32_t width = 0;   // samples along x
-  uint32_t height = 0;  // samples along y
+  uint32_t width = 0;     // samples along x
+  uint32_t height = 0;    // samples along y
   float cell_size_x = 1;  // metres between samples along x
   float cell_size_y = 1;
-  float vertical_scale = 1;  // world height = heights[i] * vertical_scale
+  float vertical_scale = 1;    // world height = heights[i] * vertical_scale
   std::vector<float> heights;  // width * height, all finite
 
   size_t sample_count() const { return size_t(width) * height; }

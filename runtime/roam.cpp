@@ -32,8 +32,10 @@ DiamondShape diamond_shape(int32_t x, int32_t y) {
     int np = 0, na = 0;
     for (const Cell& c : corners) {
       const bool one_odd = (((c.x / (2 * t)) & 1) ^ ((c.y / (2 * t)) & 1)) != 0;
-      if (one_odd) s.a[na++] = c;
-      else (np++ == 0 ? s.p : s.q) = c;
+      if (one_odd)
+        s.a[na++] = c;
+      else
+        (np++ == 0 ? s.p : s.q) = c;
     }
     assert(np == 2 && na == 2);
   } else if (x_odd) {
@@ -242,8 +244,8 @@ void run_count_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, B
                       RoamFrameStats& st) {
   const uint32_t target = std::max<uint32_t>(P.triangle_count, 2);
   // Grow while short of the target (visible diamonds only), then trim to it.
-  while (S.triangle_count < target && !S.split_queue.heap.empty() &&
-         top_priority(S, S.split_queue) > 0 && b.take())
+  while (S.triangle_count < target && !S.split_queue.heap.empty() && top_priority(S, S.split_queue) > 0 &&
+         b.take())
     roam_split(S, T, S.split_queue.heap.front());
   merge_down_to(S, T, target, -1);
   // Then trade: split the worst leaf while it is worse than the best merge, Duchaineau's loop.
@@ -260,8 +262,7 @@ void run_count_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, B
   merge_down_to(S, T, target, -1);
 }
 
-void emit(std::vector<uint32_t>& out, const RoamState& S, const RoamTerrain& T, Cell apex,
-          Cell l, Cell r) {
+void emit(std::vector<uint32_t>& out, const RoamState& S, const RoamTerrain& T, Cell apex, Cell l, Cell r) {
   const int32_t size = int32_t(T.size);
   const bool divisible = ((l.x + r.x) % 2 == 0) && ((l.y + r.y) % 2 == 0);
   const Cell m{(l.x + r.x) / 2, (l.y + r.y) / 2};
@@ -292,9 +293,8 @@ RoamTerrain build_roam_terrain(const HeightField& field) {
   T.positions.resize(n);
   for (uint32_t y = 0; y < T.size; ++y)
     for (uint32_t x = 0; x < T.size; ++x)
-      T.positions[size_t(y) * T.size + x] = {float(x) * field.cell_size_x,
-                                             field.at(x, y) * field.vertical_scale,
-                                             float(y) * field.cell_size_y};
+      T.positions[size_t(y) * T.size + x] = {
+          float(x) * field.cell_size_x, field.at(x, y) * field.vertical_scale, float(y) * field.cell_size_y};
   T.error.assign(n, 0.f);
   T.radius.assign(n, 0.f);
   T.parents.resize(n);
@@ -363,8 +363,7 @@ void roam_merge(RoamState& S, const RoamTerrain& T, int32_t d) {
     if (p >= 0 && !detail::any_child_split(S, T, p)) detail::enqueue(S.merge_queue, S, T, p);
 }
 
-RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view,
-                           const RoamParams& P) {
+RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view, const RoamParams& P) {
   RoamFrameStats st;
   const uint32_t splits0 = S.splits, merges0 = S.merges;
   roam_set_view(S, view);
@@ -372,8 +371,10 @@ RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view,
   detail::rekey(S, T, S.split_queue);
   detail::rekey(S, T, S.merge_queue);
   detail::Budget budget{P.max_operations};
-  if (P.target == RoamTarget::pixel_error) detail::run_pixel_target(S, T, P, budget, st);
-  else detail::run_count_target(S, T, P, budget, st);
+  if (P.target == RoamTarget::pixel_error)
+    detail::run_pixel_target(S, T, P, budget, st);
+  else
+    detail::run_count_target(S, T, P, budget, st);
   st.splits = S.splits - splits0;
   st.merges = S.merges - merges0;
   st.triangles = S.triangle_count;

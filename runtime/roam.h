@@ -31,9 +31,8 @@
 #pragma once
 #include <array>
 #include <cstdint>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "runtime/height_field.h"
 #include "runtime/view.h"
@@ -42,8 +41,8 @@ namespace lod {
 
 // The immutable part, built once from the height field and shared by every state.
 struct RoamTerrain {
-  uint32_t levels = 0;  // n
-  uint32_t size = 0;    // samples per side, 2^n + 1; diamond id = sample index y * size + x
+  uint32_t levels = 0;               // n
+  uint32_t size = 0;                 // samples per side, 2^n + 1; diamond id = sample index y * size + x
   std::vector<glm::vec3> positions;  // world position of every sample (x, height, y)
   std::vector<float> error;          // nested wedgie thickness per diamond, world units
   std::vector<float> radius;         // nested bounding-sphere radius around positions[d]
@@ -60,8 +59,8 @@ enum class RoamTarget : uint8_t {
 
 struct RoamParams {
   RoamTarget target = RoamTarget::pixel_error;
-  float pixel_error = 1.f;           // tau, pixels
-  uint32_t triangle_count = 20000;   // the target in triangle_count mode
+  float pixel_error = 1.f;              // tau, pixels
+  uint32_t triangle_count = 20000;      // the target in triangle_count mode
   uint32_t max_triangles = UINT32_MAX;  // pixel_error mode: splits stop at this many triangles
   uint32_t max_operations = 1u << 22;   // splits + merges per frame (a time limit, in work)
 };
@@ -75,7 +74,7 @@ struct RoamQueue {
 };
 
 struct RoamFrameStats {
-  uint32_t splits = 0;   // including forced splits
+  uint32_t splits = 0;  // including forced splits
   uint32_t merges = 0;
   uint32_t rekeyed = 0;  // front diamonds whose priority was recomputed
   uint32_t triangles = 0;
@@ -83,10 +82,10 @@ struct RoamFrameStats {
 };
 
 struct RoamState {
-  std::vector<uint8_t> split;     // per diamond
-  std::vector<float> priority;    // per diamond in either queue: projected error, pixels
-  RoamQueue split_queue;          // sign +1
-  RoamQueue merge_queue;          // sign -1
+  std::vector<uint8_t> split;   // per diamond
+  std::vector<float> priority;  // per diamond in either queue: projected error, pixels
+  RoamQueue split_queue;        // sign +1
+  RoamQueue merge_queue;        // sign -1
   uint32_t triangle_count = 2;
   uint32_t splits = 0, merges = 0;  // running totals
   // The view the priorities were computed for (roam_set_view).
@@ -120,8 +119,7 @@ RoamFrameStats roam_update(RoamState& state, const RoamTerrain& terrain, const V
 // The mesh: 3 sample indices per triangle, (apex, base end, base end), counter-clockwise in
 // grid (x, y) coordinates; the diamond split next in a triangle is centred at the midpoint of
 // its base ends. Appends to `indices` after clearing it; returns the triangle count.
-size_t roam_triangles(std::vector<uint32_t>& indices, const RoamState& state,
-                      const RoamTerrain& terrain);
+size_t roam_triangles(std::vector<uint32_t>& indices, const RoamState& state, const RoamTerrain& terrain);
 // The diamond a mesh triangle belongs to (centred at the midpoint of its base, indices 1 and
 // 2), or -1 for a finest-level triangle, which cannot be split.
 int32_t roam_diamond_of(const RoamTerrain& terrain, uint32_t base_a, uint32_t base_b);

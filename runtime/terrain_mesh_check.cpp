@@ -29,8 +29,7 @@ std::string edge_name(uint64_t a, uint64_t b, uint32_t size) {
 
 // Doubled signed areas in grid units, summed exactly in 64-bit integers.
 int64_t doubled_area(uint32_t a, uint32_t b, uint32_t c, uint32_t size) {
-  const int64_t ax = a % size, ay = a / size, bx = b % size, by = b / size, cx = c % size,
-                cy = c / size;
+  const int64_t ax = a % size, ay = a / size, bx = b % size, by = b / size, cx = c % size, cy = c / size;
   return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
 }
 

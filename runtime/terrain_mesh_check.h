@@ -10,15 +10,14 @@ namespace lod {
 
 struct TerrainMeshCheck {
   size_t triangles = 0;
-  size_t open_edges = 0;       // interior edges used once: a crack or a T-junction
-  size_t overshared_edges = 0; // edges used by more than two triangles, or twice the same way
-  size_t flipped = 0;          // triangles not counter-clockwise in grid (x, y), or degenerate
-  size_t bad_indices = 0;      // indices outside the grid
-  bool covers_grid = false;    // the triangles' areas add up to exactly the grid's
-  std::string first_problem;   // empty when ok(); names the edge or triangle
+  size_t open_edges = 0;        // interior edges used once: a crack or a T-junction
+  size_t overshared_edges = 0;  // edges used by more than two triangles, or twice the same way
+  size_t flipped = 0;           // triangles not counter-clockwise in grid (x, y), or degenerate
+  size_t bad_indices = 0;       // indices outside the grid
+  bool covers_grid = false;     // the triangles' areas add up to exactly the grid's
+  std::string first_problem;    // empty when ok(); names the edge or triangle
   bool ok() const {
-    return open_edges == 0 && overshared_edges == 0 && flipped == 0 && bad_indices == 0 &&
-           covers_grid;
+    return open_edges == 0 && overshared_edges == 0 && flipped == 0 && bad_indices == 0 && covers_grid;
   }
 };
 

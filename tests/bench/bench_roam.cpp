@@ -37,7 +37,7 @@ HeightField generated_field(uint32_t size) {
   for (uint32_t y = 0; y < size; ++y)
     for (uint32_t x = 0; x < size; ++x)
       f.heights[size_t(y) * size + x] = 400.f * std::sin(0.013f * float(x)) * std::cos(0.009f * float(y)) +
-                                         120.f * std::sin(0.05f * float(x + 2 * y)) + noise(rng);
+                                        120.f * std::sin(0.05f * float(x + 2 * y)) + noise(rng);
   return f;
 }
 
@@ -53,7 +53,8 @@ const RoamTerrain& terrain() {
     std::fprintf(stderr, "roam bench terrain: %s, %u x %u -> 1025 x 1025\n",
                  have ? real.c_str() : "generated", f.width, f.height);
     const auto t0 = std::chrono::steady_clock::now();
-    RoamTerrain built = build_roam_terrain(f.width == 1025 && f.height == 1025 ? f : resample_square(f, 1025));
+    RoamTerrain built =
+        build_roam_terrain(f.width == 1025 && f.height == 1025 ? f : resample_square(f, 1025));
     std::fprintf(stderr, "roam terrain build: %.1f ms\n",
                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     return built;

@@ -140,9 +140,9 @@ TEST(HeightFieldText, ConvertsDegreesToMetresAboutTheMidLatitude) {
       text += std::to_string(59.9 + 0.1 * i) + " " + std::to_string(10.0 + 0.1 * j) + " 5\n";
   const Status st = parse(text, f, o);
   ASSERT_TRUE(st.ok) << st.message;
-  EXPECT_EQ(f.width, 4u);   // longitude
-  EXPECT_EQ(f.height, 3u);  // latitude
-  EXPECT_NEAR(f.cell_size_y, 11119.5f, 1.f);       // 0.1 degree of latitude
+  EXPECT_EQ(f.width, 4u);                            // longitude
+  EXPECT_EQ(f.height, 3u);                           // latitude
+  EXPECT_NEAR(f.cell_size_y, 11119.5f, 1.f);         // 0.1 degree of latitude
   EXPECT_NEAR(f.cell_size_x, 11119.5f * 0.5f, 1.f);  // times cos 60
 }
 

@@ -88,7 +88,8 @@ TEST(Roam, WedgiesAreNestedAndBoundTheTrueError) {
   RoamState s;
   roam_reset(s, t);
   std::mt19937 rng(5);
-  for (int i = 0; i < 200; ++i) roam_split(s, t, int32_t(rng() % (t.positions.size() - 1)) | 1);  // odd: never a corner
+  for (int i = 0; i < 200; ++i)
+    roam_split(s, t, int32_t(rng() % (t.positions.size() - 1)) | 1);  // odd: never a corner
   const auto idx = mesh_of(s, t);
   for (size_t i = 0; i < idx.size(); i += 3) {
     const glm::vec3 a = t.positions[idx[i]], b = t.positions[idx[i + 1]], c = t.positions[idx[i + 2]];
