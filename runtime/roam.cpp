@@ -217,8 +217,13 @@ float top_priority(const RoamState& S, const RoamQueue& q) { return S.priority[q
 void run_pixel_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, Budget& b,
                       RoamFrameStats& st) {
   // Merge first: what merges here has projected error <= tau and will not split again.
-  while (!S.merge_queue.heap.empty() && top_priority(S, S.merge_queue) <= P.pixel_error && b.take())
+  while (!S.merge_queue.heap.empty() && top_priority(S, S.merge_queue) <= P.pixel_error) {
+    if (!b.take()) {
+      st.budget_bound = 1;
+      return;
+    }
     roam_merge(S, T, S.merge_queue.heap.front());
+  }
   while (!S.split_queue.heap.empty() && top_priority(S, S.split_queue) > P.pixel_error) {
     if (S.triangle_count >= P.max_triangles || !b.take()) {
       st.budget_bound = 1;

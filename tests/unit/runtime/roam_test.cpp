@@ -123,6 +123,61 @@ TEST(Roam, ForcedSplitsKeepTheMeshCrackFree) {
   }
 }
 
+TEST(Roam, SplittingEveryDiamondGivesTheFullGrid) {
+  for (uint32_t levels : {1u, 2u, 4u}) {
+    const RoamTerrain t = build_roam_terrain(make_field(levels, Relief::random));
+    RoamState s;
+    roam_reset(s, t);
+    for (size_t d = 0; d < t.positions.size(); ++d)
+      if (t.triangles[d] > 0) roam_split(s, t, int32_t(d));
+    const auto idx = mesh_of(s, t);
+    const uint32_t cells = (t.size - 1) * (t.size - 1);
+    EXPECT_EQ(idx.size() / 3, 2u * cells);
+    EXPECT_EQ(s.triangle_count, 2u * cells);
+    EXPECT_TRUE(check_terrain_mesh(idx, t.size).ok());
+    EXPECT_TRUE(s.split_queue.heap.empty());  // nothing left to split
+  }
+}
+
+TEST(Roam, UpdatesNeverReallocateTheirState) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, Relief::random));
+  RoamState s;
+  roam_reset(s, t);
+  const void* heaps[2] = {s.split_queue.heap.data(), s.merge_queue.heap.data()};
+  const void* columns[2] = {s.split.data(), s.priority.data()};
+  RoamParams p;
+  p.pixel_error = 0.5f;
+  for (int frame = 0; frame < 30; ++frame) roam_update(s, t, flying_view(t, 4 * frame), p);
+  EXPECT_EQ(heaps[0], s.split_queue.heap.data());
+  EXPECT_EQ(heaps[1], s.merge_queue.heap.data());
+  EXPECT_EQ(columns[0], s.split.data());
+  EXPECT_EQ(columns[1], s.priority.data());
+}
+
+TEST(Roam, OperationBudgetBoundsAFrameAndLaterFramesCatchUp) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, Relief::sines));
+  const View v = flying_view(t, 5);
+  RoamParams p;
+  p.pixel_error = 1.f;
+  RoamState full;
+  roam_reset(full, t);
+  roam_update(full, t, v, p);
+  p.max_operations = 40;
+  RoamState s;
+  roam_reset(s, t);
+  RoamFrameStats st = roam_update(s, t, v, p);
+  EXPECT_EQ(st.budget_bound, 1);
+  EXPECT_LT(st.triangles, full.triangle_count);
+  int frames = 1;
+  for (; st.budget_bound && frames < 1000; ++frames) {
+    st = roam_update(s, t, v, p);
+    ASSERT_TRUE(check_terrain_mesh(mesh_of(s, t), t.size).ok());
+  }
+  EXPECT_EQ(st.budget_bound, 0);
+  EXPECT_GT(frames, 2);
+  EXPECT_EQ(s.split, full.split);  // the same mesh, spread over several frames
+}
+
 class RoamFlight : public ::testing::TestWithParam<Relief> {};
 
 TEST_P(RoamFlight, EveryFrameIsCrackFreeAndMeetsThePixelError) {
