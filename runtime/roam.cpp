@@ -267,18 +267,39 @@ void run_count_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, B
   merge_down_to(S, T, target, -1);
 }
 
-void emit(std::vector<uint32_t>& out, const RoamState& S, const RoamTerrain& T, Cell apex, Cell l, Cell r) {
+bool sphere_outside(const Frustum& f, glm::vec3 c, float r) {
+  for (const glm::vec4& pl : f.planes)
+    if (glm::dot(glm::vec3(pl), c) + pl.w < -r) return true;
+  return false;
+}
+
+enum class Cull : uint8_t { none, frustum };
+
+// Walks a bintree triangle down to the mesh's leaves. With Cull::frustum a subtree whose diamond
+// sphere (which holds the triangle and every descendant) is outside the view is skipped whole.
+void emit(std::vector<uint32_t>& out, const RoamState& S, const RoamTerrain& T, Cell apex, Cell l, Cell r,
+          Cull cull) {
   const int32_t size = int32_t(T.size);
   const bool divisible = ((l.x + r.x) % 2 == 0) && ((l.y + r.y) % 2 == 0);
   const Cell m{(l.x + r.x) / 2, (l.y + r.y) / 2};
-  if (divisible && S.split[m.y * size + m.x]) {
-    emit(out, S, T, m, apex, l);
-    emit(out, S, T, m, r, apex);
+  const int32_t d = m.y * size + m.x;
+  if (divisible && cull == Cull::frustum && sphere_outside(S.frustum, T.positions[d], T.radius[d])) return;
+  if (divisible && S.split[d]) {
+    emit(out, S, T, m, apex, l, cull);
+    emit(out, S, T, m, r, apex, cull);
     return;
   }
   out.push_back(uint32_t(apex.y * size + apex.x));
   out.push_back(uint32_t(l.y * size + l.x));
   out.push_back(uint32_t(r.y * size + r.x));
+}
+
+size_t emit_mesh(std::vector<uint32_t>& indices, const RoamState& S, const RoamTerrain& T, Cull cull) {
+  indices.clear();
+  const int32_t m = int32_t(T.size - 1);
+  emit(indices, S, T, {m, 0}, {m, m}, {0, 0}, cull);
+  emit(indices, S, T, {0, m}, {0, 0}, {m, m}, cull);
+  return indices.size() / 3;
 }
 
 }  // namespace detail
@@ -333,8 +354,7 @@ void roam_set_view(RoamState& S, const View& view) {
 float roam_projected_error(const RoamState& S, const RoamTerrain& T, int32_t d) {
   const glm::vec3 c = T.positions[d];
   const float r = T.radius[d];
-  for (const glm::vec4& pl : S.frustum.planes)
-    if (glm::dot(glm::vec3(pl), c) + pl.w < -r) return 0.f;
+  if (detail::sphere_outside(S.frustum, c, r)) return 0.f;
   const float dist = std::max(glm::length(S.eye - c) - r, S.near_plane);
   return T.error[d] * S.focal / dist;
 }
@@ -387,11 +407,11 @@ RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view,
 }
 
 size_t roam_triangles(std::vector<uint32_t>& indices, const RoamState& S, const RoamTerrain& T) {
-  indices.clear();
-  const int32_t m = int32_t(T.size - 1);
-  detail::emit(indices, S, T, {m, 0}, {m, m}, {0, 0});
-  detail::emit(indices, S, T, {0, m}, {0, 0}, {m, m});
-  return indices.size() / 3;
+  return detail::emit_mesh(indices, S, T, detail::Cull::none);
+}
+
+size_t roam_visible_triangles(std::vector<uint32_t>& indices, const RoamState& S, const RoamTerrain& T) {
+  return detail::emit_mesh(indices, S, T, detail::Cull::frustum);
 }
 
 int32_t roam_diamond_of(const RoamTerrain& T, uint32_t a, uint32_t b) {

@@ -120,6 +120,10 @@ RoamFrameStats roam_update(RoamState& state, const RoamTerrain& terrain, const V
 // grid (x, y) coordinates; the diamond split next in a triangle is centred at the midpoint of
 // its base ends. Appends to `indices` after clearing it; returns the triangle count.
 size_t roam_triangles(std::vector<uint32_t>& indices, const RoamState& state, const RoamTerrain& terrain);
+// The same mesh without the subtrees whose bounding sphere is outside the state's frustum (the
+// draw list; the culled triangles are coarse already since culled diamonds have priority 0).
+size_t roam_visible_triangles(std::vector<uint32_t>& indices, const RoamState& state,
+                              const RoamTerrain& terrain);
 // The diamond a mesh triangle belongs to (centred at the midpoint of its base, indices 1 and
 // 2), or -1 for a finest-level triangle, which cannot be split.
 int32_t roam_diamond_of(const RoamTerrain& terrain, uint32_t base_a, uint32_t base_b);

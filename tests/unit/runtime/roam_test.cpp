@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -310,6 +312,40 @@ TEST(Roam, CulledSubtreesStayCoarse) {
   EXPECT_EQ(roam_update(s, t, up, p).triangles, 2u);
   EXPECT_GT(roam_update(s, t, flying_view(t, 0), p).triangles, 100u);
   EXPECT_EQ(roam_update(s, t, up, p).triangles, 2u);  // and merges back
+}
+
+// Triangles left out of the draw list lie wholly outside one frustum plane; the rest are the mesh's.
+TEST(Roam, VisibleTrianglesDropOnlyWhatIsOutsideTheFrustum) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, Relief::sines));
+  RoamState s;
+  roam_reset(s, t);
+  RoamParams p;
+  p.pixel_error = 1.f;
+  const View v = flying_view(t, 20);
+  roam_update(s, t, v, p);
+  std::vector<uint32_t> all, visible;
+  roam_triangles(all, s, t);
+  roam_visible_triangles(visible, s, t);
+  ASSERT_LT(visible.size(), all.size());
+  ASSERT_GT(visible.size(), 0u);
+  auto key = [](const uint32_t* v3) { return std::array<uint32_t, 3>{v3[0], v3[1], v3[2]}; };
+  std::vector<std::array<uint32_t, 3>> shown;
+  for (size_t i = 0; i < visible.size(); i += 3) shown.push_back(key(&visible[i]));
+  std::sort(shown.begin(), shown.end());
+  const Frustum f = frustum_of(v);
+  size_t dropped = 0;
+  for (size_t i = 0; i < all.size(); i += 3) {
+    if (std::binary_search(shown.begin(), shown.end(), key(&all[i]))) continue;
+    ++dropped;
+    bool outside_one = false;
+    for (const glm::vec4& pl : f.planes) {
+      bool all_out = true;
+      for (int k = 0; k < 3; ++k) all_out &= glm::dot(glm::vec3(pl), t.positions[all[i + k]]) + pl.w < 0;
+      outside_one |= all_out;
+    }
+    EXPECT_TRUE(outside_one) << "triangle " << i / 3 << " dropped but not outside the frustum";
+  }
+  EXPECT_EQ(dropped * 3, all.size() - visible.size());
 }
 
 TEST(TerrainMeshCheck, FindsTJunctionsHolesAndOverlaps) {
