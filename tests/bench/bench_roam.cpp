@@ -9,6 +9,7 @@
 //                     ratio = rebuild / update (frame-to-frame coherence), triangles,
 //                     changes (splits + merges) per frame, rekeyed front diamonds per frame
 //   BM_RoamFlight/1   the same at a triangle-count target (50,000)
+//   BM_RoamFlight/2   the same at 0.1 pixel (a finer mesh at a pixel-error target)
 //   BM_RoamReset      the part of a rebuild that clears the per-sample state (O(grid))
 #include <benchmark/benchmark.h>
 
@@ -89,7 +90,7 @@ double median(std::vector<double> v) {
 
 RoamParams params_for(int64_t mode) {
   RoamParams p;
-  p.pixel_error = 1.f;
+  p.pixel_error = mode == 2 ? 0.1f : 1.f;
   if (mode == 1) p.target = RoamTarget::triangle_count, p.triangle_count = 50000;
   return p;
 }
@@ -133,7 +134,7 @@ void BM_RoamFlight(benchmark::State& state) {
   state.counters["changes_per_frame"] = changes / n;
   state.counters["rekeyed_per_frame"] = rekeyed / n;
 }
-BENCHMARK(BM_RoamFlight)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(400);
+BENCHMARK(BM_RoamFlight)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(400);
 
 void BM_RoamReset(benchmark::State& state) {
   const RoamTerrain& t = terrain();
