@@ -140,6 +140,11 @@ Status parse_height_field_text(std::string_view text, const std::string& name, H
   detail::Samples s;
   if (Status st = detail::parse_samples(text, name, s); !st) return st;
   if (o.coordinates == GridCoordinates::degrees_lat_lon) s.x.swap(s.y);
+  if (o.coordinates != GridCoordinates::metres)
+    for (size_t k = 0; k < s.y.size(); ++k)
+      if (std::abs(s.y[k]) > 90.0)
+        return Status::error(detail::at_line(name, s.line[k]) +
+                             "latitude outside [-90, 90] degrees (check the column order)");
   detail::Axis ax, ay;
   if (Status st = detail::detect_axis(s.x, "x", name, ax); !st) return st;
   if (Status st = detail::detect_axis(s.y, "y", name, ay); !st) return st;

@@ -146,6 +146,16 @@ TEST(HeightFieldText, ConvertsDegreesToMetresAboutTheMidLatitude) {
   EXPECT_NEAR(f.cell_size_x, 11119.5f * 0.5f, 1.f);  // times cos 60
 }
 
+TEST(HeightFieldText, RefusesLatitudesBeyondThePoles) {
+  HeightFieldTextOptions o;
+  o.coordinates = GridCoordinates::degrees_lon_lat;
+  HeightField f;
+  const Status st = parse("0 89 1\n1 89 1\n0 91 1\n1 91 1\n", f, o);
+  ASSERT_FALSE(st.ok);
+  EXPECT_NE(st.message.find("line 3: latitude outside"), std::string::npos) << st.message;
+  EXPECT_TRUE(parse("0 88 1\n1 88 1\n0 89 1\n1 89 1\n", f, o).ok);
+}
+
 TEST(HeightFieldText, RefusesGzipWithAHint) {
   HeightField f;
   const Status st = read_height_field_text("nowhere/topography.txt.gz", f);
