@@ -194,15 +194,95 @@ bool any_child_split(const RoamState& S, const RoamTerrain& T, int32_t d) {
   return false;
 }
 
+void queue_rekey(RoamQueue& q, const std::vector<float>& keys, int32_t d) {
+  sift_up(q, keys, size_t(q.slot[d]));
+  sift_down(q, keys, size_t(q.slot[d]));
+}
+
+// How far the eye may move (without turning) before d's decision against tau can change: the
+// distance to its sphere and each plane's margin change by at most the eye's travel. A rounding
+// allowance keeps the bound safe for recomputed frustum normals.
+float slack_of(const RoamState& S, const RoamTerrain& T, int32_t d) {
+  if (T.error[d] * S.focal <= 0) return 3e38f;  // never above tau
+  const glm::vec3 c = T.positions[d];
+  const float r = T.radius[d];
+  float plane_margin = 3e38f;
+  bool culled = false;
+  for (const glm::vec4& pl : S.frustum.planes) {
+    const float m = glm::dot(glm::vec3(pl), c) + pl.w + r;
+    plane_margin = std::min(plane_margin, std::abs(m));
+    culled |= m < 0;
+  }
+  const float dist = glm::length(S.eye - c);
+  float slack = plane_margin;
+  if (!culled) {
+    const float gap = std::max(dist - r, S.near_plane) - T.error[d] * S.focal / S.tau;
+    slack = std::min(slack, std::abs(gap));
+  }
+  return slack - 1e-4f * (1 + dist + r);
+}
+
+void track(RoamState& S, const RoamTerrain& T, int32_t d) {
+  S.deadline[d] = S.travel + std::max(slack_of(S, T, d), 0.f);
+  if (S.deadline_queue.slot[d] >= 0)
+    queue_rekey(S.deadline_queue, S.deadline, d);
+  else
+    queue_insert(S.deadline_queue, S.deadline, d);
+}
+
 void enqueue(RoamQueue& q, RoamState& S, const RoamTerrain& T, int32_t d) {
   if (q.slot[d] >= 0) return;
   S.priority[d] = roam_projected_error(S, T, d);
   queue_insert(q, S.priority, d);
+  if (S.defer) track(S, T, d);
+}
+
+void dequeue(RoamQueue& q, RoamState& S, int32_t d) {
+  if (q.slot[d] < 0) return;
+  queue_remove(q, S.priority, d);
+  if (S.defer) queue_remove(S.deadline_queue, S.deadline, d);
 }
 
 void rekey(RoamState& S, const RoamTerrain& T, RoamQueue& q) {
   for (int32_t d : q.heap) S.priority[d] = roam_projected_error(S, T, d);
   heapify(q, S.priority);
+}
+
+// Whole-front re-key; with deferral on, every front diamond gets a fresh deadline.
+uint32_t rekey_all(RoamState& S, const RoamTerrain& T) {
+  rekey(S, T, S.split_queue);
+  rekey(S, T, S.merge_queue);
+  for (int32_t d : S.deadline_queue.heap) S.deadline_queue.slot[d] = -1;
+  S.deadline_queue.heap.clear();
+  if (S.defer)
+    for (const RoamQueue* q : {&S.split_queue, &S.merge_queue})
+      for (int32_t d : q->heap) {
+        S.deadline[d] = S.travel + std::max(slack_of(S, T, d), 0.f);
+        S.deadline_queue.slot[d] = int32_t(S.deadline_queue.heap.size());
+        S.deadline_queue.heap.push_back(d);
+      }
+  heapify(S.deadline_queue, S.deadline);
+  return uint32_t(S.split_queue.heap.size() + S.merge_queue.heap.size());
+}
+
+// Re-keys only the diamonds whose deadline the travel has passed.
+uint32_t rekey_due(RoamState& S, const RoamTerrain& T) {
+  uint32_t n = 0;
+  const size_t front = S.deadline_queue.heap.size();  // each is re-keyed at most once
+  while (n < front && S.deadline[S.deadline_queue.heap.front()] < S.travel) {
+    const int32_t d = S.deadline_queue.heap.front();
+    S.priority[d] = roam_projected_error(S, T, d);
+    queue_rekey(S.split_queue.slot[d] >= 0 ? S.split_queue : S.merge_queue, S.priority, d);
+    track(S, T, d);
+    ++n;
+  }
+  return n;
+}
+
+bool same_orientation(const View& a, const View& b) {
+  const glm::vec3 fa = glm::normalize(a.target - a.eye), fb = glm::normalize(b.target - b.eye);
+  return glm::length(fa - fb) < 1e-6f && a.up == b.up && a.fov_y_deg == b.fov_y_deg && a.width == b.width &&
+         a.height == b.height && a.near_plane == b.near_plane && a.far_plane == b.far_plane;
 }
 
 // ---- the targets ----
@@ -339,6 +419,10 @@ void roam_reset(RoamState& S, const RoamTerrain& T) {
   S.priority.assign(n, 0.f);
   detail::reset_queue(S.split_queue, n, 1.f);
   detail::reset_queue(S.merge_queue, n, -1.f);
+  detail::reset_queue(S.deadline_queue, n, -1.f);
+  S.deadline.assign(n, 0.f);
+  S.defer = 0;
+  S.travel = 0;
   S.triangle_count = 2;
   S.splits = S.merges = 0;
   detail::enqueue(S.split_queue, S, T, T.root);
@@ -364,26 +448,26 @@ void roam_split(RoamState& S, const RoamTerrain& T, int32_t d) {
   if (S.split[d]) return;
   for (int32_t p : T.parents[d])
     if (p >= 0) roam_split(S, T, p);  // forced: the base neighbour's parent first
-  detail::queue_remove(S.split_queue, S.priority, d);
+  detail::dequeue(S.split_queue, S, d);
   S.split[d] = 1;
   S.triangle_count += T.triangles[d];
   ++S.splits;
   detail::enqueue(S.merge_queue, S, T, d);
   for (int32_t p : T.parents[d])
-    if (p >= 0) detail::queue_remove(S.merge_queue, S.priority, p);
+    if (p >= 0) detail::dequeue(S.merge_queue, S, p);
   for (int32_t c : T.children[d])
     if (c >= 0 && detail::parents_split(S, T, c)) detail::enqueue(S.split_queue, S, T, c);
 }
 
 void roam_merge(RoamState& S, const RoamTerrain& T, int32_t d) {
   assert(S.split[d] && !detail::any_child_split(S, T, d));
-  detail::queue_remove(S.merge_queue, S.priority, d);
+  detail::dequeue(S.merge_queue, S, d);
   S.split[d] = 0;
   S.triangle_count -= T.triangles[d];
   ++S.merges;
   detail::enqueue(S.split_queue, S, T, d);
   for (int32_t c : T.children[d])
-    if (c >= 0) detail::queue_remove(S.split_queue, S.priority, c);
+    if (c >= 0) detail::dequeue(S.split_queue, S, c);
   for (int32_t p : T.parents[d])
     if (p >= 0 && !detail::any_child_split(S, T, p)) detail::enqueue(S.merge_queue, S, T, p);
 }
@@ -391,10 +475,19 @@ void roam_merge(RoamState& S, const RoamTerrain& T, int32_t d) {
 RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view, const RoamParams& P) {
   RoamFrameStats st;
   const uint32_t splits0 = S.splits, merges0 = S.merges;
+  const glm::vec3 last_eye = S.eye;
   roam_set_view(S, view);
-  st.rekeyed = uint32_t(S.split_queue.heap.size() + S.merge_queue.heap.size());
-  detail::rekey(S, T, S.split_queue);
-  detail::rekey(S, T, S.merge_queue);
+  const bool pixel = P.target == RoamTarget::pixel_error;
+  if (pixel && S.defer && S.tau == P.pixel_error && detail::same_orientation(S.anchor, view)) {
+    S.travel += glm::length(view.eye - last_eye);
+    st.rekeyed = detail::rekey_due(S, T);
+  } else {
+    S.defer = pixel ? 1 : 0;
+    S.tau = P.pixel_error;
+    S.anchor = view;
+    S.travel = 0;
+    st.rekeyed = detail::rekey_all(S, T);
+  }
   detail::Budget budget{P.max_operations};
   if (P.target == RoamTarget::pixel_error)
     detail::run_pixel_target(S, T, P, budget, st);

@@ -23,9 +23,13 @@
 //
 // Frame update: the split queue holds the unsplit diamonds whose parents are split (their
 // triangles are in the mesh), the merge queue the split diamonds with no split child. Each frame
-// re-keys only those two fronts (O(mesh), not O(grid)) and then splits and merges from where the
-// last frame stopped, so the work follows the changes. (Duchaineau's deferred re-keying by
-// camera-speed bounds is not done: every front diamond is re-keyed every frame.)
+// re-keys at most those two fronts (O(mesh), not O(grid)) and then splits and merges from where
+// the last frame stopped, so the work follows the changes. (Duchaineau's deferred re-keying by
+// camera-speed bounds is done exactly for the pixel-error target while the camera translates
+// without turning: each front diamond gets the travel distance within which neither its
+// distance test nor its frustum test can cross (both are 1-Lipschitz in the eye position), and
+// only the diamonds whose distance has run out are re-keyed; a turn, a zoom or the
+// triangle-count target re-keys the whole front.)
 // Pure functions over RoamState: no threads, no I/O; after roam_reset() no allocation (the
 // queues are reserved for every diamond; roam_triangles() reuses the caller's vector).
 #pragma once
@@ -92,6 +96,15 @@ struct RoamState {
   glm::vec3 eye{0};
   float focal = 1, near_plane = 0.1f;
   Frustum frustum{};
+  // Deferred re-keying (pixel-error target, camera translating without turning): a front
+  // diamond's split/merge decision cannot change before the camera has travelled `slack`
+  // metres, so it is re-keyed only when the travel passes its deadline.
+  uint8_t defer = 0;            // 1: deadlines are kept for the front
+  float tau = 0;                // the pixel error the deadlines were computed for
+  float travel = 0;             // metres the eye moved since deferral started
+  View anchor{};                // the view whose orientation the deadlines assume
+  std::vector<float> deadline;  // per front diamond: travel at which to re-key it
+  RoamQueue deadline_queue;     // sign -1 over deadline: the soonest first
 };
 
 // True when a width x height field can be a ROAM grid: square, 2^n + 1 with 1 <= n <= 15.

@@ -201,14 +201,14 @@ TEST(HeightFieldText, ReadsTheRealTopography) {
     v.target = v.eye + glm::vec3(1, -0.3f, 1);
     v.far_plane = 3e6f;
     v.near_plane = 10;
-    const RoamFrameStats st = roam_update(s, t, v, p);
+    const RoamFrameStats fs = roam_update(s, t, v, p);
     roam_triangles(idx, s, t);
     const TerrainMeshCheck c = check_terrain_mesh(idx, t.size);
     ASSERT_TRUE(c.ok()) << "frame " << frame << ": " << c.first_problem;
     EXPECT_GT(c.triangles, 1000u);
     if (frame < 30) continue;
-    EXPECT_LE(st.triangles, 4000u);
-    EXPECT_GE(st.triangles, 3998u);
+    EXPECT_LE(fs.triangles, 4000u);
+    EXPECT_GE(fs.triangles, 3998u);
   }
 }
 

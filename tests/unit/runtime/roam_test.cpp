@@ -268,6 +268,26 @@ TEST_P(RoamFlight, IncrementalIsWithinToleranceOfFromScratchAtATriangleCount) {
   std::printf("incremental / from-scratch worst leaf error, worst frame: %.3f\n", worst_ratio);
 }
 
+TEST_P(RoamFlight, ASteadyFlightReKeysOnlyPartOfTheFront) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, GetParam()));
+  RoamState s;
+  roam_reset(s, t);
+  RoamParams p;
+  p.pixel_error = 1.f;
+  size_t rekeyed = 0, front = 0;
+  for (int frame = 0; frame < 40; ++frame) {
+    const RoamFrameStats st = roam_update(s, t, flying_view(t, frame), p);
+    if (frame == 0) continue;
+    rekeyed += st.rekeyed;
+    front += s.split_queue.heap.size() + s.merge_queue.heap.size();
+  }
+  EXPECT_LT(rekeyed, front / 2);  // deadlines spare most of the front
+  View turned = flying_view(t, 40);
+  turned.target = turned.eye + glm::vec3(-0.6f, -0.35f, 0.7f);
+  const size_t before = s.split_queue.heap.size() + s.merge_queue.heap.size();
+  EXPECT_EQ(roam_update(s, t, turned, p).rekeyed, before);  // a turn re-keys everything
+}
+
 INSTANTIATE_TEST_SUITE_P(Reliefs, RoamFlight, ::testing::Values(Relief::sines, Relief::random));
 
 std::vector<int32_t> members(const RoamQueue& q) {
