@@ -27,6 +27,7 @@
 #include <optional>
 #include <span>
 
+#include "jobs/tsan_annotations.h"
 #include "jobs/hlod_stream.h"
 #include "runtime/geomorph.h"
 #include "runtime/hlod_asset.h"
@@ -58,30 +59,9 @@ using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 // what their node released before the loop and release what it acquires after the join.
 // Data that crosses between two nodes without an edge of the table is therefore reported.
 // No-ops in other builds.
-#if defined(__SANITIZE_THREAD__)
-#define LOD_TSAN 1
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define LOD_TSAN 1
-#endif
-#endif
-// A task must acquire before it reads even its own captures (a node's were written when the
-// graph was built, a loop chunk's live on the spawning thread's stack), so each first acquires
-// one shared address: every frame's caller and every loop's spawner release it. Nodes are thus
-// ordered after every caller (never after another node without an edge); loop chunks after
-// every spawn so far, so a missing edge is still reported for what a node's own body reads,
-// not for what only its chunks read of another node's pre-loop writes.
-#ifdef LOD_TSAN
-extern "C" void __tsan_acquire(void* addr);
-extern "C" void __tsan_release(void* addr);
-char tsan_any_frame_start, tsan_any_spawn;
-void tsan_acquire(char& at) { __tsan_acquire(&at); }
-void tsan_release(char& at) { __tsan_release(&at); }
-#else
 [[maybe_unused]] char tsan_any_frame_start, tsan_any_spawn;
-inline void tsan_acquire(char&) {}
-inline void tsan_release(char&) {}
-#endif
+using detail::tsan_acquire;
+using detail::tsan_release;
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
@@ -424,17 +404,15 @@ struct FrameGraph::Impl {
   void for_chunks(Stage stage, const Body& body) {
     char& spawn = sync.spawn[static_cast<size_t>(stage)];
     char& join = sync.join[static_cast<size_t>(stage)];
-    tsan_release(spawn);
+    const auto task = [&](const tbb::blocked_range<size_t>& r) {
+      tsan_acquire(tsan_any_spawn);
+      tsan_acquire(spawn);
+      for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
+      tsan_release(join);
+    };
+    tsan_release(spawn);  // after the task's captures are written
     tsan_release(tsan_any_spawn);
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, chunks, 1),
-        [&](const tbb::blocked_range<size_t>& r) {
-          tsan_acquire(tsan_any_spawn);
-          tsan_acquire(spawn);
-          for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
-          tsan_release(join);
-        },
-        tbb::simple_partitioner());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), task, tbb::simple_partitioner());
     tsan_acquire(join);
   }
 
@@ -443,14 +421,15 @@ struct FrameGraph::Impl {
     if (n == 0) return;
     char& spawn = sync.spawn[static_cast<size_t>(stage)];
     char& join = sync.join[static_cast<size_t>(stage)];
-    tsan_release(spawn);
-    tsan_release(tsan_any_spawn);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& r) {
+    const auto task = [&](const tbb::blocked_range<size_t>& r) {
       tsan_acquire(tsan_any_spawn);
       tsan_acquire(spawn);
       for (size_t j = r.begin(); j != r.end(); ++j) body(j);
       tsan_release(join);
-    });
+    };
+    tsan_release(spawn);  // after the task's captures are written
+    tsan_release(tsan_any_spawn);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), task);
     tsan_acquire(join);
   }
 

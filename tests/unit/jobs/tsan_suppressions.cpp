@@ -24,6 +24,7 @@ extern "C" const char* __tsan_default_suppressions() {
          "race:tbb::detail::d1::node::node\n"
          "race:tbb::detail::d1::wait_context::\n"     // completion counters
          "race:tbb::detail::d1::broadcast_cache\n"    // flow-graph successor lists
-         "race:tbb::detail::d1::spin_rw_mutex\n";
+         "race:tbb::detail::d1::spin_rw_mutex\n"
+         "race:tbb::detail::d1::task_group_context\n";  // cancellation state, read by every task
 }
 #endif
