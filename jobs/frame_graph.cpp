@@ -53,15 +53,16 @@ using Clock = std::chrono::steady_clock;
 using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 
 // ThreadSanitizer cannot see the synchronisation inside libtbb (a library not built with it),
-// so the graph marks the hand-overs TBB guarantees, each on an address of its own (SyncPoints):
-// a node acquires what each of its predecessors released when it finished (or, at a root,
-// what the frame's caller released before starting it); a parallel loop's chunks acquire
-// what their node released before the loop and release what it acquires after the join.
-// Data that crosses between two nodes without an edge of the table is therefore reported.
-// No-ops in other builds.
-[[maybe_unused]] char tsan_any_frame_start, tsan_any_spawn;
-using detail::tsan_acquire;
-using detail::tsan_release;
+// so the graph marks the hand-overs TBB guarantees: a node acquires what its predecessors
+// released when they finished (a root what the frame's caller released), a loop's chunks what
+// their spawner released before the loop, the spawner what they released after the join.
+// Each hand-over has its own byte (SyncPoints), but all are marked on one address for now:
+// with one address per edge, TSan reported loop chunks reading memory on the stacks of
+// threads TBB created, whose creation no annotated edge orders (seen only on a loaded machine);
+// one address orders any two tasks that did not overlap, as before. No-ops in other builds.
+[[maybe_unused]] char tsan_any_frame_start, tsan_any_spawn, tsan_edge;
+void tsan_acquire(char&) { detail::tsan_acquire(tsan_edge); }
+void tsan_release(char&) { detail::tsan_release(tsan_edge); }
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
@@ -247,8 +248,8 @@ struct FrameGraph::Impl {
   void make_hlod_stream(std::shared_ptr<const HlodModels> h) {
     ModelNodeLoader load = h->load;
     if (!load)
-      load = [h](uint32_t model, uint32_t node, HlodPayload& out) {
-        return read_hlod_node(h->files[model], h->trees[model].nodes[node], out);
+      load = [h](uint32_t model, uint32_t node, HlodPayload& payload) {
+        return read_hlod_node(h->files[model], h->trees[model].nodes[node], payload);
       };
     hlod_stream = std::make_unique<HlodStream>(h->trees, h->stream, load);
     hlod_inputs.resize(h->trees.size());
@@ -387,10 +388,12 @@ struct FrameGraph::Impl {
           (this->*spec.run)();
         } catch (...) {
           tsan_release(sync.done[i]);
+          tsan_release(tsan_any_spawn);
           throw;
         }
         stage_ms[static_cast<size_t>(spec.stage)] = ms_between(t0, Clock::now());
         tsan_release(sync.done[i]);
+        tsan_release(tsan_any_spawn);
       }));
     }
     for (size_t j = 0; j < kNodeCount; ++j) {
@@ -409,6 +412,7 @@ struct FrameGraph::Impl {
       tsan_acquire(spawn);
       for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
       tsan_release(join);
+      tsan_release(tsan_any_spawn);
     };
     tsan_release(spawn);  // after the task's captures are written
     tsan_release(tsan_any_spawn);
@@ -426,6 +430,7 @@ struct FrameGraph::Impl {
       tsan_acquire(spawn);
       for (size_t j = r.begin(); j != r.end(); ++j) body(j);
       tsan_release(join);
+      tsan_release(tsan_any_spawn);
     };
     tsan_release(spawn);  // after the task's captures are written
     tsan_release(tsan_any_spawn);
