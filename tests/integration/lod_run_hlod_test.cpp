@@ -132,7 +132,9 @@ TEST(LodRunHlod, ModelOutOfViewDrawsNothingAndValidates) {
   const auto r = run_lod("run --config " + cfg.string() + " --frames 10 --validate --quiet --cache " +
                          (dir / "cache").string() + " --json " + (dir / "run.json").string());
   ASSERT_EQ(r.code, 0) << r.out;
-  for (const auto& f : read_json(dir / "run.json")["frames"]) {
+  const auto run = read_json(dir / "run.json");  // held: the loop must not range over a temporary
+  ASSERT_FALSE(run["frames"].empty());
+  for (const auto& f : run["frames"]) {
     EXPECT_EQ(f["hlod_nodes_drawn"].get<uint64_t>(), 0u);
     EXPECT_EQ(f["holes"].get<uint64_t>(), 0u);
   }
