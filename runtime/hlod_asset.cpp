@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "runtime/byte_order.h"
 #include "runtime/file_write.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/lod_chain.h"
@@ -44,45 +45,11 @@ constexpr uint64_t kChecksumBytes = 8;
 
 uint64_t align8(uint64_t v) { return (v + 7) & ~uint64_t{7}; }
 
-inline uint64_t load_u64(const uint8_t* p) {
-  uint64_t v;
-  std::memcpy(&v, p, 8);
-  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap64(v);
-  return v;
-}
-inline uint32_t load_u32(const uint8_t* p) {
-  uint32_t v;
-  std::memcpy(&v, p, 4);
-  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap32(v);
-  return v;
-}
-inline float load_f32(const uint8_t* p) { return std::bit_cast<float>(load_u32(p)); }
+using detail::load_f32;
+using detail::load_u32;
+using detail::load_u64;
 
-struct Writer {
-  std::vector<uint8_t> bytes;
-  void u8(uint8_t v) { bytes.push_back(v); }
-  void u32(uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
-  }
-  void u64(uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
-  }
-  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
-  template <class T>
-  void words(const T* v, size_t count) {
-    static_assert(sizeof(T) == 4);
-    for (size_t i = 0; i < count; ++i) u32(std::bit_cast<uint32_t>(v[i]));
-  }
-  void align() {
-    while (bytes.size() % 8 != 0) bytes.push_back(0);
-  }
-  void patch_u32(size_t at, uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<uint8_t>(v >> (8 * i));
-  }
-  void patch_u64(size_t at, uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes[at + i] = static_cast<uint8_t>(v >> (8 * i));
-  }
-};
+using Writer = detail::ByteWriter;
 
 Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
 
@@ -294,15 +261,15 @@ std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const Hlo
   w.u32(uint32_t(tree.name.size()));
   w.u32(0);
   w.bytes.insert(w.bytes.end(), tree.name.begin(), tree.name.end());
-  w.align();
+  w.align8();
   for (const HlodNode& n : tree.nodes)
     if (!n.leaf()) w.u8(n.child_mask);
-  w.align();
+  w.align8();
   std::vector<uint8_t> description((count > 0 ? count - 1 + 7 : 0) / 8, 0);
   for (uint32_t i = 1; i < count; ++i)
     if (tree.nodes[i].leaf()) description[(i - 1) / 8] |= uint8_t(1u << ((i - 1) % 8));
   w.bytes.insert(w.bytes.end(), description.begin(), description.end());
-  w.align();
+  w.align8();
   for (const HlodNode& n : tree.nodes) put_record(w, n);
   const size_t table = w.bytes.size();
   w.bytes.resize(table + kOffsetBytes * count, 0);

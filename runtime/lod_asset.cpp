@@ -32,6 +32,7 @@
 #include <string_view>
 #include <system_error>
 
+#include "runtime/byte_order.h"
 #include "runtime/file_write.h"
 
 namespace lod {
@@ -70,40 +71,11 @@ std::string tag_name(uint32_t tag) {
   return s;
 }
 
-inline uint64_t load_u64(const uint8_t* p) {
-  uint64_t v;
-  std::memcpy(&v, p, 8);
-  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap64(v);
-  return v;
-}
-inline uint32_t load_u32(const uint8_t* p) {
-  uint32_t v;
-  std::memcpy(&v, p, 4);
-  if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap32(v);
-  return v;
-}
-inline float load_f32(const uint8_t* p) { return std::bit_cast<float>(load_u32(p)); }
+using detail::load_f32;
+using detail::load_u32;
+using detail::load_u64;
 
-struct Writer {
-  std::vector<uint8_t> bytes;
-  void u32(uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
-  }
-  void u64(uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
-  }
-  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
-  void raw(const void* data, size_t size) {
-    const auto* p = static_cast<const uint8_t*>(data);
-    bytes.insert(bytes.end(), p, p + size);
-  }
-  void align8() {
-    while (bytes.size() % 8 != 0) bytes.push_back(0);
-  }
-  void patch_u64(size_t at, uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes[at + i] = static_cast<uint8_t>(v >> (8 * i));
-  }
-};
+using Writer = detail::ByteWriter;
 
 void put_level(Writer& w, const LodLevel& lv) {
   w.u32(lv.first_index);
