@@ -46,7 +46,7 @@ bool entry_ok(const Frame& f, const ModelTable& models, size_t i, std::string* w
   return true;
 }
 
-// The selected levels' triangles add up to tris_selected, the finer levels of morphing
+// The selected levels' triangles and the HLOD cuts' add up to tris_selected, the finer levels of morphing
 // entries to tris_morph_extra over `morphing` entries.
 bool totals_match(const Frame& f, const ModelTable& models, std::string* why) {
   char buf[256];
@@ -67,8 +67,9 @@ bool totals_match(const Frame& f, const ModelTable& models, std::string* why) {
                   morphing, (unsigned long long)extra, f.morphing, (unsigned long long)f.tris_morph_extra);
     return fail(why, buf);
   }
+  tris += f.hlod_tris;
   if (tris != f.tris_selected) {
-    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels add up to %llu",
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels and hlod cuts add up to %llu",
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     return fail(why, buf);
   }

@@ -26,6 +26,12 @@ struct FrameRow {
   uint32_t vd_objects = 0;       // view-dependent objects drawn from their active mesh
   uint64_t vd_drawn = 0;         // their triangles (part of `drawn`)
   int64_t gpu_primitives = -1;   // GL_PRIMITIVES_GENERATED, -1 when not queried
+  uint32_t hlod_nodes = 0;       // Frame::hlod_nodes_drawn
+  uint32_t hlod_draws = 0;       // node layers and boundary patches drawn
+  uint64_t hlod_drawn = 0;       // their triangles (part of `drawn`; Frame::hlod_tris when none is missing)
+  uint32_t hlod_missing = 0;     // cut entries not drawn: node unreadable, or not in the trees
+  uint64_t resident_bytes = 0;   // Frame::resident_bytes (the LOD thread's pager)
+  uint64_t gpu_node_bytes = 0;   // the viewer's GPU copies of HLOD nodes
   uint32_t draws = 0;
   uint32_t levels_drawn = 0;     // distinct chain levels among the draws
   uint32_t rejected = 0;         // frame entries the draw list refused

@@ -6,9 +6,15 @@
 
 namespace lod::viewer {
 
-bool FrameRenderer::init(const Scene& scene, std::string* message) {
+// GPU copies of HLOD nodes: a few times the stream budget, so a cut moving back and forth
+// does not re-read, but bounded however long the flight.
+uint64_t hlod_gpu_capacity(const HlodModels& m) { return std::max<uint64_t>(4 * m.stream.budget_bytes, 64ull << 20); }
+
+bool FrameRenderer::init(const Scene& scene, const HlodModels* hlod, std::string* message) {
   scene_ = &scene;
   if (!instances_.init(message)) return false;
+  hlod_ = hlod && !hlod->empty() ? hlod : nullptr;
+  if (hlod_ && !hlod_nodes_.init(*hlod_, hlod_gpu_capacity(*hlod_), message)) return false;
   meshes_.upload(scene.chains);
   morphs_.init(scene.chains);
   vd_meshes_.init();
@@ -32,8 +38,14 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
 
   build_draw_list(frame, meshes_.layout(), list_);
   vd_meshes_.upload(frame);
-  return instances_.draw(list_, meshes_, &morphs_, &vd_meshes_, view_matrix(viewing), projection_matrix(viewing),
-                         settings);
+  DrawStats stats = instances_.draw(list_, meshes_, &morphs_, &vd_meshes_, view_matrix(viewing),
+                                    projection_matrix(viewing), settings);
+  if (hlod_) {
+    build_hlod_draw_list(frame, *hlod_, hlod_list_);
+    hlod_nodes_.prepare(hlod_list_);
+    instances_.draw_hlod(hlod_list_, hlod_nodes_, view_matrix(viewing), projection_matrix(viewing), settings, stats);
+  }
+  return stats;
 }
 
 void FrameRenderer::render_culled(const Frame& frame, std::span<const ObjectHandle> handles,

@@ -1,6 +1,7 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
 // clear, build the draw list, one instanced draw per (model, level, target level), then one draw per
-// view-dependent object from the active mesh the frame carries.
+// view-dependent object from the active mesh the frame carries, then one per node layer or
+// boundary patch of the HLOD cuts.
 #pragma once
 #include <span>
 #include <string>
@@ -10,6 +11,8 @@
 #include "runtime/frame.h"
 #include "runtime/view.h"
 #include "viewer/draw_list.h"
+#include "viewer/hlod_draw_list.h"
+#include "viewer/hlod_node_buffers.h"
 #include "viewer/instance_renderer.h"
 #include "viewer/mesh_buffers.h"
 #include "viewer/morph_buffers.h"
@@ -19,8 +22,9 @@ namespace lod::viewer {
 
 class FrameRenderer {
  public:
-  // Uploads every level of every chain; false with the reason in `message`.
-  bool init(const Scene& scene, std::string* message);
+  // Uploads every level of every chain and opens the HLOD models' files (`hlod` may be null:
+  // none); false with the reason in `message`.
+  bool init(const Scene& scene, const HlodModels* hlod, std::string* message);
   // `viewing` also gives the viewport size (width x height pixels).
   DrawStats render(const Frame& frame, const View& viewing, const RenderSettings& settings);
 
@@ -32,6 +36,8 @@ class FrameRenderer {
   const DrawList& draw_list() const { return list_; }
   const MeshBuffers& meshes() const { return meshes_; }
   const MorphBuffers& morphs() const { return morphs_; }
+  const HlodDrawList& hlod_list() const { return hlod_list_; }
+  const HlodNodeBuffers& hlod_nodes() const { return hlod_nodes_; }
 
  private:
   const Scene* scene_ = nullptr;
@@ -40,6 +46,9 @@ class FrameRenderer {
   VdMeshBuffers vd_meshes_;
   InstanceRenderer instances_;
   DrawList list_;
+  const HlodModels* hlod_ = nullptr;
+  HlodDrawList hlod_list_;
+  HlodNodeBuffers hlod_nodes_;
   Frame culled_;                             // scratch: the culled objects as a frame
   std::vector<ObjectHandle> frame_handles_;  // scratch: the frame's handles, sorted
   DrawList culled_list_;

@@ -1,5 +1,6 @@
 #include "viewer/instance_renderer.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -213,6 +214,52 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
   return stats;
+}
+
+void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers& nodes, const glm::mat4& view,
+                                 const glm::mat4& projection, const RenderSettings& settings, DrawStats& stats) {
+  if (list.draws.empty()) return;
+  glUseProgram(program_);
+  glUniformMatrix4fv(u_view_, 1, GL_FALSE, glm::value_ptr(view));
+  glUniformMatrix4fv(u_projection_, 1, GL_FALSE, glm::value_ptr(projection));
+  glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
+  glUniform1i(u_show_morph_, 0);
+  glUniform1i(u_blend_, 0);
+  glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
+  glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // nodes without normals: face normals
+  if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
+  for (const HlodDraw& d : list.draws) {
+    const HlodNodeGpu* g = nodes.find(d.model, d.node);
+    const HlodNodeRange* r = !g ? nullptr : d.layer == kHlodBoundary ? &g->boundary
+                                           : d.layer < g->layers.size() ? &g->layers[d.layer] : nullptr;
+    if (!r) {
+      ++stats.hlod_missing;
+      continue;
+    }
+    glBindVertexArray(g->vao);  // per-object attributes disabled here: the constants below hold
+    glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
+    glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
+    glVertexAttrib2f(kAttribInstanceMorph, 1.f, 0.f);
+    const auto& c = settings.colour_override ? settings.colour
+                    : settings.colour_by_level ? level_colour(d.depth)
+                                               : kModelColour;
+    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(r->index_count), GL_UNSIGNED_INT,
+                             reinterpret_cast<const void*>(size_t(r->first_index) * sizeof(uint32_t)),
+                             GLint(r->first_vertex));
+    ++stats.draws;
+    ++stats.hlod_draws;
+    stats.hlod_triangles += r->index_count / 3;
+    stats.triangles += r->index_count / 3;
+  }
+  if (settings.count_primitives) {
+    glEndQuery(GL_PRIMITIVES_GENERATED);
+    GLuint64 generated = 0;
+    glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &generated);
+    stats.gpu_primitives = std::max<int64_t>(stats.gpu_primitives, 0) + int64_t(generated);
+  }
+  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  glBindVertexArray(0);
 }
 
 }  // namespace lod::viewer

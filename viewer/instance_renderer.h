@@ -11,6 +11,8 @@
 #include <glm/glm.hpp>
 
 #include "viewer/draw_list.h"
+#include "viewer/hlod_draw_list.h"
+#include "viewer/hlod_node_buffers.h"
 #include "viewer/mesh_buffers.h"
 #include "viewer/morph_buffers.h"
 #include "viewer/vd_mesh_buffers.h"
@@ -33,6 +35,9 @@ struct DrawStats {
   uint32_t vd_draws = 0;         // view-dependent objects drawn from their active mesh
   uint64_t vd_triangles = 0;     // their triangles (part of `triangles`)
   uint32_t morph_draws = 0;      // batches drawn blending towards a coarser level
+  uint32_t hlod_draws = 0;       // HLOD node layers and boundary patches drawn
+  uint64_t hlod_triangles = 0;   // their triangles (part of `triangles`)
+  uint32_t hlod_missing = 0;     // cut entries whose node could not be read (not drawn)
   int64_t gpu_primitives = -1;   // what the GL counted, when count_primitives; else -1
 };
 
@@ -51,6 +56,10 @@ class InstanceRenderer {
   // is empty.
   DrawStats draw(const DrawList& list, const MeshBuffers& meshes, MorphBuffers* morphs, const VdMeshBuffers* vd,
                  const glm::mat4& view, const glm::mat4& projection, const RenderSettings& settings);
+  // Adds the HLOD cut's draws (nodes from `nodes`, prepared for the same list) to `stats`;
+  // colour-by-level colours a node by its octree depth.
+  void draw_hlod(const HlodDrawList& list, const HlodNodeBuffers& nodes, const glm::mat4& view,
+                 const glm::mat4& projection, const RenderSettings& settings, DrawStats& stats);
 
  private:
   GLuint program_ = 0;

@@ -34,8 +34,9 @@ int run(const lod::viewer::ViewerOptions& o) {
     return kExitBadInput;
   }
   if (o.threads >= 0) loaded.config.threads = uint32_t(o.threads);
-  std::fprintf(stderr, "lod-viewer: %zu models, %zu objects (bake %.0f ms: %zu baked, %zu cached in %s)\n",
-               loaded.scene.chains.size(), loaded.scene.objects.size(), loaded.bake.ms, loaded.bake.baked,
+  std::fprintf(stderr, "lod-viewer: %zu models (%zu hlod), %zu objects (bake %.0f ms: %zu baked, %zu cached in %s)\n",
+               loaded.scene.chains.size() + loaded.hlod->trees.size(), loaded.hlod->trees.size(),
+               loaded.scene.objects.size(), loaded.bake.ms, loaded.bake.baked,
                loaded.bake.cached, loaded.cache_dir.c_str());
 
   GlWindow window;
@@ -53,13 +54,14 @@ int run(const lod::viewer::ViewerOptions& o) {
                window.core_profile() ? "" : " (not a core profile: the driver refused 3.3 core)");
 
   FrameRenderer renderer;
-  if (!renderer.init(loaded.scene, &message)) {
+  if (!renderer.init(loaded.scene, loaded.hlod.get(), &message)) {
     std::fprintf(stderr, "lod-viewer: %s\n", message.c_str());
     return kExitNoGl;
   }
 
   ViewerSession session{o, loaded, window, renderer, {}, 0, {}, {}, {}};
   session.graph = frame_graph_options(loaded.config);
+  if (!loaded.hlod->empty()) session.graph.hlod = loaded.hlod;
   if (o.budget > 0) session.graph.selection.budget = uint64_t(o.budget);
   if (o.lod_delay_ms > 0) {
     // Through the graph's stage hook, so the delay sits inside the LOD frame, on its thread.

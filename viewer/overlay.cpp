@@ -100,6 +100,11 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
     if (fr->morphing)
       ImGui::Text("morphing     %u objects, +%s tris drawn", fr->morphing, thousands(fr->tris_morph_extra).c_str());
     ImGui::Text("budget M     %s%s", thousands(fr->budget).c_str(), fr->over_budget ? "  (over: coarsest levels)" : "");
+    // HLOD cuts: what the pager holds for the LOD thread, against its byte budget.
+    if (fr->stream_budget)
+      ImGui::Text("hlod         %u nodes, %s tris; resident %.2f / %.2f MB, %llu loads, %u holes", fr->hlod_nodes_drawn,
+                  thousands(f.drawn.hlod_triangles).c_str(), double(fr->resident_bytes) / (1 << 20),
+                  double(fr->stream_budget) / (1 << 20), (unsigned long long)fr->stream_loads, fr->holes);
 
     // Level histogram over R0's l = round(log2 tris): only the occupied span.
     size_t lo = kHistogramLevels, hi = 0;

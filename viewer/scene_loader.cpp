@@ -4,6 +4,8 @@
 #include <utility>
 #include <vector>
 
+#include "jobs/hlod_scene.h"
+
 namespace lod::viewer {
 
 std::filesystem::path default_cache_dir(const std::filesystem::path& data_dir) {
@@ -16,9 +18,16 @@ Status load_scene(const std::filesystem::path& config_file, const std::filesyste
   const std::filesystem::path data = data_dir.empty() ? default_data_dir() : data_dir;
   out.cache_dir = cache_dir.empty() ? default_cache_dir(data) : cache_dir;
   if (Status st = load_scene_config(config_file, data, out.config); !st) return st;
+  out.hlod = std::make_shared<HlodModels>();
+  size_t hlod_baked = 0, hlod_cached = 0;
+  if (Status st = bake_hlod_models(out.config, out.cache_dir, log, *out.hlod, &hlod_baked, &hlod_cached); !st)
+    return st;
+  out.config = discrete_part(out.config);
   std::vector<LodChain> chains;
   if (Status st = bake_scene_models(out.config.models, out.cache_dir, out.config.threads, chains, out.bake, log); !st)
     return st;
+  out.bake.baked += hlod_baked;
+  out.bake.cached += hlod_cached;
   out.scene = make_scene(out.config, std::move(chains));
   return Status::success();
 }

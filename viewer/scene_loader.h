@@ -1,10 +1,13 @@
 // The viewer's way to a Scene, the same as `lod run`: parse the config, bake what it needs
-// (cached by content hash), place the instances.
+// (cached by content hash), place the instances; models with hlod = true become streamed HLOD
+// models (`hlod`) and the scene holds the rest.
 #pragma once
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include "jobs/bake_jobs.h"
+#include "jobs/hlod_models.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "runtime/status.h"
@@ -12,8 +15,9 @@
 namespace lod::viewer {
 
 struct LoadedScene {
-  SceneConfig config;
+  SceneConfig config;                    // without its hlod models (discrete_part)
   Scene scene;
+  std::shared_ptr<HlodModels> hlod;      // never null; empty when the config has none
   BakeSummary bake;
   std::filesystem::path cache_dir;
 };

@@ -64,6 +64,12 @@ const FrameRow& ViewerSession::record(uint64_t viewer_frame, const Frame& frame,
   row.vd_drawn = drawn.vd_triangles;
   row.gpu_primitives = drawn.gpu_primitives;
   row.draws = drawn.draws;
+  row.hlod_nodes = frame.hlod_nodes_drawn;
+  row.hlod_draws = drawn.hlod_draws;
+  row.hlod_drawn = drawn.hlod_triangles;
+  row.hlod_missing = drawn.hlod_missing + renderer.hlod_list().rejected;
+  row.resident_bytes = frame.resident_bytes;
+  row.gpu_node_bytes = renderer.hlod_nodes().bytes();
   uint64_t levels = 0;  // bit per chain level (< kMaxLevels)
   for (const DrawBatch& b : renderer.draw_list().batches) levels |= uint64_t(1) << b.level;
   row.levels_drawn = uint32_t(std::popcount(levels));
