@@ -10,9 +10,11 @@
 #include "cli/budget_shortfall.h"
 #include "cli/commands.h"
 #include "cli/hlod_check.h"
+#include "cli/scene_hlod_check.h"
 #include "cli/run_report.h"
 #include "jobs/bake_jobs.h"
 #include "jobs/hlod_scene.h"
+#include "jobs/scene_hlod_bake.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "jobs/scene_motion.h"
@@ -97,9 +99,9 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
     }
     tris += scene.models.triangles[scene.models.first_level[m] + f.levels[i]];
   }
-  tris += f.hlod_tris;  // HLOD cuts count in the same budget
+  tris += f.hlod_tris + f.scene_proxy_tris;  // HLOD cuts and scene proxies count in the same budget
   if (tris != f.tris_selected) {
-    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels and hlod cuts add up to %llu",
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels, hlod cuts and proxies add up to %llu",
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     *why = buf;
     return false;
@@ -166,8 +168,16 @@ int run_command(const RunArgs& args) {
   Scene scene = make_scene(config, std::move(chains));
   FrameGraphOptions options = frame_graph_options(config);
   if (!hlod->empty()) options.hlod = hlod;
+  auto scene_hlod = std::make_shared<SceneHlodTree>();
+  if (auto st = bake_scene_hlod(config, scene, log, *scene_hlod); !st) {
+    std::fprintf(stderr, "lod run: %s: %s\n", args.config.c_str(), st.message.c_str());
+    return 1;
+  }
+  if (!scene_hlod->empty()) options.scene_hlod = scene_hlod;
   std::vector<ObjectHandle> handles;
   std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);
+  SceneHlodCheck scene_hlod_check;
+  if (args.validate) scene_hlod_check.load(*scene_hlod, handles);
   Service& service = *owned;
   SceneMotion motion(config, scene.objects, handles);
   // Frames are 1 / rate_hz apart on the service clock (1/60 s when the rate is unlimited).
@@ -182,6 +192,7 @@ int run_command(const RunArgs& args) {
   summary.objects = scene.objects.size();
   summary.models = scene.chains.size() + hlod->trees.size();
   summary.hlod_models = hlod->trees.size();
+  summary.scene_hlod_nodes = scene_hlod->nodes.size();
   summary.stream_budget = hlod->empty() ? 0 : hlod->stream.budget_bytes;
   summary.threads = config.threads;
   summary.budget = config.selection.budget;
@@ -222,7 +233,7 @@ int run_command(const RunArgs& args) {
         std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
         return 3;
       }
-      if (!hlod_check.check(frame, &why)) {
+      if (!hlod_check.check(frame, &why) || !scene_hlod_check.check(frame, &why)) {
         std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
         return 3;
       }

@@ -62,6 +62,10 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"stream_requests", r.stream_requests},
           {"stream_loads", r.stream_loads},
           {"holes", r.holes},
+          {"scene_proxies", r.scene_proxies},
+          {"proxy_objects", r.proxy_objects},
+          {"proxy_tris", r.proxy_tris},
+          {"draws", r.draws()},
           {"ms", ms}};
 }
 
@@ -102,6 +106,10 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"stream_evictions", s.stream_evictions},
           {"stream_failures", s.stream_failures},
           {"mean_hlod_nodes_drawn", s.mean_hlod_nodes_drawn},
+          {"scene_hlod_nodes", s.scene_hlod_nodes},
+          {"mean_scene_proxies", s.mean_scene_proxies},
+          {"mean_proxy_objects", s.mean_proxy_objects},
+          {"mean_draws", s.mean_draws},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
           {"cached_models", s.cached_models},
@@ -148,6 +156,9 @@ FrameRecord record_of(const Frame& f) {
   r.stream_loads = f.stream_loads;
   r.stream_evictions = f.stream_evictions;
   r.stream_failures = f.stream_failures;
+  r.scene_proxies = uint32_t(f.scene_proxies.size());
+  r.proxy_objects = f.scene_proxy_objects;
+  r.proxy_tris = f.scene_proxy_tris;
   return r;
 }
 
@@ -160,7 +171,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0, culled = 0, benefit = 0, changes = 0, px = 0;
   s.max_pixel_error = 0;
   s.max_resident_bytes = s.total_holes = 0;
-  double hlod_nodes = 0;
+  double hlod_nodes = 0, proxies = 0, proxy_objects = 0, draws = 0;
   s.max_drawn_over_budget = 0;
   s.frames_drawn_over_budget = 0;
   for (const auto& r : records) {
@@ -184,6 +195,9 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     s.max_resident_bytes = std::max(s.max_resident_bytes, r.resident_bytes);
     s.total_holes += r.holes;
     hlod_nodes += r.hlod_nodes_drawn;
+    proxies += r.scene_proxies;
+    proxy_objects += r.proxy_objects;
+    draws += double(r.draws());
     s.stream_loads = std::max(s.stream_loads, r.stream_loads);  // counters: the last frame's
     s.stream_evictions = std::max(s.stream_evictions, r.stream_evictions);
     s.stream_failures = std::max(s.stream_failures, r.stream_failures);
@@ -206,6 +220,9 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.mean_benefit = benefit / n;
   s.mean_level_changes = changes / n;
   s.mean_pixel_error = px / n;
+  s.mean_scene_proxies = proxies / n;
+  s.mean_proxy_objects = proxy_objects / n;
+  s.mean_draws = draws / n;
 }
 
 std::string table_legend() {
@@ -272,6 +289,13 @@ std::string summary_text(const RunSummary& s) {
                   double(s.stream_budget) / (1 << 20), (unsigned long long)s.stream_loads,
                   (unsigned long long)s.stream_evictions, (unsigned long long)s.stream_failures,
                   (unsigned long long)s.total_holes);
+    o << buf;
+  }
+  if (s.scene_hlod_nodes > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "  scene hlod: %zu proxies; mean %.1f drawn per frame standing for %.0f objects; mean %.0f draws "
+                  "(entries + proxies + hlod nodes)\n",
+                  s.scene_hlod_nodes, s.mean_scene_proxies, s.mean_proxy_objects, s.mean_draws);
     o << buf;
   }
   if (s.mean_occluded > 0) {

@@ -39,7 +39,13 @@ struct FrameRecord {
   uint64_t hlod_tris = 0, resident_bytes = 0, stream_requests = 0, stream_loads = 0, stream_evictions = 0,
            stream_failures = 0;
 
+  // Scene HLOD: proxies drawn, the static objects they stand for, their triangles.
+  uint32_t scene_proxies = 0, proxy_objects = 0;
+  uint64_t proxy_tris = 0;
+
   uint64_t drawn() const { return tris_selected + tris_morph_extra; }  // with blends
+  // Draw calls a renderer makes without instancing: entries, proxies, HLOD nodes.
+  uint64_t draws() const { return uint64_t(visible) + scene_proxies + hlod_nodes_drawn; }
 };
 
 FrameRecord record_of(const Frame& frame);
@@ -66,6 +72,8 @@ struct RunSummary {
   uint64_t stream_budget = 0, max_resident_bytes = 0, total_holes = 0, stream_loads = 0, stream_evictions = 0,
            stream_failures = 0;
   double mean_hlod_nodes_drawn = 0;
+  double mean_scene_proxies = 0, mean_proxy_objects = 0, mean_draws = 0;
+  size_t scene_hlod_nodes = 0;  // proxies in the scene HLOD (0: off)
   double bake_ms = 0;
   size_t baked_models = 0, cached_models = 0;
   double wall_s = 0;

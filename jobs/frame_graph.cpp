@@ -37,6 +37,7 @@
 #include "runtime/level_caps.h"
 #include "runtime/object_controls.h"
 #include "runtime/occlusion.h"
+#include "runtime/scene_hlod_cut.h"
 #include "runtime/selection_quality.h"
 #include "runtime/vd_share.h"
 #include "runtime/vertex_front.h"
@@ -104,10 +105,11 @@ enum Column : uint32_t {
   kHistory = 1u << 11,    // the store's last-frame levels and visibility
   kPlacing = 1u << 12,    // the frame's handles, transforms and view masks per entry
   kHlod = 1u << 13,       // HLOD cuts and the pager, the frame's hlod columns
+  kSceneHlod = 1u << 14,  // the scene HLOD cut, the frame's scene proxy columns
 };
 constexpr const char* kColumnNames[] = {"objects", "bounds", "controls", "views",  "visibility", "entries", "levels",
                                         "blend",   "fronts", "vd_mesh",  "totals", "history",    "placing",
-                                        "hlod"};
+                                        "hlod",    "scene_hlod"};
 
 }  // namespace
 
@@ -223,6 +225,14 @@ struct FrameGraph::Impl {
     uint32_t region;
   };
   std::vector<VdTask> vd_tasks;
+
+  // Scene HLOD (options.scene_hlod): per tree object, its dense index and whether it is as
+  // built, refreshed after commits (dense indices only change there).
+  SceneHlodCut scene_cut;
+  std::vector<uint32_t> scene_dense;
+  std::vector<uint8_t> scene_ok;
+  std::vector<uint32_t> scene_bad_prefix;
+  bool scene_refresh = true;
 
   // HLOD models (options.hlod): one stream for all of them; its loader threads are its own.
   std::unique_ptr<HlodStream> hlod_stream;
@@ -449,6 +459,7 @@ struct FrameGraph::Impl {
     }
     for (uint32_t slot : freed_slots)
       if (slot < vd_by_slot.size()) vd_by_slot[slot].reset();
+    if (!input->commits.empty()) scene_refresh = true;
     count = store->size();
     resize_chunks();
   }
@@ -544,6 +555,59 @@ struct FrameGraph::Impl {
     out->occluder_tris = occlusion_buffer.triangles;
   }
 
+  // Per tree object: live, same model, same sphere, not never_cull (a proxy stands only for
+  // objects exactly as it was built from).
+  void refresh_scene_validity(const SceneHlodTree& tree) {
+    const ObjectStore& s = *store;
+    const size_t n = tree.objects.size();
+    scene_dense.resize(n);
+    scene_ok.resize(n);
+    scene_bad_prefix.resize(n + 1);
+    for (size_t j = 0; j < n; ++j) {
+      const SceneHlodObject& o = tree.objects[j];
+      const uint32_t i = s.find(o.handle);
+      scene_dense[j] = i;
+      scene_ok[j] = i != kNoIndex && s.model[i] == o.model && !s.never_cull[i] && s.cx[i] == o.sphere.center[0] &&
+                    s.cy[i] == o.sphere.center[1] && s.cz[i] == o.sphere.center[2] && s.radius[i] == o.sphere.radius;
+    }
+    scene_hlod_validity(scene_bad_prefix, scene_ok);
+    scene_refresh = false;
+  }
+
+  // Objects a drawn proxy stands for leave view 0 (and the frame, unless another view sees them).
+  void cover_by_proxies(const SceneHlodTree& tree) {
+    for (uint32_t id : scene_cut.drawn) {
+      const SceneHlodNode& n = tree.nodes[id];
+      for (uint32_t j = n.first_object; j < n.first_object + n.object_count; ++j) {
+        const uint32_t i = scene_dense[j];
+        if (!(mask[i] & 1u)) continue;
+        per_view[0].visible[i] = 0;
+        mask[i] = static_cast<uint8_t>(mask[i] & ~1u);
+        chunk_visible[i / grain] -= mask[i] == 0;
+      }
+    }
+    visible_total = 0;
+    for (size_t c = 0; c < chunks; ++c) {
+      chunk_offset[c] = visible_total;
+      visible_total += chunk_visible[c];
+    }
+  }
+
+  void node_scene_hlod() {
+    Frame& f = *out;
+    f.scene_proxies.clear();
+    f.scene_proxy_objects = 0;
+    f.scene_proxy_tris = 0;
+    const SceneHlodTree* tree = options.scene_hlod.get();
+    if (!tree || tree->empty()) return;
+    if (scene_refresh || models_changed) refresh_scene_validity(*tree);
+    select_scene_hlod_cut(scene_cut, *tree, frusta[0], views[0].eye, focal[0], options.pixel_error, scene_bad_prefix);
+    cover_by_proxies(*tree);
+    f.scene_proxies.assign(scene_cut.drawn.begin(), scene_cut.drawn.end());
+    f.scene_proxy_objects = scene_cut.objects;
+    f.scene_proxy_tris = scene_cut.triangles;
+  }
+
   void node_importance() {
     const ObjectStore& s = *store;
     for_chunks(Stage::importance, [&](size_t c, size_t b, size_t e) {
@@ -637,6 +701,7 @@ struct FrameGraph::Impl {
     // from M (at most half of it, so blends never starve the selection), so that what is
     // drawn, not only what is selected, stays near M.
     SelectionParams so = options.selection;
+    if (so.count == BudgetCount::triangles) so.budget -= std::min(so.budget, out->scene_proxy_tris);  // one M
     morph_reserve = 0;
     if (so.count == BudgetCount::triangles && so.reserve_blends) {
       morph_reserve = std::min(last_morph_extra, so.budget / 2);
@@ -829,7 +894,8 @@ struct FrameGraph::Impl {
   uint64_t hlod_share() const {
     const SelectionParams& sp = options.selection;
     if (sp.count != BudgetCount::triangles) return UINT64_MAX;
-    const uint64_t left = sp.budget > selected.triangles ? sp.budget - selected.triangles : 0;
+    const uint64_t used = selected.triangles + out->scene_proxy_tris;
+    const uint64_t left = sp.budget > used ? sp.budget - used : 0;
     return left / std::max<size_t>(1, hlod_inputs.size());
   }
 
@@ -917,7 +983,7 @@ struct FrameGraph::Impl {
       f.level_cost += t.level_cost;
       for (size_t l = 0; l < kHistogramLevels; ++l) f.level_histogram[l] += t.histogram[l];
     }
-    f.tris_selected += f.hlod_tris;  // HLOD cuts draw within the same M
+    f.tris_selected += f.hlod_tris + f.scene_proxy_tris;  // HLOD cuts and proxies draw within the same M
     f.budget = options.selection.budget;
     f.budget_morph_reserve = morph_reserve;
     f.coarsest_cost = selected.coarsest_cost;
@@ -1013,11 +1079,13 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
     {Stage::view, "frustum planes, focal length per view", 0, kViews, &Impl::node_view},
     {Stage::visibility, "cull_spheres (+ cull_beyond_distance) per view + combine_view_masks; occlusion: gather_occluders, rasterize_occluder, sphere_occluded; parallel", kBounds | kControls | kViews,
      kVisibility, &Impl::node_visibility},
+    {Stage::scene_hlod, "select_scene_hlod_cut (view 0) + the objects drawn proxies stand for leave the visible set, serial",
+     kObjects | kBounds | kControls | kViews | kVisibility, kVisibility | kSceneHlod, &Impl::node_scene_hlod},
     {Stage::importance,
      "measure_objects + minima, importance_weights + choose_initial_levels per view, combine_view_choice, "
      "apply_object_controls, compaction, gather_selection, parallel",
      kObjects | kBounds | kControls | kViews | kVisibility | kHistory, kEntries | kLevels, &Impl::node_importance},
-    {Stage::selection, "lower_under_budget (greedy or greedy_multi): heap over the visible set, serial", kEntries | kLevels, kLevels,
+    {Stage::selection, "lower_under_budget (greedy or greedy_multi): heap over the visible set, serial", kEntries | kLevels | kSceneHlod, kLevels,
      &Impl::node_selection},
     {Stage::entries, "handles, transforms, view masks of the entries, parallel", kEntries | kObjects | kVisibility,
      kPlacing, &Impl::node_entries},
@@ -1027,8 +1095,8 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
     {Stage::vd_mesh, "vertex_morph_positions + compact meshes of vd objects, parallel", kEntries | kFronts, kVdMesh,
      &Impl::node_vd_mesh},
     {Stage::hlod, "select_hlod_cut per HLOD model (view 0, M minus the discrete selection) + pager update, serial",
-     kLevels | kViews, kHlod, &Impl::node_hlod},
-    {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend | kHlod,
+     kLevels | kViews | kSceneHlod, kHlod, &Impl::node_hlod},
+    {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend | kHlod | kSceneHlod,
      kTotals | kHistory, &Impl::node_publish},
 };
 
@@ -1089,6 +1157,10 @@ void FrameGraph::set_budget(uint64_t budget) { impl_->options.selection.budget =
 void FrameGraph::set_pixel_error(float pixels) { impl_->options.pixel_error = pixels; }
 void FrameGraph::set_hysteresis(float band) { impl_->options.hysteresis = band; }
 void FrameGraph::set_geomorph_seconds(float seconds) { impl_->options.geomorph_seconds = seconds; }
+void FrameGraph::set_scene_hlod(std::shared_ptr<const SceneHlodTree> tree) {
+  impl_->options.scene_hlod = std::move(tree);
+  impl_->scene_refresh = true;
+}
 const FrameGraphOptions& FrameGraph::options() const { return impl_->options; }
 ObjectStore& FrameGraph::scene_objects() { return impl_->own_store; }
 
@@ -1112,7 +1184,8 @@ std::string FrameGraph::dot() {
   }
   for (size_t j = 0; j < Impl::kNodeCount; ++j)
     for (uint32_t p = pred[j]; p; p &= p - 1)
-      s += "  " + std::string(kStageNames[std::countr_zero(p)]) + " -> " + kStageNames[j] + ";\n";
+      s += "  " + std::string(kStageNames[static_cast<size_t>(Impl::kNodes[std::countr_zero(p)].stage)]) + " -> " +
+           kStageNames[static_cast<size_t>(Impl::kNodes[j].stage)] + ";\n";
   s += "}\n";
   return s;
 }

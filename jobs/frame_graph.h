@@ -4,10 +4,13 @@
 // dependency run at the same time:
 //
 //   commit -> bounds --+
-//   view --------------+-> visibility -> importance -> selection -+-> geomorph -> publish
-//                                                                  +-> vdlod -> vd_mesh
-//                                                                  +-> hlod ------------+
+//   view --------------+-> visibility -> scene_hlod -> importance -> selection -+-> geomorph -> publish
+//                                                                                +-> vdlod -> vd_mesh
+//                                                                                +-> hlod ------------+
 //
+// scene_hlod (after visibility): view 0's cut of the scene HLOD (runtime/scene_hlod_cut); the
+// static objects a drawn proxy stands for leave view 0's visible set, and the proxies'
+// triangles come off M before selection.
 // hlod (HLOD models, jobs/hlod_stream): view 0's cut of every model from what is resident, then
 // the pager's update (never waits on I/O; loader threads read the .hlod files). Its share of M
 // is what the discrete selection left: triangle_budget = M - selected triangles (at least 0),
@@ -26,6 +29,7 @@
 #include "runtime/initial_levels.h"
 #include "runtime/object_commands.h"
 #include "runtime/object_store.h"
+#include "runtime/scene_hlod_tree.h"
 #include "runtime/slc_selection.h"
 #include "runtime/view.h"
 
@@ -60,6 +64,8 @@ struct FrameGraphOptions {
   std::function<void(Stage)> stage_hook;
   // Streamed HLOD models drawn by the hlod node (none: the node does nothing).
   std::shared_ptr<const HlodModels> hlod;
+  // Scene HLOD over static objects (handles bound), cut by the scene_hlod node; none: nothing.
+  std::shared_ptr<const SceneHlodTree> scene_hlod;
 };
 
 // The models a graph draws from: chains shared (adding a model copies none), plus the tables
@@ -101,6 +107,7 @@ class FrameGraph {
   void set_pixel_error(float pixels);
   void set_hysteresis(float band);
   void set_geomorph_seconds(float seconds);
+  void set_scene_hlod(std::shared_ptr<const SceneHlodTree> tree);
   const FrameGraphOptions& options() const;
   ObjectStore& scene_objects();  // the fixed scene's store
 

@@ -366,6 +366,23 @@ void read_stream(const Reader& r, const toml::table& root, SceneConfig& c) {
   r.integer_in(*t, "loader_threads", "stream.loader_threads", 1, 64, c.stream.loader_threads);
 }
 
+// [scene_hlod]: proxies over the static instances.
+void read_scene_hlod(const Reader& r, const toml::table& root, SceneConfig& c) {
+  const toml::table* t = r.table(root, "scene_hlod", "scene_hlod");
+  if (!t) return;
+  r.only_keys(*t, "scene_hlod", {"enabled", "min_objects", "reduction"});
+  if (const toml::node* n = t->get("enabled")) {
+    const auto* b = n->as_boolean();
+    if (!b) r.fail("scene_hlod.enabled", "must be true or false");
+    else c.scene_hlod.enabled = b->get();
+  }
+  r.integer_in(*t, "min_objects", "scene_hlod.min_objects", 2, 1 << 20, c.scene_hlod.min_objects);
+  if (auto v = r.number(*t, "reduction", "scene_hlod.reduction")) {
+    if (!(*v > 0 && *v < 1)) r.fail("scene_hlod.reduction", "must be between 0 and 1 (exclusive), got " + std::to_string(*v));
+    else c.scene_hlod.reduction = float(*v);
+  }
+}
+
 void read_models(const Reader& r, const toml::table& root, const std::filesystem::path& config_dir,
                  const std::filesystem::path& data_dir, bool required, SceneConfig& c) {
   const auto models = r.tables(root, "model", "model");
@@ -550,13 +567,14 @@ Status parse_scene_config(std::string_view text, const std::filesystem::path& fi
   c.file = file;
   const Reader r(name);
   try {
-    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "stream", "model", "instances"});
+    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "stream", "scene_hlod", "model", "instances"});
     read_run(r, root, c);
     read_budget(r, root, c);
     read_lod(r, root, c);
     read_visibility(r, root, c);
     read_camera(r, root, c);
     read_stream(r, root, c);
+    read_scene_hlod(r, root, c);
     const std::filesystem::path dir =
         file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
     read_models(r, root, dir, data_dir, !objects_optional, c);

@@ -34,6 +34,13 @@ struct StreamConfig {
   uint32_t loader_threads = 2;  // loader_threads
 };
 
+// [scene_hlod]: merged proxies over the static instances (preprocess/scene_hlod_build.h).
+struct SceneHlodConfig {
+  bool enabled = false;         // enabled
+  uint32_t min_objects = 2;     // min_objects: a cell with fewer is not split (R1: 2)
+  float reduction = 0.5f;       // reduction: a proxy keeps this fraction of its inputs' triangles
+};
+
 struct InstanceConfig {
   uint32_t model = 0;          // index into SceneConfig::models
   uint32_t count = 0;
@@ -58,6 +65,7 @@ struct SceneConfig {
   uint32_t occluders = 48;           // [visibility] occluders
   CameraPath camera;
   StreamConfig stream;
+  SceneHlodConfig scene_hlod;
   std::vector<ModelConfig> models;
   std::vector<InstanceConfig> instances;
 };

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "jobs/scene_hlod_bake.h"
 #include "jobs/service_impl.h"
 #include "runtime/lod_asset.h"
 #include "runtime/object_controls.h"
@@ -229,11 +230,16 @@ std::unique_ptr<Service> make_service(const Scene& scene, const FrameGraphOption
   m.blend_seconds = graph.geomorph_seconds;
   for (const LodChain& c : scene.chains) m.add_chain(c);
   const uint32_t models = m.model_count();
-  if (handles) handles->clear();
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const ObjectHandle h = m.queue.create(scene.objects.model[i], models, transform_of(scene.objects, i), {});
-    if (handles) handles->push_back(h);
+  std::vector<ObjectHandle> created;
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    created.push_back(m.queue.create(scene.objects.model[i], models, transform_of(scene.objects, i), {}));
+  if (graph.scene_hlod && !graph.scene_hlod->empty()) {  // its objects by the handles just given
+    auto bound = std::make_shared<SceneHlodTree>(*graph.scene_hlod);
+    bind_scene_hlod_handles(*bound, created);
+    m.graph_options.scene_hlod = bound;
+    m.graph->set_scene_hlod(bound);
   }
+  if (handles) *handles = std::move(created);
   m.queue.commit(0);
   return s;
 }

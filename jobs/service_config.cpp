@@ -5,6 +5,7 @@
 
 #include "jobs/bake_jobs.h"
 #include "jobs/hlod_scene.h"
+#include "jobs/scene_hlod_bake.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "jobs/service.h"
@@ -85,6 +86,9 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
   Scene scene = make_scene(sc, std::move(chains));
   FrameGraphOptions options = frame_graph_options(sc);
   if (!hlod->empty()) options.hlod = hlod;
+  auto scene_hlod = std::make_shared<SceneHlodTree>();
+  if (auto st = bake_scene_hlod(sc, scene, nullptr, *scene_hlod); !st) return failed(st.message);
+  if (!scene_hlod->empty()) options.scene_hlod = scene_hlod;
   std::unique_ptr<Service> s = make_service(scene, options, sc.rate_hz);
   Impl& m = s->impl();
   m.options.cache_dir = cache;

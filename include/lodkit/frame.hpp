@@ -12,10 +12,12 @@ namespace lod {
 
 // The frame graph's nodes (FrameGraph::dot() shows their edges); Frame::stage_ms per node.
 enum class Stage : uint8_t {
-  commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, hlod, publish, count
+  commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, hlod, scene_hlod,
+  publish, count
 };
 inline constexpr const char* kStageNames[] = {"commit",   "bounds",   "view",  "visibility", "importance", "selection",
-                                              "entries",  "geomorph", "vdlod", "vd_mesh",    "hlod",       "publish"};
+                                              "entries",  "geomorph", "vdlod", "vd_mesh",    "hlod",       "scene_hlod",
+                                              "publish"};
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::count);
 inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 
@@ -128,6 +130,12 @@ struct Frame {
   uint64_t stream_evictions = 0;              // nodes evicted so far (least recently used)
   uint64_t stream_failures = 0;               // node reads failed so far (each node once; parent stays drawn)
   uint32_t holes = 0;                         // wanted, not drawable, no drawn ancestor: must be 0
+
+  // Scene HLOD ([scene_hlod], view 0's cut): merged proxies drawn instead of the static objects
+  // they stand for, which then have no entry for view 0 (a renderer draws the proxies' meshes).
+  std::vector<uint32_t> scene_proxies;  // proxy (scene HLOD node) ids, breadth-first
+  uint32_t scene_proxy_objects = 0;     // objects the drawn proxies stand for
+  uint64_t scene_proxy_tris = 0;        // their triangles (in tris_selected)
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds
   double total_ms = 0;

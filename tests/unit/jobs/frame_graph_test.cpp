@@ -220,7 +220,7 @@ TEST(FrameGraph, StageTimesAreFilledAndBoundedByTheTotal) {
 // The data dependencies of the node table: each node starts after the nodes it reads from.
 constexpr std::pair<Stage, Stage> kDataEdges[] = {
     {Stage::commit, Stage::bounds},       {Stage::bounds, Stage::visibility},  {Stage::view, Stage::visibility},
-    {Stage::visibility, Stage::importance}, {Stage::importance, Stage::selection}, {Stage::selection, Stage::geomorph},
+    {Stage::visibility, Stage::scene_hlod}, {Stage::scene_hlod, Stage::importance}, {Stage::importance, Stage::selection}, {Stage::selection, Stage::geomorph},
     {Stage::selection, Stage::vdlod},     {Stage::vdlod, Stage::vd_mesh},      {Stage::geomorph, Stage::publish},
     {Stage::importance, Stage::entries},  {Stage::entries, Stage::vdlod},      {Stage::selection, Stage::hlod},
     {Stage::hlod, Stage::publish},
