@@ -37,7 +37,7 @@ struct SceneHlodSettings {
   // radius (QEM's max_error): a proxy of a small group stays close to its objects, one of a
   // quarter of the city may be as coarse as its size allows, so errors grow with the cells.
   float cell_error = 0.01f;
-  uint32_t error_samples = 1000;  // surface samples per direction when measuring a proxy (plus every vertex)
+  uint32_t error_samples = 4000;  // input vertices measured to the proxy (every proxy vertex is, to the input)
 };
 
 // `progress(done, total)` is called as nodes finish (from the caller's thread or workers).

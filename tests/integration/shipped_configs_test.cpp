@@ -34,7 +34,7 @@ TEST_P(ShippedConfig, RunsAndEveryFrameValidates) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Configs, ShippedConfig,
-                         ::testing::Values("default", "threads-1", "stress-10k", "stress-100k", "stress-scans", "town", "traffic", "hlod",
+                         ::testing::Values("default", "threads-1", "stress-10k", "stress-100k", "stress-scans", "town", "traffic", "hlod", "scene-hlod",
                                            "vdlod"),
                          [](const ::testing::TestParamInfo<const char*>& param_info) {
                            std::string s = param_info.param;
