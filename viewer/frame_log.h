@@ -32,6 +32,9 @@ struct FrameRow {
   uint32_t hlod_missing = 0;     // cut entries not drawn: node unreadable, or not in the trees
   uint64_t resident_bytes = 0;   // Frame::resident_bytes (the LOD thread's pager)
   uint64_t gpu_node_bytes = 0;   // the viewer's GPU copies of HLOD nodes
+  uint32_t proxies = 0;          // scene HLOD proxies drawn
+  uint64_t proxy_drawn = 0;      // their triangles (part of `drawn`)
+  uint32_t proxy_objects = 0;    // Frame::scene_proxy_objects
   uint32_t draws = 0;
   uint32_t levels_drawn = 0;     // distinct chain levels among the draws
   uint32_t rejected = 0;         // frame entries the draw list refused

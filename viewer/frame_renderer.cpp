@@ -26,6 +26,11 @@ bool FrameRenderer::init(const Scene& scene, const HlodModels* hlod, std::string
   return true;
 }
 
+void FrameRenderer::set_scene_hlod(const SceneHlodTree* tree) {
+  scene_hlod_ = tree && !tree->empty() ? tree : nullptr;
+  if (scene_hlod_) proxies_.upload(*scene_hlod_);
+}
+
 DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const RenderSettings& settings) {
   glViewport(0, 0, viewing.width, viewing.height);
   glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.f);
@@ -44,6 +49,10 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
     build_hlod_draw_list(frame, *hlod_, hlod_list_);
     hlod_nodes_.prepare(hlod_list_);
     instances_.draw_hlod(hlod_list_, hlod_nodes_, view_matrix(viewing), projection_matrix(viewing), settings, stats);
+  }
+  if (scene_hlod_) {
+    build_proxy_draw_list(frame, *scene_hlod_, proxy_list_);
+    instances_.draw_proxies(proxy_list_, proxies_, view_matrix(viewing), projection_matrix(viewing), settings, stats);
   }
   return stats;
 }

@@ -1,7 +1,7 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
 // clear, build the draw list, one instanced draw per (model, level, target level), then one draw per
 // view-dependent object from the active mesh the frame carries, then one per node layer or
-// boundary patch of the HLOD cuts.
+// boundary patch of the HLOD cuts and one per scene HLOD proxy.
 #pragma once
 #include <span>
 #include <string>
@@ -13,6 +13,8 @@
 #include "viewer/draw_list.h"
 #include "viewer/hlod_draw_list.h"
 #include "viewer/hlod_node_buffers.h"
+#include "viewer/proxy_draw_list.h"
+#include "viewer/scene_proxy_buffers.h"
 #include "viewer/instance_renderer.h"
 #include "viewer/mesh_buffers.h"
 #include "viewer/morph_buffers.h"
@@ -25,6 +27,8 @@ class FrameRenderer {
   // Uploads every level of every chain and opens the HLOD models' files (`hlod` may be null:
   // none); false with the reason in `message`.
   bool init(const Scene& scene, const HlodModels* hlod, std::string* message);
+  // Uploads the scene HLOD's proxies (drawn when a frame names them); call after init.
+  void set_scene_hlod(const SceneHlodTree* tree);
   // `viewing` also gives the viewport size (width x height pixels).
   DrawStats render(const Frame& frame, const View& viewing, const RenderSettings& settings);
 
@@ -38,6 +42,7 @@ class FrameRenderer {
   const MorphBuffers& morphs() const { return morphs_; }
   const HlodDrawList& hlod_list() const { return hlod_list_; }
   const HlodNodeBuffers& hlod_nodes() const { return hlod_nodes_; }
+  const ProxyDrawList& proxy_list() const { return proxy_list_; }
 
  private:
   const Scene* scene_ = nullptr;
@@ -49,6 +54,9 @@ class FrameRenderer {
   const HlodModels* hlod_ = nullptr;
   HlodDrawList hlod_list_;
   HlodNodeBuffers hlod_nodes_;
+  const SceneHlodTree* scene_hlod_ = nullptr;
+  SceneProxyBuffers proxies_;
+  ProxyDrawList proxy_list_;
   Frame culled_;                             // scratch: the culled objects as a frame
   std::vector<ObjectHandle> frame_handles_;  // scratch: the frame's handles, sorted
   DrawList culled_list_;

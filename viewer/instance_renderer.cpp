@@ -216,9 +216,8 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   return stats;
 }
 
-void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers& nodes, const glm::mat4& view,
-                                 const glm::mat4& projection, const RenderSettings& settings, DrawStats& stats) {
-  if (list.draws.empty()) return;
+void InstanceRenderer::begin_mesh_draws(const glm::mat4& view, const glm::mat4& projection,
+                                        const RenderSettings& settings) {
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_, 1, GL_FALSE, glm::value_ptr(view));
   glUniformMatrix4fv(u_projection_, 1, GL_FALSE, glm::value_ptr(projection));
@@ -226,8 +225,25 @@ void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers
   glUniform1i(u_show_morph_, 0);
   glUniform1i(u_blend_, 0);
   glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
-  glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // nodes without normals: face normals
+  glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // meshes without normals: face normals
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
+}
+
+void InstanceRenderer::end_mesh_draws(const RenderSettings& settings, DrawStats& stats) {
+  if (settings.count_primitives) {
+    glEndQuery(GL_PRIMITIVES_GENERATED);
+    GLuint64 generated = 0;
+    glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &generated);
+    stats.gpu_primitives = std::max<int64_t>(stats.gpu_primitives, 0) + int64_t(generated);
+  }
+  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  glBindVertexArray(0);
+}
+
+void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers& nodes, const glm::mat4& view,
+                                 const glm::mat4& projection, const RenderSettings& settings, DrawStats& stats) {
+  if (list.draws.empty()) return;
+  begin_mesh_draws(view, projection, settings);
   for (const HlodDraw& d : list.draws) {
     const HlodNodeGpu* g = nodes.find(d.model, d.node);
     const HlodNodeRange* r = !g ? nullptr : d.layer == kHlodBoundary ? &g->boundary
@@ -252,14 +268,32 @@ void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers
     stats.hlod_triangles += r->index_count / 3;
     stats.triangles += r->index_count / 3;
   }
-  if (settings.count_primitives) {
-    glEndQuery(GL_PRIMITIVES_GENERATED);
-    GLuint64 generated = 0;
-    glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &generated);
-    stats.gpu_primitives = std::max<int64_t>(stats.gpu_primitives, 0) + int64_t(generated);
+  end_mesh_draws(settings, stats);
+}
+
+void InstanceRenderer::draw_proxies(const ProxyDrawList& list, const SceneProxyBuffers& proxies,
+                                    const glm::mat4& view, const glm::mat4& projection,
+                                    const RenderSettings& settings, DrawStats& stats) {
+  if (list.draws.empty()) return;
+  begin_mesh_draws(view, projection, settings);
+  glBindVertexArray(proxies.vao());
+  glVertexAttrib4f(kAttribInstancePositionScale, 0.f, 0.f, 0.f, 1.f);  // world space already
+  glVertexAttrib4f(kAttribInstanceRotation, 0.f, 0.f, 0.f, 1.f);
+  glVertexAttrib2f(kAttribInstanceMorph, 1.f, 0.f);
+  for (const ProxyDraw& d : list.draws) {
+    const auto& c = settings.colour_override ? settings.colour
+                    : settings.colour_by_level ? level_colour(d.depth)
+                                               : kModelColour;
+    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(d.index_count), GL_UNSIGNED_INT,
+                             reinterpret_cast<const void*>(size_t(d.first_index) * sizeof(uint32_t)),
+                             GLint(d.first_vertex));
+    ++stats.draws;
+    ++stats.proxy_draws;
+    stats.proxy_triangles += d.index_count / 3;
+    stats.triangles += d.index_count / 3;
   }
-  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-  glBindVertexArray(0);
+  end_mesh_draws(settings, stats);
 }
 
 }  // namespace lod::viewer

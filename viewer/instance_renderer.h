@@ -13,6 +13,8 @@
 #include "viewer/draw_list.h"
 #include "viewer/hlod_draw_list.h"
 #include "viewer/hlod_node_buffers.h"
+#include "viewer/proxy_draw_list.h"
+#include "viewer/scene_proxy_buffers.h"
 #include "viewer/mesh_buffers.h"
 #include "viewer/morph_buffers.h"
 #include "viewer/vd_mesh_buffers.h"
@@ -38,6 +40,8 @@ struct DrawStats {
   uint32_t hlod_draws = 0;       // HLOD node layers and boundary patches drawn
   uint64_t hlod_triangles = 0;   // their triangles (part of `triangles`)
   uint32_t hlod_missing = 0;     // cut entries whose node could not be read (not drawn)
+  uint32_t proxy_draws = 0;      // scene HLOD proxies drawn
+  uint64_t proxy_triangles = 0;  // their triangles (part of `triangles`)
   int64_t gpu_primitives = -1;   // what the GL counted, when count_primitives; else -1
 };
 
@@ -60,8 +64,15 @@ class InstanceRenderer {
   // colour-by-level colours a node by its octree depth.
   void draw_hlod(const HlodDrawList& list, const HlodNodeBuffers& nodes, const glm::mat4& view,
                  const glm::mat4& projection, const RenderSettings& settings, DrawStats& stats);
+  // Adds the frame's scene proxies (world space) to `stats`; colour-by-level: by octree depth.
+  void draw_proxies(const ProxyDrawList& list, const SceneProxyBuffers& proxies, const glm::mat4& view,
+                    const glm::mat4& projection, const RenderSettings& settings, DrawStats& stats);
 
  private:
+  // Program state shared by the HLOD and proxy draws; starts the primitive query if asked.
+  void begin_mesh_draws(const glm::mat4& view, const glm::mat4& projection, const RenderSettings& settings);
+  void end_mesh_draws(const RenderSettings& settings, DrawStats& stats);
+
   GLuint program_ = 0;
   GLuint instance_vbo_ = 0;
   GLuint query_ = 0;

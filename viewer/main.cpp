@@ -62,6 +62,8 @@ int run(const lod::viewer::ViewerOptions& o) {
   ViewerSession session{o, loaded, window, renderer, {}, 0, {}, {}, {}};
   session.graph = frame_graph_options(loaded.config);
   if (!loaded.hlod->empty()) session.graph.hlod = loaded.hlod;
+  if (!loaded.scene_hlod->empty()) session.graph.scene_hlod = loaded.scene_hlod;  // make_service binds handles
+  renderer.set_scene_hlod(loaded.scene_hlod.get());
   if (o.budget > 0) session.graph.selection.budget = uint64_t(o.budget);
   if (o.lod_delay_ms > 0) {
     // Through the graph's stage hook, so the delay sits inside the LOD frame, on its thread.

@@ -100,6 +100,9 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
     if (fr->morphing)
       ImGui::Text("morphing     %u objects, +%s tris drawn", fr->morphing, thousands(fr->tris_morph_extra).c_str());
     ImGui::Text("budget M     %s%s", thousands(fr->budget).c_str(), fr->over_budget ? "  (over: coarsest levels)" : "");
+    if (!fr->scene_proxies.empty())
+      ImGui::Text("proxies      %zu drawn for %s objects, %s tris", fr->scene_proxies.size(),
+                  thousands(fr->scene_proxy_objects).c_str(), thousands(f.drawn.proxy_triangles).c_str());
     // HLOD cuts: what the pager holds for the LOD thread, against its byte budget.
     if (fr->stream_budget)
       ImGui::Text("hlod         %u nodes, %s tris; resident %.2f / %.2f MB, %llu loads, %u holes", fr->hlod_nodes_drawn,

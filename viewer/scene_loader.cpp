@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "jobs/hlod_scene.h"
+#include "jobs/scene_hlod_bake.h"
 
 namespace lod::viewer {
 
@@ -29,7 +30,8 @@ Status load_scene(const std::filesystem::path& config_file, const std::filesyste
   out.bake.baked += hlod_baked;
   out.bake.cached += hlod_cached;
   out.scene = make_scene(out.config, std::move(chains));
-  return Status::success();
+  out.scene_hlod = std::make_shared<SceneHlodTree>();
+  return bake_scene_hlod(out.config, out.scene, log, *out.scene_hlod);
 }
 
 }  // namespace lod::viewer

@@ -8,6 +8,7 @@
 
 #include "jobs/bake_jobs.h"
 #include "jobs/hlod_models.h"
+#include "runtime/scene_hlod_tree.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "runtime/status.h"
@@ -18,6 +19,7 @@ struct LoadedScene {
   SceneConfig config;                    // without its hlod models (discrete_part)
   Scene scene;
   std::shared_ptr<HlodModels> hlod;      // never null; empty when the config has none
+  std::shared_ptr<SceneHlodTree> scene_hlod;  // never null; empty unless [scene_hlod] enabled
   BakeSummary bake;
   std::filesystem::path cache_dir;
 };

@@ -70,10 +70,13 @@ const FrameRow& ViewerSession::record(uint64_t viewer_frame, const Frame& frame,
   row.hlod_missing = drawn.hlod_missing + renderer.hlod_list().rejected;
   row.resident_bytes = frame.resident_bytes;
   row.gpu_node_bytes = renderer.hlod_nodes().bytes();
+  row.proxies = drawn.proxy_draws;
+  row.proxy_drawn = drawn.proxy_triangles;
+  row.proxy_objects = frame.scene_proxy_objects;
   uint64_t levels = 0;  // bit per chain level (< kMaxLevels)
   for (const DrawBatch& b : renderer.draw_list().batches) levels |= uint64_t(1) << b.level;
   row.levels_drawn = uint32_t(std::popcount(levels));
-  row.rejected = renderer.draw_list().rejected;
+  row.rejected = renderer.draw_list().rejected + renderer.proxy_list().rejected;
   std::string why;
   row.whole = frame_is_whole(frame, loaded.scene, &why) ? 1 : 0;
   if (!row.whole)
