@@ -17,6 +17,7 @@ struct RunArgs {
   bool validate = false;
   bool quiet = false;
   bool strict_exit = false;  // exit 5 when any frame's coarsest levels exceed M
+  double stream_read_delay_ms = 0;  // every HLOD node read sleeps first (measuring slow storage)
 };
 int run_command(const RunArgs& args);
 

@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--quiet", run.quiet, "no per-frame table");
   run_cmd->add_flag("--strict-exit", run.strict_exit,
                     "exit with code 5 when the coarsest levels exceed the budget on any frame");
+  run_cmd->add_option("--stream-read-delay-ms", run.stream_read_delay_ms,
+                      "measuring: every HLOD node read sleeps this long first (slow storage)")
+      ->check(CLI::Range(0.0, 10000.0));
 
   lod::cli::InspectArgs inspect;
   auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels or an .hlod file's tree");

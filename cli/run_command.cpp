@@ -10,16 +10,17 @@
 #include "cli/budget_shortfall.h"
 #include "cli/commands.h"
 #include "cli/hlod_check.h"
-#include "cli/scene_hlod_check.h"
 #include "cli/run_report.h"
+#include "cli/scene_hlod_check.h"
 #include "jobs/bake_jobs.h"
 #include "jobs/hlod_scene.h"
-#include "jobs/scene_hlod_bake.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
+#include "jobs/scene_hlod_bake.h"
 #include "jobs/scene_motion.h"
 #include "jobs/service.h"
 #include "runtime/camera_path.h"
+#include "runtime/hlod_asset.h"
 #include "runtime/vertex_front.h"
 
 namespace lod::cli {
@@ -147,6 +148,13 @@ int run_command(const RunArgs& args) {
   if (auto st = bake_hlod_models(config, cache_dir, log, *hlod, &hlod_baked, &hlod_cached); !st) {
     std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
     return 1;
+  }
+  if (args.stream_read_delay_ms > 0 && !hlod->empty()) {  // slow storage, as the pager sees it
+    const auto delay = std::chrono::duration<double, std::milli>(args.stream_read_delay_ms);
+    hlod->load = [files = hlod->files, trees = hlod->trees, delay](uint32_t model, uint32_t node, HlodPayload& out) {
+      std::this_thread::sleep_for(delay);
+      return read_hlod_node(files[model], trees[model].nodes[node], out);
+    };
   }
   HlodCheck hlod_check;
   if (args.validate && !hlod->empty()) {

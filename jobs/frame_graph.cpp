@@ -33,6 +33,7 @@
 #include "runtime/hlod_asset.h"
 #include "runtime/importance.h"
 #include "runtime/level_blend.h"
+#include "runtime/budget_split.h"
 #include "runtime/derived_columns.h"
 #include "runtime/level_caps.h"
 #include "runtime/object_controls.h"
@@ -238,6 +239,7 @@ struct FrameGraph::Impl {
   std::unique_ptr<HlodStream> hlod_stream;
   std::vector<HlodModelInput> hlod_inputs;
   bool hlod_over_budget = false;
+  uint64_t hlod_wanted_last = 0;  // last frame's cuts before their budget: the HLOD demand
 
   tbb::task_arena arena;
   std::optional<tbb::flow::graph> graph;
@@ -701,7 +703,10 @@ struct FrameGraph::Impl {
     // from M (at most half of it, so blends never starve the selection), so that what is
     // drawn, not only what is selected, stays near M.
     SelectionParams so = options.selection;
-    if (so.count == BudgetCount::triangles) so.budget -= std::min(so.budget, out->scene_proxy_tris);  // one M
+    if (so.count == BudgetCount::triangles) {
+      so.budget -= std::min(so.budget, out->scene_proxy_tris);  // one M
+      if (hlod_stream) so.budget = first_share(so.budget, initial_triangles(), hlod_wanted_last);
+    }
     morph_reserve = 0;
     if (so.count == BudgetCount::triangles && so.reserve_blends) {
       morph_reserve = std::min(last_morph_extra, so.budget / 2);
@@ -711,6 +716,13 @@ struct FrameGraph::Impl {
         std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
         std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_row.data(), v),
         caps.rows, so, selection_total, std::span<HeapEntry>(heap.data(), v));
+  }
+
+  // Triangles of the visible objects at their initial levels (the pixel threshold's demand).
+  uint64_t initial_triangles() const {
+    uint64_t t = 0;
+    for (size_t k = 0; k < level_total; ++k) t += uint64_t(selection_total[k]) * caps.rows.triangles[k];
+    return t;
   }
 
   // Each entry's handle, transform and view mask, gathered from its object; beside selection,
@@ -916,12 +928,15 @@ struct FrameGraph::Impl {
       in.params.culled = options.hlod->culled;
     }
     hlod_stream->frame(frame_index, hlod_view_of(views[0]), hlod_inputs);
+    uint64_t wanted = 0;
     for (uint32_t m = 0; m < hlod_stream->model_count(); ++m) {
       const HlodCut& cut = hlod_stream->cut(m);
       for (const HlodDraw& d : cut.drawn) f.hlod_drawn.push_back({m, d.node, d.layer});
       for (const uint32_t n : cut.opened) f.hlod_opened.push_back({m, n});
       hlod_over_budget |= cut.over_budget;
+      wanted += cut.wanted_triangles;
     }
+    hlod_wanted_last = wanted;
     const HlodStreamFigures fig = hlod_stream->figures();
     f.hlod_nodes_drawn = fig.hlod_nodes_drawn;
     f.hlod_tris = fig.hlod_triangles;

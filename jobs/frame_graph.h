@@ -12,9 +12,11 @@
 // static objects a drawn proxy stands for leave view 0's visible set, and the proxies'
 // triangles come off M before selection.
 // hlod (HLOD models, jobs/hlod_stream): view 0's cut of every model from what is resident, then
-// the pager's update (never waits on I/O; loader threads read the .hlod files). Its share of M
-// is what the discrete selection left: triangle_budget = M - selected triangles (at least 0),
-// split evenly over the models, the first form of "one budget" (levels budgets: no cap).
+// the pager's update (never waits on I/O; loader threads read the .hlod files). One M: when the
+// discrete objects' initial levels and last frame's wanted cuts do not fit together, selection
+// gets M in proportion to its demand (runtime/budget_split.h); the cuts get what it leaves,
+// split evenly over the models, each undoing its least visible refinements first (levels
+// budgets: no cap).
 // The flow-graph headers stay in frame_graph.cpp.
 #pragma once
 #include <functional>

@@ -20,6 +20,13 @@ std::string hex64(uint64_t v) {
 Status cached_or_baked(const ModelConfig& m, const std::filesystem::path& cache_dir,
                        const std::function<void(const std::string&)>& log, HlodTree& tree,
                        std::filesystem::path& path, bool& from_cache) {
+  if (m.file.extension() == ".hlod") {  // named directly: used as it is
+    path = m.file;
+    from_cache = true;
+    if (Status s = read_hlod_tree(path, tree); !s) return Status::error("model " + m.name + ": " + s.message);
+    if (log) log("model " + m.name + ": " + path.string() + " (" + std::to_string(tree.nodes.size()) + " nodes)");
+    return Status::success();
+  }
   uint64_t key = 0;
   if (Status s = hlod_source_hash(m.file, m.min_verts, key); !s) return Status::error("model " + m.name + ": " + s.message);
   const std::string stem = m.name + "-" + hex64(key);

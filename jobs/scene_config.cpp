@@ -352,6 +352,12 @@ void read_hlod_model(const Reader& r, const toml::table& t, const std::string& k
     if (!b) r.fail(key + ".hlod", "must be true or false");
     m.hlod = b->get();
   }
+  // A baked .hlod is drawn through its tree as it is (never rebaked).
+  if (m.file.extension() == ".hlod") {
+    if (t.contains("hlod") && !m.hlod) r.fail(key + ".hlod", "a .hlod file is drawn through its tree: hlod cannot be false");
+    if (t.contains("min_verts")) r.fail(key + ".min_verts", "a .hlod file is already built (its leaf size is in the file)");
+    m.hlod = true;
+  }
   r.integer_in(t, "min_verts", key + ".min_verts", 3, 100000000, m.min_verts);
   if (t.contains("min_verts") && !m.hlod) r.fail(key + ".min_verts", "needs hlod = true");
   if (m.hlod && m.view_dependent) r.fail(key + ".hlod", "a model is either hlod or view_dependent, not both");

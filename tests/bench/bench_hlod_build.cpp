@@ -1,7 +1,8 @@
 // Model HLOD build time (issue 11, R1 3.1) on the 871k-triangle Stanford dragon scan
 // (../shared/data/meshes/stanford-dragon.ply), at 1 thread (the baseline, in the same binary)
 // and 2 threads; optionally the dragon subdivided twice (1-to-4 midpoint, ~14M triangles,
-// generated at run time: BM_HlodBuild14M, run it with --benchmark_filter=14M).
+// generated at run time: BM_HlodBuild14M, run it with --benchmark_filter=14M; with
+// LOD_HLOD_WRITE=FILE the built tree is written there).
 //
 //   BM_HlodBuild/threads:N   build_hlod only (the mesh is loaded and cleaned beforehand), in a
 //                            tbb arena of N threads; counters: nodes, leaves, depth, cpu_s
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <map>
@@ -25,6 +27,7 @@
 #include "preprocess/hlod_build.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
+#include "runtime/hlod_asset.h"
 #include "test_support.h"
 #include "vd_meshes.h"
 
@@ -62,6 +65,14 @@ const MeshData* dragon_14m() {
   return mesh;
 }
 
+// LOD_HLOD_WRITE=FILE keeps what was built (configs/hlod-14m.toml flies through the 14M one).
+void write_if_asked(const HlodModel& model) {
+  const char* path = std::getenv("LOD_HLOD_WRITE");
+  if (!path || !*path) return;
+  const Status st = write_hlod_asset(path, model.tree, model.payloads);
+  std::fprintf(stderr, "hlod bench: %s %s\n", st ? "wrote" : "could not write", st ? path : st.message.c_str());
+}
+
 void run_build(benchmark::State& state, const MeshData* mesh) {
   if (!mesh) {
     state.SkipWithError("needs ../shared/data/meshes/stanford-dragon.ply (absent on this machine)");
@@ -86,6 +97,7 @@ void run_build(benchmark::State& state, const MeshData* mesh) {
       return;
     }
     benchmark::DoNotOptimize(model.tree.nodes.data());
+    write_if_asked(model);
   }
   state.counters["nodes"] = double(report.nodes);
   state.counters["leaves"] = double(report.leaves);
