@@ -34,7 +34,9 @@
 #include "runtime/importance.h"
 #include "runtime/level_blend.h"
 #include "runtime/derived_columns.h"
+#include "runtime/benefit_cost_selection.h"
 #include "runtime/level_caps.h"
+#include "runtime/selection_oracle.h"
 #include "runtime/object_controls.h"
 #include "runtime/occlusion.h"
 #include "runtime/selection_quality.h"
@@ -172,6 +174,9 @@ struct FrameGraph::Impl {
   // Visible objects compacted in object order (slot k <-> Frame entry k).
   std::vector<float> visible_weight;
   std::vector<uint32_t> visible_row;
+  std::vector<float> visible_benefit;      // benefit weights: benefit_cost and the optimum only
+  std::vector<uint8_t> initial_levels;     // before selection, when the optimum is measured
+  uint64_t selection_budget = 0;           // what selection was given (M less the blend reserve)
   std::vector<uint8_t> all_ones;
   std::vector<HeapEntry> heap;
   std::vector<uint32_t> selection_counts;  // chunks x level_total
@@ -328,6 +333,7 @@ struct FrameGraph::Impl {
     visible_weight.resize(count);
     mask.resize(count);
     visible_row.resize(count);
+    visible_benefit.resize(count);
     all_ones.resize(count, 1);  // only ever ones
     heap.resize(count);
     for (uint32_t v = 0; v < view_count; ++v) {
@@ -613,6 +619,9 @@ struct FrameGraph::Impl {
     }
     assert(slot == end_slot);
     for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) f.models[k] = s.model[ids[k]];
+    if (needs_benefit_weights())
+      for (uint32_t k = chunk_offset[c]; k < end_slot; ++k)
+        visible_benefit[k] = benefit_weight(p0.area[ids[k]], p0.distance[ids[k]], s.error_scale[ids[k]], focal[0]);
     const size_t b0 = chunk_offset[c], n0 = chunk_visible[c];
     const std::span<uint32_t> counts(selection_counts.data() + c * level_total, level_total);
     std::fill(counts.begin(), counts.end(), 0u);
@@ -622,6 +631,16 @@ struct FrameGraph::Impl {
                      std::span<const float>(visible_weight.data() + b0, n0),
                      std::span<const uint32_t>(visible_row.data() + b0, n0), static_cast<uint32_t>(b0), caps.rows,
                      selection_tables);
+  }
+
+  // The frame's fraction of the optimum (Frame::benefit_optimum_fraction) is measured where the
+  // oracle is cheap: at most kOptimumEntries entries, a DP of kOptimumCells cost cells (about
+  // 300 x 4096 x levels steps, a few milliseconds, counted in publish).
+  static constexpr size_t kOptimumEntries = 300;
+  static constexpr size_t kOptimumCells = 4096;
+  bool measures_optimum() const { return options.measure_quality && visible_total <= kOptimumEntries; }
+  bool needs_benefit_weights() const {
+    return options.selection.selector == Selector::benefit_cost || measures_optimum();
   }
 
   // On the compacted visible set: the same result as on the whole range (selection breaks
@@ -642,10 +661,14 @@ struct FrameGraph::Impl {
       morph_reserve = std::min(last_morph_extra, so.budget / 2);
       so.budget -= morph_reserve;
     }
+    selection_budget = so.budget;
+    if (measures_optimum()) initial_levels.assign(out->levels.begin(), out->levels.begin() + long(v));
+    const std::span<const float> benefit =
+        so.selector == Selector::benefit_cost ? std::span<const float>(visible_benefit.data(), v) : std::span<const float>{};
     selected = lower_under_budget(
         std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
         std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_row.data(), v),
-        caps.rows, so, selection_total, std::span<HeapEntry>(heap.data(), v));
+        caps.rows, so, selection_total, std::span<HeapEntry>(heap.data(), v), benefit);
   }
 
   // Each entry's handle, transform and view mask, gathered from its object; beside selection,
@@ -927,6 +950,25 @@ struct FrameGraph::Impl {
     f.benefit = quality.benefit;
     f.pixel_error_max = quality.pixel_error_max;
     f.pixel_error_mean = quality.measured ? float(quality.pixel_error_sum / quality.measured) : 0.f;
+    measure_optimum_fraction(f);
+  }
+
+  // The selected levels' benefit over the optimum of the same problem (initial levels, weights,
+  // the budget selection had); -1 where not measured or the coarsest levels do not fit.
+  void measure_optimum_fraction(Frame& f) const {
+    f.benefit_optimum_fraction = -1;
+    f.benefit_optimum_exact = false;
+    if (!measures_optimum()) return;
+    const size_t v = visible_total;
+    const std::span<const float> w(visible_benefit.data(), v);
+    const std::span<const uint32_t> rows(visible_row.data(), v);
+    SelectionOptimum o;
+    if (!selection_optimum(initial_levels, w, rows, caps.rows, options.selection.count == BudgetCount::triangles,
+                           selection_budget, kOptimumCells, o))
+      return;
+    const double b = selection_benefit(std::span<const uint8_t>(f.levels.data(), v), w, rows, caps.rows);
+    f.benefit_optimum_fraction = o.benefit > 0 ? std::min(1.0, b / o.benefit) : 1.0;
+    f.benefit_optimum_exact = o.exact;
   }
 
   ChunkTotals sum_counts(const uint32_t* counts) const {
@@ -1017,7 +1059,7 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      "measure_objects + minima, importance_weights + choose_initial_levels per view, combine_view_choice, "
      "apply_object_controls, compaction, gather_selection, parallel",
      kObjects | kBounds | kControls | kViews | kVisibility | kHistory, kEntries | kLevels, &Impl::node_importance},
-    {Stage::selection, "lower_under_budget (greedy or greedy_multi): heap over the visible set, serial", kEntries | kLevels, kLevels,
+    {Stage::selection, "lower_under_budget (greedy, greedy_multi or benefit_cost): heap over the visible set, serial", kEntries | kLevels, kLevels,
      &Impl::node_selection},
     {Stage::entries, "handles, transforms, view masks of the entries, parallel", kEntries | kObjects | kVisibility,
      kPlacing, &Impl::node_entries},

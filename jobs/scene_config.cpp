@@ -220,8 +220,10 @@ void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
       c.selection.selector = Selector::greedy;
     else if (*v == "greedy_multi")
       c.selection.selector = Selector::greedy_multi;
+    else if (*v == "benefit_cost")
+      c.selection.selector = Selector::benefit_cost;
     else
-      r.fail("budget.selector", "must be \"greedy\" or \"greedy_multi\", got \"" + *v + "\"");
+      r.fail("budget.selector", "must be \"greedy\", \"greedy_multi\" or \"benefit_cost\", got \"" + *v + "\"");
   }
   if (c.selection.strict && c.selection.count != BudgetCount::triangles)
     r.fail("budget.strict", "needs count = \"triangles\" (blends are counted in triangles)");

@@ -602,6 +602,8 @@ TEST(SceneConfigBudgetModes, ParsesAndRefusesSelector) {
   EXPECT_EQ(frame_graph_options(c).selection.selector, Selector::greedy_multi);
   ASSERT_TRUE(load(d, "[budget]\nselector = \"greedy\"\n" + kModel + kInstances, c).ok);
   EXPECT_EQ(c.selection.selector, Selector::greedy);
+  ASSERT_TRUE(load(d, "[budget]\nselector = \"benefit_cost\"\n" + kModel + kInstances, c).ok);
+  EXPECT_EQ(frame_graph_options(c).selection.selector, Selector::benefit_cost);
   expect_refused("[budget]\nselector = \"optimal\"\n" + kModel + kInstances, "budget.selector", "greedy_multi");
 }
 
