@@ -193,6 +193,8 @@ struct FrameGraph::Impl {
   std::vector<uint32_t> chunk_occluded;
   std::vector<uint32_t> chunk_far;         // view 0's frustum, beyond max_distance
   OcclusionBuffer occlusion_buffer;
+  std::unique_ptr<OcclusionTracer> tracer;  // options.occlusion.make_tracer's; null: rasterise
+  std::vector<OccluderMesh> occluder_meshes;
   OcclusionCamera occlusion_view{};
   uint32_t visible_total = 0;
   uint64_t last_morph_extra = 0;
@@ -245,6 +247,7 @@ struct FrameGraph::Impl {
         arena(o.threads == 0 ? tbb::task_arena::automatic : static_cast<int>(o.threads)) {
     set_models(std::move(models));
     if (o.hlod && !o.hlod->empty()) make_hlod_stream(o.hlod);
+    if (o.occlusion.enabled && o.occlusion.make_tracer) tracer = o.occlusion.make_tracer();
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
   }
@@ -521,12 +524,19 @@ struct FrameGraph::Impl {
     for (size_t c = 0; c < chunks; ++c) occluders.insert(occluders.end(), chunk_occluders[c].begin(), chunk_occluders[c].end());
     keep_best_occluders(occluders, options.occlusion.occluders);
     occlusion_clear(occlusion_buffer, occlusion_view);
+    occluder_meshes.clear();
     for (const OccluderCandidate& o : occluders) {
       const LodChain& chain = *set->chains[s.model[o.object]];
       const LodLevel& l = chain.levels[occluder_level[s.model[o.object]]];
-      rasterize_occluder(occlusion_buffer, occlusion_view,
-                         std::span(chain.positions.data() + 3 * size_t(l.first_vertex), 3 * size_t(l.vertex_count)),
-                         std::span(chain.indices.data() + l.first_index, l.index_count), s.transform[o.object]);
+      occluder_meshes.push_back(
+          {std::span(chain.positions.data() + 3 * size_t(l.first_vertex), 3 * size_t(l.vertex_count)),
+           std::span(chain.indices.data() + l.first_index, l.index_count), s.transform[o.object]});
+    }
+    if (tracer) {
+      trace_occluders();
+    } else {
+      for (const OccluderMesh& m : occluder_meshes)
+        rasterize_occluder(occlusion_buffer, occlusion_view, m.positions, m.indices, m.transform);
     }
     occlusion_finish(occlusion_buffer);
     for_chunks(Stage::visibility, [&](size_t c, size_t b, size_t e) {
@@ -548,6 +558,17 @@ struct FrameGraph::Impl {
     for (size_t c = 0; c < chunks; ++c) out->occluded += chunk_occluded[c];
     out->occluders = static_cast<uint32_t>(occluders.size());
     out->occluder_tris = occlusion_buffer.triangles;
+  }
+
+  // The tracer's depth buffer, rows in parallel (blocks of 8 rows).
+  void trace_occluders() {
+    occlusion_buffer.triangles = tracer->prepare(occluder_meshes);
+    if (occluder_meshes.empty()) return;
+    constexpr int kRows = 8;
+    const int h = occlusion_buffer.height;
+    for_items(Stage::visibility, size_t((h + kRows - 1) / kRows), [&](size_t j) {
+      tracer->trace_rows(occlusion_buffer, occlusion_view, int(j) * kRows, std::min(h, int(j + 1) * kRows));
+    });
   }
 
   void node_importance() {

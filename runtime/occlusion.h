@@ -12,6 +12,7 @@
 // gap narrower than one) may be, as with any occlusion culling at a finite resolution.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -56,6 +57,26 @@ bool sphere_occluded(const OcclusionBuffer& buffer, const OcclusionCamera& camer
 size_t occlusion_cull(std::span<uint8_t> visible, std::span<const float> cx, std::span<const float> cy,
                       std::span<const float> cz, std::span<const float> radius, const OcclusionBuffer& buffer,
                       const OcclusionCamera& camera);
+
+// Another way to fill the depth buffer ([visibility] occlusion_method = "embree"): a ray from
+// the eye through the centre of every sample, the first occluder hit giving the depth (the
+// same view-space depth, so the same pyramid and sphere test follow). The frame graph hands it
+// the chosen occluders, then asks for rows in parallel. Implemented in preprocess/
+// (embree_occlusion.h), so that lod_engine links no ray tracer.
+struct OccluderMesh {
+  std::span<const float> positions;   // object space, xyz
+  std::span<const uint32_t> indices;  // level-local
+  Transform transform;
+};
+class OcclusionTracer {
+ public:
+  virtual ~OcclusionTracer() = default;
+  // What tracing these occluders needs (serial); returns the occluder triangles.
+  virtual uint64_t prepare(std::span<const OccluderMesh> occluders) = 0;
+  // Rows [y0, y1) of buffer.levels[0] (cleared, at the camera's size); disjoint rows may be
+  // traced at the same time.
+  virtual void trace_rows(OcclusionBuffer& buffer, const OcclusionCamera& camera, int y0, int y1) const = 0;
+};
 
 // Occluders: the objects of largest angular size (radius / distance) seen by the view.
 struct OccluderCandidate {

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "jobs/frame_graph.h"
+#include "preprocess/embree_occlusion.h"
 #include "runtime/occlusion.h"
 #include "runtime/world_bounds.h"
 #include "unit/jobs/box_chain.h"
@@ -105,8 +106,9 @@ std::set<uint32_t> reference_visible(const Street& s, int width, int height) {
   return seen;
 }
 
-Frame run_frame(const Street& s, bool occlusion) {
+Frame run_frame(const Street& s, bool occlusion, bool embree = false) {
   FrameGraphOptions o;
+  if (embree) o.occlusion.make_tracer = make_embree_occlusion_tracer;
   o.threads = 2;
   o.grain = 32;
   o.selection.budget = UINT64_MAX;
@@ -117,12 +119,15 @@ Frame run_frame(const Street& s, bool occlusion) {
   return f;
 }
 
-TEST(OcclusionReference, NoObjectAnyPrimaryRayHitsIsCulled) {
+// Both ways of filling the depth buffer: rasterised, and traced with Embree.
+class OcclusionReference : public ::testing::TestWithParam<bool> {};
+
+TEST_P(OcclusionReference, NoObjectAnyPrimaryRayHitsIsCulled) {
   const Street s = make_street();
   const FrameGraphOptions defaults;
   const std::set<uint32_t> reference = reference_visible(s, defaults.occlusion.width, defaults.occlusion.height);
   ASSERT_GT(reference.size(), 20u);
-  const Frame with = run_frame(s, true), without = run_frame(s, false);
+  const Frame with = run_frame(s, true, GetParam()), without = run_frame(s, false);
   const std::set<uint32_t> kept(with.objects.begin(), with.objects.end());
   for (uint32_t id : reference) EXPECT_TRUE(kept.count(id)) << "object " << id << " is seen but was culled";
   EXPECT_GT(with.occluders, 0u);
@@ -131,15 +136,16 @@ TEST(OcclusionReference, NoObjectAnyPrimaryRayHitsIsCulled) {
   EXPECT_EQ(with.visible + with.occluded, without.visible) << "occlusion only removes frustum-visible objects";
   // Most of what the frustum keeps but no ray reaches is culled.
   const uint32_t hidden = without.visible - static_cast<uint32_t>(reference.size());
-  std::printf("street: %zu objects, %u in the frustum, %zu hit by rays, %u culled by %u occluders (%llu triangles)\n",
-              s.scene.objects.size(), without.visible, reference.size(), with.occluded, with.occluders,
+  std::printf("%s street: %zu objects, %u in the frustum, %zu hit by rays, %u culled by %u occluders (%llu triangles)\n",
+              GetParam() ? "embree" : "raster", s.scene.objects.size(), without.visible, reference.size(), with.occluded, with.occluders,
               (unsigned long long)with.occluder_tris);
   EXPECT_GE(with.occluded, hidden / 2) << with.occluded << " of " << hidden << " hidden objects culled";
 }
 
-TEST(OcclusionReference, SameFramesAtOneAndTwoThreads) {
+TEST_P(OcclusionReference, SameFramesAtOneAndTwoThreads) {
   const Street s = make_street();
   FrameGraphOptions o;
+  if (GetParam()) o.occlusion.make_tracer = make_embree_occlusion_tracer;
   o.selection.budget = UINT64_MAX;
   o.occlusion.enabled = true;
   o.grain = 32;
@@ -152,6 +158,9 @@ TEST(OcclusionReference, SameFramesAtOneAndTwoThreads) {
   EXPECT_EQ(a.occluded, b.occluded);
   EXPECT_GT(a.occluded, 0u);
 }
+
+INSTANTIATE_TEST_SUITE_P(Method, OcclusionReference, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "embree" : "raster"; });
 
 }  // namespace
 }  // namespace lod
