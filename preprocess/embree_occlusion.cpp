@@ -1,6 +1,6 @@
 // Embree occlusion tracer: a BVH per occluder mesh (cached by content), a top-level scene of
 // instances rebuilt per frame (build quality low: a few dozen instances), one coherent ray per
-// buffer sample.
+// buffer sample (packets of 8).
 #include "preprocess/embree_occlusion.h"
 
 #include <embree3/rtcore.h>
@@ -62,31 +62,39 @@ class EmbreeTracer final : public OcclusionTracer {
     return triangles;
   }
 
+  // Packets of 8 neighbouring samples of a row (measured: faster than single rays here).
   void trace_rows(OcclusionBuffer& b, const OcclusionCamera& c, int y0, int y1) const override {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    constexpr float kInf = std::numeric_limits<float>::infinity();
     for (int y = y0; y < y1; ++y) {
       float* row = b.levels[0].data() + size_t(y) * size_t(b.width);
       const float v = (1 - (float(y) + 0.5f) / float(b.height) * 2) * c.tan_y;
-      for (int x = 0; x < b.width; ++x) {
-        const float u = ((float(x) + 0.5f) / float(b.width) * 2 - 1) * c.tan_x;
-        RTCRayHit rh;
-        // The direction's forward component is 1, so the hit's t is its view depth.
-        rh.ray.org_x = c.eye[0], rh.ray.org_y = c.eye[1], rh.ray.org_z = c.eye[2];
-        rh.ray.dir_x = c.forward[0] + u * c.right[0] + v * c.up[0];
-        rh.ray.dir_y = c.forward[1] + u * c.right[1] + v * c.up[1];
-        rh.ray.dir_z = c.forward[2] + u * c.right[2] + v * c.up[2];
-        rh.ray.tnear = c.near_z;
-        rh.ray.tfar = std::numeric_limits<float>::infinity();
-        rh.ray.time = 0;
-        rh.ray.mask = 0xffffffffu;
-        rh.ray.id = 0;
-        rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(top_, &context, &rh);
-        row[x] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh.ray.tfar : std::numeric_limits<float>::infinity();
+      for (int x0 = 0; x0 < b.width; x0 += 8) {
+        RTCRayHit8 rh;
+        int valid[8];
+        for (int k = 0; k < 8; ++k) {
+          const int x = x0 + k;
+          valid[k] = x < b.width ? -1 : 0;
+          const float u = ((float(x) + 0.5f) / float(b.width) * 2 - 1) * c.tan_x;
+          // The direction's forward component is 1, so the hit's t is its view depth.
+          rh.ray.org_x[k] = c.eye[0], rh.ray.org_y[k] = c.eye[1], rh.ray.org_z[k] = c.eye[2];
+          rh.ray.dir_x[k] = c.forward[0] + u * c.right[0] + v * c.up[0];
+          rh.ray.dir_y[k] = c.forward[1] + u * c.right[1] + v * c.up[1];
+          rh.ray.dir_z[k] = c.forward[2] + u * c.right[2] + v * c.up[2];
+          rh.ray.tnear[k] = c.near_z;
+          rh.ray.tfar[k] = kInf;
+          rh.ray.time[k] = 0;
+          rh.ray.mask[k] = 0xffffffffu;
+          rh.ray.id[k] = 0;
+          rh.ray.flags[k] = 0;
+          rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, top_, &context, &rh);
+        for (int k = 0; k < 8 && x0 + k < b.width; ++k)
+          row[x0 + k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? rh.ray.tfar[k] : kInf;
       }
     }
   }
