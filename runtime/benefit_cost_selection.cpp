@@ -21,9 +21,9 @@ struct Costs {
 };
 
 struct Step {
-  uint8_t to;      // == the current level when there is none
-  float key;       // benefit per unit of extra cost
-  int64_t extra;   // extra cost
+  uint8_t to;     // == the current level when there is none
+  float key;      // benefit per unit of extra cost
+  int64_t extra;  // extra cost
 };
 
 // From `cur`, the finer level in [finest, cur) of steepest benefit slope within `room`; ties

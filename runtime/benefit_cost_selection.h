@@ -37,8 +37,8 @@ struct BenefitCostResult {
 // invisible objects are left as they are. The coarsest levels must fit in `budget` (the caller
 // checks). `heap` has room for every visible object. Deterministic (ties by object id).
 BenefitCostResult raise_by_benefit_cost(std::span<uint8_t> level, std::span<const uint8_t> visible,
-                                        std::span<const float> benefit_weight, std::span<const uint32_t> model,
-                                        const ModelTable& models, BudgetCount count, uint64_t budget,
-                                        std::span<HeapEntry> heap);
+                                        std::span<const float> benefit_weight,
+                                        std::span<const uint32_t> model, const ModelTable& models,
+                                        BudgetCount count, uint64_t budget, std::span<HeapEntry> heap);
 
 }  // namespace lod

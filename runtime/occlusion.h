@@ -1,8 +1,10 @@
 // Occlusion culling against a small software depth buffer.
 //
 // Occluders (the coarse levels of large nearby objects) are point-sampled at the centre of
-// every buffer sample, each covered sample taking the triangle's farthest depth, so the
-// occluder surface at a sample is never behind the stored depth. A max-depth pyramid over the
+// every buffer sample, each covered sample taking the depth where the ray through its centre
+// meets the triangle (1 / z interpolated in screen space, made slightly farther against
+// rounding and never beyond the triangle's farthest vertex), so the stored depth is never in
+// front of the occluder surface at a sample centre. A max-depth pyramid over the
 // buffer lets an object be tested with a few texels: it is occluded when the screen rectangle
 // of its bounding sphere (bounded through the corners of the sphere's box, so it holds the
 // whole sphere) lies behind the stored depth everywhere. Depth is the view-space distance
@@ -42,7 +44,8 @@ struct OcclusionBuffer {
 void occlusion_clear(OcclusionBuffer& buffer, const OcclusionCamera& camera);
 
 // Rasterises one object's triangles (object-space positions xyz, level-local indices) placed
-// by `transform`. Triangles reaching in front of the near plane are skipped (conservative).
+// by `transform`. Triangles reaching in front of the near plane are clipped to it (what is in
+// front of it hides nothing the view can see).
 void rasterize_occluder(OcclusionBuffer& buffer, const OcclusionCamera& camera, std::span<const float> positions,
                         std::span<const uint32_t> indices, const Transform& transform);
 

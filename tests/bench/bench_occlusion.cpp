@@ -31,18 +31,21 @@ LodChain split_box_chain(const std::string& name, float hx, float hy, float hz, 
   struct Face {
     float o[3], u[3], v[3];
   };
-  const Face faces[6] = {{{hx, 0, -hz}, {0, 2 * hy, 0}, {0, 0, 2 * hz}},  {{-hx, 0, -hz}, {0, 0, 2 * hz}, {0, 2 * hy, 0}},
-                         {{-hx, 2 * hy, -hz}, {0, 0, 2 * hz}, {2 * hx, 0, 0}}, {{-hx, 0, -hz}, {2 * hx, 0, 0}, {0, 0, 2 * hz}},
-                         {{-hx, 0, hz}, {2 * hx, 0, 0}, {0, 2 * hy, 0}},  {{-hx, 0, -hz}, {0, 2 * hy, 0}, {2 * hx, 0, 0}}};
+  const Face faces[6] = {
+      {{hx, 0, -hz}, {0, 2 * hy, 0}, {0, 0, 2 * hz}},       {{-hx, 0, -hz}, {0, 0, 2 * hz}, {0, 2 * hy, 0}},
+      {{-hx, 2 * hy, -hz}, {0, 0, 2 * hz}, {2 * hx, 0, 0}}, {{-hx, 0, -hz}, {2 * hx, 0, 0}, {0, 0, 2 * hz}},
+      {{-hx, 0, hz}, {2 * hx, 0, 0}, {0, 2 * hy, 0}},       {{-hx, 0, -hz}, {0, 2 * hy, 0}, {2 * hx, 0, 0}}};
   for (const Face& f : faces) {
     const uint32_t base = static_cast<uint32_t>(c.positions.size() / 3);
     for (int j = 0; j <= n; ++j)
       for (int i = 0; i <= n; ++i)
-        for (int a = 0; a < 3; ++a) c.positions.push_back(f.o[a] + f.u[a] * float(i) / float(n) + f.v[a] * float(j) / float(n));
+        for (int a = 0; a < 3; ++a)
+          c.positions.push_back(f.o[a] + f.u[a] * float(i) / float(n) + f.v[a] * float(j) / float(n));
     const auto at = [&](int i, int j) { return base + uint32_t(j * (n + 1) + i); };
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
-        c.indices.insert(c.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        c.indices.insert(c.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j),
+                                           at(i + 1, j + 1), at(i, j + 1)});
   }
   c.normals.assign(c.positions.size(), 0.f);
   LodLevel l;
@@ -149,7 +152,8 @@ void BM_OccluderFill(benchmark::State& state) {
   keep_best_occluders(best, 48);
   const LodChain& chain = scene.chains[0];
   std::vector<OccluderMesh> meshes;
-  for (const OccluderCandidate& c : best) meshes.push_back({chain.positions, chain.indices, transforms[c.object]});
+  for (const OccluderCandidate& c : best)
+    meshes.push_back({chain.positions, chain.indices, transforms[c.object]});
   std::unique_ptr<OcclusionTracer> tracer = method == 2 ? make_embree_occlusion_tracer() : nullptr;
   OcclusionBuffer buffer;
   uint64_t triangles = 0;
@@ -159,7 +163,8 @@ void BM_OccluderFill(benchmark::State& state) {
       buffer.triangles = tracer->prepare(meshes);
       tracer->trace_rows(buffer, cam, 0, height);
     } else {
-      for (const OccluderMesh& m : meshes) rasterize_occluder(buffer, cam, m.positions, m.indices, m.transform);
+      for (const OccluderMesh& m : meshes)
+        rasterize_occluder(buffer, cam, m.positions, m.indices, m.transform);
     }
     occlusion_finish(buffer);
     triangles += buffer.triangles;

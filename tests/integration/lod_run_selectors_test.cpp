@@ -14,7 +14,8 @@ namespace {
 
 // 120 balls (6,240 triangles each at full detail, 374 at the coarsest) around an orbit; about
 // 100 in view need 85k to 110k triangles at their initial levels.
-std::filesystem::path small_scene(const std::filesystem::path& dir, uint64_t budget, const std::string& selector) {
+std::filesystem::path small_scene(const std::filesystem::path& dir, uint64_t budget,
+                                  const std::string& selector) {
   lod::test::write_text(dir / "ball.off", lod::test::sphere_off(40, 80));
   const auto cfg = dir / (selector + "-" + std::to_string(budget) + ".toml");
   lod::test::write_text(cfg, R"([run]
@@ -27,7 +28,8 @@ pixel_error = 0.05
 [budget]
 reserve_blends = false
 selector = ")" + selector + R"("
-triangles = )" + std::to_string(budget) + R"(
+triangles = )" + std::to_string(budget) +
+                                 R"(
 
 [camera]
 path = "orbit"
@@ -82,7 +84,8 @@ TEST(LodRunSelectors, FractionOfTheOptimumPerFrameForEverySelector) {
     const auto& s = j["summary"];
     EXPECT_EQ(s["optimum_frames"].get<uint64_t>(), j["frames"].size());
     EXPECT_GT(s["min_benefit_optimum_fraction"].get<double>(), 0.0);
-    EXPECT_LE(s["min_benefit_optimum_fraction"].get<double>(), s["mean_benefit_optimum_fraction"].get<double>());
+    EXPECT_LE(s["min_benefit_optimum_fraction"].get<double>(),
+              s["mean_benefit_optimum_fraction"].get<double>());
     EXPECT_LE(s["mean_benefit_optimum_fraction"].get<double>(), 1.0);
   }
 }

@@ -40,7 +40,8 @@ struct Problem {
       const uint32_t base = models.first_level[model[i]], n = models.level_count[model[i]];
       for (uint32_t l = 0; l < n; ++l) {
         k.cost.push_back(models.triangles[base + l]);
-        k.benefit.push_back(double(w[i]) * std::max(0.0, double(models.error[base + n - 1]) - models.error[base + l]));
+        k.benefit.push_back(double(w[i]) *
+                            std::max(0.0, double(models.error[base + n - 1]) - models.error[base + l]));
       }
       k.first.push_back(static_cast<uint32_t>(k.cost.size()));
     }
@@ -118,7 +119,8 @@ TEST(BenefitCostSelector, RandomScenesAgainstTheOptimum) {
     for (double share : {0.1, 0.3, 0.6}) {
       test::RandomScene s(120, seed, share);
       Problem p{s.models, s.model, {}, s.problem.capacity};
-      for (size_t i = 0; i < s.model.size(); ++i) p.w.push_back(benefit_weight(s.area[i], s.distance[i], s.scale[i], 1000.f));
+      for (size_t i = 0; i < s.model.size(); ++i)
+        p.w.push_back(benefit_weight(s.area[i], s.distance[i], s.scale[i], 1000.f));
       std::vector<uint8_t> levels(120, 0), opt(120);
       const SelectionResult r = p.select(levels);
       ASSERT_TRUE(optimal_choice(s.problem, 10, opt));
@@ -139,7 +141,8 @@ TEST(BenefitCostSelector, RandomScenesAgainstTheOptimum) {
 TEST(BenefitCostSelector, NeverFinerThanTheInitialLevelsAndKeepsThemWhenTheyFit) {
   test::RandomScene s(60, 9, 0.3);
   Problem p{s.models, s.model, {}, s.problem.capacity};
-  for (size_t i = 0; i < s.model.size(); ++i) p.w.push_back(benefit_weight(s.area[i], s.distance[i], 1.f, 1000.f));
+  for (size_t i = 0; i < s.model.size(); ++i)
+    p.w.push_back(benefit_weight(s.area[i], s.distance[i], 1.f, 1000.f));
   std::vector<uint8_t> initial(60);
   for (size_t i = 0; i < 60; ++i) initial[i] = static_cast<uint8_t>(i % s.models.level_count[s.model[i]]);
   std::vector<uint8_t> levels = initial;
@@ -162,7 +165,8 @@ TEST(BenefitCostSelector, NeverFinerThanTheInitialLevelsAndKeepsThemWhenTheyFit)
 TEST(BenefitCostSelector, LevelBudgetsAndTheOverBudgetCase) {
   test::RandomScene s(80, 4, 0.3);
   Problem p{s.models, s.model, {}, 0};
-  for (size_t i = 0; i < s.model.size(); ++i) p.w.push_back(benefit_weight(s.area[i], s.distance[i], 1.f, 1000.f));
+  for (size_t i = 0; i < s.model.size(); ++i)
+    p.w.push_back(benefit_weight(s.area[i], s.distance[i], 1.f, 1000.f));
   uint64_t coarsest = 0, finest = 0;
   for (uint32_t m : s.model) {
     coarsest += uint64_t{1} << s.models.level_l[s.models.first_level[m] + s.models.level_count[m] - 1];
