@@ -65,12 +65,9 @@ bool row_span(const Edge (&e)[3], float fy, int x0, int x1, int* lo, int* hi) {
   return true;
 }
 
-// Depth at sample centres: 1 / z is linear in screen space, so its plane through the three
-// vertices gives the surface's depth where the ray through the sample centre meets the triangle
-// (as a ray caster would see it). Made a little farther (kDepthSlack, against rounding) and never
-// beyond the triangle's farthest vertex, so the stored depth is never in front of the surface.
-constexpr float kDepthSlack = 1e-4f;
-
+// Every covered sample takes the triangle's farthest depth, so the stored depth is never in front
+// of its surface. (Interpolating 1 / z instead, the surface's depth at each sample centre, was
+// measured: 0.4 % fewer selected triangles on town.toml for a 1.4x slower fill.)
 void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[3], const float z[3]) {
   // Screen y grows downwards, so a face turned towards the eye (counter-clockwise seen from
   // outside) has a negative signed area here. Back faces are skipped: on a closed mesh they
@@ -82,12 +79,7 @@ void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[
                      pixel_edge(sx[1], sy[1], sx[0], sy[0])};
   for (int k = 0; k < 3; ++k)
     if (!std::isfinite(sx[k]) || !std::isfinite(sy[k])) return;
-  const float w[3] = {1 / z[0], 1 / z[1], 1 / z[2]};
-  const float far_z = std::max({z[0], z[1], z[2]});
-  const float wa = ((w[1] - w[0]) * (sy[2] - sy[0]) - (w[2] - w[0]) * (sy[1] - sy[0])) / area;
-  const float wb = ((w[2] - w[0]) * (sx[1] - sx[0]) - (w[1] - w[0]) * (sx[2] - sx[0])) / area;
-  const float wc = w[0] - wa * sx[0] - wb * sy[0] + 0.5f * (wa + wb);  // at sample centres
-  const float w_far = 1 / far_z;
+  const float depth = std::max({z[0], z[1], z[2]});
   const int x0 = clamped_floor(std::min({sx[0], sx[1], sx[2]}), 0, buf.width - 1);
   const int x1 = clamped_floor(std::max({sx[0], sx[1], sx[2]}) + 1, 0, buf.width - 1);
   const int y0 = clamped_floor(std::min({sy[0], sy[1], sy[2]}), 0, buf.height - 1);
@@ -98,11 +90,7 @@ void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[
     float* __restrict row = buf.levels[0].data() + size_t(y) * size_t(buf.width);
     // Every sample of the span is inside; a sample on an edge counts for both triangles that
     // share the edge, so meshes leave no cracks.
-    const float w_row = wb * float(y) + wc;
-    for (int x = lo; x <= hi; ++x) {
-      const float depth = std::min(far_z, (1 + kDepthSlack) / std::max(w_far, wa * float(x) + w_row));
-      row[x] = std::min(row[x], depth);
-    }
+    for (int x = lo; x <= hi; ++x) row[x] = std::min(row[x], depth);
   }
 }
 

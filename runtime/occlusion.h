@@ -1,10 +1,9 @@
 // Occlusion culling against a small software depth buffer.
 //
 // Occluders (the coarse levels of large nearby objects) are point-sampled at the centre of
-// every buffer sample, each covered sample taking the depth where the ray through its centre
-// meets the triangle (1 / z interpolated in screen space, made slightly farther against
-// rounding and never beyond the triangle's farthest vertex), so the stored depth is never in
-// front of the occluder surface at a sample centre. A max-depth pyramid over the
+// every buffer sample, each covered sample taking the triangle's farthest depth (triangles
+// crossing the near plane clipped to it first), so the stored depth is never in front of the
+// occluder surface. A max-depth pyramid over the
 // buffer lets an object be tested with a few texels: it is occluded when the screen rectangle
 // of its bounding sphere (bounded through the corners of the sphere's box, so it holds the
 // whole sphere) lies behind the stored depth everywhere. Depth is the view-space distance
