@@ -281,6 +281,11 @@ std::string summary_text(const RunSummary& s) {
                 "worst %.2f px\n",
                 s.mean_benefit, s.mean_level_changes, s.mean_pixel_error, s.max_pixel_error);
   o << buf;
+  if (s.optimum_frames > 0) {
+    std::snprintf(buf, sizeof buf, "  benefit over the optimum (%zu frames of <= 300 entries): min %.4f, mean %.4f\n",
+                  s.optimum_frames, s.min_benefit_optimum_fraction, s.mean_benefit_optimum_fraction);
+    o << buf;
+  }
   if (s.mean_culled > 0) {
     std::snprintf(buf, sizeof buf, "  culled (culled level or beyond lod.max_distance): mean %.0f objects per frame\n",
                   s.mean_culled);
