@@ -24,6 +24,8 @@ Status write_file(const std::filesystem::path& file, const std::string& text) {
   return write_file_atomic(file, text);
 }
 
+nlohmann::json or_null(bool measured, double value) { return measured ? nlohmann::json(value) : nlohmann::json(); }
+
 nlohmann::json frame_json(const FrameRecord& r) {
   nlohmann::json levels = nlohmann::json::object();
   for (size_t l = 0; l < r.levels.size(); ++l)
@@ -54,6 +56,8 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"culled", r.culled},
           {"level_changes", r.level_changes},
           {"benefit", r.benefit},
+          {"benefit_optimum_fraction", or_null(r.benefit_optimum_fraction >= 0, r.benefit_optimum_fraction)},
+          {"benefit_optimum_exact", r.benefit_optimum_exact},
           {"pixel_error_max", r.pixel_error_max},
           {"pixel_error_mean", r.pixel_error_mean},
           {"tris_drawn", r.drawn()},
@@ -95,6 +99,9 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"mean_occluded", s.mean_occluded},
           {"mean_culled", s.mean_culled},
           {"mean_benefit", s.mean_benefit},
+          {"optimum_frames", s.optimum_frames},
+          {"min_benefit_optimum_fraction", or_null(s.optimum_frames > 0, s.min_benefit_optimum_fraction)},
+          {"mean_benefit_optimum_fraction", or_null(s.optimum_frames > 0, s.mean_benefit_optimum_fraction)},
           {"mean_level_changes", s.mean_level_changes},
           {"mean_pixel_error", s.mean_pixel_error},
           {"max_pixel_error", s.max_pixel_error},
@@ -145,6 +152,8 @@ FrameRecord record_of(const Frame& f) {
   r.culled = f.culled;
   r.level_changes = f.level_changes;
   r.benefit = f.benefit;
+  r.benefit_optimum_fraction = f.benefit_optimum_fraction;
+  r.benefit_optimum_exact = f.benefit_optimum_exact;
   r.pixel_error_max = f.pixel_error_max;
   r.pixel_error_mean = f.pixel_error_mean;
   for (uint8_t l : f.levels) ++r.chain_levels[std::min<size_t>(l, kMaxLevels - 1)];
@@ -162,8 +171,19 @@ FrameRecord record_of(const Frame& f) {
   return r;
 }
 
+// Min and sum (summarize divides) of the fraction of the optimum over the frames measured.
+void summarize_optimum_fraction(const FrameRecord& r, RunSummary& s) {
+  if (r.benefit_optimum_fraction < 0) return;
+  s.min_benefit_optimum_fraction =
+      s.optimum_frames == 0 ? r.benefit_optimum_fraction : std::min(s.min_benefit_optimum_fraction, r.benefit_optimum_fraction);
+  s.mean_benefit_optimum_fraction += r.benefit_optimum_fraction;
+  ++s.optimum_frames;
+}
+
 void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.frames = records.size();
+  s.optimum_frames = 0;
+  s.min_benefit_optimum_fraction = s.mean_benefit_optimum_fraction = 0;
   s.over_budget_frames = 0;
   s.binding_frames = 0;
   std::vector<double> total;
@@ -189,6 +209,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     occluded += r.occluded;
     culled += r.culled;
     benefit += r.benefit;
+    summarize_optimum_fraction(r, s);
     changes += r.level_changes;
     px += r.pixel_error_mean;
     s.max_pixel_error = std::max(s.max_pixel_error, double(r.pixel_error_max));
@@ -218,6 +239,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.mean_occluded = occluded / n;
   s.mean_culled = culled / n;
   s.mean_benefit = benefit / n;
+  if (s.optimum_frames > 0) s.mean_benefit_optimum_fraction /= double(s.optimum_frames);
   s.mean_level_changes = changes / n;
   s.mean_pixel_error = px / n;
   s.mean_scene_proxies = proxies / n;
@@ -276,6 +298,11 @@ std::string summary_text(const RunSummary& s) {
                 "worst %.2f px\n",
                 s.mean_benefit, s.mean_level_changes, s.mean_pixel_error, s.max_pixel_error);
   o << buf;
+  if (s.optimum_frames > 0) {
+    std::snprintf(buf, sizeof buf, "  benefit over the optimum (%zu frames of <= 300 entries): min %.4f, mean %.4f\n",
+                  s.optimum_frames, s.min_benefit_optimum_fraction, s.mean_benefit_optimum_fraction);
+    o << buf;
+  }
   if (s.mean_culled > 0) {
     std::snprintf(buf, sizeof buf, "  culled (culled level or beyond lod.max_distance): mean %.0f objects per frame\n",
                   s.mean_culled);

@@ -32,6 +32,8 @@ struct FrameRecord {
   uint32_t culled = 0;               // at a culled level, or beyond lod.max_distance
   uint32_t level_changes = 0;        // entries at another level than last frame
   double benefit = 0;                // the oracle's benefit of the selected levels (view 0)
+  double benefit_optimum_fraction = -1;  // over the optimum of the same problem; -1: not measured
+  bool benefit_optimum_exact = false;    // against the exact optimum (else an upper bound of it)
   float pixel_error_max = 0, pixel_error_mean = 0;  // screen-space error left (view 0)
   std::array<uint32_t, kMaxLevels> chain_levels{};  // objects per chain level index
   // HLOD models (the hlod node): nodes drawn, pager bytes and counters, holes (must be 0).
@@ -66,6 +68,9 @@ struct RunSummary {
   double mean_occluded = 0;             // objects occlusion culled per frame
   double mean_culled = 0;               // culled level or beyond lod.max_distance, per frame
   double mean_benefit = 0, mean_level_changes = 0;
+  // Frames whose fraction of the optimum was measured (<= 300 entries), its min and mean there.
+  size_t optimum_frames = 0;
+  double min_benefit_optimum_fraction = 0, mean_benefit_optimum_fraction = 0;
   double mean_pixel_error = 0, max_pixel_error = 0;
   // HLOD models: the most bytes resident on any frame against [stream] budget_mb, holes summed.
   size_t hlod_models = 0;

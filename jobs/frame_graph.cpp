@@ -35,7 +35,9 @@
 #include "runtime/level_blend.h"
 #include "runtime/budget_split.h"
 #include "runtime/derived_columns.h"
+#include "runtime/benefit_cost_selection.h"
 #include "runtime/level_caps.h"
+#include "runtime/selection_oracle.h"
 #include "runtime/object_controls.h"
 #include "runtime/occlusion.h"
 #include "runtime/scene_hlod_cut.h"
@@ -175,6 +177,9 @@ struct FrameGraph::Impl {
   // Visible objects compacted in object order (slot k <-> Frame entry k).
   std::vector<float> visible_weight;
   std::vector<uint32_t> visible_row;
+  std::vector<float> visible_benefit;      // benefit weights: benefit_cost and the optimum only
+  std::vector<uint8_t> initial_levels;     // before selection, when the optimum is measured
+  uint64_t selection_budget = 0;           // what selection was given (M less the blend reserve)
   std::vector<uint8_t> all_ones;
   std::vector<HeapEntry> heap;
   std::vector<uint32_t> selection_counts;  // chunks x level_total
@@ -191,6 +196,8 @@ struct FrameGraph::Impl {
   std::vector<uint32_t> chunk_occluded;
   std::vector<uint32_t> chunk_far;         // view 0's frustum, beyond max_distance
   OcclusionBuffer occlusion_buffer;
+  std::unique_ptr<OcclusionTracer> tracer;  // options.occlusion.make_tracer's; null: rasterise
+  std::vector<OccluderMesh> occluder_meshes;
   OcclusionCamera occlusion_view{};
   uint32_t visible_total = 0;
   uint64_t last_morph_extra = 0;
@@ -252,6 +259,7 @@ struct FrameGraph::Impl {
         arena(o.threads == 0 ? tbb::task_arena::automatic : static_cast<int>(o.threads)) {
     set_models(std::move(models));
     if (o.hlod && !o.hlod->empty()) make_hlod_stream(o.hlod);
+    if (o.occlusion.enabled && o.occlusion.make_tracer) tracer = o.occlusion.make_tracer();
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
   }
@@ -340,6 +348,7 @@ struct FrameGraph::Impl {
     visible_weight.resize(count);
     mask.resize(count);
     visible_row.resize(count);
+    visible_benefit.resize(count);
     all_ones.resize(count, 1);  // only ever ones
     heap.resize(count);
     for (uint32_t v = 0; v < view_count; ++v) {
@@ -528,12 +537,19 @@ struct FrameGraph::Impl {
     for (size_t c = 0; c < chunks; ++c) occluders.insert(occluders.end(), chunk_occluders[c].begin(), chunk_occluders[c].end());
     keep_best_occluders(occluders, options.occlusion.occluders);
     occlusion_clear(occlusion_buffer, occlusion_view);
+    occluder_meshes.clear();
     for (const OccluderCandidate& o : occluders) {
       const LodChain& chain = *set->chains[s.model[o.object]];
       const LodLevel& l = chain.levels[occluder_level[s.model[o.object]]];
-      rasterize_occluder(occlusion_buffer, occlusion_view,
-                         std::span(chain.positions.data() + 3 * size_t(l.first_vertex), 3 * size_t(l.vertex_count)),
-                         std::span(chain.indices.data() + l.first_index, l.index_count), s.transform[o.object]);
+      occluder_meshes.push_back(
+          {std::span(chain.positions.data() + 3 * size_t(l.first_vertex), 3 * size_t(l.vertex_count)),
+           std::span(chain.indices.data() + l.first_index, l.index_count), s.transform[o.object]});
+    }
+    if (tracer) {
+      trace_occluders();
+    } else {
+      for (const OccluderMesh& m : occluder_meshes)
+        rasterize_occluder(occlusion_buffer, occlusion_view, m.positions, m.indices, m.transform);
     }
     occlusion_finish(occlusion_buffer);
     for_chunks(Stage::visibility, [&](size_t c, size_t b, size_t e) {
@@ -610,6 +626,17 @@ struct FrameGraph::Impl {
     f.scene_proxy_tris = scene_cut.triangles;
   }
 
+  // The tracer's depth buffer, rows in parallel (blocks of 8 rows).
+  void trace_occluders() {
+    occlusion_buffer.triangles = tracer->prepare(occluder_meshes);
+    if (occluder_meshes.empty()) return;
+    constexpr int kRows = 8;
+    const int h = occlusion_buffer.height;
+    for_items(Stage::visibility, size_t((h + kRows - 1) / kRows), [&](size_t j) {
+      tracer->trace_rows(occlusion_buffer, occlusion_view, int(j) * kRows, std::min(h, int(j + 1) * kRows));
+    });
+  }
+
   void node_importance() {
     const ObjectStore& s = *store;
     for_chunks(Stage::importance, [&](size_t c, size_t b, size_t e) {
@@ -679,6 +706,9 @@ struct FrameGraph::Impl {
     }
     assert(slot == end_slot);
     for (uint32_t k = chunk_offset[c]; k < end_slot; ++k) f.models[k] = s.model[ids[k]];
+    if (needs_benefit_weights())
+      for (uint32_t k = chunk_offset[c]; k < end_slot; ++k)
+        visible_benefit[k] = benefit_weight(p0.area[ids[k]], p0.distance[ids[k]], s.error_scale[ids[k]], focal[0]);
     const size_t b0 = chunk_offset[c], n0 = chunk_visible[c];
     const std::span<uint32_t> counts(selection_counts.data() + c * level_total, level_total);
     std::fill(counts.begin(), counts.end(), 0u);
@@ -688,6 +718,16 @@ struct FrameGraph::Impl {
                      std::span<const float>(visible_weight.data() + b0, n0),
                      std::span<const uint32_t>(visible_row.data() + b0, n0), static_cast<uint32_t>(b0), caps.rows,
                      selection_tables);
+  }
+
+  // The frame's fraction of the optimum (Frame::benefit_optimum_fraction) is measured where the
+  // oracle is cheap: at most kOptimumEntries entries, a DP of kOptimumCells cost cells (about
+  // 300 x 4096 x levels steps, a few milliseconds, counted in publish).
+  static constexpr size_t kOptimumEntries = 300;
+  static constexpr size_t kOptimumCells = 4096;
+  bool measures_optimum() const { return options.measure_quality && visible_total <= kOptimumEntries; }
+  bool needs_benefit_weights() const {
+    return options.selection.selector == Selector::benefit_cost || measures_optimum();
   }
 
   // On the compacted visible set: the same result as on the whole range (selection breaks
@@ -712,10 +752,14 @@ struct FrameGraph::Impl {
       morph_reserve = std::min(last_morph_extra, so.budget / 2);
       so.budget -= morph_reserve;
     }
+    selection_budget = so.budget;
+    if (measures_optimum()) initial_levels.assign(out->levels.begin(), out->levels.begin() + long(v));
+    const std::span<const float> benefit =
+        so.selector == Selector::benefit_cost ? std::span<const float>(visible_benefit.data(), v) : std::span<const float>{};
     selected = lower_under_budget(
         std::span<uint8_t>(out->levels.data(), v), std::span<const uint8_t>(all_ones.data(), v),
         std::span<const float>(visible_weight.data(), v), std::span<const uint32_t>(visible_row.data(), v),
-        caps.rows, so, selection_total, std::span<HeapEntry>(heap.data(), v));
+        caps.rows, so, selection_total, std::span<HeapEntry>(heap.data(), v), benefit);
   }
 
   // Triangles of the visible objects at their initial levels (the pixel threshold's demand).
@@ -1008,6 +1052,25 @@ struct FrameGraph::Impl {
     f.benefit = quality.benefit;
     f.pixel_error_max = quality.pixel_error_max;
     f.pixel_error_mean = quality.measured ? float(quality.pixel_error_sum / quality.measured) : 0.f;
+    measure_optimum_fraction(f);
+  }
+
+  // The selected levels' benefit over the optimum of the same problem (initial levels, weights,
+  // the budget selection had); -1 where not measured or the coarsest levels do not fit.
+  void measure_optimum_fraction(Frame& f) const {
+    f.benefit_optimum_fraction = -1;
+    f.benefit_optimum_exact = false;
+    if (!measures_optimum()) return;
+    const size_t v = visible_total;
+    const std::span<const float> w(visible_benefit.data(), v);
+    const std::span<const uint32_t> rows(visible_row.data(), v);
+    SelectionOptimum o;
+    if (!selection_optimum(initial_levels, w, rows, caps.rows, options.selection.count == BudgetCount::triangles,
+                           selection_budget, kOptimumCells, o))
+      return;
+    const double b = selection_benefit(std::span<const uint8_t>(f.levels.data(), v), w, rows, caps.rows);
+    f.benefit_optimum_fraction = o.benefit > 0 ? std::min(1.0, b / o.benefit) : 1.0;
+    f.benefit_optimum_exact = o.exact;
   }
 
   ChunkTotals sum_counts(const uint32_t* counts) const {
@@ -1100,7 +1163,7 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      "measure_objects + minima, importance_weights + choose_initial_levels per view, combine_view_choice, "
      "apply_object_controls, compaction, gather_selection, parallel",
      kObjects | kBounds | kControls | kViews | kVisibility | kHistory, kEntries | kLevels, &Impl::node_importance},
-    {Stage::selection, "lower_under_budget (greedy or greedy_multi): heap over the visible set, serial", kEntries | kLevels | kSceneHlod, kLevels,
+    {Stage::selection, "lower_under_budget (greedy, greedy_multi or benefit_cost): heap over the visible set, serial", kEntries | kLevels | kSceneHlod, kLevels,
      &Impl::node_selection},
     {Stage::entries, "handles, transforms, view masks of the entries, parallel", kEntries | kObjects | kVisibility,
      kPlacing, &Impl::node_entries},

@@ -31,6 +31,7 @@
 #include "runtime/initial_levels.h"
 #include "runtime/object_commands.h"
 #include "runtime/object_store.h"
+#include "runtime/occlusion.h"
 #include "runtime/scene_hlod_tree.h"
 #include "runtime/slc_selection.h"
 #include "runtime/view.h"
@@ -60,6 +61,9 @@ struct FrameGraphOptions {
     int width = 320, height = 180;     // depth buffer pixels
     uint32_t occluders = 48;
     uint32_t occluder_triangles = 256;
+    // Empty: occluders are rasterised. Set ([visibility] occlusion_method = "embree"): a tracer
+    // made once per frame graph fills the buffer by ray casting instead (runtime/occlusion.h).
+    std::function<std::unique_ptr<OcclusionTracer>()> make_tracer;
   } occlusion;
   // Called at the start of every stage, on the thread running it (tracing; tests inject
   // failures by throwing from it). Empty = no call.

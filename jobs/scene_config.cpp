@@ -220,8 +220,10 @@ void read_budget(const Reader& r, const toml::table& root, SceneConfig& c) {
       c.selection.selector = Selector::greedy;
     else if (*v == "greedy_multi")
       c.selection.selector = Selector::greedy_multi;
+    else if (*v == "benefit_cost")
+      c.selection.selector = Selector::benefit_cost;
     else
-      r.fail("budget.selector", "must be \"greedy\" or \"greedy_multi\", got \"" + *v + "\"");
+      r.fail("budget.selector", "must be \"greedy\", \"greedy_multi\" or \"benefit_cost\", got \"" + *v + "\"");
   }
   if (c.selection.strict && c.selection.count != BudgetCount::triangles)
     r.fail("budget.strict", "needs count = \"triangles\" (blends are counted in triangles)");
@@ -247,11 +249,18 @@ void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {
 }
 
 // [visibility] occlusion = true: cull what large nearby objects hide (view 0); occluders =
-// how many objects are rasterised as occluders per frame.
+// how many objects are rasterised as occluders per frame; occlusion_method = "raster" (default,
+// the faster: README "Occlusion culling") or "embree" (rays through every buffer sample).
 void read_visibility(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "visibility", "visibility");
   if (!t) return;
-  r.only_keys(*t, "visibility", {"occlusion", "occluders"});
+  r.only_keys(*t, "visibility", {"occlusion", "occluders", "occlusion_method"});
+  if (auto v = r.string(*t, "occlusion_method", "visibility.occlusion_method")) {
+    if (*v == "raster" || *v == "embree")
+      c.occlusion_embree = *v == "embree";
+    else
+      r.fail("visibility.occlusion_method", "must be \"raster\" or \"embree\", got \"" + *v + "\"");
+  }
   if (const toml::node* n = t->get("occlusion")) {
     const auto* b = n->as_boolean();
     if (!b) r.fail("visibility.occlusion", "must be true or false");

@@ -62,6 +62,7 @@ struct SceneConfig {
   float hysteresis = 0.25f;          // [lod] hysteresis
   float max_distance = 0;            // [lod] max_distance: objects farther are not drawn; 0 = no limit
   bool occlusion = false;            // [visibility] occlusion
+  bool occlusion_embree = false;     // [visibility] occlusion_method = "embree" (default "raster")
   uint32_t occluders = 48;           // [visibility] occluders
   CameraPath camera;
   StreamConfig stream;

@@ -49,7 +49,9 @@ FrameGraphOptions graph_options_of(const ServiceOptions& o) {
   g.selection.count = o.budget_unit == BudgetUnit::levels ? BudgetCount::levels : BudgetCount::triangles;
   g.selection.reserve_blends = o.reserve_blends;
   g.selection.strict = o.strict_budget;
-  g.selection.selector = o.selector == BudgetSelector::greedy_multi ? Selector::greedy_multi : Selector::greedy;
+  g.selection.selector = o.selector == BudgetSelector::greedy_multi   ? Selector::greedy_multi
+                         : o.selector == BudgetSelector::benefit_cost ? Selector::benefit_cost
+                                                                      : Selector::greedy;
   g.max_distance = o.max_distance;
   g.occlusion.enabled = o.occlusion;
   g.pixel_error = o.pixel_error;

@@ -10,6 +10,7 @@
 #include "jobs/scene_config.h"
 #include "jobs/service.h"
 #include "jobs/service_impl.h"
+#include "preprocess/embree_occlusion.h"
 #include "runtime/lod_asset.h"
 #include "runtime/view.h"
 
@@ -34,6 +35,7 @@ FrameGraphOptions frame_graph_options(const SceneConfig& config) {
   g.measure_quality = true;  // services from configs (lod run) report benefit and pixel error
   g.occlusion.enabled = config.occlusion;
   g.occlusion.occluders = config.occluders;
+  if (config.occlusion_embree) g.occlusion.make_tracer = make_embree_occlusion_tracer;
   return g;
 }
 

@@ -65,7 +65,10 @@ bool row_span(const Edge (&e)[3], float fy, int x0, int x1, int* lo, int* hi) {
   return true;
 }
 
-void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[3], float depth) {
+// Every covered sample takes the triangle's farthest depth, so the stored depth is never in front
+// of its surface. (Interpolating 1 / z instead, the surface's depth at each sample centre, was
+// measured: 0.4 % fewer selected triangles on town.toml for a 1.4x slower fill.)
+void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[3], const float z[3]) {
   // Screen y grows downwards, so a face turned towards the eye (counter-clockwise seen from
   // outside) has a negative signed area here. Back faces are skipped: on a closed mesh they
   // are behind its front faces, and leaving out an occluder's triangles only hides less.
@@ -76,6 +79,7 @@ void rasterize_triangle(OcclusionBuffer& buf, const float sx[3], const float sy[
                      pixel_edge(sx[1], sy[1], sx[0], sy[0])};
   for (int k = 0; k < 3; ++k)
     if (!std::isfinite(sx[k]) || !std::isfinite(sy[k])) return;
+  const float depth = std::max({z[0], z[1], z[2]});
   const int x0 = clamped_floor(std::min({sx[0], sx[1], sx[2]}), 0, buf.width - 1);
   const int x1 = clamped_floor(std::max({sx[0], sx[1], sx[2]}) + 1, 0, buf.width - 1);
   const int y0 = clamped_floor(std::min({sy[0], sy[1], sy[2]}), 0, buf.height - 1);
@@ -119,14 +123,45 @@ void occlusion_clear(OcclusionBuffer& b, const OcclusionCamera& c) {
   b.triangles = 0;
 }
 
+namespace {
+
+// Projects a view-space polygon (all z > 0) and rasterises it as a fan.
+void rasterize_polygon(OcclusionBuffer& buf, const OcclusionCamera& c, const V3* p, int n) {
+  float sx[4], sy[4], z[4];
+  for (int j = 0; j < n; ++j) sx[j] = px_of(c, p[j].x / p[j].z), sy[j] = py_of(c, p[j].y / p[j].z), z[j] = p[j].z;
+  for (int j = 1; j + 1 < n; ++j) {
+    const float tx[3] = {sx[0], sx[j], sx[j + 1]}, ty[3] = {sy[0], sy[j], sy[j + 1]}, tz[3] = {z[0], z[j], z[j + 1]};
+    rasterize_triangle(buf, tx, ty, tz);
+  }
+}
+
+// The part of triangle `t` beyond the near plane (a triangle or a quad, in the same winding):
+// the nearest occluders are walls reaching past the eye, too good to leave out.
+int clip_to_near(const V3 (&t)[3], float near_z, V3 (&out)[4]) {
+  int n = 0;
+  for (int j = 0; j < 3; ++j) {
+    const V3& a = t[j];
+    const V3& b = t[(j + 1) % 3];
+    const bool a_in = a.z > near_z, b_in = b.z > near_z;
+    if (a_in) out[n++] = a;
+    if (a_in != b_in) {
+      const float s = (near_z - a.z) / (b.z - a.z);
+      out[n++] = {a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), near_z};
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
 void rasterize_occluder(OcclusionBuffer& buf, const OcclusionCamera& c, std::span<const float> positions,
                         std::span<const uint32_t> indices, const Transform& t) {
   const size_t vertices = positions.size() / 3;
   float q[4];
   normalized_rotation(t, q);
   for (size_t k = 0; k + 2 < indices.size(); k += 3) {
-    float sx[3], sy[3], far_z = 0;
-    bool ok = true;
+    V3 p[3];
+    bool ok = true, all_beyond = true;
     for (int j = 0; j < 3 && ok; ++j) {
       const uint32_t v = indices[k + j];
       if (v >= vertices) {
@@ -136,14 +171,19 @@ void rasterize_occluder(OcclusionBuffer& buf, const OcclusionCamera& c, std::spa
       float w[3];
       rotate_by_quaternion(q, &positions[3 * size_t(v)], w);
       for (int a = 0; a < 3; ++a) w[a] = t.position[a] + t.scale * w[a];
-      const V3 p = to_view(c, w);
-      if (!(p.z > c.near_z)) ok = false;  // reaches in front of the near plane: not used
-      sx[j] = px_of(c, p.x / p.z);
-      sy[j] = py_of(c, p.y / p.z);
-      far_z = std::max(far_z, p.z);
+      p[j] = to_view(c, w);
+      ok = std::isfinite(p[j].x) && std::isfinite(p[j].y) && std::isfinite(p[j].z);
+      all_beyond = all_beyond && p[j].z > c.near_z;
     }
     if (!ok) continue;
-    rasterize_triangle(buf, sx, sy, far_z);
+    if (all_beyond) {
+      rasterize_polygon(buf, c, p, 3);
+    } else {
+      V3 clipped[4];
+      const int n = clip_to_near(p, c.near_z, clipped);
+      if (n < 3) continue;  // wholly in front of the near plane
+      rasterize_polygon(buf, c, clipped, n);
+    }
     ++buf.triangles;
   }
 }

@@ -1,8 +1,9 @@
 // Occlusion culling against a small software depth buffer.
 //
 // Occluders (the coarse levels of large nearby objects) are point-sampled at the centre of
-// every buffer sample, each covered sample taking the triangle's farthest depth, so the
-// occluder surface at a sample is never behind the stored depth. A max-depth pyramid over the
+// every buffer sample, each covered sample taking the triangle's farthest depth (triangles
+// crossing the near plane clipped to it first), so the stored depth is never in front of the
+// occluder surface. A max-depth pyramid over the
 // buffer lets an object be tested with a few texels: it is occluded when the screen rectangle
 // of its bounding sphere (bounded through the corners of the sphere's box, so it holds the
 // whole sphere) lies behind the stored depth everywhere. Depth is the view-space distance
@@ -12,6 +13,7 @@
 // gap narrower than one) may be, as with any occlusion culling at a finite resolution.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -41,7 +43,8 @@ struct OcclusionBuffer {
 void occlusion_clear(OcclusionBuffer& buffer, const OcclusionCamera& camera);
 
 // Rasterises one object's triangles (object-space positions xyz, level-local indices) placed
-// by `transform`. Triangles reaching in front of the near plane are skipped (conservative).
+// by `transform`. Triangles reaching in front of the near plane are clipped to it (what is in
+// front of it hides nothing the view can see).
 void rasterize_occluder(OcclusionBuffer& buffer, const OcclusionCamera& camera, std::span<const float> positions,
                         std::span<const uint32_t> indices, const Transform& transform);
 
@@ -56,6 +59,26 @@ bool sphere_occluded(const OcclusionBuffer& buffer, const OcclusionCamera& camer
 size_t occlusion_cull(std::span<uint8_t> visible, std::span<const float> cx, std::span<const float> cy,
                       std::span<const float> cz, std::span<const float> radius, const OcclusionBuffer& buffer,
                       const OcclusionCamera& camera);
+
+// Another way to fill the depth buffer ([visibility] occlusion_method = "embree"): a ray from
+// the eye through the centre of every sample, the first occluder hit giving the depth (the
+// same view-space depth, so the same pyramid and sphere test follow). The frame graph hands it
+// the chosen occluders, then asks for rows in parallel. Implemented in preprocess/
+// (embree_occlusion.h), so that lod_engine links no ray tracer.
+struct OccluderMesh {
+  std::span<const float> positions;   // object space, xyz
+  std::span<const uint32_t> indices;  // level-local
+  Transform transform;
+};
+class OcclusionTracer {
+ public:
+  virtual ~OcclusionTracer() = default;
+  // What tracing these occluders needs (serial); returns the occluder triangles.
+  virtual uint64_t prepare(std::span<const OccluderMesh> occluders) = 0;
+  // Rows [y0, y1) of buffer.levels[0] (cleared, at the camera's size); disjoint rows may be
+  // traced at the same time.
+  virtual void trace_rows(OcclusionBuffer& buffer, const OcclusionCamera& camera, int y0, int y1) const = 0;
+};
 
 // Occluders: the objects of largest angular size (radius / distance) seen by the view.
 struct OccluderCandidate {

@@ -137,4 +137,82 @@ bool greedy_choice(const KnapsackProblem& p, std::span<uint8_t> levels) {
   return true;
 }
 
+namespace {
+
+// One object's candidates as (cost, benefit), its cheapest cost, and its most valuable one.
+struct Candidates {
+  uint32_t base = 0, from = 0, last = 0;  // levels [from, last] of the row at base
+  int64_t cheapest = 0;
+  uint32_t most_valuable = 0;
+};
+
+int64_t cost_at(const ModelTable& t, uint32_t at, bool by_triangles) {
+  return by_triangles ? int64_t{t.triangles[at]} : int64_t{1} << t.level_l[at];
+}
+
+double value_at(const ModelTable& t, const Candidates& c, uint32_t k, float w) {
+  return double(w) * std::max(0.0, double(t.error[c.base + c.last]) - double(t.error[c.base + k]));
+}
+
+}  // namespace
+
+double selection_benefit(std::span<const uint8_t> level, std::span<const float> w, std::span<const uint32_t> model,
+                         const ModelTable& models) {
+  double b = 0;
+  for (size_t i = 0; i < level.size(); ++i) {
+    const uint32_t base = models.first_level[model[i]], last = models.level_count[model[i]] - 1u;
+    b += double(w[i]) * std::max(0.0, double(models.error[base + last]) - double(models.error[base + level[i]]));
+  }
+  return b;
+}
+
+bool selection_optimum(std::span<const uint8_t> initial, std::span<const float> w, std::span<const uint32_t> model,
+                       const ModelTable& models, bool by_triangles, uint64_t budget, size_t max_cells,
+                       SelectionOptimum& out) {
+  const size_t n = initial.size();
+  assert(w.size() == n && model.size() == n && max_cells >= 2);
+  std::vector<Candidates> objects(n);
+  int64_t base_cost = 0, coarsest = 0, valuable_cost = 0;
+  double valuable = 0;
+  for (size_t i = 0; i < n; ++i) {
+    Candidates& c = objects[i];
+    c.base = models.first_level[model[i]];
+    c.last = models.level_count[model[i]] - 1u;
+    c.from = std::min<uint32_t>(initial[i], c.last);
+    c.cheapest = cost_at(models, c.base + c.last, by_triangles);
+    c.most_valuable = c.last;
+    for (uint32_t k = c.from; k <= c.last; ++k) {
+      c.cheapest = std::min(c.cheapest, cost_at(models, c.base + k, by_triangles));
+      if (value_at(models, c, k, w[i]) > value_at(models, c, c.most_valuable, w[i])) c.most_valuable = k;
+    }
+    base_cost += c.cheapest;
+    coarsest += cost_at(models, c.base + c.last, by_triangles);
+    valuable_cost += cost_at(models, c.base + c.most_valuable, by_triangles);
+    valuable += value_at(models, c, c.most_valuable, w[i]);
+  }
+  const int64_t capacity = int64_t(std::min<uint64_t>(budget, uint64_t(std::numeric_limits<int64_t>::max())));
+  if (coarsest > capacity) return false;
+  if (valuable_cost <= capacity) {  // every object's best fits: nothing to choose
+    out = {valuable, true};
+    return true;
+  }
+  const uint64_t room = uint64_t(capacity - base_cost);
+  const uint64_t unit = std::max<uint64_t>(1, (room + max_cells - 2) / (max_cells - 1));
+  const size_t cells = size_t(room / unit) + 1;
+  // best[c]: the most benefit of the objects so far with rounded extra cost <= c.
+  std::vector<double> best(cells, 0.0), next(cells);
+  for (size_t i = 0; i < n; ++i) {
+    const Candidates& c = objects[i];
+    std::fill(next.begin(), next.end(), 0.0);
+    for (uint32_t k = c.from; k <= c.last; ++k) {
+      const size_t extra = size_t(uint64_t(cost_at(models, c.base + k, by_triangles) - c.cheapest) / unit);
+      const double v = value_at(models, c, k, w[i]);
+      for (size_t x = extra; x < cells; ++x) next[x] = std::max(next[x], best[x - extra] + v);
+    }
+    best.swap(next);
+  }
+  out = {best[cells - 1], unit == 1};
+  return true;
+}
+
 }  // namespace lod

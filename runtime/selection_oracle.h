@@ -46,4 +46,25 @@ bool optimal_choice(const KnapsackProblem& p, uint64_t unit, std::span<uint8_t> 
 // coarsest levels do not fit.
 bool greedy_choice(const KnapsackProblem& p, std::span<uint8_t> levels);
 
+// The optimum of one frame's selection, for Frame::benefit_optimum: objects i (all of the
+// spans) with candidate levels [initial_i, coarsest] of their rows, benefit w_i * (e(L) - e(k))
+// (w_i = benefit_weight), the budget selection had. Exact when every object's most valuable
+// candidate fits together (then that is the optimum), or when the room above the cheapest
+// candidates is at most `max_cells` - 1 cost units; otherwise costs are divided by
+// unit = ceil(room / (max_cells - 1)) and rounded down, which can only enlarge the feasible set:
+// `benefit` is then an upper bound of the optimum (within n x unit of cost of it), so a fraction
+// against it never overstates. O(n x max_cells x levels), value only. Returns false when the
+// coarsest levels do not fit.
+struct SelectionOptimum {
+  double benefit = 0;
+  bool exact = false;
+};
+bool selection_optimum(std::span<const uint8_t> initial, std::span<const float> benefit_weight,
+                       std::span<const uint32_t> model, const ModelTable& models, bool by_triangles, uint64_t budget,
+                       size_t max_cells, SelectionOptimum& out);
+
+// The same benefit of chosen levels.
+double selection_benefit(std::span<const uint8_t> level, std::span<const float> benefit_weight,
+                         std::span<const uint32_t> model, const ModelTable& models);
+
 }  // namespace lod

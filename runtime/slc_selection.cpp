@@ -14,51 +14,18 @@
 #include <cmath>
 #include <type_traits>
 
+#include "runtime/benefit_cost_selection.h"
 #include "runtime/importance.h"
+#include "runtime/selection_heap.h"
 
 namespace lod {
 
 namespace {
 
-// The max-heap is 4-ary: half the depth of a binary heap, and a node's four children share
-// one cache line. Order: higher f first, equal f by lower object id, so runs are
-// reproducible. Keys are >= 0, and non-negative floats order like their bit patterns, so
-// (key bits, ~object) packed into 64 bits compares in one integer comparison that the
-// compiler turns into conditional moves instead of unpredictable branches.
-constexpr size_t kArity = 4;
-
-inline uint64_t rank(const HeapEntry& e) {
-  return uint64_t{std::bit_cast<uint32_t>(e.key)} << 32 | uint32_t{~e.object};
-}
-
-// Moves `e` down from `hole` until the heap property holds again (hole technique: one
-// write per level instead of a swap). Top-down with an early exit, because a lowered object
-// is reinserted with a key close to its last one and usually stays near the top.
-void sift_down(HeapEntry* heap, size_t size, size_t hole, HeapEntry e) {
-  const uint64_t r = rank(e);
-  for (;;) {
-    const size_t first_child = kArity * hole + 1;
-    if (first_child >= size) break;
-    size_t best = first_child;
-    uint64_t best_rank = rank(heap[first_child]);
-    const size_t end = std::min(first_child + kArity, size);
-    for (size_t c = first_child + 1; c < end; ++c) {
-      const uint64_t rc = rank(heap[c]);
-      const bool higher = rc > best_rank;
-      best_rank = higher ? rc : best_rank;
-      best = higher ? c : best;
-    }
-    if (best_rank < r) break;  // ranks are unique: object ids differ
-    heap[hole] = heap[best];
-    hole = best;
-  }
-  heap[hole] = e;
-}
-
-void make_heap(HeapEntry* heap, size_t size) {
-  if (size < 2) return;
-  for (size_t i = (size - 2) / kArity + 1; i-- > 0;) sift_down(heap, size, i, heap[i]);
-}
+using detail::make_heap;
+using detail::sift_down;
+constexpr size_t kArity = detail::kHeapArity;
+inline uint64_t rank(const HeapEntry& e) { return detail::heap_rank(e); }
 
 inline uint64_t pow2(int32_t l) { return uint64_t{1} << l; }
 
@@ -254,6 +221,30 @@ LowerParams lower_params_of(const SelectionParams& p) {
   return {p.count == BudgetCount::triangles, p.budget, p.selector, p.multi_level_slack, p.multi_exact_tail};
 }
 
+// Pass 3 for the chosen selector: the heap lowers, benefit_cost raises from the coarsest.
+void run_selector(SelectionResult& r, std::span<HeapEntry> heap, size_t heap_size, std::span<uint8_t> level,
+                  std::span<const uint8_t> visible, std::span<const float> weight, std::span<const uint32_t> model,
+                  const ModelTable& models, const SelectionParams& params, std::span<const float> benefit_weight,
+                  uint64_t& cost, uint64_t& tri_sum, uint64_t& lev_sum) {
+  if (params.selector == Selector::benefit_cost) {
+    assert(benefit_weight.size() == level.size() && "benefit_cost needs every object's benefit weight");
+    const BenefitCostResult b = raise_by_benefit_cost(level, visible, benefit_weight, model, models, params.count,
+                                                      params.budget, heap);
+    r.lowered_steps = b.pops;
+    r.levels_lowered = b.levels_below_initial;
+    tri_sum = b.triangles;
+    lev_sum = b.level_cost;
+    cost = params.count == BudgetCount::triangles ? tri_sum : lev_sum;
+    return;
+  }
+  HeapEntry* h = heap.data();
+  make_heap(h, heap_size);  // pass 2: heapify, O(m)
+  const Lowered l = lower_from_heap(h, heap_size, level, weight, model, models, lower_params_of(params), cost,
+                                    tri_sum, lev_sum);
+  r.lowered_steps = l.pops;
+  r.levels_lowered = l.levels;
+}
+
 }  // namespace
 
 uint64_t level_cost(const ModelTable& models, uint32_t model, uint32_t level, BudgetCount count) {
@@ -265,7 +256,7 @@ uint64_t level_cost(const ModelTable& models, uint32_t model, uint32_t level, Bu
 SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
                                     std::span<const float> weight, std::span<const uint32_t> model,
                                     const ModelTable& models, const SelectionParams& params,
-                                    std::span<HeapEntry> heap) {
+                                    std::span<HeapEntry> heap, std::span<const float> benefit_weight) {
   const size_t n = visible.size();
   assert(level.size() == n && weight.size() == n && model.size() == n);
   const uint8_t* counts = models.level_count.data();
@@ -296,13 +287,9 @@ SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const ui
   }
   uint64_t cost = by_triangles ? tri_sum : lev_sum;
   if (cost > params.budget) {
-    // Pass 2: heapify, O(m).
     assert(g.heap_size <= heap.size() && "heap scratch needs room for every visible object");
-    make_heap(h, g.heap_size);
-    const Lowered l = lower_from_heap(h, g.heap_size, level, weight, model, models, lower_params_of(params), cost,
-                                      tri_sum, lev_sum);
-    r.lowered_steps = l.pops;
-    r.levels_lowered = l.levels;
+    run_selector(r, heap, g.heap_size, level, visible, weight, model, models, params, benefit_weight, cost, tri_sum,
+                 lev_sum);
   }
   r.cost = cost;
   r.triangles = tri_sum;
@@ -354,7 +341,8 @@ void gather_selection(std::span<HeapEntry> heap, std::span<uint32_t> level_count
 SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
                                    std::span<const float> weight, std::span<const uint32_t> model,
                                    const ModelTable& models, const SelectionParams& params,
-                                   std::span<const uint32_t> level_counts, std::span<HeapEntry> heap) {
+                                   std::span<const uint32_t> level_counts, std::span<HeapEntry> heap,
+                                   std::span<const float> benefit_weight) {
   const size_t n = visible.size();
   assert(level.size() == n && weight.size() == n && model.size() == n && heap.size() == n);
   assert(level_counts.size() == models.triangles.size());
@@ -388,11 +376,8 @@ SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uin
   }
   uint64_t cost = by_triangles ? tri_sum : lev_sum;
   if (cost > params.budget) {
-    make_heap(heap.data(), n);
-    const Lowered l =
-        lower_from_heap(heap.data(), n, level, weight, model, models, lower_params_of(params), cost, tri_sum, lev_sum);
-    r.lowered_steps = l.pops;
-    r.levels_lowered = l.levels;
+    run_selector(r, heap, n, level, visible, weight, model, models, params, benefit_weight, cost, tri_sum,
+                 lev_sum);
   }
   r.cost = cost;
   r.triangles = tri_sum;

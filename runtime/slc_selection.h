@@ -12,7 +12,12 @@
 //                 those steps decide who ends just above or below a level (measured: 5 % keeps
 //                 a cold start under 1/4 of greedy's pops and most of the benefit lost without
 //                 it, README "Selectors").
-// Both stop at the first step that brings the cost within M, so both meet the same budget.
+//   benefit_cost  Funkhouser-Sequin's benefit/cost greedy (R2) with the best-single-object check
+//                 (runtime/benefit_cost_selection.h): raises from the coarsest levels instead of
+//                 lowering from the initial ones, >= 1/2 of the optimal benefit guaranteed. It
+//                 needs each object's benefit weight (the `benefit_weight` argument).
+// The heap selectors stop at the first step that brings the cost within M, benefit_cost
+// never takes a step past M, so all three meet the same budget.
 // Not sub-range safe: the budget is global, so it runs on the whole object range at once.
 #pragma once
 #include <cstddef>
@@ -32,6 +37,7 @@ enum class BudgetCount : uint8_t {
 enum class Selector : uint8_t {
   greedy,        // R0: one level per pop
   greedy_multi,  // several levels per pop (see above)
+  benefit_cost,  // Funkhouser-Sequin from the coarsest levels (see above)
 };
 
 struct SelectionParams {
@@ -62,7 +68,8 @@ struct SelectionResult {
   uint64_t level_cost = 0;      // sum of 2^l
   uint64_t coarsest_cost = 0;   // cost with every visible object at its coarsest level
   uint32_t lowered_steps = 0;   // heap pops
-  uint32_t levels_lowered = 0;  // levels lowered in all (= heap pops for greedy)
+  uint32_t levels_lowered = 0;  // levels lowered in all (= heap pops for greedy; benefit_cost:
+                                // levels below the initial ones)
   bool over_budget = false;     // even the coarsest levels exceed M; they are used
 };
 
@@ -96,14 +103,17 @@ void gather_selection(std::span<HeapEntry> heap, std::span<uint32_t> level_count
                       const SelectionTables& tables);
 
 // `heap` holds one entry per object (from gather_selection); it is reordered in place.
+// `benefit_weight` (per object, benefit_weight() in runtime/benefit_cost_selection.h) is read
+// only by Selector::benefit_cost, which needs it; the heap selectors ignore it.
 SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
                                    std::span<const float> weight, std::span<const uint32_t> model,
                                    const ModelTable& models, const SelectionParams& params,
-                                   std::span<const uint32_t> level_counts, std::span<HeapEntry> heap);
+                                   std::span<const uint32_t> level_counts, std::span<HeapEntry> heap,
+                                   std::span<const float> benefit_weight = {});
 
 SelectionResult select_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,
                                     std::span<const float> weight, std::span<const uint32_t> model,
                                     const ModelTable& models, const SelectionParams& params,
-                                    std::span<HeapEntry> heap);
+                                    std::span<HeapEntry> heap, std::span<const float> benefit_weight = {});
 
 }  // namespace lod

@@ -103,6 +103,12 @@ struct Frame {
   double benefit = 0;
   float pixel_error_max = 0;
   float pixel_error_mean = 0;
+  // The benefit above over the exact optimum of the same selection problem (the initial levels,
+  // the budget selection had): measured with the benefit where a frame has <= 300 entries;
+  // -1 otherwise. Exact flags a true optimum; false: against an upper bound of it (costs rounded
+  // to 4,096 cells), so the fraction is never overstated (runtime/selection_oracle.h).
+  double benefit_optimum_fraction = -1;
+  bool benefit_optimum_exact = false;
   // Occlusion culling (view 0): objects in the frustum found hidden, occluders rasterised.
   uint32_t occluded = 0;
   uint32_t occluders = 0;

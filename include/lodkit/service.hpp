@@ -58,10 +58,11 @@ enum class BudgetUnit : uint8_t {
   levels,     // R0's sum of 2^l <= M
 };
 
-// Which selector lowers levels under the budget (both meet the same M):
+// Which selector chooses levels under the budget (all meet the same M):
 enum class BudgetSelector : uint8_t {
   greedy,        // R0's max-heap, one level per pop
   greedy_multi,  // several levels per pop: far fewer pops on a cold start, about the same benefit
+  benefit_cost,  // Funkhouser-Sequin's benefit/cost greedy from the coarsest levels (>= 1/2 of optimal)
 };
 
 // Turns a mesh file into the bytes of a baked .lod asset (cached in cache_dir when not empty).

@@ -1,11 +1,14 @@
 // How good is the selection? On random scenes (tests/unit/runtime/random_knapsack.h: 200
 // objects, budgets from 10 % to 60 % of the way from the coarsest to the finest levels), the
-// benefit of R0's heap (greedy), of the multi-level-per-pop heap (greedy_multi) and of
-// Funkhouser-Sequin's benefit/cost greedy as a fraction of the exact optimum (dynamic
-// programming). Prints the distribution.
+// benefit of R0's heap (greedy), of the multi-level-per-pop heap (greedy_multi), of the
+// runtime's Funkhouser-Sequin selector (benefit_cost) and of the oracle's reference greedy
+// (selection_oracle.h) as a fraction of the exact optimum (dynamic programming). Prints the
+// distribution.
 // What do the selectors cost? BM_SelectorsColdStart: 100,000 objects from full detail with a
 // budget that sends nearly all of them to their coarsest levels (and one 30 % of the way),
-// greedy_multi against greedy (the baseline) in the same iteration: ratios of time and pops.
+// greedy_multi and benefit_cost against greedy (the baseline) in the same iteration: ratios of
+// time and pops. (Benefit is compared in BM_SelectionQuality, where each object's importance
+// weight and benefit weight come from one distance and area, and on real scenes in `lod run`.)
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -14,18 +17,34 @@
 #include <random>
 #include <vector>
 
+#include "runtime/benefit_cost_selection.h"
 #include "unit/runtime/random_knapsack.h"
 
 namespace {
 
 using namespace lod;
 
+// The runtime's benefit_cost selector from full detail on a random scene.
+std::vector<uint8_t> benefit_cost_choice(const test::RandomScene& s) {
+  const size_t n = s.model.size();
+  std::vector<uint8_t> levels(n, 0), visible(n, 1);
+  std::vector<float> w(n);
+  for (size_t i = 0; i < n; ++i) w[i] = benefit_weight(s.area[i], s.distance[i], s.scale[i], 1000.f);
+  std::vector<HeapEntry> heap(n);
+  SelectionParams p;
+  p.budget = s.problem.capacity;
+  p.selector = Selector::benefit_cost;
+  select_under_budget(levels, visible, s.weight, s.model, s.models, p, heap, w);
+  return levels;
+}
+
 void BM_SelectionQuality(benchmark::State& state) {
-  std::vector<double> heap_share, multi_share, greedy_share;
+  std::vector<double> heap_share, multi_share, greedy_share, bc_share;
   for (auto _ : state) {
     heap_share.clear();
     multi_share.clear();
     greedy_share.clear();
+    bc_share.clear();
     for (uint32_t seed = 1; seed <= 60; ++seed) {
       for (double share : {0.1, 0.3, 0.6}) {
         test::RandomScene s(200, seed, share);
@@ -36,6 +55,7 @@ void BM_SelectionQuality(benchmark::State& state) {
         heap_share.push_back(benefit_of(s.problem, s.heap_choice()) / o);
         multi_share.push_back(benefit_of(s.problem, s.heap_choice(Selector::greedy_multi)) / o);
         greedy_share.push_back(benefit_of(s.problem, greedy) / o);
+        bc_share.push_back(benefit_of(s.problem, benefit_cost_choice(s)) / o);
       }
     }
   }
@@ -51,7 +71,8 @@ void BM_SelectionQuality(benchmark::State& state) {
   };
   stats(heap_share, "heap");
   stats(multi_share, "multi");
-  stats(greedy_share, "greedy");
+  stats(greedy_share, "oracle_greedy");
+  stats(bc_share, "benefit_cost");
   state.counters["scenes"] = double(heap_share.size());
 }
 BENCHMARK(BM_SelectionQuality)->Iterations(1)->Unit(benchmark::kSecond);
@@ -93,14 +114,16 @@ void BM_SelectorsColdStart(benchmark::State& state) {
   p.budget = coarsest + (finest - coarsest) * uint64_t(state.range(0)) / 1000;
   p.multi_level_slack = float(state.range(1)) / 100.f;
   p.multi_exact_tail = float(state.range(2)) / 100.f;
-  double ms[2] = {0, 0};
-  uint64_t pops[2] = {0, 0}, levels[2] = {0, 0};
+  double ms[3] = {0, 0, 0};
+  uint64_t pops[3] = {0, 0, 0}, levels[3] = {0, 0, 0};
+  const Selector selectors[3] = {Selector::greedy, Selector::greedy_multi, Selector::benefit_cost};
   for (auto _ : state) {
-    for (int k = 0; k < 2; ++k) {
-      p.selector = k == 0 ? Selector::greedy : Selector::greedy_multi;
+    for (int k = 0; k < 3; ++k) {
+      p.selector = selectors[k];
       std::fill(level.begin(), level.end(), uint8_t{0});
       const auto t0 = std::chrono::steady_clock::now();
-      const SelectionResult r = select_under_budget(level, visible, weight, model, t, p, heap);
+      // benefit_cost's weights: the importance weights will do for timing.
+      const SelectionResult r = select_under_budget(level, visible, weight, model, t, p, heap, weight);
       ms[k] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       benchmark::DoNotOptimize(r);
       pops[k] += r.lowered_steps;
@@ -115,6 +138,10 @@ void BM_SelectorsColdStart(benchmark::State& state) {
   state.counters["multi_pops"] = double(pops[1]) / it;
   state.counters["pops_multi_over_greedy"] = double(pops[1]) / double(pops[0]);
   state.counters["multi_levels_per_pop"] = double(levels[1]) / double(pops[1]);
+  state.counters["bc_ms"] = ms[2] / it;
+  state.counters["time_bc_over_greedy"] = ms[2] / ms[0];
+  state.counters["bc_pops"] = double(pops[2]) / it;
+
 }
 BENCHMARK(BM_SelectorsColdStart)
     ->Args({20, 50, 5})   // the defaults

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "jobs/frame_graph.h"
+#include "preprocess/embree_occlusion.h"
 #include "runtime/occlusion.h"
 #include "runtime/world_bounds.h"
 #include "unit/jobs/box_chain.h"
@@ -24,7 +25,9 @@ struct Street {
   View view;
 };
 
-Street make_street() {
+// eye_z = 8: in front of the first buildings; 0: between them, their walls reaching past the
+// eye (clipped at the near plane).
+Street make_street(float eye_z = 8) {
   Street s;
   s.scene.chains = {box_chain("building", 6, 9, 6), box_chain("prop", 0.6f, 0.6f, 0.6f)};
   s.scene.models = build_model_table(s.scene.chains);
@@ -44,7 +47,7 @@ Street make_street() {
     for (float x : {-22.f, -30.f, 22.f, 30.f}) add(1, x + float(k % 3), -4.7f * k);
     if (k % 10 == 0) add(1, float(k % 7) - 3, -4.7f * k);
   }
-  s.view.eye = {0, 1.7f, 8};
+  s.view.eye = {0, 1.7f, eye_z};
   s.view.target = {0, 1.5f, -100};
   s.view.width = 320;
   s.view.height = 180;
@@ -105,8 +108,9 @@ std::set<uint32_t> reference_visible(const Street& s, int width, int height) {
   return seen;
 }
 
-Frame run_frame(const Street& s, bool occlusion) {
+Frame run_frame(const Street& s, bool occlusion, bool embree = false) {
   FrameGraphOptions o;
+  if (embree) o.occlusion.make_tracer = make_embree_occlusion_tracer;
   o.threads = 2;
   o.grain = 32;
   o.selection.budget = UINT64_MAX;
@@ -117,29 +121,39 @@ Frame run_frame(const Street& s, bool occlusion) {
   return f;
 }
 
-TEST(OcclusionReference, NoObjectAnyPrimaryRayHitsIsCulled) {
-  const Street s = make_street();
-  const FrameGraphOptions defaults;
-  const std::set<uint32_t> reference = reference_visible(s, defaults.occlusion.width, defaults.occlusion.height);
-  ASSERT_GT(reference.size(), 20u);
-  const Frame with = run_frame(s, true), without = run_frame(s, false);
-  const std::set<uint32_t> kept(with.objects.begin(), with.objects.end());
-  for (uint32_t id : reference) EXPECT_TRUE(kept.count(id)) << "object " << id << " is seen but was culled";
-  EXPECT_GT(with.occluders, 0u);
-  EXPECT_GT(with.occluder_tris, 0u);
-  EXPECT_EQ(without.occluded, 0u);
-  EXPECT_EQ(with.visible + with.occluded, without.visible) << "occlusion only removes frustum-visible objects";
-  // Most of what the frustum keeps but no ray reaches is culled.
-  const uint32_t hidden = without.visible - static_cast<uint32_t>(reference.size());
-  std::printf("street: %zu objects, %u in the frustum, %zu hit by rays, %u culled by %u occluders (%llu triangles)\n",
-              s.scene.objects.size(), without.visible, reference.size(), with.occluded, with.occluders,
-              (unsigned long long)with.occluder_tris);
-  EXPECT_GE(with.occluded, hidden / 2) << with.occluded << " of " << hidden << " hidden objects culled";
+// Both ways of filling the depth buffer: rasterised, and traced with Embree.
+class OcclusionReference : public ::testing::TestWithParam<bool> {};
+
+TEST_P(OcclusionReference, NoObjectAnyPrimaryRayHitsIsCulled) {
+  for (float eye_z : {8.f, 0.f}) {
+    const Street s = make_street(eye_z);
+    const FrameGraphOptions defaults;
+    const std::set<uint32_t> reference =
+        reference_visible(s, defaults.occlusion.width, defaults.occlusion.height);
+    ASSERT_GT(reference.size(), 20u);
+    const Frame with = run_frame(s, true, GetParam()), without = run_frame(s, false);
+    const std::set<uint32_t> kept(with.objects.begin(), with.objects.end());
+    for (uint32_t id : reference) EXPECT_TRUE(kept.count(id)) << "object " << id << " is seen but was culled";
+    EXPECT_GT(with.occluders, 0u);
+    EXPECT_GT(with.occluder_tris, 0u);
+    EXPECT_EQ(without.occluded, 0u);
+    EXPECT_EQ(with.visible + with.occluded, without.visible)
+        << "occlusion only removes frustum-visible objects";
+    // Most of what the frustum keeps but no ray reaches is culled.
+    const uint32_t hidden = without.visible - static_cast<uint32_t>(reference.size());
+    std::printf(
+        "%s street, eye z %.0f: %zu objects, %u in the frustum, %zu hit by rays, %u culled by %u occluders "
+        "(%llu triangles)\n",
+        GetParam() ? "embree" : "raster", double(eye_z), s.scene.objects.size(), without.visible,
+        reference.size(), with.occluded, with.occluders, (unsigned long long)with.occluder_tris);
+    EXPECT_GE(with.occluded, hidden / 2) << with.occluded << " of " << hidden << " hidden objects culled";
+  }
 }
 
-TEST(OcclusionReference, SameFramesAtOneAndTwoThreads) {
+TEST_P(OcclusionReference, SameFramesAtOneAndTwoThreads) {
   const Street s = make_street();
   FrameGraphOptions o;
+  if (GetParam()) o.occlusion.make_tracer = make_embree_occlusion_tracer;
   o.selection.budget = UINT64_MAX;
   o.occlusion.enabled = true;
   o.grain = 32;
@@ -152,6 +166,9 @@ TEST(OcclusionReference, SameFramesAtOneAndTwoThreads) {
   EXPECT_EQ(a.occluded, b.occluded);
   EXPECT_GT(a.occluded, 0u);
 }
+
+INSTANTIATE_TEST_SUITE_P(Method, OcclusionReference, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "embree" : "raster"; });
 
 }  // namespace
 }  // namespace lod

@@ -526,6 +526,13 @@ TEST(SceneConfigVisibility, ParsesAndRefusesOcclusionKeys) {
   expect_refused("[visibility]\nocclusion = \"yes\"\n" + kModel + kInstances, "visibility.occlusion");
   expect_refused("[visibility]\noccluders = 0\n" + kModel + kInstances, "visibility.occluders");
   expect_refused("[visibility]\nhiz = 1\n" + kModel + kInstances, "visibility.hiz", "unknown key");
+  EXPECT_FALSE(frame_graph_options(c).occlusion.make_tracer) << "raster by default";
+  ASSERT_TRUE(load(d, "[visibility]\nocclusion = true\nocclusion_method = \"embree\"\n" + kModel + kInstances, c).ok);
+  EXPECT_TRUE(frame_graph_options(c).occlusion.make_tracer);
+  ASSERT_TRUE(load(d, "[visibility]\nocclusion_method = \"raster\"\n" + kModel + kInstances, c).ok);
+  EXPECT_FALSE(frame_graph_options(c).occlusion.make_tracer);
+  expect_refused("[visibility]\nocclusion_method = \"masked\"\n" + kModel + kInstances, "visibility.occlusion_method",
+                 "\"raster\" or \"embree\"");
 }
 
 }  // namespace
@@ -602,6 +609,8 @@ TEST(SceneConfigBudgetModes, ParsesAndRefusesSelector) {
   EXPECT_EQ(frame_graph_options(c).selection.selector, Selector::greedy_multi);
   ASSERT_TRUE(load(d, "[budget]\nselector = \"greedy\"\n" + kModel + kInstances, c).ok);
   EXPECT_EQ(c.selection.selector, Selector::greedy);
+  ASSERT_TRUE(load(d, "[budget]\nselector = \"benefit_cost\"\n" + kModel + kInstances, c).ok);
+  EXPECT_EQ(frame_graph_options(c).selection.selector, Selector::benefit_cost);
   expect_refused("[budget]\nselector = \"optimal\"\n" + kModel + kInstances, "budget.selector", "greedy_multi");
 }
 
