@@ -17,11 +17,19 @@
 namespace lod {
 namespace {
 
+// The whole file; `opened` false when it does not exist. Anything else unreadable (a folder in
+// its place, an I/O error) is read as no bytes, which the decoder refuses.
 std::vector<uint8_t> read_all(const std::filesystem::path& path, bool& opened) {
-  std::ifstream f(path, std::ios::binary);
-  opened = bool(f);
-  if (!f) return {};
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  opened = std::filesystem::exists(status);
+  if (!opened || !std::filesystem::is_regular_file(status)) return {};
+  try {
+    std::ifstream f(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+  } catch (const std::exception&) {
+    return {};
+  }
 }
 
 }  // namespace

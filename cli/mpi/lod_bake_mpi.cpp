@@ -107,7 +107,8 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
     };
   const bool talk = !quiet && !json;
   auto log = [&](const std::string& line) {
-    if (talk || line.find("rank") != std::string::npos) std::fprintf(stderr, "lod-bake-mpi: %s\n", line.c_str());
+    const bool progress = line.rfind("subtrees ", 0) == 0;  // the rest: refused entries, failures
+    if (talk || !progress) std::fprintf(stderr, "lod-bake-mpi: %s\n", line.c_str());
   };
   const std::string name = std::filesystem::path(mesh).stem().string();
   HlodDistributedResult r;
