@@ -7,12 +7,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <numeric>
 #include <thread>
+#include <ctime>
 
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_clean.h"
@@ -28,6 +30,12 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 // What a rank tells rank 0 at the end: its status and its work.
 struct RankReport {
   Status status;
@@ -40,6 +48,8 @@ std::vector<uint8_t> encode_report(const RankReport& r) {
   w.u32(r.work.subtrees);
   w.u64(r.work.triangles);
   w.u64(std::bit_cast<uint64_t>(r.work.bake_seconds));
+  w.u64(std::bit_cast<uint64_t>(r.work.bake_cpu_seconds));
+  w.u64(std::bit_cast<uint64_t>(r.work.total_seconds));
   w.u64(r.work.bytes_written);
   w.u32(uint32_t(r.status.message.size()));
   w.raw(r.status.message.data(), r.status.message.size());
@@ -48,15 +58,17 @@ std::vector<uint8_t> encode_report(const RankReport& r) {
 
 RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   RankReport r;
-  constexpr size_t fixed = 1 + 4 + 8 + 8 + 8 + 4;
-  if (b.size() < fixed || b.size() != fixed + detail::load_u32(b.data() + 29)) {
+  constexpr size_t fixed = 1 + 4 + 8 + 8 + 8 + 8 + 8 + 4;
+  if (b.size() < fixed || b.size() != fixed + detail::load_u32(b.data() + fixed - 4)) {
     r.status = Status::error("rank " + std::to_string(rank) + " sent a malformed report");
     return r;
   }
   r.work.subtrees = detail::load_u32(b.data() + 1);
   r.work.triangles = detail::load_u64(b.data() + 5);
   r.work.bake_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 13));
-  r.work.bytes_written = detail::load_u64(b.data() + 21);
+  r.work.bake_cpu_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 21));
+  r.work.total_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 29));
+  r.work.bytes_written = detail::load_u64(b.data() + 37);
   r.status = b[0] ? Status::success() : Status::error(std::string(b.begin() + fixed, b.end()));
   return r;
 }
@@ -214,6 +226,7 @@ RankReport bake_share(Job& j, const std::vector<size_t>& mine) {
   std::mutex mutex;
   std::atomic<size_t> stored{0};
   const auto t0 = Clock::now();
+  const double cpu0 = process_cpu_seconds();
   auto done = [&](size_t i, HlodSubtree&& s) -> Status {
     if (j.settings.before_store) j.settings.before_store(i, stored.load());
     uint64_t bytes = 0;
@@ -234,6 +247,7 @@ RankReport bake_share(Job& j, const std::vector<size_t>& mine) {
     }
   });
   rep.work.bake_seconds = seconds_since(t0);
+  rep.work.bake_cpu_seconds = process_cpu_seconds() - cpu0;
   if (!rep.status) rep.status.message = "rank " + std::to_string(j.comm.rank) + ": " + rep.status.message;
   return rep;
 }
@@ -341,6 +355,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   } else if (ready) {
     rep.status = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 could not plan the build");
   }
+  rep.work.total_seconds = seconds_since(t_start);
   const std::vector<std::vector<uint8_t>> reports = comm.gather(encode_report(rep));
   watch.reset();
   if (result) *result = {};

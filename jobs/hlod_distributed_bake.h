@@ -52,6 +52,8 @@ struct HlodRankWork {
   uint32_t subtrees = 0;     // baked by the rank in this run
   uint64_t triangles = 0;    // their original triangles
   double bake_seconds = 0;   // the rank's time in its bakes
+  double bake_cpu_seconds = 0;  // its process's CPU time in them (the machine may be shared)
+  double total_seconds = 0;     // the rank's whole run, up to its report
   uint64_t bytes_written = 0;
 };
 

@@ -797,8 +797,8 @@ Status HlodBuilder::Impl::finish(size_t i, Tally& tally, const SubtreeDone& done
   return Status::success();
 }
 
-// Pass 1 of every listed subtree beside the original's BVH (passes 2 need it), then passes 2
-// and 3 per subtree, each result handed on as it is finished.
+// The original's BVH (passes 2 need it) with subtrees growing beside it, then per subtree
+// passes 1 (if not grown yet), 2 and 3, each result handed on as it is finished.
 Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const SubtreeDone& done) {
   Impl& m = *impl_;
   if (!m.planned) return Status::error(m.what + ": HLOD subtrees baked before the build was planned");
@@ -809,15 +809,28 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
   }
   const ParallelFor& parallel_for = m.c.options.parallel_for;
   std::vector<Tally> tallies(which.size());
-  run_all(parallel_for, 2, [&](size_t part) {
-    if (part == 0) m.ensure_surface();
-    else run_all(parallel_for, which.size(), [&](size_t k) { grow(m.c, tallies[k], *m.frontier[which[k]]); });
-  });
+  std::vector<uint8_t> grown(which.size(), 0);
+  if (!m.surface_built) {  // subtrees grow beside the BVH for as long as it takes (none serially)
+    std::atomic<bool> surface_done{false};
+    run_all(parallel_for, 2, [&](size_t part) {
+      if (part == 0) {
+        m.ensure_surface();
+        surface_done.store(true);
+        return;
+      }
+      for (size_t k = 0; k < which.size() && !surface_done.load(); ++k) {
+        grow(m.c, tallies[k], *m.frontier[which[k]]);
+        grown[k] = 1;
+      }
+    });
+  }
   if (!m.surface) return m.surface;
+  // The rest grow and finish one by one, so that results are handed on from the start.
   std::vector<Status> finished(which.size());
   std::atomic<bool> failed{false};
   run_all(parallel_for, which.size(), [&](size_t k) {
     if (failed.load(std::memory_order_relaxed)) return;
+    if (!grown[k]) grow(m.c, tallies[k], *m.frontier[which[k]]);
     finished[k] = m.finish(which[k], tallies[k], done);
     if (!finished[k]) failed.store(true, std::memory_order_relaxed);
   });

@@ -61,15 +61,16 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
   double slowest = 0, sum = 0;
   for (const HlodRankWork& w : r.ranks) {
     per_rank.push_back({{"subtrees", w.subtrees}, {"triangles", w.triangles}, {"bake_s", w.bake_seconds},
+                        {"bake_cpu_s", w.bake_cpu_seconds}, {"until_report_s", w.total_seconds},
                         {"bytes_written", w.bytes_written}});
-    slowest = std::max(slowest, w.bake_seconds), sum += w.bake_seconds;
+    slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
   }
   return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},
           {"subtrees", r.subtrees}, {"cached", r.cached}, {"rebaked", r.rebaked}, {"nodes", r.report.nodes},
           {"entry_bytes_read", r.entry_bytes_read}, {"load_s", r.load_seconds}, {"plan_s", r.plan_seconds},
           {"lookup_s", r.lookup_seconds}, {"bake_s", r.bake_seconds}, {"assemble_s", r.assemble_seconds},
           {"write_s", r.write_seconds}, {"total_s", r.total_seconds},
-          {"balance", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
+          {"balance_cpu", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
 }
 
 int run(int argc, char** argv, const HlodRankComm& comm) {
