@@ -50,6 +50,7 @@ std::vector<uint8_t> encode_report(const RankReport& r) {
   w.u64(std::bit_cast<uint64_t>(r.work.bake_seconds));
   w.u64(std::bit_cast<uint64_t>(r.work.bake_cpu_seconds));
   w.u64(std::bit_cast<uint64_t>(r.work.total_seconds));
+  w.u64(std::bit_cast<uint64_t>(r.work.cpu_seconds));
   w.u64(r.work.bytes_written);
   w.u32(uint32_t(r.status.message.size()));
   w.raw(r.status.message.data(), r.status.message.size());
@@ -58,7 +59,7 @@ std::vector<uint8_t> encode_report(const RankReport& r) {
 
 RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   RankReport r;
-  constexpr size_t fixed = 1 + 4 + 8 + 8 + 8 + 8 + 8 + 4;
+  constexpr size_t fixed = 1 + 4 + 8 + 8 + 8 + 8 + 8 + 8 + 4;
   if (b.size() < fixed || b.size() != fixed + detail::load_u32(b.data() + fixed - 4)) {
     r.status = Status::error("rank " + std::to_string(rank) + " sent a malformed report");
     return r;
@@ -68,7 +69,8 @@ RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   r.work.bake_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 13));
   r.work.bake_cpu_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 21));
   r.work.total_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 29));
-  r.work.bytes_written = detail::load_u64(b.data() + 37);
+  r.work.cpu_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 37));
+  r.work.bytes_written = detail::load_u64(b.data() + 45);
   r.status = b[0] ? Status::success() : Status::error(std::string(b.begin() + fixed, b.end()));
   return r;
 }
@@ -329,6 +331,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
                              const std::filesystem::path& out_dir, const HlodDistributedSettings& settings,
                              const HlodRankComm& comm, const HlodBakeLog& log, HlodDistributedResult* result) {
   const auto t_start = Clock::now();
+  const double cpu_start = process_cpu_seconds();
   Job j{settings, comm, log, {}, {}, {}, {}, {}, {}, {}, {}, {}};
   j.arena = std::make_unique<tbb::task_arena>(settings.threads == 0 ? tbb::task_arena::automatic : int(settings.threads));
   std::error_code ec;
@@ -356,6 +359,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
     rep.status = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 could not plan the build");
   }
   rep.work.total_seconds = seconds_since(t_start);
+  rep.work.cpu_seconds = process_cpu_seconds() - cpu_start;
   const std::vector<std::vector<uint8_t>> reports = comm.gather(encode_report(rep));
   watch.reset();
   if (result) *result = {};
@@ -373,8 +377,10 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   }
   if (!failed) failed.message += " (the cache keeps every finished subtree: run again to resume)";
   Status st = failed;
+  const double cpu_gathered = process_cpu_seconds();
   if (st) st = collect(j);
   if (st) st = assemble_and_write(j, mesh_file, name, out_dir);
+  j.r.cpu_after_gather_seconds = process_cpu_seconds() - cpu_gathered;
   j.r.total_seconds = seconds_since(t_start);
   if (result) *result = std::move(j.r);
   return st;

@@ -54,6 +54,7 @@ struct HlodRankWork {
   double bake_seconds = 0;   // the rank's time in its bakes
   double bake_cpu_seconds = 0;  // its process's CPU time in them (the machine may be shared)
   double total_seconds = 0;     // the rank's whole run, up to its report
+  double cpu_seconds = 0;       // its process's CPU time over that run
   uint64_t bytes_written = 0;
 };
 
@@ -64,6 +65,7 @@ struct HlodDistributedResult {
   size_t subtrees = 0, cached = 0, rebaked = 0;  // rebaked: refused at assembly, baked again on rank 0
   std::vector<HlodRankWork> ranks;                // rank 0: every rank's work
   uint64_t entry_bytes_read = 0;                  // rank 0: entries read from the cache
+  double cpu_after_gather_seconds = 0;            // rank 0: CPU time reading, assembling, writing
   double load_seconds = 0, plan_seconds = 0, lookup_seconds = 0, bake_seconds = 0, assemble_seconds = 0,
          write_seconds = 0, total_seconds = 0;    // this rank's phases (lookup and assembly: rank 0)
   HlodBuildReport report;

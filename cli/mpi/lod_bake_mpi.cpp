@@ -7,7 +7,8 @@
 // byte-identical to `lod bake MESH -o DIR --hlod`. A rerun bakes only what the cache lacks.
 //
 // Fault injection for tests: LOD_MPI_FAIL_AFTER=N makes rank LOD_MPI_FAIL_RANK (default: the
-// last) die without a word to MPI once it has stored N subtrees, as a killed process would.
+// last; -1: every rank) die without a word to MPI once it has stored N subtrees, as a killed
+// process would.
 #include <mpi.h>
 
 #include <CLI/CLI.hpp>
@@ -58,18 +59,24 @@ long env_number(const char* name, long fallback) {
 
 nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
   nlohmann::json per_rank = nlohmann::json::array();
-  double slowest = 0, sum = 0;
+  double slowest = 0, sum = 0, critical = 0;
   for (const HlodRankWork& w : r.ranks) {
     per_rank.push_back({{"subtrees", w.subtrees}, {"triangles", w.triangles}, {"bake_s", w.bake_seconds},
                         {"bake_cpu_s", w.bake_cpu_seconds}, {"until_report_s", w.total_seconds},
+                        {"cpu_until_report_s", w.cpu_seconds},
                         {"bytes_written", w.bytes_written}});
     slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
+    critical = std::max(critical, w.cpu_seconds);
   }
   return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},
           {"subtrees", r.subtrees}, {"cached", r.cached}, {"rebaked", r.rebaked}, {"nodes", r.report.nodes},
           {"entry_bytes_read", r.entry_bytes_read}, {"load_s", r.load_seconds}, {"plan_s", r.plan_seconds},
           {"lookup_s", r.lookup_seconds}, {"bake_s", r.bake_seconds}, {"assemble_s", r.assemble_seconds},
           {"write_s", r.write_seconds}, {"total_s", r.total_seconds},
+          {"cpu_after_gather_s", r.cpu_after_gather_seconds},
+          // The job's length on idle cores: the slowest rank's CPU time up to the gather, then
+          // rank 0's (each rank runs one thread; the machine these figures come from is shared).
+          {"critical_cpu_s", critical + r.cpu_after_gather_seconds},
           {"balance_cpu", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
 }
 
@@ -98,7 +105,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   settings.cache_dir = cache_dir;
   const long fail_after = env_number("LOD_MPI_FAIL_AFTER", -1);
   const long fail_rank = env_number("LOD_MPI_FAIL_RANK", comm.size - 1);
-  if (fail_after >= 0 && fail_rank == comm.rank)
+  if (fail_after >= 0 && (fail_rank == comm.rank || fail_rank < 0))  // LOD_MPI_FAIL_RANK=-1: every rank
     settings.before_store = [rank = comm.rank, fail_after](size_t subtree, size_t stored) {
       if (long(stored) < fail_after) return;
       std::fprintf(stderr, "lod-bake-mpi: rank %d: injected failure (LOD_MPI_FAIL_AFTER=%ld) at subtree %zu\n", rank,
