@@ -807,6 +807,7 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
       return Status::error(m.what + ": subtree " + std::to_string(i) + " does not exist or was baked already");
     m.baked[i] = 1;
   }
+  if (which.empty()) return Status::success();  // no BVH for nothing (a rank with no share)
   const ParallelFor& parallel_for = m.c.options.parallel_for;
   std::vector<Tally> tallies(which.size());
   std::vector<uint8_t> grown(which.size(), 0);

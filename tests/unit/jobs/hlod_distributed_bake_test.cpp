@@ -197,11 +197,12 @@ TEST(HlodDistributedBake, ThreeRanksWriteTheLocalBakesBytesAndARerunBakesNothing
   }
   EXPECT_EQ(baked, first.subtrees);
   EXPECT_GE(first.subtrees, 48u) << "16 per rank";
+  const size_t subtrees = first.subtrees;  // `runs` is replaced below
 
   std::filesystem::remove(dir / "out" / "mixed.hlod");
   runs = run_ranks(3, mesh, dir / "out", dir / "cache");
   ASSERT_TRUE(runs[0].status) << runs[0].status.message;
-  EXPECT_EQ(runs[0].result.cached, first.subtrees);
+  EXPECT_EQ(runs[0].result.cached, subtrees);
   for (const HlodRankWork& w : runs[0].result.ranks) EXPECT_EQ(w.subtrees, 0u);
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
 }
