@@ -106,7 +106,7 @@ class ProgressWatch {
       lock.unlock();
       for (size_t i = 0; i < paths_.size(); ++i) {
         std::error_code ec;
-        if (!seen[i] && std::filesystem::exists(paths_[i], ec)) seen[i] = 1, ++done, tris += triangles_[i];
+        if (!seen[i] && std::filesystem::is_regular_file(paths_[i], ec)) seen[i] = 1, ++done, tris += triangles_[i];
       }
       if (done != reported) {
         reported = done;
@@ -353,8 +353,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
     j.missing = mask;
     if (comm.rank == 0) watch = watch_progress(j);
     rep = bake_share(j, my_share(j));
-    j.r.bake_seconds = rep.work.bake_seconds;
-    if (!rep.status) j.say(rep.status.message);
+    j.r.bake_seconds = rep.work.bake_seconds;  // a failure: the caller prints it, rank 0 gathers it
   } else if (ready) {
     rep.status = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 could not plan the build");
   }

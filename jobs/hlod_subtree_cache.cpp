@@ -76,7 +76,8 @@ Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64
   }
   std::filesystem::rename(temp, path, ec);
   if (ec) {
-    std::filesystem::remove(temp, ec);
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
     return Status::error(path.string() + ": cannot rename the verified entry into place: " + ec.message());
   }
   if (bytes_written) *bytes_written = bytes.size();
@@ -89,6 +90,11 @@ CacheLookup load_hlod_subtree(const std::filesystem::path& dir, uint64_t key, ui
   bool opened = false;
   const std::vector<uint8_t> bytes = read_all(path, opened);
   if (!opened) return CacheLookup::missing;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    if (why) *why = path.string() + ": is not a regular file";
+    return CacheLookup::refused;
+  }
   if (bytes_read) *bytes_read = bytes.size();
   if (Status s = decode_hlod_subtree(bytes, key, mesh_vertices, path.string(), out); !s) {
     if (why) *why = s.message;
