@@ -1,27 +1,31 @@
-// Model HLOD build (R1 3.1) in three passes:
+// Model HLOD build (R1 3.1) in three steps (issue 16), each node computed the same whichever
+// step it falls in:
 //
-//   1. per node, bottom-up over the octree (subtrees in parallel): count -> split (children +
-//      patch) -> [children] -> layer 0 (leaf geometry, or children's coarsest welded to the
-//      patch) -> two QEM halvings with ancestors' patch vertices locked -> reference samples,
-//      bounds; beside it, the original's BVH for pass 2
-//   2. every node at once: each layer's distance to the original
-//   3. children before parents: errors made monotonic
-//   then breadth-first flattening into the tree and its payloads.
+//   (a) plan: the root's cell, then the top of the octree split down to the frontier
+//   (b) per frontier subtree, bottom-up (subtrees and children in parallel): count -> split
+//       (children + patch) -> [children] -> layer 0 (leaf geometry, or children's coarsest
+//       welded to the patch) -> two QEM halvings with ancestors' patch vertices locked ->
+//       reference samples, bounds (beside it, the original's BVH); then each layer's distance
+//       to the original; errors made monotonic; records and payloads (an HlodSubtree)
+//   (c) the top's nodes the same way from the subtrees' roots, then the breadth-first splice.
 //
-// Per-vertex scratch arrays are shared by pass 1's tasks without locks: every vertex lies in
+// Per-vertex scratch arrays are shared by the tasks without locks: every vertex lies in
 // exactly one cell per depth, tasks run on disjoint subtrees, and a node only touches its own
 // cell's vertices after its children have finished, so no two tasks ever touch one vertex.
+// An ancestor's patch (all the lock test `patch_depth < depth` sees) is always split before.
 #include "preprocess/hlod_build.h"
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <memory>
 #include <string>
 
 #include "preprocess/decimater_chain.h"  // compute_vertex_normals
 #include "preprocess/surface_error.h"
+#include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/lod_chain.h"
 
 namespace lod {
@@ -44,12 +48,19 @@ struct BuildNode {
   float half = 0;
   std::vector<uint32_t> triangles;  // original triangles in the cell and in no ancestor's patch
   std::unique_ptr<BuildNode> children[8];
+  int32_t subtree = -1;             // a frontier node: which subtree it roots (-1: none)
   uint8_t child_mask = 0;
   std::vector<uint32_t> patch;      // original triangles across the children
   std::vector<Layer> layers;        // finest first
   std::vector<uint32_t> reference;  // original vertices of the node's region, thinned
   Sphere bounds;
   bool leaf() const { return child_mask == 0; }
+};
+
+// Counted per subtree (the report sums them), from any thread.
+struct Tally {
+  std::atomic<size_t> short_layers{0};
+  std::atomic<size_t> oversized_leaves{0};
 };
 
 struct Context {
@@ -64,8 +75,6 @@ struct Context {
   SurfaceDistance original;
   uint64_t total_triangles = 0;
   std::atomic<uint64_t> done_triangles{0};
-  std::atomic<size_t> short_layers{0};
-  std::atomic<size_t> oversized_leaves{0};
 
   explicit Context(const HlodBuildOptions& o) : options(o) {}
   uint32_t new_stamp() { return next_stamp.fetch_add(1, std::memory_order_relaxed); }
@@ -193,7 +202,7 @@ void lock_tetrahedron_tips(const Layer& l, std::vector<uint8_t>& lock) {
 
 // Two halvings of layers[0] with every ancestor's patch vertex locked; a layer no smaller than
 // the one before is dropped.
-void simplify_layers(Context& c, BuildNode& n) {
+void simplify_layers(Context& c, Tally& tally, BuildNode& n) {
   n.layers.reserve(3);  // `finest` stays valid while the coarser layers are appended
   const Layer& finest = n.layers[0];
   const size_t t0 = finest.triangles();
@@ -218,7 +227,7 @@ void simplify_layers(Context& c, BuildNode& n) {
   for (size_t k = 0; k < made; ++k) {
     const size_t tris = out[k].triangle_count();
     if (tris == 0 || tris >= n.layers.back().triangles()) {
-      c.short_layers.fetch_add(1, std::memory_order_relaxed);
+      tally.short_layers.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
     Layer layer;
@@ -372,58 +381,70 @@ Sphere node_bounds(const BuildNode& n) {
   return s;
 }
 
-void build_node(Context& c, BuildNode& n) {
-  const size_t vertices = count_vertices(c, n.triangles);
-  const bool splits = vertices > c.options.min_verts && n.depth < kHlodMaxDepth && split_node(c, n);
-  if (!splits) {
-    if (vertices > c.options.min_verts) c.oversized_leaves.fetch_add(1, std::memory_order_relaxed);
-    n.layers.push_back(leaf_geometry(c, n));
-  } else {
-    BuildNode* kids[8];
-    size_t count = 0;
-    for (auto& child : n.children)
-      if (child) kids[count++] = child.get();
-    auto body = [&](size_t i) { build_node(c, *kids[i]); };
-    if (c.options.parallel_for && count > 1) c.options.parallel_for(count, body);
-    else for (size_t i = 0; i < count; ++i) body(i);
-    n.layers.push_back(merged_children(c, n));
-  }
-  simplify_layers(c, n);
+
+// The octree's rule: a cell with more than min_verts vertices splits, unless it is at the
+// depth limit or every one of its triangles crosses its octants.
+bool split_if_large(Context& c, BuildNode& n, size_t& vertices) {
+  vertices = count_vertices(c, n.triangles);
+  return vertices > c.options.min_verts && n.depth < kHlodMaxDepth && split_node(c, n);
+}
+
+// A node's own layers once its children (if any) have theirs: layer 0, two halvings, its
+// reference samples and bounds.
+void build_layers(Context& c, Tally& tally, BuildNode& n) {
+  n.layers.push_back(n.leaf() ? leaf_geometry(c, n) : merged_children(c, n));
+  simplify_layers(c, tally, n);
   gather_reference(c, n);
   n.bounds = node_bounds(n);
   report_done(c, n);
 }
 
-std::vector<BuildNode*> breadth_first(BuildNode& root) {
+void run_all(const ParallelFor& parallel_for, size_t count, const std::function<void(size_t)>& body) {
+  if (parallel_for && count > 1) parallel_for(count, body);
+  else for (size_t i = 0; i < count; ++i) body(i);
+}
+
+std::vector<BuildNode*> children_of(BuildNode& n) {
+  std::vector<BuildNode*> kids;
+  for (auto& child : n.children)
+    if (child) kids.push_back(child.get());
+  return kids;
+}
+
+// Pass 1 below a frontier node: the octree and every layer, bottom-up, children in parallel.
+void grow(Context& c, Tally& tally, BuildNode& n) {
+  size_t vertices = 0;
+  if (split_if_large(c, n, vertices)) {
+    const std::vector<BuildNode*> kids = children_of(n);
+    run_all(c.options.parallel_for, kids.size(), [&](size_t i) { grow(c, tally, *kids[i]); });
+  } else if (vertices > c.options.min_verts) {
+    tally.oversized_leaves.fetch_add(1, std::memory_order_relaxed);
+  }
+  build_layers(c, tally, n);
+}
+
+// Breadth-first from `root`, children in octant order; with stop_at_frontier, the top only
+// (frontier nodes below the root neither listed nor entered).
+enum class Below : uint8_t { everything, stop_at_frontier };
+std::vector<BuildNode*> breadth_first(BuildNode& root, Below below) {
   std::vector<BuildNode*> order{&root};
+  if (below == Below::stop_at_frontier && root.subtree >= 0) return {};
   for (size_t i = 0; i < order.size(); ++i)
     for (auto& child : order[i]->children)
-      if (child) order.push_back(child.get());
+      if (child && !(below == Below::stop_at_frontier && child->subtree >= 0)) order.push_back(child.get());
   return order;
 }
 
-// Pass 1 (the octree and every layer, bottom-up) beside the original's BVH, which only pass 2
-// needs; then pass 2 over all nodes at once, then pass 3.
-Status build_passes(Context& c, BuildNode& root, const TriangleMeshView& original, const std::string& what) {
-  Status surface;
-  auto first = [&](size_t i) {
-    if (i == 0) surface = c.original.set_surface(original, what);
-    else build_node(c, root);
-  };
-  const ParallelFor& parallel_for = c.options.parallel_for;
-  if (parallel_for) parallel_for(2, first);
-  else first(0), first(1);
-  if (!surface) return surface;
-  const std::vector<BuildNode*> order = breadth_first(root);
-  std::vector<Status> measured(order.size());
-  auto second = [&](size_t i) { measured[i] = measure_layers(c, *order[i]); };
-  if (parallel_for) parallel_for(order.size(), second);
-  else for (size_t i = 0; i < order.size(); ++i) second(i);
+// Pass 2 over `nodes` at once, then pass 3 (children before parents).
+Status measure_and_order_errors(Context& c, const std::vector<BuildNode*>& nodes) {
+  std::vector<Status> measured(nodes.size());
+  run_all(c.options.parallel_for, nodes.size(), [&](size_t i) { measured[i] = measure_layers(c, *nodes[i]); });
   for (const Status& s : measured)
     if (!s) return s;
-  make_errors_monotonic(order);
+  make_errors_monotonic(nodes);
   return Status::success();
 }
+
 
 // Per-vertex normals of a layer from its own triangles, except where the vertex is an
 // original one shared with a neighbour (locked): there the original normal, so both sides
@@ -471,43 +492,132 @@ HlodPayload make_payload(Context& c, const BuildNode& n) {
   return p;
 }
 
-// Breadth-first order (children of one node contiguous, in octant order), as the file stores it.
-void flatten(Context& c, const BuildNode& root, HlodModel& out, HlodBuildReport& report) {
-  std::vector<const BuildNode*> order{&root};
-  out.tree.nodes.clear();
-  out.tree.nodes.emplace_back();
+
+// A node's record (parent and first_child left to the caller) and its payload.
+HlodNode describe_node(Context& c, const BuildNode& b, HlodPayload& payload) {
+  HlodNode h;
+  h.depth = b.depth;
+  for (int k = 0; k < 3; ++k) h.box_center[k] = b.center[k];
+  h.box_half = b.half;
+  h.bounds = b.bounds;
+  h.child_mask = b.child_mask;
+  h.child_count = uint8_t(std::popcount(unsigned(b.child_mask)));
+  h.boundary_triangles = uint32_t(b.patch.size());
+  h.layer_count = uint8_t(b.layers.size());
+  for (size_t k = 0; k < b.layers.size(); ++k)
+    h.layers[k] = {uint32_t(b.layers[k].triangles()), uint32_t(b.layers[k].vertices()), b.layers[k].error};
+  payload = make_payload(c, b);
+  h.boundary_vertices = payload.boundary.vertex_count;
+  h.resident_bytes = 4 * (payload.positions.size() + payload.normals.size() + payload.indices.size());
+  return h;
+}
+
+// A baked subtree (breadth-first `order` from its root) as records and payloads.
+HlodSubtree flatten_subtree(Context& c, const std::vector<BuildNode*>& order) {
+  HlodSubtree s;
+  s.nodes.resize(order.size());
+  s.payloads.resize(order.size());
+  uint32_t next = 1;
   for (size_t i = 0; i < order.size(); ++i) {
-    const BuildNode& b = *order[i];
-    HlodNode h = out.tree.nodes[i];  // parent already set
-    h.depth = b.depth;
-    for (int k = 0; k < 3; ++k) h.box_center[k] = b.center[k];
-    h.box_half = b.half;
-    h.bounds = b.bounds;
-    h.child_mask = b.child_mask;
-    h.boundary_triangles = uint32_t(b.patch.size());
-    h.layer_count = uint8_t(b.layers.size());
-    for (size_t k = 0; k < b.layers.size(); ++k)
-      h.layers[k] = {uint32_t(b.layers[k].triangles()), uint32_t(b.layers[k].vertices()), b.layers[k].error};
-    if (!b.leaf()) h.first_child = uint32_t(order.size());
-    for (const auto& child : b.children) {
-      if (!child) continue;
-      order.push_back(child.get());
-      HlodNode kid;
-      kid.parent = int32_t(i);
-      out.tree.nodes.push_back(kid);
-      ++h.child_count;
+    HlodNode h = describe_node(c, *order[i], s.payloads[i]);
+    h.parent = s.nodes[i].parent;  // set by the parent, below
+    h.first_child = h.child_count ? next : 0;
+    for (uint32_t k = 0; k < h.child_count; ++k) s.nodes[next + k].parent = int32_t(i);
+    next += h.child_count;
+    s.nodes[i] = h;
+  }
+  const BuildNode& root = *order[0];
+  s.root_source = root.layers.back().source;
+  s.root_reference = root.reference;
+  return s;
+}
+
+// What a frontier node is to the levels above once its subtree is baked: its coarsest layer,
+// reference samples and bounds, as the subtree's root had them.
+void make_stub(BuildNode& n, const HlodSubtree& s) {
+  for (auto& child : n.children) child.reset();
+  n.child_mask = 0;
+  std::vector<uint32_t>().swap(n.triangles);
+  std::vector<uint32_t>().swap(n.patch);
+  const HlodNode& root = s.nodes[0];
+  const LodLevel& range = s.payloads[0].layers.back();
+  Layer coarse;
+  const auto* p = s.payloads[0].positions.data() + 3 * size_t(range.first_vertex);
+  coarse.positions.assign(p, p + 3 * size_t(range.vertex_count));
+  const auto* i = s.payloads[0].indices.data() + range.first_index;
+  coarse.indices.assign(i, i + range.index_count);
+  coarse.source = s.root_source;
+  coarse.error = root.layers[root.layer_count - 1].error;
+  n.layers.clear();
+  n.layers.push_back(std::move(coarse));
+  n.reference = s.root_reference;
+  n.bounds = root.bounds;
+}
+
+// A subtree result is checked against the mesh before any of it is used as an index.
+Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, const std::string& what) {
+  if (s.nodes.empty() || s.payloads.size() != s.nodes.size()) return Status::error(what + ": no nodes, or not one payload per node");
+  const HlodNode& root = s.nodes[0];
+  if (root.depth != f.depth || root.box_half != f.half || root.box_center[0] != f.center[0] ||
+      root.box_center[1] != f.center[1] || root.box_center[2] != f.center[2])
+    return Status::error(what + ": its root is not the frontier node's cell");
+  const HlodPayload& p = s.payloads[0];
+  if (root.layer_count < 1 || p.layers.size() != root.layer_count) return Status::error(what + ": root layers do not match its record");
+  const LodLevel& range = p.layers.back();
+  if (s.root_source.size() != range.vertex_count || size_t(range.first_vertex) + range.vertex_count > p.positions.size() / 3 ||
+      size_t(range.first_index) + range.index_count > p.indices.size())
+    return Status::error(what + ": root's coarsest layer does not match its vertex sources");
+  for (size_t k = 0; k < range.index_count; ++k)
+    if (p.indices[range.first_index + k] >= range.vertex_count) return Status::error(what + ": root layer index out of range");
+  for (uint32_t v : s.root_source)
+    if (v >= vertices) return Status::error(what + ": vertex source " + std::to_string(v) + " is not in the mesh");
+  for (uint32_t v : s.root_reference)
+    if (v >= vertices) return Status::error(what + ": reference vertex " + std::to_string(v) + " is not in the mesh");
+  return Status::success();
+}
+
+// Breadth-first order of the whole tree (children of one node contiguous, in octant order), as
+// the file stores it: the top's nodes described here, each subtree's spliced in from its result.
+struct NodeRef {
+  const BuildNode* top = nullptr;  // else a subtree's node
+  HlodSubtree* subtree = nullptr;
+  uint32_t local = 0;
+};
+
+void splice(Context& c, BuildNode& root, std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport& report) {
+  auto ref_of = [&](const BuildNode& n) {
+    return n.subtree >= 0 ? NodeRef{nullptr, &baked[size_t(n.subtree)], 0} : NodeRef{&n, nullptr, 0};
+  };
+  std::vector<NodeRef> order{ref_of(root)};
+  std::vector<int32_t> parent{-1};
+  out.tree.nodes.clear();
+  out.payloads.clear();
+  for (size_t i = 0; i < order.size(); ++i) {
+    const NodeRef r = order[i];
+    HlodNode h;
+    HlodPayload payload;
+    if (r.top) {
+      h = describe_node(c, *r.top, payload);
+      for (const auto& child : r.top->children)
+        if (child) order.push_back(ref_of(*child));
+    } else {
+      h = r.subtree->nodes[r.local];
+      payload = std::move(r.subtree->payloads[r.local]);
+      for (uint32_t k = 0; k < h.child_count; ++k) order.push_back({nullptr, r.subtree, h.first_child + k});
     }
-    HlodPayload payload = make_payload(c, b);
-    h.boundary_vertices = payload.boundary.vertex_count;
-    h.resident_bytes = 4 * (payload.positions.size() + payload.normals.size() + payload.indices.size());
-    out.tree.nodes[i] = h;
+    h.parent = parent[i];
+    h.first_child = h.child_count ? uint32_t(order.size() - h.child_count) : 0;
+    h.payload_offset = h.payload_size = 0;
+    parent.resize(order.size(), int32_t(i));
+    report.leaves += h.leaf();
+    report.depth = std::max<uint32_t>(report.depth, h.depth);
+    report.boundary_triangles += h.boundary_triangles;
+    out.tree.nodes.push_back(h);
     out.payloads.push_back(std::move(payload));
-    report.leaves += b.leaf();
-    report.depth = std::max<uint32_t>(report.depth, b.depth);
-    report.boundary_triangles += b.patch.size();
   }
   report.nodes = order.size();
 }
+
 
 Status check_input(const MeshData& mesh) {
   const std::string what = mesh.source.empty() ? std::string("mesh") : mesh.source;
@@ -536,45 +646,252 @@ void root_cell(const MeshData& mesh, const std::vector<uint32_t>& triangles, Bui
   root.half = extent > 0 ? 0.5f * extent * (1 + 1e-5f) : 1.0f;
 }
 
+
+// The frontier (see the header's rule): the heaviest node above the limit splits by the
+// octree's rule until none is left; a node the rule keeps whole stays on the frontier.
+void split_top(Context& c, BuildNode& root, uint32_t subtrees) {
+  const uint64_t limit = c.total_triangles / std::max<uint32_t>(1, subtrees);
+  std::vector<BuildNode*> frontier{&root};
+  std::vector<uint8_t> whole{0};
+  for (;;) {
+    size_t pick = frontier.size();
+    for (size_t i = 0; i < frontier.size(); ++i)
+      if (!whole[i] && frontier[i]->triangles.size() > limit &&
+          (pick == frontier.size() || frontier[i]->triangles.size() > frontier[pick]->triangles.size()))
+        pick = i;
+    if (pick == frontier.size()) return;
+    BuildNode& n = *frontier[pick];
+    size_t vertices = 0;
+    if (!split_if_large(c, n, vertices)) {
+      whole[pick] = 1;
+      continue;
+    }
+    const std::vector<BuildNode*> kids = children_of(n);
+    frontier.erase(frontier.begin() + std::ptrdiff_t(pick));
+    whole.erase(whole.begin() + std::ptrdiff_t(pick));
+    frontier.insert(frontier.end(), kids.begin(), kids.end());
+    whole.insert(whole.end(), kids.size(), 0);
+  }
+}
+
+// Frontier nodes numbered in breadth-first order of the top (a top node is one split above).
+std::vector<BuildNode*> number_frontier(BuildNode& root) {
+  std::vector<BuildNode*> order{&root}, frontier;
+  for (size_t i = 0; i < order.size(); ++i) {
+    BuildNode& n = *order[i];
+    if (n.leaf()) {
+      n.subtree = int32_t(frontier.size());
+      frontier.push_back(&n);
+      continue;
+    }
+    for (auto& child : n.children)
+      if (child) order.push_back(child.get());
+  }
+  return frontier;
+}
+
+HlodSubtreeSpec describe_subtree(const Context& c, const BuildNode& n) {
+  HlodSubtreeSpec spec;
+  spec.depth = n.depth;
+  for (int k = 0; k < 3; ++k) spec.center[k] = n.center[k];
+  spec.half = n.half;
+  spec.triangles = n.triangles.size();
+  std::vector<uint32_t> words{n.depth, std::bit_cast<uint32_t>(n.center[0]), std::bit_cast<uint32_t>(n.center[1]),
+                              std::bit_cast<uint32_t>(n.center[2]), std::bit_cast<uint32_t>(n.half)};
+  words.reserve(words.size() + 5 * n.triangles.size());
+  for (uint32_t t : n.triangles) {
+    uint32_t locks = 0;
+    words.push_back(t);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = c.indices[3 * size_t(t) + k];
+      words.push_back(v);
+      locks |= uint32_t(c.patch_depth[v] < n.depth) << k;
+    }
+    words.push_back(locks);
+  }
+  spec.fingerprint = hash_bytes(words.data(), 4 * words.size(), 0x4c4f4448'53554254ull);
+  return spec;
+}
+
 }  // namespace
 
-Status build_hlod(HlodModel& out, const MeshData& mesh, const HlodBuildOptions& options, HlodBuildReport* report_out) {
+struct HlodBuilder::Impl {
+  const MeshData& mesh;
+  std::string what;
+  Context c;
+  std::unique_ptr<BuildNode> root;
+  std::vector<BuildNode*> frontier;
+  std::vector<HlodSubtreeSpec> specs;
+  std::vector<uint8_t> baked;  // per subtree: handed to bake_subtrees already
+  size_t dropped = 0;
+  bool planned = false, surface_built = false;
+  Status surface;
+  Tally top_tally;
+
+  Impl(const MeshData& m, const HlodBuildOptions& o)
+      : mesh(m), what(m.source.empty() ? std::string("mesh") : m.source), c(o) {}
+
+  void ensure_surface() {
+    if (surface_built) return;
+    const TriangleMeshView original{mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
+    surface = c.original.set_surface(original, what);
+    surface_built = true;
+  }
+  std::string name(size_t i) const {
+    return what + ": subtree " + std::to_string(i) + " (depth " + std::to_string(specs[i].depth) + ", " +
+           std::to_string(specs[i].triangles) + " triangles)";
+  }
+  Status finish(size_t i, Tally& tally, const SubtreeDone& done);
+  void build_top(BuildNode& n);
+};
+
+HlodBuilder::HlodBuilder(const MeshData& mesh, const HlodBuildOptions& options)
+    : impl_(std::make_unique<Impl>(mesh, options)) {}
+HlodBuilder::~HlodBuilder() = default;
+
+const std::vector<HlodSubtreeSpec>& HlodBuilder::subtrees() const { return impl_->specs; }
+
+Status HlodBuilder::plan() {
+  Impl& m = *impl_;
+  const MeshData& mesh = m.mesh;
+  if (m.planned) return Status::error(m.what + ": HLOD build planned twice");
   if (Status s = check_input(mesh); !s) return s;
-  const std::string what = mesh.source.empty() ? std::string("mesh") : mesh.source;
-  HlodBuildReport report;
-  auto root = std::make_unique<BuildNode>();
+  m.root = std::make_unique<BuildNode>();
   for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     const uint32_t* f = &mesh.indices[3 * size_t(t)];
-    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) ++report.dropped_triangles;
-    else root->triangles.push_back(t);
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) ++m.dropped;
+    else m.root->triangles.push_back(t);
   }
-  if (root->triangles.empty()) return Status::error(what + ": no triangles to build an HLOD from");
-  root_cell(mesh, root->triangles, *root);
-
-  Context c(options);
+  if (m.root->triangles.empty()) return Status::error(m.what + ": no triangles to build an HLOD from");
+  root_cell(mesh, m.root->triangles, *m.root);
+  Context& c = m.c;
   c.positions = mesh.positions.data();
   c.indices = mesh.indices.data();
-  c.total_triangles = root->triangles.size();
+  c.total_triangles = m.root->triangles.size();
   c.patch_depth.assign(mesh.vertex_count(), kNoPatch);
   c.stamp.assign(mesh.vertex_count(), 0);
   c.local.assign(mesh.vertex_count(), 0);
   c.normals.resize(mesh.positions.size());
   compute_vertex_normals(mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size(),
                          c.normals.data());
-  const TriangleMeshView original{mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
-  if (Status s = build_passes(c, *root, original, what); !s) return s;
+  split_top(c, *m.root, c.options.subtrees);
+  m.frontier = number_frontier(*m.root);
+  for (const BuildNode* n : m.frontier) m.specs.push_back(describe_subtree(c, *n));
+  m.baked.assign(m.frontier.size(), 0);
+  m.planned = true;
+  return Status::success();
+}
 
+// Passes 2 and 3 of a grown subtree, its result handed on, its build nodes freed.
+Status HlodBuilder::Impl::finish(size_t i, Tally& tally, const SubtreeDone& done) {
+  BuildNode& n = *frontier[i];
+  const std::vector<BuildNode*> order = breadth_first(n, Below::everything);
+  if (Status s = measure_and_order_errors(c, order); !s) return Status::error(name(i) + ": " + s.message);
+  HlodSubtree result = flatten_subtree(c, order);
+  result.short_layers = tally.short_layers.load();
+  result.oversized_leaves = tally.oversized_leaves.load();
+  for (auto& child : n.children) child.reset();
+  n.layers.clear();
+  n.reference.clear();
+  if (Status s = done(i, std::move(result)); !s) return Status::error(name(i) + ": " + s.message);
+  return Status::success();
+}
+
+// The original's BVH (passes 2 need it) with subtrees growing beside it, then per subtree
+// passes 1 (if not grown yet), 2 and 3, each result handed on as it is finished.
+Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const SubtreeDone& done) {
+  Impl& m = *impl_;
+  if (!m.planned) return Status::error(m.what + ": HLOD subtrees baked before the build was planned");
+  for (size_t i : which) {
+    if (i >= m.frontier.size() || m.baked[i])
+      return Status::error(m.what + ": subtree " + std::to_string(i) + " does not exist or was baked already");
+    m.baked[i] = 1;
+  }
+  if (which.empty()) return Status::success();  // no BVH for nothing (a rank with no share)
+  const ParallelFor& parallel_for = m.c.options.parallel_for;
+  std::vector<Tally> tallies(which.size());
+  std::vector<uint8_t> grown(which.size(), 0);
+  if (!m.surface_built) {  // subtrees grow beside the BVH for as long as it takes (none serially)
+    std::atomic<bool> surface_done{false};
+    run_all(parallel_for, 2, [&](size_t part) {
+      if (part == 0) {
+        m.ensure_surface();
+        surface_done.store(true);
+        return;
+      }
+      for (size_t k = 0; k < which.size() && !surface_done.load(); ++k) {
+        grow(m.c, tallies[k], *m.frontier[which[k]]);
+        grown[k] = 1;
+      }
+    });
+  }
+  if (!m.surface) return m.surface;
+  // The rest grow and finish one by one, so that results are handed on from the start.
+  std::vector<Status> finished(which.size());
+  std::atomic<bool> failed{false};
+  run_all(parallel_for, which.size(), [&](size_t k) {
+    if (failed.load(std::memory_order_relaxed)) return;
+    if (!grown[k]) grow(m.c, tallies[k], *m.frontier[which[k]]);
+    finished[k] = m.finish(which[k], tallies[k], done);
+    if (!finished[k]) failed.store(true, std::memory_order_relaxed);
+  });
+  for (const Status& s : finished)
+    if (!s) return s;
+  return Status::success();
+}
+
+// Pass 1 of the top, children before parents; frontier nodes are stubs by now.
+void HlodBuilder::Impl::build_top(BuildNode& n) {
+  if (n.subtree >= 0) return;
+  const std::vector<BuildNode*> kids = children_of(n);
+  run_all(c.options.parallel_for, kids.size(), [&](size_t i) { build_top(*kids[i]); });
+  build_layers(c, top_tally, n);
+}
+
+Status HlodBuilder::assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report_out) {
+  Impl& m = *impl_;
+  if (!m.planned) return Status::error(m.what + ": HLOD assembled before the build was planned");
+  if (baked.size() != m.frontier.size())
+    return Status::error(m.what + ": " + std::to_string(baked.size()) + " subtree results for " +
+                         std::to_string(m.frontier.size()) + " subtrees");
+  HlodBuildReport report;
+  report.dropped_triangles = m.dropped;
+  for (size_t i = 0; i < baked.size(); ++i) {
+    if (Status s = check_subtree(*m.frontier[i], baked[i], m.mesh.vertex_count(), m.name(i)); !s) return s;
+    make_stub(*m.frontier[i], baked[i]);
+    report.short_layers += baked[i].short_layers;
+    report.oversized_leaves += baked[i].oversized_leaves;
+  }
+  m.ensure_surface();
+  if (!m.surface) return m.surface;
+  m.build_top(*m.root);
+  if (Status s = measure_and_order_errors(m.c, breadth_first(*m.root, Below::stop_at_frontier)); !s) return s;
   HlodModel model;
-  model.tree.min_verts = options.min_verts;
-  for (int k = 0; k < 3; ++k) model.tree.box_center[k] = root->center[k];
-  model.tree.box_half = root->half;
-  model.tree.source_triangles = mesh.triangle_count();
-  flatten(c, *root, model, report);
-  report.short_layers = c.short_layers.load();
-  report.oversized_leaves = c.oversized_leaves.load();
+  model.tree.min_verts = m.c.options.min_verts;
+  for (int k = 0; k < 3; ++k) model.tree.box_center[k] = m.root->center[k];
+  model.tree.box_half = m.root->half;
+  model.tree.source_triangles = m.mesh.triangle_count();
+  splice(m.c, *m.root, baked, model, report);
+  report.short_layers += m.top_tally.short_layers.load();
+  report.oversized_leaves += m.top_tally.oversized_leaves.load();
   out = std::move(model);
   if (report_out) *report_out = report;
   return Status::success();
+}
+
+// (a), (b) for every subtree, (c): the composition a distributed build spreads out.
+Status build_hlod(HlodModel& out, const MeshData& mesh, const HlodBuildOptions& options, HlodBuildReport* report) {
+  HlodBuilder builder(mesh, options);
+  if (Status s = builder.plan(); !s) return s;
+  std::vector<HlodSubtree> baked(builder.subtrees().size());
+  std::vector<size_t> all(baked.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  const Status st = builder.bake_subtrees(all, [&](size_t i, HlodSubtree&& s) {
+    baked[i] = std::move(s);
+    return Status::success();
+  });
+  if (!st) return st;
+  return builder.assemble(baked, out, report);
 }
 
 }  // namespace lod

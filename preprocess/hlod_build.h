@@ -14,14 +14,27 @@
 //
 // Nothing here owns threads: independent subtrees run through options.parallel_for, and the
 // result is byte-identical whatever it does (in parallel, serially, or absent).
+//
+// Split (issue 16): every build is the same three steps, so that a distributed build is the
+// local one by construction: (a) plan: the top of the octree split down to a frontier of
+// subtrees, (b) bake_subtrees: each subtree on its own (whoever bakes it), (c) assemble: the
+// levels above, built from the subtrees' roots, and the breadth-first splice. Each node's
+// computation never depends on where the frontier is, so neither does the output.
+//
+// Frontier rule: starting from the root, the frontier's heaviest node (most original
+// triangles; ties: first in breadth-first order) is split by the octree's own rule while it
+// holds more than total / subtrees triangles (a node the rule keeps as a leaf stays, whatever
+// its size). A subtree's cost is estimated by its triangle count.
 #pragma once
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "preprocess/mesh.h"
 #include "preprocess/qem_simplifier.h"  // ParallelFor
+#include "runtime/hlod_subtree.h"
 #include "runtime/hlod_tree.h"
 #include "runtime/status.h"
 
@@ -43,6 +56,9 @@ struct HlodBuildOptions {
   // below it), evenly thinned to at most reference_samples, against the layer.
   float layer_samples_per_triangle = 0.25f;
   uint32_t reference_samples = 1024;
+  // About how many subtrees the top is split into (see the frontier rule). The output is the
+  // same for any value; it only decides the units a distributed build hands out.
+  uint32_t subtrees = 16;
   ParallelFor parallel_for;     // optional; independent subtrees and children in parallel
   HlodBuildProgress progress;   // optional
 };
@@ -69,5 +85,44 @@ struct HlodBuildReport {
 // written on success. tree.name and tree.source_hash are left for the caller.
 Status build_hlod(HlodModel& out, const MeshData& mesh, const HlodBuildOptions& options,
                   HlodBuildReport* report = nullptr);
+
+// One frontier node: a subtree to bake.
+struct HlodSubtreeSpec {
+  uint8_t depth = 0;
+  float center[3] = {0, 0, 0};  // its octree cell
+  float half = 0;
+  uint64_t triangles = 0;       // original triangles in it: the estimated cost
+  // Hash of its depth, cell, triangles (ids and corners) and which of its vertices ancestors'
+  // patches lock: with the mesh and the options, everything its bake depends on.
+  uint64_t fingerprint = 0;
+};
+
+// The three steps of build_hlod, for a caller that spreads (b) over processes. `mesh` and
+// `options` must outlive the builder. Not thread-safe itself; bake_subtrees runs its subtrees
+// through options.parallel_for.
+class HlodBuilder {
+ public:
+  HlodBuilder(const MeshData& mesh, const HlodBuildOptions& options);
+  ~HlodBuilder();
+  HlodBuilder(const HlodBuilder&) = delete;
+  HlodBuilder& operator=(const HlodBuilder&) = delete;
+
+  // (a) Checks the mesh (as build_hlod) and splits the top down to the frontier.
+  Status plan();
+  // Frontier nodes, in breadth-first order of the top.
+  const std::vector<HlodSubtreeSpec>& subtrees() const;
+  // (b) Bakes the listed subtrees (each at most once per builder); `done` gets each result as
+  // it is finished, possibly from several threads at once. Stops at the first failure, whose
+  // status names the subtree; `done`'s own failure stops it too.
+  using SubtreeDone = std::function<Status(size_t subtree, HlodSubtree&& result)>;
+  Status bake_subtrees(const std::vector<size_t>& which, const SubtreeDone& done);
+  // (c) The levels above the frontier and the whole tree, from every subtree's result (by
+  // subtree index; consumed). tree.name and tree.source_hash are left for the caller.
+  Status assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace lod

@@ -7,21 +7,16 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
-#include <unordered_map>
+#include <compare>
+#include <utility>
+#include <vector>
 
 namespace lod {
 namespace {
 
 struct PositionKey {
   std::array<uint32_t, 3> bits;
-  bool operator==(const PositionKey&) const = default;
-};
-struct PositionKeyHash {
-  size_t operator()(const PositionKey& k) const {
-    uint64_t h = 0x9E3779B97F4A7C15ull;
-    for (uint32_t b : k.bits) h = (h ^ b) * 0xFF51AFD7ED558CCDull;
-    return size_t(h ^ (h >> 29));
-  }
+  auto operator<=>(const PositionKey&) const = default;
 };
 
 PositionKey key_of(const float* p) {
@@ -35,14 +30,7 @@ PositionKey key_of(const float* p) {
 
 struct FaceKey {
   std::array<uint32_t, 3> v;  // sorted
-  bool operator==(const FaceKey&) const = default;
-};
-struct FaceKeyHash {
-  size_t operator()(const FaceKey& k) const {
-    uint64_t h = 0xC2B2AE3D27D4EB4Full;
-    for (uint32_t x : k.v) h = (h ^ x) * 0x9E3779B97F4A7C15ull;
-    return size_t(h ^ (h >> 31));
-  }
+  auto operator<=>(const FaceKey&) const = default;
 };
 
 bool zero_area(const float* a, const float* b, const float* c) {
@@ -50,6 +38,27 @@ bool zero_area(const float* a, const float* b, const float* c) {
   const double e1[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
   const double n[3] = {e0[1] * e1[2] - e0[2] * e1[1], e0[2] * e1[0] - e0[0] * e1[2], e0[0] * e1[1] - e0[1] * e1[0]};
   return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
+}
+
+// first[i] = the smallest j with key(j) == key(i), for i < n; returns how many i have
+// first[i] != i. By sorting (key, index) pairs: the same answer as a hash map of first
+// occurrences, without its cache misses on millions of entries.
+template <class KeyOf>
+size_t first_of_equal(size_t n, KeyOf key_of_item, std::vector<uint32_t>& first) {
+  using Key = decltype(key_of_item(size_t(0)));
+  std::vector<std::pair<Key, uint32_t>> items(n);
+  for (size_t i = 0; i < n; ++i) items[i] = {key_of_item(i), uint32_t(i)};
+  std::sort(items.begin(), items.end());  // by key, then index: a group starts at its first
+  first.resize(n);
+  size_t repeats = 0;
+  for (size_t g = 0; g < n;) {
+    size_t e = g + 1;
+    while (e < n && items[e].first == items[g].first) ++e;
+    for (size_t k = g; k < e; ++k) first[items[k].second] = items[g].second;
+    repeats += e - g - 1;
+    g = e;
+  }
+  return repeats;
 }
 
 // Submesh ranges after faces were dropped: each keeps its surviving triangles, in order; an
@@ -74,27 +83,21 @@ CleanReport clean_mesh(MeshData& mesh) {
 
   // Pass 1: weld exactly duplicated positions onto their first occurrence.
   std::vector<uint32_t> weld(nv);
-  {
-    std::unordered_map<PositionKey, uint32_t, PositionKeyHash> first;
-    first.reserve(nv);
-    for (size_t v = 0; v < nv; ++v) {
-      auto [it, inserted] = first.emplace(key_of(&mesh.positions[3 * v]), uint32_t(v));
-      weld[v] = it->second;
-      if (!inserted) ++report.duplicate_vertices;
-    }
-  }
+  report.duplicate_vertices = first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v]); }, weld);
 
-  // Pass 2: faces, in order; degenerate ones first, then repeats of an earlier vertex set.
   std::vector<uint32_t> kept;
   kept.reserve(mesh.indices.size());
   // Kept triangles before triangle t, to re-range submeshes (only when there are some).
   const bool has_submeshes = !mesh.submeshes.empty();
   std::vector<uint32_t> kept_before(has_submeshes ? mesh.triangle_count() + 1 : 0, 0);
   {
-    std::unordered_map<FaceKey, uint32_t, FaceKeyHash> seen;
-    seen.reserve(mesh.triangle_count());
-    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-      if (has_submeshes) kept_before[t] = uint32_t(kept.size() / 3);
+    // Non-degenerate faces by their sorted corners; a face is kept when it is the first of them.
+    const size_t nt = mesh.triangle_count();
+    std::vector<uint32_t> live;
+    std::vector<FaceKey> keys;
+    live.reserve(nt);
+    keys.reserve(nt);
+    for (size_t t = 0; t < nt; ++t) {
       const uint32_t a = weld[mesh.indices[3 * t]], b = weld[mesh.indices[3 * t + 1]], c = weld[mesh.indices[3 * t + 2]];
       if (a == b || b == c || a == c ||
           zero_area(&mesh.positions[3 * a], &mesh.positions[3 * b], &mesh.positions[3 * c])) {
@@ -103,11 +106,18 @@ CleanReport clean_mesh(MeshData& mesh) {
       }
       FaceKey key{{a, b, c}};
       std::sort(key.v.begin(), key.v.end());
-      if (!seen.emplace(key, uint32_t(t)).second) {
-        ++report.duplicate_faces;
-        continue;
-      }
-      kept.insert(kept.end(), {a, b, c});
+      live.push_back(uint32_t(t));
+      keys.push_back(key);
+    }
+    std::vector<uint32_t> first(live.size());
+    report.duplicate_faces = first_of_equal(live.size(), [&](size_t i) { return keys[i]; }, first);
+    size_t next = 0;
+    for (size_t t = 0; t < nt; ++t) {
+      if (has_submeshes) kept_before[t] = uint32_t(kept.size() / 3);
+      if (next == live.size() || live[next] != t) continue;  // degenerate
+      const size_t i = next++;
+      if (first[i] != i) continue;  // same corners as an earlier face
+      kept.insert(kept.end(), {weld[mesh.indices[3 * t]], weld[mesh.indices[3 * t + 1]], weld[mesh.indices[3 * t + 2]]});
     }
     if (has_submeshes) kept_before[mesh.triangle_count()] = uint32_t(kept.size() / 3);
   }

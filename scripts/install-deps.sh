@@ -8,6 +8,7 @@ PKGS=(build-essential cmake ninja-build ccache pkg-config
       libgtest-dev libgmock-dev libbenchmark-dev libmeshoptimizer-dev
       libtinygltf-dev gltfpack
       libcgal-demo xvfb xauth libgl1-mesa-dri
+      openmpi-bin libopenmpi-dev  # lod-bake-mpi (issue 16) and its mpirun tests
       clang libclang-rt-14-dev)  # clang: libFuzzer targets (scripts/fuzz.sh)
 missing=()
 for p in "${PKGS[@]}"; do

@@ -1,0 +1,145 @@
+// lod-bake-mpi: the HLOD bake of one mesh spread over MPI ranks (issue 16).
+//
+//   mpirun -np 4 lod-bake-mpi MESH -o DIR --cache DIR [--min-verts N] [--threads N] [--subtrees N]
+//
+// Every rank reads MESH itself (a path all ranks see) and bakes its share of the subtrees into
+// the cache folder (shared storage); rank 0 prints progress, assembles and writes DIR/<name>.hlod,
+// byte-identical to `lod bake MESH -o DIR --hlod`. A rerun bakes only what the cache lacks.
+//
+// Fault injection for tests: LOD_MPI_FAIL_AFTER=N makes rank LOD_MPI_FAIL_RANK (default: the
+// last; -1: every rank) die without a word to MPI once it has stored N subtrees, as a killed
+// process would.
+#include <mpi.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "jobs/hlod_distributed_bake.h"
+
+namespace {
+
+using namespace lod;
+
+HlodRankComm mpi_comm() {
+  HlodRankComm c;
+  MPI_Comm_rank(MPI_COMM_WORLD, &c.rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &c.size);
+  c.broadcast = [](std::vector<uint8_t>& bytes) {
+    unsigned long long n = bytes.size();
+    MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+    bytes.resize(size_t(n));
+    MPI_Bcast(bytes.data(), int(n), MPI_BYTE, 0, MPI_COMM_WORLD);
+  };
+  const int rank = c.rank, size = c.size;
+  c.gather = [rank, size](const std::vector<uint8_t>& mine) {
+    int n = int(mine.size());
+    std::vector<int> counts(size_t(size), 0), offsets(size_t(size), 0);
+    MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+    int total = 0;
+    for (int r = 0; r < size; ++r) offsets[size_t(r)] = total, total += counts[size_t(r)];
+    std::vector<uint8_t> all(size_t(rank == 0 ? total : 0));
+    MPI_Gatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, 0, MPI_COMM_WORLD);
+    std::vector<std::vector<uint8_t>> out;
+    if (rank != 0) return out;
+    for (int r = 0; r < size; ++r)
+      out.emplace_back(all.begin() + offsets[size_t(r)], all.begin() + offsets[size_t(r)] + counts[size_t(r)]);
+    return out;
+  };
+  return c;
+}
+
+long env_number(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::strtol(v, nullptr, 10) : fallback;
+}
+
+nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
+  nlohmann::json per_rank = nlohmann::json::array();
+  double slowest = 0, sum = 0, critical = 0;
+  for (const HlodRankWork& w : r.ranks) {
+    per_rank.push_back({{"subtrees", w.subtrees}, {"triangles", w.triangles}, {"bake_s", w.bake_seconds},
+                        {"bake_cpu_s", w.bake_cpu_seconds}, {"until_report_s", w.total_seconds},
+                        {"cpu_until_report_s", w.cpu_seconds},
+                        {"bytes_written", w.bytes_written}});
+    slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
+    critical = std::max(critical, w.cpu_seconds);
+  }
+  return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},
+          {"subtrees", r.subtrees}, {"cached", r.cached}, {"rebaked", r.rebaked}, {"nodes", r.report.nodes},
+          {"entry_bytes_read", r.entry_bytes_read}, {"load_s", r.load_seconds}, {"plan_s", r.plan_seconds},
+          {"lookup_s", r.lookup_seconds}, {"bake_s", r.bake_seconds}, {"assemble_s", r.assemble_seconds},
+          {"write_s", r.write_seconds}, {"total_s", r.total_seconds},
+          {"cpu_after_gather_s", r.cpu_after_gather_seconds},
+          // The job's length on idle cores: the slowest rank's CPU time up to the gather, then
+          // rank 0's (each rank runs one thread; the machine these figures come from is shared).
+          {"critical_cpu_s", critical + r.cpu_after_gather_seconds},
+          {"balance_cpu", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
+}
+
+int run(int argc, char** argv, const HlodRankComm& comm) {
+  CLI::App app{"HLOD bake of one mesh over MPI ranks (byte-identical to lod bake --hlod)"};
+  std::string mesh, out_dir, cache_dir;
+  int min_verts = 1000, threads = 0, subtrees = 0;
+  bool json = false, quiet = false;
+  app.add_option("mesh", mesh, "mesh file, on a path every rank sees")->required();
+  app.add_option("-o,--out", out_dir, "output directory (rank 0 writes <name>.hlod there)")->required();
+  app.add_option("--cache", cache_dir, "subtree cache directory on shared storage")->required();
+  app.add_option("--min-verts", min_verts, "a cell with more vertices splits (default 1000)")->check(CLI::Range(3, 100000000));
+  app.add_option("--threads", threads, "threads per rank, 0 = all cores")->check(CLI::Range(0, 1024));
+  app.add_option("--subtrees", subtrees, "subtrees to split into (default 16 per rank)")->check(CLI::Range(0, 1 << 20));
+  app.add_flag("--json", json, "rank 0 prints a JSON summary");
+  app.add_flag("--quiet", quiet, "print nothing but errors");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return comm.rank == 0 ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 1);
+  }
+  HlodDistributedSettings settings;
+  settings.min_verts = uint32_t(min_verts);
+  settings.threads = uint32_t(threads);
+  settings.subtrees = uint32_t(subtrees);
+  settings.cache_dir = cache_dir;
+  const long fail_after = env_number("LOD_MPI_FAIL_AFTER", -1);
+  const long fail_rank = env_number("LOD_MPI_FAIL_RANK", comm.size - 1);
+  if (fail_after >= 0 && (fail_rank == comm.rank || fail_rank < 0))  // LOD_MPI_FAIL_RANK=-1: every rank
+    settings.before_store = [rank = comm.rank, fail_after](size_t subtree, size_t stored) {
+      if (long(stored) < fail_after) return;
+      std::fprintf(stderr, "lod-bake-mpi: rank %d: injected failure (LOD_MPI_FAIL_AFTER=%ld) at subtree %zu\n", rank,
+                   fail_after, subtree);
+      std::fflush(stderr);
+      std::_Exit(3);  // no MPI_Finalize: mpirun sees a dead rank and ends the job
+    };
+  const bool talk = !quiet && !json;
+  auto log = [&](const std::string& line) {
+    const bool progress = line.rfind("subtrees ", 0) == 0;  // the rest: refused entries, failures
+    if (talk || !progress) std::fprintf(stderr, "lod-bake-mpi: %s\n", line.c_str());
+  };
+  const std::string name = std::filesystem::path(mesh).stem().string();
+  HlodDistributedResult r;
+  const Status st = bake_hlod_distributed(mesh, name, out_dir, settings, comm, log, &r);
+  if (!st) {
+    std::fprintf(stderr, "lod-bake-mpi: %s\n", st.message.c_str());
+    return 1;
+  }
+  if (comm.rank != 0) return 0;
+  if (json) std::printf("%s\n", to_json(r, comm.size).dump(1).c_str());
+  else if (!quiet)
+    std::printf("%s: %zu triangles -> %zu nodes, %zu subtrees (%zu cached) on %d ranks, %.2f MB in %s; total %.2f s\n",
+                name.c_str(), r.input_triangles, r.report.nodes, r.subtrees, r.cached, comm.size, double(r.bytes) / 1e6,
+                r.file.string().c_str(), r.total_seconds);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);  // MPI from the main thread only
+  const int code = run(argc, argv, mpi_comm());
+  MPI_Finalize();
+  return code;
+}

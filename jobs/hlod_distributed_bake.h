@@ -1,0 +1,80 @@
+// The HLOD bake spread over ranks (issue 16), one call per rank (an MPI process, say):
+//
+//   every rank   load the mesh from the shared path, plan the split (the same on every rank)
+//   rank 0       look every subtree up in the cache -> broadcast which are missing
+//   every rank   bake its share of the missing ones (longest first, to the least loaded
+//                rank), each result stored in the cache as it is finished
+//   gather       per rank: its status (a failure names the subtree), work and bytes
+//   rank 0       read the others' entries (one refused is baked again here), build the levels
+//                above, write the .hlod (write_file_atomic)
+//
+// The communication is two collectives (HlodRankComm), so that lodkit's libraries never link
+// MPI: lod-bake-mpi gives MPI_Bcast and MPI_Gatherv; tests may give threads or nothing.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "jobs/hlod_bake.h"
+
+namespace lod {
+
+struct HlodRankComm {
+  int rank = 0;
+  int size = 1;
+  // Every rank calls it; afterwards every rank's `bytes` are rank 0's.
+  std::function<void(std::vector<uint8_t>& bytes)> broadcast;
+  // Every rank calls it; rank 0 gets every rank's bytes (by rank), the others nothing.
+  std::function<std::vector<std::vector<uint8_t>>(const std::vector<uint8_t>& mine)> gather;
+};
+
+// One rank, no communication: the distributed bake run in one process.
+HlodRankComm single_rank_comm();
+
+// Longest processing time first: subtrees by cost, largest first (ties: lower index), each to
+// the rank with the least cost so far (ties: lower rank). The slowest rank then carries at
+// most the mean plus one subtree. Returns each subtree's rank.
+std::vector<int> assign_subtrees(const std::vector<uint64_t>& costs, int ranks);
+
+struct HlodDistributedSettings {
+  uint32_t min_verts = 1000;
+  uint32_t threads = 0;    // per rank; 0 = all its cores
+  uint32_t subtrees = 0;   // the frontier's target (HlodBuildOptions::subtrees); 0 = 16 per rank
+  std::filesystem::path cache_dir;
+  // Called before each of this rank's entries is stored (count: entries this rank stored so
+  // far), from the thread that finished it. Tests inject a crash here.
+  std::function<void(size_t subtree, size_t stored)> before_store;
+};
+
+struct HlodRankWork {
+  uint32_t subtrees = 0;     // baked by the rank in this run
+  uint64_t triangles = 0;    // their original triangles
+  double bake_seconds = 0;   // the rank's time in its bakes
+  double bake_cpu_seconds = 0;  // its process's CPU time in them (the machine may be shared)
+  double total_seconds = 0;     // the rank's whole run, up to its report
+  double cpu_seconds = 0;       // its process's CPU time over that run
+  uint64_t bytes_written = 0;
+};
+
+struct HlodDistributedResult {
+  std::filesystem::path file;  // rank 0: what was written
+  uint64_t bytes = 0;
+  size_t input_triangles = 0;
+  size_t subtrees = 0, cached = 0, rebaked = 0;  // rebaked: refused at assembly, baked again on rank 0
+  std::vector<HlodRankWork> ranks;                // rank 0: every rank's work
+  uint64_t entry_bytes_read = 0;                  // rank 0: entries read from the cache
+  double cpu_after_gather_seconds = 0;            // rank 0: CPU time reading, assembling, writing
+  double load_seconds = 0, plan_seconds = 0, lookup_seconds = 0, bake_seconds = 0, assemble_seconds = 0,
+         write_seconds = 0, total_seconds = 0;    // this rank's phases (lookup and assembly: rank 0)
+  HlodBuildReport report;
+};
+
+// Rank 0's log gets progress lines ("subtrees 12/64 (3 cached), 1.20 M triangles/s") and one
+// line per failure; other ranks log their own failures only.
+Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::string& name,
+                             const std::filesystem::path& out_dir, const HlodDistributedSettings& settings,
+                             const HlodRankComm& comm, const HlodBakeLog& log, HlodDistributedResult* result);
+
+}  // namespace lod

@@ -1,0 +1,123 @@
+// The subtree entry, version 1; little-endian:
+//
+//   magic "LODHSUB\n" (8) | u32 version | u32 root depth | u64 key | u64 short_layers |
+//   u64 oversized_leaves | u32 source count S | u32 reference count R | u64 asset bytes A
+//   S u32 root vertex sources | R u32 reference vertices
+//   u64 checksum = hash_bytes(everything before it)
+//   A bytes: the subtree as an .hlod asset (its root cell the asset's root cube, depths
+//            relative to the subtree's root, source_hash = key), with its own checksums
+//
+// The asset reader already refuses every broken count, offset, tree or payload; the entry adds
+// what a spliced subtree needs on top: the key, the depth it sits at, the root's vertex sources.
+#include "runtime/hlod_subtree_entry.h"
+
+#include <cstring>
+
+#include "runtime/byte_order.h"
+#include "runtime/hlod_asset.h"
+#include "runtime/lod_asset.h"  // hash_bytes
+
+namespace lod {
+namespace {
+
+constexpr char kMagic[8] = {'L', 'O', 'D', 'H', 'S', 'U', 'B', '\n'};
+constexpr uint64_t kFixedBytes = 56;
+constexpr uint64_t kChecksumBytes = 8;
+
+Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
+
+HlodTree relative_tree(const HlodSubtree& s, uint64_t key) {
+  HlodTree t;
+  const HlodNode& root = s.nodes[0];
+  t.source_hash = key;
+  t.min_verts = 1;  // the key holds the settings
+  for (int k = 0; k < 3; ++k) t.box_center[k] = root.box_center[k];
+  t.box_half = root.box_half;
+  t.nodes = s.nodes;
+  for (HlodNode& n : t.nodes) n.depth = uint8_t(n.depth - root.depth);
+  return t;
+}
+
+std::vector<uint32_t> get_ids(const uint8_t* p, uint32_t count) {
+  std::vector<uint32_t> ids(count);
+  for (uint32_t i = 0; i < count; ++i) ids[i] = detail::load_u32(p + 4 * size_t(i));
+  return ids;
+}
+
+// The decoded asset as the subtree it was: depths back at the subtree's place, no offsets.
+Status place_tree(HlodTree& t, uint32_t depth, const std::string& what) {
+  for (HlodNode& n : t.nodes) {
+    if (n.depth + depth > kHlodMaxDepth)
+      return refuse(what, "subtree at depth " + std::to_string(depth) + " reaches below depth " + std::to_string(kHlodMaxDepth));
+    n.depth = uint8_t(n.depth + depth);
+    n.payload_offset = n.payload_size = 0;
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_hlod_subtree(const HlodSubtree& s, uint64_t key) {
+  const std::vector<uint8_t> asset = encode_hlod_asset(relative_tree(s, key), s.payloads);
+  detail::ByteWriter w;
+  for (char c : kMagic) w.u8(uint8_t(c));
+  w.u32(kHlodSubtreeEntryVersion);
+  w.u32(s.nodes[0].depth);
+  w.u64(key);
+  w.u64(s.short_layers);
+  w.u64(s.oversized_leaves);
+  w.u32(uint32_t(s.root_source.size()));
+  w.u32(uint32_t(s.root_reference.size()));
+  w.u64(asset.size());
+  w.words(s.root_source.data(), s.root_source.size());
+  w.words(s.root_reference.data(), s.root_reference.size());
+  w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
+  w.raw(asset.data(), asset.size());
+  return std::move(w.bytes);
+}
+
+Status decode_hlod_subtree(std::span<const uint8_t> bytes, uint64_t key, uint64_t mesh_vertices,
+                           const std::string& what, HlodSubtree& out) {
+  using detail::load_u32;
+  using detail::load_u64;
+  const uint8_t* p = bytes.data();
+  if (bytes.size() < kFixedBytes + kChecksumBytes)
+    return refuse(what, "entry is " + std::to_string(bytes.size()) + " bytes, too short (truncated?)");
+  if (std::memcmp(p, kMagic, 8) != 0) return refuse(what, "not an HLOD subtree entry (bad magic bytes)");
+  if (load_u32(p + 8) != kHlodSubtreeEntryVersion)
+    return refuse(what, "entry version " + std::to_string(load_u32(p + 8)) + " is not " +
+                            std::to_string(kHlodSubtreeEntryVersion));
+  const uint32_t depth = load_u32(p + 12), sources = load_u32(p + 40), references = load_u32(p + 44);
+  const uint64_t asset_bytes = load_u64(p + 48);
+  const uint64_t head = kFixedBytes + 4ull * sources + 4ull * references;
+  if (head + kChecksumBytes > bytes.size() || asset_bytes != bytes.size() - head - kChecksumBytes)
+    return refuse(what, "entry is " + std::to_string(bytes.size()) + " bytes, its counts (" + std::to_string(sources) +
+                            " sources, " + std::to_string(references) + " references, asset of " +
+                            std::to_string(asset_bytes) + ") say otherwise (truncated?)");
+  if (load_u64(p + head) != hash_bytes(p, head)) return refuse(what, "entry checksum mismatch (corrupted)");
+  if (load_u64(p + 16) != key) return refuse(what, "entry was written for another key (a stale or misplaced entry)");
+  if (depth > kHlodMaxDepth) return refuse(what, "subtree depth " + std::to_string(depth) + " is too deep");
+
+  HlodSubtree s;
+  HlodTree tree;
+  if (Status st = decode_hlod_asset(bytes.subspan(head + kChecksumBytes), what, tree, s.payloads); !st) return st;
+  if (tree.source_hash != key) return refuse(what, "embedded subtree was written for another key");
+  if (Status st = place_tree(tree, depth, what); !st) return st;
+  s.nodes = std::move(tree.nodes);
+  s.short_layers = load_u64(p + 24);
+  s.oversized_leaves = load_u64(p + 32);
+  const HlodNode& root = s.nodes[0];
+  if (sources != root.layers[root.layer_count - 1].vertices)
+    return refuse(what, std::to_string(sources) + " vertex sources for a root layer of " +
+                            std::to_string(root.layers[root.layer_count - 1].vertices) + " vertices");
+  s.root_source = get_ids(p + kFixedBytes, sources);
+  s.root_reference = get_ids(p + kFixedBytes + 4ull * sources, references);
+  for (uint32_t v : s.root_source)
+    if (v >= mesh_vertices) return refuse(what, "vertex source " + std::to_string(v) + " is not among the mesh's " + std::to_string(mesh_vertices));
+  for (uint32_t v : s.root_reference)
+    if (v >= mesh_vertices) return refuse(what, "reference vertex " + std::to_string(v) + " is not among the mesh's " + std::to_string(mesh_vertices));
+  out = std::move(s);
+  return Status::success();
+}
+
+}  // namespace lod

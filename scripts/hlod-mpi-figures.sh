@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# hlod-mpi-figures.sh MESH [BUILD_DIR]: issue 16's figures for one mesh, on this machine.
+#   - lod bake --hlod (the local reference bytes, 1 thread)
+#   - lod-bake-mpi at 1, 2 and 4 ranks x 1 thread, each from an empty cache: wall time, per-rank
+#     bake CPU seconds (balance = slowest / mean), bytes identical to the local bake
+#   - 2 ranks killed at <= 50 % (each dies once it has stored a quarter of the subtrees; the first
+#     to die ends the job), then the rerun: its time against the full 2-rank build
+# Output: one JSON summary per run in $OUT (default /tmp/hlod-mpi-figures), a table on stdout.
+set -euo pipefail
+export NPS=${NPS:-1 2 4}
+mesh=$1
+build=${2:-$(cd "$(dirname "$0")/.." && pwd)/build}
+out=${OUT:-/tmp/hlod-mpi-figures}
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+mpi=(mpirun --oversubscribe --mca btl self,vader,tcp --mca btl_tcp_if_include lo --mca oob_tcp_if_include lo)
+name=$(basename "${mesh%.*}")
+rm -rf "$out" && mkdir -p "$out"
+now() { date +%s.%N; }
+
+t0=$(now); "$build/lod" bake "$mesh" -o "$out/local" --hlod --threads 1 --quiet; t1=$(now)
+echo "local  1 thread : $(echo "$t1 - $t0" | bc) s"
+for np in ${NPS:-1 2 4}; do
+  t0=$(now)
+  "${mpi[@]}" -np $np "$build/lod-bake-mpi" "$mesh" -o "$out/np$np" --cache "$out/cache$np" --threads 1 --json \
+    > "$out/np$np.json" 2> "$out/np$np.err"
+  t1=$(now)
+  echo "{\"wall_s\": $(echo "$t1 - $t0" | bc)}" > "$out/np$np.wall"
+  cmp -s "$out/local/$name.hlod" "$out/np$np/$name.hlod" && same=identical || same=DIFFERENT
+  echo "mpi np=$np x 1 thread: $(cat "$out/np$np.wall") bytes $same"
+done
+
+total=$(python3 -c "import json; print(json.load(open('$out/np2.json'))['subtrees'])")
+quarter=$((total / 4))
+t0=$(now)
+LOD_MPI_FAIL_AFTER=$quarter LOD_MPI_FAIL_RANK=-1 "${mpi[@]}" -np 2 "$build/lod-bake-mpi" "$mesh" -o "$out/resume" \
+  --cache "$out/cache-resume" --threads 1 --quiet > /dev/null 2> "$out/killed.err" || true
+t1=$(now)
+kept=$(ls "$out/cache-resume" | grep -c '\.hsub$' || true)
+echo "killed run: $(echo "$t1 - $t0" | bc) s, $kept of $total subtrees kept"
+t0=$(now)
+"${mpi[@]}" -np 2 "$build/lod-bake-mpi" "$mesh" -o "$out/resume" --cache "$out/cache-resume" --threads 1 --json \
+  > "$out/rerun.json" 2> "$out/rerun.err"
+t1=$(now)
+echo "{\"wall_s\": $(echo "$t1 - $t0" | bc)}" > "$out/rerun.wall"
+cmp -s "$out/local/$name.hlod" "$out/resume/$name.hlod" && same=identical || same=DIFFERENT
+echo "rerun: $(cat "$out/rerun.wall") bytes $same"
+
+NPS="${NPS:-1 2 4}" python3 - "$out" <<'PY'
+import json, sys
+out = sys.argv[1]
+def load(n): return json.load(open(f"{out}/{n}.json")), json.load(open(f"{out}/{n}.wall"))["wall_s"]
+import os
+runs = {int(np): load(f"np{np}") for np in os.environ.get("NPS", "1 2 4").split()}
+for np, (j, wall) in runs.items():
+    cpu = [w["bake_cpu_s"] for w in j["per_rank"]]
+    print(f"np={np}: wall {wall:.2f} s, job {j['total_s']:.2f} s (load {j['load_s']:.2f}, plan {j['plan_s']:.2f}, "
+          f"bake {j['bake_s']:.2f}, assemble {j['assemble_s']:.2f}, write {j['write_s']:.2f}), subtrees {j['subtrees']}, "
+          f"bake cpu per rank {[round(c, 2) for c in cpu]}, balance {max(cpu) / (sum(cpu) / len(cpu)):.3f}, "
+          f"entries read {j['entry_bytes_read'] / 1e6:.1f} MB, file {j['bytes'] / 1e6:.1f} MB")
+w1, w2 = runs[1][1], runs[2][1]
+c = {np: runs[np][0]["critical_cpu_s"] for np in runs}
+print("critical-path CPU s: " + ", ".join(f"{v:.2f} at {np}" for np, v in c.items()))
+print(f"speed-up 2 ranks x 1 thread vs 1 x 1: wall {w1 / w2:.2f}x, job {runs[1][0]['total_s'] / runs[2][0]['total_s']:.2f}x, "
+      f"critical-path CPU {c[1] / c[2]:.2f}x")
+r, rw = load("rerun")
+print(f"resume: rerun {rw:.2f} s wall = {rw / w2:.0%} of the full 2-rank build; critical-path CPU "
+      f"{r['critical_cpu_s']:.2f} s = {r['critical_cpu_s'] / c[2]:.0%} ({r['cached']} of {r['subtrees']} cached)")
+PY

@@ -1,0 +1,167 @@
+// lod-bake-mpi under mpirun on loopback (issue 16): at 1, 2 and 4 ranks the file is the bytes
+// of `lod bake --hlod`; a rank killed mid-run (LOD_MPI_FAIL_AFTER) fails the job, keeps the
+// partial cache, and the rerun bakes only what is missing into the same bytes; corrupted and
+// truncated entries are rebaked; a rank that fails says which subtree and why.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "run_cli.h"
+#include "test_support.h"
+
+namespace lod {
+namespace {
+
+#if defined(LOD_BAKE_MPI_PATH) && defined(LOD_MPIEXEC)
+
+test::CliResult run_shell(const std::string& cmd) {
+  test::CliResult r;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// Root may run mpirun here (containers, CI); loopback only; more ranks than cores is fine.
+// Under AddressSanitizer, OpenMPI's own allocations at exit are not reported as leaks.
+test::CliResult mpirun(int ranks, const std::string& args, const std::string& env = "") {
+  return run_shell("env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
+                   "ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:detect_leaks=0\" " +
+                   env + " " LOD_MPIEXEC " --oversubscribe --mca btl self,vader,tcp --mca btl_tcp_if_include lo" +
+                   " --mca oob_tcp_if_include lo -np " + std::to_string(ranks) + " " LOD_BAKE_MPI_PATH " " + args);
+}
+
+// A closed sphere of 48,000 triangles, written by the test (no third-party mesh).
+struct Fixture {
+  std::filesystem::path dir, mesh;
+  std::vector<uint8_t> local;  // lod bake --hlod of it
+};
+
+const Fixture& fixture() {
+  static const Fixture f = [] {
+    Fixture x;
+    x.dir = test::temp_dir("lod_bake_mpi");
+    x.mesh = x.dir / "ball.off";
+    test::write_text(x.mesh, test::sphere_off(120, 200));
+    const test::CliResult r = test::run_lod("bake " + x.mesh.string() + " -o " + (x.dir / "local").string() +
+                                            " --hlod --min-verts 300 --quiet");
+    EXPECT_EQ(r.code, 0) << r.out;
+    x.local = test::read_bytes(x.dir / "local" / "ball.hlod");
+    return x;
+  }();
+  return f;
+}
+
+std::string bake_args(const std::filesystem::path& out, const std::filesystem::path& cache) {
+  return fixture().mesh.string() + " -o " + out.string() + " --cache " + cache.string() + " --min-verts 300 --threads 1";
+}
+
+size_t entries(const std::filesystem::path& cache) {
+  size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(cache)) n += e.is_regular_file() && e.path().extension() == ".hsub";
+  return n;
+}
+
+nlohmann::json summary(const test::CliResult& r) {
+  const size_t at = r.out.find("{\n");
+  if (at == std::string::npos) return {};
+  return nlohmann::json::parse(r.out.substr(at, r.out.rfind('}') + 1 - at), nullptr, false);
+}
+
+TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
+  ASSERT_FALSE(fixture().local.empty());
+  for (int ranks : {1, 2, 4}) {
+    const auto dir = test::temp_dir("lod_bake_mpi_np" + std::to_string(ranks));
+    const test::CliResult r = mpirun(ranks, bake_args(dir / "out", dir / "cache") + " --json");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local) << ranks << " ranks";
+    const nlohmann::json j = summary(r);
+    ASSERT_TRUE(j.is_object()) << r.out;
+    EXPECT_EQ(j["ranks"], ranks);
+    EXPECT_GE(j["subtrees"].get<int>(), 16 * ranks);
+    EXPECT_EQ(j["per_rank"].size(), size_t(ranks));
+    for (const auto& w : j["per_rank"]) EXPECT_GT(w["subtrees"].get<int>(), 0) << "a rank without work";
+  }
+}
+
+TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes) {
+  const auto dir = test::temp_dir("lod_bake_mpi_kill");
+  const test::CliResult killed = mpirun(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=4 LOD_MPI_FAIL_RANK=1");
+  EXPECT_NE(killed.code, 0) << killed.out;
+  EXPECT_NE(killed.out.find("injected failure"), std::string::npos) << killed.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "ball.hlod"));
+  const size_t kept = entries(dir / "cache");
+  EXPECT_GE(kept, 4u) << "the partial cache is kept";
+
+  const test::CliResult rerun = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  ASSERT_EQ(rerun.code, 0) << rerun.out;
+  const nlohmann::json j = summary(rerun);
+  ASSERT_TRUE(j.is_object()) << rerun.out;
+  const size_t total = j["subtrees"].get<size_t>();
+  ASSERT_LT(kept, total);
+  EXPECT_EQ(j["cached"].get<size_t>(), kept);
+  size_t baked = 0;
+  for (const auto& w : j["per_rank"]) baked += w["subtrees"].get<size_t>();
+  EXPECT_EQ(baked, total - kept) << "only the missing subtrees are baked";
+  EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local);
+  EXPECT_EQ(entries(dir / "cache"), total);
+}
+
+TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
+  const auto dir = test::temp_dir("lod_bake_mpi_corrupt");
+  ASSERT_EQ(mpirun(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "cache")) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 2u);
+  std::vector<uint8_t> bytes = test::read_bytes(files[0]);
+  bytes[bytes.size() / 2] ^= 0x10;
+  test::write_bytes(files[0], bytes);
+  bytes = test::read_bytes(files[1]);
+  bytes.resize(bytes.size() - 1);
+  test::write_bytes(files[1], bytes);
+  std::filesystem::remove(dir / "out" / "ball.hlod");
+
+  const test::CliResult r = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = summary(r);
+  ASSERT_TRUE(j.is_object()) << r.out;
+  EXPECT_EQ(j["cached"].get<size_t>(), files.size() - 2);
+  EXPECT_NE(r.out.find("corrupted"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("truncated"), std::string::npos) << r.out;
+  EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local);
+}
+
+// An entry's place taken by a non-empty folder: the rank baking it cannot rename into place.
+TEST(LodBakeMpi, FailingRankNamesTheSubtreeAndTheJobFailsKeepingTheCache) {
+  const auto dir = test::temp_dir("lod_bake_mpi_fail");
+  ASSERT_EQ(mpirun(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "cache")) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  const auto blocked = files[files.size() / 2];
+  std::filesystem::remove(blocked);
+  std::filesystem::create_directories(blocked / "in-the-way");
+  std::filesystem::remove(dir / "out" / "ball.hlod");
+
+  const test::CliResult r = mpirun(2, bake_args(dir / "out", dir / "cache"));
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("subtree "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(blocked.filename().string()), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("run again"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "ball.hlod"));
+  EXPECT_EQ(entries(dir / "cache"), files.size() - 1);
+}
+
+#else
+TEST(LodBakeMpi, NeedsMpi) { GTEST_SKIP() << "built without MPI (lod-bake-mpi absent): run scripts/install-deps.sh"; }
+#endif
+
+}  // namespace
+}  // namespace lod

@@ -1,0 +1,261 @@
+// The distributed HLOD bake without MPI (issue 16): the balanced assignment, the subtree cache
+// (store, verify, refuse), and whole bakes with one rank and with ranks as threads, whose files
+// must be the local bake's bytes; reruns bake only what the cache lacks.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <barrier>
+#include <filesystem>
+#include <numeric>
+#include <random>
+#include <thread>
+
+#include "jobs/hlod_bake.h"
+#include "jobs/hlod_distributed_bake.h"
+#include "jobs/hlod_subtree_cache.h"
+#include "preprocess/mesh_io.h"
+#include "test_support.h"
+#include "vd_meshes.h"
+
+namespace lod {
+namespace {
+
+TEST(HlodAssign, LongestFirstToTheLeastLoadedRank) {
+  EXPECT_EQ(assign_subtrees({5, 4, 3, 3, 3}, 2), (std::vector<int>{0, 1, 1, 0, 1}));
+  EXPECT_EQ(assign_subtrees({1, 1, 1}, 1), (std::vector<int>{0, 0, 0}));
+  EXPECT_TRUE(assign_subtrees({}, 4).empty());
+}
+
+TEST(HlodAssign, SlowestRankCarriesAtMostTheMeanPlusOneSubtree) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int ranks = 1 + int(rng() % 8);
+    std::vector<uint64_t> costs(1 + rng() % 200);
+    for (uint64_t& c : costs) c = 1 + rng() % 5000;
+    const std::vector<int> owner = assign_subtrees(costs, ranks);
+    std::vector<uint64_t> load(size_t(ranks), 0);
+    for (size_t i = 0; i < costs.size(); ++i) {
+      ASSERT_GE(owner[i], 0);
+      ASSERT_LT(owner[i], ranks);
+      load[size_t(owner[i])] += costs[i];
+    }
+    const double mean = double(std::accumulate(costs.begin(), costs.end(), uint64_t(0))) / ranks;
+    EXPECT_LE(double(*std::max_element(load.begin(), load.end())), mean + double(*std::max_element(costs.begin(), costs.end())));
+  }
+}
+
+// The mixed test mesh as an OFF file.
+std::filesystem::path write_mesh(const std::filesystem::path& dir) {
+  const MeshData m = test::vd_concat(test::vd_sphere(40, 50, 0.4f, 0.5f, 0.3f, 0.5f), test::vd_grid(40, 40));
+  const auto path = dir / "mixed.ply";
+  EXPECT_TRUE(save_ply(path, m.positions.data(), m.vertex_count(), m.indices.data(), m.indices.size()));
+  return path;
+}
+
+HlodSubtree one_subtree(const MeshData& m, HlodBuildOptions& o, size_t which, HlodSubtreeSpec* spec = nullptr) {
+  HlodBuilder b(m, o);
+  EXPECT_TRUE(b.plan());
+  HlodSubtree out;
+  EXPECT_TRUE(b.bake_subtrees({which}, [&](size_t, HlodSubtree&& s) {
+    out = std::move(s);
+    return Status::success();
+  }));
+  if (spec) *spec = b.subtrees()[which];
+  return out;
+}
+
+TEST(HlodSubtreeCache, StoredEntryLoadsBackAndLeavesNoTemporary) {
+  const auto dir = test::temp_dir("hlod_cache");
+  const MeshData m = test::vd_sphere(40, 50);
+  HlodBuildOptions o;
+  o.min_verts = 150;
+  HlodSubtreeSpec spec;
+  const HlodSubtree s = one_subtree(m, o, 1, &spec);
+  const uint64_t key = hlod_subtree_key(42, o, spec);
+  HlodSubtree back;
+  EXPECT_EQ(load_hlod_subtree(dir, key, m.vertex_count(), back), CacheLookup::missing);
+  ASSERT_TRUE(store_hlod_subtree(dir, key, m.vertex_count(), s));
+  ASSERT_EQ(load_hlod_subtree(dir, key, m.vertex_count(), back), CacheLookup::found);
+  EXPECT_EQ(back.root_source, s.root_source);
+  EXPECT_EQ(back.nodes.size(), s.nodes.size());
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    ++files;
+    EXPECT_EQ(e.path().extension(), ".hsub");
+  }
+  EXPECT_EQ(files, 1u);
+}
+
+TEST(HlodSubtreeCache, KeyChangesWithSourceSettingsAndSubtree) {
+  HlodBuildOptions o;
+  HlodSubtreeSpec spec;
+  spec.fingerprint = 5;
+  const uint64_t k = hlod_subtree_key(1, o, spec);
+  EXPECT_NE(hlod_subtree_key(2, o, spec), k);
+  HlodBuildOptions fewer = o;
+  fewer.min_verts = 500;
+  EXPECT_NE(hlod_subtree_key(1, fewer, spec), k);
+  spec.fingerprint = 6;
+  EXPECT_NE(hlod_subtree_key(1, o, spec), k);
+}
+
+TEST(HlodSubtreeCache, TruncatedFlippedOrMisplacedEntriesAreRefused) {
+  const auto dir = test::temp_dir("hlod_cache_bad");
+  const MeshData m = test::vd_sphere(40, 50);
+  HlodBuildOptions o;
+  o.min_verts = 150;
+  const HlodSubtree s = one_subtree(m, o, 0);
+  ASSERT_TRUE(store_hlod_subtree(dir, 1, m.vertex_count(), s));
+  const auto path = hlod_subtree_entry_path(dir, 1);
+  const std::vector<uint8_t> good = test::read_bytes(path);
+  HlodSubtree out;
+  std::string why;
+  test::write_bytes(path, std::vector<uint8_t>(good.begin(), good.begin() + std::ptrdiff_t(good.size() / 2)));
+  EXPECT_EQ(load_hlod_subtree(dir, 1, m.vertex_count(), out, &why), CacheLookup::refused);
+  EXPECT_NE(why.find(path.string()), std::string::npos) << why;
+  std::vector<uint8_t> flipped = good;
+  flipped[flipped.size() / 3] ^= 4;
+  test::write_bytes(path, flipped);
+  EXPECT_EQ(load_hlod_subtree(dir, 1, m.vertex_count(), out), CacheLookup::refused);
+  std::filesystem::rename(path, hlod_subtree_entry_path(dir, 2));
+  test::write_bytes(hlod_subtree_entry_path(dir, 2), good);
+  EXPECT_EQ(load_hlod_subtree(dir, 2, m.vertex_count(), out, &why), CacheLookup::refused) << "stored under key 1";
+  EXPECT_EQ(load_hlod_subtree(dir, 2, 10, out), CacheLookup::refused) << "vertices beyond a 10-vertex mesh";
+}
+
+// Ranks as threads: the two collectives over shared slots and a barrier.
+struct ThreadRanks {
+  explicit ThreadRanks(int n) : size(n), sync(n), slots(size_t(n)) {}
+  HlodRankComm comm(int rank) {
+    HlodRankComm c;
+    c.rank = rank;
+    c.size = size;
+    c.broadcast = [this, rank](std::vector<uint8_t>& bytes) {
+      if (rank == 0) slots[0] = bytes;
+      sync.arrive_and_wait();
+      if (rank != 0) bytes = slots[0];
+      sync.arrive_and_wait();
+    };
+    c.gather = [this, rank](const std::vector<uint8_t>& mine) {
+      slots[size_t(rank)] = mine;
+      sync.arrive_and_wait();
+      std::vector<std::vector<uint8_t>> all;
+      if (rank == 0) all = slots;
+      sync.arrive_and_wait();
+      return all;
+    };
+    return c;
+  }
+  int size;
+  std::barrier<> sync;
+  std::vector<std::vector<uint8_t>> slots;
+};
+
+struct RankRun {
+  Status status;
+  HlodDistributedResult result;
+};
+
+std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, const std::filesystem::path& out,
+                           const std::filesystem::path& cache) {
+  ThreadRanks tr(ranks);
+  std::vector<RankRun> runs(static_cast<size_t>(ranks));
+  std::vector<std::thread> threads;
+  for (int r = 0; r < ranks; ++r)
+    threads.emplace_back([&, r] {
+      HlodDistributedSettings s;
+      s.min_verts = 150;
+      s.threads = 1;
+      s.cache_dir = cache;
+      runs[size_t(r)].status = bake_hlod_distributed(mesh, "mixed", out, s, tr.comm(r), {}, &runs[size_t(r)].result);
+    });
+  for (auto& t : threads) t.join();
+  return runs;
+}
+
+std::vector<uint8_t> local_bake(const std::filesystem::path& mesh, const std::filesystem::path& out) {
+  HlodBakeSettings s;
+  s.min_verts = 150;
+  HlodBakeResult r;
+  EXPECT_TRUE(bake_hlod_file(mesh, "mixed", out, s, {}, &r));
+  return test::read_bytes(r.file);
+}
+
+TEST(HlodDistributedBake, ThreeRanksWriteTheLocalBakesBytesAndARerunBakesNothing) {
+  const auto dir = test::temp_dir("hlod_dist3");
+  const auto mesh = write_mesh(dir);
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  std::vector<RankRun> runs = run_ranks(3, mesh, dir / "out", dir / "cache");
+  for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+  EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+  const HlodDistributedResult& first = runs[0].result;
+  ASSERT_EQ(first.ranks.size(), 3u);
+  size_t baked = 0;
+  for (const HlodRankWork& w : first.ranks) {
+    baked += w.subtrees;
+    EXPECT_GT(w.subtrees, 0u);
+  }
+  EXPECT_EQ(baked, first.subtrees);
+  EXPECT_GE(first.subtrees, 48u) << "16 per rank";
+  const size_t subtrees = first.subtrees;  // `runs` is replaced below
+
+  std::filesystem::remove(dir / "out" / "mixed.hlod");
+  runs = run_ranks(3, mesh, dir / "out", dir / "cache");
+  ASSERT_TRUE(runs[0].status) << runs[0].status.message;
+  EXPECT_EQ(runs[0].result.cached, subtrees);
+  for (const HlodRankWork& w : runs[0].result.ranks) EXPECT_EQ(w.subtrees, 0u);
+  EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+}
+
+TEST(HlodDistributedBake, OneRankRebakesOnlyTheCorruptedAndMissingEntries) {
+  const auto dir = test::temp_dir("hlod_dist1");
+  const auto mesh = write_mesh(dir);
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  HlodDistributedSettings s;
+  s.min_verts = 150;
+  s.cache_dir = dir / "cache";
+  HlodDistributedResult r;
+  ASSERT_TRUE(bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r));
+  EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+  std::vector<std::filesystem::path> entries;
+  for (const auto& e : std::filesystem::directory_iterator(s.cache_dir)) entries.push_back(e.path());
+  std::sort(entries.begin(), entries.end());
+  ASSERT_EQ(entries.size(), r.subtrees);
+  std::vector<uint8_t> bytes = test::read_bytes(entries[0]);
+  bytes[bytes.size() - 20] ^= 0x80;
+  test::write_bytes(entries[0], bytes);
+  std::filesystem::remove(entries[1]);
+  std::vector<std::string> lines;
+  ASSERT_TRUE(bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(),
+                                    [&](const std::string& l) { lines.push_back(l); }, &r));
+  EXPECT_EQ(r.cached, r.subtrees - 2);
+  ASSERT_EQ(r.ranks.size(), 1u);
+  EXPECT_EQ(r.ranks[0].subtrees, 2u);
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("baking it again") != std::string::npos; }));
+  EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+}
+
+TEST(HlodDistributedBake, FailingStoreNamesTheSubtreeAndKeepsTheOthers) {
+  const auto dir = test::temp_dir("hlod_dist_fail");
+  const auto mesh = write_mesh(dir);
+  HlodDistributedSettings s;
+  s.min_verts = 150;
+  s.threads = 1;
+  s.cache_dir = dir / "cache";
+  s.before_store = [](size_t, size_t stored) {
+    if (stored == 5) throw std::runtime_error("injected: the disk is full");
+  };
+  HlodDistributedResult r;
+  const Status st = bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("rank 0"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("the disk is full"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("run again"), std::string::npos) << st.message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
+  size_t kept = 0;
+  for (const auto& e : std::filesystem::directory_iterator(s.cache_dir)) kept += e.path().extension() == ".hsub";
+  EXPECT_EQ(kept, 5u);
+}
+
+}  // namespace
+}  // namespace lod

@@ -1,0 +1,178 @@
+// The distributed bake's cache entry (issue 16): a subtree round-trips bit-exactly, and every
+// truncation, flipped byte, forged count, wrong key and out-of-mesh vertex is refused.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+#include "runtime/byte_order.h"
+#include "runtime/hlod_subtree_entry.h"
+#include "runtime/lod_asset.h"  // hash_bytes
+
+namespace lod {
+namespace {
+
+constexpr uint64_t kKey = 0xfeedface12345678ull;
+constexpr uint64_t kMeshVertices = 100;
+
+// `triangles` fan triangles around vertex 0 of a fresh range.
+LodLevel add_fan(HlodPayload& p, uint32_t triangles, float shift) {
+  LodLevel r;
+  r.first_vertex = uint32_t(p.positions.size() / 3);
+  r.vertex_count = triangles ? triangles + 2 : 0;
+  r.first_index = uint32_t(p.indices.size());
+  r.index_count = 3 * triangles;
+  r.level = level_of_triangles(triangles);
+  for (uint32_t v = 0; v < r.vertex_count; ++v) {
+    const float a = 0.25f * float(v) + shift;
+    p.positions.insert(p.positions.end(), {a, 1 - a, a * a});
+    p.normals.insert(p.normals.end(), {0, 1, 0});
+  }
+  for (uint32_t f = 0; f < triangles; ++f) p.indices.insert(p.indices.end(), {0u, f + 1, f + 2});
+  return r;
+}
+
+void add_node(HlodSubtree& s, std::vector<uint32_t> tris, std::vector<float> errors, uint32_t patch) {
+  HlodNode n;
+  HlodPayload p;
+  n.layer_count = uint8_t(tris.size());
+  for (size_t k = 0; k < tris.size(); ++k) {
+    LodLevel r = add_fan(p, tris[k], 0.01f * float(k));
+    r.error = errors[k];
+    p.layers.push_back(r);
+    n.layers[k] = {tris[k], tris[k] + 2, errors[k]};
+  }
+  p.boundary = add_fan(p, patch, 0.5f);
+  n.boundary_triangles = patch;
+  n.boundary_vertices = p.boundary.vertex_count;
+  n.bounds = {{0.5f, 0.25f, -1}, 3};
+  n.resident_bytes = 4 * (p.positions.size() + p.normals.size() + p.indices.size());
+  s.nodes.push_back(n);
+  s.payloads.push_back(std::move(p));
+}
+
+// A subtree rooted at depth 3: root (octants 1 and 4) -> two leaves.
+HlodSubtree sample() {
+  HlodSubtree s;
+  add_node(s, {6, 3, 1}, {0.5f, 0.75f, 1.0f}, 3);
+  add_node(s, {5, 2}, {0, 0.25f}, 0);
+  add_node(s, {4, 2, 1}, {0, 0.25f, 0.5f}, 0);
+  HlodNode& root = s.nodes[0];
+  root.depth = 3;
+  root.box_center[0] = 1.5f, root.box_center[1] = -0.5f, root.box_center[2] = 0.25f;
+  root.box_half = 0.5f;
+  root.child_mask = 0b00010010, root.child_count = 2, root.first_child = 1;
+  const int octants[2] = {1, 4};
+  for (int c = 0; c < 2; ++c) {
+    HlodNode& n = s.nodes[1 + c];
+    n.parent = 0;
+    n.depth = 4;
+    n.box_half = root.box_half / 2;
+    for (int k = 0; k < 3; ++k) n.box_center[k] = root.box_center[k] + ((octants[c] >> k) & 1 ? n.box_half : -n.box_half);
+  }
+  s.root_source = {7, 42, 99};  // the root's coarsest layer: 1 triangle, 3 vertices
+  s.root_reference = {1, 2, 3, 5, 8, 13, 21};
+  s.short_layers = 2;
+  s.oversized_leaves = 1;
+  return s;
+}
+
+Status decode(const std::vector<uint8_t>& bytes, HlodSubtree& out, uint64_t key = kKey) {
+  return decode_hlod_subtree(bytes, key, kMeshVertices, "cache/abc.hsub", out);
+}
+
+TEST(HlodSubtreeEntry, RoundTripIsBitExact) {
+  const HlodSubtree s = sample();
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(s, kKey);
+  HlodSubtree t;
+  const Status st = decode(bytes, t);
+  ASSERT_TRUE(st) << st.message;
+  ASSERT_EQ(t.nodes.size(), s.nodes.size());
+  for (size_t i = 0; i < t.nodes.size(); ++i) {
+    const HlodNode &a = t.nodes[i], &b = s.nodes[i];
+    EXPECT_EQ(a.depth, b.depth);
+    EXPECT_EQ(a.parent, b.parent);
+    EXPECT_EQ(a.first_child, b.first_child);
+    EXPECT_EQ(a.child_mask, b.child_mask);
+    EXPECT_EQ(std::memcmp(a.box_center, b.box_center, sizeof a.box_center), 0);
+    EXPECT_EQ(a.box_half, b.box_half);
+    EXPECT_EQ(a.resident_bytes, b.resident_bytes);
+    EXPECT_EQ(a.payload_offset, 0u);
+    EXPECT_EQ(t.payloads[i].indices, s.payloads[i].indices);
+    EXPECT_EQ(t.payloads[i].positions, s.payloads[i].positions);
+  }
+  EXPECT_EQ(t.root_source, s.root_source);
+  EXPECT_EQ(t.root_reference, s.root_reference);
+  EXPECT_EQ(t.short_layers, 2u);
+  EXPECT_EQ(t.oversized_leaves, 1u);
+  EXPECT_EQ(encode_hlod_subtree(t, kKey), bytes);
+}
+
+TEST(HlodSubtreeEntry, RefusesTruncationAtEveryLength) {
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(sample(), kKey);
+  for (size_t n = 0; n < bytes.size(); ++n) {
+    HlodSubtree t;
+    t.short_layers = 77;
+    const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + std::ptrdiff_t(n));
+    ASSERT_FALSE(decode(cut, t)) << "accepted " << n << " of " << bytes.size() << " bytes";
+    ASSERT_EQ(t.short_layers, 77u) << "output touched";
+  }
+}
+
+TEST(HlodSubtreeEntry, RefusesEverySingleFlippedByte) {
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(sample(), kKey);
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    std::vector<uint8_t> bad = bytes;
+    bad[i] ^= 0x20;
+    HlodSubtree t;
+    ASSERT_FALSE(decode(bad, t)) << "accepted a flipped byte at " << i;
+  }
+}
+
+TEST(HlodSubtreeEntry, RefusesAnEntryWrittenForAnotherKey) {
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(sample(), kKey);
+  HlodSubtree t;
+  const Status st = decode(bytes, t, kKey + 1);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("another key"), std::string::npos) << st.message;
+}
+
+TEST(HlodSubtreeEntry, RefusesVerticesOutsideTheMesh) {
+  HlodSubtree s = sample();
+  s.root_source[1] = uint32_t(kMeshVertices);
+  HlodSubtree t;
+  Status st = decode(encode_hlod_subtree(s, kKey), t);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("vertex source 100"), std::string::npos) << st.message;
+  s = sample();
+  s.root_reference.back() = 1u << 31;
+  EXPECT_FALSE(decode(encode_hlod_subtree(s, kKey), t));
+}
+
+// Counts rewritten with the entry's checksum recomputed: validation, not the checksum, refuses.
+TEST(HlodSubtreeEntry, RefusesForgedCountsUnderARecomputedChecksum) {
+  const HlodSubtree s = sample();
+  const std::vector<uint8_t> good = encode_hlod_subtree(s, kKey);
+  const size_t head = 56 + 4 * (s.root_source.size() + s.root_reference.size());
+  auto forge = [&](size_t at, uint32_t value) {
+    std::vector<uint8_t> bad = good;
+    detail::ByteWriter w;
+    w.u32(value);
+    std::memcpy(&bad[at], w.bytes.data(), 4);
+    w.bytes.clear();
+    w.u64(hash_bytes(bad.data(), head));
+    std::memcpy(&bad[head], w.bytes.data(), 8);
+    return bad;
+  };
+  HlodSubtree t;
+  EXPECT_FALSE(decode(forge(12, 30), t)) << "depth 30";
+  EXPECT_FALSE(decode(forge(12, 24), t)) << "children below the depth limit";
+  EXPECT_FALSE(decode(forge(40, 0xffffffffu), t)) << "huge source count";
+  EXPECT_FALSE(decode(forge(44, 0x40000000u), t)) << "huge reference count";
+  EXPECT_FALSE(decode(forge(48, 1), t)) << "asset size";
+  EXPECT_FALSE(decode(forge(8, 2), t)) << "version";
+  EXPECT_TRUE(decode(forge(12, 3), t)) << "the forger itself";
+}
+
+}  // namespace
+}  // namespace lod
