@@ -85,8 +85,4 @@ Status bake_scene_hlod(const SceneConfig& config, const Scene& scene, const Prog
   return Status::success();
 }
 
-void bind_scene_hlod_handles(SceneHlodTree& tree, std::span<const ObjectHandle> handles) {
-  for (SceneHlodObject& o : tree.objects) o.handle = o.scene_index < handles.size() ? handles[o.scene_index] : 0;
-}
-
 }  // namespace lod

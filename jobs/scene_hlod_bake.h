@@ -1,5 +1,5 @@
 // The scene HLOD of a config's scene ([scene_hlod] enabled): built from its static instances
-// (blocks without motion) on the TBB pool, then bound to the handles the service gave them.
+// (blocks without motion) on the TBB pool; make_service binds it to the handles it gives them.
 #pragma once
 #include <span>
 
@@ -14,8 +14,5 @@ namespace lod {
 // `config` is the one `scene` was made from (its instance blocks say which objects move).
 // An empty tree when [scene_hlod] is off or fewer than min_objects objects are static.
 Status bake_scene_hlod(const SceneConfig& config, const Scene& scene, const ProgressLog& log, SceneHlodTree& out);
-
-// Sets every tree object's handle: handles[i] is scene object i's (make_service order).
-void bind_scene_hlod_handles(SceneHlodTree& tree, std::span<const ObjectHandle> handles);
 
 }  // namespace lod

@@ -4,10 +4,10 @@
 
 #include <cmath>
 
-#include "jobs/scene_hlod_bake.h"
 #include "jobs/service_impl.h"
 #include "runtime/lod_asset.h"
 #include "runtime/object_controls.h"
+#include "runtime/scene_hlod_tree.h"
 
 namespace lod {
 

@@ -8,6 +8,7 @@
 // moved, went away or changed options is never drawn again; see scene_hlod_cut.h).
 #pragma once
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "lodkit/types.hpp"
@@ -47,5 +48,10 @@ struct SceneHlodTree {
   uint64_t source_triangles = 0;        // the objects' full-detail triangles
   bool empty() const { return nodes.empty(); }
 };
+
+// Sets every tree object's handle: handles[i] is scene object i's (make_service order).
+inline void bind_scene_hlod_handles(SceneHlodTree& tree, std::span<const ObjectHandle> handles) {
+  for (SceneHlodObject& o : tree.objects) o.handle = o.scene_index < handles.size() ? handles[o.scene_index] : 0;
+}
 
 }  // namespace lod
