@@ -11,12 +11,14 @@
 #include "cli/commands.h"
 #include "cli/hlod_check.h"
 #include "cli/run_report.h"
+#include "cli/terrain_check.h"
 #include "jobs/bake_jobs.h"
 #include "jobs/hlod_scene.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "jobs/scene_motion.h"
 #include "jobs/service.h"
+#include "jobs/terrain_scene.h"
 #include "runtime/camera_path.h"
 #include "runtime/vertex_front.h"
 
@@ -97,9 +99,9 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
     }
     tris += scene.models.triangles[scene.models.first_level[m] + f.levels[i]];
   }
-  tris += f.hlod_tris;  // HLOD cuts count in the same budget
+  tris += f.hlod_tris + f.terrain_tris;  // HLOD cuts and the terrain count in the same budget
   if (tris != f.tris_selected) {
-    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels and hlod cuts add up to %llu",
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels, hlod cuts and terrain add up to %llu",
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     *why = buf;
     return false;
@@ -166,6 +168,11 @@ int run_command(const RunArgs& args) {
   Scene scene = make_scene(config, std::move(chains));
   FrameGraphOptions options = frame_graph_options(config);
   if (!hlod->empty()) options.hlod = hlod;
+  if (auto st = load_scene_terrain(config, options.terrain); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  TerrainCheck terrain_check;
   std::vector<ObjectHandle> handles;
   std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);
   Service& service = *owned;
@@ -226,6 +233,11 @@ int run_command(const RunArgs& args) {
         std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
         return 3;
       }
+      // Counted, not fatal: the summary says on how many frames the terrain cracked.
+      if (!terrain_check.check(frame, &why)) {
+        if (summary.terrain_failures++ == 0)
+          std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
+      }
       const uint64_t cost = config.selection.count == BudgetCount::levels ? frame.level_cost : frame.tris_selected;
       if (!frame.over_budget && cost > frame.budget) {
         std::fprintf(stderr, "lod run --validate: frame %u: cost %llu exceeds budget %llu without over_budget\n", n,
@@ -278,6 +290,11 @@ int run_command(const RunArgs& args) {
                 args.report_dir.c_str());
   }
   if (stats.errors) return 4;
+  if (summary.terrain_failures > 0) {
+    std::fprintf(stderr, "lod run --validate: the terrain failed the crack check on %zu frames\n",
+                 summary.terrain_failures);
+    return 3;
+  }
   if (args.strict_exit && summary.over_budget_frames > 0) {
     std::fprintf(stderr, "lod run --strict-exit: the coarsest levels exceeded the budget on %zu of %zu frames\n",
                  summary.over_budget_frames, summary.frames);

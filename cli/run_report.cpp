@@ -62,6 +62,9 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"stream_requests", r.stream_requests},
           {"stream_loads", r.stream_loads},
           {"holes", r.holes},
+          {"terrain_tris", r.terrain_tris},
+          {"terrain_splits", r.terrain_splits},
+          {"terrain_merges", r.terrain_merges},
           {"ms", ms}};
 }
 
@@ -102,6 +105,8 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"stream_evictions", s.stream_evictions},
           {"stream_failures", s.stream_failures},
           {"mean_hlod_nodes_drawn", s.mean_hlod_nodes_drawn},
+          {"mean_terrain_tris", s.mean_terrain_tris},
+          {"terrain_failures", s.terrain_failures},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
           {"cached_models", s.cached_models},
@@ -148,6 +153,9 @@ FrameRecord record_of(const Frame& f) {
   r.stream_loads = f.stream_loads;
   r.stream_evictions = f.stream_evictions;
   r.stream_failures = f.stream_failures;
+  r.terrain_tris = f.terrain_tris;
+  r.terrain_splits = f.terrain_splits;
+  r.terrain_merges = f.terrain_merges;
   return r;
 }
 
@@ -160,7 +168,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0, culled = 0, benefit = 0, changes = 0, px = 0;
   s.max_pixel_error = 0;
   s.max_resident_bytes = s.total_holes = 0;
-  double hlod_nodes = 0;
+  double hlod_nodes = 0, terrain_tris = 0;
   s.max_drawn_over_budget = 0;
   s.frames_drawn_over_budget = 0;
   for (const auto& r : records) {
@@ -184,6 +192,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     s.max_resident_bytes = std::max(s.max_resident_bytes, r.resident_bytes);
     s.total_holes += r.holes;
     hlod_nodes += r.hlod_nodes_drawn;
+    terrain_tris += double(r.terrain_tris);
     s.stream_loads = std::max(s.stream_loads, r.stream_loads);  // counters: the last frame's
     s.stream_evictions = std::max(s.stream_evictions, r.stream_evictions);
     s.stream_failures = std::max(s.stream_failures, r.stream_failures);
@@ -206,6 +215,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.mean_benefit = benefit / n;
   s.mean_level_changes = changes / n;
   s.mean_pixel_error = px / n;
+  s.mean_terrain_tris = terrain_tris / n;
 }
 
 std::string table_legend() {
@@ -272,6 +282,11 @@ std::string summary_text(const RunSummary& s) {
                   double(s.stream_budget) / (1 << 20), (unsigned long long)s.stream_loads,
                   (unsigned long long)s.stream_evictions, (unsigned long long)s.stream_failures,
                   (unsigned long long)s.total_holes);
+    o << buf;
+  }
+  if (s.mean_terrain_tris > 0) {
+    std::snprintf(buf, sizeof buf, "  terrain: mean %.0f triangles (in the budget); %zu frames failed the crack check\n",
+                  s.mean_terrain_tris, s.terrain_failures);
     o << buf;
   }
   if (s.mean_occluded > 0) {

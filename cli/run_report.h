@@ -38,6 +38,7 @@ struct FrameRecord {
   uint32_t hlod_nodes_drawn = 0, holes = 0;
   uint64_t hlod_tris = 0, resident_bytes = 0, stream_requests = 0, stream_loads = 0, stream_evictions = 0,
            stream_failures = 0;
+  uint64_t terrain_tris = 0, terrain_splits = 0, terrain_merges = 0;  // [[terrain]] (ROAM)
 
   uint64_t drawn() const { return tris_selected + tris_morph_extra; }  // with blends
 };
@@ -66,6 +67,9 @@ struct RunSummary {
   uint64_t stream_budget = 0, max_resident_bytes = 0, total_holes = 0, stream_loads = 0, stream_evictions = 0,
            stream_failures = 0;
   double mean_hlod_nodes_drawn = 0;
+  // [[terrain]]: mean triangles, and frames --validate found with a crack or T-junction.
+  double mean_terrain_tris = 0;
+  size_t terrain_failures = 0;
   double bake_ms = 0;
   size_t baked_models = 0, cached_models = 0;
   double wall_s = 0;

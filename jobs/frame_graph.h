@@ -7,11 +7,15 @@
 //   view --------------+-> visibility -> importance -> selection -+-> geomorph -> publish
 //                                                                  +-> vdlod -> vd_mesh
 //                                                                  +-> hlod ------------+
+//   view -> terrain ------------------------------------------------------------------+
 //
 // hlod (HLOD models, jobs/hlod_stream): view 0's cut of every model from what is resident, then
 // the pager's update (never waits on I/O; loader threads read the .hlod files). Its share of M
 // is what the discrete selection left: triangle_budget = M - selected triangles (at least 0),
 // split evenly over the models, the first form of "one budget" (levels budgets: no cap).
+// terrain ([[terrain]], runtime/terrain_lod): ROAM for view 0 under the terrain's share of M,
+// set before the frame from the last frame's feedback; selection and hlod get M minus it, so
+// the node needs nothing the others write and runs beside visibility, importance and selection.
 // The flow-graph headers stay in frame_graph.cpp.
 #pragma once
 #include <functional>
@@ -27,6 +31,7 @@
 #include "runtime/object_commands.h"
 #include "runtime/object_store.h"
 #include "runtime/slc_selection.h"
+#include "runtime/terrain_lod.h"
 #include "runtime/view.h"
 
 namespace lod {
@@ -60,6 +65,8 @@ struct FrameGraphOptions {
   std::function<void(Stage)> stage_hook;
   // Streamed HLOD models drawn by the hlod node (none: the node does nothing).
   std::shared_ptr<const HlodModels> hlod;
+  // The terrain drawn by the terrain node (none: the node does nothing).
+  std::shared_ptr<const TerrainModel> terrain;
 };
 
 // The models a graph draws from: chains shared (adding a model copies none), plus the tables

@@ -9,6 +9,7 @@
 #include "jobs/scene_config.h"
 #include "jobs/service.h"
 #include "jobs/service_impl.h"
+#include "jobs/terrain_scene.h"
 #include "runtime/lod_asset.h"
 #include "runtime/view.h"
 
@@ -85,6 +86,7 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
   Scene scene = make_scene(sc, std::move(chains));
   FrameGraphOptions options = frame_graph_options(sc);
   if (!hlod->empty()) options.hlod = hlod;
+  if (auto st = load_scene_terrain(sc, options.terrain); !st) return failed(st.message);
   std::unique_ptr<Service> s = make_service(scene, options, sc.rate_hz);
   Impl& m = s->impl();
   m.options.cache_dir = cache;

@@ -12,10 +12,12 @@ namespace lod {
 
 // The frame graph's nodes (FrameGraph::dot() shows their edges); Frame::stage_ms per node.
 enum class Stage : uint8_t {
-  commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, hlod, publish, count
+  commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, hlod, terrain, publish,
+  count
 };
-inline constexpr const char* kStageNames[] = {"commit",   "bounds",   "view",  "visibility", "importance", "selection",
-                                              "entries",  "geomorph", "vdlod", "vd_mesh",    "hlod",       "publish"};
+inline constexpr const char* kStageNames[] = {"commit",   "bounds",   "view",  "visibility", "importance",
+                                              "selection", "entries", "geomorph", "vdlod", "vd_mesh",
+                                              "hlod",     "terrain",  "publish"};
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::count);
 inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 
@@ -128,6 +130,18 @@ struct Frame {
   uint64_t stream_evictions = 0;              // nodes evicted so far (least recently used)
   uint64_t stream_failures = 0;               // node reads failed so far (each node once; parent stays drawn)
   uint32_t holes = 0;                         // wanted, not drawable, no drawn ancestor: must be 0
+
+  // Terrain ([[terrain]]: ROAM refined for view 0, the whole bintree mesh; what lies outside
+  // the frustum is coarse already). Its triangles count in tris_selected, within M.
+  std::vector<float> terrain_positions;   // xyz world space per vertex
+  std::vector<uint32_t> terrain_indices;  // 3 per triangle into terrain_positions (ccw in grid x, y = cw seen from +y)
+  std::vector<uint32_t> terrain_samples;  // per vertex: its grid sample, y * terrain_grid + x
+  uint32_t terrain_grid = 0;              // samples per grid side (0: no terrain)
+  uint64_t terrain_tris = 0;
+  uint64_t terrain_splits = 0;            // this frame, forced splits included
+  uint64_t terrain_merges = 0;
+  uint64_t terrain_share = 0;             // triangles of M the terrain was given this frame
+  float terrain_pixel_error = 0;          // the largest projected error left on it, pixels
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds
   double total_ms = 0;
