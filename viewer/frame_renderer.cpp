@@ -8,7 +8,7 @@ namespace lod::viewer {
 
 bool FrameRenderer::init(const Scene& scene, std::string* message) {
   scene_ = &scene;
-  if (!instances_.init(message)) return false;
+  if (!instances_.init(message) || !terrain_.init(message)) return false;
   meshes_.upload(scene.chains);
   morphs_.init(scene.chains);
   vd_meshes_.init();
@@ -32,8 +32,10 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
 
   build_draw_list(frame, meshes_.layout(), list_);
   vd_meshes_.upload(frame);
-  return instances_.draw(list_, meshes_, &morphs_, &vd_meshes_, view_matrix(viewing), projection_matrix(viewing),
-                         settings);
+  DrawStats stats = instances_.draw(list_, meshes_, &morphs_, &vd_meshes_, view_matrix(viewing),
+                                    projection_matrix(viewing), settings);
+  terrain_.draw(frame, view_matrix(viewing), projection_matrix(viewing), settings, stats);
+  return stats;
 }
 
 void FrameRenderer::render_culled(const Frame& frame, std::span<const ObjectHandle> handles,

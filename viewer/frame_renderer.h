@@ -1,6 +1,6 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
 // clear, build the draw list, one instanced draw per (model, level, target level), then one draw per
-// view-dependent object from the active mesh the frame carries.
+// view-dependent object from the active mesh the frame carries, then the terrain's mesh.
 #pragma once
 #include <span>
 #include <string>
@@ -13,6 +13,7 @@
 #include "viewer/instance_renderer.h"
 #include "viewer/mesh_buffers.h"
 #include "viewer/morph_buffers.h"
+#include "viewer/terrain_renderer.h"
 #include "viewer/vd_mesh_buffers.h"
 
 namespace lod::viewer {
@@ -39,6 +40,7 @@ class FrameRenderer {
   MorphBuffers morphs_;
   VdMeshBuffers vd_meshes_;
   InstanceRenderer instances_;
+  TerrainRenderer terrain_;
   DrawList list_;
   Frame culled_;                             // scratch: the culled objects as a frame
   std::vector<ObjectHandle> frame_handles_;  // scratch: the frame's handles, sorted
