@@ -979,7 +979,9 @@ struct FrameGraph::Impl {
     f.budget = options.selection.budget;
     f.budget_morph_reserve = morph_reserve;
     f.coarsest_cost = selected.coarsest_cost;
-    f.over_budget = selected.over_budget || hlod_over_budget;
+    // The terrain never draws under 2 triangles: a budget of 1 or 2 cannot hold it.
+    const bool terrain_over = options.selection.count == BudgetCount::triangles && f.terrain_tris > terrain_taken();
+    f.over_budget = selected.over_budget || hlod_over_budget || terrain_over;
     f.lowered_steps = selected.lowered_steps;
     f.levels_lowered = selected.levels_lowered;
     f.benefit = quality.benefit;

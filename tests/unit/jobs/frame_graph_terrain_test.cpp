@@ -110,6 +110,15 @@ TEST(FrameGraphTerrain, WithoutTerrainTheColumnsStayEmpty) {
   EXPECT_TRUE(f.terrain_positions.empty());
 }
 
+TEST(FrameGraphTerrain, BudgetTooSmallForTheTerrainIsOverBudget) {
+  const TerrainScene t;
+  FrameGraph g(t.scene, t.options(2, 2));
+  Frame f;
+  g.run(view_at(t.path, 0), f);
+  EXPECT_EQ(f.terrain_tris, 2u) << "the two base triangles at least";
+  EXPECT_TRUE(f.over_budget) << "M = 2 cannot hold terrain and objects";
+}
+
 TEST(FrameGraphTerrain, NodeFollowsViewAndPrecedesPublish) {
   const std::string dot = FrameGraph::dot();
   EXPECT_NE(dot.find("view -> terrain;"), std::string::npos) << dot;
