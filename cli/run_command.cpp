@@ -12,6 +12,7 @@
 #include "cli/hlod_check.h"
 #include "cli/run_report.h"
 #include "cli/scene_hlod_check.h"
+#include "cli/terrain_check.h"
 #include "jobs/bake_jobs.h"
 #include "jobs/hlod_scene.h"
 #include "jobs/scene.h"
@@ -19,6 +20,7 @@
 #include "jobs/scene_hlod_bake.h"
 #include "jobs/scene_motion.h"
 #include "jobs/service.h"
+#include "jobs/terrain_scene.h"
 #include "runtime/camera_path.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/vertex_front.h"
@@ -100,9 +102,9 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
     }
     tris += scene.models.triangles[scene.models.first_level[m] + f.levels[i]];
   }
-  tris += f.hlod_tris + f.scene_proxy_tris;  // HLOD cuts and scene proxies count in the same budget
+  tris += f.hlod_tris + f.scene_proxy_tris + f.terrain_tris;  // HLOD cuts, scene proxies and the terrain count in M
   if (tris != f.tris_selected) {
-    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels, hlod cuts and proxies add up to %llu",
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels, hlod cuts, proxies and terrain add up to %llu",
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     *why = buf;
     return false;
@@ -182,6 +184,11 @@ int run_command(const RunArgs& args) {
     return 1;
   }
   if (!scene_hlod->empty()) options.scene_hlod = scene_hlod;
+  if (auto st = load_scene_terrain(config, options.terrain); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  TerrainCheck terrain_check;
   std::vector<ObjectHandle> handles;
   std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);
   SceneHlodCheck scene_hlod_check;
@@ -245,6 +252,11 @@ int run_command(const RunArgs& args) {
         std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
         return 3;
       }
+      // Counted, not fatal: the summary says on how many frames the terrain cracked.
+      if (!terrain_check.check(frame, &why)) {
+        if (summary.terrain_failures++ == 0)
+          std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
+      }
       const uint64_t cost = config.selection.count == BudgetCount::levels ? frame.level_cost : frame.tris_selected;
       if (!frame.over_budget && cost > frame.budget) {
         std::fprintf(stderr, "lod run --validate: frame %u: cost %llu exceeds budget %llu without over_budget\n", n,
@@ -297,6 +309,11 @@ int run_command(const RunArgs& args) {
                 args.report_dir.c_str());
   }
   if (stats.errors) return 4;
+  if (summary.terrain_failures > 0) {
+    std::fprintf(stderr, "lod run --validate: the terrain failed the crack check on %zu frames\n",
+                 summary.terrain_failures);
+    return 3;
+  }
   if (args.strict_exit && summary.over_budget_frames > 0) {
     std::fprintf(stderr, "lod run --strict-exit: the coarsest levels exceeded the budget on %zu of %zu frames\n",
                  summary.over_budget_frames, summary.frames);

@@ -70,6 +70,9 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"proxy_objects", r.proxy_objects},
           {"proxy_tris", r.proxy_tris},
           {"draws", r.draws()},
+          {"terrain_tris", r.terrain_tris},
+          {"terrain_splits", r.terrain_splits},
+          {"terrain_merges", r.terrain_merges},
           {"ms", ms}};
 }
 
@@ -117,6 +120,8 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"mean_scene_proxies", s.mean_scene_proxies},
           {"mean_proxy_objects", s.mean_proxy_objects},
           {"mean_draws", s.mean_draws},
+          {"mean_terrain_tris", s.mean_terrain_tris},
+          {"terrain_failures", s.terrain_failures},
           {"bake_ms", s.bake_ms},
           {"baked_models", s.baked_models},
           {"cached_models", s.cached_models},
@@ -168,6 +173,9 @@ FrameRecord record_of(const Frame& f) {
   r.scene_proxies = uint32_t(f.scene_proxies.size());
   r.proxy_objects = f.scene_proxy_objects;
   r.proxy_tris = f.scene_proxy_tris;
+  r.terrain_tris = f.terrain_tris;
+  r.terrain_splits = f.terrain_splits;
+  r.terrain_merges = f.terrain_merges;
   return r;
 }
 
@@ -191,7 +199,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0, culled = 0, benefit = 0, changes = 0, px = 0;
   s.max_pixel_error = 0;
   s.max_resident_bytes = s.total_holes = 0;
-  double hlod_nodes = 0, proxies = 0, proxy_objects = 0, draws = 0;
+  double hlod_nodes = 0, proxies = 0, proxy_objects = 0, draws = 0, terrain_tris = 0;
   s.max_drawn_over_budget = 0;
   s.frames_drawn_over_budget = 0;
   for (const auto& r : records) {
@@ -219,6 +227,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
     proxies += r.scene_proxies;
     proxy_objects += r.proxy_objects;
     draws += double(r.draws());
+    terrain_tris += double(r.terrain_tris);
     s.stream_loads = std::max(s.stream_loads, r.stream_loads);  // counters: the last frame's
     s.stream_evictions = std::max(s.stream_evictions, r.stream_evictions);
     s.stream_failures = std::max(s.stream_failures, r.stream_failures);
@@ -245,6 +254,7 @@ void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
   s.mean_scene_proxies = proxies / n;
   s.mean_proxy_objects = proxy_objects / n;
   s.mean_draws = draws / n;
+  s.mean_terrain_tris = terrain_tris / n;
 }
 
 std::string table_legend() {
@@ -323,6 +333,11 @@ std::string summary_text(const RunSummary& s) {
                   "  scene hlod: %zu proxies; mean %.1f drawn per frame standing for %.0f objects; mean %.0f draws "
                   "(entries + proxies + hlod nodes)\n",
                   s.scene_hlod_nodes, s.mean_scene_proxies, s.mean_proxy_objects, s.mean_draws);
+    o << buf;
+  }
+  if (s.mean_terrain_tris > 0) {
+    std::snprintf(buf, sizeof buf, "  terrain: mean %.0f triangles (in the budget); %zu frames failed the crack check\n",
+                  s.mean_terrain_tris, s.terrain_failures);
     o << buf;
   }
   if (s.mean_occluded > 0) {

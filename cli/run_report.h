@@ -40,6 +40,7 @@ struct FrameRecord {
   uint32_t hlod_nodes_drawn = 0, holes = 0;
   uint64_t hlod_tris = 0, resident_bytes = 0, stream_requests = 0, stream_loads = 0, stream_evictions = 0,
            stream_failures = 0;
+  uint64_t terrain_tris = 0, terrain_splits = 0, terrain_merges = 0;  // [[terrain]] (ROAM)
 
   // Scene HLOD: proxies drawn, the static objects they stand for, their triangles.
   uint32_t scene_proxies = 0, proxy_objects = 0;
@@ -79,6 +80,9 @@ struct RunSummary {
   double mean_hlod_nodes_drawn = 0;
   double mean_scene_proxies = 0, mean_proxy_objects = 0, mean_draws = 0;
   size_t scene_hlod_nodes = 0;  // proxies in the scene HLOD (0: off)
+  // [[terrain]]: mean triangles, and frames --validate found with a crack or T-junction.
+  double mean_terrain_tris = 0;
+  size_t terrain_failures = 0;
   double bake_ms = 0;
   size_t baked_models = 0, cached_models = 0;
   double wall_s = 0;

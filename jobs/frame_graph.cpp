@@ -23,6 +23,7 @@
 #include <bit>
 #include <cassert>
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -109,10 +110,11 @@ enum Column : uint32_t {
   kPlacing = 1u << 12,    // the frame's handles, transforms and view masks per entry
   kHlod = 1u << 13,       // HLOD cuts and the pager, the frame's hlod columns
   kSceneHlod = 1u << 14,  // the scene HLOD cut, the frame's scene proxy columns
+  kTerrain = 1u << 15,    // the terrain's ROAM state, the frame's terrain columns
 };
 constexpr const char* kColumnNames[] = {"objects", "bounds", "controls", "views",  "visibility", "entries", "levels",
                                         "blend",   "fronts", "vd_mesh",  "totals", "history",    "placing",
-                                        "hlod",    "scene_hlod"};
+                                        "hlod",    "scene_hlod", "terrain"};
 
 }  // namespace
 
@@ -248,6 +250,10 @@ struct FrameGraph::Impl {
   bool hlod_over_budget = false;
   uint64_t hlod_wanted_last = 0;  // last frame's cuts before their budget: the HLOD demand
 
+  // The terrain (options.terrain): ROAM state and share across frames, last frame's feedback.
+  TerrainLod terrain;
+  TerrainFeedback terrain_last;
+
   tbb::task_arena arena;
   std::optional<tbb::flow::graph> graph;
   std::optional<tbb::flow::broadcast_node<tbb::flow::continue_msg>> start;
@@ -260,6 +266,7 @@ struct FrameGraph::Impl {
     set_models(std::move(models));
     if (o.hlod && !o.hlod->empty()) make_hlod_stream(o.hlod);
     if (o.occlusion.enabled && o.occlusion.make_tracer) tracer = o.occlusion.make_tracer();
+    if (o.terrain) terrain_lod_reset(terrain, *o.terrain);
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
   }
@@ -743,6 +750,7 @@ struct FrameGraph::Impl {
     // from M (at most half of it, so blends never starve the selection), so that what is
     // drawn, not only what is selected, stays near M.
     SelectionParams so = options.selection;
+    so.budget -= terrain_taken();
     if (so.count == BudgetCount::triangles) {
       so.budget -= std::min(so.budget, out->scene_proxy_tris);  // one M
       if (hlod_stream) so.budget = first_share(so.budget, initial_triangles(), hlod_wanted_last);
@@ -950,8 +958,9 @@ struct FrameGraph::Impl {
   uint64_t hlod_share() const {
     const SelectionParams& sp = options.selection;
     if (sp.count != BudgetCount::triangles) return UINT64_MAX;
+    const uint64_t objects = sp.budget - terrain_taken();
     const uint64_t used = selected.triangles + out->scene_proxy_tris;
-    const uint64_t left = sp.budget > used ? sp.budget - used : 0;
+    const uint64_t left = objects > used ? objects - used : 0;
     return left / std::max<size_t>(1, hlod_inputs.size());
   }
 
@@ -991,6 +1000,49 @@ struct FrameGraph::Impl {
     f.stream_evictions = fig.stream_evictions;
     f.stream_failures = fig.stream_failures;
     f.holes = fig.holes;
+  }
+
+  // What the terrain takes from M this frame (triangle budgets only); selection keeps >= 1.
+  uint64_t terrain_taken() const {
+    const SelectionParams& sp = options.selection;
+    if (!options.terrain || sp.count != BudgetCount::triangles) return 0;
+    return std::min(terrain.share, sp.budget - std::min<uint64_t>(sp.budget, 1));
+  }
+
+  // Before the graph fires: the share from the last frame's feedback (the first frame's from
+  // the model), so selection and the terrain node both know it from the start.
+  void plan_terrain_share() {
+    if (!options.terrain) return;
+    const SelectionParams& sp = options.selection;
+    const uint64_t m = sp.count == BudgetCount::triangles ? sp.budget : 0;
+    terrain_last.budget = m;
+    terrain.share = terrain.started ? next_terrain_share(terrain_last, *options.terrain)
+                                    : first_terrain_share(m, *options.terrain);
+    terrain.started = 1;
+  }
+
+  // ROAM for view 0 under the share, then the mesh into the frame.
+  void node_terrain() {
+    Frame& f = *out;
+    f.terrain_tris = f.terrain_splits = f.terrain_merges = f.terrain_share = 0;
+    f.terrain_grid = 0;
+    f.terrain_pixel_error = 0;
+    if (!options.terrain) {
+      f.terrain_positions.clear(), f.terrain_indices.clear(), f.terrain_samples.clear();
+      return;
+    }
+    const TerrainModel& model = *options.terrain;
+    const RoamFrameStats st = terrain_lod_update(terrain, model, views[0], terrain.share);
+    f.terrain_tris = terrain_compact_mesh(f.terrain_positions, f.terrain_indices, f.terrain_samples, terrain, model.roam);
+    f.terrain_grid = model.roam.size;
+    f.terrain_splits = st.splits;
+    f.terrain_merges = st.merges;
+    f.terrain_share = terrain.share;
+    f.terrain_pixel_error = terrain_error_left(terrain.roam);
+    terrain_last.share = terrain.share;
+    terrain_last.terrain_tris = f.terrain_tris;
+    terrain_last.terrain_bound = st.budget_bound;
+    terrain_last.terrain_error = f.terrain_pixel_error;
   }
 
   void node_publish() {
@@ -1043,10 +1095,18 @@ struct FrameGraph::Impl {
       for (size_t l = 0; l < kHistogramLevels; ++l) f.level_histogram[l] += t.histogram[l];
     }
     f.tris_selected += f.hlod_tris + f.scene_proxy_tris;  // HLOD cuts and proxies draw within the same M
+    terrain_last.objects_tris = f.tris_selected;
+    terrain_last.objects_lowered = selected.levels_lowered > 0 || selected.over_budget;
+    terrain_last.objects_coarsest = selected.coarsest_cost + f.hlod_tris;
+    // Objects whose coarsest levels do not fit count as infinitely short: the share gives way.
+    terrain_last.objects_error = selected.over_budget ? std::numeric_limits<float>::max() : quality.pixel_error_max;
+    f.tris_selected += f.terrain_tris;  // and so does the terrain
     f.budget = options.selection.budget;
     f.budget_morph_reserve = morph_reserve;
     f.coarsest_cost = selected.coarsest_cost;
-    f.over_budget = selected.over_budget || hlod_over_budget;
+    // The terrain never draws under 2 triangles: a budget of 1 or 2 cannot hold it.
+    const bool terrain_over = options.selection.count == BudgetCount::triangles && f.terrain_tris > terrain_taken();
+    f.over_budget = selected.over_budget || hlod_over_budget || terrain_over;
     f.lowered_steps = selected.lowered_steps;
     f.levels_lowered = selected.levels_lowered;
     f.benefit = quality.benefit;
@@ -1094,6 +1154,7 @@ struct FrameGraph::Impl {
   void reset_temporal_state() {
     last_morph_extra = 0;
     store->reset_temporal_state();
+    if (options.terrain) terrain_lod_reset(terrain, *options.terrain);
   }
 
   void run(const FrameInput& in, ObjectStore& objects, Frame& f) {
@@ -1110,6 +1171,7 @@ struct FrameGraph::Impl {
     }
     for (uint32_t v = 0; v < view_count; ++v) views[v] = in.views[std::min<size_t>(v, in.views.size() - 1)];
     stage_ms.fill(0);
+    plan_terrain_share();
     f.index = ++frame_index;
     f.time_s = time;
     tsan_release(sync.start);
@@ -1174,7 +1236,9 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      &Impl::node_vd_mesh},
     {Stage::hlod, "select_hlod_cut per HLOD model (view 0, M minus the discrete selection) + pager update, serial",
      kLevels | kViews | kSceneHlod, kHlod, &Impl::node_hlod},
-    {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend | kHlod | kSceneHlod,
+    {Stage::terrain, "terrain_lod_update (ROAM, view 0, its share of M) + terrain_compact_mesh, serial", kViews, kTerrain,
+     &Impl::node_terrain},
+    {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend | kHlod | kSceneHlod | kTerrain,
      kTotals | kHistory, &Impl::node_publish},
 };
 

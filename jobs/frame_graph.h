@@ -7,6 +7,7 @@
 //   view --------------+-> visibility -> scene_hlod -> importance -> selection -+-> geomorph -> publish
 //                                                                                +-> vdlod -> vd_mesh
 //                                                                                +-> hlod ------------+
+//   view -> terrain ------------------------------------------------------------------------------+
 //
 // scene_hlod (after visibility): view 0's cut of the scene HLOD (runtime/scene_hlod_cut); the
 // static objects a drawn proxy stands for leave view 0's visible set, and the proxies'
@@ -17,6 +18,9 @@
 // gets M in proportion to its demand (runtime/budget_split.h); the cuts get what it leaves,
 // split evenly over the models, each undoing its least visible refinements first (levels
 // budgets: no cap).
+// terrain ([[terrain]], runtime/terrain_lod): ROAM for view 0 under the terrain's share of M,
+// set before the frame from the last frame's feedback; selection and hlod get M minus it, so
+// the node needs nothing the others write and runs beside visibility, importance and selection.
 // The flow-graph headers stay in frame_graph.cpp.
 #pragma once
 #include <functional>
@@ -34,6 +38,7 @@
 #include "runtime/occlusion.h"
 #include "runtime/scene_hlod_tree.h"
 #include "runtime/slc_selection.h"
+#include "runtime/terrain_lod.h"
 #include "runtime/view.h"
 
 namespace lod {
@@ -72,6 +77,8 @@ struct FrameGraphOptions {
   std::shared_ptr<const HlodModels> hlod;
   // Scene HLOD over static objects (handles bound), cut by the scene_hlod node; none: nothing.
   std::shared_ptr<const SceneHlodTree> scene_hlod;
+  // The terrain drawn by the terrain node (none: the node does nothing).
+  std::shared_ptr<const TerrainModel> terrain;
 };
 
 // The models a graph draws from: chains shared (adding a model copies none), plus the tables

@@ -547,6 +547,79 @@ void read_instances(const Reader& r, const toml::table& root, bool required, Sce
   }
 }
 
+// [[terrain]]: at most one; its file is found like a mesh; numbers checked as they feed ROAM.
+void read_terrain_shares(const Reader& r, const toml::table& t, const std::string& key, TerrainConfig& c) {
+  const toml::array* a = r.array(t, "share", key + ".share");
+  if (!a) return;
+  if (a->size() != 3) r.fail(key + ".share", "expected [min, initial, max] fractions of the budget");
+  double v[3];
+  for (size_t i = 0; i < 3; ++i) v[i] = *r.number(*a->get(i), indexed(key + ".share", i));
+  if (!(v[0] > 0 && v[0] <= v[1] && v[1] <= v[2] && v[2] < 1))
+    r.fail(key + ".share", "needs 0 < min <= initial <= max < 1, got [" + number_text(v[0]) + ", " +
+                               number_text(v[1]) + ", " + number_text(v[2]) + "]");
+  c.min_share = float(v[0]), c.initial_share = float(v[1]), c.max_share = float(v[2]);
+}
+
+void read_terrain_grid(const Reader& r, const toml::table& t, const std::string& key, TerrainConfig& c) {
+  if (auto v = r.string(t, "coordinates", key + ".coordinates")) {
+    if (*v == "metres") c.coordinates = GridCoordinates::metres;
+    else if (*v == "lon_lat") c.coordinates = GridCoordinates::degrees_lon_lat;
+    else if (*v == "lat_lon") c.coordinates = GridCoordinates::degrees_lat_lon;
+    else r.fail(key + ".coordinates", "must be \"metres\", \"lon_lat\" or \"lat_lon\", got \"" + *v + "\"");
+  }
+  if (const toml::node* n = t.get("cell_size")) {
+    const toml::array* a = n->as_array();
+    if (a && a->size() != 2) r.fail(key + ".cell_size", "expected a number or [x, y] metres");
+    for (int i = 0; i < 2; ++i) {
+      const double v = a ? *r.number(*a->get(size_t(i)), indexed(key + ".cell_size", size_t(i)))
+                         : *r.number(*n, key + ".cell_size");
+      if (!(v > 0)) r.fail(key + ".cell_size", "must be > 0 metres, got " + number_text(v));
+      c.cell_size[i] = float(v);
+    }
+  }
+  if (auto v = r.number(t, "vertical_scale", key + ".vertical_scale")) {
+    if (!(*v > 0)) r.fail(key + ".vertical_scale", "must be > 0, got " + number_text(*v));
+    c.vertical_scale = float(*v);
+  }
+  if (auto v = r.number(t, "no_data", key + ".no_data", Fit::any)) c.no_data = *v;
+  if (auto v = r.string(t, "placement", key + ".placement")) {
+    if (*v == "corner") c.centered = false;
+    else if (*v != "center") r.fail(key + ".placement", "must be \"center\" or \"corner\", got \"" + *v + "\"");
+  }
+  r.vec3(t, "position", key + ".position", c.position);
+  r.integer_in(t, "samples", key + ".samples", 3, 4097, c.samples);
+  if (c.samples && !roam_size_valid(c.samples, c.samples))
+    r.fail(key + ".samples", "must be 2^n + 1 (3, 5, 9, ..., 4097), got " + std::to_string(c.samples));
+}
+
+void read_terrain(const Reader& r, const toml::table& root, const std::filesystem::path& config_dir,
+                  const std::filesystem::path& data_dir, SceneConfig& c) {
+  const auto blocks = r.tables(root, "terrain", "terrain");
+  if (blocks.empty()) return;
+  if (blocks.size() > 1) r.fail("terrain[1]", "a scene has at most one [[terrain]]");
+  const toml::table& t = *blocks[0];
+  const std::string key = "terrain[0]";
+  r.only_keys(t, key,
+              {"file", "coordinates", "cell_size", "vertical_scale", "no_data", "placement", "position", "samples",
+               "pixel_error", "target", "max_triangles", "share"});
+  TerrainConfig tc;
+  auto file = r.string(t, "file", key + ".file");
+  if (!file || file->empty()) r.fail(key + ".file", "missing");
+  tc.file = resolve_mesh(r, key + ".file", *file, config_dir, data_dir);
+  read_terrain_grid(r, t, key, tc);
+  if (auto v = r.number(t, "pixel_error", key + ".pixel_error")) {
+    if (*v <= 0 || *v > 10000) r.fail(key + ".pixel_error", "must be in (0, 10000] pixels, got " + number_text(*v));
+    tc.pixel_error = float(*v);
+  }
+  if (auto v = r.string(t, "target", key + ".target")) {
+    if (*v == "triangles") tc.target = RoamTarget::triangle_count;
+    else if (*v != "pixel_error") r.fail(key + ".target", "must be \"pixel_error\" or \"triangles\", got \"" + *v + "\"");
+  }
+  r.integer_in(t, "max_triangles", key + ".max_triangles", 2, int64_t{1} << 30, tc.max_triangles);
+  read_terrain_shares(r, t, key, tc);
+  c.terrain = std::move(tc);
+}
+
 }  // namespace
 
 Status load_scene_config(const std::filesystem::path& file, const std::filesystem::path& data_dir,
@@ -582,7 +655,7 @@ Status parse_scene_config(std::string_view text, const std::filesystem::path& fi
   c.file = file;
   const Reader r(name);
   try {
-    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "stream", "scene_hlod", "model", "instances"});
+    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "stream", "scene_hlod", "model", "instances", "terrain"});
     read_run(r, root, c);
     read_budget(r, root, c);
     read_lod(r, root, c);
@@ -594,6 +667,7 @@ Status parse_scene_config(std::string_view text, const std::filesystem::path& fi
         file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
     read_models(r, root, dir, data_dir, !objects_optional, c);
     read_instances(r, root, !objects_optional, c);
+    read_terrain(r, root, dir, data_dir, c);
   } catch (const ConfigError& e) {
     return Status::error(e.message);
   }

@@ -2,13 +2,17 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "preprocess/height_field_io.h"
 #include "preprocess/lod_bake.h"
 #include "runtime/camera_path.h"
 #include "runtime/motion_path.h"
+#include "runtime/roam.h"
 #include "runtime/slc_selection.h"
 #include "runtime/status.h"
 
@@ -52,6 +56,22 @@ struct InstanceConfig {
   MotionSpec motion;           // motion = "wander" / "orbit" with a speed: moved every frame
 };
 
+// [[terrain]] (at most one): a height field drawn by ROAM within the same budget (issue 15).
+struct TerrainConfig {
+  std::filesystem::path file;  // file: "x y z" text (preprocess/height_field_io.h), found like meshes
+  GridCoordinates coordinates = GridCoordinates::metres;  // coordinates = "metres" | "lon_lat" | "lat_lon"
+  float cell_size[2] = {0, 0};  // cell_size = m or [mx, my]: metres between samples; 0 = from the file
+  float vertical_scale = 1;     // vertical_scale: world height = elevation * this
+  double no_data = std::numeric_limits<double>::quiet_NaN();  // no_data: elevation meaning "none"
+  bool centered = true;         // placement = "center" (position = the grid's centre) | "corner"
+  float position[3] = {0, 0, 0};  // position = [x, y, z]: where that point goes (y adds to heights)
+  uint32_t samples = 0;         // samples: ROAM grid side 2^n + 1 (<= 4097); 0 = smallest holding the field
+  float pixel_error = 0;        // pixel_error: ROAM's tau; 0 = [lod] pixel_error
+  RoamTarget target = RoamTarget::pixel_error;  // target = "pixel_error" | "triangles" (= its share)
+  uint32_t max_triangles = 1u << 18;  // max_triangles: cap in any mode (the share of levels budgets)
+  float initial_share = 0.5f, min_share = 0.05f, max_share = 0.9f;  // share = [min, initial, max] of M
+};
+
 struct SceneConfig {
   std::filesystem::path file;        // the config itself
   uint32_t frames = 600;
@@ -69,6 +89,7 @@ struct SceneConfig {
   SceneHlodConfig scene_hlod;
   std::vector<ModelConfig> models;
   std::vector<InstanceConfig> instances;
+  std::optional<TerrainConfig> terrain;
 };
 
 // Refuses unknown paths, wrong types, absurd values (negative counts, zero size windows,

@@ -11,6 +11,7 @@
 #include "jobs/service.h"
 #include "jobs/service_impl.h"
 #include "preprocess/embree_occlusion.h"
+#include "jobs/terrain_scene.h"
 #include "runtime/lod_asset.h"
 #include "runtime/view.h"
 
@@ -91,6 +92,7 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
   auto scene_hlod = std::make_shared<SceneHlodTree>();
   if (auto st = bake_scene_hlod(sc, scene, nullptr, *scene_hlod); !st) return failed(st.message);
   if (!scene_hlod->empty()) options.scene_hlod = scene_hlod;
+  if (auto st = load_scene_terrain(sc, options.terrain); !st) return failed(st.message);
   std::unique_ptr<Service> s = make_service(scene, options, sc.rate_hz);
   Impl& m = s->impl();
   m.options.cache_dir = cache;

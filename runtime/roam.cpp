@@ -294,6 +294,8 @@ struct Budget {
 
 float top_priority(const RoamState& S, const RoamQueue& q) { return S.priority[q.heap.front()]; }
 
+bool merge_down_to(RoamState& S, const RoamTerrain& T, uint32_t target, int32_t watch);
+
 void run_pixel_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, Budget& b,
                       RoamFrameStats& st) {
   // Merge first: what merges here has projected error <= tau and will not split again.
@@ -310,6 +312,12 @@ void run_pixel_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, B
       break;
     }
     roam_split(S, T, S.split_queue.heap.front());
+  }
+  // A cap below the mesh (a share that shrank) or passed by a split's forced parents: merge
+  // the least error away until it holds; the cap is a budget, not a hint.
+  if (S.triangle_count > P.max_triangles) {
+    st.budget_bound = 1;
+    merge_down_to(S, T, std::max<uint32_t>(P.max_triangles, 2), -1);
   }
 }
 

@@ -5,6 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
+# The real elevation data of configs/terrain.toml (one file from Debian's libdeal.ii-doc);
+# without it (no network) the terrain config's tests skip, saying so.
+./scripts/fetch-topography.sh build/data || echo "[topography] not fetched: configs/terrain.toml cannot run" >&2
 # The same cache options as the test command (scripts/configure.sh), so either order works
 # on one build/ folder; only the lod target is built here.
 ./scripts/configure.sh build

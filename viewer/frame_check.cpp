@@ -67,9 +67,9 @@ bool totals_match(const Frame& f, const ModelTable& models, std::string* why) {
                   morphing, (unsigned long long)extra, f.morphing, (unsigned long long)f.tris_morph_extra);
     return fail(why, buf);
   }
-  tris += f.hlod_tris + f.scene_proxy_tris;
+  tris += f.hlod_tris + f.scene_proxy_tris + f.terrain_tris;  // all within the same M
   if (tris != f.tris_selected) {
-    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels and hlod cuts add up to %llu",
+    std::snprintf(buf, sizeof buf, "tris_selected %llu but the levels, hlod cuts, proxies and terrain add up to %llu",
                   (unsigned long long)f.tris_selected, (unsigned long long)tris);
     return fail(why, buf);
   }

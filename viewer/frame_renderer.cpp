@@ -12,7 +12,7 @@ uint64_t hlod_gpu_capacity(const HlodModels& m) { return std::max<uint64_t>(4 * 
 
 bool FrameRenderer::init(const Scene& scene, const HlodModels* hlod, std::string* message) {
   scene_ = &scene;
-  if (!instances_.init(message)) return false;
+  if (!instances_.init(message) || !terrain_.init(message)) return false;
   hlod_ = hlod && !hlod->empty() ? hlod : nullptr;
   if (hlod_ && !hlod_nodes_.init(*hlod_, hlod_gpu_capacity(*hlod_), message)) return false;
   meshes_.upload(scene.chains);
@@ -54,6 +54,7 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
     build_proxy_draw_list(frame, *scene_hlod_, proxy_list_);
     instances_.draw_proxies(proxy_list_, proxies_, view_matrix(viewing), projection_matrix(viewing), settings, stats);
   }
+  terrain_.draw(frame, view_matrix(viewing), projection_matrix(viewing), settings, stats);
   return stats;
 }
 

@@ -1,7 +1,7 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
 // clear, build the draw list, one instanced draw per (model, level, target level), then one draw per
 // view-dependent object from the active mesh the frame carries, then one per node layer or
-// boundary patch of the HLOD cuts and one per scene HLOD proxy.
+// boundary patch of the HLOD cuts, one per scene HLOD proxy, and the terrain's mesh.
 #pragma once
 #include <span>
 #include <string>
@@ -18,6 +18,7 @@
 #include "viewer/instance_renderer.h"
 #include "viewer/mesh_buffers.h"
 #include "viewer/morph_buffers.h"
+#include "viewer/terrain_renderer.h"
 #include "viewer/vd_mesh_buffers.h"
 
 namespace lod::viewer {
@@ -50,6 +51,7 @@ class FrameRenderer {
   MorphBuffers morphs_;
   VdMeshBuffers vd_meshes_;
   InstanceRenderer instances_;
+  TerrainRenderer terrain_;
   DrawList list_;
   const HlodModels* hlod_ = nullptr;
   HlodDrawList hlod_list_;

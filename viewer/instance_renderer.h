@@ -36,6 +36,7 @@ struct DrawStats {
   uint64_t triangles = 0;        // submitted: sum of index_count / 3 * instances, vd meshes included
   uint32_t vd_draws = 0;         // view-dependent objects drawn from their active mesh
   uint64_t vd_triangles = 0;     // their triangles (part of `triangles`)
+  uint64_t terrain_triangles = 0;  // the frame's terrain mesh (part of `triangles`)
   uint32_t morph_draws = 0;      // batches drawn blending towards a coarser level
   uint32_t hlod_draws = 0;       // HLOD node layers and boundary patches drawn
   uint64_t hlod_triangles = 0;   // their triangles (part of `triangles`)

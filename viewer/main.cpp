@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "jobs/service.h"
+#include "jobs/terrain_scene.h"
 #include "viewer/frame_renderer.h"
 #include "viewer/gl_context.h"
 #include "viewer/scene_loader.h"
@@ -30,6 +31,11 @@ int run(const lod::viewer::ViewerOptions& o) {
   LoadedScene loaded;
   auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   if (lod::Status st = load_scene(o.config, o.data_dir, o.cache_dir, loaded, log); !st) {
+    std::fprintf(stderr, "lod-viewer: %s\n", st.message.c_str());
+    return kExitBadInput;
+  }
+  std::shared_ptr<const lod::TerrainModel> terrain;  // [[terrain]]: drawn from each frame's mesh
+  if (lod::Status st = lod::load_scene_terrain(loaded.config, terrain); !st) {
     std::fprintf(stderr, "lod-viewer: %s\n", st.message.c_str());
     return kExitBadInput;
   }
@@ -64,6 +70,7 @@ int run(const lod::viewer::ViewerOptions& o) {
   if (!loaded.hlod->empty()) session.graph.hlod = loaded.hlod;
   if (!loaded.scene_hlod->empty()) session.graph.scene_hlod = loaded.scene_hlod;  // make_service binds handles
   renderer.set_scene_hlod(loaded.scene_hlod.get());
+  session.graph.terrain = terrain;
   if (o.budget > 0) session.graph.selection.budget = uint64_t(o.budget);
   if (o.lod_delay_ms > 0) {
     // Through the graph's stage hook, so the delay sits inside the LOD frame, on its thread.

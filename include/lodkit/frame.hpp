@@ -13,11 +13,11 @@ namespace lod {
 // The frame graph's nodes (FrameGraph::dot() shows their edges); Frame::stage_ms per node.
 enum class Stage : uint8_t {
   commit, bounds, view, visibility, importance, selection, entries, geomorph, vdlod, vd_mesh, hlod, scene_hlod,
-  publish, count
+  terrain, publish, count
 };
 inline constexpr const char* kStageNames[] = {"commit",   "bounds",   "view",  "visibility", "importance", "selection",
                                               "entries",  "geomorph", "vdlod", "vd_mesh",    "hlod",       "scene_hlod",
-                                              "publish"};
+                                              "terrain",  "publish"};
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::count);
 inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = round(log2 tris)
 
@@ -142,6 +142,17 @@ struct Frame {
   std::vector<uint32_t> scene_proxies;  // proxy (scene HLOD node) ids, breadth-first
   uint32_t scene_proxy_objects = 0;     // objects the drawn proxies stand for
   uint64_t scene_proxy_tris = 0;        // their triangles (in tris_selected)
+  // Terrain ([[terrain]]: ROAM refined for view 0, the whole bintree mesh; what lies outside
+  // the frustum is coarse already). Its triangles count in tris_selected, within M.
+  std::vector<float> terrain_positions;   // xyz world space per vertex
+  std::vector<uint32_t> terrain_indices;  // 3 per triangle into terrain_positions (ccw in grid x, y = cw seen from +y)
+  std::vector<uint32_t> terrain_samples;  // per vertex: its grid sample, y * terrain_grid + x
+  uint32_t terrain_grid = 0;              // samples per grid side (0: no terrain)
+  uint64_t terrain_tris = 0;
+  uint64_t terrain_splits = 0;            // this frame, forced splits included
+  uint64_t terrain_merges = 0;
+  uint64_t terrain_share = 0;             // triangles of M the terrain was given this frame
+  float terrain_pixel_error = 0;          // the largest projected error left on it, pixels
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds
   double total_ms = 0;

@@ -11,6 +11,11 @@
 //   BM_RoamFlight/1   the same at a triangle-count target (50,000)
 //   BM_RoamFlight/2   the same at 0.1 pixel (a finer mesh at a pixel-error target)
 //   BM_RoamReset      the part of a rebuild that clears the per-sample state (O(grid))
+//   BM_RoamVsChunked/T/P  the baseline: Ulrich's chunked LOD (runtime/chunked_terrain.h, P x P
+//                     cell patches with skirts) selected on the same flight at the same projected
+//                     error, T/10 pixels, against ROAM's drawn (frustum-culled) list:
+//                     tris_ratio = ROAM / chunked triangles drawn (skirts included; _no_skirts
+//                     without), median_roam_update_ms, median_chunked_select_ms, chunks
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -22,6 +27,7 @@
 #include <vector>
 
 #include "preprocess/height_field_io.h"
+#include "runtime/chunked_terrain.h"
 #include "runtime/roam.h"
 
 namespace {
@@ -44,8 +50,9 @@ HeightField generated_field(uint32_t size) {
 
 const RoamTerrain& terrain() {
   static RoamTerrain t = [] {
-    const std::filesystem::path real =
-        std::filesystem::path(LOD_SOURCE_DIR) / "build" / "data" / "topography.txt";
+    // The fetched topography: build/data of the source tree, else this build's data directory.
+    std::filesystem::path real = std::filesystem::path(LOD_SOURCE_DIR) / "build" / "data" / "topography.txt";
+    if (!std::filesystem::exists(real)) real = std::filesystem::path(LOD_DATA_DIR) / "topography.txt";
     HeightField f;
     HeightFieldTextOptions o;
     o.coordinates = GridCoordinates::degrees_lat_lon;
@@ -145,6 +152,47 @@ void BM_RoamReset(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_RoamReset)->Unit(benchmark::kMillisecond);
+
+void BM_RoamVsChunked(benchmark::State& state) {
+  const RoamTerrain& t = terrain();
+  const uint32_t patch = uint32_t(state.range(1));
+  static std::vector<ChunkedTerrain> built;  // by patch size, built once
+  auto it = std::find_if(built.begin(), built.end(), [&](const ChunkedTerrain& c) { return c.patch == patch; });
+  if (it == built.end()) {
+    const double ms = ms_of([&] { built.push_back(build_chunked_terrain(t, patch)); });
+    std::fprintf(stderr, "chunked terrain build (patch %u): %zu nodes, %.1f ms\n", patch, built.back().nodes.size(), ms);
+    it = built.end() - 1;
+  }
+  const ChunkedTerrain& chunked = *it;
+  RoamParams p;
+  p.pixel_error = float(state.range(0)) / 10;
+  RoamState s;
+  roam_reset(s, t);
+  roam_update(s, t, flight_view(t, 0), p);
+  std::vector<uint32_t> drawn, chunks;
+  std::vector<double> roam_ms, chunk_ms;
+  double roam_tris = 0, chunk_tris = 0, chunk_count = 0, skirts = 0;
+  int frame = 1;
+  for (auto _ : state) {
+    const View v = flight_view(t, frame++);
+    const double ms = ms_of([&] { roam_update(s, t, v, p); });
+    state.SetIterationTime(ms * 1e-3);
+    roam_ms.push_back(ms);
+    roam_tris += double(roam_visible_triangles(drawn, s, t));
+    ChunkedSelection sel;
+    chunk_ms.push_back(ms_of([&] { sel = select_chunks(chunks, chunked, v, p.pixel_error); }));
+    chunk_tris += double(sel.triangles), skirts += double(sel.skirt_triangles), chunk_count += sel.chunks;
+  }
+  const double n = double(roam_ms.size());
+  state.counters["roam_triangles"] = roam_tris / n;
+  state.counters["chunked_triangles"] = chunk_tris / n;
+  state.counters["chunks"] = chunk_count / n;
+  state.counters["tris_ratio"] = roam_tris / std::max(chunk_tris, 1.0);
+  state.counters["tris_ratio_no_skirts"] = roam_tris / std::max(chunk_tris - skirts, 1.0);
+  state.counters["median_roam_update_ms"] = median(roam_ms);
+  state.counters["median_chunked_select_ms"] = median(chunk_ms);
+}
+BENCHMARK(BM_RoamVsChunked)->ArgsProduct({{10, 5, 2}, {32, 8}})->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(400);
 
 }  // namespace
 

@@ -20,6 +20,8 @@ TEST_P(ShippedConfig, RunsAndEveryFrameValidates) {
   ASSERT_TRUE(std::filesystem::exists(config)) << config;
   if (name == "stress-scans") {
     if (lod::test::shared_meshes().empty()) GTEST_SKIP() << "needs ../shared/data/meshes (absent on this machine)";
+  } else if (name == "terrain" && !std::filesystem::exists(std::filesystem::path(LOD_DATA_DIR) / "topography.txt")) {
+    GTEST_SKIP() << "needs topography.txt in " << LOD_DATA_DIR << " (scripts/fetch-topography.sh " << LOD_DATA_DIR << ")";
   } else if (lod::test::data_dir().empty()) {
     GTEST_SKIP() << "needs Debian's CGAL meshes (libcgal-demo) extracted into " << LOD_DATA_DIR;
   }
@@ -35,7 +37,7 @@ TEST_P(ShippedConfig, RunsAndEveryFrameValidates) {
 
 INSTANTIATE_TEST_SUITE_P(Configs, ShippedConfig,
                          ::testing::Values("default", "threads-1", "stress-10k", "stress-100k", "stress-scans", "town", "traffic", "hlod", "scene-hlod",
-                                           "vdlod"),
+                                           "vdlod", "terrain"),
                          [](const ::testing::TestParamInfo<const char*>& param_info) {
                            std::string s = param_info.param;
                            for (auto& c : s)

@@ -1,0 +1,68 @@
+// [[terrain]] -> TerrainModel: read, resample, build the bintree, place.
+#include "jobs/terrain_scene.h"
+
+#include <algorithm>
+
+#include "preprocess/height_field_io.h"
+#include "runtime/height_field.h"
+
+namespace lod {
+namespace {
+
+inline constexpr uint32_t kMaxGridSamples = 4097;  // per side: 2^12 + 1
+
+// The smallest 2^n + 1 holding the field along both sides, at most kMaxGridSamples.
+uint32_t grid_samples_for(const HeightField& f) {
+  const uint32_t side = std::max(f.width, f.height);
+  uint32_t n = 3;
+  while (n < side && n < kMaxGridSamples) n = 2 * (n - 1) + 1;
+  return n;
+}
+
+// Where the grid's sample (0, 0) goes: `position` itself, or so that the grid's centre is there.
+glm::vec3 grid_origin(const TerrainConfig& c, const HeightField& f) {
+  glm::vec3 at(c.position[0], c.position[1], c.position[2]);
+  if (c.centered) {
+    at.x -= 0.5f * f.cell_size_x * float(f.width - 1);
+    at.z -= 0.5f * f.cell_size_y * float(f.height - 1);
+  }
+  return at;
+}
+
+}  // namespace
+
+Status load_terrain_model(const TerrainConfig& config, float pixel_error, TerrainModel& out) {
+  HeightFieldTextOptions options;
+  options.coordinates = config.coordinates;
+  options.vertical_scale = config.vertical_scale;
+  options.no_data_value = config.no_data;
+  HeightField field;
+  if (auto st = read_height_field_text(config.file, field, options); !st) return st;
+  if (config.cell_size[0] > 0) field.cell_size_x = config.cell_size[0];
+  if (config.cell_size[1] > 0) field.cell_size_y = config.cell_size[1];
+  const uint32_t samples = config.samples ? config.samples : grid_samples_for(field);
+  if (field.width != samples || field.height != samples) field = resample_square(field, samples);
+  TerrainModel m;
+  m.roam = build_roam_terrain(field);
+  const glm::vec3 origin = grid_origin(config, field);
+  for (glm::vec3& p : m.roam.positions) p += origin;
+  m.target = config.target;
+  m.pixel_error = config.pixel_error > 0 ? config.pixel_error : pixel_error;
+  m.max_triangles = config.max_triangles;
+  m.initial_share = config.initial_share;
+  m.min_share = config.min_share;
+  m.max_share = config.max_share;
+  out = std::move(m);
+  return Status::success();
+}
+
+Status load_scene_terrain(const SceneConfig& config, std::shared_ptr<const TerrainModel>& out) {
+  out.reset();
+  if (!config.terrain) return Status::success();
+  auto m = std::make_shared<TerrainModel>();
+  if (auto st = load_terrain_model(*config.terrain, config.pixel_error, *m); !st) return st;
+  out = std::move(m);
+  return Status::success();
+}
+
+}  // namespace lod

@@ -1,0 +1,21 @@
+// The scene's [[terrain]] made drawable: its height field read, resampled onto ROAM's grid and
+// placed in the world (issue 15).
+#pragma once
+#include <memory>
+
+#include "jobs/scene_config.h"
+#include "runtime/status.h"
+#include "runtime/terrain_lod.h"
+
+namespace lod {
+
+// Reads config.file (preprocess/height_field_io.h), applies cell_size and vertical_scale,
+// resamples bilinearly onto a (2^n + 1)-square grid (samples, or the smallest holding the
+// field, at most 4097), builds the bintree and moves it to its placement. `pixel_error` is
+// the tau used when the block gives none. Errors name the file.
+Status load_terrain_model(const TerrainConfig& config, float pixel_error, TerrainModel& out);
+
+// The scene's terrain, or null when it has none.
+Status load_scene_terrain(const SceneConfig& config, std::shared_ptr<const TerrainModel>& out);
+
+}  // namespace lod
