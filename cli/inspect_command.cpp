@@ -14,20 +14,22 @@
 namespace lod::cli {
 namespace {
 
-// One level in the chosen format: positions and triangles, plus normals where the format
-// has them (the chain stores one per vertex).
+// One level in the chosen format: positions and triangles, plus normals and texture
+// coordinates where the format has them (PLY: positions only).
 Status export_level(const std::filesystem::path& out, const std::string& format, const LodChain& chain,
                     const LodLevel& l, const std::string& name) {
   const float* positions = chain.positions.data() + size_t(l.first_vertex) * 3;
   const float* normals = chain.normals.size() == chain.positions.size() ? chain.normals.data() + size_t(l.first_vertex) * 3
                                                                         : nullptr;
+  const float* uvs = chain.uvs.empty() ? nullptr : chain.uvs.data() + size_t(l.first_vertex) * 2;
   const uint32_t* indices = chain.indices.data() + l.first_index;
-  if (format == "obj") return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count);
+  if (format == "obj") return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs);
   if (format == "glb" || format == "gltf") {
     GltfMeshView view;
     view.name = name;
     view.positions = positions;
     view.normals = normals;
+    view.uvs = uvs;
     view.vertex_count = l.vertex_count;
     view.indices = indices;
     view.index_count = l.index_count;
@@ -60,6 +62,7 @@ int inspect_command(const InspectArgs& args) {
     j["source_hash"] = hash;
     j["morph_targets"] = chain.morph_targets.size();  // 0 = level changes cannot blend
     j["hierarchy_nodes"] = chain.hierarchy.node_count();
+    j["texcoords"] = !chain.uvs.empty();
     j["levels"] = nlohmann::json::array();
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
@@ -72,6 +75,7 @@ int inspect_command(const InspectArgs& args) {
                              {"error_rms", l.error_rms},
                              {"bounds", {l.bounds.center[0], l.bounds.center[1], l.bounds.center[2], l.bounds.radius}},
                              {"bytes", l.vertex_count * 24ull + l.index_count * 4ull}});
+      if (!chain.uvs.empty()) j["levels"].back()["uv_error"] = chain.uv_errors[i];
     }
     // Names and paths are bytes: invalid UTF-8 is replaced (U+FFFD) rather than aborting the
     // dump; JSON escapes control characters itself.
@@ -94,6 +98,11 @@ int inspect_command(const InspectArgs& args) {
     else if (chain.levels.size() > 1)
       std::printf("morph targets: none (level changes pop; re-bake to add them)\n");
     if (!chain.hierarchy.empty()) std::printf("vertex hierarchy: %zu nodes\n", size_t(chain.hierarchy.node_count()));
+    if (!chain.uvs.empty()) {
+      std::printf("texture coordinates: every level (uv seams kept); uv error per level:");
+      for (float e : chain.uv_errors) std::printf(" %.4g", e);
+      std::printf("\n");
+    }
   }
   if (!args.export_dir.empty()) {
     std::error_code ec;

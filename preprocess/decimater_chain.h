@@ -20,6 +20,7 @@ struct ChainLevel {
   std::vector<float> positions;   // xyz per vertex
   std::vector<float> normals;     // xyz per vertex, area-weighted, unit length
   std::vector<uint32_t> indices;  // level-local, 3 per triangle
+  std::vector<float> uvs;         // uv per vertex, or empty (the input had none, or they were dropped)
   size_t target_triangles = 0;    // what the ratio asked for
   size_t triangle_count() const { return indices.size() / 3; }
   size_t vertex_count() const { return positions.size() / 3; }

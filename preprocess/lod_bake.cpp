@@ -25,7 +25,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 5;  // 5: morph targets repaired in pairs; 4: morph targets (MRPH);
+constexpr uint32_t kBakeFormatVersion = 6;  // 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
                                              // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
@@ -87,8 +87,6 @@ LodLevel culled_level(const LodChain& chain) {
 // The levels hold positions and normals only: say what the input had that they lose.
 void note_dropped_attributes(const MeshData& mesh, std::vector<std::string>& notes) {
   for (const std::string& w : mesh.warnings) notes.push_back("import: " + w);
-  if (!mesh.uvs.empty())
-    notes.push_back("texture coordinates of " + mesh.source + " are not kept in the levels (positions and normals only)");
   if (mesh.materials.size() > 1 || mesh.submeshes.size() > 1)
     notes.push_back(std::to_string(mesh.materials.size()) + " materials / " + std::to_string(mesh.submeshes.size()) +
                     " submeshes of " + mesh.source + " are not kept in the levels (one surface)");
@@ -132,6 +130,7 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
   ChainLevel& full = levels[0];
   full.positions = mesh.positions;
   full.indices = mesh.indices;
+  if (mesh.uvs.size() == 2 * mesh.vertex_count()) full.uvs = mesh.uvs;
   full.target_triangles = triangles;
   full.normals.resize(mesh.positions.size());
   compute_vertex_normals(full.positions.data(), full.vertex_count(), full.indices.data(), full.indices.size(),
@@ -144,12 +143,17 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
   std::vector<size_t> targets;
   for (size_t i = 1; i < ratios.size(); ++i) targets.push_back(size_t(std::llround(double(ratios[i]) * double(triangles))));
   std::vector<ChainLevelOut> out(targets.size());
+  bool keep_uvs = full.uvs.size() == 2 * full.vertex_count();
   if (method == SimplifyMethod::qem) {
     const ParallelFor one_by_one = [](size_t n, const std::function<void(size_t)>& body) {
       for (size_t i = 0; i < n; ++i) body(i);
     };
+    // Texture coordinates ride along as attributes: interpolated along each collapse, and
+    // vertices sharing a position (uv seams) locked, so the texture never tears at a seam.
+    QemOptions options;
+    if (keep_uvs) options.attributes = mesh.uvs.data(), options.attribute_count = 2;
     qem_simplify_chain_split(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
-                             mesh.indices.size(), targets.data(), targets.size(), QemOptions{},
+                             mesh.indices.size(), targets.data(), targets.size(), options,
                              parallel_for ? ParallelFor(parallel_for) : one_by_one);
     for (size_t i = 0; i < out.size(); ++i) {
       if (double(out[i].triangle_count()) <= 1.02 * double(targets[i])) continue;
@@ -160,21 +164,45 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
         cluster_simplify_chain(&out[i], mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
                                mesh.indices.size(), &targets[i], 1, ClusterOptions{});
         note += "; the aggressive simplifier made this level (" + std::to_string(out[i].triangle_count()) + ")";
+        keep_uvs = false;
       }
       notes.push_back(note);
     }
   } else {
     cluster_simplify_chain(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
                            mesh.indices.size(), targets.data(), targets.size(), ClusterOptions{});
+    keep_uvs = false;
+  }
+  if (!keep_uvs && !full.uvs.empty()) {
+    notes.push_back("texture coordinates of " + mesh.source +
+                    " dropped: the aggressive simplifier (vertex clustering) made a level, and it cannot keep uv seams");
+    full.uvs.clear();
   }
   for (size_t i = 0; i < out.size(); ++i) {
     ChainLevel& l = levels[i + 1];
     l.positions = std::move(out[i].positions);
     l.indices = std::move(out[i].indices);
     sources[i + 1] = std::move(out[i].source_vertex);
+    if (keep_uvs) l.uvs = std::move(out[i].attributes);
     l.target_triangles = targets[i];
     l.normals.resize(l.positions.size());
     compute_vertex_normals(l.positions.data(), l.vertex_count(), l.indices.data(), l.indices.size(), l.normals.data());
+  }
+}
+
+// Every level's uvs, and how far each level's texture slid: the largest uv distance of a vertex
+// from the input vertex it descends from (the levels' `sources`).
+void add_uvs(const std::vector<ChainLevel>& levels, const std::vector<std::vector<uint32_t>>& sources, LodChain& chain) {
+  const std::vector<float>& input = levels[0].uvs;
+  for (size_t k = 0; k < levels.size(); ++k) {
+    const ChainLevel& l = levels[k];
+    float worst = 0;
+    for (size_t v = 0; v < l.vertex_count() && v < sources[k].size(); ++v) {
+      const float* from = &input[2 * size_t(sources[k][v])];
+      worst = std::max(worst, std::hypot(l.uvs[2 * v] - from[0], l.uvs[2 * v + 1] - from[1]));
+    }
+    chain.uvs.insert(chain.uvs.end(), l.uvs.begin(), l.uvs.end());
+    chain.uv_errors.push_back(worst);
   }
 }
 
@@ -336,6 +364,7 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
     chain.indices.insert(chain.indices.end(), l.indices.begin(), l.indices.end());
     chain.levels.push_back(level);
   }
+  if (!levels[0].uvs.empty()) add_uvs(levels, sources, chain);
   // Morph targets of each level into the next, from the simplifier's vertex mapping; levels
   // are independent, so they may run in parallel.
   if (levels.size() > 1) {
@@ -364,7 +393,10 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
                                " triangles land on no level " + std::to_string(k + 1) +
                                " triangle when fully morphed (a blend there is approximate)");
   }
-  if (culled) chain.levels.push_back(culled_level(chain));
+  if (culled) {
+    chain.levels.push_back(culled_level(chain));
+    if (!chain.uvs.empty()) chain.uv_errors.push_back(chain.uv_errors.back());
+  }
   std::string problem;
   if (!validate_chain(chain, &problem)) return Status::error(what + ": baked chain is invalid: " + problem);
 

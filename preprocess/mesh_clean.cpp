@@ -28,6 +28,24 @@ PositionKey key_of(const float* p) {
   return k;
 }
 
+// Position and texture coordinate: with uvs, vertices weld only when both match, so a uv seam
+// (one position, two uvs) stays two vertices and the simplifier keeps it.
+struct TexturedKey {
+  std::array<uint32_t, 5> bits;
+  auto operator<=>(const TexturedKey&) const = default;
+};
+
+TexturedKey key_of(const float* p, const float* uv) {
+  TexturedKey k;
+  const PositionKey pk = key_of(p);
+  std::copy(pk.bits.begin(), pk.bits.end(), k.bits.begin());
+  for (int i = 0; i < 2; ++i) {
+    const float v = uv[i] == 0.0f ? 0.0f : uv[i];
+    std::memcpy(&k.bits[3 + i], &v, 4);
+  }
+  return k;
+}
+
 struct FaceKey {
   std::array<uint32_t, 3> v;  // sorted
   auto operator<=>(const FaceKey&) const = default;
@@ -81,9 +99,12 @@ CleanReport clean_mesh(MeshData& mesh) {
   const bool has_normals = mesh.normals.size() == mesh.positions.size();
   const bool has_uvs = mesh.uvs.size() == 2 * nv;
 
-  // Pass 1: weld exactly duplicated positions onto their first occurrence.
+  // Pass 1: weld exactly duplicated positions (and uvs, when there are some) onto their first
+  // occurrence.
   std::vector<uint32_t> weld(nv);
-  report.duplicate_vertices = first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v]); }, weld);
+  report.duplicate_vertices =
+      has_uvs ? first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v]); }, weld)
+              : first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v]); }, weld);
 
   std::vector<uint32_t> kept;
   kept.reserve(mesh.indices.size());

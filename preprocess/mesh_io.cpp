@@ -286,7 +286,7 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
 }
 
 Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count) {
+                const uint32_t* indices, size_t index_count, const float* uvs) {
   const std::string what = path.string();
   if (index_count % 3 != 0) return Status::error(what + ": index count " + std::to_string(index_count) + " is not a multiple of 3");
   for (size_t i = 0; i < index_count; ++i)
@@ -300,6 +300,11 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
     std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
     text += line;
   }
+  if (uvs)
+    for (size_t v = 0; v < vertex_count; ++v) {
+      std::snprintf(line, sizeof line, "vt %.9g %.9g\n", uvs[2 * v], 1.0f - uvs[2 * v + 1]);
+      text += line;
+    }
   if (normals)
     for (size_t v = 0; v < vertex_count; ++v) {
       const float* n = normals + 3 * v;
@@ -308,7 +313,11 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
     }
   for (size_t t = 0; t < index_count / 3; ++t) {
     const unsigned long a = indices[3 * t] + 1ul, b = indices[3 * t + 1] + 1ul, c = indices[3 * t + 2] + 1ul;
-    if (normals)
+    if (normals && uvs)
+      std::snprintf(line, sizeof line, "f %lu/%lu/%lu %lu/%lu/%lu %lu/%lu/%lu\n", a, a, a, b, b, b, c, c, c);
+    else if (uvs)
+      std::snprintf(line, sizeof line, "f %lu/%lu %lu/%lu %lu/%lu\n", a, a, b, b, c, c);
+    else if (normals)
       std::snprintf(line, sizeof line, "f %lu//%lu %lu//%lu %lu//%lu\n", a, a, b, b, c, c);
     else
       std::snprintf(line, sizeof line, "f %lu %lu %lu\n", a, b, c);

@@ -29,9 +29,10 @@ Status load_mesh_from_memory(const std::string& name, const std::string& extensi
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,
                 const uint32_t* indices, size_t index_count);
 
-// Writes positions (+ normals when given, else null) + triangles as Wavefront OBJ text
-// ("v", "vn", "f a//a ..." numbered from 1).
+// Writes positions (+ normals and uvs when given, else null) + triangles as Wavefront OBJ text
+// ("v", "vt", "vn", "f a/a/a ..." numbered from 1). uvs are glTF's (origin top left); OBJ's vt
+// has its origin bottom left, so v is written as 1 - v.
 Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count);
+                const uint32_t* indices, size_t index_count, const float* uvs = nullptr);
 
 }  // namespace lod

@@ -13,6 +13,8 @@
 //       offsets (i + 1), incident faces. Readers that predate it skip it (version stays 1).
 // MRPH (optional, flag 0; written only when the chain has morph targets): u32 per vertex of
 //       every level but the last (LodChain::morph_targets), checked like the levels' indices.
+// TEX0 (optional, flag 0; written only when the chain has texture coordinates): u32 level
+//       count, f32 uv error per level, then 2 f32 per vertex (LodChain::uvs).
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
 //       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
@@ -59,6 +61,7 @@ constexpr uint32_t kNrml = fourcc("NRML");
 constexpr uint32_t kIndx = fourcc("INDX");
 constexpr uint32_t kVhie = fourcc("VHIE");
 constexpr uint32_t kMrph = fourcc("MRPH");
+constexpr uint32_t kTex0 = fourcc("TEX0");
 constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
@@ -260,6 +263,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   std::vector<uint32_t> tags = {kMeta, kLevl, kPosn, kNrml, kIndx};
   if (!chain.hierarchy.empty()) tags.push_back(kVhie);
   if (!chain.morph_targets.empty()) tags.push_back(kMrph);
+  if (!chain.uvs.empty()) tags.push_back(kTex0);
   const uint32_t section_count = static_cast<uint32_t>(tags.size());
   w.raw(kMagic, sizeof(kMagic));
   w.u32(kLodAssetVersion);
@@ -267,7 +271,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   const size_t table = w.bytes.size();
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
-    w.u32(tags[s] == kVhie || tags[s] == kMrph ? 0 : kFlagRequired);
+    w.u32(tags[s] == kVhie || tags[s] == kMrph || tags[s] == kTex0 ? 0 : kFlagRequired);
     w.u64(0);  // offset, patched below
     w.u64(0);  // size
   }
@@ -302,6 +306,12 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   for (uint32_t s = 5; s < section_count; ++s) {
     if (tags[s] == kVhie) section(s, [&] { put_hierarchy(w, chain.hierarchy); });
     if (tags[s] == kMrph) section(s, [&] { put_words(w, chain.morph_targets); });
+    if (tags[s] == kTex0)
+      section(s, [&] {
+        w.u32(static_cast<uint32_t>(chain.uv_errors.size()));
+        put_floats(w, chain.uv_errors);
+        put_floats(w, chain.uvs);
+      });
   }
   w.align8();
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
@@ -347,7 +357,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     return refuse(what, "checksum mismatch (file is corrupted or truncated)");
 
   SectionRef sec[5];
-  SectionRef vhie, mrph;
+  SectionRef vhie, mrph, tex0;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -365,6 +375,11 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     if (tag == kMrph) {
       if (mrph.present) return refuse(what, name + " appears twice");
       mrph = {off, sz, true};
+      continue;
+    }
+    if (tag == kTex0) {
+      if (tex0.present) return refuse(what, name + " appears twice");
+      tex0 = {off, sz, true};
       continue;
     }
     size_t known = 0;
@@ -420,6 +435,15 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
       return refuse(what, "MRPH section is " + std::to_string(mrph.size) + " bytes but the levels but the last have " +
                               std::to_string(want) + " vertices (4 bytes each)");
     get_words(p + mrph.offset, want, chain.morph_targets);
+  }
+  if (tex0.present) {
+    const uint64_t want = 4 + 4 * uint64_t{level_count} + 8 * vertices;
+    if (tex0.size != want || load_u32(p + tex0.offset) != level_count)
+      return refuse(what, "TEX0 section is " + std::to_string(tex0.size) + " bytes; " + std::to_string(level_count) +
+                              " levels and " + std::to_string(vertices) + " vertices need " + std::to_string(want) +
+                              " (u32 level count, f32 per level, 2 f32 per vertex)");
+    get_words(p + tex0.offset + 4, level_count, chain.uv_errors);
+    get_words(p + tex0.offset + 4 + 4 * uint64_t{level_count}, 2 * vertices, chain.uvs);
   }
   std::string message;
   const char* section = "LEVL";

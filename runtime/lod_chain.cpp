@@ -66,6 +66,20 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
   if (!all_finite(chain.normals, &bad))
     return fail(message, "vertex " + std::to_string(bad / 3) + " has a " +
                              (std::isfinite(chain.normals[bad]) ? "huge (beyond 1e18)" : "non-finite") + " normal");
+  in("TEX0");
+  if (!chain.uvs.empty() || !chain.uv_errors.empty()) {
+    if (chain.uvs.size() != chain.positions.size() / 3 * 2)
+      return fail(message, "uvs hold " + std::to_string(chain.uvs.size()) + " floats for " +
+                               std::to_string(chain.positions.size() / 3) + " vertices (2 each)");
+    if (chain.uv_errors.size() != chain.levels.size())
+      return fail(message, std::to_string(chain.uv_errors.size()) + " uv errors for " +
+                               std::to_string(chain.levels.size()) + " levels");
+    if (!all_finite(chain.uvs, &bad))
+      return fail(message, "vertex " + std::to_string(bad / 2) + " has a huge or non-finite uv");
+    for (size_t k = 0; k < chain.uv_errors.size(); ++k)
+      if (!(chain.uv_errors[k] >= 0 && chain.uv_errors[k] < 1e18f))
+        return fail(message, "level " + std::to_string(k) + " has an invalid uv error");
+  }
   in("LEVL");
 
   const uint64_t vertex_total = chain.positions.size() / 3;

@@ -36,6 +36,12 @@ struct LodChain {
   std::vector<float> positions;    // xyz per vertex, all levels back to back
   std::vector<float> normals;      // xyz per vertex, same count as positions
   std::vector<uint32_t> indices;   // level-local vertex indices, all levels back to back
+  // Optional texture coordinates (empty = none): uv per vertex (glTF's convention, origin top
+  // left), laid out like positions; kept through every level by the simplifier (seams locked).
+  // uv_errors[k]: level k's largest uv distance from the input vertex each of its vertices
+  // descends from (how far the texture slid). Stored in the asset's optional TEX0 section.
+  std::vector<float> uvs;
+  std::vector<float> uv_errors;
   // Optional geomorph targets (empty = none): per vertex of every level but the last, laid out
   // like positions (level k's at levels[k].first_vertex), the level-local index of the vertex
   // of level k + 1 it merges into. Stored in the asset's optional MRPH section.
@@ -53,12 +59,13 @@ int32_t level_of_triangles(uint64_t triangles);
 // non-increasing, errors non-decreasing, l = level_of_triangles, finite values, at most
 // kMaxLevels levels. On failure `message` names the element ("level 3 index 812 references
 // vertex 90211 of 35947"); callers prefix the file.
+// Texture coordinates, when present: two per vertex, finite, one uv error per level (>= 0).
 // The culled level: an empty last level (0 triangles, 0 vertices) after level 0; no other level
 // may be empty.
 // With morph targets: one per vertex of every drawn level but the last, each < the next level's
 // vertex_count ("level 2 vertex 17 morphs into vertex 900 of level 3's 812").
 // Values must be finite and at most kMaxTreeMagnitude in size. `section`, when given, is set
-// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH") the failing element is in.
+// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH", "TEX0") the failing element is in.
 bool validate_chain(const LodChain& chain, std::string* message, const char** section = nullptr);
 
 // The culled level (a last ratio of 0): a last level, after level 0, with no triangles and no

@@ -24,10 +24,11 @@ TEST(MeshClean, LeavesACleanMeshAlone) {
 // glTF's optional attributes survive cleaning: a welded vertex keeps its first uv, and each
 // submesh keeps exactly its surviving triangles (an emptied one goes).
 TEST(MeshClean, KeepsUvsAndReRangesSubmeshes) {
-  // Vertex 4 repeats vertex 1's position (welded); triangle 1 is degenerate, triangle 3 repeats 0.
+  // Vertex 4 repeats vertex 1's position and uv (welded); triangle 1 is degenerate, triangle 3
+  // repeats 0.
   MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0},
                     {0, 1, 2, 0, 0, 1, 1, 3, 2, 2, 0, 4, 4, 3, 2});
-  m.uvs = {0, 0, 0.1f, 0, 0, 1, 1, 1, 0.9f, 0};
+  m.uvs = {0, 0, 0.1f, 0, 0, 1, 1, 1, 0.1f, 0};
   m.submeshes = {{0, 2, 0}, {2, 2, 1}, {4, 1, 0}};
   clean_mesh(m);
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
@@ -38,6 +39,19 @@ TEST(MeshClean, KeepsUvsAndReRangesSubmeshes) {
   EXPECT_EQ(m.submeshes[1].first_triangle, 1u);
   EXPECT_EQ(m.submeshes[1].triangle_count, 1u);
   EXPECT_EQ(m.submeshes[1].material, 1);
+}
+
+// The same position with another uv is a seam: two vertices, so the simplifier keeps it.
+TEST(MeshClean, KeepsUvSeams) {
+  MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0},
+                    {0, 1, 2, 4, 3, 2});
+  m.uvs = {0, 0, 0.1f, 0, 0, 1, 1, 1, 0.9f, 0};
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.duplicate_vertices, 0u);
+  EXPECT_EQ(m.vertex_count(), 5u);
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 4, 3, 2}));
+  MeshData plain = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0}, {0, 1, 2, 4, 3, 2});
+  EXPECT_EQ(clean_mesh(plain).duplicate_vertices, 1u) << "without uvs the same position welds";
 }
 
 TEST(MeshClean, DropsFacesWithARepeatedIndex) {

@@ -138,7 +138,9 @@ TEST(SceneHlodBuild, ProxiesAreCoarserThanTheirObjectsAndWithinTheirErrorOfTheFu
     }
     // A small group may keep all (cell_error stops QEM near its objects); the root may not.
     EXPECT_LE(n.triangles(), coarsest) << "a proxy never has more triangles than its objects' coarsest levels";
-    if (i == 0) EXPECT_LT(n.triangles(), coarsest / 2);
+    if (i == 0) {
+      EXPECT_LT(n.triangles(), coarsest / 2);
+    }
     SurfaceError e;
     SurfaceErrorSettings es;
     es.surface_samples = 20000;
