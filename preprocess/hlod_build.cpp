@@ -718,6 +718,7 @@ HlodSubtreeSpec describe_subtree(const Context& c, const BuildNode& n) {
 struct HlodBuilder::Impl {
   const MeshData& mesh;
   std::string what;
+  HlodBuildOptions options;  // a copy: Context keeps a reference, callers pass temporaries
   Context c;
   std::unique_ptr<BuildNode> root;
   std::vector<BuildNode*> frontier;
@@ -729,7 +730,7 @@ struct HlodBuilder::Impl {
   Tally top_tally;
 
   Impl(const MeshData& m, const HlodBuildOptions& o)
-      : mesh(m), what(m.source.empty() ? std::string("mesh") : m.source), c(o) {}
+      : mesh(m), what(m.source.empty() ? std::string("mesh") : m.source), options(o), c(options) {}
 
   void ensure_surface() {
     if (surface_built) return;

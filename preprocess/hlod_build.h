@@ -97,8 +97,8 @@ struct HlodSubtreeSpec {
   uint64_t fingerprint = 0;
 };
 
-// The three steps of build_hlod, for a caller that spreads (b) over processes. `mesh` and
-// `options` must outlive the builder. Not thread-safe itself; bake_subtrees runs its subtrees
+// The three steps of build_hlod, for a caller that spreads (b) over processes. `mesh` must
+// outlive the builder (the options are copied). Not thread-safe itself; bake_subtrees runs its subtrees
 // through options.parallel_for.
 class HlodBuilder {
  public:

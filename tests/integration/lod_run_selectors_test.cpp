@@ -77,7 +77,9 @@ TEST(LodRunSelectors, FractionOfTheOptimumPerFrameForEverySelector) {
       const double x = f["benefit_optimum_fraction"].get<double>();
       EXPECT_GT(x, 0.0);
       EXPECT_LE(x, 1.0);
-      if (std::string(selector) == "benefit_cost") EXPECT_GE(x, 0.5);
+      if (std::string(selector) == "benefit_cost") {
+        EXPECT_GE(x, 0.5);
+      }
       raised += f["lowered_steps"].get<uint64_t>();
     }
     EXPECT_GT(raised, 0u) << selector << ": the budget must bind";

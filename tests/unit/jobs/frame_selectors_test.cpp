@@ -48,7 +48,9 @@ TEST(FrameSelectors, EveryFrameHasItsFractionOfTheOptimumAndBenefitCostHoldsTheB
       EXPECT_LE(f.benefit_optimum_fraction, 1.0);
       worst = std::min(worst, f.benefit_optimum_fraction);
     }
-    if (s == Selector::benefit_cost) EXPECT_GE(worst, 0.5) << "Funkhouser-Sequin's guarantee";
+    if (s == Selector::benefit_cost) {
+      EXPECT_GE(worst, 0.5) << "Funkhouser-Sequin's guarantee";
+    }
     std::printf("selector %d: worst fraction of the optimum %.4f\n", int(s), worst);
   }
 }
