@@ -36,7 +36,7 @@ LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp
 HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp
               runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/file_write.cpp runtime/model_table.cpp
               runtime/view.cpp runtime/world_bounds.cpp)
-SCENE_SOURCES=(jobs/scene_config.cpp)
+SCENE_SOURCES=(jobs/scene_config.cpp runtime/roam.cpp runtime/height_field.cpp runtime/view.cpp)  # [[terrain]] checks grid sizes
 # The scene reader links Debian's toml++ library as lodkit does (its header-only mode has debug
 # asserts that the shipped, NDEBUG library does not: "[[[a]]" asserts there, is refused here).
 SCENE_FLAGS=(-DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1)
