@@ -534,7 +534,7 @@ HlodSubtree flatten_subtree(Context& c, const std::vector<BuildNode*>& order) {
 
 // What a frontier node is to the levels above once its subtree is baked: its coarsest layer,
 // reference samples and bounds, as the subtree's root had them.
-void make_stub(BuildNode& n, const HlodSubtree& s) {
+void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
   for (auto& child : n.children) child.reset();
   n.child_mask = 0;
   std::vector<uint32_t>().swap(n.triangles);
@@ -841,7 +841,7 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
   return Status::success();
 }
 
-// Pass 1 of the top, children before parents; frontier nodes are stubs by now.
+// Pass 1 of the top, children before parents; each frontier node stands for its baked subtree by now.
 void HlodBuilder::Impl::build_top(BuildNode& n) {
   if (n.subtree >= 0) return;
   const std::vector<BuildNode*> kids = children_of(n);
@@ -859,7 +859,7 @@ Status HlodBuilder::assemble(std::vector<HlodSubtree>& baked, HlodModel& out, Hl
   report.dropped_triangles = m.dropped;
   for (size_t i = 0; i < baked.size(); ++i) {
     if (Status s = check_subtree(*m.frontier[i], baked[i], m.mesh.vertex_count(), m.name(i)); !s) return s;
-    make_stub(*m.frontier[i], baked[i]);
+    stand_for_subtree(*m.frontier[i], baked[i]);
     report.short_layers += baked[i].short_layers;
     report.oversized_leaves += baked[i].oversized_leaves;
   }

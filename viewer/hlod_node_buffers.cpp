@@ -2,47 +2,19 @@
 
 #include <cstdio>
 
-#include "viewer/mesh_buffers.h"
-
 namespace lod::viewer {
 
 namespace {
 
 void release(HlodNodeGpu& g) {
-  if (g.ibo) glDeleteBuffers(1, &g.ibo);
-  if (g.vbo) glDeleteBuffers(1, &g.vbo);
-  if (g.vao) glDeleteVertexArrays(1, &g.vao);
+  release_static_mesh(g.gl);
   g = HlodNodeGpu{};
 }
 
 HlodNodeRange range_of(const LodLevel& l) { return {l.first_index, l.index_count, l.first_vertex}; }
 
-// Positions then normals in one buffer; the per-object attributes stay disabled, so the
-// instance shader reads the constant transform set before each draw.
 void fill(HlodNodeGpu& g, const HlodPayload& p) {
-  const size_t pos_bytes = p.positions.size() * sizeof(float);
-  const size_t nrm_bytes = p.normals.size() == p.positions.size() ? pos_bytes : 0;
-  const size_t idx_bytes = p.indices.size() * sizeof(uint32_t);
-  glGenVertexArrays(1, &g.vao);
-  glGenBuffers(1, &g.vbo);
-  glGenBuffers(1, &g.ibo);
-  glBindVertexArray(g.vao);
-  glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(pos_bytes + nrm_bytes), nullptr, GL_STATIC_DRAW);
-  glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(pos_bytes), p.positions.data());
-  glEnableVertexAttribArray(kAttribPosition);
-  glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
-  if (nrm_bytes) {
-    glBufferSubData(GL_ARRAY_BUFFER, GLintptr(pos_bytes), GLsizeiptr(nrm_bytes), p.normals.data());
-    glEnableVertexAttribArray(kAttribNormal);
-    glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float),
-                          reinterpret_cast<const void*>(pos_bytes));
-  }
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ibo);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(idx_bytes), p.indices.data(), GL_STATIC_DRAW);
-  glBindVertexArray(0);
-  glBindBuffer(GL_ARRAY_BUFFER, 0);
-  g.bytes = pos_bytes + nrm_bytes + idx_bytes;
+  g.bytes = upload_static_mesh(g.gl, p.positions, p.normals, p.indices);
   for (const LodLevel& l : p.layers) g.layers.push_back(range_of(l));
   g.boundary = range_of(p.boundary);
 }

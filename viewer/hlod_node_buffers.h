@@ -13,6 +13,7 @@
 #include "jobs/hlod_models.h"
 #include "runtime/hlod_asset.h"
 #include "viewer/hlod_draw_list.h"
+#include "viewer/mesh_buffers.h"
 
 namespace lod::viewer {
 
@@ -21,7 +22,7 @@ struct HlodNodeRange {
 };
 
 struct HlodNodeGpu {
-  GLuint vao = 0, vbo = 0, ibo = 0;
+  StaticMeshGl gl;
   uint64_t bytes = 0;
   uint64_t last_drawn = 0;               // prepare() call that last needed it
   std::vector<HlodNodeRange> layers;

@@ -252,7 +252,7 @@ void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers
       ++stats.hlod_missing;
       continue;
     }
-    glBindVertexArray(g->vao);  // per-object attributes disabled here: the constants below hold
+    glBindVertexArray(g->gl.vao);  // per-object attributes disabled here: the constants below hold
     glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
     glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
     glVertexAttrib2f(kAttribInstanceMorph, 1.f, 0.f);

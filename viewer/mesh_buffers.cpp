@@ -4,6 +4,40 @@
 
 namespace lod::viewer {
 
+size_t upload_static_mesh(StaticMeshGl& gl, std::span<const float> positions, std::span<const float> normals,
+                          std::span<const uint32_t> indices) {
+  const size_t pos_bytes = positions.size() * sizeof(float);
+  const size_t nrm_bytes = normals.size() == positions.size() ? pos_bytes : 0;
+  const size_t idx_bytes = indices.size() * sizeof(uint32_t);
+  glGenVertexArrays(1, &gl.vao);
+  glGenBuffers(1, &gl.vbo);
+  glGenBuffers(1, &gl.ibo);
+  glBindVertexArray(gl.vao);
+  glBindBuffer(GL_ARRAY_BUFFER, gl.vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(pos_bytes + nrm_bytes), nullptr, GL_STATIC_DRAW);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(pos_bytes), positions.data());
+  glEnableVertexAttribArray(kAttribPosition);
+  glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  if (nrm_bytes) {
+    glBufferSubData(GL_ARRAY_BUFFER, GLintptr(pos_bytes), GLsizeiptr(nrm_bytes), normals.data());
+    glEnableVertexAttribArray(kAttribNormal);
+    glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float),
+                          reinterpret_cast<const void*>(pos_bytes));
+  }
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gl.ibo);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(idx_bytes), indices.data(), GL_STATIC_DRAW);
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  return pos_bytes + nrm_bytes + idx_bytes;
+}
+
+void release_static_mesh(StaticMeshGl& gl) {
+  if (gl.ibo) glDeleteBuffers(1, &gl.ibo);
+  if (gl.vbo) glDeleteBuffers(1, &gl.vbo);
+  if (gl.vao) glDeleteVertexArrays(1, &gl.vao);
+  gl = StaticMeshGl{};
+}
+
 MeshBuffers::~MeshBuffers() {
   if (ibo_) glDeleteBuffers(1, &ibo_);
   if (vbo_) glDeleteBuffers(1, &vbo_);

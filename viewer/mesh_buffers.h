@@ -19,6 +19,16 @@ inline constexpr GLuint kAttribInstanceMorph = 4;          // InstanceData morph
 inline constexpr GLuint kAttribTargetPosition = 5;         // morph target stream (MorphBuffers)
 inline constexpr GLuint kAttribTargetNormal = 6;
 
+// A static mesh in its own VAO: positions then normals (when `normals` is not empty) in one
+// VBO, indices in an IBO; the per-object attributes stay disabled, so the instance shader reads
+// the constant transform set before each draw. Returns the bytes uploaded.
+struct StaticMeshGl {
+  GLuint vao = 0, vbo = 0, ibo = 0;
+};
+size_t upload_static_mesh(StaticMeshGl& gl, std::span<const float> positions, std::span<const float> normals,
+                          std::span<const uint32_t> indices);
+void release_static_mesh(StaticMeshGl& gl);
+
 class MeshBuffers {
  public:
   MeshBuffers() = default;

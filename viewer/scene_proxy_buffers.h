@@ -6,6 +6,7 @@
 #include <epoxy/gl.h>
 
 #include "runtime/scene_hlod_tree.h"
+#include "viewer/mesh_buffers.h"
 
 namespace lod::viewer {
 
@@ -17,11 +18,11 @@ class SceneProxyBuffers {
   SceneProxyBuffers& operator=(const SceneProxyBuffers&) = delete;
 
   void upload(const SceneHlodTree& tree);
-  GLuint vao() const { return vao_; }
+  GLuint vao() const { return gl_.vao; }
   size_t bytes() const { return bytes_; }
 
  private:
-  GLuint vao_ = 0, vbo_ = 0, ibo_ = 0;
+  StaticMeshGl gl_;
   size_t bytes_ = 0;
 };
 
