@@ -1,8 +1,6 @@
 // Bake jobs: one task per model on oneTBB; an asset named by the bake key is a cache hit.
 #include "jobs/bake_jobs.h"
 
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
@@ -12,6 +10,7 @@
 #include <cstdio>
 #include <mutex>
 
+#include "jobs/annotated_parallel_for.h"
 #include "preprocess/vertex_hierarchy.h"
 #include "runtime/lod_asset.h"
 
@@ -167,7 +166,7 @@ void bake_one(const ModelConfig& model, const std::filesystem::path& cache_dir, 
   // same as serially. Runs in the caller's arena, so the configured thread count holds.
   BakeSettings settings = model.bake;
   settings.parallel_for = [](size_t count, const std::function<void(size_t)>& body) {
-    tbb::parallel_for(size_t(0), count, [&](size_t i) { body(i); });
+    detail::annotated_parallel_for(count, body);
   };
   const Status baked = bake_model(model.file, model.name, settings, chain, &report, progress);
   if (!baked) {
@@ -209,17 +208,13 @@ Status bake_scene_models(const std::vector<ModelConfig>& models, const std::file
   LogLines lines(log);
   tbb::task_arena arena(threads == 0 ? tbb::task_arena::automatic : static_cast<int>(threads));
   arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, models.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t i = r.begin(); i != r.end(); ++i) {
-            try {
-              bake_one(models[i], cache_dir, lines, tasks[i]);
-            } catch (const std::exception& e) {  // e.g. bad_alloc on a huge mesh: a status, not a crash
-              tasks[i].status = Status::error("model " + models[i].name + " (" + models[i].file.string() +
-                                              "): " + e.what());
-            }
-          }
-        });
+    detail::annotated_parallel_for(models.size(), [&](size_t i) {
+      try {
+        bake_one(models[i], cache_dir, lines, tasks[i]);
+      } catch (const std::exception& e) {  // e.g. bad_alloc on a huge mesh: a status, not a crash
+        tasks[i].status = Status::error("model " + models[i].name + " (" + models[i].file.string() + "): " + e.what());
+      }
+    });
   });
 
   BakeSummary s;

@@ -58,16 +58,14 @@ using Clock = std::chrono::steady_clock;
 using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 
 // ThreadSanitizer cannot see the synchronisation inside libtbb (a library not built with it),
-// so the graph marks the hand-overs TBB guarantees: a node acquires what its predecessors
-// released when they finished (a root what the frame's caller released), a loop's chunks what
-// their spawner released before the loop, the spawner what they released after the join.
-// Each hand-over has its own byte (SyncPoints), but all are marked on one address for now:
-// with one address per edge, TSan reported loop chunks reading memory on the stacks of
-// threads TBB created, whose creation no annotated edge orders (seen only on a loaded machine);
-// one address orders any two tasks that did not overlap, as before. No-ops in other builds.
-[[maybe_unused]] char tsan_any_frame_start, tsan_any_spawn, tsan_edge;
-void tsan_acquire(char&) { detail::tsan_acquire(tsan_edge); }
-void tsan_release(char&) { detail::tsan_release(tsan_edge); }
+// so the graph marks the hand-overs TBB guarantees, each on a byte of its own (SyncPoints): a
+// node acquires what each of its predecessors released when it finished (a root, what the
+// frame's caller released before starting the graph); a loop's chunks acquire what their node
+// released before the loop, and the node what they released before the join. Data that
+// crosses between two nodes without an edge of the table is therefore reported. No-ops in
+// other builds.
+using detail::tsan_acquire;
+using detail::tsan_release;
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
@@ -142,7 +140,8 @@ struct FrameGraph::Impl {
   std::vector<uint8_t> model_blends;     // per model: discrete levels with morph targets (not vd)
   struct VdModel {
     EdgeCheck edges = EdgeCheck::corners;  // what its full mesh passes, so every front must
-    std::vector<uint8_t> regions;          // region per hierarchy node (empty: one front)
+    // Region-local numbering of the hierarchy (null: one front), shared by every object's fronts.
+    std::shared_ptr<const RegionNumbering> regions;
     uint32_t region_count = 1;
     uint32_t shared = 0;                   // nodes active in every region (seams)
   };
@@ -334,17 +333,15 @@ struct FrameGraph::Impl {
     v.edges = edge_check_of(std::span(chain.indices.data() + l0.first_index, l0.index_count));
     // Regions only pay off when the hierarchy was built in parts: a one-part tree's extra
     // regions are tiny components, kept together in one front.
-    if (vertex_tree_regions(v.regions, chain.hierarchy, kMaxVdRegions) < 2) {
-      v.regions.clear();
+    std::vector<uint8_t> region;
+    v.region_count = vertex_tree_regions(region, chain.hierarchy, kMaxVdRegions);
+    if (v.region_count < 2) {
+      v.region_count = 1;
       return v;
     }
-    v.region_count = 0;
-    for (uint8_t r : v.regions) {
-      if (r == kSharedRegion)
-        ++v.shared;
-      else
-        v.region_count = std::max<uint32_t>(v.region_count, r + 1u);
-    }
+    auto numbering = std::make_shared<const RegionNumbering>(number_regions(chain.hierarchy, std::move(region), v.region_count));
+    v.shared = numbering->shared;
+    v.regions = std::move(numbering);
     return v;
   }
 
@@ -400,28 +397,22 @@ struct FrameGraph::Impl {
     return pred;
   }
 
+  // What a node's body is given: the body is copied into the node by TBB (tsan_unseen_copy).
+  struct NodeCapture {
+    Impl* self;
+    uint32_t index, preds;
+  };
+
   void build() {
     graph.emplace();
     start.emplace(*graph);
     const auto pred = reduced_predecessors();
     nodes.reserve(kNodeCount);
     for (size_t i = 0; i < kNodeCount; ++i) {
-      nodes.push_back(std::make_unique<Node>(*graph, [this, i, preds = pred[i]](const tbb::flow::continue_msg&) {
-        tsan_acquire(tsan_any_frame_start);
-        for (uint32_t p = preds; p; p &= p - 1) tsan_acquire(sync.done[std::countr_zero(p)]);
-        const NodeSpec& spec = kNodes[i];
-        const auto t0 = Clock::now();
-        try {
-          if (options.stage_hook) options.stage_hook(spec.stage);
-          (this->*spec.run)();
-        } catch (...) {
-          tsan_release(sync.done[i]);
-          tsan_release(tsan_any_spawn);
-          throw;
-        }
-        stage_ms[static_cast<size_t>(spec.stage)] = ms_between(t0, Clock::now());
-        tsan_release(sync.done[i]);
-        tsan_release(tsan_any_spawn);
+      const NodeCapture cap{this, uint32_t(i), pred[i]};
+      nodes.push_back(std::make_unique<Node>(*graph, [cap](const tbb::flow::continue_msg&) {
+        const NodeCapture c = detail::tsan_unseen_copy(cap);
+        c.self->run_node(c.index, c.preds);
       }));
     }
     for (size_t j = 0; j < kNodeCount; ++j) {
@@ -430,40 +421,57 @@ struct FrameGraph::Impl {
     }
   }
 
+  void run_node(uint32_t i, uint32_t preds) {
+    if (preds == 0) tsan_acquire(sync.start);
+    for (uint32_t p = preds; p; p &= p - 1) tsan_acquire(sync.done[std::countr_zero(p)]);
+    const NodeSpec& spec = kNodes[i];
+    const auto t0 = Clock::now();
+    try {
+      if (options.stage_hook) options.stage_hook(spec.stage);
+      (this->*spec.run)();
+    } catch (...) {
+      tsan_release(sync.done[i]);
+      throw;
+    }
+    stage_ms[static_cast<size_t>(spec.stage)] = ms_between(t0, Clock::now());
+    tsan_release(sync.done[i]);
+  }
+
+  // A loop's hand-over: its chunks acquire `spawn`, released by the node before the loop, and
+  // release `join`, acquired by the node after it. The chunks' copies of the loop's body and
+  // range are TBB's (tsan_unseen_copy).
+  template <class Body>
+  struct Loop {
+    char* spawn;
+    char* join;
+    const Body* body;
+  };
+
   // Runs body(chunk, begin, end) for every chunk; one task per chunk.
   template <class Body>
   void for_chunks(Stage stage, const Body& body) {
-    char& spawn = sync.spawn[static_cast<size_t>(stage)];
-    char& join = sync.join[static_cast<size_t>(stage)];
-    const auto task = [&](const tbb::blocked_range<size_t>& r) {
-      tsan_acquire(tsan_any_spawn);
-      tsan_acquire(spawn);
-      for (size_t c = r.begin(); c != r.end(); ++c) body(c, c * grain, std::min(count, (c + 1) * grain));
-      tsan_release(join);
-      tsan_release(tsan_any_spawn);
-    };
-    tsan_release(spawn);  // after the task's captures are written
-    tsan_release(tsan_any_spawn);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), task, tbb::simple_partitioner());
-    tsan_acquire(join);
+    const auto each = [&](size_t c) { body(c, c * grain, std::min(count, (c + 1) * grain)); };
+    run_loop(stage, chunks, each, tbb::simple_partitioner());
   }
 
   template <class Body>
   void for_items(Stage stage, size_t n, const Body& body) {
-    if (n == 0) return;
-    char& spawn = sync.spawn[static_cast<size_t>(stage)];
-    char& join = sync.join[static_cast<size_t>(stage)];
-    const auto task = [&](const tbb::blocked_range<size_t>& r) {
-      tsan_acquire(tsan_any_spawn);
-      tsan_acquire(spawn);
-      for (size_t j = r.begin(); j != r.end(); ++j) body(j);
-      tsan_release(join);
-      tsan_release(tsan_any_spawn);
+    if (n > 0) run_loop(stage, n, body, tbb::auto_partitioner());
+  }
+
+  template <class Body, class Partitioner>
+  void run_loop(Stage stage, size_t n, const Body& body, const Partitioner& partitioner) {
+    const Loop<Body> loop{&sync.spawn[static_cast<size_t>(stage)], &sync.join[static_cast<size_t>(stage)], &body};
+    const auto task = [loop](const tbb::blocked_range<size_t>& range) {
+      const Loop<Body> l = detail::tsan_unseen_copy(loop);
+      const tbb::blocked_range<size_t> r = detail::tsan_unseen_copy(range);
+      tsan_acquire(*l.spawn);
+      for (size_t j = r.begin(); j != r.end(); ++j) (*l.body)(j);
+      tsan_release(*l.join);
     };
-    tsan_release(spawn);  // after the task's captures are written
-    tsan_release(tsan_any_spawn);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), task);
-    tsan_acquire(join);
+    tsan_release(*loop.spawn);  // after everything the body reads is written
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), task, partitioner);
+    tsan_acquire(*loop.join);
   }
 
   // ---- nodes ------------------------------------------------------------------------------
@@ -836,7 +844,7 @@ struct FrameGraph::Impl {
     const VertexTree& tree = set->chains[model]->hierarchy;
     const VdModel& vm = vd_models[model];
     const float tau = std::max(options.pixel_error, 0.05f);
-    if (vm.regions.empty()) {
+    if (!vm.regions) {
       front_init(p->fronts.emplace_back(), tree, tau);
     } else {
       p->fronts.resize(vm.region_count);
@@ -1157,6 +1165,30 @@ struct FrameGraph::Impl {
     if (options.terrain) terrain_lod_reset(terrain, *options.terrain);
   }
 
+  struct FrameBody {
+    Impl* self;
+    char& sync_byte() const { return *reinterpret_cast<char*>(const_cast<FrameBody*>(this)); }
+    void operator()() const {
+      tsan_acquire(sync_byte());
+      self->fire_graph();
+    }
+  };
+  // Starts the roots and waits for every node; then hands the nodes' writes to the caller.
+  void fire_graph() {
+    const auto join_nodes = [this] {
+      for (char& d : sync.done) tsan_acquire(d);
+      tsan_release(sync.finish);
+    };
+    start->try_put(tbb::flow::continue_msg());
+    try {
+      graph->wait_for_all();
+    } catch (...) {
+      join_nodes();
+      throw;
+    }
+    join_nodes();
+  }
+
   void run(const FrameInput& in, ObjectStore& objects, Frame& f) {
     const auto t0 = Clock::now();
     assert(!in.views.empty() && in.views.size() <= kMaxViews);
@@ -1174,24 +1206,13 @@ struct FrameGraph::Impl {
     plan_terrain_share();
     f.index = ++frame_index;
     f.time_s = time;
+    // The body may run on a worker when the arena has no free slot: it acquires on its own
+    // address, before it reads a member, what this thread released there.
+    FrameBody body{this};
     tsan_release(sync.start);
-    tsan_release(tsan_any_frame_start);
-    auto join_nodes = [this] {
-      for (char& d : sync.done) tsan_acquire(d);
-      tsan_release(sync.finish);
-    };
+    tsan_release(body.sync_byte());
     try {
-      arena.execute([&] {  // may run on a worker when the arena has no free slot
-        tsan_acquire(sync.start);
-        start->try_put(tbb::flow::continue_msg());
-        try {
-          graph->wait_for_all();
-        } catch (...) {
-          join_nodes();
-          throw;
-        }
-        join_nodes();
-      });
+      arena.execute(body);
     } catch (...) {
       tsan_acquire(sync.finish);
       graph->reset();

@@ -2,7 +2,6 @@
 // size) -> write. Progress lines every 10 %.
 #include "jobs/hlod_bake.h"
 
-#include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
@@ -13,7 +12,7 @@
 #include <mutex>
 #include <vector>
 
-#include "jobs/tsan_annotations.h"
+#include "jobs/annotated_parallel_for.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
 #include "runtime/file_write.h"
@@ -41,19 +40,7 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
 }
 
 ParallelFor tbb_parallel_for() {
-  return [](size_t count, const std::function<void(size_t)>& body) {
-    // One address per process: a task must acquire before it reads its captures, which live
-    // on the spawning thread's stack (see jobs/tsan_annotations.h).
-    static char spawn, join;
-    const auto task = [&](size_t i) {
-      detail::tsan_acquire(spawn);
-      body(i);
-      detail::tsan_release(join);
-    };
-    detail::tsan_release(spawn);  // after the task's captures are written
-    tbb::parallel_for(size_t(0), count, task);
-    detail::tsan_acquire(join);
-  };
+  return [](size_t count, const std::function<void(size_t)>& body) { detail::annotated_parallel_for(count, body); };
 }
 
 Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string& name,

@@ -18,9 +18,21 @@ extern "C" void __tsan_acquire(void* addr);
 extern "C" void __tsan_release(void* addr);
 inline void tsan_acquire(char& at) { __tsan_acquire(&at); }
 inline void tsan_release(char& at) { __tsan_release(&at); }
+// A copy of what libtbb copied into a task on one thread and ran on another (a node's or a
+// loop's body, a loop's range), read without TSan seeing it: that copy and its hand-over happen
+// inside libtbb. Everything the body reads through it is ordered by the annotations, taken
+// before it reads anything else. (GCC keeps a no_sanitize function out of instrumented callers.)
+template <class T>
+[[gnu::no_sanitize_thread, gnu::noinline]] T tsan_unseen_copy(const T& v) {
+  return v;
+}
 #else
 inline void tsan_acquire(char&) {}
 inline void tsan_release(char&) {}
+template <class T>
+T tsan_unseen_copy(const T& v) {
+  return v;
+}
 #endif
 
 }  // namespace lod::detail

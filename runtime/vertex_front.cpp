@@ -125,6 +125,7 @@ class Updater {
   void drain(uint32_t b, int c);
   VertexFront::Bucket& bucket(int c, uint32_t b);
   void append(int c, uint32_t b, uint32_t v);
+  uint32_t take_chunk();
   void compact(int c, uint32_t b);
   void release_chunks(uint32_t chunk);
   void stop_waiting(uint32_t v);
@@ -137,15 +138,15 @@ class Updater {
   uint32_t missing_dep(uint32_t p) const {
     const uint32_t i = p - t_.leaf_count;
     const uint32_t lo = t_.dep_offsets[i], hi = t_.dep_offsets[i + 1];
-    for (uint32_t k = lo; k < hi; ++k) __builtin_prefetch(&f_.state[t_.deps[k]]);
+    for (uint32_t k = lo; k < hi; ++k) __builtin_prefetch(&f_.state[f_.at(t_.deps[k])]);
     for (uint32_t k = lo; k < hi; ++k)
-      if (f_.state[t_.deps[k]] != VertexFront::kActive) return t_.deps[k];
+      if (f_.state[f_.at(t_.deps[k])] != VertexFront::kActive) return t_.deps[k];
     return kNoNode;
   }
   bool deps_active(uint32_t p) const { return missing_dep(p) == kNoNode; }
-  bool children_active(uint32_t p) const { return (f_.kids[p] & VertexFront::kKidsMask) == 2; }
-  bool watches_parent(uint32_t v) const { return f_.kids[v] & VertexFront::kFirstChild; }
-  bool is_pending(uint32_t p) const { return f_.pending_count && f_.pending_until[p - t_.leaf_count] >= 0; }
+  bool children_active(uint32_t p) const { return (f_.kids[f_.at(p)] & VertexFront::kKidsMask) == 2; }
+  bool watches_parent(uint32_t v) const { return f_.kids[f_.at(v)] & VertexFront::kFirstChild; }
+  bool is_pending(uint32_t p) const { return f_.pending_count && f_.pending_until[f_.inner_at(p)] >= 0; }
   uint32_t new_faces(uint32_t x) const {
     const uint32_t i = x - t_.leaf_count;
     return (t_.split_faces[2 * i] != kNoNode) + (t_.split_faces[2 * i + 1] != kNoNode);
@@ -166,20 +167,32 @@ class Updater {
     // A compiler barrier keeps these prefetches at the top of each visit: left free, GCC sank
     // them behind the inlined visit and the bench ran ~1.5x slower (1.15 vs 0.75 ms).
     asm volatile("" ::: "memory");
-    constexpr uint32_t kNear = 6, kFar = 12;
+    constexpr uint32_t kNear = 6, kFar = 12, kLocal = 18;
+    // A region's front also reads each node's local id, and its parent's: fetched a step
+    // earlier, so the state prefetches below do not wait on them.
+    if (f_.node_local && head_ + kLocal < tail_) {
+      const uint32_t v = f_.queue[head_ + kLocal];
+      __builtin_prefetch(&t_.bounds[v]);
+      __builtin_prefetch(&f_.node_local[v]);
+    }
     if (head_ + kFar < tail_) {
       const uint32_t v = f_.queue[head_ + kFar];
-      __builtin_prefetch(&t_.bounds[v]);
-      __builtin_prefetch(&f_.state[v]);
-      __builtin_prefetch(&f_.kids[v]);
-      __builtin_prefetch(&f_.filing[v]);
-      if (f_.waiting) __builtin_prefetch(&f_.wait_on[v]);
+      if (f_.node_local) {
+        if (const uint32_t p = t_.bounds[v].parent; p != kNoNode) __builtin_prefetch(&f_.node_local[p]);
+      } else {
+        __builtin_prefetch(&t_.bounds[v]);
+      }
+      const uint32_t at = f_.at(v);
+      __builtin_prefetch(&f_.state[at]);
+      __builtin_prefetch(&f_.kids[at]);
+      __builtin_prefetch(&f_.filing[at]);
+      if (f_.waiting) __builtin_prefetch(&f_.wait_on[at]);
     }
     if (head_ + kNear < tail_) {
       const uint32_t p = t_.bounds[f_.queue[head_ + kNear]].parent;
       if (p != kNoNode) {
         __builtin_prefetch(&t_.bounds[p]);
-        __builtin_prefetch(&f_.kids[p]);
+        __builtin_prefetch(&f_.kids[f_.at(p)]);
       }
     }
   }
@@ -210,7 +223,7 @@ VertexFront::Bucket& Updater::bucket(int c, uint32_t b) { return f_.buckets[size
 
 // Takes v out of every bucket: its entries die with the old stamp.
 void Updater::unfile(uint32_t v) {
-  VertexFront::Filing& fl = f_.filing[v];
+  VertexFront::Filing& fl = f_.filing[f_.at(v)];
   ++fl.stamp;  // first: a compaction below must already see v's entries as dead
   for (int c = 0; c < 2; ++c) {
     if (fl.bucket[c] == kUnfiled) continue;
@@ -231,7 +244,7 @@ void Updater::compact(int c, uint32_t b) {
     VertexFront::Chunk& rc = f_.chunks[r_chunk];
     for (uint32_t i = 0; i < rc.count; ++i) {
       const uint32_t v = rc.node[i];
-      if (f_.filing[v].stamp != rc.stamp[i]) continue;
+      if (f_.filing[f_.at(v)].stamp != rc.stamp[i]) continue;
       if (w == VertexFront::kChunkEntries) {
         f_.chunks[w_chunk].count = w;
         w_chunk = f_.chunks[w_chunk].next;
@@ -263,27 +276,42 @@ void Updater::release_chunks(uint32_t chunk) {
   }
 }
 
+// A recycled chunk, else a fresh one: front_init reserves the pool for the worst case the
+// compaction rule allows but touches none of it, so a front's memory follows its buckets'
+// use, not that bound (about 25 MB of chunks per front, most never used). Should the reserve
+// fall short, everything is compacted before the pool grows.
+uint32_t Updater::take_chunk() {
+  if (f_.free_chunk == kNoNode && f_.chunks.size() < f_.chunks.capacity()) {
+    f_.chunks.emplace_back();  // within the reserve: no allocation
+    return static_cast<uint32_t>(f_.chunks.size() - 1);
+  }
+  if (f_.free_chunk == kNoNode)
+    for (int cc = 0; cc < 2; ++cc)
+      for (uint32_t bb = 0; bb <= kBuckets; ++bb) compact(cc, bb);
+  if (f_.free_chunk == kNoNode) {  // only a copied front (a vector copy keeps no reserve)
+    f_.chunks.reserve(std::max<size_t>(64, 2 * f_.chunks.capacity()));
+    f_.chunks.emplace_back();
+    return static_cast<uint32_t>(f_.chunks.size() - 1);
+  }
+  const uint32_t k = f_.free_chunk;
+  f_.free_chunk = f_.chunks[k].next;
+  return k;
+}
+
 void Updater::append(int c, uint32_t b, uint32_t v) {
   VertexFront::Bucket& bk = bucket(c, b);
   if (bk.head == kNoNode || f_.chunks[bk.head].count == VertexFront::kChunkEntries) {
-    // front_init sizes the pool for the worst case the compaction rule allows; should that
-    // ever fall short, compact everything rather than write past the pool.
-    if (f_.free_chunk == kNoNode)
-      for (int cc = 0; cc < 2; ++cc)
-        for (uint32_t bb = 0; bb <= kBuckets; ++bb) compact(cc, bb);
-    if (f_.free_chunk == kNoNode) std::abort();  // unreachable: live entries fit the pool
-    const uint32_t k = f_.free_chunk;
-    f_.free_chunk = f_.chunks[k].next;
+    const uint32_t k = take_chunk();
     f_.chunks[k].next = bk.head;
     f_.chunks[k].count = 0;
     bk.head = k;
   }
   VertexFront::Chunk& ch = f_.chunks[bk.head];
   ch.node[ch.count] = v;
-  ch.stamp[ch.count] = f_.filing[v].stamp;
+  ch.stamp[ch.count] = f_.filing[f_.at(v)].stamp;
   ++ch.count;
   ++bk.live, ++bk.total;
-  f_.filing[v].bucket[c] = static_cast<uint16_t>(b);
+  f_.filing[f_.at(v)].bucket[c] = static_cast<uint16_t>(b);
 }
 
 void Updater::file(uint32_t v, int c, double slack) {
@@ -317,7 +345,7 @@ void Updater::drain(uint32_t b, int c) {
     const VertexFront::Chunk& ch = f_.chunks[k];
     for (uint32_t i = 0; i < ch.count; ++i) {
       const uint32_t v = ch.node[i];
-      VertexFront::Filing& fl = f_.filing[v];
+      VertexFront::Filing& fl = f_.filing[f_.at(v)];
       if (fl.stamp != ch.stamp[i]) continue;  // unfiled or filed again since
       fl.bucket[c] = kUnfiled;                 // this bucket is going away
       unfile(v);                               // judged now: out of the other calendar too
@@ -330,35 +358,35 @@ void Updater::drain(uint32_t b, int c) {
 
 void Updater::stop_waiting(uint32_t v) {
   if (f_.waiting == 0) return;
-  const uint32_t d = f_.wait_on[v];
+  const uint32_t d = f_.wait_on[f_.at(v)];
   if (d == kNoNode) return;
   --f_.waiting;
-  const uint32_t n = f_.wait_next[v], pr = f_.wait_prev[v];
+  const uint32_t n = f_.wait_next[f_.at(v)], pr = f_.wait_prev[f_.at(v)];
   if (pr != kNoNode)
-    f_.wait_next[pr] = n;
+    f_.wait_next[f_.at(pr)] = n;
   else
-    f_.wait_head[d] = n;
-  if (n != kNoNode) f_.wait_prev[n] = pr;
-  f_.wait_on[v] = kNoNode;
+    f_.wait_head[f_.at(d)] = n;
+  if (n != kNoNode) f_.wait_prev[f_.at(n)] = pr;
+  f_.wait_on[f_.at(v)] = kNoNode;
 }
 
 void Updater::wait_for(uint32_t v, uint32_t d) {
   stop_waiting(v);
   ++f_.waiting;
-  f_.wait_on[v] = d;
-  f_.wait_prev[v] = kNoNode;
-  f_.wait_next[v] = f_.wait_head[d];
-  if (f_.wait_next[v] != kNoNode) f_.wait_prev[f_.wait_next[v]] = v;
-  f_.wait_head[d] = v;
+  f_.wait_on[f_.at(v)] = d;
+  f_.wait_prev[f_.at(v)] = kNoNode;
+  f_.wait_next[f_.at(v)] = f_.wait_head[f_.at(d)];
+  if (f_.wait_next[f_.at(v)] != kNoNode) f_.wait_prev[f_.at(f_.wait_next[f_.at(v)])] = v;
+  f_.wait_head[f_.at(d)] = v;
 }
 
 // d became active: whoever waited on it is judged again (this frame in phase one).
 void Updater::wake(uint32_t d) {
   if (f_.waiting == 0) return;
-  while (f_.wait_head[d] != kNoNode) {
-    const uint32_t v = f_.wait_head[d];
+  while (f_.wait_head[f_.at(d)] != kNoNode) {
+    const uint32_t v = f_.wait_head[f_.at(d)];
     stop_waiting(v);
-    if (f_.state[v] != VertexFront::kActive) continue;
+    if (f_.state[f_.at(v)] != VertexFront::kActive) continue;
     unfile(v);
     if (phase_two_)
       file_next_frame(v);
@@ -372,24 +400,24 @@ void Updater::split(uint32_t x) {
   const uint32_t c1 = t_.children[2 * i], c2 = t_.children[2 * i + 1];
   if (f_.pending_count) {
     const uint32_t par = t_.parent[x];
-    if (par != kNoNode && f_.pending_until[par - t_.leaf_count] >= 0) end_pending(par);
+    if (par != kNoNode && f_.pending_until[f_.inner_at(par)] >= 0) end_pending(par);
   }
   unfile(x);
   stop_waiting(x);
   // Active list: x out (its slot goes to c1), c2 appended.
-  f_.state[x] = VertexFront::kSplit;
-  const uint32_t slot = f_.active_pos[x];
+  f_.state[f_.at(x)] = VertexFront::kSplit;
+  const uint32_t slot = f_.active_pos[f_.at(x)];
   f_.active[slot] = c1;
-  f_.active_pos[c1] = slot;
-  f_.active_pos[c2] = f_.active_count;
+  f_.active_pos[f_.at(c1)] = slot;
+  f_.active_pos[f_.at(c2)] = f_.active_count;
   f_.active[f_.active_count++] = c2;
-  f_.state[c1] = f_.state[c2] = VertexFront::kActive;
-  f_.kids[x] = (f_.kids[x] & ~VertexFront::kKidsMask) | 2;
-  if (const uint32_t par = t_.parent[x]; par != kNoNode) --f_.kids[par];
+  f_.state[f_.at(c1)] = f_.state[f_.at(c2)] = VertexFront::kActive;
+  f_.kids[f_.at(x)] = (f_.kids[f_.at(x)] & ~VertexFront::kKidsMask) | 2;
+  if (const uint32_t par = t_.parent[x]; par != kNoNode) --f_.kids[f_.at(par)];
   // Faces around x take the child holding their corner's leaf.
   const uint32_t lo1 = t_.leaf_lo[c1], hi1 = t_.leaf_hi[c1];
   for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
-    const uint32_t s = f_.face_slot[t_.inc_faces[k]];
+    const uint32_t s = f_.face_slot[f_.at_face(t_.inc_faces[k])];
     if (s == kNoNode) continue;
     const uint32_t r = t_.inc_corner[k] >> 2, j = t_.inc_corner[k] & 3;
     assert(f_.tri_indices[3 * size_t(s) + j] == x);
@@ -400,7 +428,7 @@ void Updater::split(uint32_t x) {
     const uint32_t face = t_.split_faces[2 * i + k];
     if (face == kNoNode) continue;
     const uint32_t s = f_.tri_count++;
-    f_.face_slot[face] = s;
+    f_.face_slot[f_.at_face(face)] = s;
     f_.tri_face[s] = face;
     const uint32_t lo2 = t_.leaf_lo[c2], hi2 = t_.leaf_hi[c2];
     for (int j = 0; j < 3; ++j) {
@@ -420,27 +448,27 @@ void Updater::split(uint32_t x) {
 void Updater::collapse(uint32_t p) {
   const uint32_t i = p - t_.leaf_count;
   const uint32_t c1 = t_.children[2 * i], c2 = t_.children[2 * i + 1];
-  if (f_.pending_until[i] >= 0) {
-    f_.pending_until[i] = -1;
-    const uint32_t at = f_.pending_pos[i], last = f_.pending[--f_.pending_count];
+  if (const uint32_t pi = f_.inner_at(p); f_.pending_until[pi] >= 0) {
+    f_.pending_until[pi] = -1;
+    const uint32_t at = f_.pending_pos[pi], last = f_.pending[--f_.pending_count];
     f_.pending[at] = last;
-    f_.pending_pos[last - t_.leaf_count] = at;
+    f_.pending_pos[f_.inner_at(last)] = at;
   }
   // The split's faces leave; the last triangles fill their slots.
   for (int k = 0; k < 2; ++k) {
     const uint32_t face = t_.split_faces[2 * i + k];
     if (face == kNoNode) continue;
-    const uint32_t s = f_.face_slot[face], last = --f_.tri_count;
+    const uint32_t s = f_.face_slot[f_.at_face(face)], last = --f_.tri_count;
     if (s != last) {
       const uint32_t moved = f_.tri_face[last];
       std::copy_n(&f_.tri_indices[3 * size_t(last)], 3, &f_.tri_indices[3 * size_t(s)]);
       f_.tri_face[s] = moved;
-      f_.face_slot[moved] = s;
+      f_.face_slot[f_.at_face(moved)] = s;
     }
-    f_.face_slot[face] = kNoNode;
+    f_.face_slot[f_.at_face(face)] = kNoNode;
   }
   for (uint32_t k = t_.inc_offsets[i]; k < t_.inc_offsets[i + 1]; ++k) {
-    const uint32_t s = f_.face_slot[t_.inc_faces[k]];
+    const uint32_t s = f_.face_slot[f_.at_face(t_.inc_faces[k])];
     if (s == kNoNode) continue;
     const uint32_t j = t_.inc_corner[k] & 3;
     assert(f_.tri_indices[3 * size_t(s) + j] == c1 || f_.tri_indices[3 * size_t(s) + j] == c2);
@@ -450,10 +478,10 @@ void Updater::collapse(uint32_t p) {
   unfile(c2);
   stop_waiting(c1);
   stop_waiting(c2);
-  f_.state[c1] = f_.state[c2] = VertexFront::kBelow;
-  f_.state[p] = VertexFront::kActive;
-  f_.kids[p] &= ~VertexFront::kKidsMask;
-  if (const uint32_t par = t_.parent[p]; par != kNoNode && (++f_.kids[par], children_active(par))) {
+  f_.state[f_.at(c1)] = f_.state[f_.at(c2)] = VertexFront::kBelow;
+  f_.state[f_.at(p)] = VertexFront::kActive;
+  f_.kids[f_.at(p)] &= ~VertexFront::kKidsMask;
+  if (const uint32_t par = t_.parent[p]; par != kNoNode && (++f_.kids[f_.at(par)], children_active(par))) {
     // par may merge now: its watching child (maybe p's sibling) judges it again.
     const uint32_t w = t_.children[2 * (par - t_.leaf_count)];
     if (w != p && !bulk_) {
@@ -462,12 +490,12 @@ void Updater::collapse(uint32_t p) {
     }
   }
   // Active list: p takes c1's slot, c2's slot is filled by the last entry.
-  const uint32_t s1 = f_.active_pos[c1];
+  const uint32_t s1 = f_.active_pos[f_.at(c1)];
   f_.active[s1] = p;
-  f_.active_pos[p] = s1;
-  const uint32_t s2 = f_.active_pos[c2], last = f_.active[--f_.active_count];
+  f_.active_pos[f_.at(p)] = s1;
+  const uint32_t s2 = f_.active_pos[f_.at(c2)], last = f_.active[--f_.active_count];
   f_.active[s2] = last;
-  f_.active_pos[last] = s2;
+  f_.active_pos[f_.at(last)] = s2;
   emit(p, FrontEventKind::collapse);
   ++stats_.collapses;
   ++ops_;
@@ -475,7 +503,7 @@ void Updater::collapse(uint32_t p) {
 }
 
 void Updater::begin_pending(uint32_t p) {
-  const uint32_t i = p - t_.leaf_count;
+  const uint32_t i = f_.inner_at(p);
   f_.pending_until[i] = p_.time + p_.collapse_delay;
   f_.pending_pos[i] = f_.pending_count;
   f_.pending[f_.pending_count++] = p;
@@ -483,16 +511,16 @@ void Updater::begin_pending(uint32_t p) {
 }
 
 void Updater::end_pending(uint32_t p) {
-  const uint32_t i = p - t_.leaf_count;
-  f_.pending_until[i] = -1;
-  const uint32_t at = f_.pending_pos[i], last = f_.pending[--f_.pending_count];
+  const uint32_t pi = f_.inner_at(p), i = p - t_.leaf_count;
+  f_.pending_until[pi] = -1;
+  const uint32_t at = f_.pending_pos[pi], last = f_.pending[--f_.pending_count];
   f_.pending[at] = last;
-  f_.pending_pos[last - t_.leaf_count] = at;
+  f_.pending_pos[f_.inner_at(last)] = at;
   emit(p, FrontEventKind::collapse_cancel);
   // Its children waited on the pending list, unfiled: judge them again next frame.
   for (int j = 0; j < 2; ++j) {
     const uint32_t c = t_.children[2 * i + j];
-    if (f_.state[c] == VertexFront::kActive) file_next_frame(c);
+    if (f_.state[f_.at(c)] == VertexFront::kActive) file_next_frame(c);
   }
 }
 
@@ -503,7 +531,7 @@ bool Updater::force_split(uint32_t v) {
   f_.stack[depth++] = v;
   while (depth > 0) {
     const uint32_t x = f_.stack[depth - 1];
-    if (f_.state[x] != VertexFront::kActive) {  // split on the way by an earlier entry
+    if (f_.state[f_.at(x)] != VertexFront::kActive) {  // split on the way by an earlier entry
       --depth;
       continue;
     }
@@ -523,20 +551,20 @@ bool Updater::force_split(uint32_t v) {
       continue;
     }
     // A dependency above the front cannot happen while x is active (see vertex_tree.h).
-    assert(f_.state[missing] == VertexFront::kBelow);
-    if (f_.state[missing] != VertexFront::kBelow) return false;
+    assert(f_.state[f_.at(missing)] == VertexFront::kBelow);
+    if (f_.state[f_.at(missing)] != VertexFront::kBelow) return false;
     uint32_t a = t_.parent[missing];
-    while (f_.state[a] != VertexFront::kActive) a = t_.parent[a];
+    while (f_.state[f_.at(a)] != VertexFront::kActive) a = t_.parent[a];
     f_.stack[depth++] = a;
   }
-  return f_.state[v] == VertexFront::kSplit;
+  return f_.state[f_.at(v)] == VertexFront::kSplit;
 }
 
 // One node's decision. Phase one collapses its parent (now, or deferred for geomorphing) and
 // returns true when the node wants to split instead; phase two splits. Otherwise the node is
 // filed again by its slack.
 bool Updater::consider(uint32_t v, bool phase_two) {
-  if (f_.state[v] != VertexFront::kActive) return false;
+  if (f_.state[f_.at(v)] != VertexFront::kActive) return false;
   unfile(v);
   ++stats_.visited;
   double se = kInf, sf = kInf;
@@ -545,7 +573,7 @@ bool Updater::consider(uint32_t v, bool phase_two) {
     if (d.refine) {
       if (!phase_two) return true;
       if (force_split(v)) return false;
-      if (f_.state[v] == VertexFront::kActive) file_next_frame(v);  // blocked: try again next frame
+      if (f_.state[f_.at(v)] == VertexFront::kActive) file_next_frame(v);  // blocked: try again next frame
       return false;
     }
     se = d.slack_eye;
@@ -563,7 +591,7 @@ bool Updater::consider(uint32_t v, bool phase_two) {
       }
       // Still waiting on the same finer neighbour: the collapse stays blocked, and the wait
       // list entry stands (no dependency scan, no relinking).
-      if (f_.waiting && f_.wait_on[v] != kNoNode && f_.state[f_.wait_on[v]] == VertexFront::kSplit) {
+      if (f_.waiting && f_.wait_on[f_.at(v)] != kNoNode && f_.state[f_.at(f_.wait_on[f_.at(v)])] == VertexFront::kSplit) {
         file(v, se, sf);
         return false;
       }
@@ -571,7 +599,7 @@ bool Updater::consider(uint32_t v, bool phase_two) {
       if (d != kNoNode) {
         // A finer neighbour blocks it: wait until that neighbour is active again, and meanwhile
         // keep watching v's own decision.
-        if (f_.state[d] == VertexFront::kSplit) {
+        if (f_.state[f_.at(d)] == VertexFront::kSplit) {
           wait_for(v, d);
           file(v, se, sf);
         } else {
@@ -668,7 +696,7 @@ FrontStats Updater::run(const FrontView& view) {
   // Deferred collapses whose time has come: collapse if still legal and wanted.
   for (uint32_t k = f_.pending_count; k-- > 0;) {
     const uint32_t p = f_.pending[k];
-    if (f_.pending_until[p - t_.leaf_count] > p_.time) continue;
+    if (f_.pending_until[f_.inner_at(p)] > p_.time) continue;
     if (children_active(p) && deps_active(p) &&
         !evaluate(t_, p, view_, f_.threshold / hysteresis_, reach_, split_).refine &&
         !(p_.max_operations && ops_ >= p_.max_operations)) {
@@ -679,7 +707,7 @@ FrontStats Updater::run(const FrontView& view) {
       const uint32_t i = p - t_.leaf_count;
       for (int j = 0; j < 2; ++j) {
         const uint32_t c = t_.children[2 * i + j];
-        if (f_.state[c] == VertexFront::kActive) {
+        if (f_.state[f_.at(c)] == VertexFront::kActive) {
           unfile(c);
           push(c);
         }
@@ -760,6 +788,14 @@ FrontView front_view_of(const View& view, const float position[3], float scale, 
   return out;
 }
 
+size_t front_memory_bytes(const VertexFront& f) {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return bytes(f.state) + bytes(f.kids) + bytes(f.active) + bytes(f.active_pos) + bytes(f.tri_indices) +
+         bytes(f.tri_face) + bytes(f.face_slot) + bytes(f.filing) + bytes(f.buckets) + f.chunks.size() * sizeof(f.chunks[0]) +
+         bytes(f.wait_on) + bytes(f.wait_next) + bytes(f.wait_prev) + bytes(f.wait_head) + bytes(f.pending_until) +
+         bytes(f.pending) + bytes(f.pending_pos) + bytes(f.queue) + bytes(f.stack) + bytes(f.events);
+}
+
 float front_next_threshold(float threshold, uint64_t triangles, uint64_t target, const FrontParams& p) {
   if (target == 0) return threshold;
   const double ratio = double(triangles) / double(target);
@@ -784,61 +820,81 @@ void front_set_threshold(VertexFront& f, float threshold) {
   f.threshold = threshold;
 }
 
-void front_init(VertexFront& f, const VertexTree& t, float threshold) { front_init(f, t, threshold, {}, kSharedRegion); }
+void front_init(VertexFront& f, const VertexTree& t, float threshold) { front_init(f, t, threshold, nullptr, kSharedRegion); }
 
 void front_init(VertexFront& f, const VertexTree& t, float threshold, std::span<const uint8_t> regions,
                 uint8_t region) {
+  if (regions.empty()) return front_init(f, t, threshold, nullptr, kSharedRegion);
+  uint32_t count = 0;
+  for (uint8_t r : regions)
+    if (r != kSharedRegion) count = std::max<uint32_t>(count, r + 1u);
+  front_init(f, t, threshold,
+             std::make_shared<const RegionNumbering>(
+                 number_regions(t, std::vector<uint8_t>(regions.begin(), regions.end()), std::max(count, region + 1u))),
+             region);
+}
+
+namespace {
+
+// Binds the front to its numbering and sizes the arrays each local id indexes.
+void size_front(VertexFront& f, const VertexTree& t, std::shared_ptr<const RegionNumbering> numbering, uint8_t region) {
+  f.numbering = std::move(numbering);
+  f.region = f.numbering ? region : kSharedRegion;
+  f.node_local = f.numbering ? f.numbering->local.data() : nullptr;
+  f.face_local = f.numbering ? f.numbering->local_face.data() : nullptr;
+  const bool whole = !f.numbering;
+  const uint32_t nodes = whole ? t.node_count() : f.numbering->nodes[region];
+  const uint32_t faces = whole ? t.face_count : f.numbering->faces[region];
+  f.local_leaves = whole ? t.leaf_count : f.numbering->leaves[region];
+  const uint32_t inner = nodes - f.local_leaves;
+  f.state.assign(nodes, VertexFront::kBelow);
+  f.kids.assign(nodes, 0);
+  f.active.assign(nodes, 0);
+  f.active_pos.assign(nodes, kNoNode);
+  f.filing.assign(nodes, VertexFront::Filing{});
+  f.wait_on.assign(nodes, kNoNode);
+  f.wait_next.assign(nodes, kNoNode);
+  f.wait_prev.assign(nodes, kNoNode);
+  f.wait_head.assign(nodes, kNoNode);
+  f.pending_until.assign(inner, -1.0);
+  f.pending.assign(inner, 0);
+  f.pending_pos.assign(inner, 0);
+  f.tri_indices.assign(3 * size_t(faces), 0);
+  f.tri_face.assign(faces, kNoNode);
+  f.face_slot.assign(faces, kNoNode);
+  f.queue.assign(8 * size_t(nodes) + 8, 0);  // phase one, then phase two from the middle
+  f.stack.assign(nodes + 1, 0);
+  f.events.assign(3 * size_t(inner) + 16, FrontEvent{});
+}
+
+}  // namespace
+
+void front_init(VertexFront& f, const VertexTree& t, float threshold, std::shared_ptr<const RegionNumbering> numbering,
+                uint8_t region) {
   const uint32_t n = t.node_count();
-  assert(regions.empty() || regions.size() == n);
-  f.region = regions.empty() ? kSharedRegion : region;
-  f.node_region.assign(regions.begin(), regions.end());
-  auto mine = [&](uint32_t v) { return regions.empty() || regions[v] == region || regions[v] == kSharedRegion; };
+  assert(!numbering || (numbering->local.size() == n && region < numbering->nodes.size()));
   assert(t.bounds.size() == n && "pack_vertex_bounds(tree) first");
-  const uint32_t inner = t.interior_count();
-  // Work arrays are sized for what this front can hold: its region's nodes and leaves.
-  size_t my_nodes = n, my_leaves = t.leaf_count, my_inner = inner;
-  if (!regions.empty()) {
-    my_nodes = my_leaves = my_inner = 0;
-    for (uint32_t v = 0; v < n; ++v)
-      if (mine(v)) ++my_nodes, t.is_leaf(v) ? ++my_leaves : ++my_inner;
-  }
-  f.state.assign(n, VertexFront::kBelow);
-  f.kids.assign(n, 0);
-  for (uint32_t i = 0; i < inner; ++i) f.kids[t.children[2 * size_t(i)]] = VertexFront::kFirstChild;
-  f.active.assign(n, 0);
-  f.active_pos.assign(n, kNoNode);
-  f.tri_indices.assign(3 * size_t(t.face_count), 0);
-  f.tri_face.assign(t.face_count, kNoNode);
-  f.face_slot.assign(t.face_count, kNoNode);
+  size_front(f, t, std::move(numbering), region);
+  for (uint32_t i = 0; i < t.interior_count(); ++i)
+    if (const uint32_t c = t.children[2 * size_t(i)]; f.covers(c)) f.kids[f.at(c)] = VertexFront::kFirstChild;
   f.active_count = f.tri_count = 0;
   f.threshold = threshold;
-  f.filing.assign(n, VertexFront::Filing{});
   f.buckets.assign(2 * (kBuckets + 1), VertexFront::Bucket{});
   // Live entries: at most two per active node (no more active nodes than leaves); a bucket is
   // compacted before its entries pass 4 x live + 4 chunks; each bucket wastes under a chunk.
   {
-    const size_t entries = 4 * 2 * my_leaves + 4 * size_t(VertexFront::kChunkEntries) * f.buckets.size();
+    const size_t entries = 4 * 2 * size_t(f.local_leaves) + 4 * size_t(VertexFront::kChunkEntries) * f.buckets.size();
     const size_t count = entries / VertexFront::kChunkEntries + 2 * f.buckets.size() + 16;
-    f.chunks.resize(count);
-    for (size_t k = 0; k < count; ++k) f.chunks[k].next = k + 1 < count ? static_cast<uint32_t>(k + 1) : kNoNode;
-    f.free_chunk = 0;
+    f.chunks.clear();
+    f.chunks.reserve(count);
+    f.free_chunk = kNoNode;
   }
   f.motion[0] = f.motion[1] = 0;
   f.cursor[0] = f.cursor[1] = 0;
   f.pending_motion = 0;
   f.has_view = false;
-  f.wait_on.assign(n, kNoNode);
-  f.wait_next.assign(n, kNoNode);
-  f.wait_prev.assign(n, kNoNode);
-  f.wait_head.assign(n, kNoNode);
   f.waiting = 0;
-  f.pending_until.assign(inner, -1.0);
-  f.pending.assign(inner, 0);
-  f.pending_pos.assign(inner, 0);
   f.pending_count = 0;
-  f.queue.assign(8 * my_nodes + 8, 0);  // phase one, then phase two from the middle
-  f.stack.assign(my_nodes + 1, 0);
-  f.events.assign(3 * my_inner + 16, FrontEvent{});
   f.event_count = 0;
 
   // Bounds of every node position, for the reach of view changes.
@@ -865,16 +921,16 @@ void front_init(VertexFront& f, const VertexTree& t, float threshold, std::span<
 
   // Base mesh: the roots and the faces nobody's split makes, corners mapped to their roots.
   for (uint32_t v = 0; v < n; ++v)
-    if (t.parent[v] == kNoNode && mine(v)) {
-      f.state[v] = VertexFront::kActive;
-      f.active_pos[v] = f.active_count;
+    if (t.parent[v] == kNoNode && f.covers(v)) {
+      f.state[f.at(v)] = VertexFront::kActive;
+      f.active_pos[f.at(v)] = f.active_count;
       f.active[f.active_count++] = v;
     }
   for (uint32_t face = 0; face < t.face_count; ++face) {
     if (t.face_owner[face] != kNoNode) continue;
-    if (!regions.empty() && face_region(t, regions, face) != region) continue;
+    if (!f.covers_face(t, face)) continue;
     const uint32_t s = f.tri_count++;
-    f.face_slot[face] = s;
+    f.face_slot[f.at_face(face)] = s;
     f.tri_face[s] = face;
     for (int j = 0; j < 3; ++j) {
       uint32_t v = t.face_leaves[3 * size_t(face) + j];
@@ -899,7 +955,7 @@ void front_refine_all(VertexFront& f, const VertexTree& t) {
   // Later nodes first: every dependency of a node was made before it, and its parent after
   // it, so when a node's turn comes its dependencies are active.
   for (uint32_t v = t.node_count(); v-- > t.leaf_count;)
-    if (f.state[v] == VertexFront::kActive) u.split(v);
+    if (f.covers(v) && f.state[f.at(v)] == VertexFront::kActive) u.split(v);
   for (uint32_t k = 0; k < f.active_count; ++k) {
     u.unfile(f.active[k]);
     u.file_next_frame(f.active[k]);
@@ -913,8 +969,8 @@ void front_coarsen_all(VertexFront& f, const VertexTree& t) {
   u.bulk_ = true;
   for (uint32_t v = t.leaf_count; v < t.node_count(); ++v) {
     const uint32_t i = v - t.leaf_count;
-    if (f.state[v] == VertexFront::kSplit && f.state[t.children[2 * i]] == VertexFront::kActive &&
-        f.state[t.children[2 * i + 1]] == VertexFront::kActive)
+    if (f.covers(v) && f.state[f.at(v)] == VertexFront::kSplit && f.state[f.at(t.children[2 * i])] == VertexFront::kActive &&
+        f.state[f.at(t.children[2 * i + 1])] == VertexFront::kActive)
       u.collapse(v);
   }
   for (uint32_t k = 0; k < f.active_count; ++k) {
@@ -932,27 +988,25 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
   const uint32_t n = t.node_count();
   // Active list and states agree.
   uint32_t active_states = 0;
-  for (uint32_t v = 0; v < n; ++v) active_states += f.state[v] == VertexFront::kActive;
+  for (uint32_t v = 0; v < n; ++v) active_states += f.covers(v) && f.state[f.at(v)] == VertexFront::kActive;
   if (active_states != f.active_count)
     return fail(std::to_string(active_states) + " nodes are active but the list holds " +
                 std::to_string(f.active_count));
   for (uint32_t k = 0; k < f.active_count; ++k) {
     const uint32_t v = f.active[k];
-    if (v >= n || f.state[v] != VertexFront::kActive || f.active_pos[v] != k)
+    if (v >= n || !f.covers(v) || f.state[f.at(v)] != VertexFront::kActive || f.active_pos[f.at(v)] != k)
       return fail("active list entry " + std::to_string(k) + " (node " + std::to_string(v) +
                   ") is not active there");
   }
-  const bool all = f.region == kSharedRegion || f.node_region.size() != n;
-  auto leaf_mine = [&](uint32_t l) {
-    return all || f.node_region[l] == f.region || f.node_region[l] == kSharedRegion;
-  };
-  auto face_mine = [&](uint32_t face) { return all || face_region(t, f.node_region, face) == f.region; };
+  const bool all = !f.numbering;
+  auto leaf_mine = [&](uint32_t l) { return f.covers(l); };
+  auto face_mine = [&](uint32_t face) { return f.covers_face(t, face); };
   if (!all && edges == EdgeCheck::closed) edges = EdgeCheck::oriented;  // a region is open at its seam
   // Every leaf has exactly one active ancestor-or-self: a proper front.
   for (uint32_t l = 0; l < t.leaf_count; ++l) {
     if (!leaf_mine(l)) continue;
     uint32_t count = 0;
-    for (uint32_t v = l; v != kNoNode; v = t.parent[v]) count += f.state[v] == VertexFront::kActive;
+    for (uint32_t v = l; v != kNoNode; v = t.parent[v]) count += f.state[f.at(v)] == VertexFront::kActive;
     if (count != 1)
       return fail("leaf " + std::to_string(l) + " has " + std::to_string(count) + " active ancestors");
   }
@@ -961,15 +1015,17 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
   for (uint32_t s = 0; s < f.tri_count; ++s) {
     const uint32_t face = f.tri_face[s];
     const std::string at = "triangle " + std::to_string(s) + " (face " + std::to_string(face) + ")";
-    if (face >= t.face_count || f.face_slot[face] != s) return fail(at + " is not the face's slot");
+    if (face >= t.face_count || !face_mine(face) || f.face_slot[f.at_face(face)] != s)
+      return fail(at + " is not the face's slot");
     const uint32_t* tri = &f.tri_indices[3 * size_t(s)];
     for (int j = 0; j < 3; ++j) {
-      if (tri[j] >= n)
-        return fail(at + " references vertex " + std::to_string(tri[j]) + " of " + std::to_string(n));
-      if (f.state[tri[j]] != VertexFront::kActive)
+      if (tri[j] >= n || !f.covers(tri[j]))
+        return fail(at + " references vertex " + std::to_string(tri[j]) + " of " + std::to_string(n) +
+                    (tri[j] < n ? " outside the front's region" : ""));
+      if (f.state[f.at(tri[j])] != VertexFront::kActive)
         return fail(at + " references inactive vertex " + std::to_string(tri[j]));
       uint32_t v = t.face_leaves[3 * size_t(face) + j];
-      while (f.state[v] != VertexFront::kActive) v = t.parent[v];
+      while (f.state[f.at(v)] != VertexFront::kActive) v = t.parent[v];
       if (v != tri[j])
         return fail(at + " corner " + std::to_string(j) + " is " + std::to_string(tri[j]) +
                     " but its leaf's active ancestor is " + std::to_string(v));
@@ -978,18 +1034,18 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
     for (int j = 0; j < 3; ++j) directed.push_back(uint64_t(tri[j]) << 32 | tri[(j + 1) % 3]);
   }
   uint32_t face_slots = 0;
-  for (uint32_t face = 0; face < t.face_count; ++face) face_slots += f.face_slot[face] != kNoNode;
+  for (uint32_t face = 0; face < t.face_count; ++face) face_slots += face_mine(face) && f.face_slot[f.at_face(face)] != kNoNode;
 
   if (face_slots != f.tri_count)
     return fail(std::to_string(face_slots) + " faces have slots but " + std::to_string(f.tri_count) +
                 " triangles are active");
   // A face is active exactly when its corners are distinct (no face missing).
   for (uint32_t face = 0; face < t.face_count; ++face) {
-    if (f.face_slot[face] != kNoNode || !face_mine(face)) continue;
+    if (f.face_slot[f.at_face(face)] != kNoNode || !face_mine(face)) continue;
     uint32_t c[3];
     for (int j = 0; j < 3; ++j) {
       uint32_t v = t.face_leaves[3 * size_t(face) + j];
-      while (f.state[v] != VertexFront::kActive) v = t.parent[v];
+      while (f.state[f.at(v)] != VertexFront::kActive) v = t.parent[v];
       c[j] = v;
     }
     if (c[0] != c[1] && c[1] != c[2] && c[0] != c[2])
@@ -1006,11 +1062,13 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
         for (uint32_t k = bk.head; k != kNoNode; k = f.chunks[k].next)
           for (uint32_t i = 0; i < f.chunks[k].count; ++i, ++total) {
             const uint32_t v = f.chunks[k].node[i];
-            if (f.filing[v].stamp != f.chunks[k].stamp[i]) continue;
-            if (f.filing[v].bucket[c] != b || seen[2 * size_t(v) + c]++)
+            if (v >= n || !f.covers(v))
+              return fail("calendar " + std::to_string(c) + " holds node " + std::to_string(v) + " outside the front");
+            if (f.filing[f.at(v)].stamp != f.chunks[k].stamp[i]) continue;
+            if (f.filing[f.at(v)].bucket[c] != b || seen[2 * size_t(v) + c]++)
               return fail("calendar " + std::to_string(c) + " bucket " + std::to_string(b) + " holds node " +
                           std::to_string(v) + " which is filed elsewhere");
-            if (f.state[v] != VertexFront::kActive)
+            if (f.state[f.at(v)] != VertexFront::kActive)
               return fail("calendar holds node " + std::to_string(v) + " which is not active");
             ++live;
           }
@@ -1021,7 +1079,7 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
       }
     for (uint32_t v = 0; v < n; ++v)
       for (int c = 0; c < 2; ++c)
-        if (f.filing[v].bucket[c] != kUnfiled && !seen[2 * size_t(v) + c])
+        if (f.covers(v) && f.filing[f.at(v)].bucket[c] != kUnfiled && !seen[2 * size_t(v) + c])
           return fail("node " + std::to_string(v) + " is filed in a bucket that does not hold it");
   }
   if (edges == EdgeCheck::corners) return true;
@@ -1045,7 +1103,7 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
 uint32_t front_stale_decisions(const VertexFront& f, const VertexTree& t, const FrontView& view,
                                const FrontParams& params, std::string* message) {
   const float hysteresis = std::max(1.f, params.hysteresis);
-  auto retrying = [&](uint32_t v) { return f.filing[v].bucket[0] == kBuckets; };
+  auto retrying = [&](uint32_t v) { return f.filing[f.at(v)].bucket[0] == kBuckets; };
   uint32_t stale = 0;
   auto note = [&](std::string text) {
     if (stale++ == 0 && message) *message = std::move(text);
@@ -1059,12 +1117,12 @@ uint32_t front_stale_decisions(const VertexFront& f, const VertexTree& t, const 
   for (uint32_t p = t.leaf_count; p < t.node_count(); ++p) {
     const uint32_t i = p - t.leaf_count;
     const uint32_t c1 = t.children[2 * i], c2 = t.children[2 * i + 1];
-    if (f.state[p] != VertexFront::kSplit || f.state[c1] != VertexFront::kActive ||
-        f.state[c2] != VertexFront::kActive || retrying(c1) || retrying(c2) || f.pending_until[i] >= 0)
+    if (!f.covers(p) || f.state[f.at(p)] != VertexFront::kSplit || f.state[f.at(c1)] != VertexFront::kActive ||
+        f.state[f.at(c2)] != VertexFront::kActive || retrying(c1) || retrying(c2) || f.pending_until[f.inner_at(p)] >= 0)
       continue;
     bool deps = true;
     for (uint32_t k = t.dep_offsets[i]; k < t.dep_offsets[i + 1]; ++k)
-      deps = deps && f.state[t.deps[k]] == VertexFront::kActive;
+      deps = deps && f.state[f.at(t.deps[k])] == VertexFront::kActive;
     if (deps && !evaluate(t, p, view, f.threshold / hysteresis, kInf, 0.5).refine)
       note("split node " + std::to_string(p) + " wants to merge");
   }
@@ -1078,7 +1136,7 @@ uint32_t front_compact_mesh(std::span<float> positions, std::span<uint32_t> indi
   for (uint32_t k = 0; k < f.active_count; ++k)
     std::copy_n(src + 3 * size_t(f.active[k]), 3, positions.data() + 3 * size_t(k));
   // active_pos maps a node id to its slot in the active list: the compact vertex index.
-  for (size_t k = 0; k < 3 * size_t(f.tri_count); ++k) indices[k] = f.active_pos[f.tri_indices[k]];
+  for (size_t k = 0; k < 3 * size_t(f.tri_count); ++k) indices[k] = f.active_pos[f.at(f.tri_indices[k])];
   return f.tri_count;
 }
 
@@ -1091,7 +1149,7 @@ uint32_t fronts_compact_mesh(std::span<float> positions, std::span<uint32_t> ind
     const VertexFront& f = *fronts[r];
     for (uint32_t k = 0; k < f.active_count; ++k) {
       const uint32_t v = f.active[k];
-      if (r > 0 && !f.node_region.empty() && f.node_region[v] == kSharedRegion) continue;
+      if (r > 0 && f.numbering && f.numbering->region[v] == kSharedRegion) continue;
       assert(positions.size() >= 3 * size_t(nv + 1));
       std::copy_n(src + 3 * size_t(v), 3, positions.data() + 3 * size_t(nv));
       node_index[v] = nv++;

@@ -23,6 +23,7 @@
 // threads at once.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -97,9 +98,23 @@ struct VertexFront {
   uint32_t tri_count = 0;
   float threshold = 1;  // pixel threshold (tau), moved by feedback
   // The region of the tree this front covers (vertex_tree_regions), or kSharedRegion for all of
-  // it; node_region is the tree's region per node (empty for the whole tree).
+  // it. A region's front indexes its per-node and per-face arrays by the numbering's local ids
+  // (at, at_face), so they hold its own region only; a whole-tree front by node and face ids.
   uint8_t region = kSharedRegion;
-  std::vector<uint8_t> node_region;
+  std::shared_ptr<const RegionNumbering> numbering;  // null for the whole tree
+  const uint32_t* node_local = nullptr;               // numbering->local.data(), or null
+  const uint32_t* face_local = nullptr;
+  uint32_t local_leaves = 0;  // local ids below it are leaves
+  uint32_t at(uint32_t node) const { return node_local ? node_local[node] : node; }
+  uint32_t at_face(uint32_t face) const { return face_local ? face_local[face] : face; }
+  uint32_t inner_at(uint32_t node) const { return at(node) - local_leaves; }  // interior nodes only
+  // In this front's region, or a fixed leaf (in every region).
+  bool covers(uint32_t node) const {
+    return !numbering || numbering->region[node] == region || numbering->region[node] == kSharedRegion;
+  }
+  bool covers_face(const VertexTree& tree, uint32_t face) const {
+    return !numbering || face_region(tree, numbering->region, face) == region;
+  }
 
   // Two calendars of view-motion buckets: calendar 0 by eye travel, plane offset and threshold
   // changes (object units); calendar 1 by frustum-plane turning (radians), which moves a plane
@@ -163,6 +178,13 @@ void front_init(VertexFront& front, const VertexTree& tree, float threshold);
 // as alone; together their triangles are the whole mesh (fronts_compact_mesh).
 void front_init(VertexFront& front, const VertexTree& tree, float threshold, std::span<const uint8_t> regions,
                 uint8_t region);
+// The same with the regions' numbering built once (number_regions) and shared by their fronts.
+void front_init(VertexFront& front, const VertexTree& tree, float threshold,
+                std::shared_ptr<const RegionNumbering> numbering, uint8_t region);
+
+// Bytes the front's arrays hold (their capacity; of the calendar's chunk pool, the chunks in
+// use so far, as the rest of its reserve is never touched), the shared numbering not included.
+size_t front_memory_bytes(const VertexFront& front);
 
 // Threshold feedback (front_update does it when target_triangles > 0): the next pixel threshold
 // for `triangles` active against `target` (triangles grow about as 1 / threshold^2), clamped

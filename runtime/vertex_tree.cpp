@@ -326,4 +326,30 @@ uint8_t face_region(const VertexTree& t, std::span<const uint8_t> region, uint32
   return 0;
 }
 
+RegionNumbering number_regions(const VertexTree& t, std::vector<uint8_t> region, uint32_t count) {
+  RegionNumbering out;
+  const uint32_t n = t.node_count();
+  out.local.assign(n, 0);
+  out.leaves.assign(count, 0);
+  out.nodes.assign(count, 0);
+  out.faces.assign(count, 0);
+  for (uint32_t v = 0; v < t.leaf_count; ++v)
+    if (region[v] == kSharedRegion) out.local[v] = out.shared++;
+  std::fill(out.nodes.begin(), out.nodes.end(), out.shared);
+  auto number = [&](uint32_t begin, uint32_t end) {
+    for (uint32_t v = begin; v < end; ++v)
+      if (region[v] < count) out.local[v] = out.nodes[region[v]]++;
+  };
+  number(0, t.leaf_count);  // leaves first, so a region's leaves precede its interior nodes
+  out.leaves = out.nodes;
+  number(t.leaf_count, n);
+  out.local_face.assign(t.face_count, 0);
+  for (uint32_t f = 0; f < t.face_count; ++f) {
+    const uint8_t r = face_region(t, region, f);
+    if (r < count) out.local_face[f] = out.faces[r]++;
+  }
+  out.region = std::move(region);
+  return out;
+}
+
 }  // namespace lod

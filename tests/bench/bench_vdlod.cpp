@@ -225,6 +225,11 @@ void BM_FrontSmoothRegions(benchmark::State& state) {
   state.counters["seam_vertices"] = static_cast<double>(std::count(region.begin(), region.end(), kSharedRegion));
   state.counters["base_tris"] = static_cast<double>(base_tris);
   state.counters["base_tris_one_part"] = whole.tri_count;
+  // Memory: the regions' fronts (each sized for its own region) against one whole-tree front.
+  size_t region_bytes = 0;
+  for (const VertexFront& f : fronts) region_bytes += front_memory_bytes(f);
+  state.counters["region_fronts_MB"] = double(region_bytes) / 1e6;
+  state.counters["whole_front_MB"] = double(front_memory_bytes(whole)) / 1e6;
   FrontParams p;
   // No per-region cap: the shared feedback holds the target; a cap split by region would
   // block the regions in view while the others have room.

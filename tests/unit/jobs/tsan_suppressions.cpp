@@ -6,7 +6,7 @@
 // innermost frame is in oneTBB's headers, and races with a stack inside one of TBB's internal
 // helpers under which lodkit code never runs. A race between two accesses made by lodkit
 // code is still reported; the frame graph marks TBB's spawn and join edges for TSan itself
-// (frame_graph.cpp).
+// (frame_graph.cpp) and the bake jobs' loops (jobs/annotated_parallel_for.h).
 #if defined(__SANITIZE_THREAD__)
 #define LOD_TEST_TSAN 1
 #elif defined(__has_feature)
@@ -25,6 +25,10 @@ extern "C" const char* __tsan_default_suppressions() {
          "race:tbb::detail::d1::wait_context::\n"     // completion counters
          "race:tbb::detail::d1::broadcast_cache\n"    // flow-graph successor lists
          "race:tbb::detail::d1::spin_rw_mutex\n"
-         "race:tbb::detail::d1::task_group_context\n";  // cancellation state, read by every task
+         "race:tbb::detail::d1::task_group_context\n"  // cancellation state, read by every task
+         "race:tbb::detail::d1::dynamic_grainsize_mode\n"  // the partitioner's stolen-child flag
+         // Embree builds its BVHs with its own (uninstrumented) TBB: memory it allocates on one
+         // thread and frees on another, inside the library.
+         "race:libembree3.so\n";
 }
 #endif

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -104,6 +105,54 @@ TEST(VertexFrontRegions, ManyPartsOnATinyMeshStayValid) {
     uint32_t nv = 0;
     const uint32_t nt = fronts_compact_mesh(pos, idx, scratch, fronts, r.tree, {}, &nv);
     EXPECT_TRUE(check_triangles({idx.data(), 3 * size_t(nt)}, nv, EdgeCheck::closed, &msg)) << msg;
+  }
+}
+
+// Each region's front holds per-node and per-face state for its own nodes and faces (plus the
+// fixed seam leaves every region shares), not for the whole tree: together about one front.
+TEST(VertexFrontRegions, RegionFrontsHoldStateForTheirOwnRegionOnly) {
+  const MeshData m = test::vd_sphere(60, 80);
+  const Regions r = build(m, 4);
+  ASSERT_EQ(r.count, 4u);
+  const auto numbering = std::make_shared<const RegionNumbering>(number_regions(r.tree, r.region, r.count));
+  VertexFront whole;
+  front_init(whole, r.tree, 1.f);
+  std::vector<VertexFront> f(r.count);
+  size_t nodes = 0, faces = 0, bytes = 0;
+  for (uint32_t k = 0; k < r.count; ++k) {
+    front_init(f[k], r.tree, 1.f, numbering, uint8_t(k));
+    nodes += f[k].state.size();
+    faces += f[k].face_slot.size();
+    bytes += front_memory_bytes(f[k]);
+    EXPECT_LT(f[k].state.size(), r.tree.node_count() / 2) << "region " << k << " sized for the whole tree";
+  }
+  EXPECT_EQ(nodes, r.tree.node_count() + (r.count - 1) * size_t(numbering->shared));
+  EXPECT_EQ(faces, r.tree.face_count);
+  // The calendars' bucket heads are per front (4 x 2 x 4097 entries); the rest splits.
+  const size_t fixed = r.count * (f[0].buckets.capacity() * sizeof(f[0].buckets[0]));
+  EXPECT_LT(bytes - fixed, 13 * (front_memory_bytes(whole) - fixed / r.count) / 10);
+  // The local ids are a numbering: distinct within a region, fixed leaves first, leaves before
+  // interior nodes.
+  for (uint32_t k = 0; k < r.count; ++k) {
+    std::vector<uint8_t> used(numbering->nodes[k], 0);
+    for (uint32_t v = 0; v < r.tree.node_count(); ++v) {
+      if (!f[k].covers(v)) continue;
+      const uint32_t id = numbering->local[v];
+      ASSERT_LT(id, used.size());
+      EXPECT_EQ(used[id]++, 0) << "node " << v << " shares local id " << id;
+      EXPECT_EQ(id < numbering->shared, r.region[v] == kSharedRegion) << "node " << v;
+      EXPECT_EQ(id < numbering->leaves[k], r.tree.is_leaf(v)) << "node " << v;
+    }
+  }
+  // And they still walk as one crack-free mesh.
+  std::string msg;
+  for (int i = 0; i < 40; ++i) {
+    const float a = 0.1f * i;
+    const FrontView v = view_at({2.0f * std::sin(a), 0.3f, 2.0f * std::cos(a)}, {0, 0, 0});
+    for (auto& fr : f) {
+      front_update(fr, r.tree, v, FrontParams{});
+      ASSERT_TRUE(check_front(fr, r.tree, EdgeCheck::closed, &msg)) << "frame " << i << ": " << msg;
+    }
   }
 }
 
