@@ -618,29 +618,6 @@ struct Columns {
   bool normals = false, uvs = false;
 };
 
-// Reads a T from bytes of any alignment: lets vector::insert append a buffer view's elements
-// straight into a column, without the zero-fill of resize and without aliasing the bytes.
-template <class T>
-struct LoadingIterator {
-  using iterator_category = std::random_access_iterator_tag;
-  using value_type = T;
-  using difference_type = std::ptrdiff_t;
-  using pointer = const T*;
-  using reference = T;
-  const uint8_t* p = nullptr;
-  T operator*() const { return load_as<T>(p); }
-  T operator[](difference_type i) const { return load_as<T>(p + i * difference_type(sizeof(T))); }
-  LoadingIterator& operator++() { return p += sizeof(T), *this; }
-  LoadingIterator operator++(int) { LoadingIterator old = *this; return p += sizeof(T), old; }
-  LoadingIterator& operator--() { return p -= sizeof(T), *this; }
-  LoadingIterator& operator+=(difference_type d) { return p += d * difference_type(sizeof(T)), *this; }
-  LoadingIterator& operator-=(difference_type d) { return p -= d * difference_type(sizeof(T)), *this; }
-  LoadingIterator operator+(difference_type d) const { return LoadingIterator{p + d * difference_type(sizeof(T))}; }
-  LoadingIterator operator-(difference_type d) const { return LoadingIterator{p - d * difference_type(sizeof(T))}; }
-  difference_type operator-(const LoadingIterator& o) const { return (p - o.p) / difference_type(sizeof(T)); }
-  auto operator<=>(const LoadingIterator&) const = default;
-};
-
 // Every element of an accessor into out[0, count * components): floats copied as they are,
 // integers converted (read_component); no buffer view reads as zeros.
 void decode_elements(const AccessorView& a, float* out) {
@@ -676,7 +653,8 @@ bool append_elements(const AccessorView& a, std::vector<float>& col) {
     bool any = false;
     for (size_t b = 0; b < values; b += kBlockValues) {
       const size_t e = std::min(values, b + kBlockValues), at = col.size();
-      col.insert(col.end(), LoadingIterator<float>{a.data + 4 * b}, LoadingIterator<float>{a.data + 4 * e});
+      col.resize(at + (e - b));  // zeros into one block, overwritten while it is in cache
+      std::memcpy(col.data() + at, a.data + 4 * b, 4 * (e - b));
       any = any_nonfinite(col.data() + at, e - b) || any;
     }
     return any;
@@ -726,41 +704,44 @@ size_t first_nonfinite(const float* p, size_t n) {
   return n;
 }
 
-uint32_t max_of(const uint32_t* c, size_t n) {
-  uint32_t largest = 0;
-  for (size_t i = 0; i < n; ++i) largest = std::max(largest, c[i]);
-  return largest;
+// Whether any of c[0, n) is >= limit: compares OR-ed together, which vectorizes even on
+// baseline x86-64 (an unsigned max does not: SSE2 has no pmaxud).
+bool any_at_least(const uint32_t* c, size_t n, uint32_t limit) {
+  uint32_t any = 0;
+  for (size_t i = 0; i < n; ++i) any |= uint32_t(c[i] >= limit);
+  return any != 0;
 }
 
-// Appends the primitive's corners (its indices, or 0..n-1 without) to `out`, unchecked;
-// returns the largest.
-uint32_t append_corners(const PrimitivePlan& plan, std::vector<uint32_t>& out) {
+// Appends the primitive's corners (its indices, or 0..n-1 without) to `out`; returns whether
+// any is out of range (check_corners then says which), checked block by block as they land.
+bool append_corners(const PrimitivePlan& plan, std::vector<uint32_t>& out) {
   const size_t base = out.size();
+  const uint32_t vertices = uint32_t(plan.vertices());  // fits: plan_mesh checked
   if (!plan.indexed) {
     out.resize(base + plan.vertices());
     for (size_t i = 0; i < plan.vertices(); ++i) out[base + i] = uint32_t(i);
-    return uint32_t(plan.vertices() - 1);
+    return false;
   }
   const AccessorView& a = plan.indices;
-  uint32_t largest = 0;
+  bool bad = false;
   if (a.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {  // tight: indices have no stride
     for (size_t b = 0; b < a.count; b += kBlockValues) {
       const size_t e = std::min(a.count, b + kBlockValues), at = out.size();
-      out.insert(out.end(), LoadingIterator<uint32_t>{a.data + 4 * b}, LoadingIterator<uint32_t>{a.data + 4 * e});
-      largest = std::max(largest, max_of(out.data() + at, e - b));
+      out.resize(at + (e - b));
+      std::memcpy(out.data() + at, a.data + 4 * b, 4 * (e - b));
+      bad = any_at_least(out.data() + at, e - b, vertices) || bad;
     }
-    return largest;
+    return bad;
   }
   out.resize(base + a.count);
-  for (size_t i = 0; i < a.count; ++i) out[base + i] = read_index(a, i), largest = std::max(largest, out[base + i]);
-  return largest;
+  for (size_t i = 0; i < a.count; ++i) out[base + i] = read_index(a, i);
+  return any_at_least(out.data() + base, a.count, vertices);
 }
 
-// Every corner checked against the primitive's vertices (the first bad one found only when
-// the largest is out of range), then offset by `base`.
-Status check_corners(const std::string& where, uint32_t* c, size_t count, uint32_t largest, size_t vertices,
-                     uint32_t base) {
-  if (largest >= vertices)
+// Names the first corner out of range when there is one (`suspect`), then offsets every
+// corner by `base`.
+Status check_corners(const std::string& where, uint32_t* c, size_t count, bool suspect, size_t vertices, uint32_t base) {
+  if (suspect)
     for (size_t i = 0; i < count; ++i)
       if (c[i] >= vertices)
         return Status::error(where + ": index " + std::to_string(i) + " references vertex " + std::to_string(c[i]) +
@@ -823,14 +804,14 @@ Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const 
   const bool mirrored = glm::determinant(glm::dmat3(inst.world)) < 0;
   const size_t corners = plan.indexed ? plan.indices.count : n;
   if (plan.mode == TINYGLTF_MODE_TRIANGLES && !mirrored) {  // the common case: corners are the triangles
-    const uint32_t largest = append_corners(plan, out.indices);
-    if (Status s = check_corners(where, out.indices.data() + 3 * first, corners, largest, n, uint32_t(base)); !s)
+    const bool suspect = append_corners(plan, out.indices);
+    if (Status s = check_corners(where, out.indices.data() + 3 * first, corners, suspect, n, uint32_t(base)); !s)
       return s;
     out.indices.resize(3 * (first + plan.triangles));  // a stray last corner or two
   } else {
     scratch.clear();
-    const uint32_t largest = append_corners(plan, scratch);
-    if (Status s = check_corners(where, scratch.data(), corners, largest, n, 0); !s) return s;
+    const bool suspect = append_corners(plan, scratch);
+    if (Status s = check_corners(where, scratch.data(), corners, suspect, n, 0); !s) return s;
     out.indices.resize(3 * (first + plan.triangles));
     triangles_from_corners(plan.mode, scratch.data(), plan.triangles, uint32_t(base),
                            mirrored ? Winding::flip : Winding::keep, out.indices.data() + 3 * first);
