@@ -48,6 +48,14 @@ struct BakeArgs {
 int bake_command(const BakeArgs& args);
 int bake_hlod_command(const BakeArgs& args);  // cli/bake_hlod.cpp
 
+struct ExportArgs {
+  std::string file;       // the .hlod file
+  std::string tiles_dir;  // --3dtiles DIR
+  bool force = false;     // replace DIR when it holds an earlier export
+  bool json = false;
+};
+int export_command(const ExportArgs& args);  // cli/export_command.cpp
+
 // Where baked assets are cached: $LOD_CACHE_DIR, else next to the data directory.
 std::string default_cache_dir(const std::string& data_dir);
 

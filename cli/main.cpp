@@ -52,9 +52,17 @@ int main(int argc, char** argv) {
   bake_cmd->add_option("--min-verts", bake.min_verts, "--hlod: a cell with more vertices splits (default 1000)")
       ->check(CLI::Range(int64_t{3}, int64_t{100000000}));
 
+  lod::cli::ExportArgs exp;
+  auto* export_cmd = app.add_subcommand("export", "write an .hlod file as an OGC 3D Tiles 1.1 tileset");
+  export_cmd->add_option("--3dtiles", exp.tiles_dir, "folder for tileset.json and tiles/*.glb")->required();
+  export_cmd->add_option("file", exp.file, ".hlod file")->required();
+  export_cmd->add_flag("--force", exp.force, "replace DIR when it holds an earlier export (a tileset.json)");
+  export_cmd->add_flag("--json", exp.json, "print JSON");
+
   CLI11_PARSE(app, argc, argv);
   if (run_cmd->parsed()) return lod::cli::run_command(run);
   if (inspect_cmd->parsed()) return lod::cli::inspect_command(inspect);
   if (bake_cmd->parsed()) return lod::cli::bake_command(bake);
+  if (export_cmd->parsed()) return lod::cli::export_command(exp);
   return 2;
 }

@@ -1,0 +1,35 @@
+// lod export --3dtiles DIR FILE.hlod: an OGC 3D Tiles 1.1 tileset of an .hlod tree.
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.h"
+#include "cli/names.h"
+#include "preprocess/tiles3d_export.h"
+
+namespace lod::cli {
+
+int export_command(const ExportArgs& args) {
+  if (args.tiles_dir.empty()) {
+    std::fprintf(stderr, "lod export: name what to write (--3dtiles DIR)\n");
+    return 1;
+  }
+  TilesetExportOptions options;
+  options.replace = args.force;
+  TilesetExportReport rep;
+  if (Status st = export_3d_tiles(args.file, args.tiles_dir, options, &rep); !st) {
+    std::fprintf(stderr, "lod export: %s\n", printable(st.message).c_str());
+    return 1;
+  }
+  if (args.json) {
+    const nlohmann::json j = {{"dir", args.tiles_dir}, {"nodes", rep.nodes},       {"tiles", rep.tiles},
+                              {"glb_files", rep.glb_files}, {"bytes", rep.bytes}, {"root_error", rep.root_error}};
+    std::printf("%s\n", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+    return 0;
+  }
+  std::printf("%s: %zu nodes -> %zu tiles (%zu GLBs, %.2f MB), root geometricError %.6g, in %s\n",
+              printable(args.file).c_str(), rep.nodes, rep.tiles, rep.glb_files, double(rep.bytes) / 1e6, rep.root_error,
+              printable(args.tiles_dir).c_str());
+  return 0;
+}
+
+}  // namespace lod::cli

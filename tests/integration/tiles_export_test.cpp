@@ -1,0 +1,309 @@
+// `lod export --3dtiles DIR FILE.hlod` end to end (issue 12): the tileset passes the 3D Tiles 1.1
+// JSON schemas (ajv, when ../shared holds them) and the structural checks of
+// validate_3dtiles.js, every GLB the Khronos validator with 0 errors; tiles follow the tree and
+// its measured errors; a non-empty folder is refused (or, with --force, only an earlier export
+// replaced); a corrupted .hlod writes nothing; files are named by node, never by model name.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "run_cli.h"
+#include "test_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lod::test::run_lod;
+
+fs::path schema_dir() { return fs::path(LOD_SHARED_MESHES).parent_path() / "schemas" / "3d-tiles-1.1"; }
+
+// validate_3dtiles.js on `tileset` ("-" for schemas: structure and glTF only). The node tools
+// missing is a failure, not a skip: scripts/run-tests.sh installs them before any test runs.
+lod::test::CliResult run_checker(const fs::path& tileset, const std::string& schemas, bool glbs = true) {
+  lod::test::CliResult r;
+  const fs::path tools = LOD_NODE_TOOLS;
+  for (const char* pkg : {"gltf-validator", "ajv", "ajv-formats"})
+    if (!fs::exists(LOD_NODE_EXECUTABLE) || !fs::exists(tools / "node_modules" / pkg / "package.json")) {
+      r.out = std::string("npm ") + pkg + " is not installed in " + tools.string() + ": run scripts/install-node-tools.sh";
+      return r;
+    }
+  const std::string cmd = std::string(LOD_NODE_EXECUTABLE) + " " + LOD_SOURCE_DIR "/tests/integration/validate_3dtiles.js '" +
+                          tools.string() + "' '" + schemas + "' '" + tileset.string() + "'" + (glbs ? "" : " --no-gltf") + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// The unit sphere stretched to 3 along y and moved to z = 5, so that y-up and z-up differ.
+std::string tall_ball_off() {
+  std::istringstream in(lod::test::sphere_off(60, 80));
+  std::ostringstream out;
+  std::string line;
+  std::getline(in, line);
+  out << line << "\n";
+  int vertices = 0, faces = 0, edges = 0;
+  in >> vertices >> faces >> edges;
+  out << vertices << " " << faces << " 0\n";
+  for (int v = 0; v < vertices; ++v) {
+    double x, y, z;
+    in >> x >> y >> z;
+    out << x << " " << 3 * y << " " << z + 5 << "\n";
+  }
+  std::getline(in, line);
+  while (std::getline(in, line)) out << line << "\n";
+  return out.str();
+}
+
+// A tall ball's .hlod (a few dozen nodes, three levels deep).
+fs::path bake_ball_hlod(const fs::path& dir, const std::string& stem = "ball") {
+  const fs::path mesh = dir / (stem + ".off");
+  lod::test::write_text(mesh, tall_ball_off());
+  const auto r = run_lod("bake '" + mesh.string() + "' -o '" + (dir / "hlod").string() + "' --hlod --min-verts 300 --quiet");
+  EXPECT_EQ(r.code, 0) << r.out;
+  return dir / "hlod" / (stem + ".hlod");
+}
+
+nlohmann::json read_json(const fs::path& file) {
+  std::ifstream f(file);
+  return nlohmann::json::parse(f);
+}
+
+void write_json(const fs::path& file, const nlohmann::json& j) { lod::test::write_text(file, j.dump()); }
+
+// Every tile of the tileset, depth first, with its parent's index (-1 at the root).
+void flatten(const nlohmann::json& tile, int parent, std::vector<std::pair<const nlohmann::json*, int>>& out) {
+  const int me = int(out.size());
+  out.push_back({&tile, parent});
+  if (tile.contains("children"))
+    for (const auto& c : tile["children"]) flatten(c, me, out);
+}
+
+bool hidden_leftovers(const fs::path& parent) {
+  for (const auto& e : fs::directory_iterator(parent))
+    if (e.path().filename().string().find(".partial-") != std::string::npos ||
+        e.path().filename().string().find(".old-") != std::string::npos)
+      return true;
+  return false;
+}
+
+TEST(Tiles3dExport, EveryTileFollowsTheTreeAndEveryGlbPassesTheValidator) {
+  const fs::path dir = lod::test::temp_dir("tiles3d-valid");
+  const fs::path hlod = bake_ball_hlod(dir);
+  const auto r = run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + hlod.string() + "' --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto report = nlohmann::json::parse(r.out);
+  const auto inspect = run_lod("inspect '" + hlod.string() + "' --json");
+  ASSERT_EQ(inspect.code, 0) << inspect.out;
+  const auto tree = nlohmann::json::parse(inspect.out);
+
+  // One tile per layer with triangles and per boundary patch; their errors are the layers'.
+  size_t want_tiles = 0;
+  std::multiset<double> want_errors;
+  for (const auto& n : tree["nodes"]) {
+    for (const auto& l : n["layers"]) {
+      ++want_tiles;
+      want_errors.insert(l["error"].get<double>());
+    }
+    if (n["boundary_triangles"].get<uint32_t>() > 0) ++want_tiles, want_errors.insert(0.0);
+  }
+  EXPECT_EQ(report["nodes"], tree["nodes"].size());
+  EXPECT_EQ(report["tiles"].get<size_t>(), want_tiles);
+  EXPECT_EQ(report["glb_files"].get<size_t>(), want_tiles);
+
+  const auto tileset = read_json(dir / "tiles" / "tileset.json");
+  EXPECT_EQ(tileset["asset"]["version"], "1.1");
+  EXPECT_EQ(tileset["root"]["refine"], "REPLACE");
+  std::vector<std::pair<const nlohmann::json*, int>> tiles;
+  flatten(tileset["root"], -1, tiles);
+  ASSERT_EQ(tiles.size(), want_tiles);
+  std::multiset<double> got_errors;
+  for (const auto& [t, parent] : tiles) {
+    got_errors.insert((*t)["geometricError"].get<float>());
+    EXPECT_TRUE((*t)["content"]["uri"].get<std::string>().starts_with("tiles/"));
+  }
+  std::multiset<double> want_float;
+  for (double e : want_errors) want_float.insert(float(e));
+  EXPECT_EQ(got_errors, want_float);
+  // The root tile is the root node's coarsest layer.
+  const auto& root_layers = tree["nodes"][0]["layers"];
+  EXPECT_FLOAT_EQ(tileset["root"]["geometricError"].get<float>(), root_layers.back()["error"].get<float>());
+  EXPECT_GE(tileset["geometricError"].get<double>(), tileset["root"]["geometricError"].get<double>());
+
+  // z-up: the ball's height (glTF y, 3) is the box's z axis; glTF z = 5 is tileset y = -5.
+  const auto& box = tileset["root"]["boundingVolume"]["box"];
+  EXPECT_NEAR(box[0].get<double>(), 0.0, 0.01);
+  EXPECT_NEAR(box[1].get<double>(), -5.0, 0.01);
+  EXPECT_NEAR(box[2].get<double>(), 0.0, 0.01);
+  EXPECT_NEAR(box[3].get<double>(), 1.0, 0.01);
+  EXPECT_NEAR(box[7].get<double>(), 1.0, 0.01);
+  EXPECT_NEAR(box[11].get<double>(), 3.0, 0.01);
+
+  const auto v = run_checker(dir / "tiles" / "tileset.json", "-");
+  EXPECT_EQ(v.code, 0) << v.out;
+  EXPECT_NE(v.out.find("structure errors 0 gltf errors 0 tiles " + std::to_string(want_tiles)), std::string::npos) << v.out;
+  EXPECT_FALSE(hidden_leftovers(dir));
+}
+
+TEST(Tiles3dExport, TilesetPassesThe3dTilesSchemas) {
+  if (!fs::exists(schema_dir() / "tileset.schema.json"))
+    GTEST_SKIP() << "the 3D Tiles 1.1 schemas are not at " << schema_dir() << " (../shared absent)";
+  const fs::path dir = lod::test::temp_dir("tiles3d-schema");
+  const fs::path hlod = bake_ball_hlod(dir);
+  ASSERT_EQ(run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + hlod.string() + "'").code, 0);
+  const auto v = run_checker(dir / "tiles" / "tileset.json", schema_dir().string());
+  EXPECT_EQ(v.code, 0) << v.out;
+  EXPECT_NE(v.out.find("schema errors 0 structure errors 0 gltf errors 0"), std::string::npos) << v.out;
+}
+
+// The checks must fail on broken tilesets, or the tests above prove nothing.
+TEST(Tiles3dExport, TheCheckerReportsBrokenTilesets) {
+  const fs::path dir = lod::test::temp_dir("tiles3d-broken");
+  const fs::path hlod = bake_ball_hlod(dir);
+  ASSERT_EQ(run_lod("export --3dtiles '" + (dir / "good").string() + "' '" + hlod.string() + "'").code, 0);
+  const auto good = read_json(dir / "good" / "tileset.json");
+  struct Case {
+    const char* name;
+    std::function<void(nlohmann::json&)> edit;
+    const char* says;
+  };
+  const std::vector<Case> cases = {
+      {"version", [](nlohmann::json& t) { t["asset"]["version"] = "1.0"; }, "asset.version"},
+      {"error", [](nlohmann::json& t) { t["root"]["children"][0]["geometricError"] = 1e6; }, "above its parent's"},
+      {"box", [](nlohmann::json& t) { t["root"]["children"][0]["boundingVolume"]["box"][3] = 1e3; }, "box outside its parent's"},
+      // Content shrunk to a point: the GLB's positions are outside it.
+      {"content", [](nlohmann::json& t) {
+         auto& b = t["root"]["content"]["boundingVolume"]["box"];
+         for (int k = 3; k < 12; ++k) b[size_t(k)] = 0.0;
+       }, "outside its content box"},
+      // Left in glTF's y-up frame: centre (x, y, z), half sizes along x, y, z.
+      {"y-up", [](nlohmann::json& t) {
+         for (auto* v : {&t["root"]["boundingVolume"]["box"], &t["root"]["content"]["boundingVolume"]["box"]}) {
+           auto& b = *v;
+           const double cy = b[1], cz = b[2], hy = b[7], hz = b[11];
+           b[1] = cz, b[2] = -cy, b[7] = hz, b[11] = hy;
+         }
+       }, "outside its content box"},
+      {"escape", [](nlohmann::json& t) { t["root"]["content"]["uri"] = "../tiles-outside.glb"; }, "inside the tileset"},
+      {"missing", [](nlohmann::json& t) { t["root"]["content"]["uri"] = "tiles/none.glb"; }, "does not exist"},
+  };
+  for (const Case& c : cases) {
+    const fs::path to = dir / c.name;
+    fs::copy(dir / "good", to, fs::copy_options::recursive);
+    nlohmann::json t = good;
+    c.edit(t);
+    write_json(to / "tileset.json", t);
+    const auto v = run_checker(to / "tileset.json", "-", false);
+    EXPECT_EQ(v.code, 1) << c.name << ": " << v.out;
+    EXPECT_NE(v.out.find(c.says), std::string::npos) << c.name << ": " << v.out;
+  }
+  // A GLB the glTF validator refuses.
+  const fs::path to = dir / "glb";
+  fs::copy(dir / "good", to, fs::copy_options::recursive);
+  const std::string first = good["root"]["content"]["uri"];
+  auto bytes = lod::test::read_bytes(to / first);
+  bytes.resize(bytes.size() - 8);
+  lod::test::write_bytes(to / first, bytes);
+  const auto v = run_checker(to / "tileset.json", "-");
+  EXPECT_EQ(v.code, 1) << v.out;
+  EXPECT_EQ(v.out.find("gltf errors 0"), std::string::npos) << v.out;
+  if (fs::exists(schema_dir() / "tileset.schema.json")) {  // and the schemas, a required key dropped
+    nlohmann::json t = good;
+    t["root"].erase("geometricError");
+    write_json(dir / "good" / "tileset.json", t);
+    const auto s = run_checker(dir / "good" / "tileset.json", schema_dir().string(), false);
+    EXPECT_EQ(s.code, 1) << s.out;
+    EXPECT_NE(s.out.find("required property 'geometricError'"), std::string::npos) << s.out;
+  }
+}
+
+TEST(Tiles3dExport, RefusesANonEmptyFolderAndForceReplacesOnlyAnEarlierExport) {
+  const fs::path dir = lod::test::temp_dir("tiles3d-force");
+  const fs::path hlod = bake_ball_hlod(dir);
+  const std::string args = "' '" + hlod.string() + "'";
+  fs::create_directories(dir / "empty");
+  EXPECT_EQ(run_lod("export --3dtiles '" + (dir / "empty").string() + args).code, 0) << "an empty folder is written";
+  EXPECT_TRUE(fs::exists(dir / "empty" / "tileset.json"));
+
+  fs::create_directories(dir / "mine");
+  lod::test::write_text(dir / "mine" / "notes.txt", "keep me");
+  auto r = run_lod("export --3dtiles '" + (dir / "mine").string() + args);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("is not empty"), std::string::npos) << r.out;
+  r = run_lod("export --3dtiles '" + (dir / "mine").string() + args + " --force");
+  EXPECT_NE(r.code, 0) << "a folder without a tileset.json is never replaced";
+  EXPECT_NE(r.out.find("holds no tileset.json"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "mine" / "notes.txt"));
+
+  ASSERT_EQ(run_lod("export --3dtiles '" + (dir / "out").string() + args).code, 0);
+  ASSERT_TRUE(fs::is_directory(dir / "out" / "tiles"));
+  lod::test::write_text(dir / "out" / "tiles" / "stale.glb", "from before");
+  r = run_lod("export --3dtiles '" + (dir / "out").string() + args);
+  EXPECT_NE(r.code, 0) << "an earlier export is not replaced without --force";
+  r = run_lod("export --3dtiles '" + (dir / "out").string() + args + " --force");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "out" / "tiles" / "stale.glb")) << "replaced whole, nothing stale kept";
+  EXPECT_EQ(run_checker(dir / "out" / "tileset.json", "-").code, 0);
+  lod::test::write_text(dir / "file", "x");
+  EXPECT_NE(run_lod("export --3dtiles '" + (dir / "file").string() + args).code, 0);
+  EXPECT_FALSE(hidden_leftovers(dir));
+}
+
+TEST(Tiles3dExport, ACorruptedHlodWritesNothing) {
+  const fs::path dir = lod::test::temp_dir("tiles3d-corrupt");
+  const fs::path hlod = bake_ball_hlod(dir);
+  auto bytes = lod::test::read_bytes(hlod);
+  bytes[bytes.size() - 20] ^= 0x5a;  // inside the last node's payload: every earlier GLB was written
+  lod::test::write_bytes(dir / "bad.hlod", bytes);
+  auto r = run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + (dir / "bad.hlod").string() + "'");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("bad.hlod"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("checksum"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "tiles"));
+  EXPECT_FALSE(hidden_leftovers(dir));
+  // Not an .hlod at all, and the head cut short.
+  lod::test::write_text(dir / "x.hlod", "not an hlod file at all, no");
+  r = run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + (dir / "x.hlod").string() + "'");
+  EXPECT_NE(r.code, 0);
+  bytes.resize(200);
+  lod::test::write_bytes(dir / "short.hlod", bytes);
+  r = run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + (dir / "short.hlod").string() + "'");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("short.hlod"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "tiles"));
+  EXPECT_FALSE(hidden_leftovers(dir));
+}
+
+TEST(Tiles3dExport, FilesAreNamedByNodeNeverByTheModelName) {
+  const fs::path dir = lod::test::temp_dir("tiles3d-names");
+  const fs::path hlod = bake_ball_hlod(dir, "..;$(x) ba\\ll");
+  ASSERT_TRUE(fs::exists(hlod));
+  ASSERT_EQ(run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + hlod.string() + "'").code, 0);
+  const std::regex tile_name(R"([0-9]+-([0-9]|boundary)\.glb)");
+  size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "tiles")) {
+    const fs::path rel = fs::relative(e.path(), dir / "tiles");
+    if (e.is_directory()) {
+      EXPECT_EQ(rel, "tiles");
+      continue;
+    }
+    ++files;
+    if (rel == "tileset.json") continue;
+    EXPECT_EQ(rel.parent_path(), "tiles") << rel;
+    EXPECT_TRUE(std::regex_match(rel.filename().string(), tile_name)) << rel;
+  }
+  EXPECT_GT(files, 10u);
+  EXPECT_EQ(read_json(dir / "tiles" / "tileset.json")["asset"]["extras"]["model"], "..;$(x) ba\\ll");
+}
+
+}  // namespace
