@@ -21,6 +21,7 @@
 #include <bit>
 #include <cmath>
 #include <memory>
+#include <ctime>
 #include <string>
 
 #include "preprocess/decimater_chain.h"  // compute_vertex_normals
@@ -32,6 +33,14 @@ namespace lod {
 namespace {
 
 constexpr uint8_t kNoPatch = 0xff;
+
+// The calling thread's CPU time (the BVH is built on one thread of the caller's: a report of
+// where a bake's time goes, on machines shared with other work).
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 struct Layer {
   std::vector<float> positions;
@@ -556,7 +565,8 @@ void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
 
 // A subtree result is checked against the mesh before any of it is used as an index.
 Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, const std::string& what) {
-  if (s.nodes.empty() || s.payloads.size() != s.nodes.size()) return Status::error(what + ": no nodes, or not one payload per node");
+  if (s.nodes.empty() || s.payloads.empty() || (s.payloads.size() != 1 && s.payloads.size() != s.nodes.size()))
+    return Status::error(what + ": no nodes, or neither the root's payload alone nor one payload per node");
   const HlodNode& root = s.nodes[0];
   if (root.depth != f.depth || root.box_half != f.half || root.box_center[0] != f.center[0] ||
       root.box_center[1] != f.center[1] || root.box_center[2] != f.center[2])
@@ -580,29 +590,33 @@ Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, 
 // the file stores it: the top's nodes described here, each subtree's spliced in from its result.
 struct NodeRef {
   const BuildNode* top = nullptr;  // else a subtree's node
-  HlodSubtree* subtree = nullptr;
+  const HlodSubtree* subtree = nullptr;
   uint32_t local = 0;
 };
 
-void splice(Context& c, BuildNode& root, std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport& report) {
+// The top's payloads are made here; a subtree node's stays with its subtree (origin says where).
+void splice(Context& c, BuildNode& root, const std::vector<HlodSubtree>& baked, HlodAssembly& out,
+            HlodBuildReport& report) {
   auto ref_of = [&](const BuildNode& n) {
     return n.subtree >= 0 ? NodeRef{nullptr, &baked[size_t(n.subtree)], 0} : NodeRef{&n, nullptr, 0};
   };
   std::vector<NodeRef> order{ref_of(root)};
   std::vector<int32_t> parent{-1};
-  out.tree.nodes.clear();
-  out.payloads.clear();
+  out.model.tree.nodes.clear();
+  out.model.payloads.clear();
+  out.origin.clear();
   for (size_t i = 0; i < order.size(); ++i) {
     const NodeRef r = order[i];
     HlodNode h;
     HlodPayload payload;
+    HlodAssembly::Origin origin;
     if (r.top) {
       h = describe_node(c, *r.top, payload);
       for (const auto& child : r.top->children)
         if (child) order.push_back(ref_of(*child));
     } else {
       h = r.subtree->nodes[r.local];
-      payload = std::move(r.subtree->payloads[r.local]);
+      origin = {int32_t(r.subtree - baked.data()), r.local};
       for (uint32_t k = 0; k < h.child_count; ++k) order.push_back({nullptr, r.subtree, h.first_child + k});
     }
     h.parent = parent[i];
@@ -612,8 +626,9 @@ void splice(Context& c, BuildNode& root, std::vector<HlodSubtree>& baked, HlodMo
     report.leaves += h.leaf();
     report.depth = std::max<uint32_t>(report.depth, h.depth);
     report.boundary_triangles += h.boundary_triangles;
-    out.tree.nodes.push_back(h);
-    out.payloads.push_back(std::move(payload));
+    out.model.tree.nodes.push_back(h);
+    out.model.payloads.push_back(std::move(payload));
+    out.origin.push_back(origin);
   }
   report.nodes = order.size();
 }
@@ -725,8 +740,9 @@ struct HlodBuilder::Impl {
   std::vector<HlodSubtreeSpec> specs;
   std::vector<uint8_t> baked;  // per subtree: handed to bake_subtrees already
   size_t dropped = 0;
-  bool planned = false, surface_built = false;
+  bool planned = false, surface_built = false, assembled = false;
   Status surface;
+  double surface_cpu = 0;
   Tally top_tally;
 
   Impl(const MeshData& m, const HlodBuildOptions& o)
@@ -734,8 +750,10 @@ struct HlodBuilder::Impl {
 
   void ensure_surface() {
     if (surface_built) return;
+    const double cpu0 = thread_cpu_seconds();
     const TriangleMeshView original{mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
     surface = c.original.set_surface(original, what);
+    surface_cpu = thread_cpu_seconds() - cpu0;
     surface_built = true;
   }
   std::string name(size_t i) const {
@@ -751,6 +769,7 @@ HlodBuilder::HlodBuilder(const MeshData& mesh, const HlodBuildOptions& options)
 HlodBuilder::~HlodBuilder() = default;
 
 const std::vector<HlodSubtreeSpec>& HlodBuilder::subtrees() const { return impl_->specs; }
+double HlodBuilder::surface_cpu_seconds() const { return impl_->surface_cpu; }
 
 Status HlodBuilder::plan() {
   Impl& m = *impl_;
@@ -849,9 +868,10 @@ void HlodBuilder::Impl::build_top(BuildNode& n) {
   build_layers(c, top_tally, n);
 }
 
-Status HlodBuilder::assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report_out) {
+Status HlodBuilder::assemble_top(const std::vector<HlodSubtree>& baked, HlodAssembly& out, HlodBuildReport* report_out) {
   Impl& m = *impl_;
   if (!m.planned) return Status::error(m.what + ": HLOD assembled before the build was planned");
+  if (m.assembled) return Status::error(m.what + ": HLOD assembled twice");
   if (baked.size() != m.frontier.size())
     return Status::error(m.what + ": " + std::to_string(baked.size()) + " subtree results for " +
                          std::to_string(m.frontier.size()) + " subtrees");
@@ -863,20 +883,35 @@ Status HlodBuilder::assemble(std::vector<HlodSubtree>& baked, HlodModel& out, Hl
     report.short_layers += baked[i].short_layers;
     report.oversized_leaves += baked[i].oversized_leaves;
   }
+  m.assembled = true;
   m.ensure_surface();
   if (!m.surface) return m.surface;
   m.build_top(*m.root);
   if (Status s = measure_and_order_errors(m.c, breadth_first(*m.root, Below::stop_at_frontier)); !s) return s;
-  HlodModel model;
-  model.tree.min_verts = m.c.options.min_verts;
-  for (int k = 0; k < 3; ++k) model.tree.box_center[k] = m.root->center[k];
-  model.tree.box_half = m.root->half;
-  model.tree.source_triangles = m.mesh.triangle_count();
-  splice(m.c, *m.root, baked, model, report);
+  HlodAssembly assembly;
+  assembly.model.tree.min_verts = m.c.options.min_verts;
+  for (int k = 0; k < 3; ++k) assembly.model.tree.box_center[k] = m.root->center[k];
+  assembly.model.tree.box_half = m.root->half;
+  assembly.model.tree.source_triangles = m.mesh.triangle_count();
+  splice(m.c, *m.root, baked, assembly, report);
   report.short_layers += m.top_tally.short_layers.load();
   report.oversized_leaves += m.top_tally.oversized_leaves.load();
-  out = std::move(model);
+  out = std::move(assembly);
   if (report_out) *report_out = report;
+  return Status::success();
+}
+
+Status HlodBuilder::assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report_out) {
+  Impl& m = *impl_;
+  for (size_t i = 0; i < baked.size(); ++i)
+    if (baked[i].payloads.size() != baked[i].nodes.size())
+      return Status::error(m.name(i) + ": not one payload per node");
+  HlodAssembly assembly;
+  if (Status s = assemble_top(baked, assembly, report_out); !s) return s;
+  for (size_t i = 0; i < assembly.origin.size(); ++i)
+    if (const HlodAssembly::Origin o = assembly.origin[i]; o.subtree >= 0)
+      assembly.model.payloads[i] = std::move(baked[size_t(o.subtree)].payloads[o.local]);
+  out = std::move(assembly.model);
   return Status::success();
 }
 

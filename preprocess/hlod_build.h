@@ -70,6 +70,18 @@ struct HlodModel {
   std::vector<HlodPayload> payloads;
 };
 
+// The tree assembled from the subtrees' roots (HlodBuilder::assemble_top): model.payloads[i]
+// holds node i's geometry when it is a top node and is empty when origin[i].subtree >= 0 (its
+// payload is that subtree's payloads[origin[i].local]).
+struct HlodAssembly {
+  struct Origin {
+    int32_t subtree = -1;
+    uint32_t local = 0;
+  };
+  HlodModel model;
+  std::vector<Origin> origin;  // by node
+};
+
 struct HlodBuildReport {
   size_t nodes = 0;
   size_t leaves = 0;
@@ -119,6 +131,13 @@ class HlodBuilder {
   // (c) The levels above the frontier and the whole tree, from every subtree's result (by
   // subtree index; consumed). tree.name and tree.source_hash are left for the caller.
   Status assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report = nullptr);
+  // (c) without the subtrees' payloads: each result needs its nodes and its root's payload
+  // only (payloads[0]; more are ignored). The whole tree and the top's payloads, and where each
+  // subtree node's payload comes from, for a writer that places those itself. Once per builder
+  // (assemble is this plus the payloads moved in).
+  Status assemble_top(const std::vector<HlodSubtree>& baked, HlodAssembly& out, HlodBuildReport* report = nullptr);
+  // Process CPU seconds the original's BVH took to build (0 until it is built).
+  double surface_cpu_seconds() const;
 
  private:
   struct Impl;
