@@ -1,7 +1,7 @@
 // The distributed HLOD bake, one rank's side: load -> plan -> check a share of the cache ->
 // gather / broadcast what is missing -> bake a share into the cache -> gather -> (rank 0) the
-// subtrees' roots, the top, the head -> broadcast the layout -> write own payloads -> gather ->
-// (rank 0) rename.
+// subtrees' roots, the top's layers -> broadcast them -> measure a share -> gather -> (rank 0) the
+// top's errors, the head -> broadcast the layout -> write own payloads -> gather -> (rank 0) rename.
 #include "jobs/hlod_distributed_bake.h"
 
 #include <oneapi/tbb/parallel_for.h>
@@ -19,6 +19,7 @@
 #include <type_traits>
 #include <ctime>
 
+#include "jobs/hlod_mesh_cache.h"
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
@@ -51,7 +52,8 @@ template <class Work, class F>
 void each_number(Work& w, F&& f) {
   f(w.subtrees), f(w.triangles), f(w.checked), f(w.bytes_checked), f(w.bake_seconds), f(w.bake_cpu_seconds),
       f(w.total_seconds), f(w.cpu_seconds), f(w.load_cpu_seconds), f(w.clean_cpu_seconds), f(w.plan_cpu_seconds),
-      f(w.check_cpu_seconds), f(w.surface_cpu_seconds), f(w.write_cpu_seconds), f(w.bytes_written), f(w.bytes_placed);
+      f(w.check_cpu_seconds), f(w.surface_cpu_seconds), f(w.measure_cpu_seconds), f(w.write_cpu_seconds),
+      f(w.bytes_written), f(w.bytes_placed);
 }
 
 std::vector<uint8_t> encode_report(const RankReport& r) {
@@ -182,12 +184,28 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
     into = now - cpu;
     cpu = now;
   };
-  if (Status s = load_mesh(mesh_file, j.mesh); !s) return s;
-  j.r.input_triangles = j.mesh.triangle_count();
-  lap(j.work.load_cpu_seconds);
-  clean_mesh(j.mesh);
-  lap(j.work.clean_cpu_seconds);
+  // The cleaned mesh from the cache when a run before stored it; otherwise loaded, cleaned and
+  // (rank 0) stored for the reruns.
   if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, j.source_hash); !s) return s;
+  uint64_t input_triangles = 0;
+  std::string why;
+  const CacheLookup cached =
+      load_hlod_mesh(j.settings.cache_dir, j.source_hash, mesh_file.string(), j.mesh, input_triangles, &why);
+  if (cached == CacheLookup::refused) j.say(why + ": loading the mesh again");
+  if (cached == CacheLookup::found) {
+    j.r.input_triangles = size_t(input_triangles);
+    j.r.mesh_cached = true;
+    lap(j.work.load_cpu_seconds);
+  } else {
+    if (Status s = load_mesh(mesh_file, j.mesh); !s) return s;
+    j.r.input_triangles = j.mesh.triangle_count();
+    lap(j.work.load_cpu_seconds);
+    clean_mesh(j.mesh);
+    if (j.comm.rank == 0)
+      if (Status s = store_hlod_mesh(j.settings.cache_dir, j.source_hash, j.mesh, j.r.input_triangles); !s)
+        j.say(s.message + " (the cleaned mesh is not cached; the bake goes on)");
+    lap(j.work.clean_cpu_seconds);
+  }
   j.r.load_seconds = seconds_since(t0);
   t0 = Clock::now();
   j.options.min_verts = j.settings.min_verts;
@@ -433,21 +451,121 @@ bool decode_layout(const std::vector<uint8_t>& b, Layout& l) {
   return at == b.size();
 }
 
-// Rank 0: the top, the head and the top's payloads written into the temporary at the file's
-// full size; the subtrees' places in it.
-Status assemble_and_lay_out(Job& j, const std::string& name, const std::filesystem::path& out_dir, Layout& layout) {
+// The top's layers to measure, sent by rank 0 to every rank (ok = 0: nothing to measure, the
+// job has failed), and the share of them each rank measures (by sample count, longest first).
+std::vector<uint8_t> encode_probes(bool ok, const std::vector<HlodLayerProbe>& probes) {
+  detail::ByteWriter w;
+  w.u8(ok ? 1 : 0);
+  w.u32(uint32_t(probes.size()));
+  for (const HlodLayerProbe& p : probes) {
+    w.u32(uint32_t(p.source.size())), w.u32(uint32_t(p.indices.size())), w.u32(uint32_t(p.reference.size()));
+    w.words(p.positions.data(), p.positions.size());
+    w.words(p.indices.data(), p.indices.size());
+    w.words(p.source.data(), p.source.size());
+    w.words(p.reference.data(), p.reference.size());
+  }
+  return std::move(w.bytes);
+}
+
+template <class T>
+bool take_words(const std::vector<uint8_t>& b, size_t& at, uint64_t count, std::vector<T>& out) {
+  if (count > (b.size() - at) / 4) return false;
+  out.resize(size_t(count));
+  for (T& v : out) v = std::bit_cast<T>(detail::load_u32(b.data() + at)), at += 4;
+  return true;
+}
+
+bool decode_probes(const std::vector<uint8_t>& b, bool& ok, std::vector<HlodLayerProbe>& probes) {
+  if (b.size() < 5) return false;
+  ok = b[0] == 1;
+  const uint32_t count = detail::load_u32(b.data() + 1);
+  size_t at = 5;
+  if (count > (b.size() - at) / 12) return false;
+  probes.resize(count);
+  for (HlodLayerProbe& p : probes) {
+    if (b.size() - at < 12) return false;
+    const uint32_t nv = detail::load_u32(b.data() + at), ni = detail::load_u32(b.data() + at + 4),
+                   nr = detail::load_u32(b.data() + at + 8);
+    at += 12;
+    if (!take_words(b, at, 3ull * nv, p.positions) || !take_words(b, at, ni, p.indices) ||
+        !take_words(b, at, nv, p.source) || !take_words(b, at, nr, p.reference))
+      return false;
+  }
+  return at == b.size();
+}
+
+std::vector<int> probe_owners(const std::vector<HlodLayerProbe>& probes, int ranks) {
+  std::vector<uint64_t> costs;
+  for (const HlodLayerProbe& p : probes) costs.push_back(p.source.size() + p.indices.size() / 3 + p.reference.size());
+  return assign_subtrees(costs, ranks);
+}
+
+// Every rank: its share of the top's layers measured; the reply is a status, then the errors.
+std::vector<uint8_t> measure_share(Job& j, const std::vector<HlodLayerProbe>& probes) {
+  const double cpu0 = process_cpu_seconds();
+  const std::vector<int> owner = probe_owners(probes, j.ranks());
+  std::vector<size_t> mine;
+  for (size_t i = 0; i < probes.size(); ++i)
+    if (owner[i] == j.comm.rank) mine.push_back(i);
+  std::vector<float> errors;
+  Status st;
+  j.arena->execute([&] { st = j.builder->measure_probes(probes, mine, errors); });
+  detail::ByteWriter w;
+  w.u8(st ? 1 : 0);
+  if (st) {
+    w.u32(uint32_t(errors.size()));
+    w.words(errors.data(), errors.size());
+  } else {
+    const std::string message = "rank " + std::to_string(j.comm.rank) + ": " + st.message;
+    w.raw(message.data(), message.size());
+  }
+  j.work.measure_cpu_seconds = process_cpu_seconds() - cpu0;
+  return std::move(w.bytes);
+}
+
+// Rank 0: every rank's errors back in probe order.
+Status merge_errors(const Job& j, const std::vector<HlodLayerProbe>& probes,
+                    const std::vector<std::vector<uint8_t>>& replies, std::vector<float>& errors) {
+  const std::vector<int> owner = probe_owners(probes, j.ranks());
+  errors.assign(probes.size(), 0.0f);
+  for (size_t r = 0; r < replies.size(); ++r) {
+    const std::vector<uint8_t>& b = replies[r];
+    if (b.empty()) return Status::error("rank " + std::to_string(r) + " sent no top errors");
+    if (b[0] != 1) return Status::error(std::string(b.begin() + 1, b.end()));
+    size_t at = 1;
+    std::vector<float> got;
+    if (b.size() < 5) return Status::error("rank " + std::to_string(r) + " sent malformed top errors");
+    const uint32_t count = detail::load_u32(b.data() + at);
+    at += 4;
+    if (!take_words(b, at, count, got) || at != b.size())
+      return Status::error("rank " + std::to_string(r) + " sent malformed top errors");
+    size_t k = 0;
+    for (size_t i = 0; i < probes.size(); ++i)
+      if (owner[i] == int(r)) {
+        if (k >= got.size()) return Status::error("rank " + std::to_string(r) + " sent too few top errors");
+        errors[i] = got[k++];
+      }
+    if (k != got.size()) return Status::error("rank " + std::to_string(r) + " sent too many top errors");
+  }
+  return Status::success();
+}
+
+// Rank 0: the top finished from the errors, the head and the top's payloads written into the
+// temporary at the file's full size; the subtrees' places in it.
+Status finish_and_lay_out(Job& j, const std::vector<float>& errors, const std::string& name,
+                          const std::filesystem::path& out_dir, Layout& layout) {
   auto t0 = Clock::now();
   double cpu = process_cpu_seconds();
   HlodAssembly assembly;
   Status st;
-  j.arena->execute([&] { st = j.builder->assemble_top(j.roots, assembly, &j.r.report); });
+  j.arena->execute([&] { st = j.builder->finish_top(j.roots, errors, assembly, &j.r.report); });
   if (!st) return st;
   HlodTree& tree = assembly.model.tree;
   tree.name = name;
   tree.source_hash = j.source_hash;
   j.roots.clear();
-  j.r.assemble_seconds = seconds_since(t0);
-  j.r.assemble_cpu_seconds = process_cpu_seconds() - cpu;
+  j.r.assemble_seconds += seconds_since(t0);
+  j.r.assemble_cpu_seconds += process_cpu_seconds() - cpu;
   t0 = Clock::now();
   cpu = process_cpu_seconds();
   std::error_code ec;
@@ -531,6 +649,7 @@ Status take_reports(Job& j, const std::vector<std::vector<uint8_t>>& reports, bo
     if (keep_work) j.r.ranks.push_back(other.work);
     else if (r < j.r.ranks.size()) {
       j.r.ranks[r].write_cpu_seconds = other.work.write_cpu_seconds;
+      j.r.ranks[r].measure_cpu_seconds = other.work.measure_cpu_seconds;
       j.r.ranks[r].bytes_placed = other.work.bytes_placed;
     }
     if (!other.status && failed) failed = other.status;
@@ -608,19 +727,44 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   Layout layout;
   Status st = rep.status;
   double cpu_gathered = process_cpu_seconds();
+  std::vector<HlodLayerProbe> probes;
+  double serial_cpu = 0;  // rank 0's own, while the others wait
   if (comm.rank == 0) {
     st = take_reports(j, reports, true);
     if (!st) st.message += " (the cache keeps every finished subtree: run again to resume)";
     const double cpu0 = process_cpu_seconds();
     if (st) st = collect_roots(j);
-    j.r.collect_cpu_seconds = process_cpu_seconds() - cpu0;
-    if (st) st = assemble_and_lay_out(j, name, out_dir, layout);
+    const double cpu1 = process_cpu_seconds();
+    j.r.collect_cpu_seconds = cpu1 - cpu0;
+    const auto t0 = Clock::now();
+    if (st) j.arena->execute([&] { st = j.builder->build_top(j.roots, probes); });
+    j.r.assemble_seconds = seconds_since(t0);
+    j.r.assemble_cpu_seconds = process_cpu_seconds() - cpu1;
+    serial_cpu += process_cpu_seconds() - cpu_gathered;
+  }
+  // The top's layers are measured by every rank (each holds the mesh and its BVH).
+  std::vector<uint8_t> sent = comm.rank == 0 ? encode_probes(bool(st), probes) : std::vector<uint8_t>{};
+  comm.broadcast(sent);
+  bool measuring = false;
+  if (!decode_probes(sent, measuring, probes)) {
+    measuring = false;
+    if (st) st = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 sent malformed top layers");
+  }
+  if (measuring) {
+    const std::vector<std::vector<uint8_t>> replies = comm.gather(st ? measure_share(j, probes) : std::vector<uint8_t>{});
+    if (comm.rank == 0) {
+      const double cpu0 = process_cpu_seconds();
+      std::vector<float> errors;
+      st = merge_errors(j, probes, replies, errors);
+      probes.clear();
+      if (st) st = finish_and_lay_out(j, errors, name, out_dir, layout);
+      serial_cpu += process_cpu_seconds() - cpu0;
+    }
   }
   std::vector<uint8_t> plan = comm.rank == 0 ? encode_layout(layout) : std::vector<uint8_t>{};
   comm.broadcast(plan);
   if (comm.rank != 0 && !decode_layout(plan, layout))
     st = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 sent a malformed file layout");
-  const double cpu_laid_out = process_cpu_seconds();
   if (layout.ok) {
     const RankReport wrote = write_share(j, layout, (out_dir / (name + ".hlod")).string());
     const std::vector<std::vector<uint8_t>> written = comm.gather(encode_report(wrote));
@@ -634,11 +778,13 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   }
   if (comm.rank == 0) {
     j.r.cpu_after_gather_seconds = process_cpu_seconds() - cpu_gathered;
-    double slowest = 0, slowest_write = 0;
-    for (const HlodRankWork& w : j.r.ranks)
-      slowest = std::max(slowest, w.cpu_seconds), slowest_write = std::max(slowest_write, w.write_cpu_seconds);
-    // Rank 0's own CPU between the gather and the layout broadcast is the serial part.
-    j.r.critical_cpu_seconds = slowest + (cpu_laid_out - cpu_gathered) + slowest_write;
+    double slowest = 0, slowest_measure = 0, slowest_write = 0;
+    for (const HlodRankWork& w : j.r.ranks) {
+      slowest = std::max(slowest, w.cpu_seconds);
+      slowest_measure = std::max(slowest_measure, w.measure_cpu_seconds);
+      slowest_write = std::max(slowest_write, w.write_cpu_seconds);
+    }
+    j.r.critical_cpu_seconds = slowest + serial_cpu + slowest_measure + slowest_write;
   }
   j.r.total_seconds = seconds_since(t_start);
   if (result) *result = std::move(j.r);

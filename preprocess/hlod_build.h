@@ -82,6 +82,15 @@ struct HlodAssembly {
   std::vector<Origin> origin;  // by node
 };
 
+// One layer of the top to measure against the original (HlodBuilder::build_top), whole: its
+// geometry, the original vertex each of its vertices descends from, its node's reference samples.
+struct HlodLayerProbe {
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  std::vector<uint32_t> source;
+  std::vector<uint32_t> reference;
+};
+
 struct HlodBuildReport {
   size_t nodes = 0;
   size_t leaves = 0;
@@ -136,6 +145,16 @@ class HlodBuilder {
   // subtree node's payload comes from, for a writer that places those itself. Once per builder
   // (assemble is this plus the payloads moved in).
   Status assemble_top(const std::vector<HlodSubtree>& baked, HlodAssembly& out, HlodBuildReport* report = nullptr);
+  // assemble_top in three steps, so that the top's error measurement (most of its work) can be
+  // spread like (b): build_top builds the top's layers from the subtrees' roots and lists every
+  // layer to measure; measure_probes, on any builder planned over the same mesh, measures the
+  // listed ones (errors by position in `which`); finish_top, on the builder that built the top,
+  // takes every layer's error (by probe) and makes the tree.
+  Status build_top(const std::vector<HlodSubtree>& baked, std::vector<HlodLayerProbe>& probes);
+  Status measure_probes(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& which,
+                        std::vector<float>& errors);
+  Status finish_top(const std::vector<HlodSubtree>& baked, const std::vector<float>& errors, HlodAssembly& out,
+                    HlodBuildReport* report = nullptr);
   // Process CPU seconds the original's BVH took to build (0 until it is built).
   double surface_cpu_seconds() const;
 

@@ -69,11 +69,12 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
                         {"cpu_s", {{"load", w.load_cpu_seconds}, {"clean", w.clean_cpu_seconds},
                                    {"plan", w.plan_cpu_seconds}, {"check", w.check_cpu_seconds},
                                    {"bvh", w.surface_cpu_seconds}, {"bake", w.bake_cpu_seconds},
-                                   {"write", w.write_cpu_seconds}}},
+                                   {"measure_top", w.measure_cpu_seconds}, {"write", w.write_cpu_seconds}}},
                         {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed}});
     slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
   }
   return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},
+          {"mesh_cached", r.mesh_cached},
           {"subtrees", r.subtrees}, {"cached", r.cached}, {"rebaked", r.rebaked}, {"nodes", r.report.nodes},
           {"entry_bytes_read", r.entry_bytes_read}, {"load_s", r.load_seconds}, {"plan_s", r.plan_seconds},
           {"lookup_s", r.lookup_seconds}, {"bake_s", r.bake_seconds}, {"assemble_s", r.assemble_seconds},
