@@ -763,10 +763,15 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   }
   std::vector<uint8_t> plan = comm.rank == 0 ? encode_layout(layout) : std::vector<uint8_t>{};
   comm.broadcast(plan);
-  if (comm.rank != 0 && !decode_layout(plan, layout))
+  if (comm.rank != 0 && !decode_layout(plan, layout)) {
+    // Every rank got these bytes, so every rank still meets the write's gather: this one
+    // writes nothing and reports the failure there.
+    layout.writer.clear();
     st = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 sent a malformed file layout");
+  }
   if (layout.ok) {
-    const RankReport wrote = write_share(j, layout, (out_dir / (name + ".hlod")).string());
+    RankReport wrote = write_share(j, layout, (out_dir / (name + ".hlod")).string());
+    if (!st && wrote.status) wrote.status = st;
     const std::vector<std::vector<uint8_t>> written = comm.gather(encode_report(wrote));
     if (comm.rank == 0) {
       st = take_reports(j, written, false);
