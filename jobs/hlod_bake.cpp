@@ -30,10 +30,13 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 // Content hash of the mesh file's bytes, mixed with what else decides the output.
 Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out) {
-  std::ifstream f(file, std::ios::binary);
+  std::ifstream f(file, std::ios::binary | std::ios::ate);
   if (!f) return Status::error(file.string() + ": cannot be opened for reading");
-  const std::vector<char> bytes{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-  if (f.bad()) return Status::error(file.string() + ": read error");
+  const std::streamoff size = f.tellg();
+  std::vector<char> bytes(size > 0 ? size_t(size) : 0);
+  f.seekg(0);
+  if (size < 0 || !f.read(bytes.data(), std::streamsize(bytes.size())))
+    return Status::error(file.string() + ": read error");
   const uint64_t settings[2] = {1 /* build version */, min_verts};
   out = hash_bytes(settings, sizeof settings, hash_bytes(bytes.data(), bytes.size()));
   return Status::success();

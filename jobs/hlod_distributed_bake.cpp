@@ -1,5 +1,7 @@
-// The distributed HLOD bake, one rank's side: load -> plan -> (rank 0) lookup -> broadcast ->
-// bake this rank's share into the cache -> gather -> (rank 0) read the rest, assemble, write.
+// The distributed HLOD bake, one rank's side: load -> plan -> check a share of the cache ->
+// gather / broadcast what is missing -> bake a share into the cache -> gather -> (rank 0) the
+// subtrees' roots, the top's layers -> broadcast them -> measure a share -> gather -> (rank 0) the
+// top's errors, the head -> broadcast the layout -> write own payloads -> gather -> (rank 0) rename.
 #include "jobs/hlod_distributed_bake.h"
 
 #include <oneapi/tbb/parallel_for.h>
@@ -14,14 +16,17 @@
 #include <mutex>
 #include <numeric>
 #include <thread>
+#include <type_traits>
 #include <ctime>
 
+#include "jobs/hlod_mesh_cache.h"
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
 #include "runtime/byte_order.h"
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
+#include "runtime/hlod_subtree_entry.h"
 
 namespace lod {
 namespace {
@@ -42,16 +47,22 @@ struct RankReport {
   HlodRankWork work;
 };
 
+// The report's numbers in one order for both sides.
+template <class Work, class F>
+void each_number(Work& w, F&& f) {
+  f(w.subtrees), f(w.triangles), f(w.checked), f(w.bytes_checked), f(w.bake_seconds), f(w.bake_cpu_seconds),
+      f(w.total_seconds), f(w.cpu_seconds), f(w.load_cpu_seconds), f(w.clean_cpu_seconds), f(w.plan_cpu_seconds),
+      f(w.check_cpu_seconds), f(w.surface_cpu_seconds), f(w.measure_cpu_seconds), f(w.write_cpu_seconds),
+      f(w.bytes_written), f(w.bytes_placed);
+}
+
 std::vector<uint8_t> encode_report(const RankReport& r) {
   detail::ByteWriter w;
   w.u8(r.status.ok ? 1 : 0);
-  w.u32(r.work.subtrees);
-  w.u64(r.work.triangles);
-  w.u64(std::bit_cast<uint64_t>(r.work.bake_seconds));
-  w.u64(std::bit_cast<uint64_t>(r.work.bake_cpu_seconds));
-  w.u64(std::bit_cast<uint64_t>(r.work.total_seconds));
-  w.u64(std::bit_cast<uint64_t>(r.work.cpu_seconds));
-  w.u64(r.work.bytes_written);
+  each_number(r.work, [&](const auto& v) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, double>) w.u64(std::bit_cast<uint64_t>(v));
+    else w.u64(uint64_t(v));
+  });
   w.u32(uint32_t(r.status.message.size()));
   w.raw(r.status.message.data(), r.status.message.size());
   return std::move(w.bytes);
@@ -59,18 +70,20 @@ std::vector<uint8_t> encode_report(const RankReport& r) {
 
 RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   RankReport r;
-  constexpr size_t fixed = 1 + 4 + 8 + 8 + 8 + 8 + 8 + 8 + 4;
+  size_t numbers = 0;
+  each_number(r.work, [&](auto&) { ++numbers; });
+  const size_t fixed = 1 + 8 * numbers + 4;
   if (b.size() < fixed || b.size() != fixed + detail::load_u32(b.data() + fixed - 4)) {
     r.status = Status::error("rank " + std::to_string(rank) + " sent a malformed report");
     return r;
   }
-  r.work.subtrees = detail::load_u32(b.data() + 1);
-  r.work.triangles = detail::load_u64(b.data() + 5);
-  r.work.bake_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 13));
-  r.work.bake_cpu_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 21));
-  r.work.total_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 29));
-  r.work.cpu_seconds = std::bit_cast<double>(detail::load_u64(b.data() + 37));
-  r.work.bytes_written = detail::load_u64(b.data() + 45);
+  size_t at = 1;
+  each_number(r.work, [&](auto& v) {
+    const uint64_t word = detail::load_u64(b.data() + at);
+    at += 8;
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, double>) v = std::bit_cast<double>(word);
+    else v = static_cast<std::decay_t<decltype(v)>>(word);
+  });
   r.status = b[0] ? Status::success() : Status::error(std::string(b.begin() + fixed, b.end()));
   return r;
 }
@@ -135,13 +148,17 @@ struct Job {
   const HlodRankComm& comm;
   const HlodBakeLog& log;
   HlodDistributedResult r;
+  HlodRankWork work;                   // this rank's, reported to rank 0
   MeshData mesh;
   HlodBuildOptions options;
   std::unique_ptr<HlodBuilder> builder;
+  uint64_t source_hash = 0;
   std::vector<uint64_t> keys;
-  std::vector<HlodSubtree> baked;      // rank 0: every result it holds
-  std::vector<uint8_t> have;           // rank 0: per subtree, baked[i] holds it
+  std::vector<HlodSubtree> roots;      // rank 0: each subtree's nodes and root payload, once held
+  std::vector<uint8_t> have;           // rank 0: per subtree, roots[i] holds it
   std::vector<uint8_t> missing;        // per subtree: not in the cache when the job began
+  std::vector<int32_t> writer;         // per subtree: the rank writing its payloads into the .hlod
+  std::vector<std::vector<uint8_t>> entries;  // per subtree: its entry's bytes, where this rank writes it
   std::unique_ptr<tbb::task_arena> arena;
 
   void say(const std::string& line) const {
@@ -149,56 +166,127 @@ struct Job {
   }
   uint64_t vertices() const { return mesh.vertex_count(); }
   const std::vector<HlodSubtreeSpec>& specs() const { return builder->subtrees(); }
+  int ranks() const { return std::max(1, comm.size); }
 };
+
+// What the levels above need of a subtree: its nodes and its root's payload.
+HlodSubtree root_only(HlodSubtree&& s) {
+  s.payloads.resize(std::min<size_t>(s.payloads.size(), 1));
+  s.payloads.shrink_to_fit();
+  return std::move(s);
+}
 
 Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
   auto t0 = Clock::now();
-  if (Status s = load_mesh(mesh_file, j.mesh); !s) return s;
-  j.r.input_triangles = j.mesh.triangle_count();
-  clean_mesh(j.mesh);
-  uint64_t source_hash = 0;
-  if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, source_hash); !s) return s;
+  double cpu = process_cpu_seconds();
+  auto lap = [&cpu](double& into) {
+    const double now = process_cpu_seconds();
+    into = now - cpu;
+    cpu = now;
+  };
+  // The cleaned mesh from the cache when a run before stored it; otherwise loaded, cleaned and
+  // (rank 0) stored for the reruns.
+  if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, j.source_hash); !s) return s;
+  uint64_t input_triangles = 0;
+  std::string why;
+  const CacheLookup cached =
+      load_hlod_mesh(j.settings.cache_dir, j.source_hash, mesh_file.string(), j.mesh, input_triangles, &why);
+  if (cached == CacheLookup::refused) j.say(why + ": loading the mesh again");
+  if (cached == CacheLookup::found) {
+    j.r.input_triangles = size_t(input_triangles);
+    j.r.mesh_cached = true;
+    lap(j.work.load_cpu_seconds);
+  } else {
+    if (Status s = load_mesh(mesh_file, j.mesh); !s) return s;
+    j.r.input_triangles = j.mesh.triangle_count();
+    lap(j.work.load_cpu_seconds);
+    clean_mesh(j.mesh);
+    if (j.comm.rank == 0)
+      if (Status s = store_hlod_mesh(j.settings.cache_dir, j.source_hash, j.mesh, j.r.input_triangles); !s)
+        j.say(s.message + " (the cleaned mesh is not cached; the bake goes on)");
+    lap(j.work.clean_cpu_seconds);
+  }
   j.r.load_seconds = seconds_since(t0);
   t0 = Clock::now();
   j.options.min_verts = j.settings.min_verts;
-  j.options.subtrees = j.settings.subtrees ? j.settings.subtrees : 16 * uint32_t(std::max(1, j.comm.size));
+  j.options.subtrees = j.settings.subtrees ? j.settings.subtrees : 16 * uint32_t(j.ranks());
   j.options.parallel_for = tbb_parallel_for();
   j.builder = std::make_unique<HlodBuilder>(j.mesh, j.options);
   Status planned;
   j.arena->execute([&] { planned = j.builder->plan(); });
   if (!planned) return planned;
-  for (const HlodSubtreeSpec& spec : j.specs()) j.keys.push_back(hlod_subtree_key(source_hash, j.options, spec));
+  for (const HlodSubtreeSpec& spec : j.specs()) j.keys.push_back(hlod_subtree_key(j.source_hash, j.options, spec));
   j.r.subtrees = j.keys.size();
+  const size_t n = j.keys.size();
+  j.roots.resize(n);
+  j.have.assign(n, 0);
+  j.missing.assign(n, 1);
+  j.writer.assign(n, -1);
+  j.entries.resize(n);
+  lap(j.work.plan_cpu_seconds);
   j.r.plan_seconds = seconds_since(t0);
   return Status::success();
 }
 
-// Rank 0: every entry read and checked now; what is missing or refused is baked this run.
-void look_up(Job& j) {
+std::vector<uint64_t> subtree_costs(const Job& j) {
+  std::vector<uint64_t> costs;
+  for (const HlodSubtreeSpec& spec : j.specs()) costs.push_back(spec.triangles);
+  return costs;
+}
+
+// Every rank checks its share of the entries in full (the same split on every rank) and keeps
+// the bytes of those found: it writes their payloads later. One byte per subtree for rank 0:
+// 0 not this rank's, 1 found, 2 missing or refused (a refused entry is removed, so that
+// progress counts only its replacement).
+std::vector<uint8_t> check_share(Job& j) {
   const auto t0 = Clock::now();
+  const double cpu0 = process_cpu_seconds();
   const size_t n = j.keys.size();
-  j.baked.resize(n);
-  j.have.assign(n, 0);
-  j.missing.assign(n, 1);
-  std::vector<std::string> why(n);
-  std::vector<uint64_t> bytes(n, 0);
-  std::vector<CacheLookup> found(n);
+  const std::vector<int> checker = assign_subtrees(subtree_costs(j), j.ranks());
+  std::vector<size_t> mine;
+  for (size_t i = 0; i < n; ++i)
+    if (checker[i] == j.comm.rank) mine.push_back(i);
+  std::vector<std::string> why(mine.size());
+  std::vector<uint64_t> bytes(mine.size(), 0);
+  std::vector<CacheLookup> found(mine.size());
+  std::vector<HlodSubtree> decoded(mine.size());
   j.arena->execute([&] {
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-      found[i] = load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), j.baked[i], &why[i], &bytes[i]);
+    tbb::parallel_for(size_t(0), mine.size(), [&](size_t k) {
+      const size_t i = mine[k];
+      found[k] = load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), decoded[k], &why[k], &bytes[k],
+                                   &j.entries[i]);
+      if (j.comm.rank == 0 && found[k] == CacheLookup::found) j.roots[i] = root_only(std::move(decoded[k]));
+      decoded[k] = {};
     });
   });
-  for (size_t i = 0; i < n; ++i) {
-    if (found[i] == CacheLookup::refused) {  // gone, so that progress counts only its replacement
-      j.say("subtree " + std::to_string(i) + ": " + why[i] + ": baking it again");
+  std::vector<uint8_t> bits(n, 0);
+  for (size_t k = 0; k < mine.size(); ++k) {
+    const size_t i = mine[k];
+    bits[i] = found[k] == CacheLookup::found ? 1 : 2;
+    if (found[k] == CacheLookup::refused) {
+      j.say("subtree " + std::to_string(i) + ": " + why[k] + ": baking it again");
       std::error_code ec;
       std::filesystem::remove(hlod_subtree_entry_path(j.settings.cache_dir, j.keys[i]), ec);
     }
-    if (found[i] != CacheLookup::found) continue;
-    j.have[i] = 1, j.missing[i] = 0, ++j.r.cached;
-    j.r.entry_bytes_read += bytes[i];
+    if (found[k] != CacheLookup::found) continue;
+    j.have[i] = j.comm.rank == 0;
+    ++j.work.checked;
+    j.work.bytes_checked += bytes[k];
   }
+  j.work.check_cpu_seconds = process_cpu_seconds() - cpu0;
   j.r.lookup_seconds = seconds_since(t0);
+  return bits;
+}
+
+// Rank 0: every rank's check merged into the missing mask (a subtree is cached when its
+// checker found it; a rank that could not plan found nothing).
+std::vector<uint8_t> merge_checks(const Job& j, const std::vector<std::vector<uint8_t>>& checks) {
+  std::vector<uint8_t> missing(j.keys.size(), 1);
+  for (const std::vector<uint8_t>& bits : checks)
+    if (bits.size() == missing.size() + 1 && bits.back() == 1)
+      for (size_t i = 0; i < missing.size(); ++i)
+        if (bits[i] == 1) missing[i] = 0;
+  return missing;
 }
 
 std::unique_ptr<ProgressWatch> watch_progress(const Job& j) {
@@ -210,19 +298,36 @@ std::unique_ptr<ProgressWatch> watch_progress(const Job& j) {
   return std::make_unique<ProgressWatch>(std::move(paths), std::move(tris), j.keys.size(), j.r.cached, j.log);
 }
 
-std::vector<size_t> my_share(const Job& j) {
+// Who writes each subtree's payloads: the rank that checked a cached entry, or bakes a missing one.
+void assign_writers(Job& j) {
+  const std::vector<int> checker = assign_subtrees(subtree_costs(j), j.ranks());
   std::vector<size_t> todo;
   std::vector<uint64_t> costs;
   for (size_t i = 0; i < j.missing.size(); ++i)
     if (j.missing[i]) todo.push_back(i), costs.push_back(j.specs()[i].triangles);
-  const std::vector<int> owner = assign_subtrees(costs, std::max(1, j.comm.size));
+    else j.writer[i] = checker[i];
+  const std::vector<int> owner = assign_subtrees(costs, j.ranks());
+  for (size_t k = 0; k < todo.size(); ++k) j.writer[todo[k]] = owner[k];
+}
+
+std::vector<size_t> my_share(const Job& j) {
   std::vector<size_t> mine;
-  for (size_t k = 0; k < todo.size(); ++k)
-    if (owner[k] == j.comm.rank) mine.push_back(todo[k]);
+  for (size_t i = 0; i < j.missing.size(); ++i)
+    if (j.missing[i] && j.writer[i] == j.comm.rank) mine.push_back(i);
   return mine;
 }
 
-// This rank's share, each result stored as soon as it is finished (rank 0 keeps its own too).
+// Stores a finished subtree; the rank keeps the entry's bytes to write, rank 0 the root too.
+Status keep_baked(Job& j, size_t i, HlodSubtree&& s, std::mutex& mutex, uint64_t* bytes) {
+  std::vector<uint8_t> entry;
+  if (Status st = store_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), s, bytes, &entry); !st) return st;
+  std::lock_guard lock(mutex);
+  j.entries[i] = std::move(entry);
+  if (j.comm.rank == 0) j.roots[i] = root_only(std::move(s)), j.have[i] = 1;
+  return Status::success();
+}
+
+// This rank's share, each result stored as soon as it is finished.
 RankReport bake_share(Job& j, const std::vector<size_t>& mine) {
   RankReport rep;
   std::mutex mutex;
@@ -232,13 +337,12 @@ RankReport bake_share(Job& j, const std::vector<size_t>& mine) {
   auto done = [&](size_t i, HlodSubtree&& s) -> Status {
     if (j.settings.before_store) j.settings.before_store(i, stored.load());
     uint64_t bytes = 0;
-    if (Status st = store_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), s, &bytes); !st) return st;
+    if (Status st = keep_baked(j, i, std::move(s), mutex, &bytes); !st) return st;
     stored.fetch_add(1);
     std::lock_guard lock(mutex);
-    ++rep.work.subtrees;
-    rep.work.triangles += j.specs()[i].triangles;
-    rep.work.bytes_written += bytes;
-    if (j.comm.rank == 0) j.baked[i] = std::move(s), j.have[i] = 1;
+    ++j.work.subtrees;
+    j.work.triangles += j.specs()[i].triangles;
+    j.work.bytes_written += bytes;
     return Status::success();
   };
   j.arena->execute([&] {
@@ -248,60 +352,310 @@ RankReport bake_share(Job& j, const std::vector<size_t>& mine) {
       rep.status = Status::error(std::string("rank ") + std::to_string(j.comm.rank) + ": " + e.what());
     }
   });
-  rep.work.bake_seconds = seconds_since(t0);
-  rep.work.bake_cpu_seconds = process_cpu_seconds() - cpu0;
+  j.work.bake_seconds = seconds_since(t0);
+  j.work.bake_cpu_seconds = process_cpu_seconds() - cpu0;
+  j.work.surface_cpu_seconds = j.builder->surface_cpu_seconds();
   if (!rep.status) rep.status.message = "rank " + std::to_string(j.comm.rank) + ": " + rep.status.message;
   return rep;
 }
 
-// Rank 0: the other ranks' entries; one that is refused now is baked here.
-Status collect(Job& j) {
+// Rank 0: the roots it does not hold, from the entries' first bytes; a subtree whose entry is
+// refused now is baked here (and written by rank 0).
+Status collect_roots(Job& j) {
+  const size_t n = j.keys.size();
+  std::vector<CacheLookup> found(n, CacheLookup::found);
+  std::vector<std::string> why(n);
+  std::vector<uint64_t> bytes(n, 0);
+  j.arena->execute([&] {
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      if (!j.have[i])
+        found[i] = load_hlod_subtree_root(j.settings.cache_dir, j.keys[i], j.vertices(), j.roots[i], &why[i], &bytes[i]);
+    });
+  });
   std::vector<size_t> refused;
-  for (size_t i = 0; i < j.keys.size(); ++i) {
-    if (j.have[i]) continue;
-    std::string why;
-    uint64_t bytes = 0;
-    if (load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), j.baked[i], &why, &bytes) == CacheLookup::found) {
+  for (size_t i = 0; i < n; ++i) {
+    j.r.entry_bytes_read += bytes[i];
+    if (j.have[i] || found[i] == CacheLookup::found) {
       j.have[i] = 1;
-      j.r.entry_bytes_read += bytes;
       continue;
     }
-    j.say("subtree " + std::to_string(i) + ": " + (why.empty() ? "entry missing" : why) + ": baking it again on rank 0");
+    j.say("subtree " + std::to_string(i) + ": " + (why[i].empty() ? "entry missing" : why[i]) + ": baking it again on rank 0");
     refused.push_back(i);
   }
   if (refused.empty()) return Status::success();
   j.r.rebaked = refused.size();
+  std::mutex mutex;
   Status st;
   j.arena->execute([&] {
     st = j.builder->bake_subtrees(refused, [&](size_t i, HlodSubtree&& s) {
-      if (Status stored = store_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), s); !stored) return stored;
-      j.baked[i] = std::move(s);
+      if (Status kept = keep_baked(j, i, std::move(s), mutex, nullptr); !kept) return kept;
+      j.writer[i] = 0;
       return Status::success();
     });
   });
   return st;
 }
 
-Status assemble_and_write(Job& j, const std::filesystem::path& mesh_file, const std::string& name,
-                          const std::filesystem::path& out_dir) {
-  auto t0 = Clock::now();
-  HlodModel model;
+// Where every subtree node's payload goes in the file: (offset, size) by the subtree's own
+// node order, and who writes it; the temporary file's name. Rank 0 sends it to every rank.
+struct Layout {
+  bool ok = false;
+  std::filesystem::path temp;
+  std::vector<int32_t> writer;
+  std::vector<std::vector<std::pair<uint64_t, uint64_t>>> pieces;  // by subtree, by local node
+};
+
+std::vector<uint8_t> encode_layout(const Layout& l) {
+  detail::ByteWriter w;
+  w.u8(l.ok ? 1 : 0);
+  const std::string path = l.temp.string();
+  w.u32(uint32_t(path.size()));
+  w.raw(path.data(), path.size());
+  w.u32(uint32_t(l.pieces.size()));
+  for (size_t i = 0; i < l.pieces.size(); ++i) {
+    w.u32(uint32_t(l.writer[i]));
+    w.u32(uint32_t(l.pieces[i].size()));
+    for (const auto& [offset, size] : l.pieces[i]) w.u64(offset), w.u64(size);
+  }
+  return std::move(w.bytes);
+}
+
+// Every count checked against the bytes left before it is used.
+bool decode_layout(const std::vector<uint8_t>& b, Layout& l) {
+  size_t at = 0;
+  auto has = [&](uint64_t n) { return n <= b.size() - at; };
+  if (!has(5)) return false;
+  l.ok = b[at++] == 1;
+  const uint32_t path_bytes = detail::load_u32(b.data() + at);
+  at += 4;
+  if (!has(uint64_t(path_bytes) + 4)) return false;
+  l.temp = std::string(b.begin() + std::ptrdiff_t(at), b.begin() + std::ptrdiff_t(at + path_bytes));
+  at += path_bytes;
+  const uint32_t count = detail::load_u32(b.data() + at);
+  at += 4;
+  if (!has(8ull * count)) return false;
+  l.writer.resize(count);
+  l.pieces.resize(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    if (!has(8)) return false;
+    l.writer[i] = int32_t(detail::load_u32(b.data() + at));
+    const uint32_t nodes = detail::load_u32(b.data() + at + 4);
+    at += 8;
+    if (!has(16ull * nodes)) return false;
+    l.pieces[i].resize(nodes);
+    for (auto& [offset, size] : l.pieces[i]) {
+      offset = detail::load_u64(b.data() + at), size = detail::load_u64(b.data() + at + 8);
+      at += 16;
+    }
+  }
+  return at == b.size();
+}
+
+// The top's layers to measure, sent by rank 0 to every rank (ok = 0: nothing to measure, the
+// job has failed), and the share of them each rank measures (by sample count, longest first).
+std::vector<uint8_t> encode_probes(bool ok, const std::vector<HlodLayerProbe>& probes) {
+  detail::ByteWriter w;
+  w.u8(ok ? 1 : 0);
+  w.u32(uint32_t(probes.size()));
+  for (const HlodLayerProbe& p : probes) {
+    w.u32(uint32_t(p.source.size())), w.u32(uint32_t(p.indices.size())), w.u32(uint32_t(p.reference.size()));
+    w.words(p.positions.data(), p.positions.size());
+    w.words(p.indices.data(), p.indices.size());
+    w.words(p.source.data(), p.source.size());
+    w.words(p.reference.data(), p.reference.size());
+  }
+  return std::move(w.bytes);
+}
+
+template <class T>
+bool take_words(const std::vector<uint8_t>& b, size_t& at, uint64_t count, std::vector<T>& out) {
+  if (count > (b.size() - at) / 4) return false;
+  out.resize(size_t(count));
+  for (T& v : out) v = std::bit_cast<T>(detail::load_u32(b.data() + at)), at += 4;
+  return true;
+}
+
+bool decode_probes(const std::vector<uint8_t>& b, bool& ok, std::vector<HlodLayerProbe>& probes) {
+  if (b.size() < 5) return false;
+  ok = b[0] == 1;
+  const uint32_t count = detail::load_u32(b.data() + 1);
+  size_t at = 5;
+  if (count > (b.size() - at) / 12) return false;
+  probes.resize(count);
+  for (HlodLayerProbe& p : probes) {
+    if (b.size() - at < 12) return false;
+    const uint32_t nv = detail::load_u32(b.data() + at), ni = detail::load_u32(b.data() + at + 4),
+                   nr = detail::load_u32(b.data() + at + 8);
+    at += 12;
+    if (!take_words(b, at, 3ull * nv, p.positions) || !take_words(b, at, ni, p.indices) ||
+        !take_words(b, at, nv, p.source) || !take_words(b, at, nr, p.reference))
+      return false;
+  }
+  return at == b.size();
+}
+
+std::vector<int> probe_owners(const std::vector<HlodLayerProbe>& probes, int ranks) {
+  std::vector<uint64_t> costs;
+  for (const HlodLayerProbe& p : probes) costs.push_back(p.source.size() + p.indices.size() / 3 + p.reference.size());
+  return assign_subtrees(costs, ranks);
+}
+
+// Every rank: its share of the top's layers measured; the reply is a status, then the errors.
+std::vector<uint8_t> measure_share(Job& j, const std::vector<HlodLayerProbe>& probes) {
+  const double cpu0 = process_cpu_seconds();
+  const std::vector<int> owner = probe_owners(probes, j.ranks());
+  std::vector<size_t> mine;
+  for (size_t i = 0; i < probes.size(); ++i)
+    if (owner[i] == j.comm.rank) mine.push_back(i);
+  std::vector<float> errors;
   Status st;
-  j.arena->execute([&] { st = j.builder->assemble(j.baked, model, &j.r.report); });
+  j.arena->execute([&] { st = j.builder->measure_probes(probes, mine, errors); });
+  detail::ByteWriter w;
+  w.u8(st ? 1 : 0);
+  if (st) {
+    w.u32(uint32_t(errors.size()));
+    w.words(errors.data(), errors.size());
+  } else {
+    const std::string message = "rank " + std::to_string(j.comm.rank) + ": " + st.message;
+    w.raw(message.data(), message.size());
+  }
+  j.work.measure_cpu_seconds = process_cpu_seconds() - cpu0;
+  return std::move(w.bytes);
+}
+
+// Rank 0: every rank's errors back in probe order.
+Status merge_errors(const Job& j, const std::vector<HlodLayerProbe>& probes,
+                    const std::vector<std::vector<uint8_t>>& replies, std::vector<float>& errors) {
+  const std::vector<int> owner = probe_owners(probes, j.ranks());
+  errors.assign(probes.size(), 0.0f);
+  for (size_t r = 0; r < replies.size(); ++r) {
+    const std::vector<uint8_t>& b = replies[r];
+    if (b.empty()) return Status::error("rank " + std::to_string(r) + " sent no top errors");
+    if (b[0] != 1) return Status::error(std::string(b.begin() + 1, b.end()));
+    size_t at = 1;
+    std::vector<float> got;
+    if (b.size() < 5) return Status::error("rank " + std::to_string(r) + " sent malformed top errors");
+    const uint32_t count = detail::load_u32(b.data() + at);
+    at += 4;
+    if (!take_words(b, at, count, got) || at != b.size())
+      return Status::error("rank " + std::to_string(r) + " sent malformed top errors");
+    size_t k = 0;
+    for (size_t i = 0; i < probes.size(); ++i)
+      if (owner[i] == int(r)) {
+        if (k >= got.size()) return Status::error("rank " + std::to_string(r) + " sent too few top errors");
+        errors[i] = got[k++];
+      }
+    if (k != got.size()) return Status::error("rank " + std::to_string(r) + " sent too many top errors");
+  }
+  return Status::success();
+}
+
+// Rank 0: the top finished from the errors, the head and the top's payloads written into the
+// temporary at the file's full size; the subtrees' places in it.
+Status finish_and_lay_out(Job& j, const std::vector<float>& errors, const std::string& name,
+                          const std::filesystem::path& out_dir, Layout& layout) {
+  auto t0 = Clock::now();
+  double cpu = process_cpu_seconds();
+  HlodAssembly assembly;
+  Status st;
+  j.arena->execute([&] { st = j.builder->finish_top(j.roots, errors, assembly, &j.r.report); });
   if (!st) return st;
-  model.tree.name = name;
-  if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, model.tree.source_hash); !s) return s;
-  j.r.assemble_seconds = seconds_since(t0);
+  HlodTree& tree = assembly.model.tree;
+  tree.name = name;
+  tree.source_hash = j.source_hash;
+  j.roots.clear();
+  j.r.assemble_seconds += seconds_since(t0);
+  j.r.assemble_cpu_seconds += process_cpu_seconds() - cpu;
   t0 = Clock::now();
+  cpu = process_cpu_seconds();
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) return Status::error(out_dir.string() + ": cannot create the output directory: " + ec.message());
   j.r.file = out_dir / (name + ".hlod");
-  const std::vector<uint8_t> bytes = encode_hlod_asset(model.tree, model.payloads);
-  if (Status s = write_file_atomic(j.r.file, bytes); !s) return s;
-  j.r.bytes = bytes.size();
+  const size_t count = tree.nodes.size();
+  std::vector<std::vector<uint8_t>> top(count);
+  std::vector<uint64_t> sizes(count);
+  for (size_t i = 0; i < count; ++i) {
+    if (assembly.origin[i].subtree < 0) top[i] = encode_hlod_payload(assembly.model.payloads[i]);
+    sizes[i] = assembly.origin[i].subtree < 0 ? top[i].size() : hlod_payload_bytes(tree.nodes[i]);
+  }
+  const std::vector<uint8_t> head = encode_hlod_head(tree, sizes);
+  layout.writer = j.writer;
+  layout.pieces.assign(j.keys.size(), {});
+  std::vector<FilePiece> mine{{0, head}};
+  uint64_t at = head.size();
+  for (size_t i = 0; i < count; ++i) {
+    const HlodAssembly::Origin o = assembly.origin[i];
+    if (o.subtree < 0) {
+      mine.push_back({at, top[i]});
+    } else {
+      auto& pieces = layout.pieces[size_t(o.subtree)];
+      if (pieces.size() <= o.local) pieces.resize(o.local + 1);
+      pieces[o.local] = {at, sizes[i]};
+    }
+    at += sizes[i];
+  }
+  j.r.bytes = at;
+  if (Status s = create_sized_temporary(j.r.file, at, layout.temp); !s) return s;
+  if (Status s = write_pieces(layout.temp, mine, j.r.file.string()); !s) {
+    std::filesystem::remove(layout.temp, ec);
+    return s;
+  }
+  layout.ok = true;
   j.r.write_seconds = seconds_since(t0);
+  j.r.head_cpu_seconds = process_cpu_seconds() - cpu;
   return Status::success();
+}
+
+// Every rank: the payloads of the subtrees it writes, from their entries' bytes, at the places
+// rank 0 gave (each piece's size checked against the entry's own record of it).
+RankReport write_share(Job& j, const Layout& layout, const std::string& what) {
+  RankReport rep;
+  const auto t0 = Clock::now();
+  const double cpu0 = process_cpu_seconds();
+  std::vector<FilePiece> pieces;
+  for (size_t i = 0; i < layout.writer.size() && rep.status; ++i) {
+    if (layout.writer[i] != j.comm.rank) continue;
+    const std::string entry = hlod_subtree_entry_path(j.settings.cache_dir, j.keys[i]).string();
+    std::vector<std::span<const uint8_t>> payloads;
+    if (j.entries[i].empty()) rep.status = Status::error(entry + ": this rank was to write it but holds no entry");
+    else rep.status = hlod_subtree_entry_payloads(j.entries[i], entry, payloads);
+    if (rep.status && payloads.size() != layout.pieces[i].size())
+      rep.status = Status::error(entry + ": " + std::to_string(payloads.size()) + " nodes, the assembled tree has " +
+                                 std::to_string(layout.pieces[i].size()));
+    for (size_t k = 0; rep.status && k < payloads.size(); ++k) {
+      if (payloads[k].size() != layout.pieces[i][k].second)
+        rep.status = Status::error(entry + ": node " + std::to_string(k) + "'s payload is " +
+                                   std::to_string(payloads[k].size()) + " bytes, its record says " +
+                                   std::to_string(layout.pieces[i][k].second));
+      pieces.push_back({layout.pieces[i][k].first, payloads[k]});
+      j.work.bytes_placed += payloads[k].size();
+    }
+  }
+  if (rep.status) rep.status = write_pieces(layout.temp, pieces, what);
+  if (!rep.status) rep.status.message = "rank " + std::to_string(j.comm.rank) + ": " + rep.status.message;
+  j.entries.clear();
+  j.work.write_cpu_seconds = process_cpu_seconds() - cpu0;
+  if (j.comm.rank == 0) j.r.write_seconds += seconds_since(t0);
+  rep.work = j.work;
+  return rep;
+}
+
+// Rank 0: every rank's report; the first failure (others' logged), every rank's work.
+Status take_reports(Job& j, const std::vector<std::vector<uint8_t>>& reports, bool keep_work) {
+  Status failed;
+  for (size_t r = 0; r < reports.size(); ++r) {
+    const RankReport other = decode_report(reports[r], int(r));
+    if (keep_work) j.r.ranks.push_back(other.work);
+    else if (r < j.r.ranks.size()) {
+      j.r.ranks[r].write_cpu_seconds = other.work.write_cpu_seconds;
+      j.r.ranks[r].measure_cpu_seconds = other.work.measure_cpu_seconds;
+      j.r.ranks[r].bytes_placed = other.work.bytes_placed;
+    }
+    if (!other.status && failed) failed = other.status;
+    if (!other.status && r != 0) j.say(other.status.message);
+  }
+  return failed;
 }
 
 }  // namespace
@@ -332,7 +686,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
                              const HlodRankComm& comm, const HlodBakeLog& log, HlodDistributedResult* result) {
   const auto t_start = Clock::now();
   const double cpu_start = process_cpu_seconds();
-  Job j{settings, comm, log, {}, {}, {}, {}, {}, {}, {}, {}, {}};
+  Job j{settings, comm, log, {}, {}, {}, {}, {}, 0, {}, {}, {}, {}, {}, {}, {}};
   j.arena = std::make_unique<tbb::task_arena>(settings.threads == 0 ? tbb::task_arena::automatic : int(settings.threads));
   std::error_code ec;
   std::filesystem::create_directories(settings.cache_dir, ec);
@@ -340,8 +694,11 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   Status ready = ec ? Status::error(settings.cache_dir.string() + ": cannot create the cache directory: " + ec.message())
                     : load_and_plan(j, mesh_file);
   if (!ready) ready.message = "rank " + std::to_string(comm.rank) + ": " + ready.message;
-  if (comm.rank == 0 && ready) look_up(j);
-  std::vector<uint8_t> mask = j.missing;
+  std::vector<uint8_t> check = ready ? check_share(j) : std::vector<uint8_t>{};
+  check.push_back(ready ? 1 : 0);
+  const std::vector<std::vector<uint8_t>> checks = comm.gather(check);
+  std::vector<uint8_t> mask;
+  if (comm.rank == 0 && ready) mask = merge_checks(j, checks);
   mask.push_back(ready ? 1 : 0);  // rank 0 could not plan: nobody bakes
   comm.broadcast(mask);
   const bool go = !mask.empty() && mask.back() == 1 && ready && mask.size() == j.keys.size() + 1;
@@ -351,35 +708,89 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   if (go) {
     mask.pop_back();
     j.missing = mask;
+    for (uint8_t m : j.missing) j.r.cached += m == 0;
+    assign_writers(j);
     if (comm.rank == 0) watch = watch_progress(j);
     rep = bake_share(j, my_share(j));
-    j.r.bake_seconds = rep.work.bake_seconds;  // a failure: the caller prints it, rank 0 gathers it
+    j.r.bake_seconds = j.work.bake_seconds;  // a failure: the caller prints it, rank 0 gathers it
   } else if (ready) {
     rep.status = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 could not plan the build");
   }
-  rep.work.total_seconds = seconds_since(t_start);
-  rep.work.cpu_seconds = process_cpu_seconds() - cpu_start;
+  j.work.total_seconds = seconds_since(t_start);
+  j.work.cpu_seconds = process_cpu_seconds() - cpu_start;
+  rep.work = j.work;
   const std::vector<std::vector<uint8_t>> reports = comm.gather(encode_report(rep));
   watch.reset();
   if (result) *result = {};
-  if (comm.rank != 0) {
-    j.r.total_seconds = seconds_since(t_start);
-    if (result) *result = std::move(j.r);
-    return rep.status;
+
+  // Rank 0 assembles and lays the file out; every rank then writes its part.
+  Layout layout;
+  Status st = rep.status;
+  double cpu_gathered = process_cpu_seconds();
+  std::vector<HlodLayerProbe> probes;
+  double serial_cpu = 0;  // rank 0's own, while the others wait
+  if (comm.rank == 0) {
+    st = take_reports(j, reports, true);
+    if (!st) st.message += " (the cache keeps every finished subtree: run again to resume)";
+    const double cpu0 = process_cpu_seconds();
+    if (st) st = collect_roots(j);
+    const double cpu1 = process_cpu_seconds();
+    j.r.collect_cpu_seconds = cpu1 - cpu0;
+    const auto t0 = Clock::now();
+    if (st) j.arena->execute([&] { st = j.builder->build_top(j.roots, probes); });
+    j.r.assemble_seconds = seconds_since(t0);
+    j.r.assemble_cpu_seconds = process_cpu_seconds() - cpu1;
+    serial_cpu += process_cpu_seconds() - cpu_gathered;
   }
-  Status failed;
-  for (size_t r = 0; r < reports.size(); ++r) {
-    const RankReport other = decode_report(reports[r], int(r));
-    j.r.ranks.push_back(other.work);
-    if (!other.status && failed) failed = other.status;
-    if (!other.status && r != 0) j.say(other.status.message);
+  // The top's layers are measured by every rank (each holds the mesh and its BVH).
+  std::vector<uint8_t> sent = comm.rank == 0 ? encode_probes(bool(st), probes) : std::vector<uint8_t>{};
+  comm.broadcast(sent);
+  bool measuring = false;
+  if (!decode_probes(sent, measuring, probes)) {
+    measuring = false;
+    if (st) st = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 sent malformed top layers");
   }
-  if (!failed) failed.message += " (the cache keeps every finished subtree: run again to resume)";
-  Status st = failed;
-  const double cpu_gathered = process_cpu_seconds();
-  if (st) st = collect(j);
-  if (st) st = assemble_and_write(j, mesh_file, name, out_dir);
-  j.r.cpu_after_gather_seconds = process_cpu_seconds() - cpu_gathered;
+  if (measuring) {
+    const std::vector<std::vector<uint8_t>> replies = comm.gather(st ? measure_share(j, probes) : std::vector<uint8_t>{});
+    if (comm.rank == 0) {
+      const double cpu0 = process_cpu_seconds();
+      std::vector<float> errors;
+      st = merge_errors(j, probes, replies, errors);
+      probes.clear();
+      if (st) st = finish_and_lay_out(j, errors, name, out_dir, layout);
+      serial_cpu += process_cpu_seconds() - cpu0;
+    }
+  }
+  std::vector<uint8_t> plan = comm.rank == 0 ? encode_layout(layout) : std::vector<uint8_t>{};
+  comm.broadcast(plan);
+  if (comm.rank != 0 && !decode_layout(plan, layout)) {
+    // Every rank got these bytes, so every rank still meets the write's gather: this one
+    // writes nothing and reports the failure there.
+    layout.writer.clear();
+    st = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 sent a malformed file layout");
+  }
+  if (layout.ok) {
+    RankReport wrote = write_share(j, layout, (out_dir / (name + ".hlod")).string());
+    if (!st && wrote.status) wrote.status = st;
+    const std::vector<std::vector<uint8_t>> written = comm.gather(encode_report(wrote));
+    if (comm.rank == 0) {
+      st = take_reports(j, written, false);
+      if (st) st = commit_temporary(layout.temp, j.r.file);
+      else std::filesystem::remove(layout.temp, ec);
+    } else if (st) {
+      st = wrote.status;
+    }
+  }
+  if (comm.rank == 0) {
+    j.r.cpu_after_gather_seconds = process_cpu_seconds() - cpu_gathered;
+    double slowest = 0, slowest_measure = 0, slowest_write = 0;
+    for (const HlodRankWork& w : j.r.ranks) {
+      slowest = std::max(slowest, w.cpu_seconds);
+      slowest_measure = std::max(slowest_measure, w.measure_cpu_seconds);
+      slowest_write = std::max(slowest_write, w.write_cpu_seconds);
+    }
+    j.r.critical_cpu_seconds = slowest + serial_cpu + slowest_measure + slowest_write;
+  }
   j.r.total_seconds = seconds_since(t_start);
   if (result) *result = std::move(j.r);
   return st;

@@ -1,12 +1,18 @@
 // The HLOD bake spread over ranks (issue 16), one call per rank (an MPI process, say):
 //
-//   every rank   load the mesh from the shared path, plan the split (the same on every rank)
-//   rank 0       look every subtree up in the cache -> broadcast which are missing
+//   every rank   load the mesh from the shared path, plan the split (the same on every rank),
+//                check its share of the cache's entries in full
+//   gather       which entries were found -> rank 0 broadcasts which are missing
 //   every rank   bake its share of the missing ones (longest first, to the least loaded
 //                rank), each result stored in the cache as it is finished
 //   gather       per rank: its status (a failure names the subtree), work and bytes
-//   rank 0       read the others' entries (one refused is baked again here), build the levels
-//                above, write the .hlod (write_file_atomic)
+//   rank 0       read the subtrees' roots from the entries (a refused one is baked again here),
+//                build the layers of the levels above -> broadcast them
+//   every rank   measure a share of those layers' errors against the original -> gather
+//   rank 0       finish the levels above, write the head and their payloads into a temporary
+//                file at its full size -> broadcast where every subtree node's payload goes
+//   every rank   write the payloads of the subtrees it baked or checked, at those offsets
+//   gather       per rank: its write's status -> rank 0 renames the file into place
 //
 // The communication is two collectives (HlodRankComm), so that lodkit's libraries never link
 // MPI: lod-bake-mpi gives MPI_Bcast and MPI_Gatherv; tests may give threads or nothing.
@@ -48,26 +54,40 @@ struct HlodDistributedSettings {
   std::function<void(size_t subtree, size_t stored)> before_store;
 };
 
+// One rank's work. CPU times are its process's (the machine may be shared); each phase's own.
 struct HlodRankWork {
   uint32_t subtrees = 0;     // baked by the rank in this run
   uint64_t triangles = 0;    // their original triangles
+  uint32_t checked = 0;      // cached entries it checked in full (it writes their payloads)
+  uint64_t bytes_checked = 0;
   double bake_seconds = 0;   // the rank's time in its bakes
-  double bake_cpu_seconds = 0;  // its process's CPU time in them (the machine may be shared)
-  double total_seconds = 0;     // the rank's whole run, up to its report
+  double bake_cpu_seconds = 0;  // CPU time in them (the original's BVH included)
+  double total_seconds = 0;     // the rank's whole run, up to its first report
   double cpu_seconds = 0;       // its process's CPU time over that run
-  uint64_t bytes_written = 0;
+  double load_cpu_seconds = 0, clean_cpu_seconds = 0, plan_cpu_seconds = 0, check_cpu_seconds = 0,
+         surface_cpu_seconds = 0;  // the BVH, within bake_cpu_seconds
+  double measure_cpu_seconds = 0;  // its share of the top's layers' errors
+  double write_cpu_seconds = 0;    // placing its payloads into the .hlod (after rank 0's assembly)
+  uint64_t bytes_written = 0;      // cache entries
+  uint64_t bytes_placed = 0;       // payload bytes it wrote into the .hlod
 };
 
 struct HlodDistributedResult {
   std::filesystem::path file;  // rank 0: what was written
   uint64_t bytes = 0;
   size_t input_triangles = 0;
+  bool mesh_cached = false;    // the cleaned mesh came from the cache (a run before stored it)
   size_t subtrees = 0, cached = 0, rebaked = 0;  // rebaked: refused at assembly, baked again on rank 0
   std::vector<HlodRankWork> ranks;                // rank 0: every rank's work
-  uint64_t entry_bytes_read = 0;                  // rank 0: entries read from the cache
-  double cpu_after_gather_seconds = 0;            // rank 0: CPU time reading, assembling, writing
+  uint64_t entry_bytes_read = 0;                  // rank 0: of the entries, to take up their roots
+  double cpu_after_gather_seconds = 0;            // rank 0: CPU time reading roots, assembling, writing
+  double collect_cpu_seconds = 0, assemble_cpu_seconds = 0, head_cpu_seconds = 0;  // rank 0, after the gather
+  // Rank 0: the job's length on idle cores, one thread per rank: the slowest rank up to the
+  // first gather, rank 0's serial part (roots, the top's layers, its finish, the head), the
+  // slowest rank's share of the top's errors and of the write.
+  double critical_cpu_seconds = 0;
   double load_seconds = 0, plan_seconds = 0, lookup_seconds = 0, bake_seconds = 0, assemble_seconds = 0,
-         write_seconds = 0, total_seconds = 0;    // this rank's phases (lookup and assembly: rank 0)
+         write_seconds = 0, total_seconds = 0;    // this rank's phases (lookup: its check of the cache)
   HlodBuildReport report;
 };
 

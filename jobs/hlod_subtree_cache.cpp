@@ -1,13 +1,17 @@
 // The subtree cache: key, path, store (temporary -> read back -> rename), load.
 #include "jobs/hlod_subtree_cache.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <span>
+
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <vector>
 
 #include "runtime/file_write.h"
@@ -17,6 +21,18 @@
 namespace lod {
 namespace {
 
+// `out.size()` bytes from `offset`, retrying short reads; false on an error or an early end.
+bool read_at(int fd, uint64_t offset, std::span<uint8_t> out) {
+  size_t done = 0;
+  while (done < out.size()) {
+    const ssize_t n = ::pread(fd, out.data() + done, out.size() - done, off_t(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += size_t(n);
+  }
+  return true;
+}
+
 // The whole file; `opened` false when it does not exist. Anything else unreadable (a folder in
 // its place, an I/O error) is read as no bytes, which the decoder refuses.
 std::vector<uint8_t> read_all(const std::filesystem::path& path, bool& opened) {
@@ -24,12 +40,16 @@ std::vector<uint8_t> read_all(const std::filesystem::path& path, bool& opened) {
   const auto status = std::filesystem::status(path, ec);
   opened = std::filesystem::exists(status);
   if (!opened || !std::filesystem::is_regular_file(status)) return {};
-  try {
-    std::ifstream f(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-  } catch (const std::exception&) {
-    return {};
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return {};
+  std::vector<uint8_t> bytes;
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && st.st_size > 0) {
+    bytes.resize(size_t(st.st_size));
+    if (!read_at(fd, 0, bytes)) bytes.clear();
   }
+  ::close(fd);
+  return bytes;
 }
 
 }  // namespace
@@ -53,7 +73,7 @@ std::filesystem::path hlod_subtree_entry_path(const std::filesystem::path& dir, 
 }
 
 Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,
-                          const HlodSubtree& subtree, uint64_t* bytes_written) {
+                          const HlodSubtree& subtree, uint64_t* bytes_written, std::vector<uint8_t>* entry) {
   static std::atomic<uint64_t> serial{0};
   const std::filesystem::path path = hlod_subtree_entry_path(dir, key);
   char suffix[64];  // a temporary of this process's own, beside the entry
@@ -61,14 +81,16 @@ Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64
   std::filesystem::path temp = dir / ".";
   temp += path.filename();
   temp += suffix;
-  const std::vector<uint8_t> bytes = encode_hlod_subtree(subtree, key);
+  std::vector<uint8_t> bytes = encode_hlod_subtree(subtree, key);
   if (Status s = write_file_atomic(temp, bytes); !s) return s;
+  // Verified against what was encoded: the bytes on the disk must be those (a reader decodes
+  // and checks an entry in full whenever it takes one up).
+  (void)mesh_vertices;
   bool opened = false;
   const std::vector<uint8_t> back = read_all(temp, opened);
-  HlodSubtree check;
-  Status verified = opened ? decode_hlod_subtree(back, key, mesh_vertices, temp.string(), check)
-                           : Status::error(temp.string() + ": cannot be read back");
-  if (verified && back != bytes) verified = Status::error(temp.string() + ": reads back other bytes than were written");
+  Status verified = !opened        ? Status::error(temp.string() + ": cannot be read back")
+                    : back != bytes ? Status::error(temp.string() + ": reads back other bytes than were written")
+                                    : Status::success();
   std::error_code ec;
   if (!verified) {
     std::filesystem::remove(temp, ec);
@@ -81,14 +103,15 @@ Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64
     return Status::error(path.string() + ": cannot rename the verified entry into place: " + ec.message());
   }
   if (bytes_written) *bytes_written = bytes.size();
+  if (entry) *entry = std::move(bytes);
   return Status::success();
 }
 
 CacheLookup load_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices, HlodSubtree& out,
-                              std::string* why, uint64_t* bytes_read) {
+                              std::string* why, uint64_t* bytes_read, std::vector<uint8_t>* entry) {
   const std::filesystem::path path = hlod_subtree_entry_path(dir, key);
   bool opened = false;
-  const std::vector<uint8_t> bytes = read_all(path, opened);
+  std::vector<uint8_t> bytes = read_all(path, opened);
   if (!opened) return CacheLookup::missing;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -100,6 +123,43 @@ CacheLookup load_hlod_subtree(const std::filesystem::path& dir, uint64_t key, ui
     if (why) *why = s.message;
     return CacheLookup::refused;
   }
+  if (entry) *entry = std::move(bytes);
+  return CacheLookup::found;
+}
+
+CacheLookup load_hlod_subtree_root(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,
+                                   HlodSubtree& out, std::string* why, uint64_t* bytes_read) {
+  const std::filesystem::path path = hlod_subtree_entry_path(dir, key);
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) return CacheLookup::missing;
+  auto refused = [&](const std::string& message) {
+    if (why) *why = message;
+    return CacheLookup::refused;
+  };
+  if (!std::filesystem::is_regular_file(status)) return refused(path.string() + ": is not a regular file");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  struct stat st {};
+  if (fd < 0 || ::fstat(fd, &st) != 0) {
+    if (fd >= 0) ::close(fd);
+    return refused(path.string() + ": cannot be read");
+  }
+  const uint64_t size = uint64_t(st.st_size);
+  // Most roots lie in the first 64 KiB; otherwise each answer names the bytes still wanted.
+  std::vector<uint8_t> prefix(size_t(std::min<uint64_t>(size, 64 * 1024)));
+  bool read = read_at(fd, 0, prefix);
+  for (int step = 0; read && step < 4; ++step) {
+    const uint64_t need = hlod_subtree_entry_root_bytes(prefix, size);
+    if (need == 0 || need <= prefix.size()) break;
+    const size_t have = prefix.size();
+    prefix.resize(size_t(need));
+    read = read_at(fd, have, std::span<uint8_t>(prefix).subspan(have));
+  }
+  ::close(fd);
+  if (!read) return refused(path.string() + ": cannot be read (truncated?)");
+  if (bytes_read) *bytes_read = prefix.size();
+  if (Status s = decode_hlod_subtree_root(prefix, size, key, mesh_vertices, path.string(), out); !s)
+    return refused(s.message);
   return CacheLookup::found;
 }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "preprocess/hlod_build.h"
 #include "runtime/hlod_subtree.h"
@@ -25,12 +26,20 @@ std::filesystem::path hlod_subtree_entry_path(const std::filesystem::path& dir, 
 
 // Writes, verifies and renames into place; the message names the entry and what failed.
 // Returns the entry's size in `bytes_written` when given.
+// `entry` (when given) gets the entry's bytes, as they are on the disk.
 Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,
-                          const HlodSubtree& subtree, uint64_t* bytes_written = nullptr);
+                          const HlodSubtree& subtree, uint64_t* bytes_written = nullptr,
+                          std::vector<uint8_t>* entry = nullptr);
 
 enum class CacheLookup : uint8_t { found, missing, refused };
 // `why` says why an entry was refused; `bytes_read` its size.
+// `entry` (when given) gets the checked entry's bytes.
 CacheLookup load_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,
-                              HlodSubtree& out, std::string* why = nullptr, uint64_t* bytes_read = nullptr);
+                              HlodSubtree& out, std::string* why = nullptr, uint64_t* bytes_read = nullptr,
+                              std::vector<uint8_t>* entry = nullptr);
+// The subtree's nodes and root only (decode_hlod_subtree_root), read from the entry's first
+// bytes: what the levels above need. `bytes_read`: how many were read.
+CacheLookup load_hlod_subtree_root(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,
+                                   HlodSubtree& out, std::string* why = nullptr, uint64_t* bytes_read = nullptr);
 
 }  // namespace lod

@@ -21,6 +21,7 @@
 #include <bit>
 #include <cmath>
 #include <memory>
+#include <ctime>
 #include <string>
 
 #include "preprocess/decimater_chain.h"  // compute_vertex_normals
@@ -32,6 +33,14 @@ namespace lod {
 namespace {
 
 constexpr uint8_t kNoPatch = 0xff;
+
+// The calling thread's CPU time (the BVH is built on one thread of the caller's: a report of
+// where a bake's time goes, on machines shared with other work).
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 struct Layer {
   std::vector<float> positions;
@@ -273,15 +282,15 @@ float distance_to_original(const Context& c, const float* p, uint32_t v) {
 // The node's original samples, each with a distance the layer is known to be within: to the
 // layer vertex descended from it, when it survived into the layer. (A sorted lookup, not the
 // per-vertex scratch: nodes are measured in any order, ancestors beside descendants.)
-void reference_samples(const Context& c, const BuildNode& n, const Layer& layer, std::vector<float>& points,
+void reference_samples(const Context& c, const std::vector<uint32_t>& reference, const Layer& layer, std::vector<float>& points,
                        std::vector<float>& known) {
   std::vector<std::pair<uint32_t, uint32_t>> by_source(layer.vertices());
   for (uint32_t i = 0; i < layer.vertices(); ++i) by_source[i] = {layer.source[i], i};
   std::sort(by_source.begin(), by_source.end());
-  points.resize(3 * n.reference.size());
-  known.resize(n.reference.size());
-  for (size_t k = 0; k < n.reference.size(); ++k) {
-    const uint32_t v = n.reference[k];
+  points.resize(3 * reference.size());
+  known.resize(reference.size());
+  for (size_t k = 0; k < reference.size(); ++k) {
+    const uint32_t v = reference[k];
     for (int j = 0; j < 3; ++j) points[3 * k + j] = c.positions[3 * size_t(v) + j];
     const auto it = std::lower_bound(by_source.begin(), by_source.end(), std::make_pair(v, 0u));
     known[k] = it != by_source.end() && it->first == v
@@ -314,13 +323,13 @@ void layer_samples(const Context& c, const Layer& layer, std::vector<float>& poi
 
 // Symmetric distance between a layer and the original: the layer's samples to the whole
 // original surface, the node's original samples to the layer.
-Status measure_layer(const Context& c, const BuildNode& n, const Layer& layer, float& error) {
+Status measure_layer(const Context& c, const std::vector<uint32_t>& reference, const Layer& layer, float& error) {
   const TriangleMeshView view{layer.positions.data(), layer.vertices(), layer.indices.data(), layer.indices.size()};
   std::vector<float> samples, known;
   layer_samples(c, layer, samples, known);
   SurfaceError to_original, from_original;
   if (Status s = c.original.from_points(samples.data(), samples.size() / 3, known.data(), to_original); !s) return s;
-  reference_samples(c, n, layer, samples, known);
+  reference_samples(c, reference, layer, samples, known);
   if (Status s = c.original.from_points_to(view, samples.data(), samples.size() / 3, known.data(), from_original); !s)
     return s;
   error = std::max(to_original.max, from_original.max);
@@ -338,7 +347,7 @@ void report_done(Context& c, const BuildNode& n) {
 // is the original itself).
 Status measure_layers(Context& c, BuildNode& n) {
   for (size_t k = n.leaf() ? 1 : 0; k < n.layers.size(); ++k)
-    if (Status s = measure_layer(c, n, n.layers[k], n.layers[k].error); !s) return s;
+    if (Status s = measure_layer(c, n.reference, n.layers[k], n.layers[k].error); !s) return s;
   report_done(c, n);
   return Status::success();
 }
@@ -556,7 +565,8 @@ void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
 
 // A subtree result is checked against the mesh before any of it is used as an index.
 Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, const std::string& what) {
-  if (s.nodes.empty() || s.payloads.size() != s.nodes.size()) return Status::error(what + ": no nodes, or not one payload per node");
+  if (s.nodes.empty() || s.payloads.empty() || (s.payloads.size() != 1 && s.payloads.size() != s.nodes.size()))
+    return Status::error(what + ": no nodes, or neither the root's payload alone nor one payload per node");
   const HlodNode& root = s.nodes[0];
   if (root.depth != f.depth || root.box_half != f.half || root.box_center[0] != f.center[0] ||
       root.box_center[1] != f.center[1] || root.box_center[2] != f.center[2])
@@ -580,29 +590,33 @@ Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, 
 // the file stores it: the top's nodes described here, each subtree's spliced in from its result.
 struct NodeRef {
   const BuildNode* top = nullptr;  // else a subtree's node
-  HlodSubtree* subtree = nullptr;
+  const HlodSubtree* subtree = nullptr;
   uint32_t local = 0;
 };
 
-void splice(Context& c, BuildNode& root, std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport& report) {
+// The top's payloads are made here; a subtree node's stays with its subtree (origin says where).
+void splice(Context& c, BuildNode& root, const std::vector<HlodSubtree>& baked, HlodAssembly& out,
+            HlodBuildReport& report) {
   auto ref_of = [&](const BuildNode& n) {
     return n.subtree >= 0 ? NodeRef{nullptr, &baked[size_t(n.subtree)], 0} : NodeRef{&n, nullptr, 0};
   };
   std::vector<NodeRef> order{ref_of(root)};
   std::vector<int32_t> parent{-1};
-  out.tree.nodes.clear();
-  out.payloads.clear();
+  out.model.tree.nodes.clear();
+  out.model.payloads.clear();
+  out.origin.clear();
   for (size_t i = 0; i < order.size(); ++i) {
     const NodeRef r = order[i];
     HlodNode h;
     HlodPayload payload;
+    HlodAssembly::Origin origin;
     if (r.top) {
       h = describe_node(c, *r.top, payload);
       for (const auto& child : r.top->children)
         if (child) order.push_back(ref_of(*child));
     } else {
       h = r.subtree->nodes[r.local];
-      payload = std::move(r.subtree->payloads[r.local]);
+      origin = {int32_t(r.subtree - baked.data()), r.local};
       for (uint32_t k = 0; k < h.child_count; ++k) order.push_back({nullptr, r.subtree, h.first_child + k});
     }
     h.parent = parent[i];
@@ -612,8 +626,9 @@ void splice(Context& c, BuildNode& root, std::vector<HlodSubtree>& baked, HlodMo
     report.leaves += h.leaf();
     report.depth = std::max<uint32_t>(report.depth, h.depth);
     report.boundary_triangles += h.boundary_triangles;
-    out.tree.nodes.push_back(h);
-    out.payloads.push_back(std::move(payload));
+    out.model.tree.nodes.push_back(h);
+    out.model.payloads.push_back(std::move(payload));
+    out.origin.push_back(origin);
   }
   report.nodes = order.size();
 }
@@ -725,8 +740,9 @@ struct HlodBuilder::Impl {
   std::vector<HlodSubtreeSpec> specs;
   std::vector<uint8_t> baked;  // per subtree: handed to bake_subtrees already
   size_t dropped = 0;
-  bool planned = false, surface_built = false;
+  bool planned = false, surface_built = false, assembled = false;
   Status surface;
+  double surface_cpu = 0;
   Tally top_tally;
 
   Impl(const MeshData& m, const HlodBuildOptions& o)
@@ -734,8 +750,10 @@ struct HlodBuilder::Impl {
 
   void ensure_surface() {
     if (surface_built) return;
+    const double cpu0 = thread_cpu_seconds();
     const TriangleMeshView original{mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
     surface = c.original.set_surface(original, what);
+    surface_cpu = thread_cpu_seconds() - cpu0;
     surface_built = true;
   }
   std::string name(size_t i) const {
@@ -751,6 +769,7 @@ HlodBuilder::HlodBuilder(const MeshData& mesh, const HlodBuildOptions& options)
 HlodBuilder::~HlodBuilder() = default;
 
 const std::vector<HlodSubtreeSpec>& HlodBuilder::subtrees() const { return impl_->specs; }
+double HlodBuilder::surface_cpu_seconds() const { return impl_->surface_cpu; }
 
 Status HlodBuilder::plan() {
   Impl& m = *impl_;
@@ -849,34 +868,118 @@ void HlodBuilder::Impl::build_top(BuildNode& n) {
   build_layers(c, top_tally, n);
 }
 
-Status HlodBuilder::assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report_out) {
+// The top's layers to measure, in breadth-first order of the top, finest first.
+std::vector<std::pair<BuildNode*, size_t>> top_layers(BuildNode& root) {
+  std::vector<std::pair<BuildNode*, size_t>> out;
+  for (BuildNode* n : breadth_first(root, Below::stop_at_frontier))
+    for (size_t k = n->leaf() ? 1 : 0; k < n->layers.size(); ++k) out.push_back({n, k});
+  return out;
+}
+
+Status HlodBuilder::build_top(const std::vector<HlodSubtree>& baked, std::vector<HlodLayerProbe>& probes) {
   Impl& m = *impl_;
   if (!m.planned) return Status::error(m.what + ": HLOD assembled before the build was planned");
+  if (m.assembled) return Status::error(m.what + ": HLOD assembled twice");
   if (baked.size() != m.frontier.size())
     return Status::error(m.what + ": " + std::to_string(baked.size()) + " subtree results for " +
                          std::to_string(m.frontier.size()) + " subtrees");
-  HlodBuildReport report;
-  report.dropped_triangles = m.dropped;
   for (size_t i = 0; i < baked.size(); ++i) {
     if (Status s = check_subtree(*m.frontier[i], baked[i], m.mesh.vertex_count(), m.name(i)); !s) return s;
     stand_for_subtree(*m.frontier[i], baked[i]);
-    report.short_layers += baked[i].short_layers;
-    report.oversized_leaves += baked[i].oversized_leaves;
+  }
+  m.assembled = true;
+  m.build_top(*m.root);
+  probes.clear();
+  for (const auto& [n, k] : top_layers(*m.root)) {
+    const Layer& l = n->layers[k];
+    probes.push_back({l.positions, l.indices, l.source, n->reference});
+  }
+  return Status::success();
+}
+
+Status HlodBuilder::measure_probes(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& which,
+                                   std::vector<float>& errors) {
+  Impl& m = *impl_;
+  if (!m.planned) return Status::error(m.what + ": HLOD layers measured before the build was planned");
+  const uint64_t vertices = m.mesh.vertex_count();
+  for (size_t i : which) {  // what comes from elsewhere is checked before it is used as an index
+    if (i >= probes.size()) return Status::error(m.what + ": top layer " + std::to_string(i) + " does not exist");
+    const HlodLayerProbe& p = probes[i];
+    if (p.positions.size() != 3 * p.source.size() || p.indices.size() % 3 != 0)
+      return Status::error(m.what + ": top layer " + std::to_string(i) + " has mismatched arrays");
+    for (uint32_t v : p.source)
+      if (v >= vertices) return Status::error(m.what + ": top layer " + std::to_string(i) + " names a vertex outside the mesh");
+    for (uint32_t v : p.reference)
+      if (v >= vertices) return Status::error(m.what + ": top layer " + std::to_string(i) + " names a vertex outside the mesh");
+    for (uint32_t t : p.indices)
+      if (t >= p.source.size()) return Status::error(m.what + ": top layer " + std::to_string(i) + " has an index out of range");
   }
   m.ensure_surface();
   if (!m.surface) return m.surface;
-  m.build_top(*m.root);
-  if (Status s = measure_and_order_errors(m.c, breadth_first(*m.root, Below::stop_at_frontier)); !s) return s;
-  HlodModel model;
-  model.tree.min_verts = m.c.options.min_verts;
-  for (int k = 0; k < 3; ++k) model.tree.box_center[k] = m.root->center[k];
-  model.tree.box_half = m.root->half;
-  model.tree.source_triangles = m.mesh.triangle_count();
-  splice(m.c, *m.root, baked, model, report);
+  errors.assign(which.size(), 0.0f);
+  std::vector<Status> measured(which.size());
+  run_all(m.c.options.parallel_for, which.size(), [&](size_t k) {
+    const HlodLayerProbe& p = probes[which[k]];
+    Layer layer;
+    layer.positions = p.positions;
+    layer.indices = p.indices;
+    layer.source = p.source;
+    measured[k] = measure_layer(m.c, p.reference, layer, errors[k]);
+  });
+  for (const Status& s : measured)
+    if (!s) return s;
+  return Status::success();
+}
+
+Status HlodBuilder::finish_top(const std::vector<HlodSubtree>& baked, const std::vector<float>& errors,
+                               HlodAssembly& out, HlodBuildReport* report_out) {
+  Impl& m = *impl_;
+  if (!m.assembled) return Status::error(m.what + ": HLOD top finished before it was built");
+  const std::vector<std::pair<BuildNode*, size_t>> layers = top_layers(*m.root);
+  if (errors.size() != layers.size() || baked.size() != m.frontier.size())
+    return Status::error(m.what + ": " + std::to_string(errors.size()) + " errors for " + std::to_string(layers.size()) +
+                         " top layers");
+  for (size_t i = 0; i < layers.size(); ++i) layers[i].first->layers[layers[i].second].error = errors[i];
+  const std::vector<BuildNode*> top = breadth_first(*m.root, Below::stop_at_frontier);
+  for (BuildNode* n : top) report_done(m.c, *n);
+  make_errors_monotonic(top);
+  HlodBuildReport report;
+  report.dropped_triangles = m.dropped;
+  for (const HlodSubtree& s : baked) report.short_layers += s.short_layers, report.oversized_leaves += s.oversized_leaves;
+  HlodAssembly assembly;
+  assembly.model.tree.min_verts = m.c.options.min_verts;
+  for (int k = 0; k < 3; ++k) assembly.model.tree.box_center[k] = m.root->center[k];
+  assembly.model.tree.box_half = m.root->half;
+  assembly.model.tree.source_triangles = m.mesh.triangle_count();
+  splice(m.c, *m.root, baked, assembly, report);
   report.short_layers += m.top_tally.short_layers.load();
   report.oversized_leaves += m.top_tally.oversized_leaves.load();
-  out = std::move(model);
+  out = std::move(assembly);
   if (report_out) *report_out = report;
+  return Status::success();
+}
+
+Status HlodBuilder::assemble_top(const std::vector<HlodSubtree>& baked, HlodAssembly& out, HlodBuildReport* report_out) {
+  std::vector<HlodLayerProbe> probes;
+  if (Status s = build_top(baked, probes); !s) return s;
+  std::vector<size_t> all(probes.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  std::vector<float> errors;
+  if (Status s = measure_probes(probes, all, errors); !s) return s;
+  return finish_top(baked, errors, out, report_out);
+}
+
+Status HlodBuilder::assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report_out) {
+  Impl& m = *impl_;
+  for (size_t i = 0; i < baked.size(); ++i)
+    if (baked[i].payloads.size() != baked[i].nodes.size())
+      return Status::error(m.name(i) + ": not one payload per node");
+  HlodAssembly assembly;
+  if (Status s = assemble_top(baked, assembly, report_out); !s) return s;
+  for (size_t i = 0; i < assembly.origin.size(); ++i)
+    if (const HlodAssembly::Origin o = assembly.origin[i]; o.subtree >= 0)
+      assembly.model.payloads[i] = std::move(baked[size_t(o.subtree)].payloads[o.local]);
+  out = std::move(assembly.model);
   return Status::success();
 }
 

@@ -70,6 +70,27 @@ struct HlodModel {
   std::vector<HlodPayload> payloads;
 };
 
+// The tree assembled from the subtrees' roots (HlodBuilder::assemble_top): model.payloads[i]
+// holds node i's geometry when it is a top node and is empty when origin[i].subtree >= 0 (its
+// payload is that subtree's payloads[origin[i].local]).
+struct HlodAssembly {
+  struct Origin {
+    int32_t subtree = -1;
+    uint32_t local = 0;
+  };
+  HlodModel model;
+  std::vector<Origin> origin;  // by node
+};
+
+// One layer of the top to measure against the original (HlodBuilder::build_top), whole: its
+// geometry, the original vertex each of its vertices descends from, its node's reference samples.
+struct HlodLayerProbe {
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  std::vector<uint32_t> source;
+  std::vector<uint32_t> reference;
+};
+
 struct HlodBuildReport {
   size_t nodes = 0;
   size_t leaves = 0;
@@ -119,6 +140,23 @@ class HlodBuilder {
   // (c) The levels above the frontier and the whole tree, from every subtree's result (by
   // subtree index; consumed). tree.name and tree.source_hash are left for the caller.
   Status assemble(std::vector<HlodSubtree>& baked, HlodModel& out, HlodBuildReport* report = nullptr);
+  // (c) without the subtrees' payloads: each result needs its nodes and its root's payload
+  // only (payloads[0]; more are ignored). The whole tree and the top's payloads, and where each
+  // subtree node's payload comes from, for a writer that places those itself. Once per builder
+  // (assemble is this plus the payloads moved in).
+  Status assemble_top(const std::vector<HlodSubtree>& baked, HlodAssembly& out, HlodBuildReport* report = nullptr);
+  // assemble_top in three steps, so that the top's error measurement (most of its work) can be
+  // spread like (b): build_top builds the top's layers from the subtrees' roots and lists every
+  // layer to measure; measure_probes, on any builder planned over the same mesh, measures the
+  // listed ones (errors by position in `which`); finish_top, on the builder that built the top,
+  // takes every layer's error (by probe) and makes the tree.
+  Status build_top(const std::vector<HlodSubtree>& baked, std::vector<HlodLayerProbe>& probes);
+  Status measure_probes(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& which,
+                        std::vector<float>& errors);
+  Status finish_top(const std::vector<HlodSubtree>& baked, const std::vector<float>& errors, HlodAssembly& out,
+                    HlodBuildReport* report = nullptr);
+  // Process CPU seconds the original's BVH took to build (0 until it is built).
+  double surface_cpu_seconds() const;
 
  private:
   struct Impl;

@@ -37,7 +37,11 @@ struct ByteWriter {
   template <class T>
   void words(const T* v, size_t count) {
     static_assert(sizeof(T) == 4);
-    for (size_t i = 0; i < count; ++i) u32(std::bit_cast<uint32_t>(v[i]));
+    if constexpr (std::endian::native == std::endian::little) {  // the file order already: one copy
+      if (count) raw(v, 4 * count);
+    } else {
+      for (size_t i = 0; i < count; ++i) u32(std::bit_cast<uint32_t>(v[i]));
+    }
   }
   void raw(const void* data, size_t size) {
     const auto* p = static_cast<const uint8_t*>(data);

@@ -84,4 +84,52 @@ Status write_file_atomic(const std::filesystem::path& path, const std::string& t
   return write_file_atomic(path, std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
 }
 
+Status create_sized_temporary(const std::filesystem::path& path, uint64_t size, std::filesystem::path& temp) {
+  const std::string what = path.string();
+  temp = temporary_beside(path);
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return Status::error(what + ": cannot create " + temp.string() + ": " + describe_write_errno(errno));
+  Status st;
+  // The blocks themselves, where the file system can (a full disk shows here, not mid-write).
+  if (const int err = ::posix_fallocate(fd, 0, off_t(size)); err != 0 && err != EOPNOTSUPP && err != EINVAL)
+    st = Status::error(what + ": " + describe_write_errno(err) + " while reserving " + std::to_string(size) + " bytes");
+  if (st && ::ftruncate(fd, off_t(size)) != 0)
+    st = Status::error(what + ": " + describe_write_errno(errno) + " while sizing " + temp.string());
+  if (::close(fd) != 0 && st) st = Status::error(what + ": " + describe_write_errno(errno) + " while closing");
+  std::error_code ec;
+  if (!st) std::filesystem::remove(temp, ec);
+  return st;
+}
+
+Status write_pieces(const std::filesystem::path& file, std::span<const FilePiece> pieces, const std::string& what) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return Status::error(what + ": cannot open " + file.string() + ": " + describe_write_errno(errno));
+  Status st;
+  for (const FilePiece& piece : pieces) {
+    size_t done = 0;
+    while (st && done < piece.bytes.size()) {
+      const ssize_t n = ::pwrite(fd, piece.bytes.data() + done, piece.bytes.size() - done, off_t(piece.offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0)
+        st = Status::error(what + ": " + describe_write_errno(n < 0 ? errno : EIO) + " writing " +
+                           std::to_string(piece.bytes.size()) + " bytes at " + std::to_string(piece.offset));
+      else
+        done += size_t(n);
+    }
+    if (!st) break;
+  }
+  if (st && ::fsync(fd) != 0) st = Status::error(what + ": " + describe_write_errno(errno) + " while flushing to disk");
+  if (::close(fd) != 0 && st) st = Status::error(what + ": " + describe_write_errno(errno) + " while closing");
+  return st;
+}
+
+Status commit_temporary(const std::filesystem::path& temp, const std::filesystem::path& path) {
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  if (!ec) return Status::success();
+  std::error_code ignored;
+  std::filesystem::remove(temp, ignored);
+  return Status::error(path.string() + ": cannot rename " + temp.string() + " into place: " + ec.message());
+}
+
 }  // namespace lod

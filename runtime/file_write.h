@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "runtime/status.h"
 
@@ -15,6 +16,19 @@ namespace lod {
 // `path` is the file to replace; messages start with it.
 Status write_file_atomic(const std::filesystem::path& path, std::span<const uint8_t> bytes);
 Status write_file_atomic(const std::filesystem::path& path, const std::string& text);
+
+// A file written in pieces, possibly by several processes at once (issue 16: every rank writes
+// its own subtrees' payloads into the .hlod): create_sized_temporary makes a temporary of its
+// own beside `path` at the full size; write_pieces opens it by name, writes each piece at its
+// offset and flushes it to the disk; commit_temporary renames it over `path` once every writer
+// has succeeded (otherwise remove it).
+struct FilePiece {
+  uint64_t offset = 0;
+  std::span<const uint8_t> bytes;
+};
+Status create_sized_temporary(const std::filesystem::path& path, uint64_t size, std::filesystem::path& temp);
+Status write_pieces(const std::filesystem::path& file, std::span<const FilePiece> pieces, const std::string& what);
+Status commit_temporary(const std::filesystem::path& temp, const std::filesystem::path& path);
 
 // Writes all of `bytes` to an open descriptor, retrying short writes and EINTR. On failure
 // the message says how far it got and why ("the disk is full after 4096 of 9000 bytes").

@@ -235,7 +235,9 @@ uint64_t hlod_resident_bytes(const HlodNode& n) {
   return b + 24ull * n.boundary_vertices + 12ull * n.boundary_triangles;
 }
 
-std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads) {
+uint64_t hlod_payload_bytes(const HlodNode& n) { return payload_data_bytes(n) + kChecksumBytes; }
+
+std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint64_t> payload_sizes) {
   Writer w;
   const uint32_t count = uint32_t(tree.nodes.size());
   uint32_t inner = 0;
@@ -271,27 +273,43 @@ std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const Hlo
   w.bytes.insert(w.bytes.end(), description.begin(), description.end());
   w.align8();
   for (const HlodNode& n : tree.nodes) put_record(w, n);
-  const size_t table = w.bytes.size();
-  w.bytes.resize(table + kOffsetBytes * count, 0);
-  const uint64_t head = w.bytes.size();
+  const uint64_t head = w.bytes.size() + kOffsetBytes * count;
   w.patch_u32(12, uint32_t(head));
-  w.u64(0);  // head checksum, once the offsets are in
+  uint64_t at = head + kChecksumBytes;
   for (uint32_t i = 0; i < count; ++i) {
-    const size_t begin = w.bytes.size();
-    const HlodPayload& p = payloads[i];
-    auto put_range = [&](const LodLevel& r) {
-      w.words(p.positions.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
-      w.words(p.normals.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
-      w.words(p.indices.data() + r.first_index, r.index_count);
-    };
-    for (const LodLevel& r : p.layers) put_range(r);
-    put_range(p.boundary);
-    w.u64(hash_bytes(w.bytes.data() + begin, w.bytes.size() - begin));
-    w.patch_u64(table + kOffsetBytes * i, begin);
-    w.patch_u64(table + kOffsetBytes * i + 8, w.bytes.size() - begin);
+    const uint64_t size = i < payload_sizes.size() ? payload_sizes[i] : 0;
+    w.u64(at);
+    w.u64(size);
+    at += size;
   }
-  w.patch_u64(head, hash_bytes(w.bytes.data(), head));
+  w.u64(hash_bytes(w.bytes.data(), head));
   return std::move(w.bytes);
+}
+
+std::vector<uint8_t> encode_hlod_payload(const HlodPayload& p) {
+  Writer w;
+  auto put_range = [&](const LodLevel& r) {
+    w.words(p.positions.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
+    w.words(p.normals.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
+    w.words(p.indices.data() + r.first_index, r.index_count);
+  };
+  for (const LodLevel& r : p.layers) put_range(r);
+  put_range(p.boundary);
+  w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
+  return std::move(w.bytes);
+}
+
+std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads) {
+  const size_t count = tree.nodes.size();
+  std::vector<std::vector<uint8_t>> encoded(count);
+  std::vector<uint64_t> sizes(count);
+  for (size_t i = 0; i < count; ++i) encoded[i] = encode_hlod_payload(payloads[i]), sizes[i] = encoded[i].size();
+  std::vector<uint8_t> bytes = encode_hlod_head(tree, sizes);
+  size_t total = bytes.size();
+  for (uint64_t s : sizes) total += s;
+  bytes.reserve(total);
+  for (const std::vector<uint8_t>& e : encoded) bytes.insert(bytes.end(), e.begin(), e.end());
+  return bytes;
 }
 
 Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, const std::string& what, HlodTree& out) {

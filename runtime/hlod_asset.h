@@ -25,6 +25,14 @@ inline constexpr uint32_t kHlodAssetVersion = 1;
 // payload_offset / payload_size are ignored); payloads[i] is node i's geometry.
 std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads);
 
+// The same in pieces, for a writer that places each payload itself (issue 16: every rank
+// writes its own subtrees' payloads): the head, whose offset table lays the payloads out back to
+// back in node order with these sizes, and one node's payload (its data, then its checksum).
+std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint64_t> payload_sizes);
+std::vector<uint8_t> encode_hlod_payload(const HlodPayload& payload);
+// The bytes encode_hlod_payload gives for a payload matching `node`'s counts.
+uint64_t hlod_payload_bytes(const HlodNode& node);
+
 // The tree from the file's first bytes (`head`: at least the head, possibly the whole file);
 // `file_size` is the whole file's, so that every payload range can be checked. `what` names
 // the source in messages.

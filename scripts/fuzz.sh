@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # libFuzzer over every reader: one target per mesh format (PLY, OFF, STL, OBJ, GLB), the .lod asset
 # reader (`lod`, with a mutator that keeps the checksum valid), the .hlod reader (`hlod`, the
-# same for its head and payload checksums) and the scene config reader
+# same for its head and payload checksums), the distributed bake's subtree cache entry (`hsub`,
+# the full, root-only and payload-span readers, checksums kept valid likewise) and the scene config reader
 # (`scene`), built with Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each
 # run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with
 # tests/fuzz/<target>.dict. A crash, sanitizer report, timeout (> 5 s on one input) or single
@@ -12,14 +13,14 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. scripts/fuzz.sh 20   or  scripts/fuzz.sh 180 ply lod
 # Env: LOD_FUZZ_BUILD (default build-fuzz), LOD_FUZZ_JOBS (parallel targets; default nproc),
-#      LOD_FUZZ_MAX_LEN (default 4096 bytes; 16384 for lod and 32768 for hlod, whose seeds are larger),
+#      LOD_FUZZ_MAX_LEN (default 4096 bytes; 16384 for lod and 32768 for hlod and hsub, whose seeds are larger),
 #      LOD_FUZZ_TIMEOUT (seconds per input, default 5; more on a loaded or niced run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod scene)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod hsub scene)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
 CXX=${LOD_FUZZ_CXX:-clang++}
@@ -61,12 +62,13 @@ sources_of() {
   case $1 in
     lod) echo "${LOD_SOURCES[@]}" ;;
     hlod) echo "${HLOD_SOURCES[@]}" ;;
+    hsub) echo "${HLOD_SOURCES[@]} runtime/hlod_subtree_entry.cpp" ;;
     scene) echo "${SCENE_SOURCES[@]}" ;;
     *) echo "${MESH_SOURCES[@]}" ;;
   esac
 }
 for t in "${TARGETS[@]}"; do
-  case $t in ply|off|stl|obj|glb|lod|hlod|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod scene)" >&2; exit 2 ;; esac
+  case $t in ply|off|stl|obj|glb|lod|hlod|hsub|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod hsub scene)" >&2; exit 2 ;; esac
   # shellcheck disable=SC2046
   compile $(sources_of "$t")
 done
@@ -78,6 +80,7 @@ for t in "${TARGETS[@]}"; do
   case $t in
     lod) main=tests/fuzz/asset_fuzz.cpp; extra=() ;;
     hlod) main=tests/fuzz/hlod_fuzz.cpp; extra=() ;;
+    hsub) main=tests/fuzz/hsub_fuzz.cpp; extra=() ;;
     scene) main=tests/fuzz/scene_fuzz.cpp; extra=("${SCENE_FLAGS[@]}" -ltomlplusplus) ;;
     *) main=tests/fuzz/mesh_fuzz.cpp; extra=("-DLOD_FUZZ_EXT=\".$t\"") ;;
   esac
@@ -96,6 +99,7 @@ run_one() {  # runs in a background subshell; reports by its exit status
   local max_len=${LOD_FUZZ_MAX_LEN:-4096}
   [ "$fmt" = lod ] && max_len=${LOD_FUZZ_MAX_LEN:-16384}
   [ "$fmt" = hlod ] && max_len=${LOD_FUZZ_MAX_LEN:-32768}
+  [ "$fmt" = hsub ] && max_len=${LOD_FUZZ_MAX_LEN:-32768}
   mkdir -p "$dir/corpus"
   rm -f "$dir"/crash-* "$dir"/timeout-* "$dir"/oom-* "$dir"/leak-*
   local rc=0

@@ -5,6 +5,7 @@
 #     bake CPU seconds (balance = slowest / mean), bytes identical to the local bake
 #   - 2 ranks killed at <= 50 % (each dies once it has stored a quarter of the subtrees; the first
 #     to die ends the job), then the rerun: its time against the full 2-rank build
+#   - per rank, CPU seconds per phase; critical_cpu_s (the job on idle cores) for the ratios
 # Output: one JSON summary per run in $OUT (default /tmp/hlod-mpi-figures), a table on stdout.
 set -euo pipefail
 export NPS=${NPS:-1 2 4}
@@ -57,6 +58,9 @@ for np, (j, wall) in runs.items():
           f"bake {j['bake_s']:.2f}, assemble {j['assemble_s']:.2f}, write {j['write_s']:.2f}), subtrees {j['subtrees']}, "
           f"bake cpu per rank {[round(c, 2) for c in cpu]}, balance {max(cpu) / (sum(cpu) / len(cpu)):.3f}, "
           f"entries read {j['entry_bytes_read'] / 1e6:.1f} MB, file {j['bytes'] / 1e6:.1f} MB")
+    for r, w in enumerate(j["per_rank"]):  # CPU seconds per phase (bvh is part of bake)
+        print(f"  rank {r} CPU s: " + ", ".join(f"{k} {v:.2f}" for k, v in w["cpu_s"].items()))
+    print("  rank 0 serial CPU s: " + ", ".join(f"{k} {v:.2f}" for k, v in j["rank0_cpu_s"].items()))
 w1, w2 = runs[1][1], runs[2][1]
 c = {np: runs[np][0]["critical_cpu_s"] for np in runs}
 print("critical-path CPU s: " + ", ".join(f"{v:.2f} at {np}" for np, v in c.items()))

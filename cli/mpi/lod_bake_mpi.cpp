@@ -59,24 +59,34 @@ long env_number(const char* name, long fallback) {
 
 nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
   nlohmann::json per_rank = nlohmann::json::array();
-  double slowest = 0, sum = 0, critical = 0;
+  double slowest = 0, sum = 0;
   for (const HlodRankWork& w : r.ranks) {
-    per_rank.push_back({{"subtrees", w.subtrees}, {"triangles", w.triangles}, {"bake_s", w.bake_seconds},
+    per_rank.push_back({{"subtrees", w.subtrees}, {"triangles", w.triangles}, {"checked", w.checked},
+                        {"bytes_checked", w.bytes_checked}, {"bake_s", w.bake_seconds},
                         {"bake_cpu_s", w.bake_cpu_seconds}, {"until_report_s", w.total_seconds},
                         {"cpu_until_report_s", w.cpu_seconds},
-                        {"bytes_written", w.bytes_written}});
+                        // Each phase's CPU seconds on this rank (bvh is part of bake).
+                        {"cpu_s", {{"load", w.load_cpu_seconds}, {"clean", w.clean_cpu_seconds},
+                                   {"plan", w.plan_cpu_seconds}, {"check", w.check_cpu_seconds},
+                                   {"bvh", w.surface_cpu_seconds}, {"bake", w.bake_cpu_seconds},
+                                   {"measure_top", w.measure_cpu_seconds}, {"write", w.write_cpu_seconds}}},
+                        {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed}});
     slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
-    critical = std::max(critical, w.cpu_seconds);
   }
   return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},
+          {"mesh_cached", r.mesh_cached},
           {"subtrees", r.subtrees}, {"cached", r.cached}, {"rebaked", r.rebaked}, {"nodes", r.report.nodes},
           {"entry_bytes_read", r.entry_bytes_read}, {"load_s", r.load_seconds}, {"plan_s", r.plan_seconds},
           {"lookup_s", r.lookup_seconds}, {"bake_s", r.bake_seconds}, {"assemble_s", r.assemble_seconds},
           {"write_s", r.write_seconds}, {"total_s", r.total_seconds},
           {"cpu_after_gather_s", r.cpu_after_gather_seconds},
-          // The job's length on idle cores: the slowest rank's CPU time up to the gather, then
-          // rank 0's (each rank runs one thread; the machine these figures come from is shared).
-          {"critical_cpu_s", critical + r.cpu_after_gather_seconds},
+          // Rank 0's serial CPU seconds between the gather and the layout's broadcast.
+          {"rank0_cpu_s", {{"roots", r.collect_cpu_seconds}, {"assemble", r.assemble_cpu_seconds},
+                           {"head", r.head_cpu_seconds}}},
+          // The job's length on idle cores: the slowest rank's CPU time up to the gather, rank
+          // 0's serial part, the slowest rank's write (each rank runs one thread; the machine
+          // these figures come from is shared).
+          {"critical_cpu_s", r.critical_cpu_seconds},
           {"balance_cpu", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
 }
 

@@ -111,13 +111,15 @@ TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes)
   EXPECT_EQ(baked, total - kept) << "only the missing subtrees are baked";
   EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local);
   EXPECT_EQ(entries(dir / "cache"), total);
+  EXPECT_TRUE(j["mesh_cached"].get<bool>()) << "the rerun reads the cleaned mesh the killed run stored";
 }
 
 TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
   const auto dir = test::temp_dir("lod_bake_mpi_corrupt");
   ASSERT_EQ(mpirun(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
   std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir / "cache")) files.push_back(e.path());
+  for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
+    if (e.path().extension() == ".hsub") files.push_back(e.path());
   std::sort(files.begin(), files.end());
   ASSERT_GE(files.size(), 2u);
   std::vector<uint8_t> bytes = test::read_bytes(files[0]);
@@ -143,7 +145,8 @@ TEST(LodBakeMpi, FailingRankNamesTheSubtreeAndTheJobFailsKeepingTheCache) {
   const auto dir = test::temp_dir("lod_bake_mpi_fail");
   ASSERT_EQ(mpirun(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
   std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir / "cache")) files.push_back(e.path());
+  for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
+    if (e.path().extension() == ".hsub") files.push_back(e.path());
   std::sort(files.begin(), files.end());
   const auto blocked = files[files.size() / 2];
   std::filesystem::remove(blocked);

@@ -12,6 +12,7 @@
 
 #include "jobs/hlod_bake.h"
 #include "jobs/hlod_distributed_bake.h"
+#include "jobs/hlod_mesh_cache.h"
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_io.h"
 #include "test_support.h"
@@ -217,8 +218,13 @@ TEST(HlodDistributedBake, OneRankRebakesOnlyTheCorruptedAndMissingEntries) {
   HlodDistributedResult r;
   ASSERT_TRUE(bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r));
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+  EXPECT_FALSE(r.mesh_cached);
+  uint64_t source = 0;
+  ASSERT_TRUE(hlod_source_hash(mesh, s.min_verts, source));
+  EXPECT_TRUE(std::filesystem::exists(hlod_mesh_entry_path(s.cache_dir, source))) << "the cleaned mesh is kept for reruns";
   std::vector<std::filesystem::path> entries;
-  for (const auto& e : std::filesystem::directory_iterator(s.cache_dir)) entries.push_back(e.path());
+  for (const auto& e : std::filesystem::directory_iterator(s.cache_dir))
+    if (e.path().extension() == ".hsub") entries.push_back(e.path());
   std::sort(entries.begin(), entries.end());
   ASSERT_EQ(entries.size(), r.subtrees);
   std::vector<uint8_t> bytes = test::read_bytes(entries[0]);
@@ -229,10 +235,44 @@ TEST(HlodDistributedBake, OneRankRebakesOnlyTheCorruptedAndMissingEntries) {
   ASSERT_TRUE(bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(),
                                     [&](const std::string& l) { lines.push_back(l); }, &r));
   EXPECT_EQ(r.cached, r.subtrees - 2);
+  EXPECT_TRUE(r.mesh_cached) << "the rerun reads the cleaned mesh";
   ASSERT_EQ(r.ranks.size(), 1u);
   EXPECT_EQ(r.ranks[0].subtrees, 2u);
   EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("baking it again") != std::string::npos; }));
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+}
+
+TEST(HlodMeshCache, CleanedMeshRoundTripsAndBrokenEntriesAreRefused) {
+  const auto dir = test::temp_dir("hlod_mesh_cache");
+  const MeshData m = test::vd_sphere(20, 30);
+  MeshData back;
+  uint64_t input = 0;
+  EXPECT_EQ(load_hlod_mesh(dir, 7, "ball.ply", back, input), CacheLookup::missing);
+  ASSERT_TRUE(store_hlod_mesh(dir, 7, m, 1234));
+  ASSERT_EQ(load_hlod_mesh(dir, 7, "ball.ply", back, input), CacheLookup::found);
+  EXPECT_EQ(back.positions, m.positions);
+  EXPECT_EQ(back.indices, m.indices);
+  EXPECT_EQ(back.source, "ball.ply");
+  EXPECT_EQ(input, 1234u);
+  const auto path = hlod_mesh_entry_path(dir, 7);
+  const std::vector<uint8_t> good = test::read_bytes(path);
+  std::string why;
+  for (size_t at : {size_t(3), size_t(20), good.size() / 2, good.size() - 3}) {
+    std::vector<uint8_t> bad = good;
+    bad[at] ^= 0x40;
+    test::write_bytes(path, bad);
+    MeshData out;
+    out.source = "untouched";
+    EXPECT_EQ(load_hlod_mesh(dir, 7, "ball.ply", out, input, &why), CacheLookup::refused) << "flipped byte " << at;
+    EXPECT_EQ(out.source, "untouched");
+  }
+  test::write_bytes(path, std::vector<uint8_t>(good.begin(), good.end() - 1));
+  EXPECT_EQ(load_hlod_mesh(dir, 7, "ball.ply", back, input, &why), CacheLookup::refused);
+  EXPECT_NE(why.find("truncated"), std::string::npos) << why;
+  test::write_bytes(path, good);
+  std::filesystem::rename(path, hlod_mesh_entry_path(dir, 8));
+  EXPECT_EQ(load_hlod_mesh(dir, 8, "ball.ply", back, input, &why), CacheLookup::refused) << "stored for source 7";
+  EXPECT_NE(why.find("another source"), std::string::npos) << why;
 }
 
 TEST(HlodDistributedBake, FailingStoreNamesTheSubtreeAndKeepsTheOthers) {

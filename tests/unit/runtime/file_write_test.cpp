@@ -77,3 +77,23 @@ TEST(FileWrite, FailedRenameKeepsWhatWasThereAndRemovesTheTemporary) {
   EXPECT_TRUE(std::filesystem::is_directory(target / "inside"));
   EXPECT_EQ(leftover_temporaries(dir), 0u);
 }
+
+TEST(FileWrite, PiecesFromSeveralWritersMakeTheFileOnlyWhenCommitted) {
+  const auto dir = lod::test::temp_dir("file_write_pieces");
+  const auto path = dir / "out.bin";
+  std::filesystem::path temp;
+  ASSERT_TRUE(lod::create_sized_temporary(path, 10, temp));
+  EXPECT_EQ(std::filesystem::file_size(temp), 10u);
+  const std::vector<uint8_t> a{1, 2, 3}, b{9, 8, 7, 6, 5, 4, 3};
+  const lod::FilePiece first[] = {{0, a}};
+  const lod::FilePiece second[] = {{3, b}};
+  ASSERT_TRUE(lod::write_pieces(temp, second, "out.bin"));  // any order, any writer
+  ASSERT_TRUE(lod::write_pieces(temp, first, "out.bin"));
+  EXPECT_FALSE(std::filesystem::exists(path)) << "nothing under the name before the commit";
+  ASSERT_TRUE(lod::commit_temporary(temp, path));
+  EXPECT_EQ(lod::test::read_bytes(path), (std::vector<uint8_t>{1, 2, 3, 9, 8, 7, 6, 5, 4, 3}));
+  EXPECT_FALSE(std::filesystem::exists(temp));
+  const lod::Status gone = lod::write_pieces(dir / "no-such.tmp", first, "out.bin");
+  EXPECT_FALSE(gone);
+  EXPECT_NE(gone.message.find("out.bin"), std::string::npos) << gone.message;
+}

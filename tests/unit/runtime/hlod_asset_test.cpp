@@ -133,6 +133,22 @@ TEST(HlodAsset, RoundTripIsBitExact) {
   EXPECT_EQ(encode_hlod_asset(t, p), bytes);
 }
 
+TEST(HlodAsset, HeadAndPayloadsInPiecesAreTheWholeFile) {
+  const Sample s = sample();
+  const std::vector<uint8_t> whole = encode_hlod_asset(s.tree, s.payloads);
+  std::vector<uint64_t> sizes;
+  std::vector<uint8_t> pieces;
+  for (size_t i = 0; i < s.payloads.size(); ++i) {
+    const std::vector<uint8_t> p = encode_hlod_payload(s.payloads[i]);
+    sizes.push_back(p.size());
+    EXPECT_EQ(p.size(), hlod_payload_bytes(s.tree.nodes[i])) << "the size follows from the record";
+    pieces.insert(pieces.end(), p.begin(), p.end());
+  }
+  std::vector<uint8_t> bytes = encode_hlod_head(s.tree, sizes);
+  bytes.insert(bytes.end(), pieces.begin(), pieces.end());
+  EXPECT_EQ(bytes, whole);
+}
+
 TEST(HlodAsset, ReadsTheTreeThenOneNodeAtATime) {
   const Sample s = sample();
   const auto dir = test::temp_dir("hlod_asset");

@@ -5,7 +5,11 @@
 #include <cstring>
 #include <vector>
 
+#include <algorithm>
+#include <span>
+
 #include "runtime/byte_order.h"
+#include "runtime/hlod_asset.h"
 #include "runtime/hlod_subtree_entry.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 
@@ -172,6 +176,76 @@ TEST(HlodSubtreeEntry, RefusesForgedCountsUnderARecomputedChecksum) {
   EXPECT_FALSE(decode(forge(48, 1), t)) << "asset size";
   EXPECT_FALSE(decode(forge(8, 2), t)) << "version";
   EXPECT_TRUE(decode(forge(12, 3), t)) << "the forger itself";
+}
+
+// The root alone from the entry's first bytes (what the levels above need), asked for in steps.
+Status decode_root(const std::vector<uint8_t>& bytes, HlodSubtree& out, size_t* used = nullptr) {
+  std::vector<uint8_t> prefix(bytes.begin(), bytes.begin() + std::ptrdiff_t(std::min<size_t>(bytes.size(), 16)));
+  for (int step = 0; step < 8; ++step) {
+    const uint64_t need = hlod_subtree_entry_root_bytes(prefix, bytes.size());
+    if (need == 0 || need <= prefix.size() || need > bytes.size()) break;
+    prefix.assign(bytes.begin(), bytes.begin() + std::ptrdiff_t(need));
+  }
+  if (used) *used = prefix.size();
+  return decode_hlod_subtree_root(prefix, bytes.size(), kKey, kMeshVertices, "cache/abc.hsub", out);
+}
+
+TEST(HlodSubtreeEntry, RootAloneFromTheFirstBytesMatchesTheFullDecode) {
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(sample(), kKey);
+  HlodSubtree full, root;
+  ASSERT_TRUE(decode(bytes, full));
+  size_t used = 0;
+  const Status st = decode_root(bytes, root, &used);
+  ASSERT_TRUE(st) << st.message;
+  EXPECT_LT(used, bytes.size()) << "the leaves' payloads are not read";
+  ASSERT_EQ(root.nodes.size(), full.nodes.size());
+  ASSERT_EQ(root.payloads.size(), 1u);
+  EXPECT_EQ(root.payloads[0].positions, full.payloads[0].positions);
+  EXPECT_EQ(root.payloads[0].indices, full.payloads[0].indices);
+  for (size_t i = 0; i < root.nodes.size(); ++i) {
+    EXPECT_EQ(root.nodes[i].depth, full.nodes[i].depth);
+    EXPECT_EQ(root.nodes[i].first_child, full.nodes[i].first_child);
+    EXPECT_EQ(root.nodes[i].layers[0].error, full.nodes[i].layers[0].error);
+  }
+  EXPECT_EQ(root.root_source, full.root_source);
+  EXPECT_EQ(root.root_reference, full.root_reference);
+  EXPECT_EQ(root.short_layers, full.short_layers);
+}
+
+TEST(HlodSubtreeEntry, RootAloneRefusesTruncationsAndFlippedBytesInWhatItReads) {
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(sample(), kKey);
+  size_t used = 0;
+  HlodSubtree t;
+  ASSERT_TRUE(decode_root(bytes, t, &used));
+  for (size_t n = 0; n < bytes.size(); ++n) {
+    const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + std::ptrdiff_t(n));
+    HlodSubtree u;
+    ASSERT_FALSE(decode_root(cut, u)) << "accepted " << n << " of " << bytes.size() << " bytes";
+  }
+  for (size_t i = 0; i < used; ++i) {
+    std::vector<uint8_t> bad = bytes;
+    bad[i] ^= 0x20;
+    HlodSubtree u;
+    ASSERT_FALSE(decode_root(bad, u)) << "accepted a flipped byte at " << i;
+  }
+  HlodSubtree u;
+  const std::vector<uint8_t> prefix(bytes.begin(), bytes.begin() + std::ptrdiff_t(used - 1));
+  EXPECT_FALSE(decode_hlod_subtree_root(prefix, bytes.size(), kKey, kMeshVertices, "e", u)) << "a prefix one byte short";
+}
+
+TEST(HlodSubtreeEntry, PayloadSpansAreTheFilesPayloadBytes) {
+  const HlodSubtree s = sample();
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(s, kKey);
+  std::vector<std::span<const uint8_t>> spans;
+  ASSERT_TRUE(hlod_subtree_entry_payloads(bytes, "e", spans));
+  ASSERT_EQ(spans.size(), s.nodes.size());
+  for (size_t i = 0; i < spans.size(); ++i) {
+    const std::vector<uint8_t> own = encode_hlod_payload(s.payloads[i]);
+    EXPECT_EQ(std::vector<uint8_t>(spans[i].begin(), spans[i].end()), own) << i;
+    EXPECT_EQ(own.size(), hlod_payload_bytes(s.nodes[i])) << i;
+  }
+  EXPECT_FALSE(hlod_subtree_entry_payloads(std::vector<uint8_t>(bytes.begin(), bytes.begin() + 40), "e", spans))
+      << "a truncated entry";
 }
 
 }  // namespace
