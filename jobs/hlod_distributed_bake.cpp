@@ -4,7 +4,7 @@
 // top's errors, the head -> broadcast the layout -> write own payloads -> gather -> (rank 0) rename.
 #include "jobs/hlod_distributed_bake.h"
 
-#include <oneapi/tbb/parallel_for.h>
+
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
@@ -19,6 +19,7 @@
 #include <type_traits>
 #include <ctime>
 
+#include "jobs/annotated_parallel_for.h"
 #include "jobs/hlod_mesh_cache.h"
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_clean.h"
@@ -251,7 +252,7 @@ std::vector<uint8_t> check_share(Job& j) {
   std::vector<CacheLookup> found(mine.size());
   std::vector<HlodSubtree> decoded(mine.size());
   j.arena->execute([&] {
-    tbb::parallel_for(size_t(0), mine.size(), [&](size_t k) {
+    detail::annotated_parallel_for(mine.size(), [&](size_t k) {
       const size_t i = mine[k];
       found[k] = load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), decoded[k], &why[k], &bytes[k],
                                    &j.entries[i]);
@@ -367,7 +368,7 @@ Status collect_roots(Job& j) {
   std::vector<std::string> why(n);
   std::vector<uint64_t> bytes(n, 0);
   j.arena->execute([&] {
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    detail::annotated_parallel_for(n, [&](size_t i) {
       if (!j.have[i])
         found[i] = load_hlod_subtree_root(j.settings.cache_dir, j.keys[i], j.vertices(), j.roots[i], &why[i], &bytes[i]);
     });
