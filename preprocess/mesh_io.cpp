@@ -285,15 +285,87 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
   return write_file_atomic(path, bytes);
 }
 
-Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count, const float* uvs) {
+namespace {
+
+// usemtl / newmtl names: no blanks (OBJ splits on them), unique by the index in front.
+std::string obj_material_name(const std::vector<ObjMaterialView>& materials, int32_t m) {
+  if (m < 0) return "lodkit_default";
+  std::string s = "m" + std::to_string(m);
+  if (!materials[size_t(m)].name.empty()) s += '_';
+  for (unsigned char c : materials[size_t(m)].name) s += std::isalnum(c) || c == '-' || c == '.' ? char(c) : '_';
+  return s.substr(0, 128);
+}
+
+Status check_surfaces(const std::string& what, const ObjSurfaces& s, size_t index_count) {
+  size_t covered = 0;
+  for (size_t i = 0; i < s.submeshes.size(); ++i) {
+    const ObjSubmeshView& r = s.submeshes[i];
+    if (r.first_index != covered || r.index_count % 3 != 0 || r.index_count > index_count - covered)
+      return Status::error(what + ": submesh " + std::to_string(i) + " does not continue the runs before it");
+    if (r.material < -1 || (r.material >= 0 && size_t(r.material) >= s.materials.size()))
+      return Status::error(what + ": submesh " + std::to_string(i) + " names material " + std::to_string(r.material) +
+                           " of " + std::to_string(s.materials.size()));
+    covered += r.index_count;
+  }
+  if (covered != index_count)
+    return Status::error(what + ": submeshes cover " + std::to_string(covered) + " of " + std::to_string(index_count) +
+                         " indices");
+  return Status::success();
+}
+
+// <stem>.mtl and the images it names, copied next to it.
+Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
+  std::string text = "# lodkit\nnewmtl lodkit_default\nKd 1 1 1\nd 1\n";
+  char line[160];
+  std::vector<std::filesystem::path> copied;
+  for (size_t i = 0; i < s.materials.size(); ++i) {
+    const ObjMaterialView& m = s.materials[i];
+    text += "newmtl " + obj_material_name(s.materials, int32_t(i)) + "\n";
+    std::snprintf(line, sizeof line, "Kd %.6g %.6g %.6g\nd %.6g\n", m.base_color[0], m.base_color[1], m.base_color[2],
+                  m.base_color[3]);
+    text += line;
+    if (m.base_color_image.empty()) continue;
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(m.base_color_image, ec);
+    if (ec || !std::filesystem::is_regular_file(m.base_color_image, ec) || size > (uintmax_t(256) << 20)) {
+      if (s.notes)
+        s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + m.base_color_image.string() +
+                           " is missing or larger than 256 MiB; written without it");
+      continue;
+    }
+    auto known = std::find(copied.begin(), copied.end(), m.base_color_image);
+    const size_t k = size_t(known - copied.begin());
+    const std::string name = obj.stem().string() + "-image" + std::to_string(k) + m.base_color_image.extension().string();
+    if (known == copied.end()) {
+      std::vector<uint8_t> bytes;
+      if (Status r = detail::read_regular_file(m.base_color_image, bytes); !r) return r;
+      if (Status w = write_file_atomic(obj.parent_path() / name, bytes); !w) return w;
+      copied.push_back(m.base_color_image);
+    }
+    text += "map_Kd " + name + "\n";
+  }
+  std::filesystem::path mtl = obj;
+  mtl.replace_extension(".mtl");
+  return write_file_atomic(mtl, text);
+}
+
+Status save_obj_text(const std::filesystem::path& path, const float* positions, const float* normals,
+                     size_t vertex_count, const uint32_t* indices, size_t index_count, const float* uvs,
+                     const ObjSurfaces* surfaces) {
   const std::string what = path.string();
   if (index_count % 3 != 0) return Status::error(what + ": index count " + std::to_string(index_count) + " is not a multiple of 3");
   for (size_t i = 0; i < index_count; ++i)
     if (indices[i] >= vertex_count)
       return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
                            std::to_string(indices[i]) + " of " + std::to_string(vertex_count));
+  if (surfaces)
+    if (Status s = check_surfaces(what, *surfaces, index_count); !s) return s;
   std::string text = "# lodkit\n";
+  if (surfaces) {
+    std::filesystem::path mtl = path.filename();
+    mtl.replace_extension(".mtl");
+    text += "mtllib " + mtl.string() + "\n";
+  }
   char line[160];
   for (size_t v = 0; v < vertex_count; ++v) {
     const float* p = positions + 3 * v;
@@ -311,7 +383,12 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
       std::snprintf(line, sizeof line, "vn %.6g %.6g %.6g\n", n[0], n[1], n[2]);
       text += line;
     }
+  size_t run = 0;
   for (size_t t = 0; t < index_count / 3; ++t) {
+    if (surfaces && run < surfaces->submeshes.size() && surfaces->submeshes[run].first_index == 3 * t) {
+      text += "usemtl " + obj_material_name(surfaces->materials, surfaces->submeshes[run].material) + "\n";
+      ++run;
+    }
     const unsigned long a = indices[3 * t] + 1ul, b = indices[3 * t + 1] + 1ul, c = indices[3 * t + 2] + 1ul;
     if (normals && uvs)
       std::snprintf(line, sizeof line, "f %lu/%lu/%lu %lu/%lu/%lu %lu/%lu/%lu\n", a, a, a, b, b, b, c, c, c);
@@ -323,7 +400,21 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
       std::snprintf(line, sizeof line, "f %lu %lu %lu\n", a, b, c);
     text += line;
   }
+  if (surfaces)
+    if (Status s = write_mtl(path, *surfaces); !s) return s;
   return write_file_atomic(path, text);
+}
+
+}  // namespace
+
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
+                const uint32_t* indices, size_t index_count, const float* uvs) {
+  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, nullptr);
+}
+
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
+                const uint32_t* indices, size_t index_count, const float* uvs, const ObjSurfaces& surfaces) {
+  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, &surfaces);
 }
 
 }  // namespace lod
