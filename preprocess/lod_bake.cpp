@@ -238,11 +238,12 @@ uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& se
     return 0;
   }
   uint64_t content = hash_bytes(bytes.data(), bytes.size());
-  // A .gltf's geometry may live in the files it names: they are part of the content.
+  // A .gltf's geometry (and an OBJ's materials) may live in the files it names: they are part
+  // of the content.
   std::string ext = mesh_file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".gltf" || ext == ".glb")
-    for (const auto& file : gltf_external_files(mesh_file)) {
+  if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
+    for (const auto& file : ext == ".obj" ? obj_external_files(mesh_file) : gltf_external_files(mesh_file)) {
       std::ifstream g(file, std::ios::binary);
       const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
       content = hash_bytes(more.data(), more.size(), content);

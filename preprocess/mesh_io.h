@@ -26,6 +26,10 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out);
 Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
                              MeshData& out);
 
+// The files an OBJ's materials name (its mtllib files and their map_Kd images, next to it), so
+// a cache key can cover them too; missing ones are left out (the load says why).
+std::vector<std::filesystem::path> obj_external_files(const std::filesystem::path& path);
+
 // Writes positions + triangles as binary PLY (for --export and outside tools).
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,
                 const uint32_t* indices, size_t index_count);

@@ -273,6 +273,43 @@ TEST(GltfExport, AMissingTextureIsLeftOutAndSaid) {
   EXPECT_EQ(v.code, 0) << v.out;
 }
 
+// ../shared's spot (2,930 positions, 3,225 texture coordinates, a PNG texture) given a .mtl
+// naming its texture: the bake keeps its uvs and the material in every level, and each
+// exported GLB embeds the texture and passes the validator.
+TEST(GltfExport, SpotObjKeepsItsTextureThroughEveryLevel) {
+  LOD_REQUIRE_SHARED_MESH(spot, "spot.obj");
+  const fs::path dir = lod::test::temp_dir("gltf-spot");
+  const std::vector<uint8_t> obj = lod::test::read_bytes(spot);
+  std::string text = "mtllib spot.mtl\nusemtl spot\n";
+  text.append(obj.begin(), obj.end());
+  lod::test::write_text(dir / "spot.obj", text);
+  lod::test::write_text(dir / "spot.mtl", "newmtl spot\nKd 1 1 1\nmap_Kd spot_texture.png\n");
+  fs::copy_file(spot.parent_path() / "spot_texture.png", dir / "spot_texture.png");
+  auto r = run_lod("bake " + (dir / "spot.obj").string() + " -o " + (dir / "out").string() + " --method qem --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path asset = baked_asset(dir / "out");
+  r = run_lod("inspect " + asset.string() + " --json --export " + (dir / "glb").string() + " --format glb");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["texcoords"].get<bool>());
+  ASSERT_EQ(j["materials"].size(), 1u);
+  EXPECT_EQ(j["materials"][0]["base_color_texture"], "spot_texture.png");
+  std::vector<fs::path> exported;
+  for (size_t i = 0; i < j["levels"].size(); ++i) {
+    const fs::path level = dir / "glb" / ("spot-level" + std::to_string(i) + ".glb");
+    lod::MeshData back;
+    ASSERT_TRUE(lod::load_mesh(level, back).ok) << level;
+    EXPECT_EQ(back.uvs.size(), 2 * back.vertex_count());
+    ASSERT_EQ(back.materials.size(), 1u);
+    EXPECT_TRUE(back.materials[0].base_color_texture_embedded);
+    std::printf("spot level %zu: %zu triangles, uv error %.4g\n", i, back.triangle_count(),
+                j["levels"][i]["uv_error"].get<double>());
+    exported.push_back(level);
+  }
+  const auto v = run_validator(exported);
+  EXPECT_EQ(v.code, 0) << v.out;
+}
+
 // A scene's models may name a .glb (imported and baked) and a .lod (read as it is).
 TEST(GltfScene, RunsASceneNamingGlbAndLodFiles) {
   const fs::path dir = lod::test::temp_dir("gltf-scene");
