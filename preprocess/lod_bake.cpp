@@ -26,7 +26,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 7;  // 7: materials per level (MATL), material boundaries as seams; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
+constexpr uint32_t kBakeFormatVersion = 7;  // 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
                                              // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
@@ -123,7 +123,7 @@ Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std:
 // With several materials (vertex_material: one per input vertex) the aggressive simplifier runs
 // per material; QEM keeps them apart by itself (material boundaries are split, hence locked).
 void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_material, const std::vector<float>& ratios,
-                    SimplifyMethod method, bool automatic, const BakeParallelFor& parallel_for,
+                    SimplifyMethod method, bool automatic, float uv_weight, const BakeParallelFor& parallel_for,
                     std::vector<ChainLevel>& levels, std::vector<std::vector<uint32_t>>& sources,
                     std::vector<std::string>& notes) {
   const bool per_material = distinct_materials(vertex_material) > 1;
@@ -162,7 +162,7 @@ void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_mat
     // Texture coordinates ride along as attributes: interpolated along each collapse, and
     // vertices sharing a position (uv seams) locked, so the texture never tears at a seam.
     QemOptions options;
-    if (keep_uvs) options.attributes = mesh.uvs.data(), options.attribute_count = 2;
+    if (keep_uvs) options.attributes = mesh.uvs.data(), options.attribute_count = 2, options.attribute_weight = uv_weight;
     qem_simplify_chain_split(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
                              mesh.indices.size(), targets.data(), targets.size(), options,
                              parallel_for ? ParallelFor(parallel_for) : one_by_one);
@@ -258,6 +258,7 @@ uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& se
   const uint8_t method = static_cast<uint8_t>(settings.method);
   put(&method, 1);
   put(&settings.extreme_threshold, sizeof settings.extreme_threshold);
+  put(&settings.uv_weight, sizeof settings.uv_weight);
   const uint64_t n = settings.ratios.size();
   put(&n, sizeof n);
   for (float r : settings.ratios) put(&r, sizeof r);
@@ -308,7 +309,7 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   for (int32_t& m : vertex_material)
     if (m >= int32_t(chain.materials.size())) m = -1;
   simplify_chain(mesh, vertex_material, ratios, method, settings.method == SimplifyMethod::automatic,
-                 settings.parallel_for, levels, sources, report.notes);
+                 settings.uv_weight, settings.parallel_for, levels, sources, report.notes);
 
   // A level no smaller than the one before it adds nothing: drop it.
   for (size_t i = 1; i < levels.size();) {
