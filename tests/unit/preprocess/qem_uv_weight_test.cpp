@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <thread>
 
 #include "preprocess/lod_bake.h"
 #include "test_support.h"
@@ -65,6 +66,31 @@ TEST(QemUvWeight, TheTexturedSphereKeepsItsUvsCloser) {
 TEST(QemUvWeight, SpotKeepsItsUvsCloser) {
   LOD_REQUIRE_SHARED_MESH(spot, "spot.obj");
   compare("spot", spot);
+}
+
+// Past 20,000 triangles QEM splits the mesh into halves (attribute quadrics split and merged
+// with it); the output is the same whether the halves run in parallel or one after the other.
+TEST(QemUvWeight, SplitHalvesGiveTheSameChainInParallel) {
+  const auto dir = test::temp_dir("qem-uv-split");
+  const auto file = test::write_two_material_gltf(dir, "globe", 120, 240);
+  BakeSettings settings;
+  settings.ratios = {1.0f, 0.5f, 0.1f};
+  settings.method = SimplifyMethod::qem;
+  LodChain serial, parallel;
+  ASSERT_TRUE(bake_model(file, "g", settings, serial, nullptr, nullptr).ok);
+  settings.parallel_for = [](size_t n, const std::function<void(size_t)>& body) {
+    std::vector<std::thread> threads;
+    for (size_t i = 0; i < n; ++i) threads.emplace_back(body, i);
+    for (std::thread& t : threads) t.join();
+  };
+  ASSERT_TRUE(bake_model(file, "g", settings, parallel, nullptr, nullptr).ok);
+  ASSERT_GT(serial.levels[0].triangles(), 40000u);
+  EXPECT_EQ(serial.positions, parallel.positions);
+  EXPECT_EQ(serial.indices, parallel.indices);
+  EXPECT_EQ(serial.uvs, parallel.uvs);
+  std::string why;
+  EXPECT_TRUE(validate_chain(serial, &why)) << why;
+  EXPECT_LT(serial.uv_errors[2], 0.25f);
 }
 
 }  // namespace
