@@ -9,23 +9,98 @@
 #include "cli/names.h"
 #include "preprocess/gltf_write.h"
 #include "preprocess/mesh_io.h"
+#include "preprocess/texture_uri.h"
 #include "runtime/lod_asset.h"
 
 namespace lod::cli {
 namespace {
 
+const char* alpha_name(AlphaMode a) {
+  return a == AlphaMode::mask ? "MASK" : a == AlphaMode::blend ? "BLEND" : "OPAQUE";
+}
+
+nlohmann::json materials_json(const LodChain& chain) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ChainMaterial& m : chain.materials)
+    out.push_back({{"name", m.name},
+                   {"base_color", {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]}},
+                   {"metallic", m.metallic},
+                   {"roughness", m.roughness},
+                   {"alpha_mode", alpha_name(m.alpha_mode)},
+                   {"alpha_cutoff", m.alpha_cutoff},
+                   {"double_sided", m.double_sided},
+                   {"base_color_texture", m.base_color_texture}});
+  return out;
+}
+
+// Level k's runs as {material, triangles} (material -1: the default).
+nlohmann::json level_runs_json(const LodChain& chain, uint32_t k) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const LevelSubmesh& s : level_submeshes(chain, k)) out.push_back({{"material", s.material}, {"triangles", s.index_count / 3}});
+  return out;
+}
+
+void print_materials(const LodChain& chain) {
+  std::printf("materials: %zu (texture base %s)\n", chain.materials.size(), printable(chain.texture_base).c_str());
+  for (size_t i = 0; i < chain.materials.size(); ++i) {
+    const ChainMaterial& m = chain.materials[i];
+    std::printf("  %zu '%s': base colour %.3g %.3g %.3g %.3g, metallic %.3g, roughness %.3g, %s%s%s%s\n", i,
+                printable(m.name).c_str(), m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3], m.metallic,
+                m.roughness, alpha_name(m.alpha_mode), m.double_sided ? ", double-sided" : "",
+                m.base_color_texture.empty() ? "" : ", texture ", printable(m.base_color_texture).c_str());
+  }
+  for (uint32_t k = 0; k < chain.levels.size(); ++k) {
+    const auto runs = level_submeshes(chain, k);
+    if (runs.empty()) continue;
+    std::printf("  level %u:", k);
+    for (const LevelSubmesh& s : runs) std::printf(" material %d x %u", s.material, s.index_count / 3);
+    std::printf("\n");
+  }
+}
+
+// The level's materials and runs for the writers; images resolved against the texture base.
+void export_surfaces(const LodChain& chain, uint32_t k, GltfMeshView& view) {
+  for (const ChainMaterial& m : chain.materials) {
+    GltfMaterialView g;
+    g.name = m.name;
+    std::copy(m.base_color, m.base_color + 4, g.base_color);
+    g.metallic = m.metallic;
+    g.roughness = m.roughness;
+    g.alpha_mode = m.alpha_mode;
+    g.alpha_cutoff = m.alpha_cutoff;
+    g.double_sided = m.double_sided;
+    g.base_color_image = texture_file(chain.texture_base, m.base_color_texture);
+    view.materials.push_back(std::move(g));
+  }
+  for (const LevelSubmesh& s : level_submeshes(chain, k)) view.submeshes.push_back({s.first_index, s.index_count, s.material});
+}
+
+ObjSurfaces obj_surfaces(const GltfMeshView& view) {
+  ObjSurfaces s;
+  for (const GltfMaterialView& m : view.materials)
+    s.materials.push_back({m.name, {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]}, m.base_color_image});
+  for (const GltfSubmeshView& r : view.submeshes) s.submeshes.push_back({r.first_index, r.index_count, r.material});
+  s.notes = view.notes;
+  return s;
+}
+
 // One level in the chosen format: positions and triangles, plus normals and texture
 // coordinates where the format has them (PLY: positions only).
 Status export_level(const std::filesystem::path& out, const std::string& format, const LodChain& chain,
-                    const LodLevel& l, const std::string& name) {
+                    uint32_t k, const std::string& name, std::vector<std::string>& notes) {
+  const LodLevel& l = chain.levels[k];
   const float* positions = chain.positions.data() + size_t(l.first_vertex) * 3;
   const float* normals = chain.normals.size() == chain.positions.size() ? chain.normals.data() + size_t(l.first_vertex) * 3
                                                                         : nullptr;
   const float* uvs = chain.uvs.empty() ? nullptr : chain.uvs.data() + size_t(l.first_vertex) * 2;
   const uint32_t* indices = chain.indices.data() + l.first_index;
-  if (format == "obj") return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs);
+  GltfMeshView view;
+  view.notes = &notes;
+  if (!chain.materials.empty()) export_surfaces(chain, k, view);
+  if (format == "obj" && view.submeshes.empty())
+    return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs);
+  if (format == "obj") return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs, obj_surfaces(view));
   if (format == "glb" || format == "gltf") {
-    GltfMeshView view;
     view.name = name;
     view.positions = positions;
     view.normals = normals;
@@ -63,6 +138,7 @@ int inspect_command(const InspectArgs& args) {
     j["morph_targets"] = chain.morph_targets.size();  // 0 = level changes cannot blend
     j["hierarchy_nodes"] = chain.hierarchy.node_count();
     j["texcoords"] = !chain.uvs.empty();
+    j["materials"] = materials_json(chain);
     j["levels"] = nlohmann::json::array();
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
@@ -76,6 +152,7 @@ int inspect_command(const InspectArgs& args) {
                              {"bounds", {l.bounds.center[0], l.bounds.center[1], l.bounds.center[2], l.bounds.radius}},
                              {"bytes", l.vertex_count * 24ull + l.index_count * 4ull}});
       if (!chain.uvs.empty()) j["levels"].back()["uv_error"] = chain.uv_errors[i];
+      if (!chain.materials.empty()) j["levels"].back()["submeshes"] = level_runs_json(chain, uint32_t(i));
     }
     // Names and paths are bytes: invalid UTF-8 is replaced (U+FFFD) rather than aborting the
     // dump; JSON escapes control characters itself.
@@ -103,6 +180,7 @@ int inspect_command(const InspectArgs& args) {
       for (float e : chain.uv_errors) std::printf(" %.4g", e);
       std::printf("\n");
     }
+    if (!chain.materials.empty()) print_materials(chain);
   }
   if (!args.export_dir.empty()) {
     std::error_code ec;
@@ -116,19 +194,21 @@ int inspect_command(const InspectArgs& args) {
     // the files, and always directly inside the export folder.
     const std::string stem = export_stem(chain.name);
     for (size_t i = 0; i < chain.levels.size(); ++i) {
-      const auto& l = chain.levels[i];
       const auto out = std::filesystem::path(args.export_dir) / (stem + "-level" + std::to_string(i) + "." + args.format);
       // Never written through a link planted under the export name (it could point anywhere);
-      // a .gltf also writes its .bin.
+      // a .gltf also writes its .bin, an .obj with materials its .mtl. (Images are written
+      // through a temporary file renamed over the name, which replaces a link, never follows it.)
       auto bin = out;
-      bin.replace_extension(".bin");
-      for (const auto& written : args.format == "gltf" ? std::vector{out, bin} : std::vector{out})
+      bin.replace_extension(args.format == "obj" ? ".mtl" : ".bin");
+      for (const auto& written : args.format == "gltf" || args.format == "obj" ? std::vector{out, bin} : std::vector{out})
         if (std::filesystem::is_symlink(std::filesystem::symlink_status(written, ec))) {
           std::fprintf(stderr, "lod inspect: %s is a symbolic link; not writing through it\n",
                        printable(written.string()).c_str());
           return 1;
         }
-      const Status st = export_level(out, args.format, chain, l, stem + "-level" + std::to_string(i));
+      std::vector<std::string> notes;
+      const Status st = export_level(out, args.format, chain, uint32_t(i), stem + "-level" + std::to_string(i), notes);
+      for (const std::string& n : notes) std::fprintf(stderr, "lod inspect: note: %s\n", printable(n).c_str());
       if (!st) {
         std::fprintf(stderr, "lod inspect: %s\n", printable(st.message).c_str());
         return 1;

@@ -54,6 +54,11 @@ Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string&
   MeshData mesh;
   if (Status s = load_mesh(mesh_file, mesh); !s) return s;
   r.input_triangles = mesh.triangle_count();
+  // Nothing dropped silently: the tree's nodes hold positions only.
+  if (log && (!mesh.materials.empty() || !mesh.uvs.empty()))
+    log("hlod " + name + ": " + std::to_string(mesh.materials.size()) + " materials and " +
+        (mesh.uvs.empty() ? "no" : "the") + " texture coordinates of " + mesh_file.string() +
+        " are not kept in the HLOD tree (one untextured surface)");
   clean_mesh(mesh);
   HlodModel model;
   if (Status s = hlod_source_hash(mesh_file, settings.min_verts, model.tree.source_hash); !s) return s;

@@ -1,6 +1,7 @@
 // glTF 2.0 export (Khronos glTF 2.0 specification, 4.4 "GLB File Format Specification"):
-//   check_mesh -> pack_buffer (views and accessors laid out) -> describe (JSON) -> write_glb
-//   or write_gltf_and_bin, each through a temporary file renamed into place.
+//   check_mesh -> load_images -> pack_buffer (views and accessors laid out, one primitive per
+//   submesh) -> describe (JSON, materials) -> write_glb or write_gltf_and_bin (+ images),
+//   each through a temporary file renamed into place.
 #include "preprocess/gltf_write.h"
 
 #include <algorithm>
@@ -33,7 +34,90 @@ Status check_mesh(const std::string& what, const GltfMeshView& m) {
   for (size_t i = 0; i < 3 * m.vertex_count; ++i)
     if (!std::isfinite(m.positions[i]))
       return Status::error(what + ": vertex " + std::to_string(i / 3) + " has a non-finite position");
+  size_t covered = 0;
+  for (size_t i = 0; i < m.submeshes.size(); ++i) {
+    const GltfSubmeshView& s = m.submeshes[i];
+    const std::string at = what + ": submesh " + std::to_string(i);
+    if (s.first_index != covered || s.index_count == 0 || s.index_count % 3 != 0 || s.index_count > m.index_count - covered)
+      return Status::error(at + " [" + std::to_string(s.first_index) + ", +" + std::to_string(s.index_count) +
+                           ") does not continue the runs before it (at " + std::to_string(covered) + " of " +
+                           std::to_string(m.index_count) + ") with whole triangles");
+    if (s.material < -1 || (s.material >= 0 && size_t(s.material) >= m.materials.size()))
+      return Status::error(at + " names material " + std::to_string(s.material) + " of " + std::to_string(m.materials.size()));
+    covered += s.index_count;
+  }
+  if (!m.submeshes.empty() && covered != m.index_count)
+    return Status::error(what + ": submeshes cover " + std::to_string(covered) + " of " + std::to_string(m.index_count) +
+                         " indices");
+  for (size_t i = 0; i < m.materials.size(); ++i) {
+    const GltfMaterialView& mat = m.materials[i];
+    bool ok = std::isfinite(mat.metallic) && std::isfinite(mat.roughness) && std::isfinite(mat.alpha_cutoff);
+    for (float c : mat.base_color) ok = ok && std::isfinite(c);
+    if (!ok) return Status::error(what + ": material " + std::to_string(i) + " has a non-finite factor");
+  }
   return Status::success();
+}
+
+// An image to embed or copy: its bytes and MIME type.
+struct Image {
+  std::vector<uint8_t> bytes;
+  const char* mime = nullptr;
+  const char* extension = nullptr;
+};
+
+constexpr uintmax_t kMaxImageBytes = uintmax_t(256) << 20;
+
+// The image's bytes when it is a PNG or JPEG (by its signature), else a reason.
+std::string read_image(const fs::path& file, Image& out) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) return "not found";
+  const uintmax_t size = fs::file_size(file, ec);
+  if (ec || size > kMaxImageBytes) return "larger than 256 MiB or unreadable";
+  std::ifstream f(file, std::ios::binary);
+  out.bytes.resize(size_t(size));
+  if (!f.read(reinterpret_cast<char*>(out.bytes.data()), std::streamsize(size))) return "unreadable";
+  static const uint8_t png[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+  if (size >= 8 && std::memcmp(out.bytes.data(), png, 8) == 0) {
+    out.mime = "image/png", out.extension = ".png";
+  } else if (size >= 3 && out.bytes[0] == 0xff && out.bytes[1] == 0xd8 && out.bytes[2] == 0xff) {
+    out.mime = "image/jpeg", out.extension = ".jpg";
+  } else {
+    return "neither PNG nor JPEG (glTF 2.0 core allows no other image)";
+  }
+  return {};
+}
+
+// Images of the materials, one per distinct file; image_of[material] indexes `images` (-1 = none).
+void load_images(const std::string& what, const GltfMeshView& m, std::vector<Image>& images,
+                 std::vector<int>& image_of) {
+  image_of.assign(m.materials.size(), -1);
+  std::vector<fs::path> files;
+  for (size_t i = 0; i < m.materials.size(); ++i) {
+    const fs::path& file = m.materials[i].base_color_image;
+    if (file.empty()) continue;
+    auto note = [&](const std::string& why) {
+      if (m.notes)
+        m.notes->push_back(what + ": material " + std::to_string(i) + ": base colour texture " + file.string() + " " +
+                           why + "; written without it");
+    };
+    if (!m.uvs) {
+      note("needs texture coordinates, and the mesh has none");
+      continue;
+    }
+    const auto known = std::find(files.begin(), files.end(), file);
+    if (known != files.end()) {
+      image_of[i] = int(known - files.begin());
+      continue;
+    }
+    Image img;
+    if (const std::string why = read_image(file, img); !why.empty()) {
+      note("is " + why);
+      continue;
+    }
+    image_of[i] = int(images.size());
+    files.push_back(file);
+    images.push_back(std::move(img));
+  }
 }
 
 // The binary buffer and the JSON objects describing it, built together.
@@ -68,7 +152,7 @@ std::vector<float> unit_normals(const float* n, size_t count) {
   return out;
 }
 
-json pack_buffer(const GltfMeshView& m, Packed& p) {
+json pack_buffer(const GltfMeshView& m, Packed& p, json& primitives) {
   static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
   json attributes;
   const int pos = p.add(m.positions, 12 * m.vertex_count, kArrayBuffer, kFloat, m.vertex_count, "VEC3");
@@ -87,25 +171,87 @@ json pack_buffer(const GltfMeshView& m, Packed& p) {
     attributes["NORMAL"] = p.add(n.data(), 4 * n.size(), kArrayBuffer, kFloat, m.vertex_count, "VEC3");
   }
   if (m.uvs) attributes["TEXCOORD_0"] = p.add(m.uvs, 8 * m.vertex_count, kArrayBuffer, kFloat, m.vertex_count, "VEC2");
-  int indices;
-  if (m.vertex_count <= 65535) {  // 65535 itself is the primitive-restart value, never a vertex
-    std::vector<uint16_t> small(m.indices, m.indices + m.index_count);
-    indices = p.add(small.data(), 2 * small.size(), kElementArrayBuffer, kUShort, m.index_count, "SCALAR");
-  } else {
-    indices = p.add(m.indices, 4 * m.index_count, kElementArrayBuffer, kUInt, m.index_count, "SCALAR");
+  std::vector<GltfSubmeshView> runs = m.submeshes;
+  if (runs.empty()) runs.push_back({0, m.index_count, -1});
+  primitives = json::array();
+  for (const GltfSubmeshView& run : runs) {
+    const uint32_t* first = m.indices + run.first_index;
+    int indices;
+    if (m.vertex_count <= 65535) {  // 65535 itself is the primitive-restart value, never a vertex
+      std::vector<uint16_t> small(first, first + run.index_count);
+      indices = p.add(small.data(), 2 * small.size(), kElementArrayBuffer, kUShort, run.index_count, "SCALAR");
+    } else {
+      indices = p.add(first, 4 * run.index_count, kElementArrayBuffer, kUInt, run.index_count, "SCALAR");
+    }
+    json prim = {{"attributes", attributes}, {"indices", indices}, {"mode", 4}};
+    if (run.material >= 0) prim["material"] = run.material;
+    primitives.push_back(std::move(prim));
   }
   while (p.bin.size() % 4) p.bin.push_back(0);
-  return {{"attributes", attributes}, {"indices", indices}, {"mode", 4}};
+  return primitives;
 }
 
-json describe(const GltfMeshView& m, const Packed& p, const json& primitive, const std::string& bin_uri) {
+// Embedded images (GLB): a buffer view each, without a target.
+void pack_images(const std::vector<Image>& images, Packed& p, json& out) {
+  out = json::array();
+  for (const Image& img : images) {
+    while (p.bin.size() % 4) p.bin.push_back(0);
+    p.views.push_back({{"buffer", 0}, {"byteOffset", p.bin.size()}, {"byteLength", img.bytes.size()}});
+    p.bin.insert(p.bin.end(), img.bytes.begin(), img.bytes.end());
+    out.push_back({{"bufferView", p.views.size() - 1}, {"mimeType", img.mime}});
+  }
+  while (p.bin.size() % 4) p.bin.push_back(0);
+}
+
+const char* alpha_mode_name(AlphaMode a) {
+  switch (a) {
+    case AlphaMode::mask: return "MASK";
+    case AlphaMode::blend: return "BLEND";
+    case AlphaMode::opaque: break;
+  }
+  return "OPAQUE";
+}
+
+float unit(float x) { return std::clamp(x, 0.0f, 1.0f); }
+
+// Materials, and the textures (one per image) they use.
+void describe_materials(const GltfMeshView& m, const std::vector<int>& image_of, json& j) {
+  if (m.materials.empty()) return;
+  json materials = json::array(), textures = json::array();
+  for (size_t i = 0; i < m.materials.size(); ++i) {
+    const GltfMaterialView& src = m.materials[i];
+    json pbr = {{"baseColorFactor", {unit(src.base_color[0]), unit(src.base_color[1]), unit(src.base_color[2]),
+                                     unit(src.base_color[3])}},
+                {"metallicFactor", unit(src.metallic)},
+                {"roughnessFactor", unit(src.roughness)}};
+    if (image_of[i] >= 0) {
+      const auto known = std::find(textures.begin(), textures.end(), json{{"sampler", 0}, {"source", image_of[i]}});
+      const size_t t = size_t(known - textures.begin());
+      if (known == textures.end()) textures.push_back({{"sampler", 0}, {"source", image_of[i]}});
+      pbr["baseColorTexture"] = {{"index", t}};
+    }
+    json mat = {{"pbrMetallicRoughness", pbr}, {"alphaMode", alpha_mode_name(src.alpha_mode)},
+                {"doubleSided", src.double_sided}};
+    if (!src.name.empty()) mat["name"] = src.name;
+    if (src.alpha_mode == AlphaMode::mask) mat["alphaCutoff"] = std::max(0.0f, src.alpha_cutoff);
+    materials.push_back(std::move(mat));
+  }
+  j["materials"] = std::move(materials);
+  if (!textures.empty()) {
+    j["textures"] = std::move(textures);
+    // Repeat wrapping, trilinear filtering: what the bake's uvs were made for.
+    j["samplers"] = json::array({{{"magFilter", 9729}, {"minFilter", 9987}, {"wrapS", 10497}, {"wrapT", 10497}}});
+  }
+}
+
+json describe(const GltfMeshView& m, const Packed& p, const json& primitives, const std::string& bin_uri) {
   json buffer = {{"byteLength", p.bin.size()}};
   if (!bin_uri.empty()) buffer["uri"] = bin_uri;
   json j = {{"asset", {{"version", "2.0"}, {"generator", "lodkit"}}},
             {"scene", 0},
             {"scenes", json::array({{{"nodes", {0}}}})},
             {"nodes", json::array({{{"mesh", 0}, {"name", m.name}}})},
-            {"meshes", json::array({{{"name", m.name}, {"primitives", json::array({primitive})}}})},
+            {"meshes", json::array({{{"name", m.name}, {"primitives", primitives}}})},
             {"buffers", json::array({buffer})},
             {"bufferViews", p.views},
             {"accessors", p.accessors}};
@@ -190,14 +336,32 @@ Status save_gltf(const std::filesystem::path& path, const GltfMeshView& mesh) {
   if (ext != ".glb" && ext != ".gltf")
     return Status::error(what + ": glTF export needs a .glb or .gltf name, not '" + path.extension().string() + "'");
   if (Status s = check_mesh(what, mesh); !s) return s;
+  std::vector<Image> images;
+  std::vector<int> image_of;
+  load_images(what, mesh, images, image_of);
   Packed packed;
-  const json primitive = pack_buffer(mesh, packed);
+  json primitives, image_list = json::array();
+  pack_buffer(mesh, packed, primitives);
+  if (ext == ".glb") pack_images(images, packed, image_list);
   if (uint64_t(packed.bin.size()) + (uint64_t(1) << 20) > std::numeric_limits<uint32_t>::max())
     return Status::error(what + ": " + std::to_string(packed.bin.size()) + " bytes of buffer exceed what GLB holds (4 GiB)");
-  if (ext == ".glb") return write_atomically(path, glb_bytes(describe(mesh, packed, primitive, ""), packed.bin));
+  if (ext == ".glb") {
+    json j = describe(mesh, packed, primitives, "");
+    describe_materials(mesh, image_of, j);
+    if (!images.empty()) j["images"] = image_list;
+    return write_atomically(path, glb_bytes(j, packed.bin));
+  }
   const std::string bin_name = path.stem().string() + ".bin";
   if (Status s = write_atomically(path.parent_path() / bin_name, packed.bin); !s) return s;
-  const std::string text = describe(mesh, packed, primitive, uri_of(bin_name)).dump(1, ' ', false, json::error_handler_t::replace);
+  for (size_t k = 0; k < images.size(); ++k) {
+    const std::string name = path.stem().string() + "-image" + std::to_string(k) + images[k].extension;
+    if (Status s = write_atomically(path.parent_path() / name, images[k].bytes); !s) return s;
+    image_list.push_back({{"uri", uri_of(name)}});
+  }
+  json j = describe(mesh, packed, primitives, uri_of(bin_name));
+  describe_materials(mesh, image_of, j);
+  if (!images.empty()) j["images"] = image_list;
+  const std::string text = j.dump(1, ' ', false, json::error_handler_t::replace);
   return write_atomically(path, std::vector<uint8_t>(text.begin(), text.end()));
 }
 

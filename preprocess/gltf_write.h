@@ -2,17 +2,42 @@
 // to it (by the path's extension). Written by hand (tinygltf stays inside gltf_io.cpp): one
 // buffer, one tightly packed buffer view per attribute and for the indices (each 4-byte
 // aligned, with its target), POSITION with min/max, unit NORMALs, TEXCOORD_0, u16 indices
-// when the vertices fit, else u32; one node, one scene. Output passes the Khronos validator
-// with 0 errors (tests/integration/gltf_export_test.cpp).
+// when the vertices fit, else u32; one node, one scene; one primitive per submesh (they share
+// the vertex attributes), each with its metallic-roughness material; a base colour image (PNG
+// or JPEG) is embedded in the GLB's buffer, or copied next to a .gltf. Output passes the
+// Khronos validator with 0 errors (tests/integration/gltf_export_test.cpp).
 #pragma once
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include "runtime/chain_material.h"
 #include "runtime/status.h"
 
 namespace lod {
+
+struct GltfMaterialView {
+  std::string name;
+  float base_color[4] = {1, 1, 1, 1};
+  float metallic = 1;
+  float roughness = 1;
+  AlphaMode alpha_mode = AlphaMode::opaque;
+  float alpha_cutoff = 0.5f;
+  bool double_sided = false;
+  // A PNG or JPEG file (by its first bytes) to use as baseColorTexture; empty = none. One that
+  // is missing, unreadable, not PNG/JPEG or larger than 256 MiB is left out, said in `notes`.
+  std::filesystem::path base_color_image;
+};
+
+// Triangles [first_index, first_index + index_count) of the mesh drawn with `material`
+// (-1 = the default material).
+struct GltfSubmeshView {
+  size_t first_index = 0;
+  size_t index_count = 0;
+  int32_t material = -1;
+};
 
 struct GltfMeshView {
   std::string name;                 // mesh and node name (any UTF-8)
@@ -22,11 +47,15 @@ struct GltfMeshView {
   const float* uvs = nullptr;        // uv per vertex, or null
   const uint32_t* indices = nullptr;  // 3 per triangle, each < vertex_count
   size_t index_count = 0;
+  std::vector<GltfMaterialView> materials;  // optional
+  std::vector<GltfSubmeshView> submeshes;   // optional: cover the indices in order; empty = one primitive
+  std::vector<std::string>* notes = nullptr;  // optional: what could not be written (a texture left out)
 };
 
 // Checks everything first (indices in range, a multiple of 3, at least one triangle, finite
-// positions), so a refused mesh writes nothing; then writes to a temporary file and renames.
-// For .gltf the buffer goes to <stem>.bin in the same folder.
+// positions, submeshes covering the indices with existing materials), so a refused mesh writes
+// nothing; then writes to a temporary file and renames. For .gltf the buffer goes to
+// <stem>.bin in the same folder, and image k to <stem>-image<k>.png (or .jpg).
 Status save_gltf(const std::filesystem::path& path, const GltfMeshView& mesh);
 
 }  // namespace lod

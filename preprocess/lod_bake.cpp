@@ -14,6 +14,7 @@
 #include "preprocess/cluster_simplifier.h"
 #include "preprocess/decimater_chain.h"
 #include "preprocess/gltf_io.h"
+#include "preprocess/material_runs.h"
 #include "preprocess/mesh_io.h"
 #include "preprocess/qem_simplifier.h"
 #include "preprocess/surface_error.h"
@@ -25,7 +26,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 6;  // 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
+constexpr uint32_t kBakeFormatVersion = 7;  // 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
                                              // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
@@ -84,12 +85,9 @@ LodLevel culled_level(const LodChain& chain) {
   return l;
 }
 
-// The levels hold positions and normals only: say what the input had that they lose.
-void note_dropped_attributes(const MeshData& mesh, std::vector<std::string>& notes) {
+// What the reader skipped (each naming the element).
+void note_import_warnings(const MeshData& mesh, std::vector<std::string>& notes) {
   for (const std::string& w : mesh.warnings) notes.push_back("import: " + w);
-  if (mesh.materials.size() > 1 || mesh.submeshes.size() > 1)
-    notes.push_back(std::to_string(mesh.materials.size()) + " materials / " + std::to_string(mesh.submeshes.size()) +
-                    " submeshes of " + mesh.source + " are not kept in the levels (one surface)");
 }
 
 const char* method_name(SimplifyMethod m) {
@@ -122,9 +120,22 @@ Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std:
 // output is the same as in parallel), or the aggressive simplifier does. With method "auto",
 // a QEM level stuck more than 2 % above its target is redone by the aggressive simplifier,
 // and said so in the notes.
-void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, SimplifyMethod method, bool automatic,
-                    const BakeParallelFor& parallel_for, std::vector<ChainLevel>& levels,
-                    std::vector<std::vector<uint32_t>>& sources, std::vector<std::string>& notes) {
+// With several materials (vertex_material: one per input vertex) the aggressive simplifier runs
+// per material; QEM keeps them apart by itself (material boundaries are split, hence locked).
+void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_material, const std::vector<float>& ratios,
+                    SimplifyMethod method, bool automatic, float uv_weight, const BakeParallelFor& parallel_for,
+                    std::vector<ChainLevel>& levels, std::vector<std::vector<uint32_t>>& sources,
+                    std::vector<std::string>& notes) {
+  const bool per_material = distinct_materials(vertex_material) > 1;
+  bool clustered = false;
+  auto cluster = [&](ChainLevelOut* out, const size_t* targets, size_t count) {
+    clustered = true;
+    if (per_material)
+      cluster_simplify_per_material(out, mesh, vertex_material, targets, count);
+    else
+      cluster_simplify_chain(out, mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size(),
+                             targets, count, ClusterOptions{});
+  };
   const size_t triangles = mesh.triangle_count();
   levels.assign(ratios.size(), ChainLevel{});
   ChainLevel& full = levels[0];
@@ -151,7 +162,7 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
     // Texture coordinates ride along as attributes: interpolated along each collapse, and
     // vertices sharing a position (uv seams) locked, so the texture never tears at a seam.
     QemOptions options;
-    if (keep_uvs) options.attributes = mesh.uvs.data(), options.attribute_count = 2;
+    if (keep_uvs) options.attributes = mesh.uvs.data(), options.attribute_count = 2, options.attribute_weight = uv_weight;
     qem_simplify_chain_split(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
                              mesh.indices.size(), targets.data(), targets.size(), options,
                              parallel_for ? ParallelFor(parallel_for) : one_by_one);
@@ -161,18 +172,19 @@ void simplify_chain(const MeshData& mesh, const std::vector<float>& ratios, Simp
                          std::to_string(out[i].triangle_count()) + " triangles for a target of " +
                          std::to_string(targets[i]) + " (no legal collapse left: topology or locked vertices)";
       if (automatic) {
-        cluster_simplify_chain(&out[i], mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
-                               mesh.indices.size(), &targets[i], 1, ClusterOptions{});
+        cluster(&out[i], &targets[i], 1);
         note += "; the aggressive simplifier made this level (" + std::to_string(out[i].triangle_count()) + ")";
         keep_uvs = false;
       }
       notes.push_back(note);
     }
   } else {
-    cluster_simplify_chain(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
-                           mesh.indices.size(), targets.data(), targets.size(), ClusterOptions{});
+    cluster(out.data(), targets.data(), targets.size());
     keep_uvs = false;
   }
+  if (per_material && clustered)
+    notes.push_back("the aggressive simplifier clustered each material's triangles on its own grid: where two "
+                    "materials meet, their levels may leave hairline gaps");
   if (!keep_uvs && !full.uvs.empty()) {
     notes.push_back("texture coordinates of " + mesh.source +
                     " dropped: the aggressive simplifier (vertex clustering) made a level, and it cannot keep uv seams");
@@ -226,11 +238,12 @@ uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& se
     return 0;
   }
   uint64_t content = hash_bytes(bytes.data(), bytes.size());
-  // A .gltf's geometry may live in the files it names: they are part of the content.
+  // A .gltf's geometry (and an OBJ's materials) may live in the files it names: they are part
+  // of the content.
   std::string ext = mesh_file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".gltf" || ext == ".glb")
-    for (const auto& file : gltf_external_files(mesh_file)) {
+  if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
+    for (const auto& file : ext == ".obj" ? obj_external_files(mesh_file) : gltf_external_files(mesh_file)) {
       std::ifstream g(file, std::ios::binary);
       const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
       content = hash_bytes(more.data(), more.size(), content);
@@ -245,6 +258,7 @@ uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& se
   const uint8_t method = static_cast<uint8_t>(settings.method);
   put(&method, 1);
   put(&settings.extreme_threshold, sizeof settings.extreme_threshold);
+  put(&settings.uv_weight, sizeof settings.uv_weight);
   const uint64_t n = settings.ratios.size();
   put(&n, sizeof n);
   for (float r : settings.ratios) put(&r, sizeof r);
@@ -266,7 +280,7 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   Status s = load_mesh(mesh_file, mesh);
   if (!s) return s;
   report.input_triangles = mesh.triangle_count();
-  note_dropped_attributes(mesh, report.notes);
+  note_import_warnings(mesh, report.notes);
 
   say(0.04f, "clean");
   report.cleaned = clean_mesh(mesh);
@@ -289,8 +303,13 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   say(0.06f, "simplify");
   std::vector<ChainLevel> levels;
   std::vector<std::vector<uint32_t>> sources;
-  simplify_chain(mesh, ratios, method, settings.method == SimplifyMethod::automatic, settings.parallel_for, levels,
-                 sources, report.notes);
+  LodChain chain;
+  add_chain_materials(mesh, mesh_file, chain, report.notes);
+  std::vector<int32_t> vertex_material = vertex_materials(mesh);
+  for (int32_t& m : vertex_material)
+    if (m >= int32_t(chain.materials.size())) m = -1;
+  simplify_chain(mesh, vertex_material, ratios, method, settings.method == SimplifyMethod::automatic,
+                 settings.uv_weight, settings.parallel_for, levels, sources, report.notes);
 
   // A level no smaller than the one before it adds nothing: drop it.
   for (size_t i = 1; i < levels.size();) {
@@ -304,6 +323,11 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
       ++i;
     }
   }
+
+  // Each level's triangles grouped by material (before anything reads their order).
+  if (!chain.materials.empty())
+    for (size_t i = 0; i < levels.size(); ++i)
+      group_by_material(levels[i].indices, sources[i], vertex_material, uint32_t(i), chain.submeshes);
 
   say(0.6f, "measure");
   std::vector<SurfaceError> errors(levels.size());
@@ -336,7 +360,6 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
     errors[i].rms = std::max(errors[i].rms, errors[i - 1].rms);
   }
 
-  LodChain chain;
   chain.name = name;
   Status key_status;
   chain.source_hash = bake_key(mesh_file, settings, &key_status);

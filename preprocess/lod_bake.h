@@ -14,6 +14,8 @@ namespace lod {
 
 enum class SimplifyMethod : uint8_t { qem, extreme, automatic };
 
+inline constexpr float kDefaultUvWeight = 0.2f;
+
 // Runs body(0..count-1), possibly in parallel. preprocess/ owns no threads: jobs/ passes one in.
 using BakeParallelFor = std::function<void(size_t count, const std::function<void(size_t)>& body)>;
 
@@ -21,6 +23,10 @@ struct BakeSettings {
   std::vector<float> ratios;  // fractions of the input triangles, 1.0 first; empty = defaults by size
   SimplifyMethod method = SimplifyMethod::automatic;
   uint64_t extreme_threshold = 1000000;  // auto: triangles above which the aggressive method is used
+  // Weight of the texture-coordinate error in QEM's collapse cost (QemOptions::attribute_weight;
+  // positions are in units of the model's power-of-two extent, uvs in texture units); 0 = only
+  // the geometry ranks collapses (uvs still follow, seams still locked).
+  float uv_weight = kDefaultUvWeight;
   // Optional: lets one model use several cores (the two halves of a QEM run, the levels'
   // error measurements). The output is byte-identical with or without it, so it is not
   // part of the cache key.

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-namespace lod {
+#include "runtime/chain_material.h"  // AlphaMode
 
-enum class AlphaMode : uint8_t { opaque, mask, blend };
+namespace lod {
 
 // A surface description as glTF's metallic-roughness material gives it; textures are named
 // by the URI the file uses (relative to the file), never loaded.

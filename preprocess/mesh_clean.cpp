@@ -4,6 +4,8 @@
 // result depends only on the input.
 #include "preprocess/mesh_clean.h"
 
+#include "preprocess/material_runs.h"
+
 #include <algorithm>
 #include <array>
 #include <cstring>
@@ -15,33 +17,35 @@ namespace lod {
 namespace {
 
 struct PositionKey {
-  std::array<uint32_t, 3> bits;
+  std::array<uint32_t, 4> bits;  // xyz, material
   auto operator<=>(const PositionKey&) const = default;
 };
 
-PositionKey key_of(const float* p) {
+// Vertices weld only within one material: a material boundary stays two vertices, a seam.
+PositionKey key_of(const float* p, int32_t material) {
   PositionKey k;
   for (int i = 0; i < 3; ++i) {
     const float v = p[i] == 0.0f ? 0.0f : p[i];  // -0 and +0 are the same point
     std::memcpy(&k.bits[i], &v, 4);
   }
+  k.bits[3] = uint32_t(material);
   return k;
 }
 
 // Position and texture coordinate: with uvs, vertices weld only when both match, so a uv seam
 // (one position, two uvs) stays two vertices and the simplifier keeps it.
 struct TexturedKey {
-  std::array<uint32_t, 5> bits;
+  std::array<uint32_t, 6> bits;
   auto operator<=>(const TexturedKey&) const = default;
 };
 
-TexturedKey key_of(const float* p, const float* uv) {
+TexturedKey key_of(const float* p, const float* uv, int32_t material) {
   TexturedKey k;
-  const PositionKey pk = key_of(p);
+  const PositionKey pk = key_of(p, material);
   std::copy(pk.bits.begin(), pk.bits.end(), k.bits.begin());
   for (int i = 0; i < 2; ++i) {
     const float v = uv[i] == 0.0f ? 0.0f : uv[i];
-    std::memcpy(&k.bits[3 + i], &v, 4);
+    std::memcpy(&k.bits[4 + i], &v, 4);
   }
   return k;
 }
@@ -95,6 +99,9 @@ void resubmesh(std::vector<Submesh>& submeshes, const std::vector<uint32_t>& kep
 
 CleanReport clean_mesh(MeshData& mesh) {
   CleanReport report;
+  // Pass 0: a vertex shared by two materials becomes one per material.
+  report.material_split_vertices = split_vertices_by_material(mesh);
+  const std::vector<int32_t> material = vertex_materials(mesh);
   const size_t nv = mesh.vertex_count();
   const bool has_normals = mesh.normals.size() == mesh.positions.size();
   const bool has_uvs = mesh.uvs.size() == 2 * nv;
@@ -103,8 +110,17 @@ CleanReport clean_mesh(MeshData& mesh) {
   // occurrence.
   std::vector<uint32_t> weld(nv);
   report.duplicate_vertices =
-      has_uvs ? first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v]); }, weld)
-              : first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v]); }, weld);
+      has_uvs ? first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], material[v]); }, weld)
+              : first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], material[v]); }, weld);
+
+  // Faces repeat each other by their corners' positions (and uvs) whatever their materials:
+  // the same face twice in two materials would fight for the same pixels.
+  std::vector<uint32_t> same_place;
+  const bool split = report.material_split_vertices > 0;
+  if (split)
+    has_uvs ? first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], 0); }, same_place)
+            : first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], 0); }, same_place);
+  const std::vector<uint32_t>& face_weld = split ? same_place : weld;
 
   std::vector<uint32_t> kept;
   kept.reserve(mesh.indices.size());
@@ -125,7 +141,7 @@ CleanReport clean_mesh(MeshData& mesh) {
         ++report.degenerate_faces;
         continue;
       }
-      FaceKey key{{a, b, c}};
+      FaceKey key{{face_weld[mesh.indices[3 * t]], face_weld[mesh.indices[3 * t + 1]], face_weld[mesh.indices[3 * t + 2]]}};
       std::sort(key.v.begin(), key.v.end());
       live.push_back(uint32_t(t));
       keys.push_back(key);

@@ -8,6 +8,7 @@
 
 #include "preprocess/gltf_io.h"
 #include "preprocess/mesh_readers.h"
+#include "preprocess/texture_uri.h"
 #include "runtime/file_write.h"
 
 #include <fcntl.h>
@@ -212,15 +213,64 @@ namespace detail {
 namespace {
 // Parses, then frees `owned` (the file's bytes, when load_mesh read them) before the
 // polygons are checked and triangulated, so the bytes and the triangles never coexist.
+// The materials an OBJ's faces use, in usemtl order, from its mtllib files (found next to the
+// OBJ; `base_dir` empty: nothing is read from disk, and the materials get default factors).
+Status obj_materials(const std::string& name, const fs::path& base_dir, ObjAttributes& attr,
+                     std::vector<MeshMaterial>& out) {
+  std::vector<MeshMaterial> found;
+  std::vector<std::string> found_names;
+  for (size_t i = 0; i < attr.mtllibs.size(); ++i) {
+    const std::string here = name + ":" + std::to_string(attr.mtllib_lines[i]);
+    if (base_dir.empty()) {
+      attr.warnings.push_back(here + ": mtllib '" + quote_token(attr.mtllibs[i]) + "' not read (mesh read from memory)");
+      continue;
+    }
+    const fs::path file = base_dir / attr.mtllibs[i];
+    std::error_code ec;
+    if (!fs::exists(file, ec))
+      return Status::error(here + ": mtllib '" + quote_token(attr.mtllibs[i]) + "' not found (looked for " + file.string() + ")");
+    std::vector<uint8_t> bytes;
+    if (Status r = read_regular_file(file, bytes); !r) return Status::error(here + ": mtllib: " + r.message);
+    std::string prefix = fs::path(attr.mtllibs[i]).parent_path().generic_string();
+    if (!prefix.empty()) prefix += '/';
+    if (Status r = read_mtl(file.string(), bytes.data(), bytes.size(), prefix, found, found_names, attr.warnings); !r) return r;
+  }
+  for (size_t m = 0; m < attr.material_names.size(); ++m) {
+    const auto it = std::find(found_names.begin(), found_names.end(), attr.material_names[m]);
+    if (it != found_names.end()) {
+      out.push_back(found[size_t(it - found_names.begin())]);
+      const std::string& uri = out.back().base_color_texture;
+      if (!uri.empty() && !base_dir.empty()) {
+        const fs::path image = base_dir / decode_uri(uri);
+        std::error_code ec;
+        if (!fs::is_regular_file(image, ec))
+          return Status::error(name + ": material '" + quote_token(attr.material_names[m]) + "': map_Kd '" +
+                               quote_token(decode_uri(uri)) + "' not found (looked for " + image.string() + ")");
+      }
+      continue;
+    }
+    MeshMaterial d;
+    d.name = attr.material_names[m];
+    d.metallic = 0;
+    out.push_back(d);
+    if (!base_dir.empty())
+      attr.warnings.push_back(name + ":" + std::to_string(attr.material_lines[m]) + ": usemtl '" +
+                              quote_token(attr.material_names[m]) +
+                              "' names no material of the mtllib files; it gets default factors");
+  }
+  return Status::success();
+}
+
 Status parse_and_finish(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
-                        MeshData& out, std::vector<uint8_t>* owned) {
+                        MeshData& out, std::vector<uint8_t>* owned, const fs::path& base_dir = {}) {
   static_assert(std::endian::native == std::endian::little, "the binary readers assume a little-endian host");
   const std::string ext = lower(extension);
   if (size == 0) return Status::error(name + ": file is empty");
   try {
     RawPolygons raw;
+    ObjAttributes attr;
     Status s;
-    if (ext == ".obj") s = read_obj(name, data, size, raw);
+    if (ext == ".obj") s = read_obj(name, data, size, raw, attr);
     else if (ext == ".ply") s = read_ply(name, data, size, raw);
     else if (ext == ".off") s = read_off(name, data, size, raw);
     else if (ext == ".stl") s = read_stl(name, data, size, raw);
@@ -229,6 +279,11 @@ Status parse_and_finish(const std::string& name, const std::string& extension, c
       return Status::error(name + ": unknown mesh format '" + extension + "' (expected " + kMeshFormats + ")");
     if (!s) return s;
     if (owned) std::vector<uint8_t>().swap(*owned);
+    if (attr.any()) {
+      std::vector<MeshMaterial> materials;
+      if (Status m = obj_materials(name, base_dir, attr, materials); !m) return m;
+      return finish_obj(name, raw, attr, std::move(materials), attr.material_names, out);
+    }
     return finish_polygons(name, raw, out, /*obj_numbering=*/ext == ".obj");
   } catch (const std::bad_alloc&) {
     return Status::error(name + ": not enough memory to load it (" + std::to_string(size) + " bytes)");
@@ -256,7 +311,51 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   std::vector<uint8_t> bytes;
   Status r = read_regular_file(path, bytes);
   if (!r) return r;
-  return parse_and_finish(what, path.extension().string(), bytes.data(), bytes.size(), out, &bytes);
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  return parse_and_finish(what, path.extension().string(), bytes.data(), bytes.size(), out, &bytes, dir);
+}
+
+namespace {
+
+// The last token of each line starting with `keyword` (all tokens for mtllib).
+std::vector<std::string> statement_files(const std::vector<uint8_t>& bytes, std::string_view keyword, bool all) {
+  std::vector<std::string> out;
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  for (size_t pos = 0; pos < text.size();) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    while (!line.empty() && std::isspace(uint8_t(line.front()))) line.remove_prefix(1);
+    if (line.substr(0, keyword.size()) != keyword || line.size() == keyword.size() ||
+        !std::isspace(uint8_t(line[keyword.size()])))
+      continue;
+    std::istringstream words{std::string(line.substr(keyword.size()))};
+    std::string w, last;
+    while (words >> w) {
+      if (all) out.push_back(w);
+      last = w;
+    }
+    if (!all && !last.empty()) out.push_back(last);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::filesystem::path> obj_external_files(const std::filesystem::path& path) {
+  std::vector<uint8_t> bytes;
+  if (!detail::read_regular_file(path, bytes)) return {};
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::vector<std::filesystem::path> out;
+  for (const std::string& lib : statement_files(bytes, "mtllib", true)) {
+    const std::filesystem::path mtl = dir / lib;
+    std::vector<uint8_t> m;
+    if (!detail::read_regular_file(mtl, m)) continue;
+    out.push_back(mtl);
+    for (const std::string& image : statement_files(m, "map_Kd", false)) out.push_back(mtl.parent_path() / image);
+  }
+  return out;
 }
 
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,
@@ -285,15 +384,87 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
   return write_file_atomic(path, bytes);
 }
 
-Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count, const float* uvs) {
+namespace {
+
+// usemtl / newmtl names: no blanks (OBJ splits on them), unique by the index in front.
+std::string obj_material_name(const std::vector<ObjMaterialView>& materials, int32_t m) {
+  if (m < 0) return "lodkit_default";
+  std::string s = "m" + std::to_string(m);
+  if (!materials[size_t(m)].name.empty()) s += '_';
+  for (unsigned char c : materials[size_t(m)].name) s += std::isalnum(c) || c == '-' || c == '.' ? char(c) : '_';
+  return s.substr(0, 128);
+}
+
+Status check_surfaces(const std::string& what, const ObjSurfaces& s, size_t index_count) {
+  size_t covered = 0;
+  for (size_t i = 0; i < s.submeshes.size(); ++i) {
+    const ObjSubmeshView& r = s.submeshes[i];
+    if (r.first_index != covered || r.index_count % 3 != 0 || r.index_count > index_count - covered)
+      return Status::error(what + ": submesh " + std::to_string(i) + " does not continue the runs before it");
+    if (r.material < -1 || (r.material >= 0 && size_t(r.material) >= s.materials.size()))
+      return Status::error(what + ": submesh " + std::to_string(i) + " names material " + std::to_string(r.material) +
+                           " of " + std::to_string(s.materials.size()));
+    covered += r.index_count;
+  }
+  if (covered != index_count)
+    return Status::error(what + ": submeshes cover " + std::to_string(covered) + " of " + std::to_string(index_count) +
+                         " indices");
+  return Status::success();
+}
+
+// <stem>.mtl and the images it names, copied next to it.
+Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
+  std::string text = "# lodkit\nnewmtl lodkit_default\nKd 1 1 1\nd 1\n";
+  char line[160];
+  std::vector<std::filesystem::path> copied;
+  for (size_t i = 0; i < s.materials.size(); ++i) {
+    const ObjMaterialView& m = s.materials[i];
+    text += "newmtl " + obj_material_name(s.materials, int32_t(i)) + "\n";
+    std::snprintf(line, sizeof line, "Kd %.6g %.6g %.6g\nd %.6g\n", m.base_color[0], m.base_color[1], m.base_color[2],
+                  m.base_color[3]);
+    text += line;
+    if (m.base_color_image.empty()) continue;
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(m.base_color_image, ec);
+    if (ec || !std::filesystem::is_regular_file(m.base_color_image, ec) || size > (uintmax_t(256) << 20)) {
+      if (s.notes)
+        s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + m.base_color_image.string() +
+                           " is missing or larger than 256 MiB; written without it");
+      continue;
+    }
+    auto known = std::find(copied.begin(), copied.end(), m.base_color_image);
+    const size_t k = size_t(known - copied.begin());
+    const std::string name = obj.stem().string() + "-image" + std::to_string(k) + m.base_color_image.extension().string();
+    if (known == copied.end()) {
+      std::vector<uint8_t> bytes;
+      if (Status r = detail::read_regular_file(m.base_color_image, bytes); !r) return r;
+      if (Status w = write_file_atomic(obj.parent_path() / name, bytes); !w) return w;
+      copied.push_back(m.base_color_image);
+    }
+    text += "map_Kd " + name + "\n";
+  }
+  std::filesystem::path mtl = obj;
+  mtl.replace_extension(".mtl");
+  return write_file_atomic(mtl, text);
+}
+
+Status save_obj_text(const std::filesystem::path& path, const float* positions, const float* normals,
+                     size_t vertex_count, const uint32_t* indices, size_t index_count, const float* uvs,
+                     const ObjSurfaces* surfaces) {
   const std::string what = path.string();
   if (index_count % 3 != 0) return Status::error(what + ": index count " + std::to_string(index_count) + " is not a multiple of 3");
   for (size_t i = 0; i < index_count; ++i)
     if (indices[i] >= vertex_count)
       return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
                            std::to_string(indices[i]) + " of " + std::to_string(vertex_count));
+  if (surfaces)
+    if (Status s = check_surfaces(what, *surfaces, index_count); !s) return s;
   std::string text = "# lodkit\n";
+  if (surfaces) {
+    std::filesystem::path mtl = path.filename();
+    mtl.replace_extension(".mtl");
+    text += "mtllib " + mtl.string() + "\n";
+  }
   char line[160];
   for (size_t v = 0; v < vertex_count; ++v) {
     const float* p = positions + 3 * v;
@@ -311,7 +482,12 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
       std::snprintf(line, sizeof line, "vn %.6g %.6g %.6g\n", n[0], n[1], n[2]);
       text += line;
     }
+  size_t run = 0;
   for (size_t t = 0; t < index_count / 3; ++t) {
+    if (surfaces && run < surfaces->submeshes.size() && surfaces->submeshes[run].first_index == 3 * t) {
+      text += "usemtl " + obj_material_name(surfaces->materials, surfaces->submeshes[run].material) + "\n";
+      ++run;
+    }
     const unsigned long a = indices[3 * t] + 1ul, b = indices[3 * t + 1] + 1ul, c = indices[3 * t + 2] + 1ul;
     if (normals && uvs)
       std::snprintf(line, sizeof line, "f %lu/%lu/%lu %lu/%lu/%lu %lu/%lu/%lu\n", a, a, a, b, b, b, c, c, c);
@@ -323,7 +499,21 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
       std::snprintf(line, sizeof line, "f %lu %lu %lu\n", a, b, c);
     text += line;
   }
+  if (surfaces)
+    if (Status s = write_mtl(path, *surfaces); !s) return s;
   return write_file_atomic(path, text);
+}
+
+}  // namespace
+
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
+                const uint32_t* indices, size_t index_count, const float* uvs) {
+  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, nullptr);
+}
+
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
+                const uint32_t* indices, size_t index_count, const float* uvs, const ObjSurfaces& surfaces) {
+  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, &surfaces);
 }
 
 }  // namespace lod

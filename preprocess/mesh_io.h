@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "preprocess/mesh.h"
 #include "runtime/status.h"
@@ -25,6 +26,10 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out);
 Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
                              MeshData& out);
 
+// The files an OBJ's materials name (its mtllib files and their map_Kd images, next to it), so
+// a cache key can cover them too; missing ones are left out (the load says why).
+std::vector<std::filesystem::path> obj_external_files(const std::filesystem::path& path);
+
 // Writes positions + triangles as binary PLY (for --export and outside tools).
 Status save_ply(const std::filesystem::path& path, const float* positions, size_t vertex_count,
                 const uint32_t* indices, size_t index_count);
@@ -34,5 +39,27 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
 // has its origin bottom left, so v is written as 1 - v.
 Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
                 const uint32_t* indices, size_t index_count, const float* uvs = nullptr);
+
+// Materials for save_obj: the faces of each submesh after a "usemtl", the materials in
+// <stem>.mtl next to the .obj ("mtllib"), each with Kd, d and, when it has an image, map_Kd
+// naming a copy of it, <stem>-image<k><ext>, next to the .mtl. An image that is missing or
+// larger than 256 MiB is left out and said in `notes`.
+struct ObjMaterialView {
+  std::string name;
+  float base_color[4] = {1, 1, 1, 1};
+  std::filesystem::path base_color_image;
+};
+struct ObjSubmeshView {
+  size_t first_index = 0;
+  size_t index_count = 0;
+  int32_t material = -1;  // -1: the default material (white)
+};
+struct ObjSurfaces {
+  std::vector<ObjMaterialView> materials;
+  std::vector<ObjSubmeshView> submeshes;  // cover the indices in order
+  std::vector<std::string>* notes = nullptr;
+};
+Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
+                const uint32_t* indices, size_t index_count, const float* uvs, const ObjSurfaces& surfaces);
 
 }  // namespace lod

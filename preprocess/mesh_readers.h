@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "preprocess/mesh.h"
+#include "runtime/chain_material.h"
 #include "runtime/status.h"
 
 namespace lod::detail {
@@ -28,6 +29,22 @@ struct RawPolygons {
   size_t polygon_count() const { return offsets.size() - 1; }
 };
 
+// What an OBJ adds beside its polygons (all empty when it has no vt, vn, usemtl or mtllib).
+struct ObjAttributes {
+  std::vector<float> texcoords;          // "vt u v", 2 per entry, as written (origin bottom left)
+  std::vector<float> normals;            // "vn x y z", 3 per entry
+  std::vector<int64_t> corner_uv;        // per corner: 0-based vt, -1 none (range-checked later)
+  std::vector<int64_t> corner_normal;    // per corner: 0-based vn, -1 none
+  std::vector<uint32_t> polygon_line;    // per polygon: its line, for messages
+  std::vector<int32_t> polygon_material; // per polygon: index into material_names, -1 default
+  std::vector<std::string> material_names;  // usemtl names, in order of first use
+  std::vector<uint32_t> material_lines;     // the line of each name's first usemtl
+  std::vector<std::string> mtllibs;         // mtllib file names, as written
+  std::vector<uint32_t> mtllib_lines;
+  std::vector<std::string> warnings;        // what reading the .mtl files skipped
+  bool any() const { return !texcoords.empty() || !normals.empty() || !material_names.empty() || !mtllibs.empty(); }
+};
+
 // Readers: `what` is the name used in messages (the path). On success `raw` holds at least
 // one polygon; coordinates are finite.
 Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
@@ -35,7 +52,21 @@ Status read_off(const std::string& what, const uint8_t* data, size_t size, RawPo
 Status read_stl(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
 // OBJ: corners are stored 0-based (positive v as v-1, negative resolved against the vertices
 // before the face); finish_polygons(..., obj_numbering=true) names them from 1 again.
-Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw);
+// vt / vn / usemtl / mtllib go to `attributes`.
+Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw, ObjAttributes& attributes);
+
+// Wavefront MTL (newmtl, Kd, d, Tr, map_Kd) into materials named `names` (as the OBJ uses
+// them); `what` is the .mtl file for messages. Texture file names become URIs relative to
+// the OBJ's folder (`prefix`: the .mtl's folder relative to it). Other statements are named
+// once in `warnings`.
+Status read_mtl(const std::string& what, const uint8_t* data, size_t size, const std::string& prefix,
+                std::vector<MeshMaterial>& materials, std::vector<std::string>& names, std::vector<std::string>& warnings);
+
+// An OBJ with attributes into `out`: one vertex per distinct (v, vt, vn) corner, uvs in glTF's
+// convention (v flipped), normals, submeshes by usemtl; every vt / vn index range-checked
+// ("file:line: face 3 references texture coordinate 9 of 4").
+Status finish_obj(const std::string& what, RawPolygons& raw, ObjAttributes& attributes,
+                  std::vector<MeshMaterial> materials, const std::vector<std::string>& material_names, MeshData& out);
 
 // Range-checks every corner (first bad one reported: "face F references vertex N of V",
 // N as the file wrote it) and fan-triangulates into `out` (positions moved out of `raw`).

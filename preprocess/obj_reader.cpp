@@ -7,14 +7,18 @@
 //
 // Read: "v x y z" (anything after the three numbers, such as w or a colour, is ignored) and
 // "f c0 c1 c2 ..." with corners "v", "v/vt", "v//vn" or "v/vt/vn"; a negative v counts back
-// from the last vertex before the face (-1 = that vertex). Other statements (vt, vn, g, o,
-// s, usemtl, mtllib, l, p, ...) are ignored. A line ending in '\' continues on the next one.
+// from the last vertex before the face (-1 = that vertex). "vt u [v [w]]", "vn x y z",
+// "usemtl NAME" and "mtllib FILE..." go to ObjAttributes (corners' vt / vn numbers likewise,
+// negative ones resolved the same way); arrays for them are only kept once a file uses them,
+// so a geometry-only OBJ costs nothing more. Other statements (g, o, s, l, p, ...) are ignored. A line ending in '\' continues on the next one.
 // Keywords and values are separated by any blank (space, tab, CR, VT, FF), as iostreams do.
 // A UTF-8 byte-order mark before the first line is skipped; UTF-16 is refused. A vertex
 // repeated within one face is dropped after its first corner (as OpenMesh's reader did).
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "preprocess/mesh_readers.h"
@@ -26,7 +30,7 @@ bool blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c
 
 }  // namespace
 
-Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw) {
+Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw, ObjAttributes& attr) {
   if (size >= 2 && ((data[0] == 0xFE && data[1] == 0xFF) || (data[0] == 0xFF && data[1] == 0xFE)))
     return Status::error(what + ": is UTF-16 text; OBJ files must be ASCII or UTF-8");
   if (size >= 3 && data[0] == 0xEF && data[1] == 0xBB && data[2] == 0xBF) data += 3, size -= 3;
@@ -36,6 +40,26 @@ Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPo
   std::string joined;  // a statement continued over several lines
   std::string number;  // one coordinate, NUL-terminated for strtod
   std::unordered_set<int64_t> seen;  // corners of a long face
+  bool tracking = false;             // attr's per-corner / per-polygon arrays are being kept
+  int32_t material = -1;             // current usemtl
+  auto track = [&] {
+    if (tracking) return;
+    tracking = true;
+    attr.corner_uv.assign(raw.corners.size(), -1);
+    attr.corner_normal.assign(raw.corners.size(), -1);
+    attr.polygon_material.assign(raw.polygon_count(), -1);
+  };
+  // "file:line" for messages about one statement.
+  auto at_line = [&](size_t line) { return what + ":" + std::to_string(line); };
+  // The next whitespace-separated token of `line` from `at`, or empty.
+  auto token = [](std::string_view line, size_t& at) {
+    while (at < line.size() && blank(line[at])) ++at;
+    size_t e = at;
+    while (e < line.size() && !blank(line[e])) ++e;
+    const std::string_view t = line.substr(at, e - at);
+    at = e;
+    return t;
+  };
   while (pos < size) {
     ++line_no;
     const size_t first_line = line_no;
@@ -96,13 +120,53 @@ Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPo
       if (raw.vertex_count() >= std::numeric_limits<uint32_t>::max())
         return Status::error(what + ": more than 2^32-1 vertices");
       raw.positions.insert(raw.positions.end(), xyz, xyz + 3);
+    } else if (keyword == "vt" || keyword == "vn") {
+      track();
+      const int dims = keyword == "vt" ? 2 : 3;
+      float xyz[3] = {0, 0, 0};
+      size_t at = k;
+      for (int d = 0; d < dims; ++d) {
+        number.assign(token(line, at).substr(0, 64));
+        char* stop = nullptr;
+        const double v = number.empty() ? 0 : std::strtod(number.c_str(), &stop);
+        // "vt u" alone is legal (v = 0); anything else must be a number.
+        if (number.empty() && keyword == "vt" && d == 1) break;
+        if (number.empty() || stop == number.c_str() || !std::isfinite(float(v)))
+          return Status::error(at_line(first_line) + ": '" + std::string(keyword) + "' needs " + std::to_string(dims) +
+                               " finite numbers" + (number.empty() ? "" : ", not '" + quote_token(number) + "'"));
+        xyz[d] = float(v);
+      }
+      std::vector<float>& out = keyword == "vt" ? attr.texcoords : attr.normals;
+      if (out.size() / size_t(dims) >= std::numeric_limits<uint32_t>::max())
+        return Status::error(at_line(first_line) + ": more than 2^32-1 '" + std::string(keyword) + "' entries");
+      out.insert(out.end(), xyz, xyz + dims);
+    } else if (keyword == "usemtl") {
+      track();
+      size_t at = k;
+      const std::string name(token(line, at));
+      if (name.empty()) return Status::error(at_line(first_line) + ": usemtl without a material name");
+      const auto it = std::find(attr.material_names.begin(), attr.material_names.end(), name);
+      material = int32_t(it - attr.material_names.begin());
+      if (it == attr.material_names.end()) {
+        if (attr.material_names.size() >= kMaxMaterials)
+          return Status::error(at_line(first_line) + ": more than " + std::to_string(kMaxMaterials) + " materials");
+        attr.material_names.push_back(name);
+        attr.material_lines.push_back(uint32_t(first_line));
+      }
+    } else if (keyword == "mtllib") {
+      size_t at = k;
+      for (std::string_view t = token(line, at); !t.empty(); t = token(line, at)) {
+        if (attr.mtllibs.size() >= 64) return Status::error(at_line(first_line) + ": more than 64 mtllib files");
+        attr.mtllibs.emplace_back(t);
+        attr.mtllib_lines.push_back(uint32_t(first_line));
+      }
     } else if (keyword == "f") {
       const int64_t before = int64_t(raw.vertex_count());
       const size_t face_begin = raw.corners.size();
       seen.clear();
       // A vertex repeated within a face is dropped after its first corner, as OpenMesh's
       // reader did ("f 1 2 3 4 1 2 3 4" is the quad 1 2 3 4).
-      auto add = [&](int64_t idx) {
+      auto add = [&](int64_t idx, int64_t uv, int64_t nrm) {
         const size_t n = raw.corners.size() - face_begin;
         if (n < 16) {
           for (size_t c = face_begin; c < raw.corners.size(); ++c)
@@ -112,6 +176,7 @@ Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPo
           if (!seen.insert(idx).second) return;
         }
         raw.corners.push_back(idx);
+        if (tracking) attr.corner_uv.push_back(uv), attr.corner_normal.push_back(nrm);
       };
       size_t at = k;
       for (;;) {
@@ -121,7 +186,31 @@ Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPo
         while (e < line.size() && !blank(line[e])) ++e;
         const std::string_view corner = line.substr(at, e - at);
         at = e;
-        const std::string_view index = corner.substr(0, corner.find('/'));
+        const size_t slash = corner.find('/');
+        const std::string_view index = corner.substr(0, slash);
+        // "v/vt/vn", "v//vn", "v/vt": the other two numbers, 0-based (-1 when absent).
+        int64_t uv = -1, nrm = -1;
+        if (slash != std::string_view::npos) {
+          const std::string_view rest = corner.substr(slash + 1);
+          const size_t slash2 = rest.find('/');
+          const std::string_view parts[2] = {rest.substr(0, slash2),
+                                             slash2 == std::string_view::npos ? std::string_view() : rest.substr(slash2 + 1)};
+          const int64_t counts[2] = {int64_t(attr.texcoords.size() / 2), int64_t(attr.normals.size() / 3)};
+          int64_t* outs[2] = {&uv, &nrm};
+          for (int q = 0; q < 2; ++q) {
+            if (parts[q].empty()) continue;
+            int64_t x = 0;
+            if (!parse_int(parts[q], x) || x == 0)
+              return Status::error(at_line(first_line) + ": face " + std::to_string(faces) + " has a corner with an invalid " +
+                                   (q == 0 ? "texture coordinate" : "normal") + " number ('" + quote_token(corner) + "')");
+            if (x < 0 && x < -counts[q])
+              return Status::error(at_line(first_line) + ": face " + std::to_string(faces) + " references " +
+                                   (q == 0 ? "texture coordinate " : "normal ") + std::to_string(x) + " (relative) of " +
+                                   std::to_string(counts[q]) + " before it");
+            *outs[q] = x < 0 ? counts[q] + x : x - 1;
+          }
+          if (uv >= 0 || nrm >= 0) track();
+        }
         int64_t v = 0;
         if (!parse_int(index, v) || v == 0)
           return Status::error(what + ": face " + std::to_string(faces) + " (line " + std::to_string(first_line) +
@@ -131,19 +220,111 @@ Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPo
             return Status::error(what + ": face " + std::to_string(faces) + " references vertex " +
                                  std::to_string(v) + " (relative) of " + std::to_string(before) +
                                  " before it, on line " + std::to_string(first_line));
-          add(before + v);
+          add(before + v, uv, nrm);
         } else {
-          add(v - 1);  // checked against the final count by finish_polygons
+          add(v - 1, uv, nrm);  // checked against the final count by finish_polygons
         }
       }
       if (raw.corners.size() > std::numeric_limits<uint32_t>::max())
         return Status::error(what + ": more than 2^32-1 face corners");
       raw.offsets.push_back(uint32_t(raw.corners.size()));
+      attr.polygon_line.push_back(uint32_t(std::min<size_t>(first_line, UINT32_MAX)));
+      if (tracking) attr.polygon_material.push_back(material);
       ++faces;
     }
   }
   if (faces == 0)
     return Status::error(what + ": has no faces (points only: " + std::to_string(raw.vertex_count()) + " vertices)");
+  return Status::success();
+}
+
+}  // namespace lod::detail
+
+namespace lod::detail {
+namespace {
+
+struct CornerKey {
+  int64_t v, uv, n;
+  bool operator==(const CornerKey&) const = default;
+};
+struct CornerHash {
+  size_t operator()(const CornerKey& k) const {
+    return size_t((uint64_t(k.v) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k.uv) * 0xc2b2ae3d27d4eb4full) ^
+                  (uint64_t(k.n) * 0x165667b19e3779f9ull));
+  }
+};
+
+// Every corner's three numbers within their lists, the message naming file:line.
+Status check_corners(const std::string& what, const RawPolygons& raw, const ObjAttributes& a) {
+  const int64_t counts[3] = {int64_t(raw.vertex_count()), int64_t(a.texcoords.size() / 2), int64_t(a.normals.size() / 3)};
+  const char* names[3] = {"vertex", "texture coordinate", "normal"};
+  for (size_t f = 0; f < raw.polygon_count(); ++f)
+    for (uint32_t i = raw.offsets[f]; i < raw.offsets[f + 1]; ++i) {
+      const int64_t idx[3] = {raw.corners[i], a.corner_uv[i], a.corner_normal[i]};
+      for (int q = 0; q < 3; ++q) {
+        if (idx[q] < (q == 0 ? 0 : -1) || idx[q] >= counts[q])
+          return Status::error(what + ":" + std::to_string(a.polygon_line[f]) + ": face " + std::to_string(f) +
+                               " references " + names[q] + " " + std::to_string(idx[q] + 1) + " of " +
+                               std::to_string(counts[q]) + " (OBJ numbering, from 1)");
+      }
+    }
+  return Status::success();
+}
+
+}  // namespace
+
+Status finish_obj(const std::string& what, RawPolygons& raw, ObjAttributes& a, std::vector<MeshMaterial> materials,
+                  const std::vector<std::string>& material_names, MeshData& out) {
+  a.corner_uv.resize(raw.corners.size(), -1);
+  a.corner_normal.resize(raw.corners.size(), -1);
+  a.polygon_material.resize(raw.polygon_count(), -1);
+  if (raw.polygon_count() == 0) return Status::error(what + ": has no faces");
+  if (Status s = check_corners(what, raw, a); !s) return s;
+  MeshData mesh;
+  mesh.source = what;
+  size_t without_uv = 0, without_normal = 0;
+  for (size_t i = 0; i < raw.corners.size(); ++i) without_uv += a.corner_uv[i] < 0, without_normal += a.corner_normal[i] < 0;
+  const bool uvs = !a.texcoords.empty() && without_uv < raw.corners.size();
+  const bool normals = !a.normals.empty() && without_normal == 0;
+  if (uvs && without_uv > 0)
+    mesh.warnings.push_back(what + ": " + std::to_string(without_uv) + " face corners have no texture coordinate; they get (0, 0)");
+  if (!a.normals.empty() && without_normal > 0)
+    mesh.warnings.push_back(what + ": normals dropped: " + std::to_string(without_normal) +
+                            " face corners have none (they are recomputed when baking)");
+  // One vertex per distinct (v, vt, vn) the faces use, in order of first use.
+  std::unordered_map<CornerKey, uint32_t, CornerHash> ids;
+  std::vector<uint32_t> corner_vertex(raw.corners.size());
+  for (size_t i = 0; i < raw.corners.size(); ++i) {
+    const CornerKey key{raw.corners[i], uvs ? a.corner_uv[i] : -1, normals ? a.corner_normal[i] : -1};
+    auto [it, fresh] = ids.try_emplace(key, uint32_t(mesh.vertex_count()));
+    if (fresh) {
+      const float* p = &raw.positions[3 * size_t(key.v)];
+      mesh.positions.insert(mesh.positions.end(), p, p + 3);
+      if (uvs) {
+        const float* t = key.uv >= 0 ? &a.texcoords[2 * size_t(key.uv)] : nullptr;
+        mesh.uvs.insert(mesh.uvs.end(), {t ? t[0] : 0.0f, t ? 1.0f - t[1] : 0.0f});  // OBJ: origin bottom left
+      }
+      if (normals) mesh.normals.insert(mesh.normals.end(), &a.normals[3 * size_t(key.n)], &a.normals[3 * size_t(key.n)] + 3);
+    }
+    corner_vertex[i] = it->second;
+  }
+  // Fan triangulation, runs of one material as submeshes.
+  for (size_t f = 0; f < raw.polygon_count(); ++f) {
+    const uint32_t begin = raw.offsets[f], end = raw.offsets[f + 1];
+    if (end - begin < 3) continue;
+    const int32_t m = a.polygon_material[f];
+    if (mesh.submeshes.empty() || mesh.submeshes.back().material != m)
+      mesh.submeshes.push_back({uint32_t(mesh.triangle_count()), 0, m});
+    for (uint32_t i = begin + 1; i + 1 < end; ++i) {
+      mesh.indices.insert(mesh.indices.end(), {corner_vertex[begin], corner_vertex[i], corner_vertex[i + 1]});
+      mesh.submeshes.back().triangle_count++;
+    }
+  }
+  if (mesh.indices.empty()) return Status::error(what + ": has no triangles (every face has fewer than 3 corners)");
+  if (material_names.empty()) mesh.submeshes.clear();
+  mesh.materials = std::move(materials);
+  for (std::string& w : a.warnings) mesh.warnings.push_back(std::move(w));
+  out = std::move(mesh);
   return Status::success();
 }
 

@@ -90,6 +90,55 @@ float quadric_cost(const Quadric& q, const float* p) {
   return q.w > 0 ? float(e / q.w) : float(e);
 }
 
+void attribute_add(AttributeQuadric& q, const AttributeQuadric& r) {
+  q.a00 += r.a00, q.a11 += r.a11, q.a22 += r.a22, q.a01 += r.a01, q.a02 += r.a02, q.a12 += r.a12;
+  q.b0 += r.b0, q.b1 += r.b1, q.b2 += r.b2, q.c += r.c, q.w += r.w;
+  for (size_t k = 0; k < kAttributeQuadricChannels; ++k) {
+    for (int j = 0; j < 3; ++j) q.g[k][j] += r.g[k][j];
+    q.d[k] += r.d[k];
+  }
+}
+
+// sum w (g.p + d - s_k)^2 at p with the merged vertex's attributes s (channels past
+// `channels` read nothing).
+double attribute_eval(const AttributeQuadric& q, const float* p, const float* s, size_t channels) {
+  const double x = p[0], y = p[1], z = p[2];
+  double r = x * (q.a00 * x + q.a01 * y + q.a02 * z) + y * (q.a01 * x + q.a11 * y + q.a12 * z) +
+             z * (q.a02 * x + q.a12 * y + q.a22 * z) + 2 * (q.b0 * x + q.b1 * y + q.b2 * z) + q.c;
+  for (size_t k = 0; k < channels; ++k)
+    r += -2 * double(s[k]) * (q.g[k][0] * x + q.g[k][1] * y + q.g[k][2] * z + q.d[k]) + double(s[k]) * s[k] * q.w;
+  return r;
+}
+
+// Face (p0, p1, p2) with attributes s0, s1, s2 (`channels` each): for every channel the linear
+// function g.p + d over the face's plane through the corner values, added with weight w to the
+// three corners' attribute quadrics.
+void add_face_attributes(AttributeQuadric* corners[3], const float* p0, const float* p1, const float* p2,
+                         const float* s0, const float* s1, const float* s2, size_t channels, double w) {
+  const double e1[3] = {double(p1[0]) - p0[0], double(p1[1]) - p0[1], double(p1[2]) - p0[2]};
+  const double e2[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
+  const double m11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2], m22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+  const double m12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
+  const double det = m11 * m22 - m12 * m12;
+  if (!(det > 1e-30 * m11 * m22) || !(w > 0)) return;
+  AttributeQuadric f;
+  f.w = w;
+  for (size_t k = 0; k < channels; ++k) {
+    // g = alpha e1 + beta e2 with g.e1 = s1 - s0, g.e2 = s2 - s0 (in the face's plane).
+    const double r1 = double(s1[k]) - s0[k], r2 = double(s2[k]) - s0[k];
+    const double alpha = (r1 * m22 - r2 * m12) / det, beta = (r2 * m11 - r1 * m12) / det;
+    const double g[3] = {alpha * e1[0] + beta * e2[0], alpha * e1[1] + beta * e2[1], alpha * e1[2] + beta * e2[2]};
+    const double d = s0[k] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2]);
+    f.a00 += w * g[0] * g[0], f.a11 += w * g[1] * g[1], f.a22 += w * g[2] * g[2];
+    f.a01 += w * g[0] * g[1], f.a02 += w * g[0] * g[2], f.a12 += w * g[1] * g[2];
+    f.b0 += w * d * g[0], f.b1 += w * d * g[1], f.b2 += w * d * g[2];
+    f.c += w * d * d;
+    for (int j = 0; j < 3; ++j) f.g[k][j] = w * g[j];
+    f.d[k] = w * d;
+  }
+  for (int c = 0; c < 3; ++c) attribute_add(*corners[c], f);
+}
+
 // Best point on the segment a-b (1D quadratic, clamped), midpoint when flat along it.
 void place_on_segment(const Quadric& q, const float* a, const float* b, float* out) {
   const double d[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
@@ -377,6 +426,8 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
   if (!lists_current) build_lists(w, mesh);
   float* pos = mesh.positions.data();
 
+  const bool weighted = !mesh.attribute_quadrics.empty();
+  const size_t ac = mesh.attribute_count, channels = std::min(ac, kAttributeQuadricChannels);
   // Every collapsible edge once, with its direction, position and cost.
   // Walked per vertex (each face's edge a -> next), so a's quadric is read once.
   // Written in place (a candidate built on the stack and pushed stalls on its own stores).
@@ -417,6 +468,25 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
         std::memcpy(c.p, pos + 3 * size_t(c.to), sizeof c.p);
       }
       c.cost = quadric_cost(q, c.p);
+      if (weighted) {
+        // The attribute the merged vertex gets (interpolated along the edge, as the collapse
+        // does), against the faces' attribute functions of both ends.
+        AttributeQuadric aq = mesh.attribute_quadrics[a];
+        attribute_add(aq, mesh.attribute_quadrics[b]);
+        const uint32_t f = c.from, to = c.to;
+        const float* pf = pos + 3 * size_t(f);
+        const float* pt = pos + 3 * size_t(to);
+        const float dir[3] = {pt[0] - pf[0], pt[1] - pf[1], pt[2] - pf[2]};
+        const float len2 = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
+        float t = 1;
+        if (len2 > 0)
+          t = std::clamp(((c.p[0] - pf[0]) * dir[0] + (c.p[1] - pf[1]) * dir[1] + (c.p[2] - pf[2]) * dir[2]) / len2, 0.f, 1.f);
+        float s[kAttributeQuadricChannels];
+        const float* at = mesh.attributes.data();
+        for (size_t k = 0; k < channels; ++k) s[k] = at[f * ac + k] * (1 - t) + at[to * ac + k] * t;
+        const double e = quadric_eval(q, c.p[0], c.p[1], c.p[2]) + std::max(0.0, attribute_eval(aq, c.p, s, channels));
+        c.cost = q.w > 0 ? float(e / q.w) : float(e);
+      }
       n++;
     }
   }
@@ -503,7 +573,6 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
         t = std::clamp(((c.p[0] - pa[0]) * d[0] + (c.p[1] - pa[1]) * d[1] + (c.p[2] - pa[2]) * d[2]) / len2,
                        0.f, 1.f);
       float* at = mesh.attributes.data();
-      const size_t ac = mesh.attribute_count;
       for (size_t k = 0; k < ac; ++k) at[b * ac + k] = at[a * ac + k] * (1 - t) + at[b * ac + k] * t;
     }
     if (w.kind[a] == kBorder) {
@@ -519,6 +588,7 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
     }
     std::memcpy(pos + 3 * b, c.p, sizeof c.p);
     quadric_add(mesh.quadrics[b], mesh.quadrics[a]);
+    if (weighted) attribute_add(mesh.attribute_quadrics[b], mesh.attribute_quadrics[a]);
     w.remap[a] = b;
     w.pass_lock[a] = w.pass_lock[b] = 1;
     removed_total += removed;
@@ -559,6 +629,7 @@ void compact_vertices(Work& w, QemMesh& mesh) {
   tmp.positions.resize(3 * size_t(next));
   tmp.attributes.resize(ac * size_t(next));
   tmp.quadrics.resize(next);
+  tmp.attribute_quadrics.resize(mesh.attribute_quadrics.empty() ? 0 : next);
   tmp.source_vertex.resize(next);
   tmp.lock.resize(next);
   for (uint32_t n = 0; n < next; ++n) {
@@ -566,6 +637,7 @@ void compact_vertices(Work& w, QemMesh& mesh) {
     std::memcpy(&tmp.positions[3 * size_t(n)], &mesh.positions[3 * size_t(o)], 12);
     if (ac) std::memcpy(&tmp.attributes[ac * n], &mesh.attributes[ac * o], ac * sizeof(float));
     tmp.quadrics[n] = mesh.quadrics[o];
+    if (!mesh.attribute_quadrics.empty()) tmp.attribute_quadrics[n] = mesh.attribute_quadrics[o];
     tmp.source_vertex[n] = mesh.source_vertex[o];
     tmp.lock[n] = mesh.lock[o];
   }
@@ -583,6 +655,7 @@ void compact_vertices(Work& w, QemMesh& mesh) {
   mesh.positions.swap(tmp.positions);
   mesh.attributes.swap(tmp.attributes);
   mesh.quadrics.swap(tmp.quadrics);
+  mesh.attribute_quadrics.swap(tmp.attribute_quadrics);
   mesh.source_vertex.swap(tmp.source_vertex);
   mesh.lock.swap(tmp.lock);
 }
@@ -760,6 +833,29 @@ void build_part(QemMesh& out, const float* positions, size_t vertex_count, const
     const double d = -(n[0] * p0[0] + n[1] * p0[1] + n[2] * p0[2]);
     for (int k = 0; k < 3; ++k) quadric_add_plane(out.quadrics[out.indices[3 * t + k]], n[0], n[1], n[2], d, 0.5 * len);
   }
+  // Attribute quadrics, on every face; a shared vertex gets them in one part only (as its
+  // point quadric), so that merging adds them once.
+  if (ac && options.attribute_weight > 0) {
+    const size_t channels = std::min(ac, kAttributeQuadricChannels);
+    const double w2 = double(options.attribute_weight) * options.attribute_weight;
+    out.attribute_quadrics.assign(nv, AttributeQuadric{});
+    AttributeQuadric unused;
+    for (size_t t = 0; t < nt; ++t) {
+      const uint32_t* c = &out.indices[3 * t];
+      const float* p0 = &out.positions[3 * size_t(c[0])];
+      const float* p1 = &out.positions[3 * size_t(c[1])];
+      const float* p2 = &out.positions[3 * size_t(c[2])];
+      const double e1[3] = {double(p1[0]) - p0[0], double(p1[1]) - p0[1], double(p1[2]) - p0[2]};
+      const double e2[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
+      const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+      const double area = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      AttributeQuadric* corners[3];
+      for (int k = 0; k < 3; ++k)
+        corners[k] = seam && (*seam)[c[k]] && !point_terms_on_seam ? &unused : &out.attribute_quadrics[c[k]];
+      add_face_attributes(corners, p0, p1, p2, &out.attributes[ac * c[0]], &out.attributes[ac * c[1]],
+                          &out.attributes[ac * c[2]], channels, w2 * area);
+    }
+  }
   for (size_t v = 0; v < nv; ++v) {
     Quadric& q = out.quadrics[v];
     if (!(q.w > 0) || (seam && (*seam)[v] && !point_terms_on_seam)) continue;
@@ -914,6 +1010,8 @@ size_t qem_split(QemMesh* parts, const QemMesh& whole) {
       if (ac) part.attributes.insert(part.attributes.end(), &whole.attributes[ac * v], &whole.attributes[ac * v] + ac);
       // A shared vertex's quadric goes to part 0 only, so merging can simply add them.
       part.quadrics.push_back(seam && p == 1 ? Quadric{} : whole.quadrics[v]);
+      if (!whole.attribute_quadrics.empty())
+        part.attribute_quadrics.push_back(seam && p == 1 ? AttributeQuadric{} : whole.attribute_quadrics[v]);
       part.source_vertex.push_back(whole.source_vertex[v]);
       part.lock.push_back(uint8_t(whole.lock[v] | (seam ? QemMesh::kLockSeam : 0)));
     }
@@ -947,6 +1045,7 @@ void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
       if ((part.lock[v] & QemMesh::kLockSeam) && merged[src] != ~0u) {
         local[v] = merged[src];
         quadric_add(out.quadrics[merged[src]], part.quadrics[v]);
+        if (!part.attribute_quadrics.empty()) attribute_add(out.attribute_quadrics[merged[src]], part.attribute_quadrics[v]);
         continue;
       }
       local[v] = uint32_t(out.source_vertex.size());
@@ -954,6 +1053,7 @@ void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
       out.positions.insert(out.positions.end(), &part.positions[3 * v], &part.positions[3 * v] + 3);
       if (ac) out.attributes.insert(out.attributes.end(), &part.attributes[ac * v], &part.attributes[ac * v] + ac);
       out.quadrics.push_back(part.quadrics[v]);
+      if (!part.attribute_quadrics.empty()) out.attribute_quadrics.push_back(part.attribute_quadrics[v]);
       out.source_vertex.push_back(src);
       out.lock.push_back(uint8_t(part.lock[v] & ~QemMesh::kLockSeam));
     }

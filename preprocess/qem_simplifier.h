@@ -40,7 +40,16 @@ struct QemOptions {
   // normal seams) are locked, so seams survive every level.
   const float* attributes = nullptr;
   size_t attribute_count = 0;
+  // Weight of the attribute error in the collapse cost (Hoppe 1999's memory-efficient
+  // attribute quadrics, as meshoptimizer's simplifyWithAttributes weights them): per face, the
+  // first kAttributeQuadricChannels attributes' linear gradient over the face; a collapse
+  // costs its plane error plus weight^2 x the area-weighted squared difference between each
+  // face's interpolated attribute and the one the merged vertex carries. Positions are still
+  // placed by the plane quadric alone; 0 = attributes do not enter the cost.
+  float attribute_weight = 0;
 };
+
+inline constexpr size_t kAttributeQuadricChannels = 2;
 
 // One simplified level. Its vertices are new (collapses move them to optimal positions);
 // source_vertex says which input vertex each descends from.
@@ -74,12 +83,24 @@ struct Quadric {
   double w = 0;                                                 // summed area weight
 };
 
+// The attribute part of a vertex's error (Hoppe 1999): sum over its faces of w (g.p + d - s)^2
+// per channel, s the vertex's attribute, with the p-only terms in a..c and the cross terms in
+// g, d (channel k: gradient sum g[k], offset sum d[k]); w = weight^2 x face area, summed in w.
+struct AttributeQuadric {
+  double a00 = 0, a11 = 0, a22 = 0, a01 = 0, a02 = 0, a12 = 0;
+  double b0 = 0, b1 = 0, b2 = 0, c = 0;
+  double g[kAttributeQuadricChannels][3] = {};
+  double d[kAttributeQuadricChannels] = {};
+  double w = 0;
+};
+
 // A mesh being simplified, with its quadrics. Positions are divided by a power-of-two scale of
 // the whole input (object = normalised * scale, exactly), so parts of one input share a frame.
 struct QemMesh {
   std::vector<float> positions;
   std::vector<float> attributes;
   std::vector<Quadric> quadrics;
+  std::vector<AttributeQuadric> attribute_quadrics;  // per vertex, or empty (no weighted attributes)
   std::vector<uint32_t> indices;
   std::vector<uint32_t> source_vertex;  // input vertex id
   std::vector<uint8_t> lock;            // kLockUser | kLockSeam bits per vertex

@@ -15,6 +15,13 @@
 //       every level but the last (LodChain::morph_targets), checked like the levels' indices.
 // TEX0 (optional, flag 0; written only when the chain has texture coordinates): u32 level
 //       count, f32 uv error per level, then 2 f32 per vertex (LodChain::uvs).
+// MATL (optional, flag 0; written only when the chain has materials): u32 material count,
+//       u32 submesh count, u32 texture base bytes, u32 0; the texture base (UTF-8); 16 bytes
+//       per submesh (u32 level, u32 first index, u32 index count, i32 material); then per
+//       material 40 bytes (u32 name bytes, u32 texture URI bytes, f32 base colour[4], f32
+//       metallic, f32 roughness, f32 alpha cutoff, u8 alpha mode, u8 double-sided, u16 0) and
+//       its name and URI. Every count and length is checked against the section's bytes
+//       before anything is allocated; the values by validate_chain.
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
 //       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
@@ -62,6 +69,10 @@ constexpr uint32_t kIndx = fourcc("INDX");
 constexpr uint32_t kVhie = fourcc("VHIE");
 constexpr uint32_t kMrph = fourcc("MRPH");
 constexpr uint32_t kTex0 = fourcc("TEX0");
+constexpr uint32_t kMatl = fourcc("MATL");
+constexpr size_t kMatlFixedBytes = 16;
+constexpr size_t kSubmeshBytes = 16;
+constexpr size_t kMaterialFixedBytes = 40;
 constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
@@ -219,6 +230,86 @@ Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, V
   return Status::success();
 }
 
+void put_materials(Writer& w, const LodChain& c) {
+  w.u32(static_cast<uint32_t>(c.materials.size()));
+  w.u32(static_cast<uint32_t>(c.submeshes.size()));
+  w.u32(static_cast<uint32_t>(c.texture_base.size()));
+  w.u32(0);
+  w.raw(c.texture_base.data(), c.texture_base.size());
+  for (const LevelSubmesh& s : c.submeshes) {
+    w.u32(s.level);
+    w.u32(s.first_index);
+    w.u32(s.index_count);
+    w.u32(static_cast<uint32_t>(s.material));
+  }
+  for (const ChainMaterial& m : c.materials) {
+    w.u32(static_cast<uint32_t>(m.name.size()));
+    w.u32(static_cast<uint32_t>(m.base_color_texture.size()));
+    for (float f : m.base_color) w.f32(f);
+    w.f32(m.metallic);
+    w.f32(m.roughness);
+    w.f32(m.alpha_cutoff);
+    w.u8(static_cast<uint8_t>(m.alpha_mode));
+    w.u8(m.double_sided ? 1 : 0);
+    w.u8(0);
+    w.u8(0);
+    w.raw(m.name.data(), m.name.size());
+    w.raw(m.base_color_texture.data(), m.base_color_texture.size());
+  }
+}
+
+// Structure only (counts, lengths, what fits where); the values are validate_chain's.
+Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, LodChain& chain) {
+  auto bad = [&](const std::string& why) { return refuse(what, "MATL section: " + why); };
+  if (size < kMatlFixedBytes)
+    return bad(std::to_string(size) + " bytes, needs " + std::to_string(kMatlFixedBytes) + " at least");
+  const uint64_t materials = load_u32(p), submeshes = load_u32(p + 4), base_bytes = load_u32(p + 8);
+  if (load_u32(p + 12) != 0) return bad("reserved word is not 0");
+  if (materials > kMaxMaterials)
+    return bad(std::to_string(materials) + " materials, at most " + std::to_string(kMaxMaterials));
+  if (base_bytes > kMaxMaterialString) return bad("texture base of " + std::to_string(base_bytes) + " bytes is too long");
+  uint64_t at = kMatlFixedBytes;
+  const uint64_t fixed = base_bytes + submeshes * kSubmeshBytes + materials * kMaterialFixedBytes;
+  if (fixed > size - at)
+    return bad(std::to_string(materials) + " materials and " + std::to_string(submeshes) + " submeshes need " +
+               std::to_string(at + fixed) + " bytes at least, the section has " + std::to_string(size));
+  chain.texture_base.assign(reinterpret_cast<const char*>(p + at), base_bytes);
+  at += base_bytes;
+  chain.submeshes.resize(submeshes);
+  for (LevelSubmesh& s : chain.submeshes) {
+    s.level = load_u32(p + at);
+    s.first_index = load_u32(p + at + 4);
+    s.index_count = load_u32(p + at + 8);
+    s.material = static_cast<int32_t>(load_u32(p + at + 12));
+    at += kSubmeshBytes;
+  }
+  chain.materials.resize(materials);
+  for (uint64_t i = 0; i < materials; ++i) {
+    const std::string where = "material " + std::to_string(i);
+    if (kMaterialFixedBytes > size - at) return bad(where + " is cut off at byte " + std::to_string(at));
+    ChainMaterial& m = chain.materials[i];
+    const uint64_t name_bytes = load_u32(p + at), uri_bytes = load_u32(p + at + 4);
+    for (int c = 0; c < 4; ++c) m.base_color[c] = load_f32(p + at + 8 + 4 * c);
+    m.metallic = load_f32(p + at + 24);
+    m.roughness = load_f32(p + at + 28);
+    m.alpha_cutoff = load_f32(p + at + 32);
+    const uint8_t mode = p[at + 36], sided = p[at + 37];
+    if (mode > uint8_t(AlphaMode::blend)) return bad(where + " has unknown alpha mode " + std::to_string(mode));
+    if (sided > 1) return bad(where + " has double-sided flag " + std::to_string(sided));
+    m.alpha_mode = static_cast<AlphaMode>(mode);
+    m.double_sided = sided == 1;
+    at += kMaterialFixedBytes;
+    if (name_bytes > kMaxMaterialString || uri_bytes > kMaxMaterialString || name_bytes + uri_bytes > size - at)
+      return bad(where + " says its name and URI take " + std::to_string(name_bytes) + " + " +
+                 std::to_string(uri_bytes) + " bytes; " + std::to_string(size - at) + " are left");
+    m.name.assign(reinterpret_cast<const char*>(p + at), name_bytes);
+    m.base_color_texture.assign(reinterpret_cast<const char*>(p + at + name_bytes), uri_bytes);
+    at += name_bytes + uri_bytes;
+  }
+  if (at != size) return bad(std::to_string(size - at) + " bytes left over after the last material");
+  return Status::success();
+}
+
 }  // namespace
 
 uint64_t hash_bytes(const void* data, size_t size, uint64_t seed) {
@@ -264,6 +355,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   if (!chain.hierarchy.empty()) tags.push_back(kVhie);
   if (!chain.morph_targets.empty()) tags.push_back(kMrph);
   if (!chain.uvs.empty()) tags.push_back(kTex0);
+  if (!chain.materials.empty() || !chain.submeshes.empty()) tags.push_back(kMatl);
   const uint32_t section_count = static_cast<uint32_t>(tags.size());
   w.raw(kMagic, sizeof(kMagic));
   w.u32(kLodAssetVersion);
@@ -271,7 +363,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   const size_t table = w.bytes.size();
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
-    w.u32(tags[s] == kVhie || tags[s] == kMrph || tags[s] == kTex0 ? 0 : kFlagRequired);
+    w.u32(tags[s] == kVhie || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kMatl ? 0 : kFlagRequired);
     w.u64(0);  // offset, patched below
     w.u64(0);  // size
   }
@@ -312,6 +404,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
         put_floats(w, chain.uv_errors);
         put_floats(w, chain.uvs);
       });
+    if (tags[s] == kMatl) section(s, [&] { put_materials(w, chain); });
   }
   w.align8();
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
@@ -357,7 +450,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     return refuse(what, "checksum mismatch (file is corrupted or truncated)");
 
   SectionRef sec[5];
-  SectionRef vhie, mrph, tex0;
+  SectionRef vhie, mrph, tex0, matl;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -380,6 +473,11 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     if (tag == kTex0) {
       if (tex0.present) return refuse(what, name + " appears twice");
       tex0 = {off, sz, true};
+      continue;
+    }
+    if (tag == kMatl) {
+      if (matl.present) return refuse(what, name + " appears twice");
+      matl = {off, sz, true};
       continue;
     }
     size_t known = 0;
@@ -445,6 +543,8 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     get_words(p + tex0.offset + 4, level_count, chain.uv_errors);
     get_words(p + tex0.offset + 4 + 4 * uint64_t{level_count}, 2 * vertices, chain.uvs);
   }
+  if (matl.present)
+    if (Status st = get_materials(p + matl.offset, matl.size, what, chain); !st) return st;
   std::string message;
   const char* section = "LEVL";
   if (!validate_chain(chain, &message, &section)) return refuse(what, std::string(section) + " section: " + message);

@@ -37,6 +37,70 @@ bool all_finite(const std::vector<float>& values, size_t* bad) {
   return true;
 }
 
+// Names and URIs: bounded, no control bytes (they end up in files, JSON and terminals).
+bool printable_string(const std::string& s) {
+  if (s.size() > kMaxMaterialString) return false;
+  for (unsigned char c : s)
+    if (c < 0x20 || c == 0x7f) return false;
+  return true;
+}
+
+bool unit_factor(float x) { return std::isfinite(x) && x >= 0 && x <= 1; }
+
+bool validate_materials(const LodChain& chain, std::string* message) {
+  if (chain.materials.empty() && chain.submeshes.empty()) return true;
+  if (chain.materials.size() > kMaxMaterials)
+    return fail(message, std::to_string(chain.materials.size()) + " materials, at most " +
+                             std::to_string(kMaxMaterials) + " are supported");
+  if (!printable_string(chain.texture_base)) return fail(message, "texture base folder is too long or has control bytes");
+  for (size_t i = 0; i < chain.materials.size(); ++i) {
+    const ChainMaterial& m = chain.materials[i];
+    const std::string at = "material " + std::to_string(i);
+    if (!printable_string(m.name)) return fail(message, at + " name is too long or has control bytes");
+    if (!printable_string(m.base_color_texture))
+      return fail(message, at + " base colour texture URI is too long or has control bytes");
+    for (float c : m.base_color)
+      if (!unit_factor(c)) return fail(message, at + " has a base colour factor outside [0, 1]");
+    if (!unit_factor(m.metallic) || !unit_factor(m.roughness))
+      return fail(message, at + " has a metallic or roughness factor outside [0, 1]");
+    if (uint8_t(m.alpha_mode) > uint8_t(AlphaMode::blend))
+      return fail(message, at + " has unknown alpha mode " + std::to_string(unsigned(m.alpha_mode)));
+    if (!(std::isfinite(m.alpha_cutoff) && m.alpha_cutoff >= 0 && m.alpha_cutoff <= 1e6f))
+      return fail(message, at + " has an invalid alpha cutoff");
+  }
+  // Runs in level order, each level's covering its indices back to back.
+  const size_t drawn = drawn_levels(chain);
+  size_t r = 0;
+  for (size_t k = 0; k < chain.levels.size(); ++k) {
+    const LodLevel& lv = chain.levels[k];
+    uint64_t covered = 0;
+    for (; r < chain.submeshes.size() && chain.submeshes[r].level == k; ++r) {
+      const LevelSubmesh& s = chain.submeshes[r];
+      const std::string at = "submesh " + std::to_string(r) + " (level " + std::to_string(k) + ")";
+      if (k >= drawn) return fail(message, at + " belongs to the culled level");
+      if (s.first_index != covered)
+        return fail(message, at + " starts at index " + std::to_string(s.first_index) + ", the runs before end at " +
+                                 std::to_string(covered));
+      if (s.index_count == 0 || s.index_count % 3 != 0)
+        return fail(message, at + " has " + std::to_string(s.index_count) + " indices, not a positive multiple of 3");
+      covered += s.index_count;
+      if (covered > lv.index_count)
+        return fail(message, at + " ends at index " + std::to_string(covered) + " past the level's " +
+                                 std::to_string(lv.index_count));
+      if (s.material < -1 || (s.material >= 0 && size_t(s.material) >= chain.materials.size()))
+        return fail(message, at + " names material " + std::to_string(s.material) + " of " +
+                                 std::to_string(chain.materials.size()));
+    }
+    if (k < drawn && covered != lv.index_count)
+      return fail(message, "level " + std::to_string(k) + "'s material runs cover " + std::to_string(covered) +
+                               " of its " + std::to_string(lv.index_count) + " indices");
+  }
+  if (r != chain.submeshes.size())
+    return fail(message, "submesh " + std::to_string(r) + " names level " + std::to_string(chain.submeshes[r].level) +
+                             " out of order or of " + std::to_string(chain.levels.size()));
+  return true;
+}
+
 }  // namespace
 
 bool validate_chain(const LodChain& chain, std::string* message, const char** section) {
@@ -150,7 +214,16 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
                                    std::to_string(k + 1) + "'s " + std::to_string(next));
     }
   }
+  in("MATL");
+  if (!validate_materials(chain, message)) return false;
   return true;
+}
+
+std::span<const LevelSubmesh> level_submeshes(const LodChain& chain, uint32_t level) {
+  const auto by_level = [](const LevelSubmesh& s, uint32_t k) { return s.level < k; };
+  const auto lo = std::lower_bound(chain.submeshes.begin(), chain.submeshes.end(), level, by_level);
+  const auto hi = std::lower_bound(lo, chain.submeshes.end(), level + 1, by_level);
+  return {chain.submeshes.data() + (lo - chain.submeshes.begin()), size_t(hi - lo)};
 }
 
 bool has_culled_level(const LodChain& chain) {

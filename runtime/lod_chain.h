@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/chain_material.h"
 #include "runtime/vertex_tree.h"
 
 namespace lod {
@@ -42,6 +43,13 @@ struct LodChain {
   // descends from (how far the texture slid). Stored in the asset's optional TEX0 section.
   std::vector<float> uvs;
   std::vector<float> uv_errors;
+  // Optional materials (empty = one default surface): every drawn level's triangles grouped by
+  // material, each group a LevelSubmesh (sorted by level; a level's runs cover its indices in
+  // order). Texture URIs are relative to texture_base (the source's folder when baked, absolute).
+  // Stored in the asset's optional MATL section.
+  std::vector<ChainMaterial> materials;
+  std::vector<LevelSubmesh> submeshes;
+  std::string texture_base;
   // Optional geomorph targets (empty = none): per vertex of every level but the last, laid out
   // like positions (level k's at levels[k].first_vertex), the level-local index of the vertex
   // of level k + 1 it merges into. Stored in the asset's optional MRPH section.
@@ -64,9 +72,17 @@ int32_t level_of_triangles(uint64_t triangles);
 // may be empty.
 // With morph targets: one per vertex of every drawn level but the last, each < the next level's
 // vertex_count ("level 2 vertex 17 morphs into vertex 900 of level 3's 812").
+// With materials: at most kMaxMaterials, factors finite in [0, 1], alpha mode known, names
+// and URIs at most kMaxMaterialString bytes without control characters; submeshes sorted by
+// level, each drawn level's runs non-empty, whole triangles, covering its indices in order,
+// each naming a material that exists (or -1); the culled level has none.
 // Values must be finite and at most kMaxTreeMagnitude in size. `section`, when given, is set
-// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH", "TEX0") the failing element is in.
+// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH", "TEX0", "MATL") the failing
+// element is in.
 bool validate_chain(const LodChain& chain, std::string* message, const char** section = nullptr);
+
+// Level k's material runs (a subrange of chain.submeshes; empty for a chain without materials).
+std::span<const LevelSubmesh> level_submeshes(const LodChain& chain, uint32_t level);
 
 // The culled level (a last ratio of 0): a last level, after level 0, with no triangles and no
 // vertices; an object there is not drawn. validate_chain accepts no other empty level.

@@ -31,7 +31,8 @@ mkdir -p "$OUT/obj"
 FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
        -I. -Iinclude -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
-              preprocess/obj_reader.cpp preprocess/gltf_io.cpp runtime/file_write.cpp)  # gltf_io compiles tinygltf in
+              preprocess/obj_reader.cpp preprocess/mtl_reader.cpp preprocess/texture_uri.cpp preprocess/gltf_io.cpp
+              runtime/file_write.cpp)  # gltf_io compiles tinygltf in
 LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/vertex_front.cpp
              runtime/file_write.cpp runtime/model_table.cpp runtime/view.cpp)
 HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp

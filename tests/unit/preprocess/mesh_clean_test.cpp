@@ -30,10 +30,13 @@ TEST(MeshClean, KeepsUvsAndReRangesSubmeshes) {
                     {0, 1, 2, 0, 0, 1, 1, 3, 2, 2, 0, 4, 4, 3, 2});
   m.uvs = {0, 0, 0.1f, 0, 0, 1, 1, 1, 0.1f, 0};
   m.submeshes = {{0, 2, 0}, {2, 2, 1}, {4, 1, 0}};
-  clean_mesh(m);
-  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
-  EXPECT_EQ(m.uvs, (std::vector<float>{0, 0, 0.1f, 0, 0, 1, 1, 1}));
-  ASSERT_EQ(m.submeshes.size(), 2u);  // kept: triangle 0 | triangle 2 | none (4 repeats 2)
+  // Triangles 0 (material 0) and 2 (material 1) share vertices 1 and 2: material 1 gets
+  // copies of them (5, 6 after the input's), so the boundary is a seam.
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.material_split_vertices, 5u);  // 1, 2, 0 for material 1; 4, 3 for the last run (material 0)
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 4, 3, 5}));
+  EXPECT_EQ(m.uvs, (std::vector<float>{0, 0, 0.1f, 0, 0, 1, 1, 1, 0.1f, 0, 0, 1}));
+  ASSERT_EQ(m.submeshes.size(), 2u);  // kept: triangle 0 | triangle 2 | none (4 repeats 2 in place)
   EXPECT_EQ(m.submeshes[0].first_triangle, 0u);
   EXPECT_EQ(m.submeshes[0].triangle_count, 1u);
   EXPECT_EQ(m.submeshes[1].first_triangle, 1u);

@@ -326,5 +326,111 @@ TEST(LodAsset, HostileFieldsAreRefusedNamingTheSection) {
   EXPECT_NE(st.message.find("META says 1099511627776"), std::string::npos) << st.message;
 }
 
+// ---- MATL: materials and per-level runs -------------------------------------------------------
+
+LodChain chain_with_materials() {
+  LodChain c = test::fan_chain("bunny", {9, 4, 2});
+  c.texture_base = "/data/models";
+  ChainMaterial a, b;
+  a.name = "bark";
+  a.base_color_texture = "tex/bark%20d.png";
+  a.alpha_mode = AlphaMode::mask;
+  a.alpha_cutoff = 0.3f;
+  b.name = "leaf";
+  b.double_sided = true;
+  b.base_color[1] = 0.5f;
+  c.materials = {a, b};
+  for (uint32_t k = 0; k < c.levels.size(); ++k) {
+    const uint32_t n = c.levels[k].index_count;
+    const uint32_t first = n / 3 / 2 * 3;
+    if (first > 0) c.submeshes.push_back({k, 0, first, 1});
+    c.submeshes.push_back({k, first, n - first, k == 0 ? -1 : 0});
+  }
+  return c;
+}
+
+// Offset of the MATL section in an encoded asset (0 when there is none).
+uint64_t matl_offset(const std::vector<uint8_t>& bytes) {
+  uint32_t count = 0;
+  std::memcpy(&count, bytes.data() + 12, 4);
+  for (uint32_t s = 0; s < count; ++s)
+    if (std::memcmp(bytes.data() + 16 + 24 * s, "MATL", 4) == 0) {
+      uint64_t off = 0;
+      std::memcpy(&off, bytes.data() + 16 + 24 * s + 8, 8);
+      return off;
+    }
+  return 0;
+}
+
+void reseal(std::vector<uint8_t>& bytes) {
+  const uint64_t h = hash_bytes(bytes.data(), bytes.size() - 8);
+  std::memcpy(bytes.data() + bytes.size() - 8, &h, 8);
+}
+
+TEST(LodAssetMaterials, RoundTripKeepsMaterialsAndRuns) {
+  const LodChain c = chain_with_materials();
+  std::string why;
+  ASSERT_TRUE(validate_chain(c, &why)) << why;
+  const std::vector<uint8_t> bytes = encode_lod_asset(c);
+  ASSERT_NE(matl_offset(bytes), 0u);
+  LodChain back;
+  const Status st = decode_lod_asset(bytes, "bunny.lod", back);
+  ASSERT_TRUE(st) << st.message;
+  expect_same_chain(c, back);
+  EXPECT_EQ(back.texture_base, c.texture_base);
+  ASSERT_EQ(back.materials.size(), 2u);
+  EXPECT_EQ(back.materials[0].base_color_texture, "tex/bark%20d.png");
+  EXPECT_EQ(back.materials[0].alpha_mode, AlphaMode::mask);
+  EXPECT_TRUE(back.materials[1].double_sided);
+  ASSERT_EQ(back.submeshes.size(), c.submeshes.size());
+  EXPECT_EQ(level_submeshes(back, 1).size(), 2u);
+  EXPECT_EQ(level_submeshes(back, 1)[0].material, 1);
+  EXPECT_EQ(encode_lod_asset(back), bytes);
+  EXPECT_EQ(matl_offset(encode_lod_asset(test::fan_chain("plain", {4}))), 0u) << "no MATL without materials";
+}
+
+TEST(LodAssetMaterials, HostileSectionsAreRefusedNamingWhatIsWrong) {
+  struct Case {
+    const char* expect;
+    size_t at;  // byte within MATL
+    uint32_t value;
+  };
+  const std::vector<uint8_t> good = encode_lod_asset(chain_with_materials());
+  const uint64_t matl = matl_offset(good);
+  const size_t submeshes = 16 + 12;  // after the header and the texture base "/data/models"
+  const size_t first_material = submeshes + 16 * chain_with_materials().submeshes.size();
+  const Case cases[] = {
+      {"MATL section: 4294967295 materials", 0, 0xffffffffu},
+      {"MATL section: 2 materials and 268435456 submeshes need", 4, 1u << 28},
+      {"MATL section: texture base of 4000000000 bytes is too long", 8, 4000000000u},
+      {"MATL section: reserved word", 12, 1},
+      {"MATL section: submesh 0 (level 0) names material 5 of 2", submeshes + 12, 5},
+      {"MATL section: submesh 0 (level 0) starts at index 3", submeshes + 4, 3},
+      {"MATL section: level 0's material runs cover 0 of its 27 indices", submeshes, 99},
+      {"MATL section: material 0 says its name and URI take 3000", first_material, 3000},
+      {"MATL section: material 0 says its name and URI take 4 + 4000000", first_material + 4, 4000000},
+      {"MATL section: material 0 has unknown alpha mode 7", first_material + 36, 7},
+      {"MATL section: material 0 has a base colour factor outside [0, 1]", first_material + 8, 0x7fc00000u},
+  };
+  for (const Case& k : cases) {
+    std::vector<uint8_t> bytes = good;
+    std::memcpy(bytes.data() + matl + k.at, &k.value, 4);
+    reseal(bytes);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+    ASSERT_FALSE(st) << k.expect;
+    EXPECT_EQ(st.message.rfind(std::string("bunny.lod: ") + k.expect, 0), 0u) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+  // A control byte in a name (terminal escapes) is refused too.
+  std::vector<uint8_t> bytes = good;
+  bytes[matl + first_material + 40] = 0x1b;
+  reseal(bytes);
+  LodChain out;
+  const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("material 0 name is too long or has control bytes"), std::string::npos) << st.message;
+}
+
 }  // namespace
 }  // namespace lod

@@ -1,0 +1,127 @@
+// Wavefront MTL reader: the statements that map onto glTF's metallic-roughness material.
+//   newmtl NAME            starts a material
+//   Kd r g b               base colour factor (clamped to [0, 1] by the bake)
+//   d a / Tr t             alpha (Tr is 1 - d); below 1 the material blends
+//   map_Kd [opts] FILE     base colour texture (options and their values skipped; the rest
+//                          of the line is the file)
+// Ns, Ka, Ks, Ke, illum, bump and the other maps have no place in the levels' material: each
+// keyword is named once in the warnings. Errors name the file and line.
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
+#include <set>
+
+#include "preprocess/mesh_readers.h"
+#include "preprocess/texture_uri.h"
+
+namespace lod::detail {
+namespace {
+
+bool blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+std::string_view next_token(std::string_view line, size_t& at) {
+  while (at < line.size() && blank(line[at])) ++at;
+  size_t e = at;
+  while (e < line.size() && !blank(line[e])) ++e;
+  const std::string_view t = line.substr(at, e - at);
+  at = e;
+  return t;
+}
+
+}  // namespace
+
+Status read_mtl(const std::string& what, const uint8_t* data, size_t size, const std::string& prefix,
+                std::vector<MeshMaterial>& materials, std::vector<std::string>& names, std::vector<std::string>& warnings) {
+  const char* text = reinterpret_cast<const char*>(data);
+  if (size >= 3 && data[0] == 0xEF && data[1] == 0xBB && data[2] == 0xBF) text += 3, size -= 3;
+  std::set<std::string> skipped;
+  MeshMaterial* current = nullptr;
+  size_t pos = 0, line_no = 0;
+  std::string number;
+  while (pos < size) {
+    ++line_no;
+    const void* nl = std::memchr(text + pos, '\n', size - pos);
+    const size_t end = nl ? size_t(static_cast<const char*>(nl) - text) : size;
+    const std::string_view line(text + pos, end - pos);
+    pos = nl ? end + 1 : size;
+    size_t at = 0;
+    const std::string_view key = next_token(line, at);
+    if (key.empty() || key[0] == '#') continue;
+    const std::string here = what + ":" + std::to_string(line_no);
+    auto numbers = [&](float* out, int count, int needed) -> Status {
+      for (int i = 0; i < count; ++i) {
+        number.assign(next_token(line, at).substr(0, 64));
+        if (number.empty() && i >= needed) {
+          out[i] = out[i - 1];  // "Kd 0.5" is grey
+          continue;
+        }
+        char* stop = nullptr;
+        const double v = number.empty() ? 0 : std::strtod(number.c_str(), &stop);
+        if (number.empty() || stop == number.c_str() || !std::isfinite(float(v)))
+          return Status::error(here + ": '" + std::string(key) + "' needs " + std::to_string(needed) + " finite numbers");
+        out[i] = float(v);
+      }
+      return Status::success();
+    };
+    if (key == "newmtl") {
+      const std::string name(next_token(line, at));
+      if (name.empty()) return Status::error(here + ": newmtl without a name");
+      if (materials.size() >= kMaxMaterials)
+        return Status::error(here + ": more than " + std::to_string(kMaxMaterials) + " materials");
+      materials.emplace_back();
+      names.push_back(name);
+      current = &materials.back();
+      current->name = name;
+      current->metallic = 0;  // OBJ's materials are dielectric
+      continue;
+    }
+    if (!current) {
+      skipped.insert(std::string(key) + " (before any newmtl)");
+      continue;
+    }
+    if (key == "Kd") {
+      if (Status s = numbers(current->base_color, 3, 1); !s) return s;
+    } else if (key == "d" || key == "Tr") {
+      float a = 1;
+      if (Status s = numbers(&a, 1, 1); !s) return s;
+      current->base_color[3] = key == "d" ? a : 1 - a;
+      if (current->base_color[3] < 1) current->alpha_mode = AlphaMode::blend;
+    } else if (key == "map_Kd") {
+      // Options ("-s 1 1 1", "-clamp on", ...) first, each with its values; the rest of the
+      // line is the file (names may hold spaces).
+      std::string_view file;
+      for (;;) {
+        size_t before = at;
+        const std::string_view t = next_token(line, at);
+        if (t.empty()) break;
+        if (t[0] != '-' || t.size() < 2 || std::isdigit(uint8_t(t[1])) || t[1] == '.') {
+          while (before < line.size() && blank(line[before])) ++before;
+          file = line.substr(before);
+          while (!file.empty() && blank(file.back())) file.remove_suffix(1);
+          break;
+        }
+        for (size_t peek = at;;) {  // the option's values: numbers, on / off
+          const std::string_view v = next_token(line, peek);
+          char* stop = nullptr;
+          number.assign(v.substr(0, 64));
+          const bool numeric = !v.empty() && (std::strtod(number.c_str(), &stop), stop != number.c_str());
+          if (!(numeric || v == "on" || v == "off")) break;
+          at = peek;
+        }
+      }
+      if (file.empty()) return Status::error(here + ": map_Kd without a file name");
+      current->base_color_texture = path_to_uri(prefix + std::string(file));
+    } else {
+      skipped.insert(std::string(key));
+    }
+  }
+  if (!skipped.empty()) {
+    std::string list;
+    for (const std::string& k : skipped) list += (list.empty() ? "" : ", ") + k;
+    warnings.push_back(what + ": not imported (no place in the levels' material): " + list);
+  }
+  return Status::success();
+}
+
+}  // namespace lod::detail

@@ -1,0 +1,183 @@
+// Materials through every level: a sphere whose two halves have two materials (one textured)
+// keeps both in every level, each triangle on its own side of the equator where they meet
+// (the boundary is a seam: its vertices are locked in both materials), the runs cover every
+// level's triangles grouped by material, and the materials round-trip through the asset.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "preprocess/lod_bake.h"
+#include "preprocess/material_runs.h"
+#include "preprocess/mesh_clean.h"
+#include "preprocess/mesh_io.h"
+#include "runtime/lod_asset.h"
+#include "test_support.h"
+#include "textured_fixture.h"
+
+namespace lod {
+namespace {
+
+constexpr int kRings = 24, kSegments = 48;
+
+LodChain bake(const std::filesystem::path& gltf, SimplifyMethod method, BakeReport* report = nullptr) {
+  BakeSettings settings;
+  settings.ratios = {1.0f, 0.5f, 0.25f, 0.1f};
+  settings.method = method;
+  LodChain chain;
+  BakeReport r;
+  const Status st = bake_model(gltf, "globe", settings, chain, &r, nullptr);
+  EXPECT_TRUE(st.ok) << st.message;
+  if (report) *report = r;
+  return chain;
+}
+
+// y of the equator ring, where the two materials meet.
+float equator_y() {
+  const float theta = std::numbers::pi_v<float> * (0.02f + 0.96f * float(kRings / 2) / float(kRings));
+  return std::cos(theta);
+}
+
+TEST(MaterialRuns, CleaningSplitsASharedVertexPerMaterial) {
+  MeshData m = test::two_material_sphere(4, 8);
+  const size_t before = m.vertex_count();
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.material_split_vertices, 9u) << "the equator ring (8 + the seam copy) once more";
+  EXPECT_EQ(m.vertex_count(), before + 9);
+  const std::vector<int32_t> vm = vertex_materials(m);
+  const std::vector<int32_t> tm = triangle_materials(m);
+  for (size_t t = 0; t < m.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(vm[m.indices[3 * t + size_t(c)]], tm[t]) << "one material per vertex";
+}
+
+TEST(LodBakeMaterials, EveryLevelKeepsEachTrianglesMaterial) {
+  const auto dir = test::temp_dir("bake-materials");
+  const auto gltf = test::write_two_material_gltf(dir, "globe", kRings, kSegments);
+  ASSERT_FALSE(gltf.empty());
+  BakeReport report;
+  const LodChain chain = bake(gltf, SimplifyMethod::qem, &report);
+  for (const std::string& n : report.notes) EXPECT_EQ(n.find("not kept"), std::string::npos) << n;
+  ASSERT_EQ(chain.levels.size(), 4u);
+  ASSERT_EQ(chain.materials.size(), 2u);
+  EXPECT_EQ(chain.materials[0].name, "cap");
+  EXPECT_EQ(chain.materials[0].base_color_texture, "globe-image0.png");
+  EXPECT_TRUE(chain.materials[1].double_sided);
+  EXPECT_FLOAT_EQ(chain.materials[1].base_color[0], 0.8f);
+  EXPECT_EQ(std::filesystem::path(chain.texture_base), std::filesystem::absolute(dir).lexically_normal());
+  std::string why;
+  ASSERT_TRUE(validate_chain(chain, &why)) << why;
+  const float eq = equator_y();
+  for (uint32_t k = 0; k < chain.levels.size(); ++k) {
+    SCOPED_TRACE("level " + std::to_string(k));
+    const LodLevel& l = chain.levels[k];
+    const auto runs = level_submeshes(chain, k);
+    ASSERT_EQ(runs.size(), 2u) << "both materials in every level";
+    EXPECT_EQ(runs[0].material, 0);
+    EXPECT_EQ(runs[1].material, 1);
+    EXPECT_EQ(runs[0].index_count + runs[1].index_count, l.index_count);
+    // Each material's triangles stay on its side of the equator, and the equator ring is
+    // still there in both (locked: no collapse moved a vertex across the boundary).
+    std::set<std::pair<float, float>> ring[2];
+    for (int r = 0; r < 2; ++r)
+      for (uint32_t i = runs[size_t(r)].first_index; i < runs[size_t(r)].first_index + runs[size_t(r)].index_count; ++i) {
+        const float* p = &chain.positions[3 * size_t(l.first_vertex + chain.indices[l.first_index + i])];
+        if (r == 0) EXPECT_GE(p[1], eq - 1e-5f);
+        else EXPECT_LE(p[1], eq + 1e-5f);
+        if (p[1] == eq) ring[r].insert({p[0], p[2]});
+      }
+    EXPECT_EQ(ring[0].size(), size_t(kSegments)) << "the boundary survives in the cap";
+    EXPECT_EQ(ring[1], ring[0]) << "and meets the base's boundary exactly";
+  }
+  EXPECT_LT(chain.levels.back().triangles(), chain.levels[0].triangles() / 5);
+  EXPECT_EQ(chain.uvs.size(), chain.positions.size() / 3 * 2) << "uvs kept beside the materials";
+}
+
+TEST(LodBakeMaterials, TheAggressiveSimplifierClustersPerMaterial) {
+  const auto dir = test::temp_dir("bake-materials-extreme");
+  const auto gltf = test::write_two_material_gltf(dir, "globe", kRings, kSegments);
+  BakeReport report;
+  const LodChain chain = bake(gltf, SimplifyMethod::extreme, &report);
+  std::string why;
+  ASSERT_TRUE(validate_chain(chain, &why)) << why;
+  bool said = false;
+  for (const std::string& n : report.notes) said |= n.find("each material's triangles") != std::string::npos;
+  EXPECT_TRUE(said) << "the per-material grids are said in the notes";
+  const float eq = equator_y();
+  for (uint32_t k = 1; k < chain.levels.size(); ++k) {
+    const LodLevel& l = chain.levels[k];
+    const auto runs = level_submeshes(chain, k);
+    ASSERT_EQ(runs.size(), 2u) << k;
+    // A cell's vertex lies inside its material's cluster of input vertices, so on its side
+    // (up to the cell's extent along y, well under a ring's spacing beyond the boundary here).
+    double mean[2] = {0, 0};
+    for (int r = 0; r < 2; ++r) {
+      for (uint32_t i = runs[size_t(r)].first_index; i < runs[size_t(r)].first_index + runs[size_t(r)].index_count; ++i)
+        mean[r] += chain.positions[3 * size_t(l.first_vertex + chain.indices[l.first_index + i]) + 1];
+      mean[r] /= runs[size_t(r)].index_count;
+    }
+    EXPECT_GT(mean[0], eq) << k;
+    EXPECT_LT(mean[1], eq) << k;
+  }
+}
+
+TEST(LodBakeMaterials, MaterialsRoundTripThroughTheAsset) {
+  const auto dir = test::temp_dir("bake-materials-io");
+  const LodChain chain = bake(test::write_two_material_gltf(dir, "globe"), SimplifyMethod::qem);
+  LodChain back;
+  const Status st = decode_lod_asset(encode_lod_asset(chain), "globe.lod", back);
+  ASSERT_TRUE(st.ok) << st.message;
+  ASSERT_EQ(back.materials.size(), chain.materials.size());
+  for (size_t i = 0; i < chain.materials.size(); ++i) {
+    EXPECT_EQ(back.materials[i].name, chain.materials[i].name);
+    EXPECT_EQ(back.materials[i].base_color_texture, chain.materials[i].base_color_texture);
+    EXPECT_EQ(back.materials[i].double_sided, chain.materials[i].double_sided);
+    EXPECT_EQ(back.materials[i].alpha_mode, chain.materials[i].alpha_mode);
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(back.materials[i].base_color[c], chain.materials[i].base_color[c]);
+  }
+  EXPECT_EQ(back.texture_base, chain.texture_base);
+  ASSERT_EQ(back.submeshes.size(), chain.submeshes.size());
+  for (size_t i = 0; i < chain.submeshes.size(); ++i) {
+    EXPECT_EQ(back.submeshes[i].level, chain.submeshes[i].level);
+    EXPECT_EQ(back.submeshes[i].first_index, chain.submeshes[i].first_index);
+    EXPECT_EQ(back.submeshes[i].index_count, chain.submeshes[i].index_count);
+    EXPECT_EQ(back.submeshes[i].material, chain.submeshes[i].material);
+  }
+  EXPECT_EQ(encode_lod_asset(back), encode_lod_asset(chain));
+}
+
+TEST(LodBakeMaterials, InvalidRunsAndMaterialsAreRefused) {
+  const LodChain chain = bake(test::write_two_material_gltf(test::temp_dir("bake-materials-bad"), "globe"),
+                              SimplifyMethod::qem);
+  auto refused = [](const LodChain& c, const char* needle) {
+    std::string why;
+    const char* section = nullptr;
+    EXPECT_FALSE(validate_chain(c, &why, &section)) << needle;
+    EXPECT_STREQ(section, "MATL");
+    EXPECT_NE(why.find(needle), std::string::npos) << why;
+  };
+  LodChain c = chain;
+  c.submeshes[1].material = 7;
+  refused(c, "names material 7");
+  c = chain;
+  c.submeshes[0].index_count -= 3;
+  refused(c, "starts at index");
+  c = chain;
+  c.submeshes.pop_back();
+  refused(c, "cover");
+  c = chain;
+  std::swap(c.submeshes[0], c.submeshes.back());
+  refused(c, "");
+  c = chain;
+  c.materials[0].base_color[2] = std::nanf("");
+  refused(c, "base colour");
+  c = chain;
+  c.materials[1].name = std::string("a\x1b[2Jb");
+  refused(c, "control bytes");
+  c = chain;
+  c.materials[1].alpha_mode = AlphaMode(9);
+  refused(c, "alpha mode");
+}
+
+}  // namespace
+}  // namespace lod

@@ -1,0 +1,165 @@
+// OBJ with texture coordinates, normals and materials (issue 12): vt / vn / usemtl / mtllib
+// are kept (uvs flipped into glTF's convention, one vertex per distinct v/vt/vn corner,
+// submeshes by usemtl, the .mtl's Kd, d / Tr and map_Kd), and hostile files are refused
+// naming file:line.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "preprocess/lod_bake.h"
+#include "preprocess/mesh_io.h"
+#include "test_support.h"
+#include "textured_fixture.h"
+
+namespace lod {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Two quads side by side (x 0..1 and 1..2), one material each; the shared edge has one uv.
+const char* kObj = R"(# two quads
+mtllib quads.mtl
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 2 0 0
+v 2 1 0
+vt 0 0
+vt 0.5 0
+vt 0.5 1
+vt 0 1
+vt 1 0
+vt 1 1
+vn 0 0 1
+usemtl left
+f 1/1/1 2/2/1 3/3/1 4/4/1
+usemtl right
+f 2/2/1 5/5/1 6/6/1 3/3/1
+)";
+
+const char* kMtl = R"(# materials
+newmtl left
+Kd 0.8 0.4 0.2
+d 0.5
+Ns 20
+illum 2
+newmtl right
+Kd 0.1
+map_Kd -s 1 1 1 -clamp on tex dir/wood.png
+)";
+
+fs::path write_quads(const std::string& tag, const std::string& obj = kObj, const std::string& mtl = kMtl) {
+  const fs::path dir = test::temp_dir(tag);
+  test::write_text(dir / "quads.obj", obj);
+  test::write_text(dir / "quads.mtl", mtl);
+  fs::create_directories(dir / "tex dir");
+  test::write_bytes(dir / "tex dir" / "wood.png", test::checker_png(16, 4));
+  return dir / "quads.obj";
+}
+
+TEST(ObjMaterials, KeepsUvsNormalsAndMaterials) {
+  MeshData m;
+  const Status s = load_mesh(write_quads("obj-materials"), m);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(m.triangle_count(), 4u);
+  EXPECT_EQ(m.vertex_count(), 6u) << "one vertex per distinct v/vt/vn corner";
+  ASSERT_EQ(m.uvs.size(), 2 * m.vertex_count());
+  ASSERT_EQ(m.normals.size(), 3 * m.vertex_count());
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    // vt (u, v) with the origin bottom left -> glTF's (u, 1 - v); here u = x / 2, v = y.
+    EXPECT_FLOAT_EQ(m.uvs[2 * v], m.positions[3 * v] / 2) << v;
+    EXPECT_FLOAT_EQ(m.uvs[2 * v + 1], 1 - m.positions[3 * v + 1]) << v;
+    EXPECT_FLOAT_EQ(m.normals[3 * v + 2], 1.0f);
+  }
+  ASSERT_EQ(m.submeshes.size(), 2u);
+  EXPECT_EQ(m.submeshes[0].triangle_count, 2u);
+  EXPECT_EQ(m.submeshes[1].material, 1);
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[0].name, "left");
+  EXPECT_FLOAT_EQ(m.materials[0].base_color[1], 0.4f);
+  EXPECT_FLOAT_EQ(m.materials[0].base_color[3], 0.5f);
+  EXPECT_EQ(m.materials[0].alpha_mode, AlphaMode::blend);
+  EXPECT_FLOAT_EQ(m.materials[1].base_color[2], 0.1f) << "Kd with one value is grey";
+  EXPECT_EQ(m.materials[1].base_color_texture, "tex%20dir/wood.png") << "options skipped, the rest of the line, as a URI";
+  bool said = false;
+  for (const std::string& w : m.warnings) said |= w.find("Ns, illum") != std::string::npos;
+  EXPECT_TRUE(said) << "what the .mtl had that is not kept is said";
+}
+
+TEST(ObjMaterials, TheBakeKeepsThemInEveryLevel) {
+  const fs::path obj = write_quads("obj-materials-bake");
+  BakeSettings settings;
+  settings.ratios = {1.0f, 0.5f};
+  settings.method = SimplifyMethod::qem;
+  LodChain chain;
+  BakeReport report;
+  const Status st = bake_model(obj, "quads", settings, chain, &report, nullptr);
+  ASSERT_TRUE(st.ok) << st.message;
+  ASSERT_EQ(chain.materials.size(), 2u);
+  EXPECT_EQ(chain.materials[1].base_color_texture, "tex%20dir/wood.png");
+  EXPECT_EQ(level_submeshes(chain, 0).size(), 2u);
+  EXPECT_FALSE(chain.uvs.empty());
+  Status key;
+  const uint64_t before = bake_key(obj, settings, &key);
+  test::write_text(obj.parent_path() / "quads.mtl", std::string(kMtl) + "Kd 0 0 0\n");
+  EXPECT_NE(bake_key(obj, settings, &key), before) << "the .mtl is part of the cache key";
+}
+
+struct Hostile {
+  const char* name;
+  std::string obj, mtl;
+  const char* expect;
+};
+
+TEST(ObjMaterials, HostileFilesAreRefusedNamingFileAndLine) {
+  const std::string quads = kObj;
+  const Hostile cases[] = {
+      {"vt past the end", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/9 3/1\n", kMtl,
+       "quads.obj:5: face 0 references texture coordinate 9 of 1"},
+      {"vn past the end", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n", kMtl,
+       "quads.obj:5: face 0 references normal 2 of 1"},
+      {"relative vt before any", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/-1 2/-1 3/-1\n", kMtl,
+       "quads.obj:4: face 0 references texture coordinate -1 (relative) of 0"},
+      {"huge vt number", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/99999999999999999999 2/1 3/1\n", kMtl,
+       "quads.obj:5: face 0 has a corner with an invalid texture coordinate number"},
+      {"non-numeric vt", "v 0 0 0\nvt 0 x\n", kMtl, "quads.obj:2: 'vt' needs 2 finite numbers, not 'x'"},
+      {"missing mtl", "mtllib nope.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", kMtl,
+       "quads.obj:1: mtllib 'nope.mtl' not found"},
+      {"bad Kd", quads, "newmtl left\nKd red\n", "quads.mtl:2: 'Kd' needs 1 finite numbers"},
+      {"missing texture", quads, "newmtl right\nmap_Kd gone.png\n", "material 'right': map_Kd 'gone.png' not found"},
+      {"usemtl without a name", "v 0 0 0\nusemtl\n", kMtl, "quads.obj:2: usemtl without a material name"},
+  };
+  for (const Hostile& h : cases) {
+    MeshData m;
+    m.source = "untouched";
+    const Status s = load_mesh(write_quads("obj-hostile", h.obj, h.mtl), m);
+    ASSERT_FALSE(s.ok) << h.name;
+    EXPECT_NE(s.message.find(h.expect), std::string::npos) << h.name << ": " << s.message;
+    EXPECT_EQ(m.source, "untouched") << h.name;
+  }
+}
+
+TEST(ObjMaterials, UsemtlWithoutItsMaterialGetsDefaultsAndIsSaid) {
+  MeshData m;
+  const Status s = load_mesh(write_quads("obj-usemtl", kObj, "newmtl left\nKd 1 0 0\n"), m);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[1].name, "right");
+  bool said = false;
+  for (const std::string& w : m.warnings) said |= w.find("quads.obj:18: usemtl 'right' names no material") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+TEST(ObjMaterials, AGeometryOnlyObjIsReadAsBefore) {
+  MeshData m;
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+  ASSERT_TRUE(load_mesh_from_memory("plain.obj", ".obj", reinterpret_cast<const uint8_t*>(obj.data()), obj.size(), m).ok);
+  EXPECT_EQ(m.vertex_count(), 4u);
+  EXPECT_TRUE(m.uvs.empty());
+  EXPECT_TRUE(m.submeshes.empty());
+  EXPECT_TRUE(m.materials.empty());
+}
+
+}  // namespace
+}  // namespace lod
