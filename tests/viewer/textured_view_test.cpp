@@ -1,0 +1,132 @@
+// lod-viewer --screenshot of a textured, two-material glTF sphere (tests/textured_fixture.h):
+// with materials (the default) its upper half shows both colours of the checker texture and
+// its lower half the second material's red factor; with --color-by-level none of them.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+#include "textured_fixture.h"
+#include "viewer/picture_checks.h"
+#include "viewer/viewer_harness.h"
+
+namespace {
+
+using lod::test::Image;
+
+const char* kRun = "[run]\nframes = 1\nthreads = 1\n[budget]\ntriangles = 1000000\n";
+
+const char* kCamera = R"([camera]
+fov_deg = 60
+width = 400
+height = 300
+path = "keyframes"
+near = 0.5
+far = 500.0
+[[camera.keyframe]]
+frame = 0
+position = [0.0, 0.0, 30.0]
+look_at = [0.0, 0.0, 0.0]
+)";
+
+const char* kModel = R"([[model]]
+name = "textured"
+file = "textured/globe.gltf"
+ratios = [1.0, 0.5]
+)";
+
+const char* kInstance = R"([[instances]]
+model = "textured"
+count = 1
+placement = "grid"
+box_min = [0.0, 0.0, 0.0]
+box_max = [0.0, 0.0, 0.0]
+scale = 9.0
+)";
+
+// The fixture's checker colours (0..255) and the second material's base colour factor.
+constexpr std::array<float, 3> kCheckerLight = {230, 200, 60};
+constexpr std::array<float, 3> kCheckerDark = {40, 90, 160};
+constexpr std::array<float, 3> kBaseFactor = {0.8f, 0.2f, 0.1f};
+
+// Shading scales every channel alike: compare hues after dividing by the largest channel.
+// Dim pixels (largest channel < 60) are left out, their rounding blurs the hue.
+bool same_hue(const uint8_t* px, std::array<float, 3> c) {
+  const float pm = float(std::max({px[0], px[1], px[2]}));
+  const float cm = std::max({c[0], c[1], c[2]});
+  if (pm < 60) return false;
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(float(px[k]) / pm - c[size_t(k)] / cm) > 0.06f) return false;
+  return true;
+}
+
+struct HueCounts {
+  int light_above = 0, dark_above = 0, base_below = 0, any_checker = 0, any_base = 0;
+};
+
+HueCounts count_hues(const Image& img) {
+  HueCounts n;
+  const int centre_row = lod::test::project({0, 0, 0}, img.width, img.height)[1];
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* px = img.at(x, y);
+      const bool light = same_hue(px, kCheckerLight), dark = same_hue(px, kCheckerDark);
+      const bool base = same_hue(px, kBaseFactor);
+      n.light_above += light && y < centre_row;
+      n.dark_above += dark && y < centre_row;
+      n.base_below += base && y > centre_row;
+      n.any_checker += light || dark;
+      n.any_base += base;
+    }
+  return n;
+}
+
+TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("textured", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  const auto lit = scene.dir / "materials.png";
+  const auto levels = scene.dir / "levels.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << r.output;
+  r = lod::test::run_viewer(scene, "--screenshot '" + levels.string() + "' --color-by-level --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  const HueCounts m = count_hues(img);
+  EXPECT_GE(m.light_above, 300) << "light checker squares on the textured cap";
+  EXPECT_GE(m.dark_above, 300) << "dark checker squares on the textured cap";
+  EXPECT_GE(m.base_below, 300) << "the untextured material's base colour factor below the equator";
+
+  Image by_level;
+  ASSERT_TRUE(lod::test::load_png(levels, by_level));
+  const HueCounts c = count_hues(by_level);
+  EXPECT_LE(c.any_checker, 10) << "colour-by-level must not show the texture";
+  EXPECT_LE(c.any_base, 10) << "colour-by-level must not show the material factor";
+}
+
+TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  // Bake first (the texture is not read by the bake), then break the image.
+  const auto png = scene.dir / "out.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  lod::test::write_text(scene.dir / "textured" / "globe-image0.png", "not a png");
+  r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const size_t at = r.output.find("globe-image0.png");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("globe-image0.png", at + 1), std::string::npos) << "logged more than once: " << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(png, img));
+  const HueCounts m = count_hues(img);
+  EXPECT_LE(m.any_checker, 10) << "no texture colours without the texture";
+  EXPECT_GE(m.base_below, 300) << "the rest of the model is still drawn";
+}
+
+}  // namespace
