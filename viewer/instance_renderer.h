@@ -25,6 +25,7 @@ namespace lod::viewer {
 
 struct RenderSettings {
   bool colour_by_level = false;
+  bool backdrop = true;           // sky gradient and ground plane; false: flat kBackground
   bool wireframe = false;
   bool flat_normals = false;      // face normals from screen-space derivatives
   bool count_primitives = false;  // GL_PRIMITIVES_GENERATED query around the draws (waits for the GPU)

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <set>
 
 #include "textured_fixture.h"
 #include "viewer/picture_checks.h"
@@ -127,6 +128,48 @@ TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   const HueCounts m = count_hues(img);
   EXPECT_LE(m.any_checker, 10) << "no texture colours without the texture";
   EXPECT_GE(m.base_below, 300) << "the rest of the model is still drawn";
+}
+
+}  // namespace
+
+namespace {
+
+// Sky and ground (--backdrop on): the eye is level with the globe's centre, so the rows above
+// the globe are sky, darkening towards the zenith, and the rows below the horizon are ground,
+// whose two tile shades both appear; --backdrop off keeps the flat background.
+TEST(ViewerBackdrop, SkyGradientAboveGroundTilesBelowFlatWhenOff) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("backdrop", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  const auto on = scene.dir / "backdrop.png";
+  const auto off = scene.dir / "flat.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + on.string() + "' --width 400 --height 300 --backdrop on");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = lod::test::run_viewer(scene, "--screenshot '" + off.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(on, img));
+  const int w = img.width, h = img.height;
+  const uint8_t* top = img.at(5, 0);
+  const uint8_t* near_horizon = img.at(5, h / 2 - 10);
+  EXPECT_FALSE(lod::test::is_background(top));
+  EXPECT_GT(top[2], top[0] + 40) << "the zenith is blue";
+  EXPECT_GT(int(near_horizon[0]), int(top[0]) + 30) << "the sky lightens towards the horizon";
+  // Ground: below the globe, near the bottom; two tile shades among its pixels.
+  std::set<int> shades;
+  for (int x = 0; x < w; ++x) {
+    const uint8_t* px = img.at(x, h - 3);
+    EXPECT_LT(std::abs(int(px[0]) - int(px[1])), 20) << "ground is grey-green at x " << x;
+    shades.insert(px[1] / 8);
+  }
+  EXPECT_GE(shades.size(), 2u) << "the ground shows its tiles";
+  EXPECT_LT(int(img.at(5, h - 3)[2]), int(top[2])) << "ground is not sky";
+
+  Image flat;
+  ASSERT_TRUE(lod::test::load_png(off, flat));
+  EXPECT_TRUE(lod::test::is_background(flat.at(5, 0)));
+  EXPECT_TRUE(lod::test::is_background(flat.at(5, flat.height - 3)));
 }
 
 }  // namespace
