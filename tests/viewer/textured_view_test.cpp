@@ -173,3 +173,31 @@ TEST(ViewerBackdrop, SkyGradientAboveGroundTilesBelowFlatWhenOff) {
 }
 
 }  // namespace
+
+namespace {
+
+// The statistics overlay (--overlay) at 1280 x 720: the pixels it changes against the same
+// frame without it stay under a tenth of the picture (its panels start collapsed).
+TEST(ViewerOverlay, CoversLessThanATenthOfThePicture) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("overlay", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  const auto with = scene.dir / "overlay.png";
+  const auto without = scene.dir / "plain.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + with.string() + "' --overlay --frames 3 --width 1280 --height 720");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = lod::test::run_viewer(scene, "--screenshot '" + without.string() + "' --frames 3 --width 1280 --height 720");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image a, b;
+  ASSERT_TRUE(lod::test::load_png(with, a));
+  ASSERT_TRUE(lod::test::load_png(without, b));
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  size_t changed = 0;
+  for (size_t p = 0; p < a.rgb.size(); p += 3)
+    changed += a.rgb[p] != b.rgb[p] || a.rgb[p + 1] != b.rgb[p + 1] || a.rgb[p + 2] != b.rgb[p + 2];
+  const double fraction = double(changed) / double(a.width * a.height);
+  EXPECT_GT(fraction, 0.005) << "the overlay is drawn";
+  EXPECT_LT(fraction, 0.10) << "the overlay covers " << fraction * 100 << " % of the picture";
+}
+
+}  // namespace
