@@ -75,7 +75,7 @@ GroundPlane ground_under(const ObjectSet& o) {
   const float extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-3f});
   if (!std::isfinite(extent)) return g;
   g.height = lo[1] - 0.001f * extent;  // a hair under, so resting objects do not fight it
-  g.tile = std::pow(10.f, std::floor(std::log10(extent / 2)));
+  g.tile = std::pow(10.f, std::floor(std::log10(extent / 10)));
   g.fade_distance = 4 * extent;
   return g;
 }

@@ -12,7 +12,7 @@
 namespace lod::viewer {
 
 // Where the ground lies and how it is tiled, from the scene's objects: just under the lowest
-// level-0 bounding sphere, tiles the power of ten at or under half the scene's extent.
+// level-0 bounding sphere, tiles the power of ten at or under a tenth of the scene's extent.
 struct GroundPlane {
   float height = 0;
   float tile = 1;
