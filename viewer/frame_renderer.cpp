@@ -12,7 +12,8 @@ uint64_t hlod_gpu_capacity(const HlodModels& m) { return std::max<uint64_t>(4 * 
 
 bool FrameRenderer::init(const Scene& scene, const HlodModels* hlod, std::string* message) {
   scene_ = &scene;
-  if (!instances_.init(message) || !terrain_.init(message)) return false;
+  if (!instances_.init(message) || !terrain_.init(message) || !backdrop_.init(message)) return false;
+  ground_ = ground_under(scene.objects);
   hlod_ = hlod && !hlod->empty() ? hlod : nullptr;
   if (hlod_ && !hlod_nodes_.init(*hlod_, hlod_gpu_capacity(*hlod_), message)) return false;
   meshes_.upload(scene.chains);
@@ -41,6 +42,10 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
   glDisable(GL_BLEND);
   glDisable(GL_SCISSOR_TEST);
 
+  // A terrain is the ground: then the sky only.
+  if (settings.backdrop)
+    backdrop_.draw(view_matrix(viewing), projection_matrix(viewing), viewing.eye, ground_,
+                   frame.terrain_indices.empty());
   build_draw_list(frame, meshes_.layout(), list_);
   vd_meshes_.upload(frame);
   DrawStats stats = instances_.draw(list_, meshes_, &morphs_, &vd_meshes_, view_matrix(viewing),

@@ -1,5 +1,5 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
-// clear, build the draw list, one instanced draw per (model, level, target level), then one draw per
+// clear, sky and ground (the backdrop), build the draw list, one instanced draw per (model, level, target level), then one draw per
 // view-dependent object from the active mesh the frame carries, then one per node layer or
 // boundary patch of the HLOD cuts, one per scene HLOD proxy, and the terrain's mesh.
 #pragma once
@@ -10,6 +10,7 @@
 #include "jobs/scene.h"
 #include "runtime/frame.h"
 #include "runtime/view.h"
+#include "viewer/backdrop_renderer.h"
 #include "viewer/draw_list.h"
 #include "viewer/hlod_draw_list.h"
 #include "viewer/hlod_node_buffers.h"
@@ -51,6 +52,8 @@ class FrameRenderer {
   MorphBuffers morphs_;
   VdMeshBuffers vd_meshes_;
   InstanceRenderer instances_;
+  BackdropRenderer backdrop_;
+  GroundPlane ground_;
   TerrainRenderer terrain_;
   DrawList list_;
   const HlodModels* hlod_ = nullptr;

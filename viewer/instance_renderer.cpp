@@ -24,12 +24,14 @@ layout(location = 3) in vec4 i_rotation;
 layout(location = 4) in vec2 i_morph_weight;
 layout(location = 5) in vec3 a_target_position;
 layout(location = 6) in vec3 a_target_normal;
+layout(location = 7) in vec2 a_uv;
 uniform mat4 u_view;
 uniform mat4 u_projection;
 uniform int u_blend;
 out vec3 v_position_view;
 out vec3 v_normal_view;
 out float v_morph;
+out vec2 v_uv;
 // q v q* for a unit quaternion, without building a matrix.
 vec3 rotate(vec4 q, vec3 v) {
   vec3 t = 2.0 * cross(q.xyz, v);
@@ -45,6 +47,7 @@ void main() {
   v_position_view = view_pos.xyz;
   v_normal_view = mat3(u_view) * rotate(q, n);
   v_morph = i_morph_weight.x;
+  v_uv = a_uv;
   gl_Position = u_projection * view_pos;
 }
 )";
@@ -53,7 +56,12 @@ const char* kFragmentShader = R"(#version 330 core
 in vec3 v_position_view;
 in vec3 v_normal_view;
 in float v_morph;
-uniform vec3 u_colour;
+in vec2 v_uv;
+uniform vec3 u_colour;        // a material's base colour factor (rgb) or the mode's colour
+uniform float u_alpha;        // the factor's alpha
+uniform float u_alpha_cutoff; // alpha mode MASK: fragments below are dropped; < 0 otherwise
+uniform int u_textured;
+uniform sampler2D u_texture;  // base colour, unit 0
 uniform int u_flat;
 uniform int u_show_morph;
 out vec4 o_colour;
@@ -62,9 +70,12 @@ void main() {
   vec3 n = (u_flat != 0 || dot(v_normal_view, v_normal_view) < 1e-12) ? face : normalize(v_normal_view);
   vec3 to_eye = normalize(-v_position_view);
   float lambert = abs(dot(n, to_eye));  // headlight; abs so either winding is lit
-  vec3 base = u_colour;
+  vec4 surface = vec4(u_colour, u_alpha);
+  if (u_textured != 0) surface *= texture(u_texture, v_uv);
+  if (surface.a < u_alpha_cutoff) discard;
+  vec3 base = surface.rgb;
   if (u_show_morph != 0) base = mix(base, vec3(1.0), 0.5 * clamp(1.0 - v_morph, 0.0, 1.0));
-  o_colour = vec4(base * (0.25 + 0.75 * lambert), 1.0);
+  o_colour = vec4(base * (0.25 + 0.75 * lambert), surface.a);
 }
 )";
 
@@ -83,7 +94,61 @@ void point_instance_attributes(size_t offset) {
                         at(offsetof(InstanceData, morph)));
 }
 
+// Material colours are drawn unless a mode colours the draws.
+bool draws_materials(const RenderSettings& settings) { return !settings.colour_override && !settings.colour_by_level; }
+
 }  // namespace
+
+void InstanceRenderer::set_plain_surface(const std::array<float, 3>& c) {
+  glUniform3f(u_colour_, c[0], c[1], c[2]);
+  glUniform1f(u_alpha_, 1.f);
+  glUniform1f(u_alpha_cutoff_, -1.f);
+  glUniform1i(u_textured_, 0);
+  glDisable(GL_BLEND);
+}
+
+// BLEND materials blend over what is drawn before them, in draw order (no sorting); MASK ones
+// drop the fragments below their cutoff.
+void InstanceRenderer::set_material(const GpuMaterial& m) {
+  glUniform3f(u_colour_, m.base_color[0], m.base_color[1], m.base_color[2]);
+  glUniform1f(u_alpha_, m.base_color[3]);
+  glUniform1f(u_alpha_cutoff_, m.alpha_mode == AlphaMode::mask ? m.alpha_cutoff : -1.f);
+  glUniform1i(u_textured_, m.texture ? 1 : 0);
+  if (m.texture) glBindTexture(GL_TEXTURE_2D, m.texture);
+  if (m.alpha_mode == AlphaMode::blend) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  } else {
+    glDisable(GL_BLEND);
+  }
+}
+
+// One level range: a draw per material run in material mode (when the chain has materials),
+// else one draw in the colour already set. `base_vertex` is 0 when the vertex attributes were
+// re-pointed at the level's first vertex.
+void InstanceRenderer::draw_range(const MeshBuffers& meshes, const LevelRange& r, uint32_t instances,
+                                  int32_t base_vertex, const RenderSettings& settings) {
+  auto draw = [&](uint32_t first_index, uint32_t count) {
+    glDrawElementsInstancedBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
+                                      reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)),
+                                      GLsizei(instances), base_vertex);
+  };
+  if (!draws_materials(settings) || r.run_count == 0) {
+    draw(r.first_index, r.index_count);
+    return;
+  }
+  const auto& materials = meshes.materials().materials();
+  for (uint32_t k = r.first_run; k < r.first_run + r.run_count; ++k) {
+    const MaterialRun& run = meshes.layout().runs[k];
+    if (run.material >= 0 && size_t(run.material) < materials.size()) {
+      set_material(materials[size_t(run.material)]);
+    } else {
+      set_plain_surface(kModelColour);
+    }
+    draw(run.first_index, run.index_count);
+  }
+  set_plain_surface(kModelColour);
+}
 
 InstanceRenderer::~InstanceRenderer() {
   if (query_) glDeleteQueries(1, &query_);
@@ -100,6 +165,12 @@ bool InstanceRenderer::init(std::string* message) {
   u_flat_ = glGetUniformLocation(program_, "u_flat");
   u_show_morph_ = glGetUniformLocation(program_, "u_show_morph");
   u_blend_ = glGetUniformLocation(program_, "u_blend");
+  u_alpha_ = glGetUniformLocation(program_, "u_alpha");
+  u_alpha_cutoff_ = glGetUniformLocation(program_, "u_alpha_cutoff");
+  u_textured_ = glGetUniformLocation(program_, "u_textured");
+  glUseProgram(program_);
+  glUniform1i(glGetUniformLocation(program_, "u_texture"), 0);
+  glUseProgram(0);
   glGenBuffers(1, &instance_vbo_);
   glGenQueries(1, &query_);
   return true;
@@ -115,6 +186,8 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
   glUniform1i(u_show_morph_, settings.colour_by_level ? 1 : 0);
   glUniform1i(u_blend_, 0);
+  glActiveTexture(GL_TEXTURE0);
+  set_plain_surface(kModelColour);
 
   glBindVertexArray(meshes.vao());
   glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
@@ -139,7 +212,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
     const auto& c = settings.colour_override ? settings.colour
                     : settings.colour_by_level ? level_colour(b.level)
                                                : kModelColour;
-    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    set_plain_surface(c);
     const LevelRange& r = meshes.layout().ranges[b.range];
     const int64_t stream = b.target_level != b.level && morphs ? morphs->stream(b.model, b.level, b.target_level) : -1;
     if (stream >= 0) {
@@ -150,6 +223,9 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
       glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<const void*>(own));
       glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
                             reinterpret_cast<const void*>(own + 3 * sizeof(float)));
+      glBindBuffer(GL_ARRAY_BUFFER, meshes.uv_vbo());
+      glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float),
+                            reinterpret_cast<const void*>(size_t(r.base_vertex) * 2 * sizeof(float)));
       glBindBuffer(GL_ARRAY_BUFFER, morphs->buffer());
       const size_t target = size_t(stream) * 6 * sizeof(float);
       glEnableVertexAttribArray(kAttribTargetPosition);
@@ -159,9 +235,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
       glVertexAttribPointer(kAttribTargetNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
                             reinterpret_cast<const void*>(target + 3 * sizeof(float)));
       glUniform1i(u_blend_, 1);
-      glDrawElementsInstanced(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,
-                              reinterpret_cast<const void*>(size_t(r.first_index) * sizeof(uint32_t)),
-                              GLsizei(b.instance_count));
+      draw_range(meshes, r, b.instance_count, 0, settings);
       glUniform1i(u_blend_, 0);
       glDisableVertexAttribArray(kAttribTargetPosition);
       glDisableVertexAttribArray(kAttribTargetNormal);
@@ -169,12 +243,12 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
       glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
       glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
                             reinterpret_cast<const void*>(3 * sizeof(float)));
+      glBindBuffer(GL_ARRAY_BUFFER, meshes.uv_vbo());
+      glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
       glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
       ++stats.morph_draws;
     } else {
-      glDrawElementsInstancedBaseVertex(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,
-                                        reinterpret_cast<const void*>(size_t(r.first_index) * sizeof(uint32_t)),
-                                        GLsizei(b.instance_count), r.base_vertex);
+      draw_range(meshes, r, b.instance_count, r.base_vertex, settings);
     }
     ++stats.draws;
     stats.instances += b.instance_count;
@@ -186,10 +260,11 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
     // set below are the transform; a zero normal makes the shader use face normals.
     glBindVertexArray(vd->vao());
     glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);
+    glVertexAttrib2f(kAttribUv, 0.f, 0.f);
     const auto& c = settings.colour_override ? settings.colour
                     : settings.colour_by_level ? kViewDependentColour
                                                : kModelColour;
-    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    set_plain_surface(c);
     for (const VdDraw& d : list.vd) {
       glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
       glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
@@ -226,6 +301,8 @@ void InstanceRenderer::begin_mesh_draws(const glm::mat4& view, const glm::mat4& 
   glUniform1i(u_blend_, 0);
   glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
   glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // meshes without normals: face normals
+  glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  set_plain_surface(kModelColour);
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
 }
 
@@ -259,7 +336,7 @@ void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers
     const auto& c = settings.colour_override ? settings.colour
                     : settings.colour_by_level ? level_colour(d.depth)
                                                : kModelColour;
-    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    set_plain_surface(c);
     glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(r->index_count), GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(size_t(r->first_index) * sizeof(uint32_t)),
                              GLint(r->first_vertex));
@@ -284,7 +361,7 @@ void InstanceRenderer::draw_proxies(const ProxyDrawList& list, const SceneProxyB
     const auto& c = settings.colour_override ? settings.colour
                     : settings.colour_by_level ? level_colour(d.depth)
                                                : kModelColour;
-    glUniform3f(u_colour_, c[0], c[1], c[2]);
+    set_plain_surface(c);
     glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(d.index_count), GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(size_t(d.first_index) * sizeof(uint32_t)),
                              GLint(d.first_vertex));

@@ -2,6 +2,8 @@
 // batch; per-instance position, scale, rotation quaternion, geomorph factor and blend weight are vertex
 // attributes with divisor 1. A blended batch adds the composed morph-target stream of its
 // (level, target level) pair as a second vertex stream. Lighting is a headlight Lambert term.
+// Unless a mode colours the draws (colour-by-level, an override colour), each level is drawn
+// run by run with its materials: base colour factor x base colour texture.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -23,6 +25,7 @@ namespace lod::viewer {
 
 struct RenderSettings {
   bool colour_by_level = false;
+  bool backdrop = true;           // sky gradient and ground plane; false: flat kBackground
   bool wireframe = false;
   bool flat_normals = false;      // face normals from screen-space derivatives
   bool count_primitives = false;  // GL_PRIMITIVES_GENERATED query around the draws (waits for the GPU)
@@ -73,12 +76,17 @@ class InstanceRenderer {
   // Program state shared by the HLOD and proxy draws; starts the primitive query if asked.
   void begin_mesh_draws(const glm::mat4& view, const glm::mat4& projection, const RenderSettings& settings);
   void end_mesh_draws(const RenderSettings& settings, DrawStats& stats);
+  void set_plain_surface(const std::array<float, 3>& colour);
+  void set_material(const GpuMaterial& material);
+  void draw_range(const MeshBuffers& meshes, const LevelRange& r, uint32_t instances, int32_t base_vertex,
+                  const RenderSettings& settings);
 
   GLuint program_ = 0;
   GLuint instance_vbo_ = 0;
   GLuint query_ = 0;
   size_t instance_capacity_ = 0;
   GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1, u_blend_ = -1;
+  GLint u_alpha_ = -1, u_alpha_cutoff_ = -1, u_textured_ = -1;
 };
 
 }  // namespace lod::viewer

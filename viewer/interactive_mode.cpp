@@ -65,6 +65,9 @@ void apply_keys(const std::vector<int>& keys, ViewerControls& controls) {
       case GLFW_KEY_Z:
         controls.wireframe = !controls.wireframe;
         break;
+      case GLFW_KEY_B:
+        controls.backdrop = !controls.backdrop;
+        break;
       case GLFW_KEY_C:
         controls.colour_by_level = !controls.colour_by_level;
         break;
@@ -120,6 +123,7 @@ int run_interactive(ViewerSession& s) {
   ViewerControls controls;
   controls.colour_by_level = o.colour_by_level;
   controls.wireframe = o.wireframe;
+  controls.backdrop = o.backdrop;
   controls.budget = s.graph.selection.budget;
   CameraMode last_mode = controls.mode;
   FlyCamera fly;
@@ -236,6 +240,7 @@ int run_interactive(ViewerSession& s) {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     settings.colour_by_level = controls.colour_by_level;
     settings.wireframe = controls.wireframe;
+    settings.backdrop = controls.backdrop;
     settings.flat_normals = controls.flat_normals;
     const DrawStats drawn = s.renderer.render(frame, viewing, settings);
     if (controls.freeze_lod || controls.mode == CameraMode::overhead) {

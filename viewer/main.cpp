@@ -3,6 +3,7 @@
 // Exit codes: 0 done; 1 bad command line, config, assets or output file; 2 no display, no
 // OpenGL 3.3, or the GL refused a resource.
 #include <chrono>
+#include <map>
 #include <cstdio>
 #include <thread>
 
@@ -106,6 +107,9 @@ int main(int argc, char** argv) {
   app.add_option("--lod-delay-ms", o.lod_delay_ms, "slow the LOD thread down: sleep this long in every LOD frame");
   app.add_option("--stats", o.stats, "write one CSV row per viewer frame");
   app.add_flag("--color-by-level,--colour-by-level", o.colour_by_level, "colour objects by their chain level");
+  app.add_option("--backdrop", o.backdrop, "sky gradient and ground plane: on (default) or off (flat background)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_flag("--wireframe", o.wireframe, "draw triangle edges only");
   app.add_flag("--bird-eye", o.bird_eye, "look from above the scene at what the path camera's LOD frames select");
   app.add_flag("--overlay", o.overlay, "screenshot: draw the statistics overlay too");

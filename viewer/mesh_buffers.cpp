@@ -41,6 +41,7 @@ void release_static_mesh(StaticMeshGl& gl) {
 MeshBuffers::~MeshBuffers() {
   if (ibo_) glDeleteBuffers(1, &ibo_);
   if (vbo_) glDeleteBuffers(1, &vbo_);
+  if (uv_vbo_) glDeleteBuffers(1, &uv_vbo_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
 
@@ -49,6 +50,8 @@ void MeshBuffers::upload(std::span<const LodChain> chains) {
   std::vector<float> vertices;
   std::vector<uint32_t> indices;
   pack_vertices(chains, vertices, indices);
+  std::vector<float> uvs;
+  pack_uvs(chains, uvs);
 
   glGenVertexArrays(1, &vao_);
   glGenBuffers(1, &vbo_);
@@ -61,13 +64,19 @@ void MeshBuffers::upload(std::span<const LodChain> chains) {
   glEnableVertexAttribArray(kAttribNormal);
   glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
                         reinterpret_cast<const void*>(3 * sizeof(float)));
+  glGenBuffers(1, &uv_vbo_);
+  glBindBuffer(GL_ARRAY_BUFFER, uv_vbo_);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(uvs.size() * sizeof(float)), uvs.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(kAttribUv);
+  glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
   // The element buffer binding is VAO state: bound while the VAO is.
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data(),
                GL_STATIC_DRAW);
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
-  bytes_ = vertices.size() * sizeof(float) + indices.size() * sizeof(uint32_t);
+  materials_.upload(chains);
+  bytes_ = (vertices.size() + uvs.size()) * sizeof(float) + indices.size() * sizeof(uint32_t) + materials_.bytes();
 }
 
 }  // namespace lod::viewer

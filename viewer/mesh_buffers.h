@@ -1,11 +1,13 @@
-// MeshBuffers: every level of every model uploaded once into one VBO (position + normal) and
-// one IBO, with a VAO whose instance attributes the instance renderer fills per draw.
+// MeshBuffers: every level of every model uploaded once into one VBO (position + normal), a
+// second VBO of texture coordinates and one IBO, with a VAO whose instance attributes the
+// instance renderer fills per draw; and the chains' materials with their textures.
 #pragma once
 #include <span>
 
 #include <epoxy/gl.h>
 
 #include "runtime/lod_chain.h"
+#include "viewer/material_textures.h"
 #include "viewer/mesh_layout.h"
 
 namespace lod::viewer {
@@ -18,6 +20,7 @@ inline constexpr GLuint kAttribInstanceRotation = 3;       // InstanceData::rota
 inline constexpr GLuint kAttribInstanceMorph = 4;          // InstanceData morph, blend weight
 inline constexpr GLuint kAttribTargetPosition = 5;         // morph target stream (MorphBuffers)
 inline constexpr GLuint kAttribTargetNormal = 6;
+inline constexpr GLuint kAttribUv = 7;
 
 // A static mesh in its own VAO: positions then normals (when `normals` is not empty) in one
 // VBO, indices in an IBO; the per-object attributes stay disabled, so the instance shader reads
@@ -41,11 +44,14 @@ class MeshBuffers {
   const MeshLayout& layout() const { return layout_; }
   GLuint vao() const { return vao_; }
   GLuint vbo() const { return vbo_; }  // position + normal, 6 floats per vertex
+  GLuint uv_vbo() const { return uv_vbo_; }  // uv, 2 floats per vertex
+  const MaterialTextures& materials() const { return materials_; }
   size_t bytes() const { return bytes_; }
 
  private:
   MeshLayout layout_;
-  GLuint vao_ = 0, vbo_ = 0, ibo_ = 0;
+  MaterialTextures materials_;
+  GLuint vao_ = 0, vbo_ = 0, uv_vbo_ = 0, ibo_ = 0;
   size_t bytes_ = 0;
 };
 

@@ -71,27 +71,16 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.8f);
   ImGui::Begin("lod-viewer", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::Text("%.1f fps  (%.2f ms per viewer frame)", f.viewer_ms > 0 ? 1000.0 / f.viewer_ms : 0.0, f.viewer_ms);
-  ImGui::TextDisabled("%s", f.gl.c_str());
-  ImGui::Text("LOD thread: %u threads, %llu frames, %.2f ms mean, %llu errors", f.threads,
-              (unsigned long long)f.service.frames, f.service.mean_ms, (unsigned long long)f.service.errors);
+  // Headline figures always; stage times, graphs and controls in sections that start closed,
+  // so the window stays a small corner of the picture.
+  ImGui::Text("%.1f fps  %.2f ms  |  LOD %.2f ms", f.viewer_ms > 0 ? 1000.0 / f.viewer_ms : 0.0, f.viewer_ms,
+              f.frame ? f.frame->total_ms : 0.0);
 
   if (const Frame* fr = f.frame) {
-    ImGui::Separator();
-    ImGui::Text("LOD frame %llu: %.3f ms", (unsigned long long)fr->index, fr->total_ms);
-    if (ImGui::BeginTable("stages", 4, ImGuiTableFlags_SizingFixedFit)) {
-      for (size_t s = 0; s < kStageCount; ++s) {
-        ImGui::TableNextColumn();
-        ImGui::Text("%s", kStageNames[s]);
-        ImGui::TableNextColumn();
-        ImGui::Text("%7.3f ms", fr->stage_ms[s]);
-      }
-      ImGui::EndTable();
-    }
-    ImGui::Text("visible      %s / %s objects", thousands(fr->visible).c_str(), thousands(f.objects).c_str());
-    ImGui::Text("tris in view %s", thousands(fr->tris_in_view).c_str());
-    ImGui::Text("selected     %s", thousands(f.selected).c_str());
-    ImGui::Text("drawn        %s  (%u draws)", thousands(f.drawn.triangles).c_str(), f.drawn.draws);
+    ImGui::Text("visible %s / %s  in view %s tris", thousands(fr->visible).c_str(), thousands(f.objects).c_str(),
+                thousands(fr->tris_in_view).c_str());
+    ImGui::Text("selected %s  drawn %s (%u draws)", thousands(f.selected).c_str(),
+                thousands(f.drawn.triangles).c_str(), f.drawn.draws);
     // Both figures count view-dependent objects at their active mesh, not their level.
     if (!fr->vd_objects.empty())
       ImGui::Text("view-dep.    %u objects, %s active tris drawn", f.drawn.vd_draws,
@@ -99,7 +88,7 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
     // Objects blending between two levels are drawn at the finer one until they settle.
     if (fr->morphing)
       ImGui::Text("morphing     %u objects, +%s tris drawn", fr->morphing, thousands(fr->tris_morph_extra).c_str());
-    ImGui::Text("budget M     %s%s", thousands(fr->budget).c_str(), fr->over_budget ? "  (over: coarsest levels)" : "");
+    ImGui::Text("budget M %s%s", thousands(fr->budget).c_str(), fr->over_budget ? "  (over: coarsest levels)" : "");
     if (!fr->scene_proxies.empty())
       ImGui::Text("proxies      %zu drawn for %s objects, %s tris", fr->scene_proxies.size(),
                   thousands(fr->scene_proxy_objects).c_str(), thousands(f.drawn.proxy_triangles).c_str());
@@ -109,6 +98,27 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
                   thousands(f.drawn.hlod_triangles).c_str(), double(fr->resident_bytes) / (1 << 20),
                   double(fr->stream_budget) / (1 << 20), (unsigned long long)fr->stream_loads, fr->holes);
 
+    if (ImGui::CollapsingHeader("LOD stages")) {
+      ImGui::TextDisabled("%s", f.gl.c_str());
+      ImGui::Text("LOD thread: %u threads, %llu frames, %.2f ms mean, %llu errors", f.threads,
+                  (unsigned long long)f.service.frames, f.service.mean_ms, (unsigned long long)f.service.errors);
+      ImGui::Text("LOD frame %llu: %.3f ms", (unsigned long long)fr->index, fr->total_ms);
+      if (ImGui::BeginTable("stages", 4, ImGuiTableFlags_SizingFixedFit)) {
+        for (size_t s = 0; s < kStageCount; ++s) {
+          ImGui::TableNextColumn();
+          ImGui::Text("%s", kStageNames[s]);
+          ImGui::TableNextColumn();
+          ImGui::Text("%7.3f ms", fr->stage_ms[s]);
+        }
+        ImGui::EndTable();
+      }
+    }
+  } else {
+    ImGui::Text("waiting for the first LOD frame");
+  }
+
+  const bool graphs = ImGui::CollapsingHeader("graphs");
+  if (const Frame* fr = f.frame; fr && graphs) {
     // Level histogram over R0's l = round(log2 tris): only the occupied span.
     size_t lo = kHistogramLevels, hi = 0;
     for (size_t l = 0; l < kHistogramLevels; ++l)
@@ -119,12 +129,9 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
       std::snprintf(label, sizeof label, "objects per l\n(l = %zu..%zu)", lo, hi);
       ImGui::PlotHistogram(label, plot_.data(), int(plot_.size()), 0, nullptr, 0.f, FLT_MAX, ImVec2(260, 60));
     }
-  } else {
-    ImGui::Text("waiting for the first LOD frame");
   }
 
-  if (history_.size() > 1) {
-    ImGui::Separator();
+  if (graphs && history_.size() > 1) {
     auto plot = [&](const char* label, float Sample::*field, const char* unit) {
       plot_.clear();
       float top = 0;
@@ -138,8 +145,7 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
     plot("selected k", &Sample::selected_k, "k tris");
   }
 
-  if (with_controls) {
-    ImGui::Separator();
+  if (with_controls && ImGui::CollapsingHeader("controls")) {
     int mode = int(c.mode);
     ImGui::Text("camera");
     for (int m = 0; m < kCameraModeCount; ++m) {
@@ -155,6 +161,8 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
     ImGui::Checkbox("colour by level [C]", &c.colour_by_level);
     ImGui::SameLine();
     ImGui::Checkbox("flat [F]", &c.flat_normals);
+    ImGui::SameLine();
+    ImGui::Checkbox("sky, ground [B]", &c.backdrop);
     uint64_t budget = c.budget;
     const uint64_t lo = 1000, hi = 100000000;
     if (ImGui::SliderScalar("budget M [ ]", ImGuiDataType_U64, &budget, &lo, &hi, "%llu",
@@ -162,6 +170,7 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
       c.budget = budget;
       c.budget_changed = true;
     }
+    ImGui::TextDisabled("1/2/3/4 path/fly/orbit/bird's-eye, WASD QE + right mouse,\nwheel, H hides, Esc quits");
   }
   if (c.colour_by_level) {
     ImGui::Text("level");
@@ -171,8 +180,7 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
       ImGui::TextColored(ImVec4(col[0], col[1], col[2], 1), "%zu", l);
     }
   }
-  if (with_controls)
-    ImGui::TextDisabled("1/2/3/4 path/fly/orbit/bird's-eye, WASD QE + right mouse, wheel, H hides, Esc quits");
+  if (with_controls) ImGui::TextDisabled("H hides, Esc quits");
   ImGui::End();
 
   ImGui::Render();

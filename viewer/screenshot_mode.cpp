@@ -68,11 +68,13 @@ int run_screenshot(ViewerSession& s) {
   RenderSettings settings;
   settings.colour_by_level = o.colour_by_level;
   settings.wireframe = o.wireframe;
+  settings.backdrop = o.backdrop;
   settings.count_primitives = true;  // every drawn frame is checked against the GL's own count
 
   ViewerControls controls;  // the overlay shows them; nothing reads them back here
   controls.colour_by_level = o.colour_by_level;
   controls.wireframe = o.wireframe;
+  controls.backdrop = o.backdrop;
   controls.budget = s.graph.selection.budget;
   controls.mode = o.bird_eye ? CameraMode::overhead : CameraMode::path;
 

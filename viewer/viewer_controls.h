@@ -15,6 +15,7 @@ struct ViewerControls {
   bool paused = false;          // camera path stops advancing
   bool wireframe = false;
   bool colour_by_level = false;
+  bool backdrop = true;         // sky and ground
   bool flat_normals = false;
   bool freeze_lod = false;      // the LOD camera stays where it was; the viewing camera moves on
   bool show_overlay = true;

@@ -33,6 +33,7 @@ struct ViewerOptions {
   double lod_rate_hz = -1;           // -1 = the config's rate_hz
   double lod_delay_ms = 0;           // sleep added to every LOD frame (measuring that the viewer never waits)
   bool colour_by_level = false;
+  bool backdrop = true;              // sky gradient and ground plane (--backdrop off: flat colour)
   bool wireframe = false;
   bool bird_eye = false;             // draw from above the scene; the LOD camera still follows the path
   bool overlay = false;              // screenshot: draw the overlay too (interactive always has it)

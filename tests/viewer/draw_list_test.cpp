@@ -86,6 +86,50 @@ TEST(MeshLayout, OffsetsAddEachChainsBases) {
   EXPECT_EQ(vertices[6 * 20 + 4], 1.f);
 }
 
+// Chain 0 without materials; chain 1 with two materials, level 0 split into runs of 3 and 2
+// triangles, level 1 one run of the default material, level 2 one run of material 1.
+TEST(MeshLayout, MaterialRunsSitInTheSharedIndexBufferWithSceneWideMaterials) {
+  std::vector<LodChain> chains = {chain_with_levels({4, 2}), chain_with_levels({5, 3, 1})};
+  LodChain& c = chains[1];
+  c.materials.resize(2);
+  c.submeshes = {{0, 0, 9, 1}, {0, 9, 6, 0}, {1, 0, 9, -1}, {2, 0, 3, 1}};
+  c.uvs.assign(2 * (c.positions.size() / 3), 0.5f);
+  const MeshLayout m = layout_meshes(chains);
+  EXPECT_EQ(m.first_material, (std::vector<uint32_t>{0, 0}));
+  EXPECT_EQ(m.material_count, 2u);
+  EXPECT_EQ(m.ranges[0].run_count, 0u);
+  EXPECT_EQ(m.ranges[1].run_count, 0u);
+  ASSERT_EQ(m.ranges[2].run_count, 2u);
+  ASSERT_EQ(m.runs.size(), 4u);
+  const MaterialRun& second = m.runs[m.ranges[2].first_run + 1];
+  EXPECT_EQ(second.first_index, 18u + 9u);
+  EXPECT_EQ(second.index_count, 6u);
+  EXPECT_EQ(second.material, 0);
+  EXPECT_EQ(m.runs[m.ranges[3].first_run].material, -1);
+  EXPECT_EQ(m.runs[m.ranges[4].first_run].first_index, 18u + 24u);
+  EXPECT_EQ(m.runs[m.ranges[4].first_run].material, 1);
+
+  // A third chain's materials come after chain 1's.
+  chains.push_back(chains[1]);
+  EXPECT_EQ(layout_meshes(chains).first_material, (std::vector<uint32_t>{0, 0, 2}));
+
+  std::vector<float> uvs;
+  pack_uvs(chains, uvs);
+  ASSERT_EQ(uvs.size(), 2 * (18u + 27u + 27u));
+  EXPECT_EQ(uvs[0], 0.f);             // chain 0 has none: zeros
+  EXPECT_EQ(uvs[2 * 18], 0.5f);       // chain 1's first vertex
+}
+
+// A run reaching past its level (an unvalidated chain) is dropped, not drawn from the next level.
+TEST(MeshLayout, RunPastItsLevelIsDropped) {
+  std::vector<LodChain> chains = {chain_with_levels({2, 1})};
+  chains[0].materials.resize(1);
+  chains[0].submeshes = {{0, 0, 3, 0}, {0, 3, 9, 0}, {1, 0, 3, 0}};
+  const MeshLayout m = layout_meshes(chains);
+  EXPECT_EQ(m.ranges[0].run_count, 1u);
+  EXPECT_EQ(m.ranges[1].run_count, 1u);
+}
+
 TEST(MeshLayout, ChainWithoutNormalsGetsZeroNormals) {
   LodChain c = chain_with_levels({1});
   c.normals.clear();

@@ -80,7 +80,7 @@ RunResult run_viewer(const ViewerScene& scene, const std::string& args, bool und
   std::filesystem::remove(rc);
   std::ostringstream viewer;
   viewer << env_prefix << " '" << LOD_VIEWER_BINARY << "' --config '" << scene.config.string() << "' --cache '"
-         << (scene.dir / "cache").string() << "' " << args << " > '" << log.string() << "' 2>&1; echo $? > '"
+         << (scene.dir / "cache").string() << "' --backdrop off " << args << " > '" << log.string() << "' 2>&1; echo $? > '"
          << rc.string() << "'";
   // The viewer's own exit code goes through a file: xvfb-run's can differ (it reports its
   // own clean-up trouble).

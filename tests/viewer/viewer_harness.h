@@ -29,7 +29,8 @@ struct RunResult {
 
 bool have_xvfb();
 // Runs lod-viewer with `args`, under `xvfb-run -a` when `headless`. The bake cache is the
-// scene's own folder.
+// scene's own folder. Pictures are checked against the flat background colour, so the run
+// starts with `--backdrop off`; a test that wants sky and ground passes `--backdrop on`.
 RunResult run_viewer(const ViewerScene& scene, const std::string& args, bool under_xvfb = true,
                      const std::string& env_prefix = "");
 

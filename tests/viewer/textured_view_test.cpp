@@ -1,0 +1,203 @@
+// lod-viewer --screenshot of a textured, two-material glTF sphere (tests/textured_fixture.h):
+// with materials (the default) its upper half shows both colours of the checker texture and
+// its lower half the second material's red factor; with --color-by-level none of them.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <set>
+
+#include "textured_fixture.h"
+#include "viewer/picture_checks.h"
+#include "viewer/viewer_harness.h"
+
+namespace {
+
+using lod::test::Image;
+
+const char* kRun = "[run]\nframes = 1\nthreads = 1\n[budget]\ntriangles = 1000000\n";
+
+const char* kCamera = R"([camera]
+fov_deg = 60
+width = 400
+height = 300
+path = "keyframes"
+near = 0.5
+far = 500.0
+[[camera.keyframe]]
+frame = 0
+position = [0.0, 0.0, 30.0]
+look_at = [0.0, 0.0, 0.0]
+)";
+
+const char* kModel = R"([[model]]
+name = "textured"
+file = "textured/globe.gltf"
+ratios = [1.0, 0.5]
+)";
+
+const char* kInstance = R"([[instances]]
+model = "textured"
+count = 1
+placement = "grid"
+box_min = [0.0, 0.0, 0.0]
+box_max = [0.0, 0.0, 0.0]
+scale = 9.0
+)";
+
+// The fixture's checker colours (0..255) and the second material's base colour factor.
+constexpr std::array<float, 3> kCheckerLight = {230, 200, 60};
+constexpr std::array<float, 3> kCheckerDark = {40, 90, 160};
+constexpr std::array<float, 3> kBaseFactor = {0.8f, 0.2f, 0.1f};
+
+// Shading scales every channel alike: compare hues after dividing by the largest channel.
+// Dim pixels (largest channel < 60) are left out, their rounding blurs the hue.
+bool same_hue(const uint8_t* px, std::array<float, 3> c) {
+  const float pm = float(std::max({px[0], px[1], px[2]}));
+  const float cm = std::max({c[0], c[1], c[2]});
+  if (pm < 60) return false;
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(float(px[k]) / pm - c[size_t(k)] / cm) > 0.06f) return false;
+  return true;
+}
+
+struct HueCounts {
+  int light_above = 0, dark_above = 0, base_below = 0, any_checker = 0, any_base = 0;
+};
+
+HueCounts count_hues(const Image& img) {
+  HueCounts n;
+  const int centre_row = lod::test::project({0, 0, 0}, img.width, img.height)[1];
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* px = img.at(x, y);
+      const bool light = same_hue(px, kCheckerLight), dark = same_hue(px, kCheckerDark);
+      const bool base = same_hue(px, kBaseFactor);
+      n.light_above += light && y < centre_row;
+      n.dark_above += dark && y < centre_row;
+      n.base_below += base && y > centre_row;
+      n.any_checker += light || dark;
+      n.any_base += base;
+    }
+  return n;
+}
+
+TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("textured", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  const auto lit = scene.dir / "materials.png";
+  const auto levels = scene.dir / "levels.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << r.output;
+  r = lod::test::run_viewer(scene, "--screenshot '" + levels.string() + "' --color-by-level --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  const HueCounts m = count_hues(img);
+  EXPECT_GE(m.light_above, 300) << "light checker squares on the textured cap";
+  EXPECT_GE(m.dark_above, 300) << "dark checker squares on the textured cap";
+  EXPECT_GE(m.base_below, 300) << "the untextured material's base colour factor below the equator";
+
+  Image by_level;
+  ASSERT_TRUE(lod::test::load_png(levels, by_level));
+  const HueCounts c = count_hues(by_level);
+  EXPECT_LE(c.any_checker, 10) << "colour-by-level must not show the texture";
+  EXPECT_LE(c.any_base, 10) << "colour-by-level must not show the material factor";
+}
+
+TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  // Bake first (the texture is not read by the bake), then break the image.
+  const auto png = scene.dir / "out.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  lod::test::write_text(scene.dir / "textured" / "globe-image0.png", "not a png");
+  r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const size_t at = r.output.find("globe-image0.png");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("globe-image0.png", at + 1), std::string::npos) << "logged more than once: " << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(png, img));
+  const HueCounts m = count_hues(img);
+  EXPECT_LE(m.any_checker, 10) << "no texture colours without the texture";
+  EXPECT_GE(m.base_below, 300) << "the rest of the model is still drawn";
+}
+
+}  // namespace
+
+namespace {
+
+// Sky and ground (--backdrop on): the eye is level with the globe's centre, so the rows above
+// the globe are sky, darkening towards the zenith, and the rows below the horizon are ground,
+// whose two tile shades both appear; --backdrop off keeps the flat background.
+TEST(ViewerBackdrop, SkyGradientAboveGroundTilesBelowFlatWhenOff) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("backdrop", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  const auto on = scene.dir / "backdrop.png";
+  const auto off = scene.dir / "flat.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + on.string() + "' --width 400 --height 300 --backdrop on");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = lod::test::run_viewer(scene, "--screenshot '" + off.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(on, img));
+  const int w = img.width, h = img.height;
+  const uint8_t* top = img.at(5, 0);
+  const uint8_t* near_horizon = img.at(5, h / 2 - 10);
+  EXPECT_FALSE(lod::test::is_background(top));
+  EXPECT_GT(top[2], top[0] + 40) << "the zenith is blue";
+  EXPECT_GT(int(near_horizon[0]), int(top[0]) + 30) << "the sky lightens towards the horizon";
+  // Ground: below the globe, near the bottom; two tile shades among its pixels.
+  std::set<int> shades;
+  for (int x = 0; x < w; ++x) {
+    const uint8_t* px = img.at(x, h - 3);
+    EXPECT_LT(std::abs(int(px[0]) - int(px[1])), 20) << "ground is grey-green at x " << x;
+    shades.insert(px[1] / 8);
+  }
+  EXPECT_GE(shades.size(), 2u) << "the ground shows its tiles";
+  EXPECT_LT(int(img.at(5, h - 3)[2]), int(top[2])) << "ground is not sky";
+
+  Image flat;
+  ASSERT_TRUE(lod::test::load_png(off, flat));
+  EXPECT_TRUE(lod::test::is_background(flat.at(5, 0)));
+  EXPECT_TRUE(lod::test::is_background(flat.at(5, flat.height - 3)));
+}
+
+}  // namespace
+
+namespace {
+
+// The statistics overlay (--overlay) at 1280 x 720: the pixels it changes against the same
+// frame without it stay under a tenth of the picture (its panels start collapsed).
+TEST(ViewerOverlay, CoversLessThanATenthOfThePicture) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("overlay", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  const auto with = scene.dir / "overlay.png";
+  const auto without = scene.dir / "plain.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + with.string() + "' --overlay --frames 3 --width 1280 --height 720");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = lod::test::run_viewer(scene, "--screenshot '" + without.string() + "' --frames 3 --width 1280 --height 720");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image a, b;
+  ASSERT_TRUE(lod::test::load_png(with, a));
+  ASSERT_TRUE(lod::test::load_png(without, b));
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  size_t changed = 0;
+  for (size_t p = 0; p < a.rgb.size(); p += 3)
+    changed += a.rgb[p] != b.rgb[p] || a.rgb[p + 1] != b.rgb[p + 1] || a.rgb[p + 2] != b.rgb[p + 2];
+  const double fraction = double(changed) / double(a.width * a.height);
+  EXPECT_GT(fraction, 0.005) << "the overlay is drawn";
+  EXPECT_LT(fraction, 0.10) << "the overlay covers " << fraction * 100 << " % of the picture";
+}
+
+}  // namespace

@@ -1,0 +1,94 @@
+#include "viewer/material_textures.h"
+
+#include <cstdio>
+#include <map>
+
+#include <stb_image.h>  // Debian's libstb.so holds the implementation
+
+#include "preprocess/texture_uri.h"
+
+namespace lod::viewer {
+
+namespace {
+
+// RGBA8 pixels of `file`, or empty with the reason in `why`; the size is checked from the
+// header before anything is decoded.
+std::vector<unsigned char> decode_image(const std::string& file, int& width, int& height, std::string& why) {
+  int channels = 0;
+  if (!stbi_info(file.c_str(), &width, &height, &channels)) {
+    why = stbi_failure_reason() ? stbi_failure_reason() : "not an image stb_image reads";
+    return {};
+  }
+  if (width <= 0 || height <= 0 || width > kMaxTextureSide || height > kMaxTextureSide) {
+    why = std::to_string(width) + " x " + std::to_string(height) + " pixels, more than " +
+          std::to_string(kMaxTextureSide) + " on a side";
+    return {};
+  }
+  unsigned char* pixels = stbi_load(file.c_str(), &width, &height, &channels, 4);
+  if (!pixels) {
+    why = stbi_failure_reason() ? stbi_failure_reason() : "decoding failed";
+    return {};
+  }
+  std::vector<unsigned char> out(pixels, pixels + size_t(width) * size_t(height) * 4);
+  stbi_image_free(pixels);
+  return out;
+}
+
+// A mipmapped, repeating RGBA8 texture. The image's rows go up as stored: glTF's uv origin is
+// the image's top left, which is where GL's t = 0 row (the first uploaded) sits.
+GLuint make_texture(const std::vector<unsigned char>& rgba, int width, int height) {
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_2D, t);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  return t;
+}
+
+}  // namespace
+
+MaterialTextures::~MaterialTextures() {
+  if (!textures_.empty()) glDeleteTextures(GLsizei(textures_.size()), textures_.data());
+}
+
+void MaterialTextures::upload(std::span<const LodChain> chains) {
+  std::map<std::string, GLuint> by_file;  // decoded once per file; 0 = could not be read
+  for (const LodChain& chain : chains) {
+    for (const ChainMaterial& m : chain.materials) {
+      GpuMaterial g;
+      std::copy(m.base_color, m.base_color + 4, g.base_color);
+      g.alpha_mode = m.alpha_mode;
+      g.alpha_cutoff = m.alpha_cutoff;
+      if (!m.base_color_texture.empty()) {
+        const std::string file = texture_file(chain.texture_base, m.base_color_texture).string();
+        if (file.empty()) {
+          std::fprintf(stderr, "lod-viewer: %s: material '%s' texture '%s' is not a file (data URI or URL); drawn without it\n",
+                       chain.name.c_str(), m.name.c_str(), m.base_color_texture.c_str());
+        } else if (auto it = by_file.find(file); it != by_file.end()) {
+          g.texture = it->second;
+        } else {
+          int w = 0, h = 0;
+          std::string why;
+          const std::vector<unsigned char> rgba = decode_image(file, w, h, why);
+          if (rgba.empty()) {
+            std::fprintf(stderr, "lod-viewer: texture %s: %s; drawn without it\n", file.c_str(), why.c_str());
+          } else {
+            g.texture = make_texture(rgba, w, h);
+            textures_.push_back(g.texture);
+            bytes_ += rgba.size() * 4 / 3;  // with its mipmaps
+          }
+          by_file[file] = g.texture;
+        }
+      }
+      materials_.push_back(g);
+    }
+  }
+}
+
+}  // namespace lod::viewer

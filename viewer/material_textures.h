@@ -1,0 +1,48 @@
+// MaterialTextures: every chain's materials as the shader needs them, scene-wide in
+// MeshLayout::first_material order; each base colour image is decoded once (stb_image), however
+// many materials name it, into one mipmapped GL texture.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+#include "runtime/lod_chain.h"
+
+namespace lod::viewer {
+
+// Images wider or taller than this are refused (drawn without texture), so a hostile or huge
+// file cannot ask for gigabytes of decoded pixels.
+inline constexpr int kMaxTextureSide = 8192;
+
+struct GpuMaterial {
+  float base_color[4] = {1, 1, 1, 1};
+  GLuint texture = 0;  // 0 = no base colour texture (or it could not be read)
+  AlphaMode alpha_mode = AlphaMode::opaque;
+  float alpha_cutoff = 0.5f;
+};
+
+class MaterialTextures {
+ public:
+  MaterialTextures() = default;
+  ~MaterialTextures();
+  MaterialTextures(const MaterialTextures&) = delete;
+  MaterialTextures& operator=(const MaterialTextures&) = delete;
+
+  // Reads every chain's base colour images; an unreadable one is logged once on stderr
+  // (naming the file and why) and its materials draw with their factor only.
+  void upload(std::span<const LodChain> chains);
+
+  const std::vector<GpuMaterial>& materials() const { return materials_; }
+  size_t texture_count() const { return textures_.size(); }
+  size_t bytes() const { return bytes_; }
+
+ private:
+  std::vector<GpuMaterial> materials_;
+  std::vector<GLuint> textures_;
+  size_t bytes_ = 0;
+};
+
+}  // namespace lod::viewer
