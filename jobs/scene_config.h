@@ -58,8 +58,8 @@ struct InstanceConfig {
 
 // [[terrain]] (at most one): a height field drawn by ROAM within the same budget (issue 15).
 struct TerrainConfig {
-  std::filesystem::path file;  // file: "x y z" text (preprocess/height_field_io.h), found like meshes
-  GridCoordinates coordinates = GridCoordinates::metres;  // coordinates = "metres" | "lon_lat" | "lat_lon"
+  std::filesystem::path file;  // file: "x y z" text, PNG or a GDAL raster (preprocess/height_field_read.h), found like meshes
+  GridCoordinates coordinates = GridCoordinates::metres;  // coordinates = "metres" | "lon_lat" | "lat_lon" (text; rasters carry theirs)
   float cell_size[2] = {0, 0};  // cell_size = m or [mx, my]: metres between samples; 0 = from the file
   float vertical_scale = 1;     // vertical_scale: world height = elevation * this
   double no_data = std::numeric_limits<double>::quiet_NaN();  // no_data: elevation meaning "none"

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "preprocess/height_field_io.h"
+#include "preprocess/height_field_read.h"
 #include "runtime/height_field.h"
 
 namespace lod {
@@ -32,12 +32,12 @@ glm::vec3 grid_origin(const TerrainConfig& c, const HeightField& f) {
 }  // namespace
 
 Status load_terrain_model(const TerrainConfig& config, float pixel_error, TerrainModel& out) {
-  HeightFieldTextOptions options;
+  HeightFieldOptions options;
   options.coordinates = config.coordinates;
   options.vertical_scale = config.vertical_scale;
   options.no_data_value = config.no_data;
   HeightField field;
-  if (auto st = read_height_field_text(config.file, field, options); !st) return st;
+  if (auto st = read_height_field(config.file, field, options); !st) return st;
   if (config.cell_size[0] > 0) field.cell_size_x = config.cell_size[0];
   if (config.cell_size[1] > 0) field.cell_size_y = config.cell_size[1];
   const uint32_t samples = config.samples ? config.samples : grid_samples_for(field);

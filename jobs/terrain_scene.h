@@ -9,7 +9,7 @@
 
 namespace lod {
 
-// Reads config.file (preprocess/height_field_io.h), applies cell_size and vertical_scale,
+// Reads config.file (preprocess/height_field_read.h: text, PNG or any GDAL raster), applies cell_size and vertical_scale,
 // resamples bilinearly onto a (2^n + 1)-square grid (samples, or the smallest holding the
 // field, at most 4097), builds the bintree and moves it to its placement. `pixel_error` is
 // the tau used when the block gives none. Errors name the file.

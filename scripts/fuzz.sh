@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # libFuzzer over every reader: one target per mesh format (PLY, OFF, STL, OBJ, GLB), the .lod asset
 # reader (`lod`, with a mutator that keeps the checksum valid), the .hlod reader (`hlod`, the
-# same for its head and payload checksums) and the scene config reader
-# (`scene`), built with Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each
+# same for its head and payload checksums), the scene config reader
+# (`scene`) and the height-field readers (`heightmap`: PNG through stb, ESRI ASCII grid through
+# GDAL, "x y z" text; the first input byte picks one), built with Debian's clang
+# (-fsanitize=fuzzer,address,undefined; UB aborts), each
 # run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with
 # tests/fuzz/<target>.dict. A crash, sanitizer report, timeout (> 5 s on one input) or single
 # allocation over 64 MB fails the run; the input is kept in $OUT/<target>/ (crash-*, timeout-*,
@@ -19,7 +21,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod scene)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod scene heightmap)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
 CXX=${LOD_FUZZ_CXX:-clang++}
@@ -28,7 +30,7 @@ mkdir -p "$OUT/obj"
 
 # ---- build (objects shared by the targets; rebuilt when a source or header is newer) ----
 FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
-       -I. -Iinclude -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
+       -I. -Iinclude -I/usr/include/gdal -I/usr/include/stb -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
               preprocess/obj_reader.cpp preprocess/gltf_io.cpp runtime/file_write.cpp)  # gltf_io compiles tinygltf in
 LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/vertex_front.cpp
@@ -36,6 +38,8 @@ LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp
 HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp
               runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/file_write.cpp runtime/model_table.cpp
               runtime/view.cpp runtime/world_bounds.cpp)
+HEIGHTMAP_SOURCES=(preprocess/height_field_io.cpp preprocess/height_field_png.cpp preprocess/height_field_raster.cpp
+                   runtime/height_field.cpp)  # GDAL itself is Debian's, uninstrumented
 SCENE_SOURCES=(jobs/scene_config.cpp runtime/roam.cpp runtime/height_field.cpp runtime/view.cpp)  # [[terrain]] checks grid sizes
 # The scene reader links Debian's toml++ library as lodkit does (its header-only mode has debug
 # asserts that the shipped, NDEBUG library does not: "[[[a]]" asserts there, is refused here).
@@ -62,11 +66,12 @@ sources_of() {
     lod) echo "${LOD_SOURCES[@]}" ;;
     hlod) echo "${HLOD_SOURCES[@]}" ;;
     scene) echo "${SCENE_SOURCES[@]}" ;;
+    heightmap) echo "${HEIGHTMAP_SOURCES[@]}" ;;
     *) echo "${MESH_SOURCES[@]}" ;;
   esac
 }
 for t in "${TARGETS[@]}"; do
-  case $t in ply|off|stl|obj|glb|lod|hlod|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod scene)" >&2; exit 2 ;; esac
+  case $t in ply|off|stl|obj|glb|lod|hlod|scene|heightmap) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod scene heightmap)" >&2; exit 2 ;; esac
   # shellcheck disable=SC2046
   compile $(sources_of "$t")
 done
@@ -79,6 +84,7 @@ for t in "${TARGETS[@]}"; do
     lod) main=tests/fuzz/asset_fuzz.cpp; extra=() ;;
     hlod) main=tests/fuzz/hlod_fuzz.cpp; extra=() ;;
     scene) main=tests/fuzz/scene_fuzz.cpp; extra=("${SCENE_FLAGS[@]}" -ltomlplusplus) ;;
+    heightmap) main=tests/fuzz/height_field_fuzz.cpp; extra=(-lgdal) ;;
     *) main=tests/fuzz/mesh_fuzz.cpp; extra=("-DLOD_FUZZ_EXT=\".$t\"") ;;
   esac
   if [ ! -x "$bin" ] || [ "$main" -nt "$bin" ] || [ -n "$(find "${objs[@]}" -newer "$bin")" ]; then

@@ -140,5 +140,29 @@ TEST(TerrainModelLoad, BadHeightFileIsNamed) {
   EXPECT_NE(s.message.find("bad.txt"), std::string::npos) << s.message;
 }
 
+TEST(TerrainModelLoad, ReadsAnEsriAsciiGridThroughGdal) {
+  TerrainDir d;
+  // 5 x 3 at 10 m, the same hills as hills.txt (the top text row is the north edge, y = 2).
+  std::string asc = "ncols 5\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 10\n";
+  for (int y = 2; y >= 0; --y) {
+    for (int x = 0; x < 5; ++x) asc += std::to_string(x + y) + " ";
+    asc += "\n";
+  }
+  test::write_text(d.dir / "hills.asc", asc);
+  SceneConfig text, raster;
+  ASSERT_TRUE(d.load("file = \"hills.txt\"\n", text).ok);
+  ASSERT_TRUE(d.load("file = \"hills.asc\"\n", raster).ok);
+  TerrainModel a, b;
+  ASSERT_TRUE(load_terrain_model(*text.terrain, 1, a).ok);
+  const Status s = load_terrain_model(*raster.terrain, 1, b);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(a.roam.positions.size(), b.roam.positions.size());
+  for (size_t i = 0; i < a.roam.positions.size(); ++i) {
+    EXPECT_FLOAT_EQ(a.roam.positions[i].x, b.roam.positions[i].x);
+    EXPECT_FLOAT_EQ(a.roam.positions[i].y, b.roam.positions[i].y) << i;
+    EXPECT_FLOAT_EQ(a.roam.positions[i].z, b.roam.positions[i].z);
+  }
+}
+
 }  // namespace
 }  // namespace lod
