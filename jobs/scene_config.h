@@ -54,6 +54,7 @@ struct InstanceConfig {
   float scale_min = 1, scale_max = 1;
   uint64_t seed = 1;            // absent: 1 for block 0, a mix of the block index for later ones
   MotionSpec motion;           // motion = "wander" / "orbit" with a speed: moved every frame
+  bool on_terrain = false;     // on_terrain = true: y = the [[terrain]]'s height at (x, z) + the box's y (static blocks)
 };
 
 // [[terrain]] (at most one): a height field drawn by ROAM within the same budget (issue 15).
