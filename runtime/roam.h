@@ -31,7 +31,8 @@
 // only the diamonds whose distance has run out are re-keyed; a turn, a zoom or the
 // triangle-count target re-keys the whole front.)
 // Pure functions over RoamState: no threads, no I/O; after roam_reset() no allocation (the
-// queues are reserved for every diamond; roam_triangles() reuses the caller's vector).
+// queues are reserved for every diamond; roam_triangles() reuses the caller's vector; the
+// events log grows to the largest frame's changes once).
 #pragma once
 #include <array>
 #include <cstdint>
