@@ -177,6 +177,12 @@ int run_command(const RunArgs& args) {
 
   Scene scene = make_scene(config, std::move(chains));
   FrameGraphOptions options = frame_graph_options(config);
+  // The terrain before the scene HLOD: on_terrain blocks stand on it first.
+  if (auto st = load_scene_terrain(config, options.terrain); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  if (options.terrain) place_on_terrain(scene, config, *options.terrain);
   if (!hlod->empty()) options.hlod = hlod;
   auto scene_hlod = std::make_shared<SceneHlodTree>();
   if (auto st = bake_scene_hlod(config, scene, log, *scene_hlod); !st) {
@@ -184,10 +190,6 @@ int run_command(const RunArgs& args) {
     return 1;
   }
   if (!scene_hlod->empty()) options.scene_hlod = scene_hlod;
-  if (auto st = load_scene_terrain(config, options.terrain); !st) {
-    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
-    return 1;
-  }
   TerrainCheck terrain_check;
   std::vector<ObjectHandle> handles;
   std::unique_ptr<Service> owned = make_service(scene, options, config.rate_hz, &handles);

@@ -73,6 +73,7 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"terrain_tris", r.terrain_tris},
           {"terrain_splits", r.terrain_splits},
           {"terrain_merges", r.terrain_merges},
+          {"terrain_morphing", r.terrain_morphing},
           {"ms", ms}};
 }
 
@@ -176,6 +177,7 @@ FrameRecord record_of(const Frame& f) {
   r.terrain_tris = f.terrain_tris;
   r.terrain_splits = f.terrain_splits;
   r.terrain_merges = f.terrain_merges;
+  r.terrain_morphing = f.terrain_morphing;
   return r;
 }
 

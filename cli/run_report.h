@@ -41,6 +41,7 @@ struct FrameRecord {
   uint64_t hlod_tris = 0, resident_bytes = 0, stream_requests = 0, stream_loads = 0, stream_evictions = 0,
            stream_failures = 0;
   uint64_t terrain_tris = 0, terrain_splits = 0, terrain_merges = 0;  // [[terrain]] (ROAM)
+  uint32_t terrain_morphing = 0;  // its vertices geomorphing
 
   // Scene HLOD: proxies drawn, the static objects they stand for, their triangles.
   uint32_t scene_proxies = 0, proxy_objects = 0;

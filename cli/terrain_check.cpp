@@ -29,6 +29,11 @@ bool TerrainCheck::check(const Frame& f, std::string* why) {
       return fail(why, "index " + std::to_string(i) + " outside the vertices or the grid");
     grid_indices_[i] = f.terrain_samples[local];
   }
+  // One vertex per sample: a geomorphing vertex has one displayed height for every triangle
+  // using it, so the topological check below is also a geometric one.
+  seen_.assign(samples, 0);
+  for (uint32_t s : f.terrain_samples)
+    if (s >= samples || seen_[s]++) return fail(why, "sample " + std::to_string(s) + " drawn as two vertices");
   const TerrainMeshCheck c = check_terrain_mesh(grid_indices_, f.terrain_grid);
   if (!c.ok())
     return fail(why, std::to_string(c.open_edges) + " open edges (cracks or T-junctions), " +

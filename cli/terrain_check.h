@@ -17,6 +17,7 @@ class TerrainCheck {
 
  private:
   std::vector<uint32_t> grid_indices_;  // the frame's triangles in sample ids
+  std::vector<uint8_t> seen_;           // per sample: drawn as a vertex
 };
 
 }  // namespace lod::cli

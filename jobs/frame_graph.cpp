@@ -265,7 +265,7 @@ struct FrameGraph::Impl {
     set_models(std::move(models));
     if (o.hlod && !o.hlod->empty()) make_hlod_stream(o.hlod);
     if (o.occlusion.enabled && o.occlusion.make_tracer) tracer = o.occlusion.make_tracer();
-    if (o.terrain) terrain_lod_reset(terrain, *o.terrain);
+    if (o.terrain) terrain_lod_reset(terrain, *o.terrain, o.geomorph_seconds);
     // Built inside the arena, the graph attaches to it: its tasks run on these threads.
     arena.execute([&] { build(); });
   }
@@ -1034,18 +1034,21 @@ struct FrameGraph::Impl {
     Frame& f = *out;
     f.terrain_tris = f.terrain_splits = f.terrain_merges = f.terrain_share = 0;
     f.terrain_grid = 0;
+    f.terrain_morphing = 0;
     f.terrain_pixel_error = 0;
     if (!options.terrain) {
       f.terrain_positions.clear(), f.terrain_indices.clear(), f.terrain_samples.clear();
       return;
     }
     const TerrainModel& model = *options.terrain;
-    const RoamFrameStats st = terrain_lod_update(terrain, model, views[0], terrain.share);
+    terrain.morph.duration = options.geomorph_seconds;  // set_geomorph_seconds applies from the next change
+    const RoamFrameStats st = terrain_lod_update(terrain, model, views[0], terrain.share, time);
     f.terrain_tris = terrain_compact_mesh(f.terrain_positions, f.terrain_indices, f.terrain_samples, terrain, model.roam);
     f.terrain_grid = model.roam.size;
     f.terrain_splits = st.splits;
     f.terrain_merges = st.merges;
     f.terrain_share = terrain.share;
+    f.terrain_morphing = terrain.last_morph.morphing;
     f.terrain_pixel_error = terrain_error_left(terrain.roam);
     terrain_last.share = terrain.share;
     terrain_last.terrain_tris = f.terrain_tris;
@@ -1162,7 +1165,7 @@ struct FrameGraph::Impl {
   void reset_temporal_state() {
     last_morph_extra = 0;
     store->reset_temporal_state();
-    if (options.terrain) terrain_lod_reset(terrain, *options.terrain);
+    if (options.terrain) terrain_lod_reset(terrain, *options.terrain, options.geomorph_seconds);
   }
 
   struct FrameBody {
@@ -1257,7 +1260,7 @@ const FrameGraph::Impl::NodeSpec FrameGraph::Impl::kNodes[] = {
      &Impl::node_vd_mesh},
     {Stage::hlod, "select_hlod_cut per HLOD model (view 0, M minus the discrete selection) + pager update, serial",
      kLevels | kViews | kSceneHlod, kHlod, &Impl::node_hlod},
-    {Stage::terrain, "terrain_lod_update (ROAM, view 0, its share of M) + terrain_compact_mesh, serial", kViews, kTerrain,
+    {Stage::terrain, "terrain_lod_update (ROAM, view 0, its share of M; geomorphs) + terrain_compact_mesh, serial", kViews, kTerrain,
      &Impl::node_terrain},
     {Stage::publish, "totals, measure_selection_quality, levels -> history, parallel", kEntries | kLevels | kVisibility | kBlend | kHlod | kSceneHlod | kTerrain,
      kTotals | kHistory, &Impl::node_publish},

@@ -490,7 +490,7 @@ void read_instances(const Reader& r, const toml::table& root, bool required, Sce
     const std::string key = indexed("instances", i);
     r.only_keys(t, key,
                 {"model", "count", "placement", "box_min", "box_max", "scale", "scale_range", "seed", "motion",
-                 "speed"});
+                 "speed", "on_terrain"});
     InstanceConfig inst;
     auto model = r.string(t, "model", key + ".model");
     if (!model) r.fail(key + ".model", "missing");
@@ -543,6 +543,13 @@ void read_instances(const Reader& r, const toml::table& root, bool required, Sce
     inst.seed = default_seed(i);
     r.integer_in(t, "seed", key + ".seed", 0, INT64_MAX, inst.seed);
     read_motion(r, t, key, inst);
+    if (const toml::node* n = t.get("on_terrain")) {
+      const auto* b = n->as_boolean();
+      if (!b) r.fail(key + ".on_terrain", "must be true or false");
+      inst.on_terrain = b->get();
+      if (inst.on_terrain && inst.motion.kind != MotionKind::none)
+        r.fail(key + ".on_terrain", "needs a static block (a moving object would leave the ground)");
+    }
     c.instances.push_back(inst);
   }
 }
@@ -668,6 +675,9 @@ Status parse_scene_config(std::string_view text, const std::filesystem::path& fi
     read_models(r, root, dir, data_dir, !objects_optional, c);
     read_instances(r, root, !objects_optional, c);
     read_terrain(r, root, dir, data_dir, c);
+    for (size_t i = 0; i < c.instances.size(); ++i)
+      if (c.instances[i].on_terrain && !c.terrain)
+        r.fail(indexed("instances", i) + ".on_terrain", "the scene has no [[terrain]]");
   } catch (const ConfigError& e) {
     return Status::error(e.message);
   }

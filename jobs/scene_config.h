@@ -54,12 +54,13 @@ struct InstanceConfig {
   float scale_min = 1, scale_max = 1;
   uint64_t seed = 1;            // absent: 1 for block 0, a mix of the block index for later ones
   MotionSpec motion;           // motion = "wander" / "orbit" with a speed: moved every frame
+  bool on_terrain = false;     // on_terrain = true: y = the [[terrain]]'s height at (x, z) + the box's y (static blocks)
 };
 
 // [[terrain]] (at most one): a height field drawn by ROAM within the same budget (issue 15).
 struct TerrainConfig {
-  std::filesystem::path file;  // file: "x y z" text (preprocess/height_field_io.h), found like meshes
-  GridCoordinates coordinates = GridCoordinates::metres;  // coordinates = "metres" | "lon_lat" | "lat_lon"
+  std::filesystem::path file;  // file: "x y z" text, PNG or a GDAL raster (preprocess/height_field_read.h), found like meshes
+  GridCoordinates coordinates = GridCoordinates::metres;  // coordinates = "metres" | "lon_lat" | "lat_lon" (text; rasters carry theirs)
   float cell_size[2] = {0, 0};  // cell_size = m or [mx, my]: metres between samples; 0 = from the file
   float vertical_scale = 1;     // vertical_scale: world height = elevation * this
   double no_data = std::numeric_limits<double>::quiet_NaN();  // no_data: elevation meaning "none"

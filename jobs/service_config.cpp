@@ -88,11 +88,12 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
     return failed(st.message);
   Scene scene = make_scene(sc, std::move(chains));
   FrameGraphOptions options = frame_graph_options(sc);
+  if (auto st = load_scene_terrain(sc, options.terrain); !st) return failed(st.message);
+  if (options.terrain) place_on_terrain(scene, sc, *options.terrain);  // before the scene HLOD
   if (!hlod->empty()) options.hlod = hlod;
   auto scene_hlod = std::make_shared<SceneHlodTree>();
   if (auto st = bake_scene_hlod(sc, scene, nullptr, *scene_hlod); !st) return failed(st.message);
   if (!scene_hlod->empty()) options.scene_hlod = scene_hlod;
-  if (auto st = load_scene_terrain(sc, options.terrain); !st) return failed(st.message);
   std::unique_ptr<Service> s = make_service(scene, options, sc.rate_hz);
   Impl& m = s->impl();
   m.options.cache_dir = cache;

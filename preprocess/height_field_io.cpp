@@ -3,12 +3,17 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
+#include <unistd.h>
+
 namespace lod {
 namespace detail {
+
+inline constexpr double kMaxElevation = 1e9;  // beyond: no data (e.g. an undeclared -3.4e38)
 
 struct Samples {
   std::vector<double> x, y;
@@ -43,6 +48,8 @@ Status parse_line(std::string_view l, size_t n, const std::string& name, Samples
   if (skip_blanks(p, end) != end) return Status::error(at_line(name, n) + "more than three values");
   for (double x : v)
     if (!std::isfinite(x)) return Status::error(at_line(name, n) + "value is not finite");
+  if (std::abs(v[2]) > kMaxElevation)
+    return Status::error(at_line(name, n) + "elevation " + std::to_string(v[2]) + " beyond +-1e9");
   s.x.push_back(v[0]), s.y.push_back(v[1]), s.z.push_back(float(v[2])), s.line.push_back(n);
   return Status::success();
 }
@@ -119,21 +126,60 @@ void set_cell_sizes(HeightField& f, const Axis& ax, const Axis& ay, GridCoordina
   }
   // x is longitude, y latitude (swapped on reading for degrees_lat_lon).
   const double lat_mid = ay.origin + 0.5 * ay.step * double(ay.count - 1);
-  f.cell_size_x = float(ax.step * kDegree * kEarthRadius * std::cos(lat_mid * kDegree));
-  f.cell_size_y = float(ay.step * kDegree * kEarthRadius);
+  geographic_cell_sizes(ax.step, ay.step, lat_mid, f.cell_size_x, f.cell_size_y);
 }
 
-Status fill_no_data(HeightField& f, double no_data, const std::string& name) {
-  if (std::isnan(no_data)) return Status::success();
+std::string gib(uint64_t bytes) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f GiB", double(bytes) / double(uint64_t(1) << 30));
+  return b;
+}
+
+}  // namespace detail
+
+void geographic_cell_sizes(double step_lon, double step_lat, double lat_mid, float& cell_x, float& cell_y) {
+  cell_x = float(std::abs(step_lon) * detail::kDegree * detail::kEarthRadius * std::cos(lat_mid * detail::kDegree));
+  cell_y = float(std::abs(step_lat) * detail::kDegree * detail::kEarthRadius);
+}
+
+uint64_t available_memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  uint64_t kib = 0;
+  std::string unit;
+  while (in >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024;
+  const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? uint64_t(pages) * uint64_t(page) : UINT64_MAX;
+}
+
+Status check_height_field_size(const std::string& name, uint64_t width, uint64_t height,
+                               const HeightFieldOptions& o, uint64_t bytes_per_sample) {
+  const std::string dims = std::to_string(width) + " x " + std::to_string(height);
+  if (width < 2 || height < 2) return Status::error(name + ": a " + dims + " grid is too small (need 2 x 2 samples)");
+  const double samples = double(width) * double(height);
+  if (samples > double(o.max_samples))
+    return Status::error(name + ": declares a grid of " + dims + ", more than the limit of " +
+                         std::to_string(o.max_samples) + " samples");
+  const double need = samples * double(bytes_per_sample);
+  const uint64_t have = available_memory_bytes();
+  if (need > double(have))
+    return Status::error(name + ": a grid of " + dims + " needs " + detail::gib(uint64_t(need)) + ", only " +
+                         detail::gib(have) + " of memory is available");
+  return Status::success();
+}
+
+Status fill_no_data_samples(HeightField& f, double no_data, const std::string& name, size_t* filled) {
   std::vector<uint8_t> missing(f.sample_count());
   size_t holes = 0;
-  for (size_t i = 0; i < missing.size(); ++i) holes += missing[i] = f.heights[i] == float(no_data);
+  const bool flag = !std::isnan(no_data);
+  for (size_t i = 0; i < missing.size(); ++i)
+    holes += missing[i] = !(std::abs(f.heights[i]) <= detail::kMaxElevation) || (flag && f.heights[i] == float(no_data));
+  if (filled) *filled = holes;
   if (holes == 0) return Status::success();
   if (fill_missing_heights(f, missing) == 0) return Status::error(name + ": every sample is no-data");
   return Status::success();
 }
-
-}  // namespace detail
 
 Status parse_height_field_text(std::string_view text, const std::string& name, HeightField& out,
                                const HeightFieldTextOptions& o) {
@@ -153,6 +199,7 @@ Status parse_height_field_text(std::string_view text, const std::string& name, H
     return Status::error(name + ": the samples span a grid of " + std::to_string(ax.count) + " x " +
                          std::to_string(ay.count) + ", more than the limit of " +
                          std::to_string(o.max_samples) + " samples");
+  if (Status st = check_height_field_size(name, ax.count, ay.count, o, sizeof(float) + 2); !st) return st;
   if (size_t(cells) != s.z.size())
     return Status::error(name + ": not a regular grid: " + std::to_string(s.z.size()) +
                          " samples for a grid of " + std::to_string(ax.count) + " x " +
@@ -162,7 +209,8 @@ Status parse_height_field_text(std::string_view text, const std::string& name, H
   f.vertical_scale = o.vertical_scale;
   if (Status st = detail::place_samples(s, ax, ay, name, f.heights); !st) return st;
   detail::set_cell_sizes(f, ax, ay, o.coordinates);
-  if (Status st = detail::fill_no_data(f, o.no_data_value, name); !st) return st;
+  if (!std::isnan(o.no_data_value))
+    if (Status st = fill_no_data_samples(f, o.no_data_value, name); !st) return st;
   out = std::move(f);
   return Status::success();
 }

@@ -21,6 +21,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "runtime/height_field.h"
 #include "runtime/status.h"
@@ -33,12 +34,38 @@ enum class GridCoordinates : uint8_t {
   degrees_lat_lon,  // latitude longitude elevation (the deal.II step-53 topography)
 };
 
-struct HeightFieldTextOptions {
-  GridCoordinates coordinates = GridCoordinates::metres;
+// Options of every height-field reader (text here, GDAL rasters in height_field_raster.h, PNG
+// in height_field_png.h; height_field_read.h picks one by the file's extension).
+struct HeightFieldOptions {
+  GridCoordinates coordinates = GridCoordinates::metres;  // text only: rasters carry their own
   float vertical_scale = 1;
-  double no_data_value = std::numeric_limits<double>::quiet_NaN();  // NaN: none
+  double no_data_value = std::numeric_limits<double>::quiet_NaN();  // NaN: none (rasters: the band's own)
   size_t max_samples = size_t(1) << 28;                             // 1 GiB of floats
+  // GDAL rasters: the drivers allowed to open the file (short names, e.g. "GTiff", "AAIGrid",
+  // "SRTMHGT"); empty: every installed driver. Some GDAL drivers allocate for the declared size
+  // while opening, before the size check here can run: a list keeps untrusted input to drivers
+  // that do not (the fuzz target uses {"AAIGrid"}).
+  std::vector<std::string> gdal_drivers;
 };
+using HeightFieldTextOptions = HeightFieldOptions;
+
+// Checks a declared width x height before anything that size is allocated: at least 2 x 2, at
+// most options.max_samples, and the memory a reader needs for it (bytes_per_sample each) under
+// what the machine has available now. The error names the file and says which limit.
+Status check_height_field_size(const std::string& name, uint64_t width, uint64_t height,
+                               const HeightFieldOptions& options, uint64_t bytes_per_sample);
+
+// Available memory in bytes (MemAvailable of /proc/meminfo; physical pages when absent).
+uint64_t available_memory_bytes();
+
+// Every sample equal to no_data (when not NaN), not finite or beyond +-1e9 (an undeclared float
+// no-data such as -3.4e38; the text reader refuses those) is filled from its neighbours
+// (fill_missing_heights); refused when every sample is no-data. `filled` counts them.
+Status fill_no_data_samples(HeightField& field, double no_data, const std::string& name, size_t* filled = nullptr);
+
+// Degrees to metres, as the text reader does: the equirectangular cell sizes of a grid with
+// steps (step_lon, step_lat) degrees about latitude lat_mid.
+void geographic_cell_sizes(double step_lon, double step_lat, double lat_mid, float& cell_x, float& cell_y);
 
 // `name` labels messages (the file name). On error `out` is unchanged.
 Status parse_height_field_text(std::string_view text, const std::string& name, HeightField& out,

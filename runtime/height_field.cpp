@@ -7,42 +7,56 @@
 namespace lod {
 namespace detail {
 
-// One outward sweep: every missing sample with a valid 4-neighbour takes their mean. Reads the
-// validity of the previous sweep only, so a hole fills in rings from its rim inwards.
-size_t fill_sweep(HeightField& f, std::vector<uint8_t>& missing, std::vector<uint8_t>& next) {
-  size_t filled = 0;
-  next = missing;
-  for (uint32_t y = 0; y < f.height; ++y)
-    for (uint32_t x = 0; x < f.width; ++x) {
-      const size_t i = size_t(y) * f.width + x;
-      if (!missing[i]) continue;
-      float sum = 0;
-      int n = 0;
-      auto take = [&](uint32_t nx, uint32_t ny) {
-        const size_t j = size_t(ny) * f.width + nx;
-        if (!missing[j]) sum += f.heights[j], ++n;
-      };
-      if (x > 0) take(x - 1, y);
-      if (x + 1 < f.width) take(x + 1, y);
-      if (y > 0) take(x, y - 1);
-      if (y + 1 < f.height) take(x, y + 1);
-      if (n == 0) continue;
-      f.heights[i] = sum / float(n);
-      next[i] = 0;
-      ++filled;
-    }
-  missing.swap(next);
-  return filled;
+template <typename Fn>
+void for_each_neighbour(const HeightField& f, size_t i, Fn&& fn) {
+  const uint32_t x = uint32_t(i % f.width), y = uint32_t(i / f.width);
+  if (x > 0) fn(i - 1);
+  if (x + 1 < f.width) fn(i + 1);
+  if (y > 0) fn(i - f.width);
+  if (y + 1 < f.height) fn(i + f.width);
+}
+
+// One ring: every sample of `ring` takes the mean of its neighbours valid before the ring
+// (all written first, then marked valid), so a hole fills from its rim inwards; the next ring
+// is the still-missing neighbours of this one. Each sample is in one ring: O(samples) in all.
+void fill_ring(HeightField& f, std::vector<uint8_t>& missing, std::vector<uint8_t>& queued,
+               std::vector<size_t>& ring, std::vector<size_t>& next) {
+  for (size_t i : ring) {
+    double sum = 0;  // float could overflow on two near-FLT_MAX neighbours
+    int n = 0;
+    for_each_neighbour(f, i, [&](size_t j) {
+      if (!missing[j]) sum += f.heights[j], ++n;
+    });
+    f.heights[i] = float(sum / n);
+  }
+  for (size_t i : ring) missing[i] = 0;
+  next.clear();
+  for (size_t i : ring)
+    for_each_neighbour(f, i, [&](size_t j) {
+      if (missing[j] && !queued[j]) queued[j] = 1, next.push_back(j);
+    });
+  ring.swap(next);
 }
 
 }  // namespace detail
 
 size_t fill_missing_heights(HeightField& field, std::span<const uint8_t> missing) {
   assert(missing.size() == field.sample_count());
-  std::vector<uint8_t> left(missing.begin(), missing.end()), next;
+  std::vector<uint8_t> left(missing.begin(), missing.end());
   if (std::find(left.begin(), left.end(), uint8_t(0)) == left.end()) return 0;
+  std::vector<uint8_t> queued(left.size(), 0);
+  std::vector<size_t> ring, next;
+  for (size_t i = 0; i < left.size(); ++i) {
+    if (!left[i]) continue;
+    bool rim = false;
+    detail::for_each_neighbour(field, i, [&](size_t j) { rim |= !left[j]; });
+    if (rim) queued[i] = 1, ring.push_back(i);
+  }
   size_t total = 0;
-  for (size_t filled = 1; filled != 0;) total += filled = detail::fill_sweep(field, left, next);
+  while (!ring.empty()) {
+    total += ring.size();
+    detail::fill_ring(field, left, queued, ring, next);
+  }
   return total;
 }
 

@@ -22,7 +22,7 @@ struct HeightField {
 };
 
 // No-data: samples flagged in `missing` (1 = no data, one flag per sample) get the mean of
-// their valid 4-neighbours, sweeping outwards until every sample has a value, so holes take the
+// their valid 4-neighbours, ring by ring outwards from the valid samples (O(samples)), so holes take the
 // elevation of their rim. Returns the number filled; 0 filled and nothing changed when every
 // sample is missing (the caller refuses such a field).
 size_t fill_missing_heights(HeightField& field, std::span<const uint8_t> missing);

@@ -361,20 +361,19 @@ bool sphere_outside(const Frustum& f, glm::vec3 c, float r) {
   return false;
 }
 
-enum class Cull : uint8_t { none, frustum };
-
-// Walks a bintree triangle down to the mesh's leaves. With Cull::frustum a subtree whose diamond
-// sphere (which holds the triangle and every descendant) is outside the view is skipped whole.
-void emit(std::vector<uint32_t>& out, const RoamState& S, const RoamTerrain& T, Cell apex, Cell l, Cell r,
-          Cull cull) {
+// Walks a bintree triangle down to the mesh's leaves (split: one flag per sample). With a
+// frustum, a subtree whose diamond sphere (which holds the triangle and every descendant) is
+// outside the view is skipped whole.
+void emit(std::vector<uint32_t>& out, const uint8_t* split, const Frustum* cull, const RoamTerrain& T, Cell apex,
+          Cell l, Cell r) {
   const int32_t size = int32_t(T.size);
   const bool divisible = ((l.x + r.x) % 2 == 0) && ((l.y + r.y) % 2 == 0);
   const Cell m{(l.x + r.x) / 2, (l.y + r.y) / 2};
   const int32_t d = m.y * size + m.x;
-  if (divisible && cull == Cull::frustum && sphere_outside(S.frustum, T.positions[d], T.radius[d])) return;
-  if (divisible && S.split[d]) {
-    emit(out, S, T, m, apex, l, cull);
-    emit(out, S, T, m, r, apex, cull);
+  if (divisible && cull && sphere_outside(*cull, T.positions[d], T.radius[d])) return;
+  if (divisible && split[d]) {
+    emit(out, split, cull, T, m, apex, l);
+    emit(out, split, cull, T, m, r, apex);
     return;
   }
   out.push_back(uint32_t(apex.y * size + apex.x));
@@ -382,11 +381,11 @@ void emit(std::vector<uint32_t>& out, const RoamState& S, const RoamTerrain& T, 
   out.push_back(uint32_t(r.y * size + r.x));
 }
 
-size_t emit_mesh(std::vector<uint32_t>& indices, const RoamState& S, const RoamTerrain& T, Cull cull) {
+size_t emit_mesh(std::vector<uint32_t>& indices, const uint8_t* split, const Frustum* cull, const RoamTerrain& T) {
   indices.clear();
   const int32_t m = int32_t(T.size - 1);
-  emit(indices, S, T, {m, 0}, {m, m}, {0, 0}, cull);
-  emit(indices, S, T, {0, m}, {0, 0}, {m, m}, cull);
+  emit(indices, split, cull, T, {m, 0}, {m, m}, {0, 0});
+  emit(indices, split, cull, T, {0, m}, {0, 0}, {m, m});
   return indices.size() / 3;
 }
 
@@ -433,6 +432,8 @@ void roam_reset(RoamState& S, const RoamTerrain& T) {
   S.travel = 0;
   S.triangle_count = 2;
   S.splits = S.merges = 0;
+  S.events.clear();
+  S.events.reserve(4096);
   detail::enqueue(S.split_queue, S, T, T.root);
 }
 
@@ -460,6 +461,7 @@ void roam_split(RoamState& S, const RoamTerrain& T, int32_t d) {
   S.split[d] = 1;
   S.triangle_count += T.triangles[d];
   ++S.splits;
+  S.events.push_back(d);
   detail::enqueue(S.merge_queue, S, T, d);
   for (int32_t p : T.parents[d])
     if (p >= 0) detail::dequeue(S.merge_queue, S, p);
@@ -473,6 +475,7 @@ void roam_merge(RoamState& S, const RoamTerrain& T, int32_t d) {
   S.split[d] = 0;
   S.triangle_count -= T.triangles[d];
   ++S.merges;
+  S.events.push_back(~d);
   detail::enqueue(S.split_queue, S, T, d);
   for (int32_t c : T.children[d])
     if (c >= 0) detail::dequeue(S.split_queue, S, c);
@@ -484,6 +487,7 @@ RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view,
   RoamFrameStats st;
   const uint32_t splits0 = S.splits, merges0 = S.merges;
   const glm::vec3 last_eye = S.eye;
+  S.events.clear();
   roam_set_view(S, view);
   const bool pixel = P.target == RoamTarget::pixel_error;
   if (pixel && S.defer && S.tau == P.pixel_error && detail::same_orientation(S.anchor, view)) {
@@ -508,11 +512,27 @@ RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view,
 }
 
 size_t roam_triangles(std::vector<uint32_t>& indices, const RoamState& S, const RoamTerrain& T) {
-  return detail::emit_mesh(indices, S, T, detail::Cull::none);
+  return detail::emit_mesh(indices, S.split.data(), nullptr, T);
 }
 
 size_t roam_visible_triangles(std::vector<uint32_t>& indices, const RoamState& S, const RoamTerrain& T) {
-  return detail::emit_mesh(indices, S, T, detail::Cull::frustum);
+  return detail::emit_mesh(indices, S.split.data(), &S.frustum, T);
+}
+
+size_t roam_triangles_of(std::vector<uint32_t>& indices, std::span<const uint8_t> split, const RoamTerrain& T) {
+  assert(split.size() == T.positions.size());
+  return detail::emit_mesh(indices, split.data(), nullptr, T);
+}
+
+std::array<int32_t, 2> roam_base_ends(const RoamTerrain& T, int32_t d) {
+  const int32_t size = int32_t(T.size);
+  const detail::DiamondShape s = detail::diamond_shape(d % size, d / size);
+  return {s.p.y * size + s.p.x, s.q.y * size + s.q.x};
+}
+
+int roam_depth(const RoamTerrain& T, int32_t d) {
+  const int32_t size = int32_t(T.size);
+  return detail::depth_of(d % size, d / size, T.levels);
 }
 
 int32_t roam_diamond_of(const RoamTerrain& T, uint32_t a, uint32_t b) {

@@ -31,11 +31,13 @@
 // only the diamonds whose distance has run out are re-keyed; a turn, a zoom or the
 // triangle-count target re-keys the whole front.)
 // Pure functions over RoamState: no threads, no I/O; after roam_reset() no allocation (the
-// queues are reserved for every diamond; roam_triangles() reuses the caller's vector).
+// queues are reserved for every diamond; roam_triangles() reuses the caller's vector; the
+// events log grows to the largest frame's changes once).
 #pragma once
 #include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <span>
 #include <vector>
 
 #include "runtime/height_field.h"
@@ -105,6 +107,9 @@ struct RoamState {
   View anchor{};                // the view whose orientation the deadlines assume
   std::vector<float> deadline;  // per front diamond: travel at which to re-key it
   RoamQueue deadline_queue;     // sign -1 over deadline: the soonest first
+  // This update's changes in order, for geomorphing (runtime/terrain_morph.h): a split of d
+  // is logged as d, a merge as ~d; roam_update clears it first.
+  std::vector<int32_t> events;
 };
 
 // True when a width x height field can be a ROAM grid: square, 2^n + 1 with 1 <= n <= 15.
@@ -137,6 +142,14 @@ size_t roam_triangles(std::vector<uint32_t>& indices, const RoamState& state, co
 // draw list; the culled triangles are coarse already since culled diamonds have priority 0).
 size_t roam_visible_triangles(std::vector<uint32_t>& indices, const RoamState& state,
                               const RoamTerrain& terrain);
+// The same mesh for an explicit split flag per sample (e.g. ROAM's splits plus merges still
+// geomorphing); the flags must be closed under parents (a flagged diamond's parents flagged).
+size_t roam_triangles_of(std::vector<uint32_t>& indices, std::span<const uint8_t> split, const RoamTerrain& terrain);
+// A diamond's base ends (the samples its centre splits the base between) and its depth in the
+// bintree (root 0, finest 2n - 1): a diamond's base ends are vertices of coarser depth.
+std::array<int32_t, 2> roam_base_ends(const RoamTerrain& terrain, int32_t diamond);
+int roam_depth(const RoamTerrain& terrain, int32_t diamond);
+
 // The diamond a mesh triangle belongs to (centred at the midpoint of its base, indices 1 and
 // 2), or -1 for a finest-level triangle, which cannot be split.
 int32_t roam_diamond_of(const RoamTerrain& terrain, uint32_t base_a, uint32_t base_b);

@@ -38,8 +38,10 @@ double wanted_share(const TerrainFeedback& f) {
 
 }  // namespace
 
-void terrain_lod_reset(TerrainLod& lod, const TerrainModel& model) {
+void terrain_lod_reset(TerrainLod& lod, const TerrainModel& model, float morph_seconds) {
   roam_reset(lod.roam, model.roam);
+  terrain_morph_reset(lod.morph, model.roam, morph_seconds);
+  lod.last_morph = {};
   lod.share = 0;
   lod.started = 0;
   lod.grid_indices.clear();
@@ -61,14 +63,22 @@ uint64_t next_terrain_share(const TerrainFeedback& last, const TerrainModel& mod
   return static_cast<uint64_t>(want);
 }
 
-RoamFrameStats terrain_lod_update(TerrainLod& lod, const TerrainModel& model, const View& view, uint64_t share) {
+RoamFrameStats terrain_lod_update(TerrainLod& lod, const TerrainModel& model, const View& view, uint64_t share,
+                                  double now) {
   RoamParams p;
   p.target = model.target;
   p.pixel_error = model.pixel_error;
-  const uint32_t cap = static_cast<uint32_t>(std::clamp<uint64_t>(share, 2, model.max_triangles));
+  const uint64_t total = std::clamp<uint64_t>(share, 2, model.max_triangles);
+  // Room for merges still lowering, at most an eighth of the share: each merge made for this
+  // room lowers too, so an unbounded reserve would feed on itself while the camera moves.
+  const uint64_t lowering = std::min<uint64_t>({lod.morph.ghost_wanted, total / 8, total - 2});
+  const uint32_t cap = static_cast<uint32_t>(total - lowering);
   p.max_triangles = cap;
   p.triangle_count = cap;
-  return roam_update(lod.roam, model.roam, view, p);
+  const RoamFrameStats st = roam_update(lod.roam, model.roam, view, p);
+  const uint64_t room = total > lod.roam.triangle_count ? total - lod.roam.triangle_count : 0;
+  lod.last_morph = terrain_morph_update(lod.morph, lod.roam, model.roam, now, room);
+  return st;
 }
 
 float terrain_error_left(const RoamState& state) {
@@ -79,7 +89,7 @@ float terrain_error_left(const RoamState& state) {
 size_t terrain_compact_mesh(std::vector<float>& positions, std::vector<uint32_t>& indices,
                             std::vector<uint32_t>& samples, TerrainLod& lod, const RoamTerrain& terrain) {
   assert(lod.remap.size() == terrain.positions.size());
-  const size_t tris = roam_triangles(lod.grid_indices, lod.roam, terrain);
+  const size_t tris = roam_triangles_of(lod.grid_indices, lod.morph.shown, terrain);
   positions.clear();
   samples.clear();
   indices.resize(lod.grid_indices.size());
@@ -90,7 +100,7 @@ size_t terrain_compact_mesh(std::vector<float>& positions, std::vector<uint32_t>
       local = static_cast<uint32_t>(samples.size());
       samples.push_back(s);
       const glm::vec3& p = terrain.positions[s];
-      positions.insert(positions.end(), {p.x, p.y, p.z});
+      positions.insert(positions.end(), {p.x, lod.morph.height[s], p.z});
     }
     indices[i] = local;
   }

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "runtime/roam.h"
+#include "runtime/terrain_morph.h"
 #include "runtime/view.h"
 
 namespace lod {
@@ -47,14 +48,17 @@ struct TerrainFeedback {
 
 struct TerrainLod {
   RoamState roam;
+  TerrainMorph morph;                  // geomorphs of ROAM's splits and merges (the drawn mesh)
+  TerrainMorphStats last_morph;
   uint64_t share = 0;                  // triangles of M this frame
   uint8_t started = 0;                 // 0 until the first share is set
   std::vector<uint32_t> grid_indices;  // scratch: the mesh in sample ids
   std::vector<uint32_t> remap;         // scratch per sample: UINT32_MAX between calls
 };
 
-// The coarsest mesh, share unset; sizes every array once.
-void terrain_lod_reset(TerrainLod& lod, const TerrainModel& model);
+// The coarsest mesh, share unset; sizes every array once. Splits and merges geomorph over
+// morph_seconds (0: none).
+void terrain_lod_reset(TerrainLod& lod, const TerrainModel& model, float morph_seconds = 0);
 
 // The share for the first frame, then from each frame's feedback; within
 // [min_share, max_share] * M and never above max_triangles.
@@ -62,14 +66,18 @@ uint64_t first_terrain_share(uint64_t budget, const TerrainModel& model);
 uint64_t next_terrain_share(const TerrainFeedback& last, const TerrainModel& model);
 
 // ROAM for `view` under `share` (pixel_error target: max_triangles = share; triangle_count
-// target: the count is the share).
-RoamFrameStats terrain_lod_update(TerrainLod& lod, const TerrainModel& model, const View& view, uint64_t share);
+// target: the count is the share), then the geomorphs at time `now` (seconds). ROAM gets the
+// share minus the triangles last frame's lowering merges drew (at most an eighth of it), and
+// this frame's lowering merges are cut to what is left, so the drawn mesh stays within the share.
+RoamFrameStats terrain_lod_update(TerrainLod& lod, const TerrainModel& model, const View& view, uint64_t share,
+                                  double now = 0);
 
 // The largest projected error of a mesh triangle, pixels: the split queue's top.
 float terrain_error_left(const RoamState& state);
 
-// The mesh compacted for a renderer: xyz world positions per used sample, 3 local indices per
-// triangle, and per vertex its sample id (y * size + x; check_terrain_mesh takes those back).
+// The drawn mesh (ROAM's plus merges still lowering, at their geomorphed heights) compacted for
+// a renderer: xyz world positions per used sample, 3 local indices per triangle, and per vertex
+// its sample id (y * size + x; check_terrain_mesh takes those back); one vertex per sample.
 // Uses lod.remap and lod.grid_indices as scratch; returns the triangle count.
 size_t terrain_compact_mesh(std::vector<float>& positions, std::vector<uint32_t>& indices,
                             std::vector<uint32_t>& samples, TerrainLod& lod, const RoamTerrain& terrain);

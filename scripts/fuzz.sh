@@ -2,8 +2,10 @@
 # libFuzzer over every reader: one target per mesh format (PLY, OFF, STL, OBJ, GLB), the .lod asset
 # reader (`lod`, with a mutator that keeps the checksum valid), the .hlod reader (`hlod`, the
 # same for its head and payload checksums), the distributed bake's subtree cache entry (`hsub`,
-# the full, root-only and payload-span readers, checksums kept valid likewise) and the scene config reader
-# (`scene`), built with Debian's clang (-fsanitize=fuzzer,address,undefined; UB aborts), each
+# the full, root-only and payload-span readers, checksums kept valid likewise), the scene config
+# reader (`scene`) and the height-field readers (`heightmap`: PNG through stb, ESRI ASCII grid
+# through GDAL, "x y z" text; the first input byte picks one), built with Debian's clang
+# (-fsanitize=fuzzer,address,undefined; UB aborts), each
 # run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with
 # tests/fuzz/<target>.dict. A crash, sanitizer report, timeout (> 5 s on one input) or single
 # allocation over 64 MB fails the run; the input is kept in $OUT/<target>/ (crash-*, timeout-*,
@@ -20,7 +22,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod hsub scene)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod hsub scene heightmap)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
 CXX=${LOD_FUZZ_CXX:-clang++}
@@ -29,7 +31,7 @@ mkdir -p "$OUT/obj"
 
 # ---- build (objects shared by the targets; rebuilt when a source or header is newer) ----
 FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
-       -I. -Iinclude -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
+       -I. -Iinclude -I/usr/include/gdal -I/usr/include/stb -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
               preprocess/obj_reader.cpp preprocess/mtl_reader.cpp preprocess/texture_uri.cpp preprocess/gltf_io.cpp
               runtime/file_write.cpp)  # gltf_io compiles tinygltf in
@@ -38,6 +40,8 @@ LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/vertex_tree.cpp
 HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp
               runtime/lod_chain.cpp runtime/vertex_tree.cpp runtime/file_write.cpp runtime/model_table.cpp
               runtime/view.cpp runtime/world_bounds.cpp)
+HEIGHTMAP_SOURCES=(preprocess/height_field_io.cpp preprocess/height_field_png.cpp preprocess/height_field_raster.cpp
+                   runtime/height_field.cpp)  # GDAL itself is Debian's, uninstrumented
 SCENE_SOURCES=(jobs/scene_config.cpp runtime/roam.cpp runtime/height_field.cpp runtime/view.cpp)  # [[terrain]] checks grid sizes
 # The scene reader links Debian's toml++ library as lodkit does (its header-only mode has debug
 # asserts that the shipped, NDEBUG library does not: "[[[a]]" asserts there, is refused here).
@@ -65,11 +69,12 @@ sources_of() {
     hlod) echo "${HLOD_SOURCES[@]}" ;;
     hsub) echo "${HLOD_SOURCES[@]} runtime/hlod_subtree_entry.cpp" ;;
     scene) echo "${SCENE_SOURCES[@]}" ;;
+    heightmap) echo "${HEIGHTMAP_SOURCES[@]}" ;;
     *) echo "${MESH_SOURCES[@]}" ;;
   esac
 }
 for t in "${TARGETS[@]}"; do
-  case $t in ply|off|stl|obj|glb|lod|hlod|hsub|scene) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod hsub scene)" >&2; exit 2 ;; esac
+  case $t in ply|off|stl|obj|glb|lod|hlod|hsub|scene|heightmap) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod hsub scene heightmap)" >&2; exit 2 ;; esac
   # shellcheck disable=SC2046
   compile $(sources_of "$t")
 done
@@ -83,6 +88,7 @@ for t in "${TARGETS[@]}"; do
     hlod) main=tests/fuzz/hlod_fuzz.cpp; extra=() ;;
     hsub) main=tests/fuzz/hsub_fuzz.cpp; extra=() ;;
     scene) main=tests/fuzz/scene_fuzz.cpp; extra=("${SCENE_FLAGS[@]}" -ltomlplusplus) ;;
+    heightmap) main=tests/fuzz/height_field_fuzz.cpp; extra=(-lgdal) ;;
     *) main=tests/fuzz/mesh_fuzz.cpp; extra=("-DLOD_FUZZ_EXT=\".$t\"") ;;
   esac
   if [ ! -x "$bin" ] || [ "$main" -nt "$bin" ] || [ -n "$(find "${objs[@]}" -newer "$bin")" ]; then

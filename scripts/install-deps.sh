@@ -7,6 +7,7 @@ PKGS=(build-essential cmake ninja-build ccache pkg-config
       libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
       libgtest-dev libgmock-dev libbenchmark-dev libmeshoptimizer-dev
       libtinygltf-dev gltfpack
+      libgdal-dev  # elevation rasters for [[terrain]] (issue 15)
       libcgal-demo xvfb xauth libgl1-mesa-dri
       openmpi-bin libopenmpi-dev  # lod-bake-mpi (issue 16) and its mpirun tests
       clang libclang-rt-14-dev)  # clang: libFuzzer targets (scripts/fuzz.sh)

@@ -35,11 +35,7 @@ int run(const lod::viewer::ViewerOptions& o) {
     std::fprintf(stderr, "lod-viewer: %s\n", st.message.c_str());
     return kExitBadInput;
   }
-  std::shared_ptr<const lod::TerrainModel> terrain;  // [[terrain]]: drawn from each frame's mesh
-  if (lod::Status st = lod::load_scene_terrain(loaded.config, terrain); !st) {
-    std::fprintf(stderr, "lod-viewer: %s\n", st.message.c_str());
-    return kExitBadInput;
-  }
+  std::shared_ptr<const lod::TerrainModel> terrain = loaded.terrain;  // [[terrain]]: drawn from each frame's mesh
   if (o.threads >= 0) loaded.config.threads = uint32_t(o.threads);
   std::fprintf(stderr, "lod-viewer: %zu models (%zu hlod), %zu objects (bake %.0f ms: %zu baked, %zu cached in %s)\n",
                loaded.scene.chains.size() + loaded.hlod->trees.size(), loaded.hlod->trees.size(),

@@ -6,6 +6,7 @@
 
 #include "jobs/hlod_scene.h"
 #include "jobs/scene_hlod_bake.h"
+#include "jobs/terrain_scene.h"
 
 namespace lod::viewer {
 
@@ -30,6 +31,8 @@ Status load_scene(const std::filesystem::path& config_file, const std::filesyste
   out.bake.baked += hlod_baked;
   out.bake.cached += hlod_cached;
   out.scene = make_scene(out.config, std::move(chains));
+  if (Status st = load_scene_terrain(out.config, out.terrain); !st) return st;
+  if (out.terrain) place_on_terrain(out.scene, out.config, *out.terrain);  // before the scene HLOD
   out.scene_hlod = std::make_shared<SceneHlodTree>();
   return bake_scene_hlod(out.config, out.scene, log, *out.scene_hlod);
 }

@@ -12,6 +12,7 @@
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
 #include "runtime/status.h"
+#include "runtime/terrain_lod.h"
 
 namespace lod::viewer {
 
@@ -20,6 +21,7 @@ struct LoadedScene {
   Scene scene;
   std::shared_ptr<HlodModels> hlod;      // never null; empty when the config has none
   std::shared_ptr<SceneHlodTree> scene_hlod;  // never null; empty unless [scene_hlod] enabled
+  std::shared_ptr<const TerrainModel> terrain;  // [[terrain]], null without; on_terrain objects stand on it
   BakeSummary bake;
   std::filesystem::path cache_dir;
 };

@@ -152,6 +152,7 @@ struct Frame {
   uint64_t terrain_splits = 0;            // this frame, forced splits included
   uint64_t terrain_merges = 0;
   uint64_t terrain_share = 0;             // triangles of M the terrain was given this frame
+  uint32_t terrain_morphing = 0;          // vertices geomorphing (splits rising, merges lowering)
   float terrain_pixel_error = 0;          // the largest projected error left on it, pixels
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds

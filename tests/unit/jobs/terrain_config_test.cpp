@@ -6,6 +6,7 @@
 
 #include "jobs/scene_config.h"
 #include "jobs/terrain_scene.h"
+#include "synthetic_scene.h"
 #include "test_support.h"
 
 namespace lod {
@@ -138,6 +139,76 @@ TEST(TerrainModelLoad, BadHeightFileIsNamed) {
   const Status s = load_terrain_model(*c.terrain, 1, m);
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.message.find("bad.txt"), std::string::npos) << s.message;
+}
+
+TEST(TerrainConfig, OnTerrainNeedsATerrainAndAStaticBlock) {
+  TerrainDir d;
+  SceneConfig c;
+  test::write_text(d.dir / "scene.toml", kObjects + "on_terrain = true\n");
+  Status s = load_scene_config(d.dir / "scene.toml", d.dir, c);
+  ASSERT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("instances[0].on_terrain: the scene has no [[terrain]]"), std::string::npos) << s.message;
+  test::write_text(d.dir / "scene.toml",
+                   kObjects + "on_terrain = true\nmotion = \"wander\"\nspeed = 2\n[[terrain]]\nfile = \"hills.txt\"\n");
+  s = load_scene_config(d.dir / "scene.toml", d.dir, c);
+  ASSERT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("instances[0].on_terrain: needs a static block"), std::string::npos) << s.message;
+}
+
+TEST(TerrainPlacement, OnTerrainObjectsStandOnTheSurface) {
+  TerrainDir d;
+  SceneConfig c;
+  // Two blocks: the first on the terrain, 1 m above it; the second as the box says.
+  test::write_text(d.dir / "scene.toml",
+                   "[[model]]\nname = \"ball\"\nfile = \"ball.off\"\n"
+                   "[[instances]]\nmodel = \"ball\"\ncount = 20\nbox_min = [-20, 1, -10]\nbox_max = [20, 1, 10]\n"
+                   "on_terrain = true\n"
+                   "[[instances]]\nmodel = \"ball\"\ncount = 5\nbox_min = [-20, 3, -10]\nbox_max = [20, 3, 10]\n"
+                   "[[terrain]]\nfile = \"hills.txt\"\nvertical_scale = 2\n");
+  const Status s = load_scene_config(d.dir / "scene.toml", d.dir, c);
+  ASSERT_TRUE(s.ok) << s.message;
+  TerrainModel m;
+  ASSERT_TRUE(load_terrain_model(*c.terrain, 1, m).ok);
+  Scene scene = make_scene(c, {test::synthetic_chain("ball", {8, 4}, 0.01f, 1.f)});
+  const std::vector<float> y0(scene.objects.y.begin(), scene.objects.y.end());
+  const std::vector<float> cy0(scene.objects.cy.begin(), scene.objects.cy.end());
+  EXPECT_EQ(place_on_terrain(scene, c, m), 20u);
+  // The hills: height x + y (grid units) at 10 m steps, scaled by 2, centred on the origin.
+  for (size_t i = 0; i < 25; ++i) {
+    const float gx = (scene.objects.x[i] + 20) / 10, gy = (scene.objects.z[i] + 10) / 10;
+    const float ground = 2 * (gx + gy);
+    if (i < 20) {
+      EXPECT_NEAR(scene.objects.y[i], 1 + ground, 1e-4) << i;
+      EXPECT_NEAR(scene.objects.cy[i] - cy0[i], scene.objects.y[i] - y0[i], 1e-4) << "its sphere moved with it";
+    } else {
+      EXPECT_EQ(scene.objects.y[i], y0[i]) << "the second block stays where its box put it";
+    }
+  }
+  EXPECT_FLOAT_EQ(terrain_height_at(m, -100, -100), 0.f) << "beyond the grid: the nearest edge";
+}
+
+TEST(TerrainModelLoad, ReadsAnEsriAsciiGridThroughGdal) {
+  TerrainDir d;
+  // 5 x 3 at 10 m, the same hills as hills.txt (the top text row is the north edge, y = 2).
+  std::string asc = "ncols 5\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 10\n";
+  for (int y = 2; y >= 0; --y) {
+    for (int x = 0; x < 5; ++x) asc += std::to_string(x + y) + " ";
+    asc += "\n";
+  }
+  test::write_text(d.dir / "hills.asc", asc);
+  SceneConfig text, raster;
+  ASSERT_TRUE(d.load("file = \"hills.txt\"\n", text).ok);
+  ASSERT_TRUE(d.load("file = \"hills.asc\"\n", raster).ok);
+  TerrainModel a, b;
+  ASSERT_TRUE(load_terrain_model(*text.terrain, 1, a).ok);
+  const Status s = load_terrain_model(*raster.terrain, 1, b);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(a.roam.positions.size(), b.roam.positions.size());
+  for (size_t i = 0; i < a.roam.positions.size(); ++i) {
+    EXPECT_FLOAT_EQ(a.roam.positions[i].x, b.roam.positions[i].x);
+    EXPECT_FLOAT_EQ(a.roam.positions[i].y, b.roam.positions[i].y) << i;
+    EXPECT_FLOAT_EQ(a.roam.positions[i].z, b.roam.positions[i].z);
+  }
 }
 
 }  // namespace

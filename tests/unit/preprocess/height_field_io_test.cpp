@@ -73,6 +73,13 @@ TEST(HeightFieldText, RefusesAMissingOrRepeatedPoint) {
   EXPECT_NE(twice.message.find("regular grid"), std::string::npos) << twice.message;
 }
 
+TEST(HeightFieldText, RefusesAnElevationBeyondAFloat) {
+  HeightField f;
+  const Status st = parse("0 0 1\n1 0 2\n0 1 1e39\n1 1 4\n", f);
+  ASSERT_FALSE(st.ok);
+  EXPECT_NE(st.message.find("t.xyz: line 3: elevation"), std::string::npos) << st.message;
+}
+
 TEST(HeightFieldText, RefusesNaNWithItsLine) {
   HeightField f;
   const Status st = parse("0 0 1\n1 0 2\n0 1 nan\n1 1 4\n", f);
