@@ -1041,7 +1041,7 @@ bool check_front(const VertexFront& f, const VertexTree& t, EdgeCheck edges, std
                 " triangles are active");
   // A face is active exactly when its corners are distinct (no face missing).
   for (uint32_t face = 0; face < t.face_count; ++face) {
-    if (f.face_slot[f.at_face(face)] != kNoNode || !face_mine(face)) continue;
+    if (!face_mine(face) || f.face_slot[f.at_face(face)] != kNoNode) continue;  // another region's face: not ours to index
     uint32_t c[3];
     for (int j = 0; j < 3; ++j) {
       uint32_t v = t.face_leaves[3 * size_t(face) + j];
