@@ -74,6 +74,7 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"terrain_splits", r.terrain_splits},
           {"terrain_merges", r.terrain_merges},
           {"terrain_morphing", r.terrain_morphing},
+          {"terrain_time_bound", r.terrain_time_bound},
           {"ms", ms}};
 }
 
@@ -178,6 +179,7 @@ FrameRecord record_of(const Frame& f) {
   r.terrain_splits = f.terrain_splits;
   r.terrain_merges = f.terrain_merges;
   r.terrain_morphing = f.terrain_morphing;
+  r.terrain_time_bound = f.terrain_time_bound;
   return r;
 }
 

@@ -42,6 +42,7 @@ struct FrameRecord {
            stream_failures = 0;
   uint64_t terrain_tris = 0, terrain_splits = 0, terrain_merges = 0;  // [[terrain]] (ROAM)
   uint32_t terrain_morphing = 0;  // its vertices geomorphing
+  uint32_t terrain_time_bound = 0;  // 1: [[terrain]] max_ms stopped ROAM's update
 
   // Scene HLOD: proxies drawn, the static objects they stand for, their triangles.
   uint32_t scene_proxies = 0, proxy_objects = 0;

@@ -71,6 +71,11 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
+// The clock ROAM's time limit reads ([[terrain]] max_ms).
+double steady_now_ms(const void*) {
+  return std::chrono::duration<double, std::milli>(Clock::now().time_since_epoch()).count();
+}
+
 // What publish sums per chunk before the chunks are merged in order.
 struct ChunkTotals {
   uint64_t tris_in_view = 0;
@@ -1036,13 +1041,15 @@ struct FrameGraph::Impl {
     f.terrain_grid = 0;
     f.terrain_morphing = 0;
     f.terrain_pixel_error = 0;
+    f.terrain_time_bound = 0;
     if (!options.terrain) {
       f.terrain_positions.clear(), f.terrain_indices.clear(), f.terrain_samples.clear();
       return;
     }
     const TerrainModel& model = *options.terrain;
     terrain.morph.duration = options.geomorph_seconds;  // set_geomorph_seconds applies from the next change
-    const RoamFrameStats st = terrain_lod_update(terrain, model, views[0], terrain.share, time);
+    const RoamFrameStats st =
+        terrain_lod_update(terrain, model, views[0], terrain.share, time, RoamClock{&steady_now_ms, nullptr});
     f.terrain_tris = terrain_compact_mesh(f.terrain_positions, f.terrain_indices, f.terrain_samples, terrain, model.roam);
     f.terrain_grid = model.roam.size;
     f.terrain_splits = st.splits;
@@ -1050,9 +1057,10 @@ struct FrameGraph::Impl {
     f.terrain_share = terrain.share;
     f.terrain_morphing = terrain.last_morph.morphing;
     f.terrain_pixel_error = terrain_error_left(terrain.roam);
+    f.terrain_time_bound = st.time_bound;
     terrain_last.share = terrain.share;
     terrain_last.terrain_tris = f.terrain_tris;
-    terrain_last.terrain_bound = st.budget_bound;
+    terrain_last.terrain_bound = st.budget_bound && !st.time_bound;  // a larger share would not help the clock
     terrain_last.terrain_error = f.terrain_pixel_error;
   }
 

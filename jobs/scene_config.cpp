@@ -608,7 +608,7 @@ void read_terrain(const Reader& r, const toml::table& root, const std::filesyste
   const std::string key = "terrain[0]";
   r.only_keys(t, key,
               {"file", "coordinates", "cell_size", "vertical_scale", "no_data", "placement", "position", "samples",
-               "pixel_error", "target", "max_triangles", "share"});
+               "pixel_error", "target", "max_ms", "max_triangles", "share"});
   TerrainConfig tc;
   auto file = r.string(t, "file", key + ".file");
   if (!file || file->empty()) r.fail(key + ".file", "missing");
@@ -620,8 +620,16 @@ void read_terrain(const Reader& r, const toml::table& root, const std::filesyste
   }
   if (auto v = r.string(t, "target", key + ".target")) {
     if (*v == "triangles") tc.target = RoamTarget::triangle_count;
-    else if (*v != "pixel_error") r.fail(key + ".target", "must be \"pixel_error\" or \"triangles\", got \"" + *v + "\"");
+    else if (*v == "time") tc.target = RoamTarget::time_limit;
+    else if (*v != "pixel_error")
+      r.fail(key + ".target", "must be \"pixel_error\", \"triangles\" or \"time\", got \"" + *v + "\"");
   }
+  if (auto v = r.number(t, "max_ms", key + ".max_ms")) {
+    if (!(*v >= 0 && *v <= 1000)) r.fail(key + ".max_ms", "must be in [0, 1000] milliseconds, got " + number_text(*v));
+    else tc.max_ms = float(*v);
+  }
+  if (tc.target == RoamTarget::time_limit && !(tc.max_ms > 0))
+    r.fail(key + ".max_ms", "target = \"time\" needs max_ms > 0 (the update's time limit per frame, milliseconds)");
   r.integer_in(t, "max_triangles", key + ".max_triangles", 2, int64_t{1} << 30, tc.max_triangles);
   read_terrain_shares(r, t, key, tc);
   c.terrain = std::move(tc);

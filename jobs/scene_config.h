@@ -68,7 +68,8 @@ struct TerrainConfig {
   float position[3] = {0, 0, 0};  // position = [x, y, z]: where that point goes (y adds to heights)
   uint32_t samples = 0;         // samples: ROAM grid side 2^n + 1 (<= 4097); 0 = smallest holding the field
   float pixel_error = 0;        // pixel_error: ROAM's tau; 0 = [lod] pixel_error
-  RoamTarget target = RoamTarget::pixel_error;  // target = "pixel_error" | "triangles" (= its share)
+  RoamTarget target = RoamTarget::pixel_error;  // target = "pixel_error" | "triangles" (= its share) | "time"
+  float max_ms = 0;             // max_ms: ROAM's time limit per frame, any target (needed by "time"); 0 = none
   uint32_t max_triangles = 1u << 18;  // max_triangles: cap in any mode (the share of levels budgets)
   float initial_share = 0.5f, min_share = 0.05f, max_share = 0.9f;  // share = [min, initial, max] of M
 };

@@ -48,6 +48,7 @@ Status load_terrain_model(const TerrainConfig& config, float pixel_error, Terrai
   const glm::vec3 origin = grid_origin(config, field);
   for (glm::vec3& p : m.roam.positions) p += origin;
   m.target = config.target;
+  m.max_ms = config.max_ms;
   m.pixel_error = config.pixel_error > 0 ? config.pixel_error : pixel_error;
   m.max_triangles = config.max_triangles;
   m.initial_share = config.initial_share;

@@ -287,32 +287,50 @@ bool same_orientation(const View& a, const View& b) {
 
 // ---- the targets ----
 
+// Operations left this frame, and the deadline when a clock is lent.
 struct Budget {
   uint32_t left;
-  bool take() { return left > 0 ? (--left, true) : false; }
+  const RoamClock* clock = nullptr;
+  double deadline = 0;
+  uint32_t until_read = kRoamClockStride;
+  bool expired = false;
+  bool take() {
+    if (left == 0 || expired) return false;
+    if (clock && --until_read == 0) {
+      until_read = kRoamClockStride;
+      if (clock->now_ms(clock->context) >= deadline) return !(expired = true);
+    }
+    --left;
+    return true;
+  }
 };
 
 float top_priority(const RoamState& S, const RoamQueue& q) { return S.priority[q.heap.front()]; }
 
 bool merge_down_to(RoamState& S, const RoamTerrain& T, uint32_t target, int32_t watch);
 
+bool merge_wanted(const RoamState& S, float tau) {
+  return !S.merge_queue.heap.empty() && top_priority(S, S.merge_queue) <= tau;
+}
+bool split_wanted(const RoamState& S, float tau) {
+  return !S.split_queue.heap.empty() && top_priority(S, S.split_queue) > tau;
+}
+
 void run_pixel_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, Budget& b,
                       RoamFrameStats& st) {
-  // Merge first: what merges here has projected error <= tau and will not split again.
-  while (!S.merge_queue.heap.empty() && top_priority(S, S.merge_queue) <= P.pixel_error) {
-    if (!b.take()) {
-      st.budget_bound = 1;
-      return;
-    }
-    roam_merge(S, T, S.merge_queue.heap.front());
+  // Merges first (what merges has projected error <= tau and will not split again; it frees
+  // room for the splits); against a clock the two alternate, so a frame cut short did both.
+  bool merge_turn = true;
+  for (;;) {
+    const bool merge = merge_wanted(S, P.pixel_error);
+    const bool split = split_wanted(S, P.pixel_error) && S.triangle_count < P.max_triangles;
+    if (!merge && !split) break;
+    if (!b.take()) break;
+    if (merge && (!split || merge_turn)) roam_merge(S, T, S.merge_queue.heap.front());
+    else roam_split(S, T, S.split_queue.heap.front());
+    merge_turn = b.clock ? !merge_turn : true;
   }
-  while (!S.split_queue.heap.empty() && top_priority(S, S.split_queue) > P.pixel_error) {
-    if (S.triangle_count >= P.max_triangles || !b.take()) {
-      st.budget_bound = 1;
-      break;
-    }
-    roam_split(S, T, S.split_queue.heap.front());
-  }
+  if (split_wanted(S, P.pixel_error) || merge_wanted(S, P.pixel_error)) st.budget_bound = 1;
   // A cap below the mesh (a share that shrank) or passed by a split's forced parents: merge
   // the least error away until it holds; the cap is a budget, not a hint.
   if (S.triangle_count > P.max_triangles) {
@@ -337,9 +355,13 @@ void run_count_target(RoamState& S, const RoamTerrain& T, const RoamParams& P, B
                       RoamFrameStats& st) {
   const uint32_t target = std::max<uint32_t>(P.triangle_count, 2);
   // Grow while short of the target (visible diamonds only), then trim to it.
-  while (S.triangle_count < target && !S.split_queue.heap.empty() && top_priority(S, S.split_queue) > 0 &&
-         b.take())
+  while (S.triangle_count < target && !S.split_queue.heap.empty() && top_priority(S, S.split_queue) > 0) {
+    if (!b.take()) {
+      st.budget_bound = 1;
+      break;
+    }
     roam_split(S, T, S.split_queue.heap.front());
+  }
   merge_down_to(S, T, target, -1);
   // Then trade: split the worst leaf while it is worse than the best merge, Duchaineau's loop.
   while (!S.split_queue.heap.empty() && !S.merge_queue.heap.empty() &&
@@ -485,6 +507,7 @@ void roam_merge(RoamState& S, const RoamTerrain& T, int32_t d) {
 
 RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view, const RoamParams& P) {
   RoamFrameStats st;
+  const double start_ms = P.max_ms > 0 && P.clock.now_ms ? P.clock.now_ms(P.clock.context) : 0;
   const uint32_t splits0 = S.splits, merges0 = S.merges;
   const glm::vec3 last_eye = S.eye;
   S.events.clear();
@@ -501,6 +524,10 @@ RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view,
     st.rekeyed = detail::rekey_all(S, T);
   }
   detail::Budget budget{P.max_operations};
+  if (P.max_ms > 0 && P.clock.now_ms) {
+    budget.clock = &P.clock;
+    budget.deadline = start_ms + double(P.max_ms);
+  }
   if (P.target == RoamTarget::pixel_error)
     detail::run_pixel_target(S, T, P, budget, st);
   else
@@ -508,6 +535,8 @@ RoamFrameStats roam_update(RoamState& S, const RoamTerrain& T, const View& view,
   st.splits = S.splits - splits0;
   st.merges = S.merges - merges0;
   st.triangles = S.triangle_count;
+  st.time_bound = budget.expired ? 1 : 0;
+  st.budget_bound |= st.time_bound;
   return st;
 }
 

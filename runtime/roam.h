@@ -61,6 +61,14 @@ struct RoamTerrain {
 enum class RoamTarget : uint8_t {
   pixel_error,     // every visible leaf's projected error <= pixel_error (optionally capped)
   triangle_count,  // target - 2 <= triangles <= target: within one diamond of the target
+  time_limit,      // the finest mesh max_ms allows: the triangle_count loop (largest errors first), stopped by the clock
+};
+
+// A clock the caller lends for a time limit: runtime/ reads none itself, so tests can drive
+// one. now_ms(context) is monotonic, in milliseconds from any origin.
+struct RoamClock {
+  double (*now_ms)(const void* context) = nullptr;
+  const void* context = nullptr;
 };
 
 struct RoamParams {
@@ -69,7 +77,16 @@ struct RoamParams {
   uint32_t triangle_count = 20000;      // the target in triangle_count mode
   uint32_t max_triangles = UINT32_MAX;  // pixel_error mode: splits stop at this many triangles
   uint32_t max_operations = 1u << 22;   // splits + merges per frame (a time limit, in work)
+  // With a clock, any target: splits and merges stop once max_ms have passed since the update
+  // began (re-keying included), checked every kRoamClockStride operations; the next frame goes
+  // on from there. Pixel-error splits and merges then alternate, so a frame cut short has done
+  // some of both. 0 = no limit.
+  float max_ms = 0;
+  RoamClock clock;
 };
+
+// Operations between two clock reads under a time limit (a read costs ~20 ns, a split ~100 ns).
+inline constexpr uint32_t kRoamClockStride = 32;
 
 // One indexed binary heap over diamond ids; sign = +1 keeps the largest priority on top (split
 // queue), -1 the smallest (merge queue). slot[d] = position in heap, -1 when absent.
@@ -84,7 +101,8 @@ struct RoamFrameStats {
   uint32_t merges = 0;
   uint32_t rekeyed = 0;  // front diamonds whose priority was recomputed
   uint32_t triangles = 0;
-  uint8_t budget_bound = 0;  // 1: max_operations or max_triangles stopped the update early
+  uint8_t budget_bound = 0;  // 1: max_operations, max_triangles or max_ms stopped the update early
+  uint8_t time_bound = 0;    // 1: it was max_ms
 };
 
 struct RoamState {

@@ -64,10 +64,12 @@ uint64_t next_terrain_share(const TerrainFeedback& last, const TerrainModel& mod
 }
 
 RoamFrameStats terrain_lod_update(TerrainLod& lod, const TerrainModel& model, const View& view, uint64_t share,
-                                  double now) {
+                                  double now, const RoamClock& clock) {
   RoamParams p;
   p.target = model.target;
   p.pixel_error = model.pixel_error;
+  p.max_ms = model.max_ms;
+  p.clock = clock;
   const uint64_t total = std::clamp<uint64_t>(share, 2, model.max_triangles);
   // Room for merges still lowering, at most an eighth of the share: each merge made for this
   // room lowers too, so an unbounded reserve would feed on itself while the camera moves.

@@ -26,7 +26,9 @@ namespace lod {
 // The immutable terrain a frame graph draws, shared by every frame.
 struct TerrainModel {
   RoamTerrain roam;                          // positions are world space (placement applied)
-  RoamTarget target = RoamTarget::pixel_error;  // pixel_error: the share caps it; triangle_count: = share
+  RoamTarget target = RoamTarget::pixel_error;  // pixel_error: the share caps it; triangle_count: = share;
+                                                // time_limit: toward the share while max_ms lasts
+  float max_ms = 0;                          // ROAM's time limit per frame, any target (0: none)
   float pixel_error = 1;                     // tau, pixels
   uint32_t max_triangles = 1u << 18;         // absolute cap (and the share under levels budgets)
   float initial_share = 0.5f;                // fractions of M
@@ -69,8 +71,9 @@ uint64_t next_terrain_share(const TerrainFeedback& last, const TerrainModel& mod
 // target: the count is the share), then the geomorphs at time `now` (seconds). ROAM gets the
 // share minus the triangles last frame's lowering merges drew (at most an eighth of it), and
 // this frame's lowering merges are cut to what is left, so the drawn mesh stays within the share.
+// `clock` times model.max_ms (without one there is no time limit).
 RoamFrameStats terrain_lod_update(TerrainLod& lod, const TerrainModel& model, const View& view, uint64_t share,
-                                  double now = 0);
+                                  double now = 0, const RoamClock& clock = {});
 
 // The largest projected error of a mesh triangle, pixels: the split queue's top.
 float terrain_error_left(const RoamState& state);

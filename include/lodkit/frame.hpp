@@ -154,6 +154,7 @@ struct Frame {
   uint64_t terrain_share = 0;             // triangles of M the terrain was given this frame
   uint32_t terrain_morphing = 0;          // vertices geomorphing (splits rising, merges lowering)
   float terrain_pixel_error = 0;          // the largest projected error left on it, pixels
+  uint8_t terrain_time_bound = 0;         // 1: its max_ms stopped ROAM's update (it goes on next frame)
 
   std::array<double, kStageCount> stage_ms{};  // per stage, milliseconds
   double total_ms = 0;

@@ -11,6 +11,10 @@
 //                     target_missed_frames (target not met although the error allowed it)
 //   BM_RoamFlight/1   the same at a triangle-count target (50,000)
 //   BM_RoamFlight/2   the same at 0.1 pixel (a finer mesh at a pixel-error target)
+//   BM_RoamFlight/3   the time target: the 50,000-triangle loop stopped at max_ms = 0.25 by the
+//                     steady clock (rebuilds without the limit): also max_update_ms,
+//                     time_bound_frames, median_error_px (the largest projected error left)
+//   BM_RoamFlight/4   0.1 pixel with max_ms = 0.25 (the same counters)
 //   BM_RoamReset      the part of a rebuild that clears the per-sample state (O(grid))
 //   BM_RoamVsChunked/T/P  the baseline: Ulrich's chunked LOD (runtime/chunked_terrain.h, P x P
 //                     cell patches with skirts) selected on the same flight at the same projected
@@ -96,10 +100,16 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+double steady_ms(const void*) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 RoamParams params_for(int64_t mode) {
   RoamParams p;
-  p.pixel_error = mode == 2 ? 0.1f : 1.f;
-  if (mode == 1) p.target = RoamTarget::triangle_count, p.triangle_count = 50000;
+  p.pixel_error = mode == 2 || mode == 4 ? 0.1f : 1.f;
+  if (mode == 1 || mode == 3) p.target = RoamTarget::triangle_count, p.triangle_count = 50000;
+  if (mode == 3) p.target = RoamTarget::time_limit;
+  if (mode >= 3) p.max_ms = 0.25f, p.clock = {&steady_ms, nullptr};
   return p;
 }
 
@@ -115,6 +125,7 @@ double ms_of(F&& f) {
 // target, a count outside [target - 2, target] (one diamond) while visible error was left.
 bool target_missed(const RoamState& s, const RoamParams& p, const RoamFrameStats& st) {
   const float top = s.split_queue.heap.empty() ? 0.f : s.priority[s.split_queue.heap.front()];
+  if (st.time_bound) return false;  // the clock, not the error, stopped it
   if (p.target == RoamTarget::pixel_error) return top > p.pixel_error && !st.budget_bound;
   const bool short_of = st.triangles + 2 < p.triangle_count && top > 0;
   return short_of || st.triangles > p.triangle_count;
@@ -123,12 +134,14 @@ bool target_missed(const RoamState& s, const RoamParams& p, const RoamFrameStats
 void BM_RoamFlight(benchmark::State& state) {
   const RoamTerrain& t = terrain();
   const RoamParams p = params_for(state.range(0));
+  RoamParams unlimited = p;
+  unlimited.max_ms = 0;
   RoamState s, fresh;
   roam_reset(s, t);
   roam_reset(fresh, t);
   roam_update(s, t, flight_view(t, 0), p);  // settle the first frame outside the timing
-  std::vector<double> update_ms, rebuild_ms;
-  double tris = 0, changes = 0, rekeyed = 0, missed = 0;
+  std::vector<double> update_ms, rebuild_ms, error_px;
+  double tris = 0, changes = 0, rekeyed = 0, missed = 0, time_bound = 0;
   int frame = 1;
   for (auto _ : state) {
     const View v = flight_view(t, frame);
@@ -138,10 +151,12 @@ void BM_RoamFlight(benchmark::State& state) {
     update_ms.push_back(ms);
     tris += st.triangles, changes += st.splits + st.merges, rekeyed += st.rekeyed;
     missed += target_missed(s, p, st);
+    time_bound += st.time_bound;
+    error_px.push_back(s.split_queue.heap.empty() ? 0.0 : s.priority[s.split_queue.heap.front()]);
     if (frame % 8 == 0)
       rebuild_ms.push_back(ms_of([&] {
         roam_reset(fresh, t);
-        roam_update(fresh, t, v, p);
+        roam_update(fresh, t, v, unlimited);
       }));
     ++frame;
   }
@@ -153,8 +168,11 @@ void BM_RoamFlight(benchmark::State& state) {
   state.counters["changes_per_frame"] = changes / n;
   state.counters["rekeyed_per_frame"] = rekeyed / n;
   state.counters["target_missed_frames"] = missed;
+  state.counters["max_update_ms"] = *std::max_element(update_ms.begin(), update_ms.end());
+  state.counters["time_bound_frames"] = time_bound;
+  state.counters["median_error_px"] = median(error_px);
 }
-BENCHMARK(BM_RoamFlight)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(400);
+BENCHMARK(BM_RoamFlight)->DenseRange(0, 4)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(400);
 
 void BM_RoamReset(benchmark::State& state) {
   const RoamTerrain& t = terrain();

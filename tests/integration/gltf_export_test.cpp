@@ -50,14 +50,7 @@ lod::test::CliResult run_validator(const std::vector<fs::path>& files) {
   std::string cmd = std::string(LOD_NODE_EXECUTABLE) + " " + LOD_SOURCE_DIR "/tests/integration/validate_gltf.js " +
                     validator.string();
   for (const fs::path& f : files) cmd += " '" + f.string() + "'";
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return lod::test::run_shell(cmd);
 }
 
 fs::path baked_asset(const fs::path& dir) {
@@ -318,44 +311,12 @@ TEST(GltfScene, RunsASceneNamingGlbAndLodFiles) {
   auto r = run_lod("bake " + (dir / "pebble.off").string() + " -o " + (dir / "pre").string() + " --quiet");
   ASSERT_EQ(r.code, 0) << r.out;
   fs::copy_file(baked_asset(dir / "pre"), dir / "pebble.lod");
-  lod::test::write_text(dir / "scene.toml", R"([run]
-frames = 4
-threads = 2
-
-[budget]
-triangles = 20000
-
-[camera]
-path = "orbit"
-center = [0, 0, 0]
-radius = 60.0
-height_above = 10.0
-period_frames = 4
-width = 320
-height = 200
-
-[[model]]
-name = "ball"
-file = "ball.glb"
-
-[[model]]
-name = "pebble"
-file = "pebble.lod"
-
-[[instances]]
-model = "ball"
-count = 20
-box_min = [-30, 0, -30]
-box_max = [30, 0, 30]
-seed = 3
-
-[[instances]]
-model = "pebble"
-count = 20
-box_min = [-30, 0, -30]
-box_max = [30, 0, 30]
-seed = 4
-)");
+  using namespace lod::test;
+  write_text(dir / "scene.toml", run_block(4) + budget_block(20000) +
+                                     orbit_camera_block({.radius = 60, .period_frames = 4, .width = 320, .height = 200}) +
+                                     model_block("ball", "ball.glb") + model_block("pebble", "pebble.lod") +
+                                     scattered_block("ball", 20, 30, "seed = 3\n") +
+                                     scattered_block("pebble", 20, 30, "seed = 4\n"));
   r = run_lod("run --config " + (dir / "scene.toml").string() + " --cache " + (dir / "cache").string() +
               " --json " + (dir / "run.json").string() + " --validate");
   ASSERT_EQ(r.code, 0) << r.out;

@@ -16,17 +16,7 @@ namespace {
 
 #if defined(LOD_BAKE_MPI_PATH) && defined(LOD_MPIEXEC)
 
-test::CliResult run_shell(const std::string& cmd) {
-  test::CliResult r;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::run_shell;
 
 // Root may run mpirun here (containers, CI); loopback only; more ranks than cores is fine.
 // Under AddressSanitizer, OpenMPI's own allocations at exit are not reported as leaks.

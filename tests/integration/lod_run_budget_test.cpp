@@ -18,60 +18,10 @@ using lod::test::run_lod;
 // 300 balls (6,240 triangles) and 100 pebbles (528); `ball_ratios` and `extra` TOML vary it.
 std::filesystem::path budget_scene(const std::filesystem::path& dir, uint64_t budget,
                                    const std::string& ball_ratios, const std::string& extra = "") {
-  lod::test::write_text(dir / "ball.off", lod::test::sphere_off(40, 80));
-  lod::test::write_text(dir / "pebble.off", lod::test::sphere_off(12, 24));
-  const auto cfg = dir / "scene.toml";
-  lod::test::write_text(cfg, extra + R"(
-[run]
-frames = 24
-threads = 2
-
-[budget]
-triangles = )" + std::to_string(budget) +
-                                 R"(
-
-[camera]
-path = "orbit"
-center = [0, 0, 0]
-radius = 120.0
-height_above = 10.0
-period_frames = 24
-width = 640
-height = 360
-
-[[model]]
-name = "ball"
-file = "ball.off"
-ratios = )" + ball_ratios + R"(
-
-[[model]]
-name = "pebble"
-file = "pebble.off"
-ratios = [1.0, 0.5, 0.25]
-
-[[instances]]
-model = "ball"
-count = 300
-box_min = [-100, 0, -100]
-box_max = [100, 0, 100]
-scale_range = [1.0, 3.0]
-seed = 7
-
-[[instances]]
-model = "pebble"
-count = 100
-placement = "grid"
-box_min = [-50, 0, -50]
-box_max = [50, 0, 50]
-scale = 2.0
-)");
-  return cfg;
+  return lod::test::balls_and_pebbles(dir, budget, ball_ratios, "[1.0, 0.5, 0.25]", extra);
 }
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  return nlohmann::json::parse(f);
-}
+using lod::test::read_json;
 
 std::string read_text(const std::filesystem::path& p) {
   std::ifstream f(p, std::ios::binary);

@@ -14,10 +14,7 @@ namespace {
 
 using lod::test::run_lod;
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  return nlohmann::json::parse(f);
-}
+using lod::test::read_json;
 
 // Every frame: no hole, resident bytes within the budget, something drawn; counters grow.
 void expect_streamed_frames(const nlohmann::json& j, uint64_t budget_bytes, size_t frames) {
@@ -60,51 +57,13 @@ std::filesystem::path write_mixed_scene(const std::filesystem::path& dir, const 
   lod::test::write_text(dir / "ball.off", lod::test::sphere_off(12, 24));   // 528 triangles
   lod::test::write_text(dir / "big.off", lod::test::sphere_off(80, 160));   // ~25k triangles
   const auto cfg = dir / "scene.toml";
-  lod::test::write_text(cfg, R"([run]
-frames = 40
-threads = 2
-
-[budget]
-triangles = 60000
-
-[stream]
-budget_mb = 1
-loader_threads = 2
-
-[camera]
-path = "keyframes"
-near = 0.1
-
-[[camera.keyframe]]
-frame = 0
-position = [0.0, 5.0, 400.0]
-look_at = [0.0, 0.0, 0.0]
-
-[[camera.keyframe]]
-frame = 39
-position = [0.0, 2.0, 25.0]
-look_at = [0.0, 0.0, 0.0]
-
-[[model]]
-name = "ball"
-file = "ball.off"
-ratios = [1.0, 0.5, 0.25]
-
-[[model]]
-name = "big"
-file = "big.off"
-hlod = true
-min_verts = 500
-
-[[instances]]
-model = "ball"
-count = 50
-box_min = [-100, 0, -100]
-box_max = [100, 0, 100]
-
-[[instances]]
-model = "big"
-)" + hlod_instances);
+  using namespace lod::test;
+  write_text(cfg, run_block(40) + budget_block(60000) + "[stream]\nbudget_mb = 1\nloader_threads = 2\n\n" +
+                      keyframe_camera_block(0.1, 0, {{0, "[0.0, 5.0, 400.0]", "[0.0, 0.0, 0.0]"},
+                                                     {39, "[0.0, 2.0, 25.0]", "[0.0, 0.0, 0.0]"}}) +
+                      model_block("ball", "ball.off", "[1.0, 0.5, 0.25]") +
+                      model_block("big", "big.off", "", "hlod = true\nmin_verts = 500\n") +
+                      scattered_block("ball", 50, 100) + "[[instances]]\nmodel = \"big\"\n" + hlod_instances);
   return cfg;
 }
 

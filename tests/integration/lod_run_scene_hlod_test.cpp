@@ -15,10 +15,7 @@ namespace {
 
 using lod::test::run_lod;
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  return nlohmann::json::parse(f);
-}
+using lod::test::read_json;
 
 // 600 static spheres of two sizes on a 600 x 600 field and 20 that wander; the camera comes
 // in from 4 km to 30 m over the field.
@@ -26,64 +23,15 @@ std::filesystem::path write_field(const std::filesystem::path& dir, const std::s
   lod::test::write_text(dir / "ball.off", lod::test::sphere_off(16, 32));
   lod::test::write_text(dir / "big.off", lod::test::sphere_off(24, 48));
   const auto cfg = dir / "scene.toml";
-  lod::test::write_text(cfg, R"([run]
-frames = 40
-threads = 2
-
-[budget]
-triangles = 10000000
-
-[lod]
-pixel_error = 1.0
-
-)" + scene_hlod + R"(
-[camera]
-path = "keyframes"
-near = 0.5
-far = 100000.0
-
-[[camera.keyframe]]
-frame = 0
-position = [0.0, 2000.0, 4000.0]
-look_at = [0.0, 0.0, 0.0]
-
-[[camera.keyframe]]
-frame = 39
-position = [0.0, 30.0, 330.0]
-look_at = [0.0, 10.0, 0.0]
-
-[[model]]
-name = "ball"
-file = "ball.off"
-ratios = [1.0, 0.25, 0.08]
-
-[[model]]
-name = "big"
-file = "big.off"
-ratios = [1.0, 0.25, 0.08]
-
-[[instances]]
-model = "ball"
-count = 400
-box_min = [-300, 0, -300]
-box_max = [300, 0, 300]
-scale_range = [2.0, 4.0]
-
-[[instances]]
-model = "big"
-count = 200
-box_min = [-300, 0, -300]
-box_max = [300, 0, 300]
-scale_range = [3.0, 5.0]
-
-[[instances]]
-model = "ball"
-count = 20
-box_min = [-300, 0, -300]
-box_max = [300, 0, 300]
-motion = "wander"
-speed = 5.0
-)");
+  using namespace lod::test;
+  const std::string wander = "motion = \"wander\"\nspeed = 5.0\n";
+  write_text(cfg, run_block(40) + budget_block(10000000) + "[lod]\npixel_error = 1.0\n\n" + scene_hlod + "\n" +
+                      keyframe_camera_block(0.5, 100000, {{0, "[0.0, 2000.0, 4000.0]", "[0.0, 0.0, 0.0]"},
+                                                          {39, "[0.0, 30.0, 330.0]", "[0.0, 10.0, 0.0]"}}) +
+                      model_block("ball", "ball.off", "[1.0, 0.25, 0.08]") +
+                      model_block("big", "big.off", "[1.0, 0.25, 0.08]") +
+                      scattered_block("ball", 400, 300, "scale_range = [2.0, 4.0]\n") +
+                      scattered_block("big", 200, 300, "scale_range = [3.0, 5.0]\n") + scattered_block("ball", 20, 300, wander));
   return cfg;
 }
 

@@ -18,41 +18,12 @@ std::filesystem::path small_scene(const std::filesystem::path& dir, uint64_t bud
                                   const std::string& selector) {
   lod::test::write_text(dir / "ball.off", lod::test::sphere_off(40, 80));
   const auto cfg = dir / (selector + "-" + std::to_string(budget) + ".toml");
-  lod::test::write_text(cfg, R"([run]
-frames = 12
-threads = 2
-
-[lod]
-pixel_error = 0.05
-
-[budget]
-reserve_blends = false
-selector = ")" + selector + R"("
-triangles = )" + std::to_string(budget) +
-                                 R"(
-
-[camera]
-path = "orbit"
-center = [0, 0, 0]
-radius = 120.0
-height_above = 10.0
-period_frames = 12
-width = 640
-height = 360
-
-[[model]]
-name = "ball"
-file = "ball.off"
-ratios = [1.0, 0.5, 0.25, 0.12, 0.06]
-
-[[instances]]
-model = "ball"
-count = 120
-box_min = [-100, 0, -100]
-box_max = [100, 0, 100]
-scale_range = [1.0, 3.0]
-seed = 7
-)");
+  using namespace lod::test;
+  write_text(cfg, run_block(12) + "[lod]\npixel_error = 0.05\n\n" +
+                      budget_block(budget, "reserve_blends = false\nselector = \"" + selector + "\"\n") +
+                      orbit_camera_block({.period_frames = 12}) +
+                      model_block("ball", "ball.off", "[1.0, 0.5, 0.25, 0.12, 0.06]") +
+                      scattered_block("ball", 120, 100, "scale_range = [1.0, 3.0]\nseed = 7\n"));
   return cfg;
 }
 
@@ -61,8 +32,7 @@ nlohmann::json run_json(const std::filesystem::path& dir, const std::filesystem:
   const auto r = lod::test::run_lod("run --config " + cfg.string() + " --cache " + (dir / "cache").string() +
                                     " --quiet --json " + json.string());
   EXPECT_EQ(r.code, 0) << r.out;
-  std::ifstream f(json);
-  return nlohmann::json::parse(f);
+  return lod::test::read_json(json);
 }
 
 TEST(LodRunSelectors, FractionOfTheOptimumPerFrameForEverySelector) {

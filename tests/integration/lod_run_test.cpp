@@ -14,58 +14,11 @@ namespace {
 using lod::test::run_lod;
 
 // A two-model scene of generated spheres: 400 objects, a budget that binds.
-std::filesystem::path write_scene(const std::filesystem::path& dir, uint64_t budget, const std::string& extra = "") {
-  lod::test::write_text(dir / "ball.off", lod::test::sphere_off(40, 80));   // 6,240 triangles
-  lod::test::write_text(dir / "pebble.off", lod::test::sphere_off(12, 24)); // 528 triangles
-  const auto cfg = dir / "scene.toml";
-  lod::test::write_text(cfg, R"([run]
-frames = 24
-threads = 2
-
-[budget]
-triangles = )" + std::to_string(budget) + R"(
-
-[camera]
-path = "orbit"
-center = [0, 0, 0]
-radius = 120.0
-height_above = 10.0
-period_frames = 24
-width = 640
-height = 360
-
-[[model]]
-name = "ball"
-file = "ball.off"
-ratios = [1.0, 0.5, 0.25, 0.12, 0.06]
-
-[[model]]
-name = "pebble"
-file = "pebble.off"
-
-[[instances]]
-model = "ball"
-count = 300
-box_min = [-100, 0, -100]
-box_max = [100, 0, 100]
-scale_range = [1.0, 3.0]
-seed = 7
-
-[[instances]]
-model = "pebble"
-count = 100
-placement = "grid"
-box_min = [-50, 0, -50]
-box_max = [50, 0, 50]
-scale = 2.0
-)" + extra);
-  return cfg;
+std::filesystem::path write_scene(const std::filesystem::path& dir, uint64_t budget) {
+  return lod::test::balls_and_pebbles(dir, budget, "[1.0, 0.5, 0.25, 0.12, 0.06]");
 }
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  return nlohmann::json::parse(f);
-}
+using lod::test::read_json;
 
 TEST(LodRun, WritesEveryFrameWithinBudgetAndCachesTheBake) {
   const auto dir = lod::test::temp_dir("lodrun");

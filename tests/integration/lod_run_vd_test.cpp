@@ -7,66 +7,27 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "run_cli.h"
 #include "test_support.h"
 
 namespace {
 
+// `lod run` on the scene; its exit code, the output into `out`.
 int run_lod_vd(const std::string& args, std::string* out) {
-  const std::string cmd = std::string(LOD_CLI_PATH) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return -1;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out->append(buf, n);
-  const int status = pclose(p);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const lod::test::CliResult r = lod::test::run_lod(args);
+  *out += r.out;
+  return r.code;
 }
 
 std::filesystem::path write_vd_scene(const std::filesystem::path& dir, const std::string& flag) {
   lod::test::write_text(dir / "ball.off", lod::test::sphere_off(60, 120));  // 14,160 triangles
   lod::test::write_text(dir / "pebble.off", lod::test::sphere_off(12, 24));
   const auto cfg = dir / "scene.toml";
-  lod::test::write_text(cfg, R"([run]
-frames = 40
-threads = 2
-
-[budget]
-triangles = 30000
-
-[camera]
-path = "orbit"
-center = [0, 0, 0]
-radius = 60.0
-height_above = 10.0
-period_frames = 80
-width = 640
-height = 360
-
-[[model]]
-name = "ball"
-file = "ball.off"
-ratios = [1.0, 0.5, 0.25, 0.12]
-view_dependent = )" + flag + R"(
-
-[[model]]
-name = "pebble"
-file = "pebble.off"
-
-[[instances]]
-model = "ball"
-count = 1
-placement = "grid"
-box_min = [0, 0, 0]
-box_max = [0, 0, 0]
-scale = 20.0
-
-[[instances]]
-model = "pebble"
-count = 100
-box_min = [-100, 0, -100]
-box_max = [100, 0, 100]
-seed = 2
-)");
+  using namespace lod::test;
+  write_text(cfg, run_block(40) + budget_block(30000) + orbit_camera_block({.radius = 60, .period_frames = 80}) +
+                      model_block("ball", "ball.off", "[1.0, 0.5, 0.25, 0.12]", "view_dependent = " + flag + "\n") +
+                      model_block("pebble", "pebble.off") + single_block("ball", "[0, 0, 0]", 20) +
+                      scattered_block("pebble", 100, 100, "seed = 2\n"));
   return cfg;
 }
 

@@ -34,15 +34,8 @@ lod::test::CliResult run_checker(const fs::path& tileset, const std::string& sch
       return r;
     }
   const std::string cmd = std::string(LOD_NODE_EXECUTABLE) + " " + LOD_SOURCE_DIR "/tests/integration/validate_3dtiles.js '" +
-                          tools.string() + "' '" + schemas + "' '" + tileset.string() + "'" + (glbs ? "" : " --no-gltf") + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+                          tools.string() + "' '" + schemas + "' '" + tileset.string() + "'" + (glbs ? "" : " --no-gltf");
+  return lod::test::run_shell(cmd);
 }
 
 // The unit sphere stretched to 3 along y and moved to z = 5, so that y-up and z-up differ.

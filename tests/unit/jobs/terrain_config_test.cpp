@@ -111,7 +111,24 @@ TEST(TerrainConfig, RefusesUnknownPlacement) {
 TEST(TerrainConfig, RefusesSharesOutOfOrder) {
   expect_refused("file = \"hills.txt\"\nshare = [0.5, 0.2, 0.9]\n", "terrain[0].share", "min <= initial <= max");
 }
-TEST(TerrainConfig, RefusesUnknownTarget) { expect_refused("file = \"hills.txt\"\ntarget = \"time\"\n", "terrain[0].target"); }
+TEST(TerrainConfig, RefusesUnknownTarget) { expect_refused("file = \"hills.txt\"\ntarget = \"speed\"\n", "terrain[0].target"); }
+TEST(TerrainConfig, TimeTargetTakesItsLimit) {
+  TerrainDir d;
+  SceneConfig c;
+  ASSERT_TRUE(d.load("file = \"hills.txt\"\ntarget = \"time\"\nmax_ms = 0.25\n", c).ok);
+  EXPECT_EQ(c.terrain->target, RoamTarget::time_limit);
+  EXPECT_EQ(c.terrain->max_ms, 0.25f);
+  TerrainModel m;
+  ASSERT_TRUE(load_terrain_model(*c.terrain, 1.f, m).ok);
+  EXPECT_EQ(m.target, RoamTarget::time_limit);
+  EXPECT_EQ(m.max_ms, 0.25f);
+}
+TEST(TerrainConfig, RefusesATimeTargetWithoutALimit) {
+  expect_refused("file = \"hills.txt\"\ntarget = \"time\"\n", "terrain[0].max_ms", "needs max_ms > 0");
+}
+TEST(TerrainConfig, RefusesANegativeTimeLimit) {
+  expect_refused("file = \"hills.txt\"\nmax_ms = -1\n", "terrain[0].max_ms", "[0, 1000]");
+}
 
 TEST(TerrainModelLoad, ResamplesOntoTheRoamGridAndCentresIt) {
   TerrainDir d;

@@ -156,6 +156,21 @@ TEST(Roam, UpdatesNeverReallocateTheirState) {
   EXPECT_EQ(columns[1], s.priority.data());
 }
 
+// Frames after a bound one, at the same view: crack-free each, unbound within a few, and then
+// the mesh one unbounded update made (`full`), spread over several frames.
+void expect_catches_up(RoamState& s, const RoamTerrain& t, const View& v, const RoamParams& p, const RoamState& full) {
+  RoamFrameStats st;
+  int frames = 1;
+  do {
+    st = roam_update(s, t, v, p);
+    ASSERT_TRUE(check_terrain_mesh(mesh_of(s, t), t.size).ok());
+  } while (st.budget_bound && ++frames < 1000);
+  EXPECT_EQ(st.budget_bound, 0);
+  EXPECT_EQ(st.time_bound, 0);
+  EXPECT_GE(frames, 2);
+  EXPECT_EQ(s.split, full.split);
+}
+
 TEST(Roam, OperationBudgetBoundsAFrameAndLaterFramesCatchUp) {
   const RoamTerrain t = build_roam_terrain(make_field(7, Relief::sines));
   const View v = flying_view(t, 5);
@@ -167,17 +182,109 @@ TEST(Roam, OperationBudgetBoundsAFrameAndLaterFramesCatchUp) {
   p.max_operations = 40;
   RoamState s;
   roam_reset(s, t);
-  RoamFrameStats st = roam_update(s, t, v, p);
+  const RoamFrameStats st = roam_update(s, t, v, p);
   EXPECT_EQ(st.budget_bound, 1);
   EXPECT_LT(st.triangles, full.triangle_count);
-  int frames = 1;
-  for (; st.budget_bound && frames < 1000; ++frames) {
+  expect_catches_up(s, t, v, p, full);
+}
+
+// A clock that moves `step` ms at every read, so a time limit stops at a known operation.
+struct SteppingClock {
+  double now = 0, step = 0;
+  uint32_t reads = 0;
+  static double read(const void* c) {
+    auto* self = const_cast<SteppingClock*>(static_cast<const SteppingClock*>(c));
+    ++self->reads;
+    return self->now += self->step;
+  }
+  RoamClock clock() const { return {&SteppingClock::read, this}; }
+};
+
+TEST(Roam, TimeLimitStopsAtTheClockAndLaterFramesCatchUp) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, Relief::sines));
+  const View v = flying_view(t, 5);
+  RoamParams p;
+  p.pixel_error = 1.f;
+  RoamState full;
+  roam_reset(full, t);
+  roam_update(full, t, v, p);
+  SteppingClock c{0, 1.0};  // 1 ms a read: the first read after the start passes 0.5 ms
+  p.max_ms = 0.5f;
+  p.clock = c.clock();
+  RoamState s;
+  roam_reset(s, t);
+  const RoamFrameStats st = roam_update(s, t, v, p);
+  EXPECT_EQ(st.time_bound, 1);
+  EXPECT_EQ(st.budget_bound, 1);
+  EXPECT_EQ(c.reads, 2u);  // the start, then one read a stride: the second one expired
+  EXPECT_GE(st.splits, kRoamClockStride - 1);  // forced splits come with some of the operations
+  EXPECT_LT(st.triangles, full.triangle_count);
+  expect_catches_up(s, t, v, p, full);
+}
+
+TEST(Roam, AClockThatDoesNotRunOutChangesNothing) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, Relief::random, 4));
+  RoamParams p;
+  p.pixel_error = 1.5f;
+  RoamParams timed = p;
+  SteppingClock c{0, 0.0};
+  timed.max_ms = 1.f;
+  timed.clock = c.clock();
+  RoamState a, b;
+  roam_reset(a, t);
+  roam_reset(b, t);
+  for (int frame = 0; frame < 30; ++frame) {
+    roam_update(a, t, flying_view(t, 4 * frame), p);
+    const RoamFrameStats st = roam_update(b, t, flying_view(t, 4 * frame), timed);
+    ASSERT_EQ(st.time_bound, 0);
+    ASSERT_EQ(a.split, b.split) << "frame " << frame;
+  }
+  EXPECT_GT(c.reads, 30u);  // it was read, every frame
+}
+
+TEST(Roam, ACutShortPixelFrameBothSplitsAndMerges) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, Relief::sines));
+  RoamParams p;
+  p.pixel_error = 1.f;
+  RoamState s;
+  roam_reset(s, t);
+  roam_update(s, t, flying_view(t, 0), p);
+  SteppingClock c{0, 1.0};
+  p.max_ms = 0.5f;
+  p.clock = c.clock();
+  // Far ahead: much to merge behind, much to split in front; a frame cut short does some of both.
+  const RoamFrameStats st = roam_update(s, t, flying_view(t, 90), p);
+  EXPECT_EQ(st.time_bound, 1);
+  EXPECT_GT(st.splits, 0u);
+  EXPECT_GT(st.merges, 0u);
+  EXPECT_TRUE(check_terrain_mesh(mesh_of(s, t), t.size).ok());
+}
+
+TEST(Roam, TimeTargetRefinesTowardsItsCountAsTheClockAllows) {
+  const RoamTerrain t = build_roam_terrain(make_field(7, Relief::random, 2));
+  RoamParams p;
+  p.target = RoamTarget::time_limit;
+  p.triangle_count = 4001;
+  SteppingClock c{0, 1.0};
+  p.max_ms = 2.5f;  // two strides a frame
+  p.clock = c.clock();
+  RoamState s;
+  roam_reset(s, t);
+  const View v = flying_view(t, 10);
+  uint32_t last = 0;
+  RoamFrameStats st;
+  int frames = 0;
+  for (; frames < 400; ++frames) {
     st = roam_update(s, t, v, p);
     ASSERT_TRUE(check_terrain_mesh(mesh_of(s, t), t.size).ok());
+    ASSERT_LE(st.triangles, p.triangle_count);
+    if (!st.time_bound) break;
+    if (last + 2 < p.triangle_count) EXPECT_GE(st.triangles, last);  // a still camera: each frame goes on from the last
+    last = st.triangles;
   }
-  EXPECT_EQ(st.budget_bound, 0);
-  EXPECT_GT(frames, 2);
-  EXPECT_EQ(s.split, full.split);  // the same mesh, spread over several frames
+  EXPECT_GT(frames, 5);
+  EXPECT_EQ(st.time_bound, 0);
+  EXPECT_GE(st.triangles + 2, p.triangle_count);
 }
 
 class RoamFlight : public ::testing::TestWithParam<Relief> {};
