@@ -75,7 +75,9 @@ bool write_torus_obj(const fs::path& dir, int rings, int segments) {
   const double R = 1.0, r = 0.35;
   for (int i = 0; i <= rings; ++i)
     for (int j = 0; j <= segments; ++j) {
-      const double a = 2 * std::numbers::pi * i / rings, b = 2 * std::numbers::pi * j / segments;
+      // The last row and column are the first again (i % rings, j % segments), so the seam's
+      // copies share their positions bit for bit: a seam, not two borders a rounding apart.
+      const double a = 2 * std::numbers::pi * (i % rings) / rings, b = 2 * std::numbers::pi * (j % segments) / segments;
       const double rr = r * (1 + 0.08 * std::sin(5 * a) * std::cos(3 * b));  // curvature to trade against the texture
       out << "v " << (R + rr * std::cos(b)) * std::cos(a) << ' ' << rr * std::sin(b) << ' '
           << (R + rr * std::cos(b)) * std::sin(a) << "\nvt " << double(i) / rings << ' ' << double(j) / segments << '\n';
