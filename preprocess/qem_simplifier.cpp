@@ -1,7 +1,9 @@
 // QEM edge collapse in sorted passes (see qem_simplifier.h for the papers).
 //
-// Once per call: vertex kinds (manifold / border / locked) and border loops; on manifold input
-// both stay valid because every allowed collapse keeps the kinds (next to a non-manifold vertex
+// Once per call: vertex kinds (manifold / border / seam / locked) and border loops; a seam
+// vertex is one of two copies at a position whose open edges are each other's twins, and it
+// collapses only with its copy, along both sides of the seam at once. On manifold input kinds
+// and loops stay valid because every allowed collapse keeps them (next to a non-manifold vertex
 // a loop may point at a vertex gone since, which only leaves that border edge uncollapsed).
 // Each pass: build vertex -> face lists (CSR, each entry the face's other two corners) from
 // the current index buffer; give every collapsible edge its position and quadric cost;
