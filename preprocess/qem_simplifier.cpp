@@ -810,6 +810,7 @@ void compact_vertices(Work& w, QemMesh& mesh) {
     nx[n] = w.next[o] == ~0u ? ~0u : w.vmap[w.next[o]];
     pv[n] = w.prev[o] == ~0u ? ~0u : w.vmap[w.prev[o]];
     sib[n] = w.sibling[o] == ~0u ? ~0u : w.vmap[w.sibling[o]];
+    if (kind[n] == kSeam && sib[n] == ~0u) kind[n] = kLocked;  // its copy is gone (cannot happen on a pair)
   }
   w.kind.swap(kind);
   w.next.swap(nx);
