@@ -1,7 +1,8 @@
 // Textured models simplified side by side with meshoptimizer's gltfpack (issue 12 item 6):
 // `gltfpack -si R -noq` (Debian's gltfpack, run as a process; -noq keeps float attributes so
 // that only the simplification differs) and lodkit's bake (QEM, uvs as attributes, seams
-// locked) at the triangle count gltfpack reached for each R in 50 %, 25 %, 12.5 %, 6.25 %.
+// simplified along their length) at the triangle count gltfpack reached for each R in 50 %,
+// 25 %, 12.5 %, 6.25 %.
 // Both are measured by the same code against the same original: geometric error
 // (preprocess/surface_error: Embree closest points, symmetric, RMS and max, in % of the
 // bounding-box diagonal) and texture-coordinate error (preprocess/uv_error, in texels of the
