@@ -121,7 +121,8 @@ Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std:
 // a QEM level stuck more than 2 % above its target is redone by the aggressive simplifier,
 // and said so in the notes.
 // With several materials (vertex_material: one per input vertex) the aggressive simplifier runs
-// per material; QEM keeps them apart by itself (material boundaries are split, hence locked).
+// per material; QEM keeps them apart by itself (material boundaries are split: seams, which it
+// simplifies only along their length).
 void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_material, const std::vector<float>& ratios,
                     SimplifyMethod method, bool automatic, float uv_weight, const BakeParallelFor& parallel_for,
                     std::vector<ChainLevel>& levels, std::vector<std::vector<uint32_t>>& sources,
@@ -159,8 +160,9 @@ void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_mat
     const ParallelFor one_by_one = [](size_t n, const std::function<void(size_t)>& body) {
       for (size_t i = 0; i < n; ++i) body(i);
     };
-    // Texture coordinates ride along as attributes: interpolated along each collapse, and
-    // vertices sharing a position (uv seams) locked, so the texture never tears at a seam.
+    // Texture coordinates ride along as attributes: interpolated along each collapse; vertices
+    // sharing a position (uv seams) move only along their seam, both copies together, so the
+    // texture never tears or smears across a seam.
     QemOptions options;
     if (keep_uvs) options.attributes = mesh.uvs.data(), options.attribute_count = 2, options.attribute_weight = uv_weight;
     qem_simplify_chain_split(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),

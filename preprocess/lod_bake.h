@@ -25,7 +25,7 @@ struct BakeSettings {
   uint64_t extreme_threshold = 1000000;  // auto: triangles above which the aggressive method is used
   // Weight of the texture-coordinate error in QEM's collapse cost (QemOptions::attribute_weight;
   // positions are in units of the model's power-of-two extent, uvs in texture units); 0 = only
-  // the geometry ranks collapses (uvs still follow, seams still locked).
+  // the geometry ranks collapses (uvs still follow, seams still move only along themselves).
   float uv_weight = kDefaultUvWeight;
   // Optional: lets one model use several cores (the two halves of a QEM run, the levels'
   // error measurements). The output is byte-identical with or without it, so it is not

@@ -1,6 +1,7 @@
 // Materials through the levels. A material boundary is a seam: vertices where materials meet
-// are split (one copy per material, same position), so the QEM simplifier locks them as it
-// locks uv seams, every collapse stays inside one material, and each level's triangle keeps
+// are split (one copy per material, same position), so the QEM simplifier moves them only
+// along the boundary, both copies together, as it does uv seams; every collapse stays inside
+// one material, and each level's triangle keeps
 // its material (that of the input vertex its corners descend from). Each level's triangles
 // are then grouped by material into LevelSubmesh runs. The aggressive simplifier (vertex
 // clustering) runs on each material's triangles alone.

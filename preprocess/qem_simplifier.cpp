@@ -1,7 +1,9 @@
 // QEM edge collapse in sorted passes (see qem_simplifier.h for the papers).
 //
-// Once per call: vertex kinds (manifold / border / locked) and border loops; on manifold input
-// both stay valid because every allowed collapse keeps the kinds (next to a non-manifold vertex
+// Once per call: vertex kinds (manifold / border / seam / locked) and border loops; a seam
+// vertex is one of two copies at a position whose open edges are each other's twins, and it
+// collapses only with its copy, along both sides of the seam at once. On manifold input kinds
+// and loops stay valid because every allowed collapse keeps them (next to a non-manifold vertex
 // a loop may point at a vertex gone since, which only leaves that border edge uncollapsed).
 // Each pass: build vertex -> face lists (CSR, each entry the face's other two corners) from
 // the current index buffer; give every collapsible edge its position and quadric cost;
@@ -23,6 +25,9 @@ namespace {
 constexpr uint8_t kManifold = 0;
 constexpr uint8_t kBorder = 1;
 constexpr uint8_t kLocked = 2;
+// One of a pair of copies on an attribute seam: it collapses only onto its neighbour along
+// its side of the seam, and its copy onto the same neighbour's copy on the other side.
+constexpr uint8_t kSeam = 3;
 
 // A collapse must not turn a face by more than this (cosine between old and new normal):
 // 0 would only refuse flips; a margin also refuses folds that create near-vertical slivers.
@@ -193,7 +198,9 @@ struct Work {
   std::vector<uint32_t> offset, fill;  // CSR vertex -> faces
   std::vector<uint32_t> ring;          // per CSR entry: the face's next and previous corner
   std::vector<uint8_t> kind;
-  std::vector<uint32_t> next, prev;    // border loops, for border vertices
+  std::vector<uint32_t> next, prev;    // border loops, for border (and seam) vertices
+  std::vector<uint32_t> sibling;       // a seam vertex's copy on the other side
+  std::vector<uint8_t> seam_out;       // the open edge v -> next[v] has a twin (a seam edge)
   std::vector<uint32_t> stamp;
   std::vector<uint8_t> out_count, in_count;
   std::vector<uint32_t> remap;
@@ -220,6 +227,40 @@ struct Work {
   }
 };
 
+// The copy of t that f's copy collapses onto when f collapses onto t along their seam: the
+// copy's neighbour the other way along its own side. ~0u when there is none to take (t is the
+// closed end of a slit, which both copies would reach at once).
+uint32_t seam_partner(const Work& w, uint32_t f, uint32_t t) {
+  const uint32_t g = w.sibling[f];
+  const uint32_t tp = w.next[f] == t ? w.prev[g] : w.prev[f] == t ? w.next[g] : ~0u;
+  if (tp == ~0u || tp == t || tp == f || tp == g) return ~0u;
+  return tp;
+}
+
+// Cost of collapsing seam vertex f onto t with its copy g onto t's copy tp, all at t's place:
+// the plane error of all four, plus each side's attribute error with that side's attributes
+// of t (each copy keeps the uvs of its own side). Infinite when the pair cannot collapse.
+float seam_cost(const Work& w, const QemMesh& mesh, uint32_t f, uint32_t t) {
+  const uint32_t g = w.sibling[f], tp = seam_partner(w, f, t);
+  if (tp == ~0u || w.offset[g + 1] - w.offset[g] > kMaxValence || w.offset[tp + 1] - w.offset[tp] > kMaxValence)
+    return std::numeric_limits<float>::infinity();
+  Quadric q = quadric_sum(mesh.quadrics[f], mesh.quadrics[t]);
+  quadric_add(q, mesh.quadrics[g]);
+  quadric_add(q, mesh.quadrics[tp]);
+  const float* p = &mesh.positions[3 * size_t(t)];
+  double e = quadric_eval(q, p[0], p[1], p[2]);
+  if (!mesh.attribute_quadrics.empty()) {
+    const size_t ac = mesh.attribute_count, channels = std::min(ac, kAttributeQuadricChannels);
+    AttributeQuadric side = mesh.attribute_quadrics[f];
+    attribute_add(side, mesh.attribute_quadrics[t]);
+    e += std::max(0.0, attribute_eval(side, p, &mesh.attributes[ac * t], channels));
+    side = mesh.attribute_quadrics[g];
+    attribute_add(side, mesh.attribute_quadrics[tp]);
+    e += std::max(0.0, attribute_eval(side, p, &mesh.attributes[ac * tp], channels));
+  }
+  return q.w > 0 ? float(e / q.w) : float(e);
+}
+
 // CSR lists for the current index buffer: each face of v as its (next, previous) corners.
 void build_lists(Work& w, const QemMesh& mesh) {
   const size_t nv = mesh.positions.size() / 3;
@@ -239,6 +280,78 @@ void build_lists(Work& w, const QemMesh& mesh) {
     uint32_t* rc = &w.ring[2 * size_t(w.fill[c]++)];
     rc[0] = a, rc[1] = b;
   }
+}
+
+bool same_position(const QemMesh& mesh, uint32_t a, uint32_t b) {
+  return std::memcmp(&mesh.positions[3 * size_t(a)], &mesh.positions[3 * size_t(b)], 12) == 0;
+}
+
+// Copies at one position among the live vertices: `group` links each copy to the next one at
+// its position, in a cycle.
+void link_copies(Work& w, const QemMesh& mesh, std::vector<uint32_t>& group) {
+  const size_t nv = mesh.positions.size() / 3;
+  group.assign(nv, ~0u);
+  size_t copies = 0;
+  for (size_t v = 0; v < nv; ++v) copies += (mesh.lock[v] & QemMesh::kCopy) && w.offset[v] != w.offset[v + 1];
+  size_t cap = 16;
+  while (cap < 2 * copies) cap *= 2;
+  std::vector<uint32_t> table(cap, ~0u);
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (!(mesh.lock[v] & QemMesh::kCopy) || w.offset[v] == w.offset[v + 1]) continue;
+    uint32_t h[3];
+    std::memcpy(h, &mesh.positions[3 * size_t(v)], 12);
+    size_t slot = (h[0] * 73856093u ^ h[1] * 19349663u ^ h[2] * 83492791u) & (cap - 1);
+    while (table[slot] != ~0u && !same_position(mesh, table[slot], v)) slot = (slot + 1) & (cap - 1);
+    const uint32_t o = table[slot];
+    if (o == ~0u) {
+      table[slot] = v;
+      group[v] = v;
+    } else {
+      group[v] = group[o];
+      group[o] = v;
+    }
+  }
+}
+
+// Seam pairs among the copies (kSeam from classify): the two copies at a position are a pair
+// when each one's open edges are the other's, reversed (the side of one ends where the other's
+// begins). Anything else at a copy (a third copy, a missing twin in this part, a seam meeting
+// a border or ending inside the surface) locks it. Also marks which open edges are seam edges,
+// and locks the single vertex at the closed end of a slit (a seam ending inside the surface,
+// whose two open edges lead to the two copies of one position).
+void pair_seams(Work& w, const QemMesh& mesh) {
+  const size_t nv = mesh.positions.size() / 3;
+  w.sibling.assign(nv, ~0u);
+  w.seam_out.assign(nv, 0);
+  std::vector<uint32_t> group;
+  link_copies(w, mesh, group);
+  auto open_ok = [&](uint32_t v) {
+    return w.next[v] != ~0u && w.prev[v] != ~0u && w.next[v] != w.prev[v] && !same_position(mesh, v, w.next[v]) &&
+           !same_position(mesh, v, w.prev[v]);
+  };
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (group[v] == ~0u) {
+      // The closed end of a slit: both open edges lead to one position.
+      if (w.kind[v] == kBorder && open_ok(v) && same_position(mesh, w.next[v], w.prev[v]))
+        w.kind[v] = kLocked, w.seam_out[v] = 1;
+      continue;
+    }
+    for (uint32_t u = group[v]; u != v; u = group[u])
+      if (w.next[v] != ~0u && w.prev[u] != ~0u && w.prev[u] != w.next[v] && same_position(mesh, w.prev[u], w.next[v]))
+        w.seam_out[v] = 1;
+    if (w.kind[v] != kSeam) continue;
+    const uint32_t u = group[v];
+    const bool pair = u != v && group[u] == v && w.kind[u] == kSeam && open_ok(v) && open_ok(u) &&
+                      same_position(mesh, w.next[v], w.prev[u]) && same_position(mesh, w.prev[v], w.next[u]);
+    if (pair) {
+      w.sibling[v] = u;
+    } else {
+      w.kind[v] = kLocked;
+    }
+  }
+  // A pair whose other half was locked above is no pair.
+  for (uint32_t v = 0; v < nv; ++v)
+    if (w.kind[v] == kSeam && (w.sibling[v] == ~0u || w.kind[w.sibling[v]] != kSeam)) w.kind[v] = kLocked, w.sibling[v] = ~0u;
 }
 
 // Vertex kinds and border loops, once per call: collapses that pass the link condition keep
@@ -283,9 +396,13 @@ void classify(Work& w, const QemMesh& mesh, bool lock_border, bool move_nonmanif
     if (complex && move_nonmanifold) kind = kManifold;
     if (complex && kind == kManifold && !mesh.lock[v]) w.dedupe_faces = true;
     if (border_out == 1 && border_in == 1 && (!complex || move_nonmanifold)) kind = lock_border ? kLocked : kBorder;
-    if (mesh.lock[v]) kind = kLocked;
+    // A copy is a seam vertex only if pair_seams finds its twin; one open edge each way is the
+    // shape it needs (its side's fan ends at the seam on both hands).
+    if (mesh.lock[v] & QemMesh::kCopy) kind = border_out == 1 && border_in == 1 && !complex ? kSeam : kLocked;
+    if (mesh.lock[v] & QemMesh::kLockMask) kind = kLocked;
     w.kind[v] = kind;
   }
+  pair_seams(w, mesh);
 }
 
 void radix_sort(Work& w, size_t n) {
@@ -418,6 +535,51 @@ size_t drop_duplicate_faces(Work& w, std::vector<uint32_t>& indices) {
   return kept;
 }
 
+// Whether the faces around f and t reach neither g nor tp: the two sides' collapses of a
+// seam pair are then independent, and checking each alone checks both.
+bool sides_apart(const Work& w, uint32_t f, uint32_t t, uint32_t g, uint32_t tp) {
+  for (uint32_t v : {f, t})
+    for (uint32_t i = 2 * w.offset[v]; i < 2 * w.offset[v + 1]; ++i) {
+      const uint32_t x = w.remap[w.ring[i]];
+      if (x == g || x == tp) return false;
+    }
+  return true;
+}
+
+// Collapses a onto b at p: b takes a's quadrics, its border loop place and its faces (through
+// the remap table), and the attribute at p interpolated along the edge a-b.
+void apply_collapse(Work& w, QemMesh& mesh, uint32_t a, uint32_t b, const float* p) {
+  float* pos = mesh.positions.data();
+  const size_t ac = mesh.attribute_count;
+  if (ac) {
+    const float* pa = pos + 3 * size_t(a);
+    const float* pb = pos + 3 * size_t(b);
+    const float d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
+    const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    float t = 1;
+    if (len2 > 0)
+      t = std::clamp(((p[0] - pa[0]) * d[0] + (p[1] - pa[1]) * d[1] + (p[2] - pa[2]) * d[2]) / len2, 0.f, 1.f);
+    float* at = mesh.attributes.data();
+    for (size_t k = 0; k < ac; ++k) at[b * ac + k] = at[a * ac + k] * (1 - t) + at[b * ac + k] * t;
+  }
+  if (w.kind[a] == kBorder || w.kind[a] == kSeam) {
+    // a leaves its border loop (a seam vertex: its side's open loop)
+    const uint32_t pa = w.prev[a], na = w.next[a];
+    if (na == b) {
+      if (pa != ~0u) w.next[pa] = b;
+      w.prev[b] = pa;
+    } else {
+      if (na != ~0u) w.prev[na] = b;
+      w.next[b] = na;
+    }
+  }
+  std::memcpy(pos + 3 * size_t(b), p, 3 * sizeof(float));
+  quadric_add(mesh.quadrics[b], mesh.quadrics[a]);
+  if (!mesh.attribute_quadrics.empty()) attribute_add(mesh.attribute_quadrics[b], mesh.attribute_quadrics[a]);
+  w.remap[a] = b;
+  w.pass_lock[a] = w.pass_lock[b] = 1;
+}
+
 // Pass over the current mesh: returns the number of faces removed.
 size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, bool& hit_limit,
                      bool lists_current) {
@@ -443,8 +605,24 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
       if (ka == kLocked && kb == kLocked) continue;
       if (w.offset[b + 1] - w.offset[b] > kMaxValence) continue;
       const bool border = (ka == kBorder && w.next[a] == b) || (kb == kBorder && w.prev[b] == a);
-      if (!border && a > b) continue;  // an interior edge is seen from both faces
+      const bool seam = (ka == kSeam || kb == kSeam) && (w.next[a] == b || w.prev[b] == a);
+      if (!border && !seam && a > b) continue;  // an interior edge is seen from both faces
       Candidate& c = w.cands[n];
+      if (seam && ka != kManifold && kb != kManifold) {
+        // Along the seam: the pair at one end onto the pair at the other; the cheaper way when
+        // both ends may move. Each seam edge is seen from both sides: kept from the side whose
+        // moving copy has the lower id.
+        float cab = std::numeric_limits<float>::infinity(), cba = cab;
+        if (ka == kSeam && a < w.sibling[a]) cab = seam_cost(w, mesh, a, b);
+        if (kb == kSeam && b < w.sibling[b]) cba = seam_cost(w, mesh, b, a);
+        if (!(std::min(cab, cba) < std::numeric_limits<float>::infinity())) continue;
+        c.from = cab <= cba ? a : b;
+        c.to = cab <= cba ? b : a;
+        c.cost = std::min(cab, cba);
+        std::memcpy(c.p, pos + 3 * size_t(c.to), sizeof c.p);
+        n++;
+        continue;
+      }
       const Quadric q = quadric_sum(qa, mesh.quadrics[b]);
       if (ka == kManifold && kb == kManifold) {
         c.from = a, c.to = b;
@@ -559,38 +737,21 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
     const uint32_t a = c.from, b = c.to;
     if (w.pass_lock[a] || w.pass_lock[b]) continue;
     size_t removed = 0;
-    const bool b_moves = std::memcmp(c.p, pos + 3 * size_t(b), sizeof c.p) != 0;
-    if (!collapse_allowed(w, mesh, a, b, c.p, b_moves, removed)) continue;
-
-    if (mesh.attribute_count) {
-      // Attribute at the new position: interpolated along the edge by the projection.
-      const float* pa = pos + 3 * a;
-      const float* pb = pos + 3 * b;
-      const float d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
-      const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-      float t = 1;
-      if (len2 > 0)
-        t = std::clamp(((c.p[0] - pa[0]) * d[0] + (c.p[1] - pa[1]) * d[1] + (c.p[2] - pa[2]) * d[2]) / len2,
-                       0.f, 1.f);
-      float* at = mesh.attributes.data();
-      for (size_t k = 0; k < ac; ++k) at[b * ac + k] = at[a * ac + k] * (1 - t) + at[b * ac + k] * t;
+    if (w.kind[a] == kSeam) {
+      // Both copies along their own sides of the seam, or neither.
+      const uint32_t a2 = w.sibling[a], b2 = seam_partner(w, a, b);
+      if (b2 == ~0u || w.pass_lock[a2] || w.pass_lock[b2] || !sides_apart(w, a, b, a2, b2)) continue;
+      size_t removed2 = 0;
+      if (!collapse_allowed(w, mesh, a, b, c.p, false, removed) || !collapse_allowed(w, mesh, a2, b2, c.p, false, removed2))
+        continue;
+      apply_collapse(w, mesh, a, b, c.p);
+      apply_collapse(w, mesh, a2, b2, c.p);
+      removed += removed2;
+    } else {
+      const bool b_moves = std::memcmp(c.p, pos + 3 * size_t(b), sizeof c.p) != 0;
+      if (!collapse_allowed(w, mesh, a, b, c.p, b_moves, removed)) continue;
+      apply_collapse(w, mesh, a, b, c.p);
     }
-    if (w.kind[a] == kBorder) {
-      // a leaves its border loop
-      const uint32_t pa = w.prev[a], na = w.next[a];
-      if (na == b) {
-        if (pa != ~0u) w.next[pa] = b;
-        w.prev[b] = pa;
-      } else {
-        if (na != ~0u) w.prev[na] = b;
-        w.next[b] = na;
-      }
-    }
-    std::memcpy(pos + 3 * b, c.p, sizeof c.p);
-    quadric_add(mesh.quadrics[b], mesh.quadrics[a]);
-    if (weighted) attribute_add(mesh.attribute_quadrics[b], mesh.attribute_quadrics[a]);
-    w.remap[a] = b;
-    w.pass_lock[a] = w.pass_lock[b] = 1;
     removed_total += removed;
     collapses++;
     mesh.error = std::max(mesh.error, double(c.cost));
@@ -642,16 +803,19 @@ void compact_vertices(Work& w, QemMesh& mesh) {
     tmp.lock[n] = mesh.lock[o];
   }
   std::vector<uint8_t> kind(next);
-  std::vector<uint32_t> nx(next), pv(next);
+  std::vector<uint32_t> nx(next), pv(next), sib(next);
   for (uint32_t n = 0; n < next; ++n) {
     const uint32_t o = order[n];
     kind[n] = w.kind[o];
     nx[n] = w.next[o] == ~0u ? ~0u : w.vmap[w.next[o]];
     pv[n] = w.prev[o] == ~0u ? ~0u : w.vmap[w.prev[o]];
+    sib[n] = w.sibling[o] == ~0u ? ~0u : w.vmap[w.sibling[o]];
+    if (kind[n] == kSeam && sib[n] == ~0u) kind[n] = kLocked;  // its copy is gone (cannot happen on a pair)
   }
   w.kind.swap(kind);
   w.next.swap(nx);
   w.prev.swap(pv);
+  w.sibling.swap(sib);
   mesh.positions.swap(tmp.positions);
   mesh.attributes.swap(tmp.attributes);
   mesh.quadrics.swap(tmp.quadrics);
@@ -707,6 +871,7 @@ struct Frame {
   std::vector<uint8_t> finite;
   std::vector<uint8_t> lock;    // per input vertex
   std::vector<uint32_t> faces;  // valid input faces, input ids
+  std::vector<uint32_t> first_copy;  // per input vertex: the first vertex at its position
 };
 
 void make_frame(Frame& f, const float* positions, size_t vertex_count, const uint32_t* indices, size_t index_count,
@@ -737,12 +902,16 @@ void make_frame(Frame& f, const float* positions, size_t vertex_count, const uin
   f.lock.assign(vertex_count, 0);
   if (options.vertex_lock)
     for (size_t v = 0; v < vertex_count; ++v) f.lock[v] = options.vertex_lock[v] ? QemMesh::kLockUser : 0;
-  // Vertices sharing a position (attribute seams, unwelded input) are locked: moving one copy
-  // alone would tear the surface open.
+  // Vertices sharing a position (attribute seams, unwelded input) are copies: a pair moves
+  // only together along its seam (classify decides where it may), and three or more at one
+  // place (a branch of the seam) stay put, since moving one copy alone would tear the surface.
   {
     size_t cap = 16;
     while (cap < 2 * vertex_count) cap *= 2;
     std::vector<uint32_t> table(cap, ~0u);
+    std::vector<uint32_t>& first = f.first_copy;
+    first.assign(vertex_count, ~0u);
+    std::vector<uint32_t> copies(vertex_count, 0);   // per first vertex: how many share it
     for (size_t v = 0; v < vertex_count; ++v) {
       if (!f.finite[v]) continue;
       const float* p = positions + 3 * v;
@@ -753,15 +922,22 @@ void make_frame(Frame& f, const float* positions, size_t vertex_count, const uin
         const uint32_t o = table[slot];
         if (o == ~0u) {
           table[slot] = uint32_t(v);
+          first[v] = uint32_t(v);
           break;
         }
         if (std::memcmp(positions + 3 * size_t(o), p, 12) == 0) {
-          f.lock[v] |= QemMesh::kLockUser;
-          f.lock[o] |= QemMesh::kLockUser;
+          first[v] = o;
           break;
         }
         slot = (slot + 1) & (cap - 1);
       }
+      copies[first[v]]++;
+    }
+    for (size_t v = 0; v < vertex_count; ++v) {
+      if (first[v] == ~0u) continue;
+      const uint32_t n = copies[first[v]];
+      if (n >= 2) f.lock[v] |= QemMesh::kCopy;
+      if (n >= 3) f.lock[v] |= QemMesh::kLockUser;
     }
   }
 
@@ -882,8 +1058,9 @@ namespace {
 
 // Constraint planes through border edges, once per mesh, from the classification the first
 // simplification makes anyway; edges between two vertices shared with another part are the
-// cut, not a border.
-void add_border_planes(const Work& w, QemMesh& mesh, float border_weight) {
+// cut, not a border. Seam edges (open on each side, the surface continuing on the other) get
+// seam_weight instead, just enough to keep a seam on its line as it is simplified.
+void add_border_planes(const Work& w, QemMesh& mesh, float border_weight, float seam_weight) {
   const size_t nv = mesh.positions.size() / 3;
   for (size_t v = 0; v < nv; ++v) {
     const uint32_t b = w.next[v];
@@ -905,7 +1082,8 @@ void add_border_planes(const Work& w, QemMesh& mesh, float border_weight) {
     if (!(len > 0)) continue;
     for (double& x : m) x /= len;
     const double d = -(m[0] * pa[0] + m[1] * pa[1] + m[2] * pa[2]);
-    const double wgt = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) * border_weight;
+    const double wgt = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) * (w.seam_out[v] ? seam_weight : border_weight);
+    if (!(wgt > 0)) continue;
     // Constraint planes add error but no area: the cost stays a mean over the surface.
     for (uint32_t x : {uint32_t(v), b}) {
       const double keep = mesh.quadrics[x].w;
@@ -929,7 +1107,8 @@ size_t qem_simplify_mesh(ChainLevelOut* levels, QemMesh& mesh, const size_t* tar
   build_lists(w, mesh);
   classify(w, mesh, options.lock_border, options.move_nonmanifold);
   if (!mesh.border_planes) {
-    if (options.border_weight > 0) add_border_planes(w, mesh, options.border_weight);
+    if (options.border_weight > 0 || options.seam_weight > 0)
+      add_border_planes(w, mesh, options.border_weight, options.seam_weight);
     mesh.border_planes = true;
   }
   bool lists_current = true;
@@ -1134,8 +1313,14 @@ size_t qem_simplify_chain_split(ChainLevelOut* levels, const float* positions, s
     faces_in[side[t]]++;
     for (int k = 0; k < 3; ++k) used[f.faces[3 * t + k]] |= uint8_t(1u << side[t]);
   }
+  // Shared vertices, and copies of an attribute seam split between the halves (each half
+  // holds one and locks it): both stay put until the halves are merged.
+  std::vector<uint8_t> sides(vertex_count, 0);
+  for (size_t v = 0; v < vertex_count; ++v)
+    if (f.lock[v] & QemMesh::kCopy) sides[f.first_copy[v]] |= used[v];
   size_t seam = 0;
-  for (uint8_t u : used) seam += u == 3;
+  for (size_t v = 0; v < vertex_count; ++v)
+    seam += used[v] == 3 || (used[v] && (f.lock[v] & QemMesh::kCopy) && sides[f.first_copy[v]] == 3);
 
   // The halves run alone while their locked shared border is small next to the target.
   constexpr size_t kSeamFactor = 12;

@@ -27,6 +27,10 @@ struct QemOptions {
   float max_error = 0;
   // Weight of the boundary constraint planes relative to the surface's own planes.
   float border_weight = 10;
+  // Weight of the constraint planes along attribute seams (open edges whose twin is another
+  // copy's edge), which hold a seam to its line as it is simplified along its length; the
+  // surface on both sides is kept by its own planes.
+  float seam_weight = 10;
   // Non-manifold vertices (on edges with three or more faces, or with faces of both
   // orientations) move like manifold ones (as in meshoptimizer), also at the open end of a fin;
   // those on exactly one border loop slide along it. Dirty scans (Stanford's decimated ones)
@@ -36,8 +40,12 @@ struct QemOptions {
   // Optional: nonzero = that input vertex never moves (others may collapse onto it).
   const uint8_t* vertex_lock = nullptr;
   // Optional per-vertex attributes (normals, uv, ...): attribute_count floats per vertex,
-  // interpolated along each collapse. Vertices sharing a position with another vertex (uv or
-  // normal seams) are locked, so seams survive every level.
+  // interpolated along each collapse. Vertices sharing a position with another vertex (uv,
+  // normal or material seams: one position, a copy per side) move only along their seam, both
+  // copies together, each keeping its own side's attributes (as meshoptimizer's seam
+  // collapses), so the seam stays closed and no texture smears across it; where a seam
+  // branches, ends or meets a border (three or more copies, or copies whose open edges are
+  // not each other's twins) the copies stay put.
   const float* attributes = nullptr;
   size_t attribute_count = 0;
   // Weight of the attribute error in the collapse cost (Hoppe 1999's memory-efficient
@@ -103,15 +111,20 @@ struct QemMesh {
   std::vector<AttributeQuadric> attribute_quadrics;  // per vertex, or empty (no weighted attributes)
   std::vector<uint32_t> indices;
   std::vector<uint32_t> source_vertex;  // input vertex id
-  std::vector<uint8_t> lock;            // kLockUser | kLockSeam bits per vertex
+  std::vector<uint8_t> lock;            // kLockUser | kLockSeam | kCopy bits per vertex
   size_t attribute_count = 0;
   size_t input_vertex_count = 0;
   float scale = 1;
   double error = 0;  // largest normalised collapse error so far
   bool border_planes = false;  // boundary constraint planes added (by the first simplification)
 
-  static constexpr uint8_t kLockUser = 1;  // options.vertex_lock, attribute seams, locked borders
+  static constexpr uint8_t kLockUser = 1;  // options.vertex_lock; seam branch points (3+ copies)
   static constexpr uint8_t kLockSeam = 2;  // shared between parts of a split; cleared by merge
+  // One of several input vertices at one position (an attribute seam). With exactly two it
+  // moves only along the seam with its copy, and stays put in a mesh (a part of a split) that
+  // holds only one of them; with three or more (the seam branches) it has kLockUser too.
+  static constexpr uint8_t kCopy = 4;
+  static constexpr uint8_t kLockMask = kLockUser | kLockSeam;
   size_t triangle_count() const { return indices.size() / 3; }
 };
 

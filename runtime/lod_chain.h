@@ -38,7 +38,7 @@ struct LodChain {
   std::vector<float> normals;      // xyz per vertex, same count as positions
   std::vector<uint32_t> indices;   // level-local vertex indices, all levels back to back
   // Optional texture coordinates (empty = none): uv per vertex (glTF's convention, origin top
-  // left), laid out like positions; kept through every level by the simplifier (seams locked).
+  // left), laid out like positions; kept through every level by the simplifier (seams kept closed).
   // uv_errors[k]: level k's largest uv distance from the input vertex each of its vertices
   // descends from (how far the texture slid). Stored in the asset's optional TEX0 section.
   std::vector<float> uvs;
