@@ -216,58 +216,6 @@ TEST(HashBytes, SwappedWordsDoNotCollide) {
   EXPECT_NE(hash_bytes(w, 32), hash_bytes(t, 32));
 }
 
-// Every string of the new layout lies inside the section: cutting the section's last string
-// short (its length one byte longer than what is left) is refused, for each of the six.
-TEST(LodAssetMaterials, EveryStringLengthIsCheckedAgainstTheSection) {
-  const LodChain c = chain_with_materials();
-  const std::vector<uint8_t> good = encode_lod_asset(c);
-  const uint64_t matl = matl_offset(good);
-  const size_t first_material = 16 + 12 + 16 * c.submeshes.size();
-  const size_t offsets[] = {0, 4, 40, 44, 48, 52};  // name, then the URIs in slot order
-  for (size_t k = 0; k < 6; ++k) {
-    std::vector<uint8_t> bytes = good;
-    uint32_t n = 0;
-    std::memcpy(&n, bytes.data() + matl + first_material + offsets[k], 4);
-    n += 4096 - 64;  // still under kMaxMaterialString, past the section's end
-    std::memcpy(bytes.data() + matl + first_material + offsets[k], &n, 4);
-    reseal(bytes);
-    LodChain out = sentinel();
-    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
-    ASSERT_FALSE(st) << k;
-    EXPECT_NE(st.message.find("MATL section: material 0 says its name and URIs take"), std::string::npos) << st.message;
-    EXPECT_EQ(out.name, "untouched");
-  }
-}
-
-// A bake format 7 asset (MATL layout 0: base colour texture only), the fuzz seed, still reads:
-// its materials get the new fields' defaults. (A cache of them rebakes: the bake format is in
-// the cache key.)
-TEST(LodAssetMaterials, ReadsTheFormat7LayoutWithDefaultsForTheNewFields) {
-  const std::filesystem::path seed = std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/lod/materials0.lod";
-  LodChain out;
-  const Status st = read_lod_asset(seed, out);
-  ASSERT_TRUE(st) << st.message;
-  ASSERT_FALSE(out.materials.empty());
-  const std::vector<uint8_t> bytes = test::read_bytes(seed);
-  uint32_t layout = 1;
-  std::memcpy(&layout, bytes.data() + matl_offset(bytes) + 12, 4);
-  EXPECT_EQ(layout, 0u) << "the seed is the old layout";
-  for (const ChainMaterial& m : out.materials) {
-    EXPECT_TRUE(m.normal_texture.empty());
-    EXPECT_TRUE(m.emissive_texture.empty());
-    EXPECT_EQ(m.normal_scale, 1.0f);
-    EXPECT_EQ(m.occlusion_strength, 1.0f);
-    EXPECT_EQ(m.emissive[0], 0.0f);
-  }
-  // Written again, it is the new layout, and reads back the same.
-  const std::vector<uint8_t> again = encode_lod_asset(out);
-  std::memcpy(&layout, again.data() + matl_offset(again) + 12, 4);
-  EXPECT_EQ(layout, 1u);
-  LodChain back;
-  ASSERT_TRUE(decode_lod_asset(again, "again.lod", back));
-  EXPECT_EQ(encode_lod_asset(back), again);
-}
-
 }  // namespace
 }  // namespace lod
 
@@ -558,6 +506,18 @@ TEST(LodAssetMaterials, ReadsTheFormat7LayoutWithDefaultsForTheNewFields) {
   LodChain back;
   ASSERT_TRUE(decode_lod_asset(again, "again.lod", back));
   EXPECT_EQ(encode_lod_asset(back), again);
+}
+
+// The layout 1 fuzz seed (materials0.lod with every texture slot filled) reads with them.
+TEST(LodAssetMaterials, TheLayout1SeedReadsWithEveryTexture) {
+  LodChain out;
+  const Status st = read_lod_asset(std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/lod/materials1.lod", out);
+  ASSERT_TRUE(st) << st.message;
+  ASSERT_FALSE(out.materials.empty());
+  EXPECT_EQ(out.materials[0].normal_texture, "n%20map.png");
+  EXPECT_EQ(out.materials[0].emissive_texture, "e.jpg");
+  EXPECT_EQ(out.materials[0].normal_scale, 0.5f);
+  EXPECT_EQ(out.materials[0].emissive[1], 0.5f);
 }
 
 }  // namespace
