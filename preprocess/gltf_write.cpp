@@ -94,6 +94,8 @@ std::string read_image(const fs::path& file, Image& out) {
 // Images of the materials, one per distinct file; image_of[material][slot] indexes `images`
 // (-1 = none).
 using SlotImages = std::array<int, kTextureSlots>;
+// Slots by name, in kTextureSlots order (runtime/chain_material.h).
+constexpr size_t kBaseColorSlot = 0, kMetallicRoughnessSlot = 1, kNormalSlot = 2, kOcclusionSlot = 3, kEmissiveSlot = 4;
 void load_images(const std::string& what, const GltfMeshView& m, std::vector<Image>& images,
                  std::vector<SlotImages>& image_of) {
   SlotImages none;
@@ -166,7 +168,7 @@ std::vector<float> unit_normals(const float* n, size_t count) {
 // Tangents are written when a primitive's material has a normal texture (and there are normals
 // and uvs), and referenced by those primitives only (elsewhere they would go unused).
 bool wants_tangents(const GltfMeshView& m, const std::vector<SlotImages>& image_of, int32_t material) {
-  return m.normals && m.uvs && material >= 0 && image_of[size_t(material)][2] >= 0;
+  return m.normals && m.uvs && material >= 0 && image_of[size_t(material)][kNormalSlot] >= 0;
 }
 
 json pack_buffer(const GltfMeshView& m, const std::vector<SlotImages>& image_of, Packed& p, json& primitives) {
@@ -255,13 +257,13 @@ void describe_materials(const GltfMeshView& m, const std::vector<SlotImages>& im
                                      unit(src.base_color[3])}},
                 {"metallicFactor", unit(src.metallic)},
                 {"roughnessFactor", unit(src.roughness)}};
-    if (img[0] >= 0) pbr["baseColorTexture"] = {{"index", texture(img[0])}};
-    if (img[1] >= 0) pbr["metallicRoughnessTexture"] = {{"index", texture(img[1])}};
+    if (img[kBaseColorSlot] >= 0) pbr["baseColorTexture"] = {{"index", texture(img[kBaseColorSlot])}};
+    if (img[kMetallicRoughnessSlot] >= 0) pbr["metallicRoughnessTexture"] = {{"index", texture(img[kMetallicRoughnessSlot])}};
     json mat = {{"pbrMetallicRoughness", pbr}, {"alphaMode", alpha_mode_name(src.alpha_mode)},
                 {"doubleSided", src.double_sided}};
-    if (img[2] >= 0) mat["normalTexture"] = {{"index", texture(img[2])}, {"scale", std::max(0.0f, src.normal_scale)}};
-    if (img[3] >= 0) mat["occlusionTexture"] = {{"index", texture(img[3])}, {"strength", unit(src.occlusion_strength)}};
-    if (img[4] >= 0) mat["emissiveTexture"] = {{"index", texture(img[4])}};
+    if (img[kNormalSlot] >= 0) mat["normalTexture"] = {{"index", texture(img[kNormalSlot])}, {"scale", std::max(0.0f, src.normal_scale)}};
+    if (img[kOcclusionSlot] >= 0) mat["occlusionTexture"] = {{"index", texture(img[kOcclusionSlot])}, {"strength", unit(src.occlusion_strength)}};
+    if (img[kEmissiveSlot] >= 0) mat["emissiveTexture"] = {{"index", texture(img[kEmissiveSlot])}};
     // The factor alone emits too (glTF: emitted = factor x texture, the texture 1 when absent).
     if (src.emissive[0] > 0 || src.emissive[1] > 0 || src.emissive[2] > 0)
       mat["emissiveFactor"] = {unit(src.emissive[0]), unit(src.emissive[1]), unit(src.emissive[2])};

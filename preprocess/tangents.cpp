@@ -33,8 +33,8 @@ V3 perpendicular(V3 n) {
 
 }  // namespace
 
-void compute_tangents(float* out, const float* positions, const float* normals, const float* uvs, size_t vertex_count,
-                      const uint32_t* indices, size_t index_count) {
+void compute_tangents(float* out, const float* positions, const float* normals, const float* uvs,
+                      size_t vertex_count, const uint32_t* indices, size_t index_count) {
   std::vector<V3> du(vertex_count), dv(vertex_count);
   for (size_t t = 0; t + 2 < index_count; t += 3) {
     const uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];

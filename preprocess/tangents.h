@@ -14,7 +14,7 @@ namespace lod {
 // out: 4 floats per vertex, each xyz unit length and perpendicular to the (normalised) normal,
 // w = +1 or -1. A vertex no triangle gives a usable direction (zero-area uv triangles only) gets
 // a unit vector perpendicular to its normal; a zero or non-finite normal is taken as +z.
-void compute_tangents(float* out, const float* positions, const float* normals, const float* uvs, size_t vertex_count,
-                      const uint32_t* indices, size_t index_count);
+void compute_tangents(float* out, const float* positions, const float* normals, const float* uvs,
+                      size_t vertex_count, const uint32_t* indices, size_t index_count);
 
 }  // namespace lod

@@ -1,12 +1,12 @@
 // Tangents for normal mapping (preprocess/tangents.h): along +u on a plain quad with w = +1,
 // w = -1 where the texture is mirrored, unit and perpendicular to the normal everywhere, and a
 // usable unit vector where the uvs give no direction.
+#include "preprocess/tangents.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
-
-#include "preprocess/tangents.h"
 
 namespace lod {
 namespace {
@@ -30,7 +30,8 @@ void expect_unit_and_perpendicular(const std::vector<float>& t, const std::vecto
 
 TEST(Tangents, FollowUWithPositiveHandednessOnAPlainQuad) {
   std::vector<float> t(16);
-  compute_tangents(t.data(), kPositions.data(), kNormals.data(), kUvs.data(), 4, kIndices.data(), kIndices.size());
+  compute_tangents(t.data(), kPositions.data(), kNormals.data(), kUvs.data(), 4, kIndices.data(),
+                   kIndices.size());
   for (size_t v = 0; v < 4; ++v) {
     EXPECT_NEAR(t[4 * v], 1.0f, 1e-6) << v;
     EXPECT_NEAR(t[4 * v + 1], 0.0f, 1e-6) << v;
@@ -43,7 +44,8 @@ TEST(Tangents, AMirroredTextureFlipsTheHandedness) {
   std::vector<float> uvs = kUvs;
   for (size_t v = 0; v < 4; ++v) uvs[2 * v + 1] = 1 - uvs[2 * v + 1];  // v up instead of down
   std::vector<float> t(16);
-  compute_tangents(t.data(), kPositions.data(), kNormals.data(), uvs.data(), 4, kIndices.data(), kIndices.size());
+  compute_tangents(t.data(), kPositions.data(), kNormals.data(), uvs.data(), 4, kIndices.data(),
+                   kIndices.size());
   for (size_t v = 0; v < 4; ++v) {
     EXPECT_NEAR(t[4 * v], 1.0f, 1e-6) << v;
     EXPECT_EQ(t[4 * v + 3], -1.0f) << v;
@@ -63,7 +65,8 @@ TEST(Tangents, DegenerateUvsAndZeroNormalsStillGiveUnitTangents) {
   std::vector<float> n = kNormals;
   n[6] = n[7] = n[8] = 0;  // vertex 2 has no normal: taken as +z
   std::vector<float> t(16, 7.0f);
-  compute_tangents(t.data(), kPositions.data(), n.data(), flat_uvs.data(), 4, kIndices.data(), kIndices.size());
+  compute_tangents(t.data(), kPositions.data(), n.data(), flat_uvs.data(), 4, kIndices.data(),
+                   kIndices.size());
   std::vector<float> as_used = n;
   as_used[8] = 1;
   expect_unit_and_perpendicular(t, as_used);
