@@ -29,7 +29,14 @@ nlohmann::json materials_json(const LodChain& chain) {
                    {"alpha_mode", alpha_name(m.alpha_mode)},
                    {"alpha_cutoff", m.alpha_cutoff},
                    {"double_sided", m.double_sided},
-                   {"base_color_texture", m.base_color_texture}});
+                   {"base_color_texture", m.base_color_texture},
+                   {"metallic_roughness_texture", m.metallic_roughness_texture},
+                   {"normal_texture", m.normal_texture},
+                   {"normal_scale", m.normal_scale},
+                   {"occlusion_texture", m.occlusion_texture},
+                   {"occlusion_strength", m.occlusion_strength},
+                   {"emissive", {m.emissive[0], m.emissive[1], m.emissive[2]}},
+                   {"emissive_texture", m.emissive_texture}});
   return out;
 }
 
@@ -44,10 +51,20 @@ void print_materials(const LodChain& chain) {
   std::printf("materials: %zu (texture base %s)\n", chain.materials.size(), printable(chain.texture_base).c_str());
   for (size_t i = 0; i < chain.materials.size(); ++i) {
     const ChainMaterial& m = chain.materials[i];
-    std::printf("  %zu '%s': base colour %.3g %.3g %.3g %.3g, metallic %.3g, roughness %.3g, %s%s%s%s\n", i,
+    std::printf("  %zu '%s': base colour %.3g %.3g %.3g %.3g, metallic %.3g, roughness %.3g, %s%s%s%s", i,
                 printable(m.name).c_str(), m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3], m.metallic,
                 m.roughness, alpha_name(m.alpha_mode), m.double_sided ? ", double-sided" : "",
                 m.base_color_texture.empty() ? "" : ", texture ", printable(m.base_color_texture).c_str());
+    if (m.emissive[0] > 0 || m.emissive[1] > 0 || m.emissive[2] > 0)
+      std::printf(", emissive %.3g %.3g %.3g", m.emissive[0], m.emissive[1], m.emissive[2]);
+    if (!m.metallic_roughness_texture.empty())
+      std::printf(", metallic-roughness texture %s", printable(m.metallic_roughness_texture).c_str());
+    if (!m.normal_texture.empty())
+      std::printf(", normal texture %s (scale %.3g)", printable(m.normal_texture).c_str(), m.normal_scale);
+    if (!m.occlusion_texture.empty())
+      std::printf(", occlusion texture %s (strength %.3g)", printable(m.occlusion_texture).c_str(), m.occlusion_strength);
+    if (!m.emissive_texture.empty()) std::printf(", emissive texture %s", printable(m.emissive_texture).c_str());
+    std::printf("\n");
   }
   for (uint32_t k = 0; k < chain.levels.size(); ++k) {
     const auto runs = level_submeshes(chain, k);
@@ -69,7 +86,12 @@ void export_surfaces(const LodChain& chain, uint32_t k, GltfMeshView& view) {
     g.alpha_mode = m.alpha_mode;
     g.alpha_cutoff = m.alpha_cutoff;
     g.double_sided = m.double_sided;
-    g.base_color_image = texture_file(chain.texture_base, m.base_color_texture);
+    g.normal_scale = m.normal_scale;
+    g.occlusion_strength = m.occlusion_strength;
+    std::copy(m.emissive, m.emissive + 3, g.emissive);
+    const auto uris = texture_slots(m);
+    const auto images = image_slots(g);
+    for (size_t s = 0; s < kTextureSlots; ++s) *images[s] = texture_file(chain.texture_base, *uris[s]);
     view.materials.push_back(std::move(g));
   }
   for (const LevelSubmesh& s : level_submeshes(chain, k)) view.submeshes.push_back({s.first_index, s.index_count, s.material});

@@ -832,7 +832,32 @@ AlphaMode alpha_mode_of(const std::string& s) {
   return AlphaMode::opaque;
 }
 
-Status read_materials(const std::string& what, const tinygltf::Model& m, std::vector<MeshMaterial>& out) {
+// One texture reference (textureInfo) of material `i`: the texture and image it names must
+// exist; an image inside the file is marked embedded; one read through another TEXCOORD than
+// the imported TEXCOORD_0 is left out with a warning.
+Status read_texture(const std::string& what, const tinygltf::Model& m, size_t i, const char* slot, int index,
+                    int tex_coord, std::string& uri, bool& embedded, std::vector<std::string>& warnings) {
+  if (index < 0) return Status::success();
+  const std::string name = what + ": material " + std::to_string(i) + ": " + slot;
+  if (size_t(index) >= m.textures.size())
+    return Status::error(name + " references texture " + std::to_string(index) + " of " + std::to_string(m.textures.size()));
+  const int image = m.textures[size_t(index)].source;
+  if (image < 0) return Status::success();
+  if (size_t(image) >= m.images.size())
+    return Status::error(name + ": texture " + std::to_string(index) + " references image " + std::to_string(image) +
+                         " of " + std::to_string(m.images.size()));
+  if (tex_coord != 0) {
+    warnings.push_back(name + " reads TEXCOORD_" + std::to_string(tex_coord) +
+                       "; only TEXCOORD_0 is imported, so the texture is not kept");
+    return Status::success();
+  }
+  uri = m.images[size_t(image)].uri;
+  embedded = uri.empty();
+  return Status::success();
+}
+
+Status read_materials(const std::string& what, const tinygltf::Model& m, std::vector<MeshMaterial>& out,
+                      std::vector<std::string>& warnings) {
   for (size_t i = 0; i < m.materials.size(); ++i) {
     const tinygltf::Material& src = m.materials[i];
     const tinygltf::PbrMetallicRoughness& pbr = src.pbrMetallicRoughness;
@@ -844,19 +869,25 @@ Status read_materials(const std::string& what, const tinygltf::Model& m, std::ve
     mat.alpha_mode = alpha_mode_of(src.alphaMode);
     mat.alpha_cutoff = float(src.alphaCutoff);
     mat.double_sided = src.doubleSided;
-    if (const int t = pbr.baseColorTexture.index; t >= 0) {
-      const std::string name = what + ": material " + std::to_string(i) + ": baseColorTexture";
-      if (size_t(t) >= m.textures.size())
-        return Status::error(name + " references texture " + std::to_string(t) + " of " + std::to_string(m.textures.size()));
-      const int image = m.textures[size_t(t)].source;
-      if (image >= 0) {
-        if (size_t(image) >= m.images.size())
-          return Status::error(name + ": texture " + std::to_string(t) + " references image " + std::to_string(image) +
-                               " of " + std::to_string(m.images.size()));
-        mat.base_color_texture = m.images[size_t(image)].uri;
-        mat.base_color_texture_embedded = mat.base_color_texture.empty();
-      }
-    }
+    // Factors as written; the bake clamps what is out of range and says so (add_chain_materials).
+    mat.normal_scale = float(src.normalTexture.scale);
+    mat.occlusion_strength = float(src.occlusionTexture.strength);
+    for (size_t c = 0; c < 3 && c < src.emissiveFactor.size(); ++c) mat.emissive[c] = float(src.emissiveFactor[c]);
+    const auto slots = texture_slots(mat);
+    const struct {
+      const char* name;
+      int index, tex_coord;
+    } refs[kTextureSlots] = {
+        {"baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord},
+        {"metallicRoughnessTexture", pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord},
+        {"normalTexture", src.normalTexture.index, src.normalTexture.texCoord},
+        {"occlusionTexture", src.occlusionTexture.index, src.occlusionTexture.texCoord},
+        {"emissiveTexture", src.emissiveTexture.index, src.emissiveTexture.texCoord}};
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (Status s = read_texture(what, m, i, refs[k].name, refs[k].index, refs[k].tex_coord, *slots[k].uri,
+                                  *slots[k].embedded, warnings);
+          !s)
+        return s;
     out.push_back(std::move(mat));
   }
   return Status::success();
@@ -958,7 +989,7 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
       }))
     warnings.push_back(what + ": normals dropped: " + missing_normals + " has none (they are recomputed when baking)");
   if (!missing_uvs.empty()) warnings.push_back(what + ": " + missing_uvs + " has no TEXCOORD_0; its vertices get (0, 0)");
-  if (Status s = read_materials(what, m, mesh.materials); !s) return s;
+  if (Status s = read_materials(what, m, mesh.materials, warnings); !s) return s;
   if (Status s = check_images(src, m); !s) return s;
   cap_warnings(mesh.warnings);
   out = std::move(mesh);

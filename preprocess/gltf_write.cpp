@@ -4,6 +4,8 @@
 //   each through a temporary file renamed into place.
 #include "preprocess/gltf_write.h"
 
+#include "preprocess/tangents.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -51,7 +53,9 @@ Status check_mesh(const std::string& what, const GltfMeshView& m) {
                          " indices");
   for (size_t i = 0; i < m.materials.size(); ++i) {
     const GltfMaterialView& mat = m.materials[i];
-    bool ok = std::isfinite(mat.metallic) && std::isfinite(mat.roughness) && std::isfinite(mat.alpha_cutoff);
+    bool ok = std::isfinite(mat.metallic) && std::isfinite(mat.roughness) && std::isfinite(mat.alpha_cutoff) &&
+              std::isfinite(mat.normal_scale) && std::isfinite(mat.occlusion_strength);
+    for (float c : mat.emissive) ok = ok && std::isfinite(c);
     for (float c : mat.base_color) ok = ok && std::isfinite(c);
     if (!ok) return Status::error(what + ": material " + std::to_string(i) + " has a non-finite factor");
   }
@@ -87,36 +91,45 @@ std::string read_image(const fs::path& file, Image& out) {
   return {};
 }
 
-// Images of the materials, one per distinct file; image_of[material] indexes `images` (-1 = none).
+// Images of the materials, one per distinct file; image_of[material][slot] indexes `images`
+// (-1 = none).
+using SlotImages = std::array<int, kTextureSlots>;
+// Slots by name, in kTextureSlots order (runtime/chain_material.h).
+constexpr size_t kBaseColorSlot = 0, kMetallicRoughnessSlot = 1, kNormalSlot = 2, kOcclusionSlot = 3, kEmissiveSlot = 4;
 void load_images(const std::string& what, const GltfMeshView& m, std::vector<Image>& images,
-                 std::vector<int>& image_of) {
-  image_of.assign(m.materials.size(), -1);
+                 std::vector<SlotImages>& image_of) {
+  SlotImages none;
+  none.fill(-1);
+  image_of.assign(m.materials.size(), none);
   std::vector<fs::path> files;
   for (size_t i = 0; i < m.materials.size(); ++i) {
-    const fs::path& file = m.materials[i].base_color_image;
-    if (file.empty()) continue;
-    auto note = [&](const std::string& why) {
-      if (m.notes)
-        m.notes->push_back(what + ": material " + std::to_string(i) + ": base colour texture " + file.string() + " " +
-                           why + "; written without it");
-    };
-    if (!m.uvs) {
-      note("needs texture coordinates, and the mesh has none");
-      continue;
+    const auto slots = image_slots(m.materials[i]);
+    for (size_t k = 0; k < kTextureSlots; ++k) {
+      const fs::path& file = *slots[k];
+      if (file.empty()) continue;
+      auto note = [&](const std::string& why) {
+        if (m.notes)
+          m.notes->push_back(what + ": material " + std::to_string(i) + ": " + kTextureSlotNames[k] + " texture " +
+                             file.string() + " " + why + "; written without it");
+      };
+      if (!m.uvs) {
+        note("needs texture coordinates, and the mesh has none");
+        continue;
+      }
+      const auto known = std::find(files.begin(), files.end(), file);
+      if (known != files.end()) {
+        image_of[i][k] = int(known - files.begin());
+        continue;
+      }
+      Image img;
+      if (const std::string why = read_image(file, img); !why.empty()) {
+        note("is " + why);
+        continue;
+      }
+      image_of[i][k] = int(images.size());
+      files.push_back(file);
+      images.push_back(std::move(img));
     }
-    const auto known = std::find(files.begin(), files.end(), file);
-    if (known != files.end()) {
-      image_of[i] = int(known - files.begin());
-      continue;
-    }
-    Image img;
-    if (const std::string why = read_image(file, img); !why.empty()) {
-      note("is " + why);
-      continue;
-    }
-    image_of[i] = int(images.size());
-    files.push_back(file);
-    images.push_back(std::move(img));
   }
 }
 
@@ -152,7 +165,13 @@ std::vector<float> unit_normals(const float* n, size_t count) {
   return out;
 }
 
-json pack_buffer(const GltfMeshView& m, Packed& p, json& primitives) {
+// Tangents are written when a primitive's material has a normal texture (and there are normals
+// and uvs), and referenced by those primitives only (elsewhere they would go unused).
+bool wants_tangents(const GltfMeshView& m, const std::vector<SlotImages>& image_of, int32_t material) {
+  return m.normals && m.uvs && material >= 0 && image_of[size_t(material)][kNormalSlot] >= 0;
+}
+
+json pack_buffer(const GltfMeshView& m, const std::vector<SlotImages>& image_of, Packed& p, json& primitives) {
   static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
   json attributes;
   const int pos = p.add(m.positions, 12 * m.vertex_count, kArrayBuffer, kFloat, m.vertex_count, "VEC3");
@@ -173,6 +192,11 @@ json pack_buffer(const GltfMeshView& m, Packed& p, json& primitives) {
   if (m.uvs) attributes["TEXCOORD_0"] = p.add(m.uvs, 8 * m.vertex_count, kArrayBuffer, kFloat, m.vertex_count, "VEC2");
   std::vector<GltfSubmeshView> runs = m.submeshes;
   if (runs.empty()) runs.push_back({0, m.index_count, -1});
+  if (std::any_of(runs.begin(), runs.end(), [&](const GltfSubmeshView& r) { return wants_tangents(m, image_of, r.material); })) {
+    std::vector<float> t(4 * m.vertex_count);
+    compute_tangents(t.data(), m.positions, m.normals, m.uvs, m.vertex_count, m.indices, m.index_count);
+    attributes["TANGENT"] = p.add(t.data(), 4 * t.size(), kArrayBuffer, kFloat, m.vertex_count, "VEC4");
+  }
   primitives = json::array();
   for (const GltfSubmeshView& run : runs) {
     const uint32_t* first = m.indices + run.first_index;
@@ -184,6 +208,7 @@ json pack_buffer(const GltfMeshView& m, Packed& p, json& primitives) {
       indices = p.add(first, 4 * run.index_count, kElementArrayBuffer, kUInt, run.index_count, "SCALAR");
     }
     json prim = {{"attributes", attributes}, {"indices", indices}, {"mode", 4}};
+    if (!wants_tangents(m, image_of, run.material)) prim["attributes"].erase("TANGENT");
     if (run.material >= 0) prim["material"] = run.material;
     primitives.push_back(std::move(prim));
   }
@@ -215,23 +240,33 @@ const char* alpha_mode_name(AlphaMode a) {
 float unit(float x) { return std::clamp(x, 0.0f, 1.0f); }
 
 // Materials, and the textures (one per image) they use.
-void describe_materials(const GltfMeshView& m, const std::vector<int>& image_of, json& j) {
+void describe_materials(const GltfMeshView& m, const std::vector<SlotImages>& image_of, json& j) {
   if (m.materials.empty()) return;
   json materials = json::array(), textures = json::array();
+  auto texture = [&](int image) {
+    const json t = {{"sampler", 0}, {"source", image}};
+    const auto known = std::find(textures.begin(), textures.end(), t);
+    if (known != textures.end()) return size_t(known - textures.begin());
+    textures.push_back(t);
+    return textures.size() - 1;
+  };
   for (size_t i = 0; i < m.materials.size(); ++i) {
     const GltfMaterialView& src = m.materials[i];
+    const SlotImages& img = image_of[i];
     json pbr = {{"baseColorFactor", {unit(src.base_color[0]), unit(src.base_color[1]), unit(src.base_color[2]),
                                      unit(src.base_color[3])}},
                 {"metallicFactor", unit(src.metallic)},
                 {"roughnessFactor", unit(src.roughness)}};
-    if (image_of[i] >= 0) {
-      const auto known = std::find(textures.begin(), textures.end(), json{{"sampler", 0}, {"source", image_of[i]}});
-      const size_t t = size_t(known - textures.begin());
-      if (known == textures.end()) textures.push_back({{"sampler", 0}, {"source", image_of[i]}});
-      pbr["baseColorTexture"] = {{"index", t}};
-    }
+    if (img[kBaseColorSlot] >= 0) pbr["baseColorTexture"] = {{"index", texture(img[kBaseColorSlot])}};
+    if (img[kMetallicRoughnessSlot] >= 0) pbr["metallicRoughnessTexture"] = {{"index", texture(img[kMetallicRoughnessSlot])}};
     json mat = {{"pbrMetallicRoughness", pbr}, {"alphaMode", alpha_mode_name(src.alpha_mode)},
                 {"doubleSided", src.double_sided}};
+    if (img[kNormalSlot] >= 0) mat["normalTexture"] = {{"index", texture(img[kNormalSlot])}, {"scale", std::max(0.0f, src.normal_scale)}};
+    if (img[kOcclusionSlot] >= 0) mat["occlusionTexture"] = {{"index", texture(img[kOcclusionSlot])}, {"strength", unit(src.occlusion_strength)}};
+    if (img[kEmissiveSlot] >= 0) mat["emissiveTexture"] = {{"index", texture(img[kEmissiveSlot])}};
+    // The factor alone emits too (glTF: emitted = factor x texture, the texture 1 when absent).
+    if (src.emissive[0] > 0 || src.emissive[1] > 0 || src.emissive[2] > 0)
+      mat["emissiveFactor"] = {unit(src.emissive[0]), unit(src.emissive[1]), unit(src.emissive[2])};
     if (!src.name.empty()) mat["name"] = src.name;
     if (src.alpha_mode == AlphaMode::mask) mat["alphaCutoff"] = std::max(0.0f, src.alpha_cutoff);
     materials.push_back(std::move(mat));
@@ -337,11 +372,11 @@ Status save_gltf(const std::filesystem::path& path, const GltfMeshView& mesh) {
     return Status::error(what + ": glTF export needs a .glb or .gltf name, not '" + path.extension().string() + "'");
   if (Status s = check_mesh(what, mesh); !s) return s;
   std::vector<Image> images;
-  std::vector<int> image_of;
+  std::vector<SlotImages> image_of;
   load_images(what, mesh, images, image_of);
   Packed packed;
   json primitives, image_list = json::array();
-  pack_buffer(mesh, packed, primitives);
+  pack_buffer(mesh, image_of, packed, primitives);
   if (ext == ".glb") pack_images(images, packed, image_list);
   if (uint64_t(packed.bin.size()) + (uint64_t(1) << 20) > std::numeric_limits<uint32_t>::max())
     return Status::error(what + ": " + std::to_string(packed.bin.size()) + " bytes of buffer exceed what GLB holds (4 GiB)");

@@ -3,10 +3,15 @@
 // buffer, one tightly packed buffer view per attribute and for the indices (each 4-byte
 // aligned, with its target), POSITION with min/max, unit NORMALs, TEXCOORD_0, u16 indices
 // when the vertices fit, else u32; one node, one scene; one primitive per submesh (they share
-// the vertex attributes), each with its metallic-roughness material; a base colour image (PNG
-// or JPEG) is embedded in the GLB's buffer, or copied next to a .gltf. Output passes the
-// Khronos validator with 0 errors (tests/integration/gltf_export_test.cpp).
+// the vertex attributes), each with its metallic-roughness material; its images (PNG or JPEG:
+// base colour, metallic-roughness, normal, occlusion, emissive) are embedded in the GLB's
+// buffer, or copied next to a .gltf. With a normal texture (and normals and uvs) the mesh gets
+// TANGENTs computed here (per-triangle accumulation from positions and uvs, orthogonalised
+// against the normal, w the handedness), referenced by the primitives whose material has the
+// normal texture, so no viewer has to generate a tangent space. Output passes the Khronos
+// validator with 0 errors (tests/integration/gltf_export_test.cpp).
 #pragma once
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -26,10 +31,25 @@ struct GltfMaterialView {
   AlphaMode alpha_mode = AlphaMode::opaque;
   float alpha_cutoff = 0.5f;
   bool double_sided = false;
-  // A PNG or JPEG file (by its first bytes) to use as baseColorTexture; empty = none. One that
-  // is missing, unreadable, not PNG/JPEG or larger than 256 MiB is left out, said in `notes`.
+  // PNG or JPEG files (by their first bytes) for the textures; empty = none. One that is
+  // missing, unreadable, not PNG/JPEG or larger than 256 MiB is left out, said in `notes`.
   std::filesystem::path base_color_image;
+  std::filesystem::path metallic_roughness_image;
+  std::filesystem::path normal_image;
+  std::filesystem::path occlusion_image;
+  std::filesystem::path emissive_image;
+  float normal_scale = 1;        // written as normalTexture.scale
+  float occlusion_strength = 1;  // occlusionTexture.strength
+  float emissive[3] = {0, 0, 0};  // emissiveFactor
 };
+
+// The images in kTextureSlots order (runtime/chain_material.h).
+inline std::array<const std::filesystem::path*, kTextureSlots> image_slots(const GltfMaterialView& m) {
+  return {&m.base_color_image, &m.metallic_roughness_image, &m.normal_image, &m.occlusion_image, &m.emissive_image};
+}
+inline std::array<std::filesystem::path*, kTextureSlots> image_slots(GltfMaterialView& m) {
+  return {&m.base_color_image, &m.metallic_roughness_image, &m.normal_image, &m.occlusion_image, &m.emissive_image};
+}
 
 // Triangles [first_index, first_index + index_count) of the mesh drawn with `material`
 // (-1 = the default material).

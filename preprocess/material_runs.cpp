@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <unordered_map>
 
@@ -137,10 +138,40 @@ bool storable(const std::string& s) {
   return true;
 }
 
-float unit(float x, bool& clamped) {
-  const float y = std::isfinite(x) ? std::clamp(x, 0.0f, 1.0f) : 1.0f;
-  clamped = clamped || y != x;
+float unit(float x, bool& clamped, float fallback = 1.0f) {
+  const float y = std::isfinite(x) ? std::clamp(x, 0.0f, 1.0f) : fallback;
+  clamped = clamped || !(y == x);
   return y;
+}
+
+std::string number_text(float x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", double(x));
+  return b;
+}
+
+// The texture factors: normalTexture.scale >= 0 and finite (a negative one, which would turn
+// the relief inside out, becomes 0 with a note: no viewer or exporter here flips normals),
+// occlusion strength and emissive factor in [0, 1].
+void keep_texture_factors(const MeshMaterial& m, const std::string& at, ChainMaterial& c, std::vector<std::string>& notes) {
+  if (std::isfinite(m.normal_scale) && m.normal_scale >= 0 && m.normal_scale <= 1e6f) {
+    c.normal_scale = m.normal_scale;
+  } else {
+    c.normal_scale = std::isfinite(m.normal_scale) ? std::clamp(m.normal_scale, 0.0f, 1e6f) : 1.0f;
+    notes.push_back(at + ": normalTexture.scale " + number_text(m.normal_scale) + " is " +
+                    (std::isfinite(m.normal_scale) ? "out of [0, 1e6]" : "not finite") + ", clamped to " +
+                    number_text(c.normal_scale));
+  }
+  bool clamped = false;
+  c.occlusion_strength = unit(m.occlusion_strength, clamped);
+  if (clamped)
+    notes.push_back(at + ": occlusionTexture.strength " + number_text(m.occlusion_strength) + " outside [0, 1], clamped to " +
+                    number_text(c.occlusion_strength));
+  clamped = false;
+  for (int k = 0; k < 3; ++k) c.emissive[k] = unit(m.emissive[k], clamped, 0.0f);
+  if (clamped)
+    notes.push_back(at + ": emissive factor " + number_text(m.emissive[0]) + " " + number_text(m.emissive[1]) + " " +
+                    number_text(m.emissive[2]) + " outside [0, 1] or not finite, clamped");
 }
 
 }  // namespace
@@ -157,27 +188,32 @@ void add_chain_materials(const MeshData& mesh, const std::filesystem::path& sour
                     std::to_string(kMaxMaterials) + " are drawn with the default material (not kept)");
   for (size_t i = 0; i < count; ++i) {
     const MeshMaterial& m = mesh.materials[i];
-    const std::string at = "material " + std::to_string(i) + " ('" + (storable(m.name) ? m.name : "?") + "')";
+    const std::string at = mesh.source + ": material " + std::to_string(i) + " ('" + (storable(m.name) ? m.name : "?") + "')";
     ChainMaterial c;
     c.name = storable(m.name) ? m.name : "material" + std::to_string(i);
     bool clamped = false;
     for (int k = 0; k < 4; ++k) c.base_color[k] = unit(m.base_color[k], clamped);
     c.metallic = unit(m.metallic, clamped);
     c.roughness = unit(m.roughness, clamped);
-    if (clamped) notes.push_back(at + ": factors outside [0, 1] clamped");
+    if (clamped) notes.push_back(at + ": base colour, metallic or roughness factors outside [0, 1] clamped");
     c.alpha_mode = m.alpha_mode;
     c.alpha_cutoff = std::isfinite(m.alpha_cutoff) && m.alpha_cutoff >= 0 ? std::min(m.alpha_cutoff, 1e6f) : 0.5f;
     c.double_sided = m.double_sided;
-    const std::string& uri = m.base_color_texture;
-    if (m.base_color_texture_embedded || uri.rfind("data:", 0) == 0)
-      notes.push_back(at + ": its base colour texture is embedded in " + mesh.source +
-                      "; the levels reference no texture for it (not kept)");
-    else if (!storable(uri))
-      notes.push_back(at + ": base colour texture URI is too long or has control bytes (not kept)");
-    else if (chain.texture_base.empty() && !uri.empty())
-      notes.push_back(at + ": the source's folder cannot be stored, so its texture '" + uri + "' is not kept");
-    else
-      c.base_color_texture = uri;
+    keep_texture_factors(m, at, c, notes);
+    const auto from = texture_slots(m);
+    const auto to = texture_slots(c);
+    for (size_t k = 0; k < kTextureSlots; ++k) {
+      const std::string& uri = *from[k].uri;
+      const std::string slot = kTextureSlotNames[k];
+      if (*from[k].embedded || uri.rfind("data:", 0) == 0)
+        notes.push_back(at + ": its " + slot + " texture is embedded in the file; the levels reference no texture for it (not kept)");
+      else if (!storable(uri))
+        notes.push_back(at + ": " + slot + " texture URI is too long or has control bytes (not kept)");
+      else if (chain.texture_base.empty() && !uri.empty())
+        notes.push_back(at + ": the source's folder cannot be stored, so its " + slot + " texture '" + uri + "' is not kept");
+      else
+        *to[k] = uri;
+    }
     chain.materials.push_back(std::move(c));
   }
 }

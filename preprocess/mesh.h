@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "runtime/chain_material.h"  // AlphaMode
@@ -22,7 +23,37 @@ struct MeshMaterial {
   AlphaMode alpha_mode = AlphaMode::opaque;
   float alpha_cutoff = 0.5f;  // for AlphaMode::mask
   bool double_sided = false;
+  // The other textures, each an image URI (empty when none) with its own embedded flag, in
+  // kTextureSlots order after the base colour: metallic-roughness, normal, occlusion, emissive.
+  std::string metallic_roughness_texture;
+  std::string normal_texture;
+  std::string occlusion_texture;
+  std::string emissive_texture;
+  bool metallic_roughness_texture_embedded = false;
+  bool normal_texture_embedded = false;
+  bool occlusion_texture_embedded = false;
+  bool emissive_texture_embedded = false;
+  float normal_scale = 1;          // glTF normalTexture.scale (MTL: bump -bm); the bake keeps it >= 0
+  float occlusion_strength = 1;    // glTF occlusionTexture.strength, [0, 1]
+  float emissive[3] = {0, 0, 0};   // glTF emissiveFactor (MTL: Ke), linear RGB in [0, 1]
 };
+
+// A material's textures in kTextureSlots order (runtime/chain_material.h), for loops over them.
+template <class Material, class Uri = std::conditional_t<std::is_const_v<Material>, const std::string, std::string>,
+          class Flag = std::conditional_t<std::is_const_v<Material>, const bool, bool>>
+struct MeshTextureSlot {
+  Uri* uri;
+  Flag* embedded;
+};
+template <class Material>
+  requires std::is_same_v<std::remove_const_t<Material>, MeshMaterial>
+std::array<MeshTextureSlot<Material>, kTextureSlots> texture_slots(Material& m) {
+  return {{{&m.base_color_texture, &m.base_color_texture_embedded},
+           {&m.metallic_roughness_texture, &m.metallic_roughness_texture_embedded},
+           {&m.normal_texture, &m.normal_texture_embedded},
+           {&m.occlusion_texture, &m.occlusion_texture_embedded},
+           {&m.emissive_texture, &m.emissive_texture_embedded}}};
+}
 
 // A run of consecutive triangles drawn with one material (-1 = the default material).
 struct Submesh {

@@ -239,12 +239,14 @@ Status obj_materials(const std::string& name, const fs::path& base_dir, ObjAttri
     const auto it = std::find(found_names.begin(), found_names.end(), attr.material_names[m]);
     if (it != found_names.end()) {
       out.push_back(found[size_t(it - found_names.begin())]);
-      const std::string& uri = out.back().base_color_texture;
-      if (!uri.empty() && !base_dir.empty()) {
+      static const char* kStatement[kTextureSlots] = {"map_Kd", "", "map_Bump", "", "map_Ke"};
+      for (size_t k = 0; k < kTextureSlots; ++k) {
+        const std::string& uri = *texture_slots(out.back())[k].uri;
+        if (uri.empty() || base_dir.empty()) continue;
         const fs::path image = base_dir / decode_uri(uri);
         std::error_code ec;
         if (!fs::is_regular_file(image, ec))
-          return Status::error(name + ": material '" + quote_token(attr.material_names[m]) + "': map_Kd '" +
+          return Status::error(name + ": material '" + quote_token(attr.material_names[m]) + "': " + kStatement[k] + " '" +
                                quote_token(decode_uri(uri)) + "' not found (looked for " + image.string() + ")");
       }
       continue;

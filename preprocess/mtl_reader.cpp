@@ -4,10 +4,18 @@
 //   d a / Tr t             alpha (Tr is 1 - d); below 1 the material blends
 //   map_Kd [opts] FILE     base colour texture (options and their values skipped; the rest
 //                          of the line is the file)
-// Ns, Ka, Ks, Ke, illum, bump and the other maps have no place in the levels' material: each
-// keyword is named once in the warnings. Errors name the file and line.
+//   Ke r g b               emissive factor (clamped to [0, 1] by the bake)
+//   map_Ke [opts] FILE     emissive texture (before any non-zero Ke, the factor becomes 1 1 1:
+//                          glTF multiplies the texture by it)
+//   map_Bump / bump / norm [-bm s] [opts] FILE
+//                          normal texture (read as a tangent-space normal map, as glTF's
+//                          normalTexture; -bm gives its scale). A height-field bump map is
+//                          not converted: it is taken as a normal map.
+// Ns, Ka, Ks, illum and the other maps have no place in the levels' material: each keyword is
+// named once in the warnings. Errors name the file and line.
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <set>
@@ -27,6 +35,33 @@ std::string_view next_token(std::string_view line, size_t& at) {
   const std::string_view t = line.substr(at, e - at);
   at = e;
   return t;
+}
+
+// The file a map statement names, after its options ("-s 1 1 1", "-clamp on", ...), each with
+// its values; the rest of the line is the file (names may hold spaces). The value of "-bm"
+// (bump multiplier) goes to `bm` when it is a number.
+std::string_view map_file(std::string_view line, size_t& at, std::string& number, float& bm) {
+  for (;;) {
+    size_t before = at;
+    const std::string_view t = next_token(line, at);
+    if (t.empty()) return {};
+    if (t[0] != '-' || t.size() < 2 || std::isdigit(uint8_t(t[1])) || t[1] == '.') {
+      while (before < line.size() && blank(line[before])) ++before;
+      std::string_view file = line.substr(before);
+      while (!file.empty() && blank(file.back())) file.remove_suffix(1);
+      return file;
+    }
+    for (size_t peek = at, values = 0;; ++values) {  // the option's values: numbers, on / off
+      const std::string_view v = next_token(line, peek);
+      char* stop = nullptr;
+      number.assign(v.substr(0, 64));
+      const double d = v.empty() ? 0 : std::strtod(number.c_str(), &stop);
+      const bool numeric = !v.empty() && stop != number.c_str();
+      if (!(numeric || v == "on" || v == "off")) break;
+      if (numeric && values == 0 && t == "-bm") bm = float(d);
+      at = peek;
+    }
+  }
 }
 
 }  // namespace
@@ -87,31 +122,26 @@ Status read_mtl(const std::string& what, const uint8_t* data, size_t size, const
       if (Status s = numbers(&a, 1, 1); !s) return s;
       current->base_color[3] = key == "d" ? a : 1 - a;
       if (current->base_color[3] < 1) current->alpha_mode = AlphaMode::blend;
-    } else if (key == "map_Kd") {
-      // Options ("-s 1 1 1", "-clamp on", ...) first, each with its values; the rest of the
-      // line is the file (names may hold spaces).
-      std::string_view file;
-      for (;;) {
-        size_t before = at;
-        const std::string_view t = next_token(line, at);
-        if (t.empty()) break;
-        if (t[0] != '-' || t.size() < 2 || std::isdigit(uint8_t(t[1])) || t[1] == '.') {
-          while (before < line.size() && blank(line[before])) ++before;
-          file = line.substr(before);
-          while (!file.empty() && blank(file.back())) file.remove_suffix(1);
-          break;
-        }
-        for (size_t peek = at;;) {  // the option's values: numbers, on / off
-          const std::string_view v = next_token(line, peek);
-          char* stop = nullptr;
-          number.assign(v.substr(0, 64));
-          const bool numeric = !v.empty() && (std::strtod(number.c_str(), &stop), stop != number.c_str());
-          if (!(numeric || v == "on" || v == "off")) break;
-          at = peek;
-        }
+    } else if (key == "Ke") {
+      if (Status s = numbers(current->emissive, 3, 1); !s) return s;
+    } else if (key == "map_Kd" || key == "map_Ke" || key == "map_Bump" || key == "map_bump" || key == "bump" ||
+               key == "norm") {
+      float bm = 1;
+      const std::string_view file = map_file(line, at, number, bm);
+      if (file.empty()) return Status::error(here + ": " + std::string(key) + " without a file name");
+      const std::string uri = path_to_uri(prefix + std::string(file));
+      if (key == "map_Kd") {
+        current->base_color_texture = uri;
+      } else if (key == "map_Ke") {
+        current->emissive_texture = uri;
+        // glTF multiplies the texture by the factor: without a Ke so far, the texture emits as is.
+        if (current->emissive[0] == 0 && current->emissive[1] == 0 && current->emissive[2] == 0)
+          std::fill(current->emissive, current->emissive + 3, 1.0f);
+      } else {
+        if (!std::isfinite(bm)) return Status::error(here + ": " + std::string(key) + " -bm needs a finite number");
+        current->normal_texture = uri;
+        current->normal_scale = bm;
       }
-      if (file.empty()) return Status::error(here + ": map_Kd without a file name");
-      current->base_color_texture = path_to_uri(prefix + std::string(file));
     } else {
       skipped.insert(std::string(key));
     }

@@ -2,6 +2,7 @@
 // read them (from glTF or OBJ/MTL), with textures named by URI, never loaded; and the runs
 // of each level's triangles drawn with one material (a level's triangles grouped by material).
 #pragma once
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -22,10 +23,30 @@ struct ChainMaterial {
   AlphaMode alpha_mode = AlphaMode::opaque;
   float alpha_cutoff = 0.5f;  // for AlphaMode::mask, >= 0
   bool double_sided = false;
-  // Base colour image: an RFC 3986 relative URI (percent-encoded, '/' separated) against
-  // LodChain::texture_base, the source file's folder; empty = none.
+  // Images: RFC 3986 relative URIs (percent-encoded, '/' separated) against
+  // LodChain::texture_base, the source file's folder; empty = none. All read TEXCOORD_0.
   std::string base_color_texture;
+  std::string metallic_roughness_texture;  // glTF: roughness in G, metalness in B
+  std::string normal_texture;              // tangent-space normals
+  std::string occlusion_texture;           // ambient occlusion in R
+  std::string emissive_texture;            // sRGB emitted colour
+  float normal_scale = 1;                  // normalTexture.scale, >= 0 (finite)
+  float occlusion_strength = 1;            // occlusionTexture.strength, [0, 1]
+  float emissive[3] = {0, 0, 0};           // emissiveFactor, each in [0, 1]
 };
+
+// The five texture slots of a material, in this order everywhere (asset, export, messages).
+inline constexpr size_t kTextureSlots = 5;
+inline constexpr const char* kTextureSlotNames[kTextureSlots] = {"base colour", "metallic-roughness", "normal",
+                                                                 "occlusion", "emissive"};
+inline std::array<std::string*, kTextureSlots> texture_slots(ChainMaterial& m) {
+  return {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.occlusion_texture,
+          &m.emissive_texture};
+}
+inline std::array<const std::string*, kTextureSlots> texture_slots(const ChainMaterial& m) {
+  return {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.occlusion_texture,
+          &m.emissive_texture};
+}
 
 // Triangles [first_index, first_index + index_count) of level `level` (level-local: 0 is the
 // level's first index) drawn with material `material` (-1 = the default material).

@@ -1,4 +1,4 @@
-// The .lod asset, version 1. All integers and floats little-endian:
+// The .lod asset, version 1 (optional sections added since; see each). All integers and floats little-endian:
 //
 //   magic "LODKIT\x1a\n" (8) | u32 version | u32 section count
 //   section table: count x {u32 tag, u32 flags, u64 offset, u64 size}
@@ -16,12 +16,16 @@
 // TEX0 (optional, flag 0; written only when the chain has texture coordinates): u32 level
 //       count, f32 uv error per level, then 2 f32 per vertex (LodChain::uvs).
 // MATL (optional, flag 0; written only when the chain has materials): u32 material count,
-//       u32 submesh count, u32 texture base bytes, u32 0; the texture base (UTF-8); 16 bytes
-//       per submesh (u32 level, u32 first index, u32 index count, i32 material); then per
-//       material 40 bytes (u32 name bytes, u32 texture URI bytes, f32 base colour[4], f32
-//       metallic, f32 roughness, f32 alpha cutoff, u8 alpha mode, u8 double-sided, u16 0) and
-//       its name and URI. Every count and length is checked against the section's bytes
-//       before anything is allocated; the values by validate_chain.
+//       u32 submesh count, u32 texture base bytes, u32 layout; the texture base (UTF-8); 16
+//       bytes per submesh (u32 level, u32 first index, u32 index count, i32 material); then per
+//       material a fixed record and its strings. Layout 1 (written since bake format 8): 76
+//       bytes (u32 name bytes, u32 base colour URI bytes, f32 base colour[4], f32 metallic, f32
+//       roughness, f32 alpha cutoff, u8 alpha mode, u8 double-sided, u16 0, u32 URI bytes of
+//       the metallic-roughness, normal, occlusion and emissive textures, f32 normal scale, f32
+//       occlusion strength, f32 emissive[3]), then its name and five URIs in that order.
+//       Layout 0 (bake format 7, read as before): the first 40 bytes only, name and base
+//       colour URI. Every count and length is checked against the section's bytes before
+//       anything is allocated or copied; the values by validate_chain.
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
 //       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
@@ -72,7 +76,9 @@ constexpr uint32_t kTex0 = fourcc("TEX0");
 constexpr uint32_t kMatl = fourcc("MATL");
 constexpr size_t kMatlFixedBytes = 16;
 constexpr size_t kSubmeshBytes = 16;
-constexpr size_t kMaterialFixedBytes = 40;
+constexpr size_t kMaterialFixedBytes = 40;     // layout 0's record
+constexpr size_t kMaterialTexturedBytes = 76;  // layout 1's
+constexpr uint32_t kMatlLayout = 1;
 constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
@@ -234,7 +240,7 @@ void put_materials(Writer& w, const LodChain& c) {
   w.u32(static_cast<uint32_t>(c.materials.size()));
   w.u32(static_cast<uint32_t>(c.submeshes.size()));
   w.u32(static_cast<uint32_t>(c.texture_base.size()));
-  w.u32(0);
+  w.u32(kMatlLayout);
   w.raw(c.texture_base.data(), c.texture_base.size());
   for (const LevelSubmesh& s : c.submeshes) {
     w.u32(s.level);
@@ -253,8 +259,13 @@ void put_materials(Writer& w, const LodChain& c) {
     w.u8(m.double_sided ? 1 : 0);
     w.u8(0);
     w.u8(0);
+    const auto uris = texture_slots(m);
+    for (size_t k = 1; k < kTextureSlots; ++k) w.u32(static_cast<uint32_t>(uris[k]->size()));
+    w.f32(m.normal_scale);
+    w.f32(m.occlusion_strength);
+    for (float f : m.emissive) w.f32(f);
     w.raw(m.name.data(), m.name.size());
-    w.raw(m.base_color_texture.data(), m.base_color_texture.size());
+    for (const std::string* uri : uris) w.raw(uri->data(), uri->size());
   }
 }
 
@@ -264,12 +275,16 @@ Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, L
   if (size < kMatlFixedBytes)
     return bad(std::to_string(size) + " bytes, needs " + std::to_string(kMatlFixedBytes) + " at least");
   const uint64_t materials = load_u32(p), submeshes = load_u32(p + 4), base_bytes = load_u32(p + 8);
-  if (load_u32(p + 12) != 0) return bad("reserved word is not 0");
+  const uint32_t layout = load_u32(p + 12);
+  if (layout > kMatlLayout)
+    return bad("layout " + std::to_string(layout) + " is newer than this build reads (" + std::to_string(kMatlLayout) +
+               "); use a newer lodkit or re-bake it");
+  const uint64_t record = layout == 0 ? kMaterialFixedBytes : kMaterialTexturedBytes;
   if (materials > kMaxMaterials)
     return bad(std::to_string(materials) + " materials, at most " + std::to_string(kMaxMaterials));
   if (base_bytes > kMaxMaterialString) return bad("texture base of " + std::to_string(base_bytes) + " bytes is too long");
   uint64_t at = kMatlFixedBytes;
-  const uint64_t fixed = base_bytes + submeshes * kSubmeshBytes + materials * kMaterialFixedBytes;
+  const uint64_t fixed = base_bytes + submeshes * kSubmeshBytes + materials * record;
   if (fixed > size - at)
     return bad(std::to_string(materials) + " materials and " + std::to_string(submeshes) + " submeshes need " +
                std::to_string(at + fixed) + " bytes at least, the section has " + std::to_string(size));
@@ -286,9 +301,10 @@ Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, L
   chain.materials.resize(materials);
   for (uint64_t i = 0; i < materials; ++i) {
     const std::string where = "material " + std::to_string(i);
-    if (kMaterialFixedBytes > size - at) return bad(where + " is cut off at byte " + std::to_string(at));
+    if (record > size - at) return bad(where + " is cut off at byte " + std::to_string(at));
     ChainMaterial& m = chain.materials[i];
-    const uint64_t name_bytes = load_u32(p + at), uri_bytes = load_u32(p + at + 4);
+    const auto uris = texture_slots(m);
+    uint64_t lengths[1 + kTextureSlots] = {load_u32(p + at), load_u32(p + at + 4)};  // name, then the URIs
     for (int c = 0; c < 4; ++c) m.base_color[c] = load_f32(p + at + 8 + 4 * c);
     m.metallic = load_f32(p + at + 24);
     m.roughness = load_f32(p + at + 28);
@@ -298,13 +314,29 @@ Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, L
     if (sided > 1) return bad(where + " has double-sided flag " + std::to_string(sided));
     m.alpha_mode = static_cast<AlphaMode>(mode);
     m.double_sided = sided == 1;
-    at += kMaterialFixedBytes;
-    if (name_bytes > kMaxMaterialString || uri_bytes > kMaxMaterialString || name_bytes + uri_bytes > size - at)
-      return bad(where + " says its name and URI take " + std::to_string(name_bytes) + " + " +
-                 std::to_string(uri_bytes) + " bytes; " + std::to_string(size - at) + " are left");
-    m.name.assign(reinterpret_cast<const char*>(p + at), name_bytes);
-    m.base_color_texture.assign(reinterpret_cast<const char*>(p + at + name_bytes), uri_bytes);
-    at += name_bytes + uri_bytes;
+    if (layout >= 1) {
+      for (size_t k = 1; k < kTextureSlots; ++k) lengths[1 + k] = load_u32(p + at + 40 + 4 * (k - 1));
+      m.normal_scale = load_f32(p + at + 56);
+      m.occlusion_strength = load_f32(p + at + 60);
+      for (int c = 0; c < 3; ++c) m.emissive[c] = load_f32(p + at + 64 + 4 * c);
+    }
+    at += record;
+    // Each length bounded first, so their sum cannot overflow.
+    uint64_t strings = 0;
+    for (uint64_t n : lengths) {
+      if (n > kMaxMaterialString)
+        return bad(where + " has a name or URI of " + std::to_string(n) + " bytes, at most " + std::to_string(kMaxMaterialString));
+      strings += n;
+    }
+    if (strings > size - at)
+      return bad(where + " says its name and URIs take " + std::to_string(strings) + " bytes; " + std::to_string(size - at) +
+                 " are left");
+    m.name.assign(reinterpret_cast<const char*>(p + at), lengths[0]);
+    at += lengths[0];
+    for (size_t k = 0; k < kTextureSlots; ++k) {
+      uris[k]->assign(reinterpret_cast<const char*>(p + at), lengths[1 + k]);
+      at += lengths[1 + k];
+    }
   }
   if (at != size) return bad(std::to_string(size - at) + " bytes left over after the last material");
   return Status::success();

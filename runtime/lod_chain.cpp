@@ -57,8 +57,15 @@ bool validate_materials(const LodChain& chain, std::string* message) {
     const ChainMaterial& m = chain.materials[i];
     const std::string at = "material " + std::to_string(i);
     if (!printable_string(m.name)) return fail(message, at + " name is too long or has control bytes");
-    if (!printable_string(m.base_color_texture))
-      return fail(message, at + " base colour texture URI is too long or has control bytes");
+    const auto uris = texture_slots(m);
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (!printable_string(*uris[k]))
+        return fail(message, at + " " + kTextureSlotNames[k] + " texture URI is too long or has control bytes");
+    if (!(std::isfinite(m.normal_scale) && m.normal_scale >= 0 && m.normal_scale <= 1e6f))
+      return fail(message, at + " has a normal texture scale outside [0, 1e6]");
+    if (!unit_factor(m.occlusion_strength)) return fail(message, at + " has an occlusion strength outside [0, 1]");
+    for (float c : m.emissive)
+      if (!unit_factor(c)) return fail(message, at + " has an emissive factor outside [0, 1]");
     for (float c : m.base_color)
       if (!unit_factor(c)) return fail(message, at + " has a base colour factor outside [0, 1]");
     if (!unit_factor(m.metallic) || !unit_factor(m.roughness))

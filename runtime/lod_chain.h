@@ -72,7 +72,8 @@ int32_t level_of_triangles(uint64_t triangles);
 // may be empty.
 // With morph targets: one per vertex of every drawn level but the last, each < the next level's
 // vertex_count ("level 2 vertex 17 morphs into vertex 900 of level 3's 812").
-// With materials: at most kMaxMaterials, factors finite in [0, 1], alpha mode known, names
+// With materials: at most kMaxMaterials, factors finite in [0, 1] (the normal texture scale in
+// [0, 1e6]), alpha mode known, names
 // and URIs at most kMaxMaterialString bytes without control characters; submeshes sorted by
 // level, each drawn level's runs non-empty, whole triangles, covering its indices in order,
 // each naming a material that exists (or -1); the culled level has none.

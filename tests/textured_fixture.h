@@ -99,8 +99,11 @@ inline MeshData two_material_sphere(int rings, int segments) {
 
 // The sphere as <dir>/<name>.gltf (+ .bin) with its texture as <name>-image0.png next to it
 // (material 0's base colour texture, named by URI); returns the .gltf, empty on failure.
+// With `every_texture`, material 0 also has metallic-roughness, normal (scale 0.625),
+// occlusion (strength 0.375) and emissive textures (<name>-image1..4.png, each a different
+// image) and emissive factor (0.5, 0.25, 0.125), and the sphere has normals.
 inline std::filesystem::path write_two_material_gltf(const std::filesystem::path& dir, const std::string& name,
-                                                    int rings = 24, int segments = 48) {
+                                                    int rings = 24, int segments = 48, bool every_texture = false) {
   const MeshData m = two_material_sphere(rings, segments);
   std::filesystem::create_directories(dir);
   write_bytes(dir / "checker.png", checker_png(64, 8));
@@ -109,6 +112,8 @@ inline std::filesystem::path write_two_material_gltf(const std::filesystem::path
   view.positions = m.positions.data();
   view.vertex_count = m.vertex_count();
   view.uvs = m.uvs.data();
+  const std::vector<float> normals = m.positions;  // a unit sphere's normals are its positions
+  if (every_texture) view.normals = normals.data();
   view.indices = m.indices.data();
   view.index_count = m.indices.size();
   for (const MeshMaterial& src : m.materials) {
@@ -123,6 +128,18 @@ inline std::filesystem::path write_two_material_gltf(const std::filesystem::path
   for (const Submesh& s : m.submeshes) view.submeshes.push_back({3 * size_t(s.first_triangle), 3 * size_t(s.triangle_count), s.material});
   const std::filesystem::path file = dir / (name + ".gltf");
   view.materials[0].base_color_image = dir / "checker.png";
+  if (every_texture) {
+    GltfMaterialView& g = view.materials[0];
+    const char* files[] = {"mr.png", "normal.png", "occlusion.png", "emissive.png"};
+    for (int k = 0; k < 4; ++k) write_bytes(dir / files[k], checker_png(uint32_t(8 + 8 * k), 2));
+    g.metallic_roughness_image = dir / files[0];
+    g.normal_image = dir / files[1];
+    g.occlusion_image = dir / files[2];
+    g.emissive_image = dir / files[3];
+    g.normal_scale = 0.625f;
+    g.occlusion_strength = 0.375f;
+    g.emissive[0] = 0.5f, g.emissive[1] = 0.25f, g.emissive[2] = 0.125f;
+  }
   if (!save_gltf(file, view).ok) return {};
   return file;
 }

@@ -62,12 +62,32 @@ uniform float u_alpha;        // the factor's alpha
 uniform float u_alpha_cutoff; // alpha mode MASK: fragments below are dropped; < 0 otherwise
 uniform int u_textured;
 uniform sampler2D u_texture;  // base colour, unit 0
+uniform int u_normal_mapped;
+uniform sampler2D u_normal_texture;  // tangent-space normals, unit 1
+uniform float u_normal_scale;
 uniform int u_flat;
 uniform int u_show_morph;
 out vec4 o_colour;
+// The normal texture's normal in view space, on the tangent frame the screen-space derivatives
+// of position and uv give (Schueler's cotangent frame: no tangent attribute needed). glTF's
+// +Y is up the image, i.e. towards decreasing v: hence -b.
+vec3 mapped_normal(vec3 n) {
+  vec3 m = texture(u_normal_texture, v_uv).xyz * 2.0 - 1.0;  // before any branch: implicit lod
+  vec3 dp1 = dFdx(v_position_view), dp2 = dFdy(v_position_view);
+  vec2 duv1 = dFdx(v_uv), duv2 = dFdy(v_uv);
+  vec3 dp2perp = cross(dp2, n), dp1perp = cross(n, dp1);
+  vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
+  vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+  float size = max(dot(t, t), dot(b, b));
+  if (size < 1e-30) return n;  // no uv change across the pixel: no frame
+  float inv = inversesqrt(size);
+  m.xy *= u_normal_scale;
+  return normalize(mat3(t * inv, -b * inv, n) * m);
+}
 void main() {
   vec3 face = normalize(cross(dFdx(v_position_view), dFdy(v_position_view)));
   vec3 n = (u_flat != 0 || dot(v_normal_view, v_normal_view) < 1e-12) ? face : normalize(v_normal_view);
+  if (u_normal_mapped != 0 && u_flat == 0) n = mapped_normal(n);
   vec3 to_eye = normalize(-v_position_view);
   float lambert = abs(dot(n, to_eye));  // headlight; abs so either winding is lit
   vec4 surface = vec4(u_colour, u_alpha);
@@ -104,6 +124,7 @@ void InstanceRenderer::set_plain_surface(const std::array<float, 3>& c) {
   glUniform1f(u_alpha_, 1.f);
   glUniform1f(u_alpha_cutoff_, -1.f);
   glUniform1i(u_textured_, 0);
+  glUniform1i(u_normal_mapped_, 0);
   glDisable(GL_BLEND);
 }
 
@@ -115,6 +136,13 @@ void InstanceRenderer::set_material(const GpuMaterial& m) {
   glUniform1f(u_alpha_cutoff_, m.alpha_mode == AlphaMode::mask ? m.alpha_cutoff : -1.f);
   glUniform1i(u_textured_, m.texture ? 1 : 0);
   if (m.texture) glBindTexture(GL_TEXTURE_2D, m.texture);
+  glUniform1i(u_normal_mapped_, m.normal_texture ? 1 : 0);
+  if (m.normal_texture) {
+    glUniform1f(u_normal_scale_, m.normal_scale);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, m.normal_texture);
+    glActiveTexture(GL_TEXTURE0);
+  }
   if (m.alpha_mode == AlphaMode::blend) {
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -168,8 +196,11 @@ bool InstanceRenderer::init(std::string* message) {
   u_alpha_ = glGetUniformLocation(program_, "u_alpha");
   u_alpha_cutoff_ = glGetUniformLocation(program_, "u_alpha_cutoff");
   u_textured_ = glGetUniformLocation(program_, "u_textured");
+  u_normal_mapped_ = glGetUniformLocation(program_, "u_normal_mapped");
+  u_normal_scale_ = glGetUniformLocation(program_, "u_normal_scale");
   glUseProgram(program_);
   glUniform1i(glGetUniformLocation(program_, "u_texture"), 0);
+  glUniform1i(glGetUniformLocation(program_, "u_normal_texture"), 1);
   glUseProgram(0);
   glGenBuffers(1, &instance_vbo_);
   glGenQueries(1, &query_);

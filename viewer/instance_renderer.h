@@ -86,7 +86,7 @@ class InstanceRenderer {
   GLuint query_ = 0;
   size_t instance_capacity_ = 0;
   GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1, u_blend_ = -1;
-  GLint u_alpha_ = -1, u_alpha_cutoff_ = -1, u_textured_ = -1;
+  GLint u_alpha_ = -1, u_alpha_cutoff_ = -1, u_textured_ = -1, u_normal_mapped_ = -1, u_normal_scale_ = -1;
 };
 
 }  // namespace lod::viewer

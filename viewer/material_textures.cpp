@@ -60,32 +60,38 @@ MaterialTextures::~MaterialTextures() {
 void MaterialTextures::upload(std::span<const LodChain> chains) {
   std::map<std::string, GLuint> by_file;  // decoded once per file; 0 = could not be read
   for (const LodChain& chain : chains) {
+    // The texture a URI names, decoded at its first use; 0 when it cannot be read (said once).
+    auto texture_of = [&](const ChainMaterial& m, const std::string& uri) -> GLuint {
+      if (uri.empty()) return 0;
+      const std::string file = texture_file(chain.texture_base, uri).string();
+      if (file.empty()) {
+        std::fprintf(stderr, "lod-viewer: %s: material '%s' texture '%s' is not a file (data URI or URL); drawn without it\n",
+                     chain.name.c_str(), m.name.c_str(), uri.c_str());
+        return 0;
+      }
+      if (auto it = by_file.find(file); it != by_file.end()) return it->second;
+      int w = 0, h = 0;
+      std::string why;
+      const std::vector<unsigned char> rgba = decode_image(file, w, h, why);
+      GLuint t = 0;
+      if (rgba.empty()) {
+        std::fprintf(stderr, "lod-viewer: texture %s: %s; drawn without it\n", file.c_str(), why.c_str());
+      } else {
+        t = make_texture(rgba, w, h);
+        textures_.push_back(t);
+        bytes_ += rgba.size() * 4 / 3;  // with its mipmaps
+      }
+      by_file[file] = t;
+      return t;
+    };
     for (const ChainMaterial& m : chain.materials) {
       GpuMaterial g;
       std::copy(m.base_color, m.base_color + 4, g.base_color);
       g.alpha_mode = m.alpha_mode;
       g.alpha_cutoff = m.alpha_cutoff;
-      if (!m.base_color_texture.empty()) {
-        const std::string file = texture_file(chain.texture_base, m.base_color_texture).string();
-        if (file.empty()) {
-          std::fprintf(stderr, "lod-viewer: %s: material '%s' texture '%s' is not a file (data URI or URL); drawn without it\n",
-                       chain.name.c_str(), m.name.c_str(), m.base_color_texture.c_str());
-        } else if (auto it = by_file.find(file); it != by_file.end()) {
-          g.texture = it->second;
-        } else {
-          int w = 0, h = 0;
-          std::string why;
-          const std::vector<unsigned char> rgba = decode_image(file, w, h, why);
-          if (rgba.empty()) {
-            std::fprintf(stderr, "lod-viewer: texture %s: %s; drawn without it\n", file.c_str(), why.c_str());
-          } else {
-            g.texture = make_texture(rgba, w, h);
-            textures_.push_back(g.texture);
-            bytes_ += rgba.size() * 4 / 3;  // with its mipmaps
-          }
-          by_file[file] = g.texture;
-        }
-      }
+      g.texture = texture_of(m, m.base_color_texture);
+      g.normal_texture = texture_of(m, m.normal_texture);
+      g.normal_scale = m.normal_scale;
       materials_.push_back(g);
     }
   }

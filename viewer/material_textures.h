@@ -1,6 +1,6 @@
 // MaterialTextures: every chain's materials as the shader needs them, scene-wide in
-// MeshLayout::first_material order; each base colour image is decoded once (stb_image), however
-// many materials name it, into one mipmapped GL texture.
+// MeshLayout::first_material order; each base colour or normal image is decoded once
+// (stb_image), however many materials name it, into one mipmapped GL texture.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -20,6 +20,8 @@ inline constexpr int kMaxTextureSide = 8192;
 struct GpuMaterial {
   float base_color[4] = {1, 1, 1, 1};
   GLuint texture = 0;  // 0 = no base colour texture (or it could not be read)
+  GLuint normal_texture = 0;  // 0 = none: the interpolated normal is used as is
+  float normal_scale = 1;
   AlphaMode alpha_mode = AlphaMode::opaque;
   float alpha_cutoff = 0.5f;
 };
@@ -31,7 +33,7 @@ class MaterialTextures {
   MaterialTextures(const MaterialTextures&) = delete;
   MaterialTextures& operator=(const MaterialTextures&) = delete;
 
-  // Reads every chain's base colour images; an unreadable one is logged once on stderr
+  // Reads every chain's base colour and normal images; an unreadable one is logged once on stderr
   // (naming the file and why) and its materials draw with their factor only.
   void upload(std::span<const LodChain> chains);
 

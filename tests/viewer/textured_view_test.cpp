@@ -1,6 +1,7 @@
 // lod-viewer --screenshot of a textured, two-material glTF sphere (tests/textured_fixture.h):
 // with materials (the default) its upper half shows both colours of the checker texture and
-// its lower half the second material's red factor; with --color-by-level none of them.
+// its lower half the second material's red factor; with --color-by-level none of them; a
+// normal texture shades its own material only.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -128,6 +129,41 @@ TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   const HueCounts m = count_hues(img);
   EXPECT_LE(m.any_checker, 10) << "no texture colours without the texture";
   EXPECT_GE(m.base_below, 300) << "the rest of the model is still drawn";
+}
+
+// A normal texture changes the lit shading of the material that has it and nothing else:
+// the same globe drawn with its normal image and with that image broken (drawn without it,
+// said once) differs on many cap pixels and on none below the equator.
+TEST(ViewerTextured, TheNormalTextureShadesItsMaterialOnly) {
+  LOD_REQUIRE_XVFB();
+  const auto scene = lod::test::write_viewer_scene("textured-normal", kRun, kCamera, kInstance, kModel);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/true).empty());
+  const auto mapped = scene.dir / "mapped.png";
+  const auto plain = scene.dir / "plain.png";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + mapped.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "a texture was not read: " << r.output;
+  lod::test::write_text(scene.dir / "textured" / "globe-image2.png", "not a png");  // the normal texture
+  r = lod::test::run_viewer(scene, "--screenshot '" + plain.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("globe-image2.png"), std::string::npos) << r.output;
+
+  Image a, b;
+  ASSERT_TRUE(lod::test::load_png(mapped, a));
+  ASSERT_TRUE(lod::test::load_png(plain, b));
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  const int centre_row = lod::test::project({0, 0, 0}, a.width, a.height)[1];
+  int changed_above = 0, changed_below = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      const uint8_t *p = a.at(x, y), *q = b.at(x, y);
+      const int d = std::max({std::abs(p[0] - q[0]), std::abs(p[1] - q[1]), std::abs(p[2] - q[2])});
+      if (d <= 8) continue;
+      if (y < centre_row - 4) ++changed_above;
+      if (y > centre_row + 4) ++changed_below;
+    }
+  EXPECT_GE(changed_above, 1000) << "the normal texture shades the cap";
+  EXPECT_EQ(changed_below, 0) << "the material without one is drawn as before";
 }
 
 }  // namespace

@@ -405,6 +405,52 @@ TEST(GltfImport, ReadsMaterialsAsSubmeshes) {
   expect_refused(load_mesh(file, m), "image 0 'bark%20texture.png' not found");
 }
 
+TEST(GltfImport, ReadsEveryTextureSlotWithItsFactors) {
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  f.j["meshes"][0]["primitives"][0]["material"] = 0;
+  f.j["images"] = json::array({{{"uri", "c.png"}}, {{"uri", "mr.png"}}, {{"uri", "n.png"}}, {{"uri", "ao.png"}}, {{"uri", "e.png"}}});
+  f.j["textures"] = json::array({{{"source", 0}}, {{"source", 1}}, {{"source", 2}}, {{"source", 3}}, {{"source", 4}}});
+  f.j["materials"] = json::array(
+      {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 1}}}}},
+        {"normalTexture", {{"index", 2}, {"scale", 0.5}}},
+        {"occlusionTexture", {{"index", 3}, {"strength", 0.25}}},
+        {"emissiveTexture", {{"index", 4}}},
+        {"emissiveFactor", {1.0, 0.5, 0.125}}}});
+  place_meshes(f);
+  MeshData m;
+  const Status s = load_glb(f, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(m.materials.size(), 1u);
+  const MeshMaterial& mat = m.materials[0];
+  EXPECT_EQ(mat.base_color_texture, "c.png");
+  EXPECT_EQ(mat.metallic_roughness_texture, "mr.png");
+  EXPECT_EQ(mat.normal_texture, "n.png");
+  EXPECT_EQ(mat.occlusion_texture, "ao.png");
+  EXPECT_EQ(mat.emissive_texture, "e.png");
+  EXPECT_FALSE(mat.normal_texture_embedded);
+  EXPECT_FLOAT_EQ(mat.normal_scale, 0.5f);
+  EXPECT_FLOAT_EQ(mat.occlusion_strength, 0.25f);
+  EXPECT_FLOAT_EQ(mat.emissive[0], 1.0f);
+  EXPECT_FLOAT_EQ(mat.emissive[1], 0.5f);
+  EXPECT_FLOAT_EQ(mat.emissive[2], 0.125f);
+}
+
+TEST(GltfImport, ATextureReadThroughTexcoord1IsLeftOutAndSaid) {
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  f.j["meshes"][0]["primitives"][0]["material"] = 0;
+  f.j["images"] = json::array({{{"uri", "n.png"}}});
+  f.j["textures"] = json::array({{{"source", 0}}});
+  f.j["materials"] = json::array({{{"normalTexture", {{"index", 0}, {"texCoord", 1}}}}});
+  place_meshes(f);
+  MeshData m;
+  const Status s = load_glb(f, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_TRUE(m.materials[0].normal_texture.empty());
+  EXPECT_TRUE(has_warning(m, "t.glb: material 0: normalTexture reads TEXCOORD_1")) << (m.warnings.empty() ? "" : m.warnings[0]);
+}
+
 TEST(GltfImport, AppliesTheBaseColourTextureTransformToTexcoords) {
   GltfFixture f;
   const int pos = f.add_accessor(f.add_view(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), kFloat, 3, "VEC3");
@@ -698,6 +744,34 @@ TEST(GltfMalformed, RefusesABadTextureReference) {
   f.j["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 4}}}}}}});
   MeshData m;
   expect_refused(load_glb(f, m), "material 0: baseColorTexture references texture 4 of 0");
+}
+
+TEST(GltfMalformed, RefusesAnOutOfRangeTextureInEverySlot) {
+  const std::vector<std::pair<json, std::string>> cases = {
+      {{{"normalTexture", {{"index", 3}}}}, "t.glb: material 0: normalTexture references texture 3 of 1"},
+      {{{"occlusionTexture", {{"index", 9}}}}, "t.glb: material 0: occlusionTexture references texture 9 of 1"},
+      {{{"emissiveTexture", {{"index", 1}}}}, "t.glb: material 0: emissiveTexture references texture 1 of 1"},
+      {{{"pbrMetallicRoughness", {{"metallicRoughnessTexture", {{"index", 2}}}}}},
+       "t.glb: material 0: metallicRoughnessTexture references texture 2 of 1"},
+  };
+  for (const auto& [material, expect] : cases) {
+    GltfFixture f;
+    f.add_float_mesh(kQuad, kQuadIndices);
+    place_meshes(f);
+    f.j["images"] = json::array({{{"uri", "a.png"}}});
+    f.j["textures"] = json::array({{{"source", 0}}});
+    f.j["materials"] = json::array({material});
+    MeshData m;
+    expect_refused(load_glb(f, m), expect);
+  }
+  // A texture naming an image that does not exist, in the normal slot.
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  place_meshes(f);
+  f.j["textures"] = json::array({{{"source", 4}}});
+  f.j["materials"] = json::array({{{"normalTexture", {{"index", 0}}}}});
+  MeshData m;
+  expect_refused(load_glb(f, m), "t.glb: material 0: normalTexture: texture 0 references image 4 of 0");
 }
 
 TEST(GltfMalformed, RefusesTruncatedGlbAtEveryLength) {

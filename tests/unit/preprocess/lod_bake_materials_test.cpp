@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "preprocess/lod_bake.h"
@@ -16,11 +17,19 @@
 #include "runtime/lod_asset.h"
 #include "test_support.h"
 #include "textured_fixture.h"
+#include "unit/runtime/runtime_fixtures.h"
 
 namespace lod {
 namespace {
 
 constexpr int kRings = 24, kSegments = 48;
+
+// The chain's materials alone against validate_chain (its runs made to cover each level).
+bool validate_materials_only(LodChain& chain, std::string& why) {
+  chain.submeshes.clear();
+  for (uint32_t k = 0; k < chain.levels.size(); ++k) chain.submeshes.push_back({k, 0, chain.levels[k].index_count, 0});
+  return validate_chain(chain, &why);
+}
 
 LodChain bake(const std::filesystem::path& gltf, SimplifyMethod method, BakeReport* report = nullptr) {
   BakeSettings settings;
@@ -185,6 +194,55 @@ TEST(LodBakeMaterials, InvalidRunsAndMaterialsAreRefused) {
   c = chain;
   c.materials[1].alpha_mode = AlphaMode(9);
   refused(c, "alpha mode");
+  c = chain;
+  c.materials[0].normal_scale = -1;
+  refused(c, "normal texture scale");
+  c = chain;
+  c.materials[0].occlusion_strength = std::nanf("");
+  refused(c, "occlusion strength");
+  c = chain;
+  c.materials[1].emissive[2] = 2;
+  refused(c, "emissive factor");
+  c = chain;
+  c.materials[0].normal_texture = std::string("n\x07.png");
+  refused(c, "material 0 normal texture URI");
+}
+
+// Out-of-range or NaN texture factors from a file (glTF's JSON cannot hold NaN, but a huge
+// number parses as infinity; MTL's -bm can be negative) are clamped, each said naming the
+// file and the material; the chain then validates.
+TEST(LodBakeMaterials, HostileTextureFactorsAreClampedAndSaid) {
+  MeshData mesh;
+  mesh.source = "hostile.gltf";
+  MeshMaterial m;
+  m.name = "rock";
+  m.normal_texture = "n.png";
+  m.normal_scale = -2;
+  m.occlusion_strength = std::nanf("");
+  m.emissive[0] = 3;
+  m.emissive[1] = std::numeric_limits<float>::infinity();
+  m.emissive_texture = "e.png";
+  mesh.materials = {m};
+  LodChain chain = test::fan_chain("rock", {9});
+  std::vector<std::string> notes;
+  add_chain_materials(mesh, "/data/hostile.gltf", chain, notes);
+  ASSERT_EQ(chain.materials.size(), 1u);
+  const ChainMaterial& c = chain.materials[0];
+  EXPECT_EQ(c.normal_scale, 0.0f);
+  EXPECT_EQ(c.occlusion_strength, 1.0f);
+  EXPECT_EQ(c.emissive[0], 1.0f);
+  EXPECT_EQ(c.emissive[1], 0.0f) << "a non-finite factor emits nothing";
+  EXPECT_EQ(c.normal_texture, "n.png");
+  auto said = [&](const std::string& needle) {
+    for (const std::string& n : notes)
+      if (n.find(needle) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(said("hostile.gltf: material 0 ('rock'): normalTexture.scale -2 is out of [0, 1e6], clamped to 0"));
+  EXPECT_TRUE(said("hostile.gltf: material 0 ('rock'): occlusionTexture.strength nan outside [0, 1]"));
+  EXPECT_TRUE(said("hostile.gltf: material 0 ('rock'): emissive factor 3 inf 0"));
+  std::string why;
+  EXPECT_TRUE(validate_materials_only(chain, why)) << why;
 }
 
 }  // namespace

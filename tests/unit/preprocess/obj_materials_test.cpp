@@ -1,6 +1,6 @@
 // OBJ with texture coordinates, normals and materials (issue 12): vt / vn / usemtl / mtllib
 // are kept (uvs flipped into glTF's convention, one vertex per distinct v/vt/vn corner,
-// submeshes by usemtl, the .mtl's Kd, d / Tr and map_Kd), and hostile files are refused
+// submeshes by usemtl, the .mtl's Kd, d / Tr, map_Kd, Ke / map_Ke and bump), and hostile files are refused
 // naming file:line.
 #include <gtest/gtest.h>
 
@@ -106,6 +106,50 @@ TEST(ObjMaterials, TheBakeKeepsThemInEveryLevel) {
   EXPECT_NE(bake_key(obj, settings, &key), before) << "the .mtl is part of the cache key";
 }
 
+// map_Bump / bump / norm (with -bm) are the normal texture and its scale; Ke and map_Ke the
+// emissive factor and texture (map_Ke alone emits the texture as is). The bake keeps them.
+const char* kBumpMtl = R"(newmtl left
+Kd 0.8 0.4 0.2
+Ke 0.5 0.25 0
+map_Bump -bm 0.4 -clamp on tex dir/wood.png
+newmtl right
+map_Ke tex dir/wood.png
+norm tex dir/wood.png
+)";
+
+TEST(ObjMaterials, BumpAndKeBecomeNormalAndEmissive) {
+  const fs::path obj = write_quads("obj-bump", kObj, kBumpMtl);
+  MeshData m;
+  const Status s = load_mesh(obj, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[0].normal_texture, "tex%20dir/wood.png");
+  EXPECT_FLOAT_EQ(m.materials[0].normal_scale, 0.4f);
+  EXPECT_FLOAT_EQ(m.materials[0].emissive[0], 0.5f);
+  EXPECT_FLOAT_EQ(m.materials[0].emissive[1], 0.25f);
+  EXPECT_FLOAT_EQ(m.materials[0].emissive[2], 0.0f);
+  EXPECT_TRUE(m.materials[0].emissive_texture.empty());
+  EXPECT_EQ(m.materials[1].normal_texture, "tex%20dir/wood.png");
+  EXPECT_FLOAT_EQ(m.materials[1].normal_scale, 1.0f) << "no -bm: scale 1";
+  EXPECT_EQ(m.materials[1].emissive_texture, "tex%20dir/wood.png");
+  EXPECT_FLOAT_EQ(m.materials[1].emissive[1], 1.0f) << "map_Ke without Ke emits the texture as is";
+  for (const std::string& w : m.warnings) EXPECT_EQ(w.find("Ke"), std::string::npos) << w;
+
+  BakeSettings settings;
+  settings.ratios = {1.0f, 0.5f};
+  settings.method = SimplifyMethod::qem;
+  LodChain chain;
+  BakeReport report;
+  const Status st = bake_model(obj, "quads", settings, chain, &report, nullptr);
+  ASSERT_TRUE(st.ok) << st.message;
+  ASSERT_EQ(chain.materials.size(), 2u);
+  EXPECT_EQ(chain.materials[0].normal_texture, "tex%20dir/wood.png");
+  EXPECT_FLOAT_EQ(chain.materials[0].normal_scale, 0.4f);
+  EXPECT_FLOAT_EQ(chain.materials[0].emissive[0], 0.5f);
+  EXPECT_EQ(chain.materials[1].emissive_texture, "tex%20dir/wood.png");
+  EXPECT_TRUE(chain.materials[1].metallic_roughness_texture.empty());
+}
+
 struct Hostile {
   const char* name;
   std::string obj, mtl;
@@ -129,6 +173,11 @@ TEST(ObjMaterials, HostileFilesAreRefusedNamingFileAndLine) {
       {"bad Kd", quads, "newmtl left\nKd red\n", "quads.mtl:2: 'Kd' needs 1 finite numbers"},
       {"missing texture", quads, "newmtl right\nmap_Kd gone.png\n", "material 'right': map_Kd 'gone.png' not found"},
       {"usemtl without a name", "v 0 0 0\nusemtl\n", kMtl, "quads.obj:2: usemtl without a material name"},
+      {"NaN bump multiplier", quads, "newmtl left\nbump -bm nan tex dir/wood.png\n", "quads.mtl:2: bump -bm needs a finite number"},
+      {"bump without a file", quads, "newmtl left\nmap_Bump -bm 2\n", "quads.mtl:2: map_Bump without a file name"},
+      {"bad Ke", quads, "newmtl left\nKe 1 inf 0\n", "quads.mtl:2: 'Ke' needs 1 finite numbers"},
+      {"missing normal texture", quads, "newmtl left\nmap_Bump gone.png\n", "material 'left': map_Bump 'gone.png' not found"},
+      {"missing emissive texture", quads, "newmtl right\nmap_Ke gone.png\n", "material 'right': map_Ke 'gone.png' not found"},
   };
   for (const Hostile& h : cases) {
     MeshData m;

@@ -336,6 +336,13 @@ LodChain chain_with_materials() {
   a.base_color_texture = "tex/bark%20d.png";
   a.alpha_mode = AlphaMode::mask;
   a.alpha_cutoff = 0.3f;
+  a.metallic_roughness_texture = "tex/mr.png";
+  a.normal_texture = "tex/n.png";
+  a.occlusion_texture = "tex/ao.png";
+  a.emissive_texture = "e.jpg";
+  a.normal_scale = 0.75f;
+  a.occlusion_strength = 0.5f;
+  a.emissive[0] = 0.25f, a.emissive[2] = 1;
   b.name = "leaf";
   b.double_sided = true;
   b.base_color[1] = 0.5f;
@@ -381,6 +388,17 @@ TEST(LodAssetMaterials, RoundTripKeepsMaterialsAndRuns) {
   ASSERT_EQ(back.materials.size(), 2u);
   EXPECT_EQ(back.materials[0].base_color_texture, "tex/bark%20d.png");
   EXPECT_EQ(back.materials[0].alpha_mode, AlphaMode::mask);
+  EXPECT_EQ(back.materials[0].metallic_roughness_texture, "tex/mr.png");
+  EXPECT_EQ(back.materials[0].normal_texture, "tex/n.png");
+  EXPECT_EQ(back.materials[0].occlusion_texture, "tex/ao.png");
+  EXPECT_EQ(back.materials[0].emissive_texture, "e.jpg");
+  EXPECT_EQ(back.materials[0].normal_scale, 0.75f);
+  EXPECT_EQ(back.materials[0].occlusion_strength, 0.5f);
+  EXPECT_EQ(back.materials[0].emissive[0], 0.25f);
+  EXPECT_EQ(back.materials[0].emissive[1], 0.0f);
+  EXPECT_EQ(back.materials[0].emissive[2], 1.0f);
+  EXPECT_TRUE(back.materials[1].normal_texture.empty());
+  EXPECT_EQ(back.materials[1].normal_scale, 1.0f);
   EXPECT_TRUE(back.materials[1].double_sided);
   ASSERT_EQ(back.submeshes.size(), c.submeshes.size());
   EXPECT_EQ(level_submeshes(back, 1).size(), 2u);
@@ -403,12 +421,18 @@ TEST(LodAssetMaterials, HostileSectionsAreRefusedNamingWhatIsWrong) {
       {"MATL section: 4294967295 materials", 0, 0xffffffffu},
       {"MATL section: 2 materials and 268435456 submeshes need", 4, 1u << 28},
       {"MATL section: texture base of 4000000000 bytes is too long", 8, 4000000000u},
-      {"MATL section: reserved word", 12, 1},
+      {"MATL section: layout 2 is newer than this build reads (1)", 12, 2},
       {"MATL section: submesh 0 (level 0) names material 5 of 2", submeshes + 12, 5},
       {"MATL section: submesh 0 (level 0) starts at index 3", submeshes + 4, 3},
       {"MATL section: level 0's material runs cover 0 of its 27 indices", submeshes, 99},
-      {"MATL section: material 0 says its name and URI take 3000", first_material, 3000},
-      {"MATL section: material 0 says its name and URI take 4 + 4000000", first_material + 4, 4000000},
+      {"MATL section: material 0 says its name and URIs take 3050 bytes", first_material, 3000},
+      {"MATL section: material 0 has a name or URI of 4000000 bytes, at most 4096", first_material + 4, 4000000},
+      {"MATL section: material 0 has a name or URI of 5000 bytes", first_material + 40, 5000},
+      {"MATL section: material 0 says its name and URIs take 4045 bytes", first_material + 44, 4000},
+      {"MATL section: material 0 has a normal texture scale outside [0, 1e6]", first_material + 56, 0x7fc00000u},
+      {"MATL section: material 0 has an occlusion strength outside [0, 1]", first_material + 60, 0x40000000u},
+      {"MATL section: material 0 has an emissive factor outside [0, 1]", first_material + 68, 0xbf800000u},
+      {"MATL section: 3 materials and 6 submeshes need", 0, 3},
       {"MATL section: material 0 has unknown alpha mode 7", first_material + 36, 7},
       {"MATL section: material 0 has a base colour factor outside [0, 1]", first_material + 8, 0x7fc00000u},
   };
@@ -424,12 +448,76 @@ TEST(LodAssetMaterials, HostileSectionsAreRefusedNamingWhatIsWrong) {
   }
   // A control byte in a name (terminal escapes) is refused too.
   std::vector<uint8_t> bytes = good;
-  bytes[matl + first_material + 40] = 0x1b;
+  bytes[matl + first_material + 76] = 0x1b;
   reseal(bytes);
   LodChain out;
   const Status st = decode_lod_asset(bytes, "bunny.lod", out);
   ASSERT_FALSE(st);
   EXPECT_NE(st.message.find("material 0 name is too long or has control bytes"), std::string::npos) << st.message;
+}
+
+// Every string of the new layout lies inside the section: cutting the section's last string
+// short (its length one byte longer than what is left) is refused, for each of the six.
+TEST(LodAssetMaterials, EveryStringLengthIsCheckedAgainstTheSection) {
+  const LodChain c = chain_with_materials();
+  const std::vector<uint8_t> good = encode_lod_asset(c);
+  const uint64_t matl = matl_offset(good);
+  const size_t first_material = 16 + 12 + 16 * c.submeshes.size();
+  const size_t offsets[] = {0, 4, 40, 44, 48, 52};  // name, then the URIs in slot order
+  for (size_t k = 0; k < 6; ++k) {
+    std::vector<uint8_t> bytes = good;
+    uint32_t n = 0;
+    std::memcpy(&n, bytes.data() + matl + first_material + offsets[k], 4);
+    n += 4096 - 64;  // still under kMaxMaterialString, past the section's end
+    std::memcpy(bytes.data() + matl + first_material + offsets[k], &n, 4);
+    reseal(bytes);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+    ASSERT_FALSE(st) << k;
+    EXPECT_NE(st.message.find("MATL section: material 0 says its name and URIs take"), std::string::npos) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+}
+
+// A bake format 7 asset (MATL layout 0: base colour texture only), the fuzz seed, still reads:
+// its materials get the new fields' defaults. (A cache of them rebakes: the bake format is in
+// the cache key.)
+TEST(LodAssetMaterials, ReadsTheFormat7LayoutWithDefaultsForTheNewFields) {
+  const std::filesystem::path seed = std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/lod/materials0.lod";
+  LodChain out;
+  const Status st = read_lod_asset(seed, out);
+  ASSERT_TRUE(st) << st.message;
+  ASSERT_FALSE(out.materials.empty());
+  const std::vector<uint8_t> bytes = test::read_bytes(seed);
+  uint32_t layout = 1;
+  std::memcpy(&layout, bytes.data() + matl_offset(bytes) + 12, 4);
+  EXPECT_EQ(layout, 0u) << "the seed is the old layout";
+  for (const ChainMaterial& m : out.materials) {
+    EXPECT_TRUE(m.normal_texture.empty());
+    EXPECT_TRUE(m.emissive_texture.empty());
+    EXPECT_EQ(m.normal_scale, 1.0f);
+    EXPECT_EQ(m.occlusion_strength, 1.0f);
+    EXPECT_EQ(m.emissive[0], 0.0f);
+  }
+  // Written again, it is the new layout, and reads back the same.
+  const std::vector<uint8_t> again = encode_lod_asset(out);
+  std::memcpy(&layout, again.data() + matl_offset(again) + 12, 4);
+  EXPECT_EQ(layout, 1u);
+  LodChain back;
+  ASSERT_TRUE(decode_lod_asset(again, "again.lod", back));
+  EXPECT_EQ(encode_lod_asset(back), again);
+}
+
+// The layout 1 fuzz seed (materials0.lod with every texture slot filled) reads with them.
+TEST(LodAssetMaterials, TheLayout1SeedReadsWithEveryTexture) {
+  LodChain out;
+  const Status st = read_lod_asset(std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/lod/materials1.lod", out);
+  ASSERT_TRUE(st) << st.message;
+  ASSERT_FALSE(out.materials.empty());
+  EXPECT_EQ(out.materials[0].normal_texture, "n%20map.png");
+  EXPECT_EQ(out.materials[0].emissive_texture, "e.jpg");
+  EXPECT_EQ(out.materials[0].normal_scale, 0.5f);
+  EXPECT_EQ(out.materials[0].emissive[1], 0.5f);
 }
 
 }  // namespace
