@@ -844,7 +844,12 @@ bool HlodBuilder::whole_surface_built() const { return impl_->whole_built.load()
 
 void HlodBuilder::set_region(const std::vector<size_t>& subtrees) {
   impl_->region_subtrees = subtrees;
-  impl_->region_wanted = true;
+  // Every subtree (one rank): the whole original is the region, without the part's pass.
+  std::vector<uint8_t> seen(impl_->specs.size(), 0);
+  size_t distinct = 0;
+  for (size_t i : subtrees)
+    if (i < seen.size() && !seen[i]) seen[i] = 1, ++distinct;
+  impl_->region_wanted = distinct < impl_->specs.size();
 }
 
 // The region's BVH: the triangles reaching into its subtrees' cells grown by a quarter of their

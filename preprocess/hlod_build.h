@@ -163,6 +163,7 @@ class HlodBuilder {
   // cell's half-edge) and, where that cannot answer exactly as the whole original would (the
   // nearest found is not provably the nearest), to the whole original's BVH, built on first
   // need only. The bytes are the same either way. Before bake_subtrees and measure_probes_part.
+  // Every subtree listed (one rank): the whole original, as without a region.
   void set_region(const std::vector<size_t>& subtrees);
   // The top's errors split by sample rather than by layer, for builders with a region: per
   // probe, the largest distance to the original among its layer samples the region answers
