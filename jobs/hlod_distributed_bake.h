@@ -3,12 +3,14 @@
 //   every rank   load the mesh from the shared path, plan the split (the same on every rank),
 //                check its share of the cache's entries in full
 //   gather       which entries were found -> rank 0 broadcasts which are missing
-//   every rank   bake its share of the missing ones (longest first, to the least loaded
-//                rank), each result stored in the cache as it is finished
+//   every rank   bake its share of the missing ones (spatially contiguous runs balanced by
+//                cost), each result stored in the cache as it is finished; queries against
+//                the original go to a BVH over the rank's region (HlodBuilder::set_region)
 //   gather       per rank: its status (a failure names the subtree), work and bytes
 //   rank 0       read the subtrees' roots from the entries (a refused one is baked again here),
 //                build the layers of the levels above -> broadcast them
-//   every rank   measure a share of those layers' errors against the original -> gather
+//   every rank   measure those layers' samples its region answers (and the other side of a
+//                share of them) -> gather -> rank 0 measures any sample no region answered
 //   rank 0       finish the levels above, write the head and their payloads into a temporary
 //                file at its full size -> broadcast where every subtree node's payload goes
 //   every rank   write the payloads of the subtrees it baked or checked, at those offsets
