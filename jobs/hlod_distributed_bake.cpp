@@ -54,7 +54,7 @@ void each_number(Work& w, F&& f) {
   f(w.subtrees), f(w.triangles), f(w.checked), f(w.bytes_checked), f(w.bake_seconds), f(w.bake_cpu_seconds),
       f(w.total_seconds), f(w.cpu_seconds), f(w.load_cpu_seconds), f(w.clean_cpu_seconds), f(w.plan_cpu_seconds),
       f(w.check_cpu_seconds), f(w.surface_cpu_seconds), f(w.measure_cpu_seconds), f(w.write_cpu_seconds),
-      f(w.bytes_written), f(w.bytes_placed);
+      f(w.bytes_written), f(w.bytes_placed), f(w.region_triangles), f(w.whole_surface);
 }
 
 std::vector<uint8_t> encode_report(const RankReport& r) {
@@ -229,10 +229,17 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
   return Status::success();
 }
 
-std::vector<uint64_t> subtree_costs(const Job& j) {
+// The listed subtrees (all of them when `which` is null) in contiguous runs of the top's
+// depth-first order, by estimated cost: by position in the list.
+std::vector<int> spatial_share(const Job& j, const std::vector<size_t>* which) {
+  std::vector<size_t> ids = which ? *which : std::vector<size_t>(j.specs().size());
+  if (!which) std::iota(ids.begin(), ids.end(), size_t(0));
   std::vector<uint64_t> costs;
-  for (const HlodSubtreeSpec& spec : j.specs()) costs.push_back(spec.triangles);
-  return costs;
+  for (size_t i : ids) costs.push_back(j.specs()[i].triangles);
+  std::vector<size_t> order(ids.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return j.specs()[ids[a]].spatial < j.specs()[ids[b]].spatial; });
+  return assign_subtrees_spatially(costs, order, j.ranks());
 }
 
 // Every rank checks its share of the entries in full (the same split on every rank) and keeps
@@ -243,7 +250,7 @@ std::vector<uint8_t> check_share(Job& j) {
   const auto t0 = Clock::now();
   const double cpu0 = process_cpu_seconds();
   const size_t n = j.keys.size();
-  const std::vector<int> checker = assign_subtrees(subtree_costs(j), j.ranks());
+  const std::vector<int> checker = spatial_share(j, nullptr);
   std::vector<size_t> mine;
   for (size_t i = 0; i < n; ++i)
     if (checker[i] == j.comm.rank) mine.push_back(i);
@@ -299,16 +306,20 @@ std::unique_ptr<ProgressWatch> watch_progress(const Job& j) {
   return std::make_unique<ProgressWatch>(std::move(paths), std::move(tris), j.keys.size(), j.r.cached, j.log);
 }
 
-// Who writes each subtree's payloads: the rank that checked a cached entry, or bakes a missing one.
+// Who writes each subtree's payloads: the rank that checked a cached entry, or bakes a missing
+// one (the missing ones in contiguous runs of their own). A rank's region is what it writes.
 void assign_writers(Job& j) {
-  const std::vector<int> checker = assign_subtrees(subtree_costs(j), j.ranks());
+  const std::vector<int> checker = spatial_share(j, nullptr);
   std::vector<size_t> todo;
-  std::vector<uint64_t> costs;
   for (size_t i = 0; i < j.missing.size(); ++i)
-    if (j.missing[i]) todo.push_back(i), costs.push_back(j.specs()[i].triangles);
+    if (j.missing[i]) todo.push_back(i);
     else j.writer[i] = checker[i];
-  const std::vector<int> owner = assign_subtrees(costs, j.ranks());
+  const std::vector<int> owner = spatial_share(j, &todo);
   for (size_t k = 0; k < todo.size(); ++k) j.writer[todo[k]] = owner[k];
+  std::vector<size_t> region;
+  for (size_t i = 0; i < j.writer.size(); ++i)
+    if (j.writer[i] == j.comm.rank) region.push_back(i);
+  j.builder->set_region(region);
 }
 
 std::vector<size_t> my_share(const Job& j) {
@@ -356,6 +367,8 @@ RankReport bake_share(Job& j, const std::vector<size_t>& mine) {
   j.work.bake_seconds = seconds_since(t0);
   j.work.bake_cpu_seconds = process_cpu_seconds() - cpu0;
   j.work.surface_cpu_seconds = j.builder->surface_cpu_seconds();
+  j.work.region_triangles = j.builder->region_triangles();
+  j.work.whole_surface = j.builder->whole_surface_built() ? 1 : 0;
   if (!rep.status) rep.status.message = "rank " + std::to_string(j.comm.rank) + ": " + rep.status.message;
   return rep;
 }
@@ -501,21 +514,35 @@ std::vector<int> probe_owners(const std::vector<HlodLayerProbe>& probes, int ran
   return assign_subtrees(costs, ranks);
 }
 
-// Every rank: its share of the top's layers measured; the reply is a status, then the errors.
+// Every rank: the top's layers measured by sample, each rank the samples its region answers
+// (the original's side of its share of the layers as well). The reply: a status, then per
+// layer the largest distance found, the other side's errors of its share, and per layer which
+// samples it answered (bits).
 std::vector<uint8_t> measure_share(Job& j, const std::vector<HlodLayerProbe>& probes) {
   const double cpu0 = process_cpu_seconds();
   const std::vector<int> owner = probe_owners(probes, j.ranks());
   std::vector<size_t> mine;
   for (size_t i = 0; i < probes.size(); ++i)
     if (owner[i] == j.comm.rank) mine.push_back(i);
-  std::vector<float> errors;
+  std::vector<float> to_max, from_max;
+  std::vector<std::vector<uint8_t>> answered;
   Status st;
-  j.arena->execute([&] { st = j.builder->measure_probes(probes, mine, errors); });
+  j.arena->execute([&] { st = j.builder->measure_probes_part(probes, mine, to_max, answered, from_max); });
   detail::ByteWriter w;
   w.u8(st ? 1 : 0);
   if (st) {
-    w.u32(uint32_t(errors.size()));
-    w.words(errors.data(), errors.size());
+    w.u32(uint32_t(to_max.size()));
+    w.words(to_max.data(), to_max.size());
+    w.u32(uint32_t(from_max.size()));
+    w.words(from_max.data(), from_max.size());
+    for (const std::vector<uint8_t>& flags : answered) {
+      w.u32(uint32_t(flags.size()));
+      for (size_t i = 0; i < flags.size(); i += 8) {
+        uint8_t byte = 0;
+        for (size_t b = 0; b < 8 && i + b < flags.size(); ++b) byte |= uint8_t(flags[i + b] ? 1u << b : 0u);
+        w.u8(byte);
+      }
+    }
   } else {
     const std::string message = "rank " + std::to_string(j.comm.rank) + ": " + st.message;
     w.raw(message.data(), message.size());
@@ -524,30 +551,58 @@ std::vector<uint8_t> measure_share(Job& j, const std::vector<HlodLayerProbe>& pr
   return std::move(w.bytes);
 }
 
-// Rank 0: every rank's errors back in probe order.
-Status merge_errors(const Job& j, const std::vector<HlodLayerProbe>& probes,
+// Rank 0: every rank's answers merged (largest distances, answered samples, the other side's
+// errors in probe order), the samples nobody answered measured here, the errors made.
+Status merge_errors(Job& j, const std::vector<HlodLayerProbe>& probes,
                     const std::vector<std::vector<uint8_t>>& replies, std::vector<float>& errors) {
+  const double cpu0 = process_cpu_seconds();
   const std::vector<int> owner = probe_owners(probes, j.ranks());
-  errors.assign(probes.size(), 0.0f);
+  const size_t n = probes.size();
+  std::vector<float> to_max(n, 0.0f), from_max(n, 0.0f);
+  std::vector<std::vector<uint8_t>> answered(n);
   for (size_t r = 0; r < replies.size(); ++r) {
     const std::vector<uint8_t>& b = replies[r];
-    if (b.empty()) return Status::error("rank " + std::to_string(r) + " sent no top errors");
+    const std::string from = "rank " + std::to_string(r);
+    if (b.empty()) return Status::error(from + " sent no top errors");
     if (b[0] != 1) return Status::error(std::string(b.begin() + 1, b.end()));
     size_t at = 1;
-    std::vector<float> got;
-    if (b.size() < 5) return Status::error("rank " + std::to_string(r) + " sent malformed top errors");
-    const uint32_t count = detail::load_u32(b.data() + at);
-    at += 4;
-    if (!take_words(b, at, count, got) || at != b.size())
-      return Status::error("rank " + std::to_string(r) + " sent malformed top errors");
+    auto count = [&](uint32_t& c) {
+      if (b.size() - at < 4) return false;
+      c = detail::load_u32(b.data() + at);
+      at += 4;
+      return true;
+    };
+    const Status bad = Status::error(from + " sent malformed top errors");
+    uint32_t nt = 0, nf = 0;
+    std::vector<float> to, fr;
+    if (!count(nt) || nt != n || !take_words(b, at, nt, to) || !count(nf) || !take_words(b, at, nf, fr)) return bad;
     size_t k = 0;
-    for (size_t i = 0; i < probes.size(); ++i)
-      if (owner[i] == int(r)) {
-        if (k >= got.size()) return Status::error("rank " + std::to_string(r) + " sent too few top errors");
-        errors[i] = got[k++];
-      }
-    if (k != got.size()) return Status::error("rank " + std::to_string(r) + " sent too many top errors");
+    for (size_t i = 0; i < n; ++i) {
+      to_max[i] = std::max(to_max[i], to[i]);
+      if (owner[i] != int(r)) continue;
+      if (k >= fr.size()) return Status::error(from + " sent too few top errors");
+      from_max[i] = fr[k++];
+    }
+    if (k != fr.size()) return Status::error(from + " sent too many top errors");
+    for (size_t i = 0; i < n; ++i) {
+      uint32_t samples = 0;
+      if (!count(samples) || (uint64_t(samples) + 7) / 8 > b.size() - at) return bad;
+      if (r == 0) answered[i].assign(samples, 0);
+      if (answered[i].size() != samples) return Status::error(from + " sent another sample count for top layer " + std::to_string(i));
+      for (size_t s = 0; s < samples; ++s) answered[i][s] |= (b[at + s / 8] >> (s % 8)) & 1;
+      at += (size_t(samples) + 7) / 8;
+    }
+    if (at != b.size()) return bad;
   }
+  for (const std::vector<uint8_t>& flags : answered)
+    for (uint8_t f : flags) j.r.top_samples_left += f == 0;
+  Status st;
+  j.arena->execute([&] { st = j.builder->measure_probes_rest(probes, answered, to_max); });
+  if (!st) return st;
+  j.r.top_whole_surface = j.builder->whole_surface_built();
+  errors.resize(n);
+  for (size_t i = 0; i < n; ++i) errors[i] = std::max(to_max[i], from_max[i]);
+  j.r.top_rest_cpu_seconds = process_cpu_seconds() - cpu0;
   return Status::success();
 }
 
@@ -666,6 +721,23 @@ HlodRankComm single_rank_comm() {
   c.broadcast = [](std::vector<uint8_t>&) {};
   c.gather = [](const std::vector<uint8_t>& mine) { return std::vector<std::vector<uint8_t>>{mine}; };
   return c;
+}
+
+std::vector<int> assign_subtrees_spatially(const std::vector<uint64_t>& costs, const std::vector<size_t>& order,
+                                           int ranks) {
+  const uint64_t total = std::accumulate(costs.begin(), costs.end(), uint64_t(0));
+  const int r = std::max(1, ranks);
+  std::vector<int> owner(costs.size(), 0);
+  uint64_t before = 0;
+  for (size_t i : order) {
+    if (i >= costs.size()) continue;
+    // The middle of its cost, as a fraction of the total, picks the rank (doubled: no halves).
+    const unsigned __int128 middle = (unsigned __int128)(2 * before + costs[i]) * unsigned(r);
+    const uint64_t of = std::max<uint64_t>(1, 2 * total);
+    owner[i] = int(std::min<unsigned __int128>(middle / of, unsigned(r - 1)));
+    before += costs[i];
+  }
+  return owner;
 }
 
 std::vector<int> assign_subtrees(const std::vector<uint64_t>& costs, int ranks) {

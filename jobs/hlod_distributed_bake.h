@@ -3,12 +3,14 @@
 //   every rank   load the mesh from the shared path, plan the split (the same on every rank),
 //                check its share of the cache's entries in full
 //   gather       which entries were found -> rank 0 broadcasts which are missing
-//   every rank   bake its share of the missing ones (longest first, to the least loaded
-//                rank), each result stored in the cache as it is finished
+//   every rank   bake its share of the missing ones (spatially contiguous runs balanced by
+//                cost), each result stored in the cache as it is finished; queries against
+//                the original go to a BVH over the rank's region (HlodBuilder::set_region)
 //   gather       per rank: its status (a failure names the subtree), work and bytes
 //   rank 0       read the subtrees' roots from the entries (a refused one is baked again here),
 //                build the layers of the levels above -> broadcast them
-//   every rank   measure a share of those layers' errors against the original -> gather
+//   every rank   measure those layers' samples its region answers (and the other side of a
+//                share of them) -> gather -> rank 0 measures any sample no region answered
 //   rank 0       finish the levels above, write the head and their payloads into a temporary
 //                file at its full size -> broadcast where every subtree node's payload goes
 //   every rank   write the payloads of the subtrees it baked or checked, at those offsets
@@ -44,6 +46,13 @@ HlodRankComm single_rank_comm();
 // most the mean plus one subtree. Returns each subtree's rank.
 std::vector<int> assign_subtrees(const std::vector<uint64_t>& costs, int ranks);
 
+// Spatially contiguous runs: subtrees taken in `order` (a permutation of their indices; the
+// top's depth-first order keeps neighbours together), each to the rank whose 1/ranks of the
+// total cost holds the middle of the subtree's cost. The slowest rank then carries at most the
+// mean plus one subtree, and each rank's cells form a few compact regions (its BVH's region).
+std::vector<int> assign_subtrees_spatially(const std::vector<uint64_t>& costs, const std::vector<size_t>& order,
+                                           int ranks);
+
 struct HlodDistributedSettings {
   uint32_t min_verts = 1000;
   uint32_t threads = 0;    // per rank; 0 = all its cores
@@ -70,6 +79,8 @@ struct HlodRankWork {
   double write_cpu_seconds = 0;    // placing its payloads into the .hlod (after rank 0's assembly)
   uint64_t bytes_written = 0;      // cache entries
   uint64_t bytes_placed = 0;       // payload bytes it wrote into the .hlod
+  uint64_t region_triangles = 0;   // in its region's BVH (the original's triangles near its cells)
+  uint32_t whole_surface = 0;      // 1: it needed the whole original's BVH too
 };
 
 struct HlodDistributedResult {
@@ -82,6 +93,11 @@ struct HlodDistributedResult {
   uint64_t entry_bytes_read = 0;                  // rank 0: of the entries, to take up their roots
   double cpu_after_gather_seconds = 0;            // rank 0: CPU time reading roots, assembling, writing
   double collect_cpu_seconds = 0, assemble_cpu_seconds = 0, head_cpu_seconds = 0;  // rank 0, after the gather
+  // Rank 0: the top's samples no rank's region answered (measured by rank 0 near them), and
+  // whether rank 0 needed the whole original's BVH at all (a refused entry rebaked, or those).
+  size_t top_samples_left = 0;
+  bool top_whole_surface = false;
+  double top_rest_cpu_seconds = 0;  // rank 0: merging the top's answers and measuring those left
   // Rank 0: the job's length on idle cores, one thread per rank: the slowest rank up to the
   // first gather, rank 0's serial part (roots, the top's layers, its finish, the head), the
   // slowest rank's share of the top's errors and of the write.

@@ -21,6 +21,7 @@
 #include <bit>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <ctime>
 #include <string>
 
@@ -81,7 +82,9 @@ struct Context {
   std::vector<uint32_t> stamp;         // per vertex: which node last visited it
   std::vector<uint32_t> local;         // per vertex: its index in that node's arrays
   std::atomic<uint32_t> next_stamp{1};
-  SurfaceDistance original;
+  SurfaceDistance original;                        // the whole original, when built
+  const SurfaceDistance* region = nullptr;         // a part of it (set_region): queries go there first
+  std::function<const SurfaceDistance*()> whole;  // with a region: the whole original, built on first call
   uint64_t total_triangles = 0;
   std::atomic<uint64_t> done_triangles{0};
 
@@ -321,18 +324,37 @@ void layer_samples(const Context& c, const Layer& layer, std::vector<float>& poi
   }
 }
 
+// The layer's samples to the whole original surface (through the region when there is one:
+// the same distances).
+Status layer_to_original(const Context& c, const Layer& layer, float& max) {
+  std::vector<float> samples, known;
+  layer_samples(c, layer, samples, known);
+  SurfaceError e;
+  const Status s = c.region ? c.region->from_points_part(samples.data(), samples.size() / 3, known.data(), c.whole, e, nullptr)
+                            : c.original.from_points(samples.data(), samples.size() / 3, known.data(), e);
+  max = e.max;
+  return s;
+}
+
+// The node's original samples to the layer (its own BVH, on any surface's Embree device).
+Status original_to_layer(const Context& c, const SurfaceDistance& device, const std::vector<uint32_t>& reference,
+                         const Layer& layer, float& max) {
+  const TriangleMeshView view{layer.positions.data(), layer.vertices(), layer.indices.data(), layer.indices.size()};
+  std::vector<float> samples, known;
+  reference_samples(c, reference, layer, samples, known);
+  SurfaceError e;
+  const Status s = device.from_points_to(view, samples.data(), samples.size() / 3, known.data(), e);
+  max = e.max;
+  return s;
+}
+
 // Symmetric distance between a layer and the original: the layer's samples to the whole
 // original surface, the node's original samples to the layer.
 Status measure_layer(const Context& c, const std::vector<uint32_t>& reference, const Layer& layer, float& error) {
-  const TriangleMeshView view{layer.positions.data(), layer.vertices(), layer.indices.data(), layer.indices.size()};
-  std::vector<float> samples, known;
-  layer_samples(c, layer, samples, known);
-  SurfaceError to_original, from_original;
-  if (Status s = c.original.from_points(samples.data(), samples.size() / 3, known.data(), to_original); !s) return s;
-  reference_samples(c, reference, layer, samples, known);
-  if (Status s = c.original.from_points_to(view, samples.data(), samples.size() / 3, known.data(), from_original); !s)
-    return s;
-  error = std::max(to_original.max, from_original.max);
+  float to = 0, from = 0;
+  if (Status s = layer_to_original(c, layer, to); !s) return s;
+  if (Status s = original_to_layer(c, c.region ? *c.region : c.original, reference, layer, from); !s) return s;
+  error = std::max(to, from);
   return Status::success();
 }
 
@@ -728,6 +750,34 @@ HlodSubtreeSpec describe_subtree(const Context& c, const BuildNode& n) {
   return spec;
 }
 
+// Frontier nodes' places in depth-first order of the top (octant order: a Morton order of cells).
+void number_spatially(const BuildNode& n, std::vector<HlodSubtreeSpec>& specs, uint32_t& next) {
+  if (n.subtree >= 0) {
+    specs[size_t(n.subtree)].spatial = next++;
+    return;
+  }
+  for (const auto& child : n.children)
+    if (child) number_spatially(*child, specs, next);
+}
+
+// The grid a region is chosen on: 128^3 cells over the root cube.
+SurfaceGrid region_grid(const BuildNode& root) {
+  SurfaceGrid g;
+  for (int k = 0; k < 3; ++k) g.lo[k] = root.center[k] - root.half;
+  g.edge = 2 * root.half;
+  g.n = 128;
+  return g;
+}
+
+// Flags every cell the box [lo, hi] reaches into.
+void want_box(const SurfaceGrid& g, const float* lo, const float* hi, std::vector<uint8_t>& wanted) {
+  uint32_t a[3], b[3];
+  for (int k = 0; k < 3; ++k) a[k] = g.cell(lo[k], k), b[k] = g.cell(hi[k], k);
+  for (uint32_t z = a[2]; z <= b[2]; ++z)
+    for (uint32_t y = a[1]; y <= b[1]; ++y)
+      for (uint32_t x = a[0]; x <= b[0]; ++x) wanted[(size_t(z) * g.n + y) * g.n + x] = 1;
+}
+
 }  // namespace
 
 struct HlodBuilder::Impl {
@@ -740,22 +790,41 @@ struct HlodBuilder::Impl {
   std::vector<HlodSubtreeSpec> specs;
   std::vector<uint8_t> baked;  // per subtree: handed to bake_subtrees already
   size_t dropped = 0;
-  bool planned = false, surface_built = false, assembled = false;
-  Status surface;
-  double surface_cpu = 0;
+  bool planned = false, assembled = false;
+  std::once_flag whole_once;
+  std::atomic<bool> whole_built{false};
+  Status surface;  // the whole original's BVH, once built
+  double whole_cpu = 0, region_cpu = 0;
+  std::vector<size_t> region_subtrees;
+  bool region_wanted = false, region_built = false;
+  SurfaceDistance region;
+  Status region_status;
   Tally top_tally;
 
   Impl(const MeshData& m, const HlodBuildOptions& o)
       : mesh(m), what(m.source.empty() ? std::string("mesh") : m.source), options(o), c(options) {}
 
-  void ensure_surface() {
-    if (surface_built) return;
-    const double cpu0 = thread_cpu_seconds();
-    const TriangleMeshView original{mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
-    surface = c.original.set_surface(original, what);
-    surface_cpu = thread_cpu_seconds() - cpu0;
-    surface_built = true;
+  TriangleMeshView original() const {
+    return {mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
   }
+  // The whole original's BVH, built once from whichever thread needs it first; null on failure.
+  const SurfaceDistance* whole_surface() {
+    std::call_once(whole_once, [this] {
+      const double cpu0 = thread_cpu_seconds();
+      surface = c.original.set_surface(original(), what);
+      whole_cpu = thread_cpu_seconds() - cpu0;
+      whole_built.store(true);
+    });
+    return surface ? &c.original : nullptr;
+  }
+  void ensure_region();
+  // What queries start from: the region when one is set, else the whole original.
+  void ensure_queries() {
+    if (region_wanted) ensure_region();
+    else whole_surface();
+  }
+  bool queries_built() const { return region_wanted ? region_built : whole_built.load(); }
+  const Status& queries_status() const { return region_wanted ? region_status : surface; }
   std::string name(size_t i) const {
     return what + ": subtree " + std::to_string(i) + " (depth " + std::to_string(specs[i].depth) + ", " +
            std::to_string(specs[i].triangles) + " triangles)";
@@ -769,7 +838,42 @@ HlodBuilder::HlodBuilder(const MeshData& mesh, const HlodBuildOptions& options)
 HlodBuilder::~HlodBuilder() = default;
 
 const std::vector<HlodSubtreeSpec>& HlodBuilder::subtrees() const { return impl_->specs; }
-double HlodBuilder::surface_cpu_seconds() const { return impl_->surface_cpu; }
+double HlodBuilder::surface_cpu_seconds() const { return impl_->whole_cpu + impl_->region_cpu; }
+size_t HlodBuilder::region_triangles() const { return impl_->region_built ? impl_->region.triangles() : 0; }
+bool HlodBuilder::whole_surface_built() const { return impl_->whole_built.load(); }
+
+void HlodBuilder::set_region(const std::vector<size_t>& subtrees) {
+  impl_->region_subtrees = subtrees;
+  // Every subtree (one rank): the whole original is the region, without the part's pass.
+  std::vector<uint8_t> seen(impl_->specs.size(), 0);
+  size_t distinct = 0;
+  for (size_t i : subtrees)
+    if (i < seen.size() && !seen[i]) seen[i] = 1, ++distinct;
+  impl_->region_wanted = distinct < impl_->specs.size();
+}
+
+// The region's BVH: the triangles reaching into its subtrees' cells grown by a quarter of their
+// half-edge (so that a query from a subtree's layer, within a fraction of the cell of the
+// surface, finds its nearest point there).
+void HlodBuilder::Impl::ensure_region() {
+  if (region_built) return;
+  const double cpu0 = thread_cpu_seconds();
+  const SurfaceGrid grid = region_grid(*root);
+  std::vector<uint8_t> wanted(grid.cells(), 0);
+  for (size_t i : region_subtrees) {
+    if (i >= specs.size()) continue;
+    const HlodSubtreeSpec& spec = specs[i];
+    const float grow = 1.25f * spec.half;
+    float lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) lo[k] = spec.center[k] - grow, hi[k] = spec.center[k] + grow;
+    want_box(grid, lo, hi, wanted);
+  }
+  region_status = region.set_surface_part(original(), grid, wanted, what + " (region)");
+  c.region = &region;
+  c.whole = [this] { return whole_surface(); };
+  region_cpu = thread_cpu_seconds() - cpu0;
+  region_built = true;
+}
 
 Status HlodBuilder::plan() {
   Impl& m = *impl_;
@@ -797,6 +901,8 @@ Status HlodBuilder::plan() {
   split_top(c, *m.root, c.options.subtrees);
   m.frontier = number_frontier(*m.root);
   for (const BuildNode* n : m.frontier) m.specs.push_back(describe_subtree(c, *n));
+  uint32_t next = 0;
+  number_spatially(*m.root, m.specs, next);
   m.baked.assign(m.frontier.size(), 0);
   m.planned = true;
   return Status::success();
@@ -831,11 +937,11 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
   const ParallelFor& parallel_for = m.c.options.parallel_for;
   std::vector<Tally> tallies(which.size());
   std::vector<uint8_t> grown(which.size(), 0);
-  if (!m.surface_built) {  // subtrees grow beside the BVH for as long as it takes (none serially)
+  if (!m.queries_built()) {  // subtrees grow beside the BVH for as long as it takes (none serially)
     std::atomic<bool> surface_done{false};
     run_all(parallel_for, 2, [&](size_t part) {
       if (part == 0) {
-        m.ensure_surface();
+        m.ensure_queries();
         surface_done.store(true);
         return;
       }
@@ -845,7 +951,7 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
       }
     });
   }
-  if (!m.surface) return m.surface;
+  if (!m.queries_status()) return m.queries_status();
   // The rest grow and finish one by one, so that results are handed on from the start.
   std::vector<Status> finished(which.size());
   std::atomic<bool> failed{false};
@@ -897,34 +1003,142 @@ Status HlodBuilder::build_top(const std::vector<HlodSubtree>& baked, std::vector
   return Status::success();
 }
 
+namespace {
+
+// What comes from elsewhere is checked before it is used as an index.
+Status check_probes(const std::string& what, uint64_t vertices, const std::vector<HlodLayerProbe>& probes,
+                    const std::vector<size_t>& which) {
+  for (size_t i : which) {
+    if (i >= probes.size()) return Status::error(what + ": top layer " + std::to_string(i) + " does not exist");
+    const HlodLayerProbe& p = probes[i];
+    if (p.positions.size() != 3 * p.source.size() || p.indices.size() % 3 != 0)
+      return Status::error(what + ": top layer " + std::to_string(i) + " has mismatched arrays");
+    for (uint32_t v : p.source)
+      if (v >= vertices) return Status::error(what + ": top layer " + std::to_string(i) + " names a vertex outside the mesh");
+    for (uint32_t v : p.reference)
+      if (v >= vertices) return Status::error(what + ": top layer " + std::to_string(i) + " names a vertex outside the mesh");
+    for (uint32_t t : p.indices)
+      if (t >= p.source.size()) return Status::error(what + ": top layer " + std::to_string(i) + " has an index out of range");
+  }
+  return Status::success();
+}
+
+Layer probe_layer(const HlodLayerProbe& p) {
+  Layer layer;
+  layer.positions = p.positions;
+  layer.indices = p.indices;
+  layer.source = p.source;
+  return layer;
+}
+
+std::vector<size_t> every(size_t n) {
+  std::vector<size_t> all(n);
+  for (size_t i = 0; i < n; ++i) all[i] = i;
+  return all;
+}
+
+}  // namespace
+
 Status HlodBuilder::measure_probes(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& which,
                                    std::vector<float>& errors) {
   Impl& m = *impl_;
   if (!m.planned) return Status::error(m.what + ": HLOD layers measured before the build was planned");
-  const uint64_t vertices = m.mesh.vertex_count();
-  for (size_t i : which) {  // what comes from elsewhere is checked before it is used as an index
-    if (i >= probes.size()) return Status::error(m.what + ": top layer " + std::to_string(i) + " does not exist");
-    const HlodLayerProbe& p = probes[i];
-    if (p.positions.size() != 3 * p.source.size() || p.indices.size() % 3 != 0)
-      return Status::error(m.what + ": top layer " + std::to_string(i) + " has mismatched arrays");
-    for (uint32_t v : p.source)
-      if (v >= vertices) return Status::error(m.what + ": top layer " + std::to_string(i) + " names a vertex outside the mesh");
-    for (uint32_t v : p.reference)
-      if (v >= vertices) return Status::error(m.what + ": top layer " + std::to_string(i) + " names a vertex outside the mesh");
-    for (uint32_t t : p.indices)
-      if (t >= p.source.size()) return Status::error(m.what + ": top layer " + std::to_string(i) + " has an index out of range");
-  }
-  m.ensure_surface();
-  if (!m.surface) return m.surface;
+  if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, which); !s) return s;
+  m.ensure_queries();
+  if (!m.queries_status()) return m.queries_status();
   errors.assign(which.size(), 0.0f);
   std::vector<Status> measured(which.size());
   run_all(m.c.options.parallel_for, which.size(), [&](size_t k) {
     const HlodLayerProbe& p = probes[which[k]];
-    Layer layer;
-    layer.positions = p.positions;
-    layer.indices = p.indices;
-    layer.source = p.source;
-    measured[k] = measure_layer(m.c, p.reference, layer, errors[k]);
+    measured[k] = measure_layer(m.c, p.reference, probe_layer(p), errors[k]);
+  });
+  for (const Status& s : measured)
+    if (!s) return s;
+  return Status::success();
+}
+
+Status HlodBuilder::measure_probes_part(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& reference,
+                                        std::vector<float>& to_max, std::vector<std::vector<uint8_t>>& answered,
+                                        std::vector<float>& from_max) {
+  Impl& m = *impl_;
+  if (!m.planned) return Status::error(m.what + ": HLOD layers measured before the build was planned");
+  if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, every(probes.size())); !s) return s;
+  for (size_t i : reference)
+    if (i >= probes.size()) return Status::error(m.what + ": top layer " + std::to_string(i) + " does not exist");
+  m.ensure_queries();
+  if (!m.queries_status()) return m.queries_status();
+  const SurfaceDistance& queries = m.region_wanted ? m.region : m.c.original;
+  to_max.assign(probes.size(), 0.0f);
+  answered.assign(probes.size(), {});
+  from_max.assign(reference.size(), 0.0f);
+  std::vector<Status> measured(probes.size() + reference.size());
+  run_all(m.c.options.parallel_for, measured.size(), [&](size_t k) {
+    if (k >= probes.size()) {  // the original's side of a listed probe
+      const HlodLayerProbe& p = probes[reference[k - probes.size()]];
+      measured[k] = original_to_layer(m.c, queries, p.reference, probe_layer(p), from_max[k - probes.size()]);
+      return;
+    }
+    // The layer's side: only the samples in cells the region holds whole are asked about.
+    std::vector<float> points, known, mine_points, mine_known;
+    layer_samples(m.c, probe_layer(probes[k]), points, known);
+    const size_t n = known.size();
+    std::vector<uint32_t> mine;
+    for (size_t i = 0; i < n; ++i)
+      if (queries.holds(&points[3 * i])) {
+        mine.push_back(uint32_t(i));
+        mine_points.insert(mine_points.end(), &points[3 * i], &points[3 * i] + 3);
+        mine_known.push_back(known[i]);
+      }
+    std::vector<uint8_t> got;
+    SurfaceError e;
+    measured[k] = queries.from_points_part(mine_points.data(), mine.size(), mine_known.data(), {}, e, &got);
+    to_max[k] = e.max;
+    answered[k].assign(n, 0);
+    for (size_t i = 0; i < mine.size() && i < got.size(); ++i) answered[k][mine[i]] = got[i];
+  });
+  for (const Status& s : measured)
+    if (!s) return s;
+  return Status::success();
+}
+
+Status HlodBuilder::measure_probes_rest(const std::vector<HlodLayerProbe>& probes,
+                                        const std::vector<std::vector<uint8_t>>& answered, std::vector<float>& to_max) {
+  Impl& m = *impl_;
+  if (!m.planned) return Status::error(m.what + ": HLOD layers measured before the build was planned");
+  if (answered.size() != probes.size() || to_max.size() != probes.size())
+    return Status::error(m.what + ": " + std::to_string(answered.size()) + " answered lists for " +
+                         std::to_string(probes.size()) + " top layers");
+  if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, every(probes.size())); !s) return s;
+  // Each probe's unanswered samples, and the cells within their known bounds (a cell's width more).
+  std::vector<std::vector<float>> points(probes.size()), known(probes.size());
+  const SurfaceGrid grid = region_grid(*m.root);
+  std::vector<uint8_t> wanted(grid.cells(), 0);
+  size_t left = 0;
+  for (size_t k = 0; k < probes.size(); ++k) {
+    std::vector<float> pts, kn;
+    layer_samples(m.c, probe_layer(probes[k]), pts, kn);
+    if (answered[k].size() != kn.size()) return Status::error(m.what + ": top layer " + std::to_string(k) + ": answered flags do not match its samples");
+    for (size_t i = 0; i < kn.size(); ++i) {
+      if (answered[k][i]) continue;
+      ++left;
+      points[k].insert(points[k].end(), &pts[3 * i], &pts[3 * i] + 3);
+      known[k].push_back(kn[i]);
+      const float reach = std::isfinite(kn[i]) ? kn[i] * 1.01f + grid.edge / float(grid.n) : grid.edge;
+      float lo[3], hi[3];
+      for (int j = 0; j < 3; ++j) lo[j] = pts[3 * i + j] - reach, hi[j] = pts[3 * i + j] + reach;
+      want_box(grid, lo, hi, wanted);
+    }
+  }
+  if (left == 0) return Status::success();
+  SurfaceDistance near;
+  if (Status s = near.set_surface_part(m.original(), grid, wanted, m.what + " (near the top's samples)"); !s) return s;
+  const std::function<const SurfaceDistance*()> whole = [&m] { return m.whole_surface(); };
+  std::vector<Status> measured(probes.size());
+  run_all(m.c.options.parallel_for, probes.size(), [&](size_t k) {
+    if (known[k].empty()) return;
+    SurfaceError e;
+    measured[k] = near.from_points_part(points[k].data(), known[k].size(), known[k].data(), whole, e, nullptr);
+    to_max[k] = std::max(to_max[k], e.max);
   });
   for (const Status& s : measured)
     if (!s) return s;

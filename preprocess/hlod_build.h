@@ -116,6 +116,8 @@ struct HlodSubtreeSpec {
   // Hash of its depth, cell, triangles (ids and corners) and which of its vertices ancestors'
   // patches lock: with the mesh and the options, everything its bake depends on.
   uint64_t fingerprint = 0;
+  // Its place in depth-first (octant) order of the top: subtrees close in it are close in space.
+  uint32_t spatial = 0;
 };
 
 // The three steps of build_hlod, for a caller that spreads (b) over processes. `mesh` must
@@ -155,8 +157,31 @@ class HlodBuilder {
                         std::vector<float>& errors);
   Status finish_top(const std::vector<HlodSubtree>& baked, const std::vector<float>& errors, HlodAssembly& out,
                     HlodBuildReport* report = nullptr);
-  // Process CPU seconds the original's BVH took to build (0 until it is built).
+  // A distributed build's region (issue 16): the subtrees this builder bakes, or whose cells'
+  // share of the top's samples it measures (measure_probes_part). Its queries against the
+  // original then go to a BVH over the triangles near their cells (a margin of a quarter of a
+  // cell's half-edge) and, where that cannot answer exactly as the whole original would (the
+  // nearest found is not provably the nearest), to the whole original's BVH, built on first
+  // need only. The bytes are the same either way. Before bake_subtrees and measure_probes_part.
+  // Every subtree listed (one rank): the whole original, as without a region.
+  void set_region(const std::vector<size_t>& subtrees);
+  // The top's errors split by sample rather than by layer, for builders with a region: per
+  // probe, the largest distance to the original among its layer samples the region answers
+  // (to_max) and which samples those are (answered, one flag per sample); for the probes listed
+  // in `reference`, the other side (the node's original samples to the layer; from_max, by
+  // position in `reference`). A layer's error is max(to_max over every sample, from_max).
+  Status measure_probes_part(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& reference,
+                             std::vector<float>& to_max, std::vector<std::vector<uint8_t>>& answered,
+                             std::vector<float>& from_max);
+  // The samples no region answered (answered: every region's flags merged), measured against
+  // the original near them (the whole original only where that cannot answer); raises to_max.
+  Status measure_probes_rest(const std::vector<HlodLayerProbe>& probes,
+                             const std::vector<std::vector<uint8_t>>& answered, std::vector<float>& to_max);
+  // Process CPU seconds the original's BVHs took to build (region and whole; 0 until built).
   double surface_cpu_seconds() const;
+  // Triangles in the region's BVH (0 without one), and whether the whole original's was built.
+  size_t region_triangles() const;
+  bool whole_surface_built() const;
 
  private:
   struct Impl;

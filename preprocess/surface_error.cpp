@@ -63,6 +63,7 @@ struct QueryMesh {
   std::vector<float> positions;
   std::vector<uint32_t> indices;
   RTCScene scene = nullptr;
+  float slack = 0;  // above float rounding of any distance computed to it (see closest_within)
 
   ~QueryMesh() { release(); }
   void release() {
@@ -86,10 +87,19 @@ bool closest_point_callback(RTCPointQueryFunctionArguments* args) {
   const float dsq = dot(d, d);
   if (dsq < st->best_sq) {
     st->best_sq = dsq;
-    args->query->radius = std::sqrt(dsq);
-    return true;  // the query sphere shrank
+    // Not to the distance itself: a triangle within rounding of the nearest is still visited,
+    // so the minimum does not depend on the order the BVH visits them in (nor on which BVH).
+    args->query->radius = std::sqrt(dsq) * (1 + 1e-5f) + st->mesh->slack;
+    return true;  // the query sphere changed
   }
   return false;
+}
+
+// Above the rounding of a closest point computed among coordinates this large (a few ulps).
+float rounding_slack(const float* positions, size_t floats) {
+  float extent = 0;
+  for (size_t i = 0; i < floats; ++i) extent = std::max(extent, std::fabs(positions[i]));
+  return 1e-6f * extent;
 }
 
 std::string device_error_text(RTCDevice device) {
@@ -104,6 +114,8 @@ std::string device_error_text(RTCDevice device) {
   }
 }
 
+Status commit_query_mesh(RTCDevice device, const std::string& what, QueryMesh& out);
+
 Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const std::string& what, QueryMesh& out) {
   out.release();
   if (view.index_count % 3 != 0 || view.index_count == 0)
@@ -114,13 +126,19 @@ Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const st
                            std::to_string(view.indices[i]) + " of " + std::to_string(view.vertex_count));
   out.positions.assign(view.positions, view.positions + 3 * view.vertex_count);
   out.indices.assign(view.indices, view.indices + view.index_count);
+  out.slack = rounding_slack(view.positions, 3 * view.vertex_count);
+  return commit_query_mesh(device, what, out);
+}
 
+// out's arrays into an Embree scene.
+Status commit_query_mesh(RTCDevice device, const std::string& what, QueryMesh& out) {
+  const size_t vertex_count = out.positions.size() / 3, index_count = out.indices.size();
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   if (!geom) return Status::error(what + ": Embree could not create a geometry (" + device_error_text(device) + ")");
   auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                         3 * sizeof(float), view.vertex_count));
+                                                         3 * sizeof(float), vertex_count));
   auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                            3 * sizeof(uint32_t), view.index_count / 3));
+                                                            3 * sizeof(uint32_t), index_count / 3));
   if (!vb || !ib) {
     rtcReleaseGeometry(geom);
     return Status::error(what + ": Embree could not allocate buffers (" + device_error_text(device) + ")");
@@ -185,41 +203,55 @@ std::vector<float> sample_surface(const TriangleMeshView& view, size_t count, ui
   return samples;
 }
 
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The nearest distance from p to `mesh` among the triangles a query of `radius` visits (+inf
+// when none). When the true nearest lies within the radius, that is the least distance computed
+// to any triangle of the mesh, whatever its BVH: the sphere never shrinks below the nearest plus
+// the rounding slack (closest_point_callback).
+double closest_within(const QueryMesh& mesh, Vec3 p, float radius, RTCPointQueryContext& context) {
+  QueryState st{&mesh, p, kInf};
+  RTCPointQuery q;
+  q.x = p.x;
+  q.y = p.y;
+  q.z = p.z;
+  q.time = 0;
+  q.radius = radius;
+  rtcPointQuery(mesh.scene, &q, &context, closest_point_callback, &st);
+  return st.best_sq == kInf ? double(kInf) : std::sqrt(double(st.best_sq));
+}
+
+// Triangle inequality: the surface is no farther than the previous sample's distance plus the
+// step between the samples (or the caller's own bound, when tighter). Starting the query with
+// that radius prunes most of the BVH; the margins cover float rounding.
+float start_radius(Vec3 p, Vec3 prev, double prev_d, const float* known, size_t i, float slack) {
+  const Vec3 step = p - prev;
+  double bound = prev_d + std::sqrt(double(dot(step, step)));
+  if (known) bound = std::min(bound, double(known[i]));
+  return float(bound * 1.0001 + 1e-12) + slack;
+}
+
+// One sample's distance as every query on a whole surface makes it: within the start radius,
+// then open when nothing was found there.
+double sample_distance(const QueryMesh& mesh, Vec3 p, float radius, RTCPointQueryContext& context) {
+  const double d = closest_within(mesh, p, radius, context);
+  return d == double(kInf) ? closest_within(mesh, p, kInf, context) : d;
+}
+
 // Distances from every sample to `mesh`: updates max and the sum of squares.
 void query_distances(const float* samples, size_t sample_floats, const float* known, const QueryMesh& mesh,
                      double& max_d, double& sum_sq, size_t& n) {
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
-  constexpr float kInf = std::numeric_limits<float>::infinity();
   Vec3 prev{0, 0, 0};
   double prev_d = kInf;
   for (size_t i = 0; i + 2 < sample_floats; i += 3) {
-    QueryState st{&mesh, load(&samples[i]), kInf};
-    if (known && known[i / 3] == 0) {  // a point of the surface itself: nothing to look up
-      prev = st.point;
-      prev_d = 0;
-      ++n;
-      continue;
-    }
-    RTCPointQuery q;
-    q.x = st.point.x;
-    q.y = st.point.y;
-    q.z = st.point.z;
-    q.time = 0;
-    // Triangle inequality: the surface is no farther than the previous sample's distance
-    // plus the step between the samples. Starting the query with that radius prunes most of
-    // the BVH; the margin covers float rounding, and a miss falls back to an open query.
-    const Vec3 step = st.point - prev;
-    double bound = prev_d + std::sqrt(double(dot(step, step)));
-    if (known) bound = std::min(bound, double(known[i / 3]));  // the caller's own bound, when tighter
-    q.radius = float(bound * 1.0001 + 1e-12);
-    rtcPointQuery(mesh.scene, &q, &context, closest_point_callback, &st);
-    if (st.best_sq == kInf) {
-      q.radius = kInf;
-      rtcPointQuery(mesh.scene, &q, &context, closest_point_callback, &st);
-    }
-    const double d = std::sqrt(double(st.best_sq));
-    prev = st.point;
+    const Vec3 p = load(&samples[i]);
+    // known 0: a point of the surface itself, nothing to look up
+    const double d = known && known[i / 3] == 0
+                         ? 0.0
+                         : sample_distance(mesh, p, start_radius(p, prev, prev_d, known, i / 3, mesh.slack), context);
+    prev = p;
     prev_d = d;
     max_d = std::max(max_d, d);
     sum_sq += d * d;
@@ -282,11 +314,56 @@ Status SurfaceErrorMeter::measure(const TriangleMeshView& mesh, SurfaceError& ou
   return Status::success();
 }
 
+uint32_t SurfaceGrid::cell(float x, int axis) const {
+  const float t = (x - lo[axis]) * (float(n) / edge);  // monotonic in x, so is the cell
+  if (!(t > 0)) return 0;                               // below, or NaN
+  return t >= float(n) ? n - 1 : std::min(n - 1, uint32_t(t));
+}
+
+namespace {
+
+// A box's cells: [lo, hi] per axis, inclusive.
+struct CellRange {
+  uint32_t lo[3], hi[3];
+  size_t count() const { return size_t(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1); }
+  template <class F>
+  bool all(const SurfaceGrid& g, F&& f) const {  // f(cell index) true for every cell
+    for (uint32_t z = lo[2]; z <= hi[2]; ++z)
+      for (uint32_t y = lo[1]; y <= hi[1]; ++y)
+        for (uint32_t x = lo[0]; x <= hi[0]; ++x)
+          if (!f((size_t(z) * g.n + y) * g.n + x)) return false;
+    return true;
+  }
+};
+
+CellRange cells_of_box(const SurfaceGrid& g, const float* lo, const float* hi) {
+  CellRange r;
+  for (int k = 0; k < 3; ++k) r.lo[k] = g.cell(lo[k], k), r.hi[k] = g.cell(hi[k], k);
+  return r;
+}
+
+// A triangle spanning more cells than this stays in every part (bounds the cost of huge ones).
+constexpr size_t kPartSpanCells = 4096;
+
+}  // namespace
+
 struct SurfaceDistance::Impl {
   RTCDevice device = nullptr;
   QueryMesh surface;
   std::string what;
   bool ready = false;
+  bool part = false;
+  size_t triangles = 0;
+  SurfaceGrid grid;
+  std::vector<uint8_t> complete;  // a part's: per cell, no triangle outside the part reaches in
+
+  // Whether every triangle of the whole surface within `radius` of p is in the part: each one
+  // reaches into a cell the ball's box reaches into (cells are monotonic in the coordinate).
+  bool holds_ball(Vec3 p, double radius) const {
+    const float r = float(radius);
+    const float lo[3] = {p.x - r, p.y - r, p.z - r}, hi[3] = {p.x + r, p.y + r, p.z + r};
+    return cells_of_box(grid, lo, hi).all(grid, [&](size_t c) { return complete[c] != 0; });
+  }
 
   ~Impl() {
     surface.release();
@@ -306,8 +383,76 @@ Status SurfaceDistance::set_surface(const TriangleMeshView& surface, const std::
     if (!m.device) return Status::error(what + ": Embree device could not be created");
   }
   if (Status s = build_query_mesh(m.device, surface, what, m.surface); !s) return s;
+  m.part = false;
+  m.triangles = surface.index_count / 3;
   m.ready = true;
   return Status::success();
+}
+
+Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const SurfaceGrid& grid,
+                                         const std::vector<uint8_t>& wanted, const std::string& what) {
+  Impl& m = *impl_;
+  m.ready = false;
+  m.what = what;
+  m.surface.release();
+  if (whole.index_count % 3 != 0 || grid.n == 0 || wanted.size() != grid.cells())
+    return Status::error(what + ": a surface part needs whole triangles and one flag per grid cell");
+  for (size_t i = 0; i < whole.index_count; ++i)
+    if (whole.indices[i] >= whole.vertex_count)
+      return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
+                           std::to_string(whole.indices[i]) + " of " + std::to_string(whole.vertex_count));
+  if (!m.device) {
+    m.device = rtcNewDevice(nullptr);
+    if (!m.device) return Status::error(what + ": Embree device could not be created");
+  }
+  // A triangle is kept when its box reaches into a wanted cell; otherwise every cell its box
+  // reaches into is incomplete.
+  m.grid = grid;
+  m.complete.assign(grid.cells(), 1);
+  std::vector<uint32_t> remap(whole.vertex_count, UINT32_MAX);
+  QueryMesh& part = m.surface;
+  part.positions.clear();
+  part.indices.clear();
+  for (size_t t = 0; t < whole.index_count / 3; ++t) {
+    const uint32_t* f = whole.indices + 3 * t;
+    float lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      const float a = whole.positions[3 * size_t(f[0]) + k], b = whole.positions[3 * size_t(f[1]) + k],
+                  c = whole.positions[3 * size_t(f[2]) + k];
+      lo[k] = std::min({a, b, c}), hi[k] = std::max({a, b, c});
+    }
+    const CellRange range = cells_of_box(grid, lo, hi);
+    const bool keep = range.count() > kPartSpanCells || !range.all(grid, [&](size_t c) { return wanted[c] == 0; });
+    if (!keep) {
+      range.all(grid, [&](size_t c) { return m.complete[c] = 0, true; });
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& v = remap[f[k]];
+      if (v == UINT32_MAX) {
+        v = uint32_t(part.positions.size() / 3);
+        part.positions.insert(part.positions.end(), whole.positions + 3 * size_t(f[k]), whole.positions + 3 * size_t(f[k]) + 3);
+      }
+      part.indices.push_back(v);
+    }
+  }
+  // The whole surface's slack, so that start radii and sphere updates are the whole's.
+  part.slack = rounding_slack(whole.positions, 3 * whole.vertex_count);
+  m.part = true;
+  m.triangles = part.indices.size() / 3;
+  if (m.triangles > 0)
+    if (Status s = commit_query_mesh(m.device, what, part); !s) return s;
+  m.ready = true;
+  return Status::success();
+}
+
+size_t SurfaceDistance::triangles() const { return impl_->triangles; }
+
+bool SurfaceDistance::holds(const float* p) const {
+  const Impl& m = *impl_;
+  if (!m.part) return m.ready;
+  const float q[3] = {p[0], p[1], p[2]};
+  return cells_of_box(m.grid, q, q).all(m.grid, [&](size_t c) { return m.complete[c] != 0; });
 }
 
 namespace {
@@ -339,6 +484,46 @@ Status SurfaceDistance::from_points_to(const TriangleMeshView& mesh, const float
   double max_d = 0, sum_sq = 0;
   size_t n = 0;
   query_distances(points, 3 * count, known, other, max_d, sum_sq, n);
+  out = distance_summary(max_d, sum_sq, n);
+  return Status::success();
+}
+
+Status SurfaceDistance::from_points_part(const float* points, size_t count, const float* known,
+                                         const std::function<const SurfaceDistance*()>& whole, SurfaceError& out,
+                                         std::vector<uint8_t>* answered) const {
+  const Impl& m = *impl_;
+  if (!m.ready) return Status::error("surface distance: no surface set");
+  if (answered) answered->assign(count, m.part ? 0 : 1);
+  if (!m.part) return from_points(points, count, known, out);
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  const float slack = m.surface.slack;
+  Vec3 prev{0, 0, 0};
+  double prev_d = kInf, max_d = 0, sum_sq = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < count; ++i) {
+    const Vec3 p = load(points + 3 * i);
+    double d = 0;
+    if (!(known && known[i] == 0)) {
+      const float radius = start_radius(p, prev, prev_d, known, i, slack);
+      d = m.triangles ? closest_within(m.surface, p, radius, context) : double(kInf);
+      // Found within the start radius, rounding included (so the whole's query visits its
+      // nearest too), and every triangle as near as it held here: the whole's answer.
+      const bool mine = d + 0.5 * slack <= double(radius) && m.holds_ball(p, d * (1 + 1e-4) + 4.0 * slack);
+      if (!mine) {
+        const SurfaceDistance* w = whole ? whole() : nullptr;
+        if (whole && !w) return Status::error(m.what + ": the whole surface could not be built");
+        if (!w) continue;  // unanswered: the caller asks elsewhere
+        d = sample_distance(w->impl_->surface, p, radius, context);
+      }
+    }
+    if (answered) (*answered)[i] = 1;
+    prev = p;
+    prev_d = d;
+    max_d = std::max(max_d, d);
+    sum_sq += d * d;
+    ++n;
+  }
   out = distance_summary(max_d, sum_sq, n);
   return Status::success();
 }

@@ -5,8 +5,10 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "runtime/status.h"
 
@@ -51,8 +53,23 @@ class SurfaceErrorMeter {
   std::unique_ptr<Impl> impl_;
 };
 
+// n^3 cubic cells over a cube (x fastest), to say which part of a surface a SurfaceDistance holds.
+struct SurfaceGrid {
+  float lo[3] = {0, 0, 0};  // the cube's lowest corner
+  float edge = 1;           // the cube's edge
+  uint32_t n = 1;
+  size_t cells() const { return size_t(n) * n * n; }
+  // The cell holding coordinate x on `axis`, clamped into the grid (monotonic in x).
+  uint32_t cell(float x, int axis) const;
+};
+
 // One surface held for closest-point queries from many threads at once (HLOD builds measure
 // every node's layers against one original). The const members are thread-safe.
+//
+// A part (set_surface_part) holds only the triangles of a whole surface that reach into some
+// wanted cells, and knows which cells it holds completely (no other triangle reaches in). A
+// query found nearest within complete cells is provably the whole surface's answer, to the bit
+// (every query visits all triangles within float rounding of the nearest, on any BVH).
 class SurfaceDistance {
  public:
   SurfaceDistance();
@@ -62,6 +79,14 @@ class SurfaceDistance {
 
   // Copies `surface` into a BVH. `what` names it in messages.
   Status set_surface(const TriangleMeshView& surface, const std::string& what);
+  // Copies the triangles of `whole` whose box reaches into a `wanted` cell (grid.cells() flags;
+  // a triangle spanning very many cells is always kept). No triangle: every query unanswered.
+  Status set_surface_part(const TriangleMeshView& whole, const SurfaceGrid& grid, const std::vector<uint8_t>& wanted,
+                          const std::string& what);
+  // Triangles held (a part's; the whole surface's otherwise).
+  size_t triangles() const;
+  // A part: whether the cell holding p is held completely (a caller choosing points to ask about).
+  bool holds(const float* p) const;
   // Distance from each of `count` points (xyz) to the held surface: max into out.max,
   // RMS into out.rms (samples = count). `known` (optional, one per point): a distance the
   // surface is known to be within (e.g. to a surface vertex the point came from), so the
@@ -71,6 +96,13 @@ class SurfaceDistance {
   // this call only (a small layer measured from the original's samples).
   Status from_points_to(const TriangleMeshView& mesh, const float* points, size_t count, const float* known,
                         SurfaceError& out) const;
+  // from_points on a part: a point it cannot answer exactly as the whole surface would goes to
+  // whole() (from any thread, possibly several at once; it returns the whole surface, ready, or
+  // null on failure) or, when `whole` is empty, is left out of `out` (answered[i] = 0; answered
+  // may be null then only if every point is sure to be answered).
+  Status from_points_part(const float* points, size_t count, const float* known,
+                          const std::function<const SurfaceDistance*()>& whole, SurfaceError& out,
+                          std::vector<uint8_t>* answered) const;
 
  private:
   struct Impl;

@@ -70,7 +70,8 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
                                    {"plan", w.plan_cpu_seconds}, {"check", w.check_cpu_seconds},
                                    {"bvh", w.surface_cpu_seconds}, {"bake", w.bake_cpu_seconds},
                                    {"measure_top", w.measure_cpu_seconds}, {"write", w.write_cpu_seconds}}},
-                        {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed}});
+                        {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed},
+                        {"region_triangles", w.region_triangles}, {"whole_bvh", w.whole_surface != 0}});
     slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
   }
   return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},
@@ -82,7 +83,9 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
           {"cpu_after_gather_s", r.cpu_after_gather_seconds},
           // Rank 0's serial CPU seconds between the gather and the layout's broadcast.
           {"rank0_cpu_s", {{"roots", r.collect_cpu_seconds}, {"assemble", r.assemble_cpu_seconds},
-                           {"head", r.head_cpu_seconds}}},
+                           {"head", r.head_cpu_seconds}, {"top_rest", r.top_rest_cpu_seconds}}},
+          // The top's samples no rank's region answered; whether rank 0 built the whole BVH.
+          {"top_samples_left", r.top_samples_left}, {"rank0_whole_bvh", r.top_whole_surface},
           // The job's length on idle cores: the slowest rank's CPU time up to the gather, rank
           // 0's serial part, the slowest rank's write (each rank runs one thread; the machine
           // these figures come from is shared).

@@ -45,6 +45,29 @@ TEST(HlodAssign, SlowestRankCarriesAtMostTheMeanPlusOneSubtree) {
   }
 }
 
+TEST(HlodAssign, SpatialRunsAreContiguousAndBalanced) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int ranks = 1 + int(rng() % 8);
+    std::vector<uint64_t> costs(1 + rng() % 200);
+    for (uint64_t& c : costs) c = 1 + rng() % 5000;
+    std::vector<size_t> order(costs.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::shuffle(order.begin(), order.end(), rng);
+    const std::vector<int> owner = assign_subtrees_spatially(costs, order, ranks);
+    std::vector<uint64_t> load(size_t(ranks), 0);
+    for (size_t k = 0; k < order.size(); ++k) {
+      ASSERT_GE(owner[order[k]], 0);
+      ASSERT_LT(owner[order[k]], ranks);
+      if (k) ASSERT_GE(owner[order[k]], owner[order[k - 1]]) << "runs follow the order";
+      load[size_t(owner[order[k]])] += costs[order[k]];
+    }
+    const double mean = double(std::accumulate(costs.begin(), costs.end(), uint64_t(0))) / ranks;
+    EXPECT_LE(double(*std::max_element(load.begin(), load.end())), mean + double(*std::max_element(costs.begin(), costs.end())));
+  }
+  EXPECT_EQ(assign_subtrees_spatially({1, 1, 1, 1}, {3, 2, 1, 0}, 2), (std::vector<int>{1, 1, 0, 0}));
+}
+
 // The mixed test mesh as an OFF file.
 std::filesystem::path write_mesh(const std::filesystem::path& dir) {
   const MeshData m = test::vd_concat(test::vd_sphere(40, 50, 0.4f, 0.5f, 0.3f, 0.5f), test::vd_grid(40, 40));

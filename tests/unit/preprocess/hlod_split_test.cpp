@@ -84,6 +84,62 @@ TEST(HlodSplit, SubtreesBakedByOtherBuildersSpliceIntoTheSameFile) {
   EXPECT_EQ(bytes_of(model), local_build(m, 16));
 }
 
+// Two builders with regions (the two spatial halves of the frontier) bake and measure the top by
+// sample as a distributed build does, a third assembles: the local bytes, from BVHs over less
+// than the whole mesh.
+TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
+  const MeshData m = mesh();
+  const HlodBuildOptions o = options_with(16);
+  HlodBuilder a(m, o), b(m, o), root(m, o);
+  ASSERT_TRUE(a.plan());
+  ASSERT_TRUE(b.plan());
+  ASSERT_TRUE(root.plan());
+  const size_t n = root.subtrees().size();
+  std::vector<size_t> low, high;
+  for (size_t i = 0; i < n; ++i) (root.subtrees()[i].spatial < n / 2 ? low : high).push_back(i);
+  a.set_region(low);
+  b.set_region(high);
+  std::vector<HlodSubtree> baked(n);
+  auto keep = [&](size_t i, HlodSubtree&& s) {
+    baked[i] = std::move(s);
+    return Status::success();
+  };
+  ASSERT_TRUE(a.bake_subtrees(low, keep));
+  ASSERT_TRUE(b.bake_subtrees(high, keep));
+  for (const HlodBuilder* x : {&a, &b}) {
+    EXPECT_GT(x->region_triangles(), 0u);
+    EXPECT_LT(x->region_triangles(), m.triangle_count());
+  }
+  std::vector<HlodLayerProbe> probes;
+  ASSERT_TRUE(root.build_top(baked, probes));
+  std::vector<size_t> first, second;
+  for (size_t i = 0; i < probes.size(); ++i) (i % 2 ? second : first).push_back(i);
+  std::vector<float> to_a, to_b, from_a, from_b;
+  std::vector<std::vector<uint8_t>> ans_a, ans_b;
+  ASSERT_TRUE(a.measure_probes_part(probes, first, to_a, ans_a, from_a));
+  ASSERT_TRUE(b.measure_probes_part(probes, second, to_b, ans_b, from_b));
+  std::vector<float> to(probes.size()), errors(probes.size());
+  std::vector<std::vector<uint8_t>> answered(probes.size());
+  size_t samples = 0, by_regions = 0;
+  for (size_t i = 0; i < probes.size(); ++i) {
+    to[i] = std::max(to_a[i], to_b[i]);
+    ASSERT_EQ(ans_a[i].size(), ans_b[i].size());
+    answered[i].resize(ans_a[i].size());
+    for (size_t k = 0; k < answered[i].size(); ++k) answered[i][k] = ans_a[i][k] | ans_b[i][k];
+    samples += answered[i].size();
+    by_regions += size_t(std::count(answered[i].begin(), answered[i].end(), 1));
+  }
+  EXPECT_GT(by_regions, samples / 2) << "most of the top's samples are answered by a region";
+  ASSERT_TRUE(root.measure_probes_rest(probes, answered, to));
+  for (size_t i = 0; i < probes.size(); ++i) errors[i] = std::max(to[i], (i % 2 ? from_b[i / 2] : from_a[i / 2]));
+  HlodAssembly assembly;
+  ASSERT_TRUE(root.finish_top(baked, errors, assembly));
+  for (size_t i = 0; i < assembly.origin.size(); ++i)
+    if (const HlodAssembly::Origin org = assembly.origin[i]; org.subtree >= 0)
+      assembly.model.payloads[i] = std::move(baked[size_t(org.subtree)].payloads[org.local]);
+  EXPECT_EQ(bytes_of(assembly.model), local_build(m, 16));
+}
+
 TEST(HlodSplit, AssemblyRefusesASubtreeInTheWrongPlace) {
   const MeshData m = mesh();
   const HlodBuildOptions o = options_with(16);

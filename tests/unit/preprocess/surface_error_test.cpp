@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <functional>
+#include <random>
 
 #include "preprocess/mesh_io.h"
 #include "test_support.h"
@@ -103,6 +106,64 @@ TEST(SurfaceError, MeterReusesItsReference) {
   ASSERT_TRUE(meter.measure(view(up, kSquareTris), shifted).ok);
   EXPECT_LT(same.max, 1e-6f);
   EXPECT_NEAR(shifted.max, 0.5f, 1e-6f);
+}
+
+// A surface part answers a point only when it is provably the whole surface's answer, to the
+// bit; the others go to the whole (or are left unanswered); cells outside reach none of it.
+TEST(SurfaceDistance, PartAnswersExactlyAsTheWhole) {
+  // A wavy 60 x 60 sheet over [0, 1]^2.
+  std::vector<float> p;
+  std::vector<uint32_t> t;
+  const uint32_t n = 60;
+  for (uint32_t y = 0; y <= n; ++y)
+    for (uint32_t x = 0; x <= n; ++x) {
+      const float u = float(x) / n, v = float(y) / n;
+      p.insert(p.end(), {u, v, 0.05f * std::sin(9 * u) * std::cos(7 * v) + 0.5f});
+    }
+  for (uint32_t y = 0; y < n; ++y)
+    for (uint32_t x = 0; x < n; ++x) {
+      const uint32_t a = y * (n + 1) + x;
+      t.insert(t.end(), {a, a + 1, a + n + 2, a, a + n + 2, a + n + 1});
+    }
+  SurfaceDistance whole, part;
+  ASSERT_TRUE(whole.set_surface(view(p, t), "sheet"));
+  SurfaceGrid grid;
+  grid.n = 16;
+  std::vector<uint8_t> wanted(grid.cells(), 0);
+  for (uint32_t z = 0; z < grid.n; ++z)
+    for (uint32_t y = 0; y < grid.n; ++y)
+      for (uint32_t x = 0; x < grid.n / 2; ++x) wanted[(size_t(z) * grid.n + y) * grid.n + x] = 1;  // x < 0.5
+  ASSERT_TRUE(part.set_surface_part(view(p, t), grid, wanted, "half sheet"));
+  EXPECT_GT(part.triangles(), t.size() / 3 / 3);
+  EXPECT_LT(part.triangles(), t.size() / 3 * 2 / 3);
+  auto on_sheet = [](float u, float v) { return 0.05f * std::sin(9 * u) * std::cos(7 * v) + 0.5f; };
+  const float inside[3] = {0.2f, 0.5f, on_sheet(0.2f, 0.5f)}, outside[3] = {0.8f, 0.5f, on_sheet(0.8f, 0.5f)};
+  EXPECT_TRUE(part.holds(inside));
+  EXPECT_FALSE(part.holds(outside));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0, 1), h(0.3f, 0.7f);
+  size_t mine = 0, theirs = 0;
+  const std::function<const SurfaceDistance*()> ask_whole = [&] { return &whole; };
+  for (int k = 0; k < 2000; ++k) {
+    const float q[3] = {u(rng), u(rng), h(rng)};
+    SurfaceError w, a, b;
+    std::vector<uint8_t> answered;
+    ASSERT_TRUE(whole.from_points(q, 1, nullptr, w));
+    ASSERT_TRUE(part.from_points_part(q, 1, nullptr, ask_whole, a, nullptr));
+    EXPECT_EQ(std::bit_cast<uint32_t>(a.max), std::bit_cast<uint32_t>(w.max)) << q[0] << " " << q[1] << " " << q[2];
+    ASSERT_TRUE(part.from_points_part(q, 1, nullptr, {}, b, &answered));
+    ASSERT_EQ(answered.size(), 1u);
+    if (answered[0]) {
+      ++mine;
+      EXPECT_EQ(std::bit_cast<uint32_t>(b.max), std::bit_cast<uint32_t>(w.max));
+      EXPECT_LT(q[0], 0.5f + 1e-6f + w.max) << "answered from a half that cannot hold the nearest point";
+    } else {
+      ++theirs;
+      EXPECT_EQ(b.samples, 0u);
+    }
+  }
+  EXPECT_GT(mine, 300u);
+  EXPECT_GT(theirs, 300u);
 }
 
 TEST(SurfaceError, RefusesBadInput) {
