@@ -546,19 +546,22 @@ bool sides_apart(const Work& w, uint32_t f, uint32_t t, uint32_t g, uint32_t tp)
   return true;
 }
 
+// Where p projects onto the edge from a to b, as a fraction of it in [0, 1] (1 for a point edge):
+// the weight of b's attribute in the one the collapse gives.
+float edge_parameter(const float* pa, const float* pb, const float* p) {
+  const float d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
+  const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  if (!(len2 > 0)) return 1;
+  return std::clamp(((p[0] - pa[0]) * d[0] + (p[1] - pa[1]) * d[1] + (p[2] - pa[2]) * d[2]) / len2, 0.f, 1.f);
+}
+
 // Collapses a onto b at p: b takes a's quadrics, its border loop place and its faces (through
 // the remap table), and the attribute at p interpolated along the edge a-b.
 void apply_collapse(Work& w, QemMesh& mesh, uint32_t a, uint32_t b, const float* p) {
   float* pos = mesh.positions.data();
   const size_t ac = mesh.attribute_count;
   if (ac) {
-    const float* pa = pos + 3 * size_t(a);
-    const float* pb = pos + 3 * size_t(b);
-    const float d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
-    const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    float t = 1;
-    if (len2 > 0)
-      t = std::clamp(((p[0] - pa[0]) * d[0] + (p[1] - pa[1]) * d[1] + (p[2] - pa[2]) * d[2]) / len2, 0.f, 1.f);
+    const float t = edge_parameter(pos + 3 * size_t(a), pos + 3 * size_t(b), p);
     float* at = mesh.attributes.data();
     for (size_t k = 0; k < ac; ++k) at[b * ac + k] = at[a * ac + k] * (1 - t) + at[b * ac + k] * t;
   }
@@ -652,13 +655,7 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
         AttributeQuadric aq = mesh.attribute_quadrics[a];
         attribute_add(aq, mesh.attribute_quadrics[b]);
         const uint32_t f = c.from, to = c.to;
-        const float* pf = pos + 3 * size_t(f);
-        const float* pt = pos + 3 * size_t(to);
-        const float dir[3] = {pt[0] - pf[0], pt[1] - pf[1], pt[2] - pf[2]};
-        const float len2 = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
-        float t = 1;
-        if (len2 > 0)
-          t = std::clamp(((c.p[0] - pf[0]) * dir[0] + (c.p[1] - pf[1]) * dir[1] + (c.p[2] - pf[2]) * dir[2]) / len2, 0.f, 1.f);
+        const float t = edge_parameter(pos + 3 * size_t(f), pos + 3 * size_t(to), c.p);
         float s[kAttributeQuadricChannels];
         const float* at = mesh.attributes.data();
         for (size_t k = 0; k < channels; ++k) s[k] = at[f * ac + k] * (1 - t) + at[to * ac + k] * t;

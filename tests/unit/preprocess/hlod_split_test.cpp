@@ -63,9 +63,7 @@ TEST(HlodSplit, SubtreesBakedByOtherBuildersSpliceIntoTheSameFile) {
   const MeshData m = mesh();
   const HlodBuildOptions o = options_with(16);
   HlodBuilder a(m, o), b(m, o), root(m, o);
-  ASSERT_TRUE(a.plan());
-  ASSERT_TRUE(b.plan());
-  ASSERT_TRUE(root.plan());
+  for (HlodBuilder* builder : {&a, &b, &root}) ASSERT_TRUE(builder->plan());
   const size_t n = root.subtrees().size();
   ASSERT_EQ(a.subtrees().size(), n);
   std::vector<size_t> even, odd;
@@ -91,9 +89,7 @@ TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
   const MeshData m = mesh();
   const HlodBuildOptions o = options_with(16);
   HlodBuilder a(m, o), b(m, o), root(m, o);
-  ASSERT_TRUE(a.plan());
-  ASSERT_TRUE(b.plan());
-  ASSERT_TRUE(root.plan());
+  for (HlodBuilder* builder : {&a, &b, &root}) ASSERT_TRUE(builder->plan());
   const size_t n = root.subtrees().size();
   std::vector<size_t> low, high;
   for (size_t i = 0; i < n; ++i) (root.subtrees()[i].spatial < n / 2 ? low : high).push_back(i);

@@ -87,14 +87,24 @@ TEST(ObjMaterials, KeepsUvsNormalsAndMaterials) {
   EXPECT_TRUE(said) << "what the .mtl had that is not kept is said";
 }
 
-TEST(ObjMaterials, TheBakeKeepsThemInEveryLevel) {
-  const fs::path obj = write_quads("obj-materials-bake");
+// QEM to full and half detail.
+BakeSettings half_settings() {
   BakeSettings settings;
   settings.ratios = {1.0f, 0.5f};
   settings.method = SimplifyMethod::qem;
-  LodChain chain;
+  return settings;
+}
+
+Status bake_half(const fs::path& obj, LodChain& chain) {
   BakeReport report;
-  const Status st = bake_model(obj, "quads", settings, chain, &report, nullptr);
+  return bake_model(obj, "quads", half_settings(), chain, &report, nullptr);
+}
+
+TEST(ObjMaterials, TheBakeKeepsThemInEveryLevel) {
+  const fs::path obj = write_quads("obj-materials-bake");
+  const BakeSettings settings = half_settings();
+  LodChain chain;
+  const Status st = bake_half(obj, chain);
   ASSERT_TRUE(st.ok) << st.message;
   ASSERT_EQ(chain.materials.size(), 2u);
   EXPECT_EQ(chain.materials[1].base_color_texture, "tex%20dir/wood.png");
@@ -135,12 +145,8 @@ TEST(ObjMaterials, BumpAndKeBecomeNormalAndEmissive) {
   EXPECT_FLOAT_EQ(m.materials[1].emissive[1], 1.0f) << "map_Ke without Ke emits the texture as is";
   for (const std::string& w : m.warnings) EXPECT_EQ(w.find("Ke"), std::string::npos) << w;
 
-  BakeSettings settings;
-  settings.ratios = {1.0f, 0.5f};
-  settings.method = SimplifyMethod::qem;
   LodChain chain;
-  BakeReport report;
-  const Status st = bake_model(obj, "quads", settings, chain, &report, nullptr);
+  const Status st = bake_half(obj, chain);
   ASSERT_TRUE(st.ok) << st.message;
   ASSERT_EQ(chain.materials.size(), 2u);
   EXPECT_EQ(chain.materials[0].normal_texture, "tex%20dir/wood.png");

@@ -156,6 +156,14 @@ TEST(Roam, UpdatesNeverReallocateTheirState) {
   EXPECT_EQ(columns[1], s.priority.data());
 }
 
+// A fresh state after one update (unbounded unless p says otherwise).
+RoamState updated_once(const RoamTerrain& t, const View& v, const RoamParams& p) {
+  RoamState s;
+  roam_reset(s, t);
+  roam_update(s, t, v, p);
+  return s;
+}
+
 // Frames after a bound one, at the same view: crack-free each, unbound within a few, and then
 // the mesh one unbounded update made (`full`), spread over several frames.
 void expect_catches_up(RoamState& s, const RoamTerrain& t, const View& v, const RoamParams& p, const RoamState& full) {
@@ -176,9 +184,7 @@ TEST(Roam, OperationBudgetBoundsAFrameAndLaterFramesCatchUp) {
   const View v = flying_view(t, 5);
   RoamParams p;
   p.pixel_error = 1.f;
-  RoamState full;
-  roam_reset(full, t);
-  roam_update(full, t, v, p);
+  const RoamState full = updated_once(t, v, p);
   p.max_operations = 40;
   RoamState s;
   roam_reset(s, t);
@@ -205,9 +211,7 @@ TEST(Roam, TimeLimitStopsAtTheClockAndLaterFramesCatchUp) {
   const View v = flying_view(t, 5);
   RoamParams p;
   p.pixel_error = 1.f;
-  RoamState full;
-  roam_reset(full, t);
-  roam_update(full, t, v, p);
+  const RoamState full = updated_once(t, v, p);
   SteppingClock c{0, 1.0};  // 1 ms a read: the first read after the start passes 0.5 ms
   p.max_ms = 0.5f;
   p.clock = c.clock();
