@@ -6,6 +6,7 @@
 //   BM_FaceGroupsHashed   the same answer by hash groups (first_of_equal, what clean uses)
 //   BM_Clean/indexed      clean_mesh of the indexed sphere (nothing to weld)
 //   BM_Clean/soup         clean_mesh of the same triangles, three vertices each (all to weld)
+//   BM_SurfaceBuild / BM_SurfaceQuery   the closest-point BVH over it: build, and queries
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
 #include "preprocess/mesh_readers.h"
+#include "preprocess/surface_error.h"
 #include "vd_meshes.h"
 
 namespace {
@@ -134,11 +136,42 @@ void BM_Clean(benchmark::State& state) {
   state.counters["welded"] = double(welded);
 }
 
+// The closest-point BVH every HLOD bake builds over the original (and each rank over its part).
+void BM_SurfaceBuild(benchmark::State& state) {
+  const MeshData& m = sphere();
+  for (auto _ : state) {
+    SurfaceDistance d;
+    if (!d.set_surface({m.positions.data(), m.vertex_count(), m.indices.data(), m.indices.size()}, "bench"))
+      state.SkipWithError("the BVH was not built");
+  }
+  state.counters["triangles"] = double(m.triangle_count());
+}
+
+// Every 7th vertex pushed off the surface by 0.1 %, each query started from a 1 % radius.
+void BM_SurfaceQuery(benchmark::State& state) {
+  const MeshData& m = sphere();
+  SurfaceDistance d;
+  if (!d.set_surface({m.positions.data(), m.vertex_count(), m.indices.data(), m.indices.size()}, "bench"))
+    state.SkipWithError("the BVH was not built");
+  std::vector<float> points;
+  for (size_t v = 0; v < m.vertex_count(); v += 7)
+    for (int k = 0; k < 3; ++k) points.push_back(m.positions[3 * v + k] * 1.001f);
+  const std::vector<float> known(points.size() / 3, 0.01f);
+  for (auto _ : state) {
+    SurfaceError e;
+    if (!d.from_points(points.data(), points.size() / 3, known.data(), e)) state.SkipWithError("query failed");
+    benchmark::DoNotOptimize(e.max);
+  }
+  state.counters["queries"] = double(points.size() / 3);
+}
+
 BENCHMARK(BM_ReadBytes)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_LoadPly)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_FaceGroupsSorted)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_FaceGroupsHashed)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_Clean)->ArgName("soup")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_SurfaceBuild)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_SurfaceQuery)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
 
