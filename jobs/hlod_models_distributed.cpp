@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <numeric>
 #include <sstream>
@@ -123,6 +124,7 @@ struct Job {
   std::filesystem::path out_dir;
   std::vector<Model> models;
   std::vector<HlodModelFigures> figures;  // of the models this rank handled
+  std::vector<size_t> figure_model;        // each one's model index
   HlodModelsRankWork work;
   std::vector<double> split_cpu;          // rank 0: per rank, its CPU in split bakes
   std::atomic<size_t> stored{0};
@@ -225,7 +227,7 @@ std::vector<uint8_t> check_share(Job& j, tbb::task_arena& arena) {
   for (size_t k = 0; k < mine.size(); ++k) {
     states[mine[k]] = state[k];
     if (state[k] == kFound) ++j.work.checked;
-    if (state[k] != kMissing) j.figures.push_back(std::move(found[k]));
+    if (state[k] != kMissing) j.figures.push_back(std::move(found[k])), j.figure_model.push_back(mine[k]);
   }
   for (size_t i = 0; i < j.models.size(); ++i) w.u8(states[i]), w.u64(j.models[i].source_hash);
   j.work.check_cpu_seconds = process_cpu_seconds() - cpu0;
@@ -355,6 +357,7 @@ void bake_whole(Job& j, size_t i) {
     j.work.estimated += m.estimate;
   }
   j.figures.push_back(std::move(f));
+  j.figure_model.push_back(i);
 }
 
 // One model by all ranks together; rank 0 takes the file into the cache and copies it to DIR.
@@ -403,6 +406,7 @@ void bake_split(Job& j, size_t i) {
   if (st) take_tree(f, tree, bytes.size());
   else j.failed(f, st.message);
   j.figures.push_back(std::move(f));
+  j.figure_model.push_back(i);
 }
 
 // ---- the final report: status, work, the figures of the models a rank handled ----
@@ -413,7 +417,7 @@ void each_number(Work& w, F&& f) {
       f(w.bake_cpu_seconds), f(w.cpu_seconds), f(w.total_seconds), f(w.bytes_stored);
 }
 
-std::vector<uint8_t> encode_report(const Job& j, const std::vector<size_t>& index_of) {
+std::vector<uint8_t> encode_report(const Job& j) {
   detail::ByteWriter w;
   each_number(j.work, [&](const auto& v) {
     if constexpr (std::is_same_v<std::decay_t<decltype(v)>, double>) w.u64(std::bit_cast<uint64_t>(v));
@@ -422,7 +426,7 @@ std::vector<uint8_t> encode_report(const Job& j, const std::vector<size_t>& inde
   w.u64(j.figures.size());
   for (size_t k = 0; k < j.figures.size(); ++k) {
     const HlodModelFigures& f = j.figures[k];
-    w.u64(index_of[k]);
+    w.u64(j.figure_model[k]);
     w.u8(uint8_t(f.route));
     w.u64(uint64_t(int64_t(f.rank)));
     w.u64(f.source_triangles), w.u64(f.nodes), w.u64(f.bytes);
@@ -522,6 +526,17 @@ uint64_t estimate_mesh_triangles(const std::filesystem::path& mesh_file) {
   return n ? n : std::max<uint64_t>(1, uint64_t(size / 24));
 }
 
+Status hlod_model_names_unique(const std::vector<std::filesystem::path>& meshes) {
+  std::map<std::string, size_t> first;
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const auto [at, added] = first.emplace(meshes[i].stem().string(), i);
+    if (!added)
+      return Status::error("two models named '" + at->first + "' (" + meshes[at->second].string() + ", " +
+                           meshes[i].string() + ") would write one .hlod file");
+  }
+  return Status::success();
+}
+
 std::vector<int> plan_hlod_models(const std::vector<uint64_t>& costs, const std::vector<uint8_t>& missing, int ranks) {
   const int r = std::max(1, ranks);
   std::vector<int> plan(costs.size(), kHlodModelNotBaked);
@@ -548,11 +563,7 @@ Status bake_hlod_models_distributed(const std::vector<std::filesystem::path>& me
   const double cpu_start = process_cpu_seconds();
   if (result) *result = {};
   // The same on every rank, before any collective: one .hlod name per model.
-  for (size_t a = 0; a < meshes.size(); ++a)
-    for (size_t b = 0; b < a; ++b)
-      if (meshes[a].stem() == meshes[b].stem())
-        return Status::error("two models named '" + meshes[a].stem().string() + "' (" + meshes[b].string() + ", " +
-                             meshes[a].string() + ") would write one .hlod file");
+  if (Status s = hlod_model_names_unique(meshes); !s) return s;
   Job j(settings, comm, log, out_dir);
   for (const auto& m : meshes) j.models.push_back({m, m.stem().string()});
   j.split_cpu.assign(size_t(j.ranks()), 0.0);
@@ -606,15 +617,7 @@ Status bake_hlod_models_distributed(const std::vector<std::filesystem::path>& me
   }
   j.work.total_seconds = seconds_since(t_start);
   j.work.cpu_seconds = process_cpu_seconds() - cpu_start;
-  // The figures name models by index in the report.
-  std::vector<size_t> index_of;
-  for (const HlodModelFigures& f : j.figures)
-    for (size_t i = 0; i < n; ++i)
-      if (j.models[i].name == f.name) {
-        index_of.push_back(i);
-        break;
-      }
-  const std::vector<std::vector<uint8_t>> reports = comm.gather(encode_report(j, index_of));
+  const std::vector<std::vector<uint8_t>> reports = comm.gather(encode_report(j));
   Status st = ready;
   if (comm.rank == 0) {
     HlodModelsResult r;

@@ -31,6 +31,10 @@ namespace lod {
 // 0 when the file cannot be read (its bake then fails and says why).
 uint64_t estimate_mesh_triangles(const std::filesystem::path& mesh_file);
 
+// Every model's .hlod name (its file's stem) once; otherwise the first two sharing one, as
+// `lod bake --hlod` refuses them.
+Status hlod_model_names_unique(const std::vector<std::filesystem::path>& meshes);
+
 inline constexpr int kHlodModelSplit = -1;     // baked by all ranks together
 inline constexpr int kHlodModelNotBaked = -2;  // not missing
 

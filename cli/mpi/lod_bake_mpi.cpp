@@ -154,14 +154,10 @@ int run_models(const std::vector<std::string>& meshes, const std::string& out_di
     if (talk || !progress) std::fprintf(stderr, "lod-bake-mpi: %s\n", line.c_str());
   };
   std::vector<std::filesystem::path> files(meshes.begin(), meshes.end());
-  for (size_t a = 0; a < files.size(); ++a)  // as lod bake --hlod: every rank refuses, rank 0 says so
-    for (size_t b = 0; b < a; ++b)
-      if (files[a].stem() == files[b].stem()) {
-        if (comm.rank == 0)
-          std::fprintf(stderr, "lod-bake-mpi: two models named '%s' (%s, %s) would write one .hlod file\n",
-                       files[a].stem().c_str(), files[b].c_str(), files[a].c_str());
-        return 1;
-      }
+  if (Status names = hlod_model_names_unique(files); !names) {  // every rank refuses, rank 0 says so
+    if (comm.rank == 0) std::fprintf(stderr, "lod-bake-mpi: %s\n", names.message.c_str());
+    return 1;
+  }
   HlodModelsResult r;
   const Status st = bake_hlod_models_distributed(files, out_dir, settings, comm, log, &r);
   if (comm.rank == 0 && json) std::printf("%s\n", to_json(r, comm.size).dump(1).c_str());
