@@ -279,6 +279,21 @@ TEST(HlodModelsDistributedBake, FailingStoreNamesTheModelAndTheRerunBakesOnlyThe
   expect_local_bytes(scene, dir / "out");
 }
 
+TEST(HlodModelsDistributedBake, UnreadableModelIsNamedAndTheOthersAreStillBaked) {
+  const auto dir = test::temp_dir("hlod_models_unreadable");
+  Scene scene = write_scene(dir);
+  scene.meshes.insert(scene.meshes.begin() + 1, dir / "absent.ply");
+  std::vector<RankRun> runs = run_ranks(2, scene, dir / "out", dir / "cache");
+  ASSERT_FALSE(runs[0].status);
+  EXPECT_NE(runs[0].status.message.find("model absent (" + (dir / "absent.ply").string() + ")"), std::string::npos)
+      << runs[0].status.message;
+  EXPECT_NE(runs[0].status.message.find("1 of 5 models failed"), std::string::npos) << runs[0].status.message;
+  EXPECT_EQ(runs[0].result.failed, 1u);
+  EXPECT_EQ(runs[0].result.models[1].route, HlodModelRoute::failed);
+  scene.meshes.erase(scene.meshes.begin() + 1);
+  expect_local_bytes(scene, dir / "out");
+}
+
 TEST(HlodModelsDistributedBake, TwoModelsWithOneNameAreRefusedBeforeAnything) {
   const auto dir = test::temp_dir("hlod_models_names");
   std::filesystem::create_directories(dir / "a");
