@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "jobs/annotated_parallel_for.h"
+#include "jobs/cache_progress.h"
 #include "jobs/hlod_model_cache.h"
 #include "runtime/byte_order.h"
 #include "runtime/file_write.h"
@@ -253,60 +254,6 @@ std::vector<uint8_t> merge_checks(const Job& j, const std::vector<std::vector<ui
   w.u8(all ? 1 : 0);
   return std::move(w.bytes);
 }
-
-// Rank 0's view of the job: model entries appearing in the cache, as "models done / total,
-// triangles per second" (the estimates' triangles).
-class ModelProgress {
- public:
-  ModelProgress(std::vector<std::filesystem::path> paths, std::vector<uint64_t> triangles, size_t total,
-                size_t cached, std::function<void(const std::string&)> say)
-      : paths_(std::move(paths)), triangles_(std::move(triangles)), total_(total), cached_(cached), say_(std::move(say)) {
-    thread_ = std::thread([this] { watch(); });
-  }
-  ~ModelProgress() {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-  }
-
- private:
-  void watch() {
-    const auto t0 = Clock::now();
-    std::vector<uint8_t> seen(paths_.size(), 0);
-    size_t done = 0, reported = SIZE_MAX;
-    uint64_t tris = 0;
-    std::unique_lock lock(mutex_);
-    for (bool last = false; !last;) {
-      last = stopping_;
-      lock.unlock();
-      for (size_t i = 0; i < paths_.size(); ++i) {
-        std::error_code ec;
-        if (!seen[i] && std::filesystem::is_regular_file(paths_[i], ec)) seen[i] = 1, ++done, tris += triangles_[i];
-      }
-      if (done != reported) {
-        reported = done;
-        char line[160];
-        std::snprintf(line, sizeof line, "models %zu/%zu (%zu cached), %.2f M triangles/s", cached_ + done, total_,
-                      cached_, 1e-6 * double(tris) / std::max(1e-3, seconds_since(t0)));
-        say_(line);
-      }
-      lock.lock();
-      if (!last) wake_.wait_for(lock, std::chrono::milliseconds(250), [this] { return stopping_; });
-    }
-  }
-
-  std::vector<std::filesystem::path> paths_;
-  std::vector<uint64_t> triangles_;
-  size_t total_, cached_;
-  std::function<void(const std::string&)> say_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stopping_ = false;
-  std::thread thread_;
-};
 
 // A folder of this process's (and rank's) own inside the cache, for one bake's output.
 std::filesystem::path stage_dir(const Job& j, size_t i, bool shared) {
@@ -598,7 +545,7 @@ Status bake_hlod_models_distributed(const std::vector<std::filesystem::path>& me
     plan = plan_hlod_models(costs(j), missing, j.ranks());
   }
   {
-    std::unique_ptr<ModelProgress> progress;  // rank 0, until every model is baked
+    std::unique_ptr<CacheProgress> progress;  // rank 0, until every model is baked
     if (go && comm.rank == 0 && log) {
       std::vector<std::filesystem::path> paths;
       std::vector<uint64_t> tris;
@@ -607,7 +554,7 @@ Status bake_hlod_models_distributed(const std::vector<std::filesystem::path>& me
         cached += m.state == kFound;
         if (m.state == kMissing) paths.push_back(hlod_model_entry_path(settings.cache_dir, m.key)), tris.push_back(m.estimate);
       }
-      progress = std::make_unique<ModelProgress>(std::move(paths), std::move(tris), n, cached,
+      progress = std::make_unique<CacheProgress>("models", std::move(paths), std::move(tris), n, cached,
                                                  [&j](const std::string& line) { j.say(line); });
     }
     for (size_t i = 0; i < n; ++i)

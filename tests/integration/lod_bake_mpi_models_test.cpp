@@ -18,14 +18,7 @@ namespace {
 
 #if defined(LOD_BAKE_MPI_PATH) && defined(LOD_MPIEXEC)
 
-using test::run_shell;
-
-test::CliResult mpirun(int ranks, const std::string& args, const std::string& env = "") {
-  return run_shell("env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
-                   "ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:detect_leaks=0\" " +
-                   env + " " LOD_MPIEXEC " --oversubscribe --mca btl self,vader,tcp --mca btl_tcp_if_include lo" +
-                   " --mca oob_tcp_if_include lo -np " + std::to_string(ranks) + " " LOD_BAKE_MPI_PATH " " + args);
-}
+using test::run_mpi;
 
 // Five closed spheres of 400 to 16,000 triangles, written by the test. The boulder holds two
 // thirds of the triangles (split over the ranks at 2 and 4); the rest go whole.
@@ -90,7 +83,7 @@ TEST(LodBakeMpiModels, EveryModelHasTheLocalBakesBytesAtOneTwoAndFourRanks) {
   for (const auto& bytes : fixture().local) ASSERT_FALSE(bytes.empty());
   for (int ranks : {1, 2, 4}) {
     const auto dir = test::temp_dir("lod_bake_mpi_models_np" + std::to_string(ranks));
-    const test::CliResult r = mpirun(ranks, bake_args(dir / "out", dir / "cache") + " --json");
+    const test::CliResult r = run_mpi(ranks, bake_args(dir / "out", dir / "cache") + " --json");
     ASSERT_EQ(r.code, 0) << r.out;
     expect_local_bytes(dir / "out", std::to_string(ranks) + " ranks");
     const nlohmann::json j = summary(r);
@@ -108,14 +101,14 @@ TEST(LodBakeMpiModels, EveryModelHasTheLocalBakesBytesAtOneTwoAndFourRanks) {
 
 TEST(LodBakeMpiModels, KilledRankThenRerunBakesOnlyTheMissingModelsIntoTheSameBytes) {
   const auto dir = test::temp_dir("lod_bake_mpi_models_kill");
-  const test::CliResult killed = mpirun(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=1 LOD_MPI_FAIL_RANK=1");
+  const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=1 LOD_MPI_FAIL_RANK=1");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("injected failure"), std::string::npos) << killed.out;
   const size_t kept = entries(dir / "cache", ".hlod").size();
   EXPECT_GE(kept, 1u) << "the killed rank's first model is kept";
   ASSERT_LT(kept, 5u);
 
-  const test::CliResult rerun = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
   const nlohmann::json j = summary(rerun);
   ASSERT_TRUE(j.is_object()) << rerun.out;
@@ -128,14 +121,14 @@ TEST(LodBakeMpiModels, KilledRankThenRerunBakesOnlyTheMissingModelsIntoTheSameBy
 // takes the whole models from the cache and the boulder's finished subtrees too.
 TEST(LodBakeMpiModels, KilledInASplitModelThenRerunKeepsItsSubtrees) {
   const auto dir = test::temp_dir("lod_bake_mpi_models_kill_split");
-  const test::CliResult killed = mpirun(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=3 LOD_MPI_FAIL_RANK=0");
+  const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=3 LOD_MPI_FAIL_RANK=0");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("subtree"), std::string::npos) << killed.out;
   EXPECT_EQ(entries(dir / "cache", ".hlod").size(), 4u) << "the four whole models are finished before the split one";
   const size_t subtrees = entries(dir / "cache", ".hsub").size();
   EXPECT_GE(subtrees, 2u);
 
-  const test::CliResult rerun = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
   const nlohmann::json j = summary(rerun);
   ASSERT_TRUE(j.is_object()) << rerun.out;
@@ -146,7 +139,7 @@ TEST(LodBakeMpiModels, KilledInASplitModelThenRerunKeepsItsSubtrees) {
 
 TEST(LodBakeMpiModels, CorruptedAndTruncatedModelEntriesAreRebaked) {
   const auto dir = test::temp_dir("lod_bake_mpi_models_corrupt");
-  ASSERT_EQ(mpirun(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
+  ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
   const std::vector<std::filesystem::path> files = entries(dir / "cache", ".hlod");
   ASSERT_EQ(files.size(), 5u);
   std::vector<uint8_t> bytes = test::read_bytes(files[0]);
@@ -157,7 +150,7 @@ TEST(LodBakeMpiModels, CorruptedAndTruncatedModelEntriesAreRebaked) {
   test::write_bytes(files[1], bytes);
   std::filesystem::remove_all(dir / "out");
 
-  const test::CliResult r = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  const test::CliResult r = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json j = summary(r);
   ASSERT_TRUE(j.is_object()) << r.out;
@@ -173,7 +166,7 @@ TEST(LodBakeMpiModels, CorruptedAndTruncatedModelEntriesAreRebaked) {
 TEST(LodBakeMpiModels, FailingRankNamesTheModelAndTheJobFailsKeepingTheCache) {
   const auto dir = test::temp_dir("lod_bake_mpi_models_fail");
   std::filesystem::create_directories(dir / "out" / "rock.hlod" / "in-the-way");
-  const test::CliResult r = mpirun(2, bake_args(dir / "out", dir / "cache"));
+  const test::CliResult r = run_mpi(2, bake_args(dir / "out", dir / "cache"));
   EXPECT_NE(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("model rock ("), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("run again"), std::string::npos) << r.out;
@@ -182,7 +175,7 @@ TEST(LodBakeMpiModels, FailingRankNamesTheModelAndTheJobFailsKeepingTheCache) {
     EXPECT_TRUE(std::filesystem::is_regular_file(dir / "out" / (std::string(name) + ".hlod"))) << name;
 
   std::filesystem::remove_all(dir / "out" / "rock.hlod");
-  const test::CliResult rerun = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
   EXPECT_EQ(summary(rerun)["cached"], 5);
   expect_local_bytes(dir / "out", "after the rerun");
@@ -194,7 +187,7 @@ TEST(LodBakeMpiModels, TwoModelsWithOneNameAreRefused) {
   std::filesystem::create_directories(dir / "b");
   test::write_text(dir / "a" / "ball.off", test::sphere_off(8, 10));
   test::write_text(dir / "b" / "ball.off", test::sphere_off(9, 10));
-  const test::CliResult r = mpirun(2, (dir / "a" / "ball.off").string() + " " + (dir / "b" / "ball.off").string() +
+  const test::CliResult r = run_mpi(2, (dir / "a" / "ball.off").string() + " " + (dir / "b" / "ball.off").string() +
                                           " -o " + (dir / "out").string() + " --cache " + (dir / "cache").string());
   EXPECT_NE(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("two models named 'ball'"), std::string::npos) << r.out;

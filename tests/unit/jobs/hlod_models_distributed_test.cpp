@@ -4,7 +4,6 @@
 // bytes; reruns bake only what the cache lacks, a failing store names its model.
 #include <gtest/gtest.h>
 
-#include <barrier>
 #include <filesystem>
 #include <numeric>
 #include <random>
@@ -15,10 +14,13 @@
 #include "jobs/hlod_models_distributed.h"
 #include "preprocess/mesh_io.h"
 #include "test_support.h"
+#include "unit/jobs/thread_ranks.h"
 #include "vd_meshes.h"
 
 namespace lod {
 namespace {
+
+using test::ThreadRanks;
 
 TEST(HlodModelsPlan, ModelsAboveARanksShareAreSplitTheRestGoWhole) {
   // total 200 at 2 ranks: 120 > 100 is split; 50, 20, 10 whole, longest first.
@@ -137,34 +139,6 @@ TEST(HlodModelCache, StoredEntryLoadsBackAndBrokenOrMisplacedEntriesAreRefused) 
   EXPECT_FALSE(std::filesystem::exists(dir / "cache" / "stage" / "ball.hlod")) << "a bad bake is removed";
   EXPECT_FALSE(std::filesystem::exists(hlod_model_entry_path(dir / "cache", key + 1)));
 }
-
-// Ranks as threads: the two collectives over shared slots and a barrier.
-struct ThreadRanks {
-  explicit ThreadRanks(int n) : size(n), sync(n), slots(size_t(n)) {}
-  HlodRankComm comm(int rank) {
-    HlodRankComm c;
-    c.rank = rank;
-    c.size = size;
-    c.broadcast = [this, rank](std::vector<uint8_t>& bytes) {
-      if (rank == 0) slots[0] = bytes;
-      sync.arrive_and_wait();
-      if (rank != 0) bytes = slots[0];
-      sync.arrive_and_wait();
-    };
-    c.gather = [this, rank](const std::vector<uint8_t>& mine) {
-      slots[size_t(rank)] = mine;
-      sync.arrive_and_wait();
-      std::vector<std::vector<uint8_t>> all;
-      if (rank == 0) all = slots;
-      sync.arrive_and_wait();
-      return all;
-    };
-    return c;
-  }
-  int size;
-  std::barrier<> sync;
-  std::vector<std::vector<uint8_t>> slots;
-};
 
 struct Scene {
   std::vector<std::filesystem::path> meshes;
