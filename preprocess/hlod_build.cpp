@@ -760,12 +760,12 @@ void number_spatially(const BuildNode& n, std::vector<HlodSubtreeSpec>& specs, u
     if (child) number_spatially(*child, specs, next);
 }
 
-// The grid a region is chosen on: 128^3 cells over the root cube.
+// The grid a region is chosen on: 256^3 cells over the root cube (16 MB of flags).
 SurfaceGrid region_grid(const BuildNode& root) {
   SurfaceGrid g;
   for (int k = 0; k < 3; ++k) g.lo[k] = root.center[k] - root.half;
   g.edge = 2 * root.half;
-  g.n = 128;
+  g.n = 256;
   return g;
 }
 
@@ -852,9 +852,10 @@ void HlodBuilder::set_region(const std::vector<size_t>& subtrees) {
   impl_->region_wanted = distinct < impl_->specs.size();
 }
 
-// The region's BVH: the triangles reaching into its subtrees' cells grown by a quarter of their
-// half-edge (so that a query from a subtree's layer, within a fraction of the cell of the
-// surface, finds its nearest point there).
+// The region's BVH: the triangles reaching into its subtrees' cells grown by a sixteenth of
+// their half-edge: a layer's vertices are vertices of its cell's triangles, so its samples lie
+// within a triangle of the cell, and their nearest points within the layer's error of them
+// (~1 % of the cell). A query the region cannot answer exactly still goes to the whole.
 void HlodBuilder::Impl::ensure_region() {
   if (region_built) return;
   const double cpu0 = thread_cpu_seconds();
@@ -863,7 +864,7 @@ void HlodBuilder::Impl::ensure_region() {
   for (size_t i : region_subtrees) {
     if (i >= specs.size()) continue;
     const HlodSubtreeSpec& spec = specs[i];
-    const float grow = 1.25f * spec.half;
+    const float grow = 1.0625f * spec.half;
     float lo[3], hi[3];
     for (int k = 0; k < 3; ++k) lo[k] = spec.center[k] - grow, hi[k] = spec.center[k] + grow;
     want_box(grid, lo, hi, wanted);
@@ -881,6 +882,7 @@ Status HlodBuilder::plan() {
   if (m.planned) return Status::error(m.what + ": HLOD build planned twice");
   if (Status s = check_input(mesh); !s) return s;
   m.root = std::make_unique<BuildNode>();
+  m.root->triangles.reserve(mesh.triangle_count());
   for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     const uint32_t* f = &mesh.indices[3 * size_t(t)];
     if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) ++m.dropped;
