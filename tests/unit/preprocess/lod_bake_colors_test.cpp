@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "preprocess/gltf_write.h"
 #include "preprocess/lod_bake.h"
@@ -90,6 +91,8 @@ TEST(LodBakeColors, EveryLevelKeepsColoursAndTexcoord1WithinTheInputRange) {
         if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) seam += is_red(&colors[4 * i]) != is_red(&colors[4 * j]);
       }
     }
+    std::printf("painted level %zu: %u triangles, colour seam pairs %zu, colour error %.4f, uv1 error %.4f\n", k,
+                l.index_count / 3, seam, chain.color_errors[k], chain.uv1_errors[k]);
     EXPECT_GE(seam, 4u);
     EXPECT_LT(green_lo, 0.2f);
     EXPECT_GT(green_hi, 0.4f);
