@@ -20,6 +20,7 @@
 #include <ctime>
 
 #include "jobs/annotated_parallel_for.h"
+#include "jobs/cache_progress.h"
 #include "jobs/hlod_mesh_cache.h"
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_clean.h"
@@ -88,61 +89,6 @@ RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   r.status = b[0] ? Status::success() : Status::error(std::string(b.begin() + fixed, b.end()));
   return r;
 }
-
-// Rank 0's view of the job while the ranks bake: entries appearing in the cache (every rank
-// writes there, so nothing needs sending), as "subtrees done / total, triangles per second".
-class ProgressWatch {
- public:
-  ProgressWatch(std::vector<std::filesystem::path> paths, std::vector<uint64_t> triangles, size_t total, size_t cached,
-                const HlodBakeLog& log)
-      : paths_(std::move(paths)), triangles_(std::move(triangles)), total_(total), cached_(cached), log_(log) {
-    if (log_) thread_ = std::thread([this] { watch(); });
-  }
-  ~ProgressWatch() { stop(); }
-  void stop() {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-
- private:
-  void watch() {
-    const auto t0 = Clock::now();
-    std::vector<uint8_t> seen(paths_.size(), 0);
-    size_t done = 0, reported = SIZE_MAX;
-    uint64_t tris = 0;
-    std::unique_lock lock(mutex_);
-    for (bool last = false; !last;) {
-      last = stopping_;
-      lock.unlock();
-      for (size_t i = 0; i < paths_.size(); ++i) {
-        std::error_code ec;
-        if (!seen[i] && std::filesystem::is_regular_file(paths_[i], ec)) seen[i] = 1, ++done, tris += triangles_[i];
-      }
-      if (done != reported) {
-        reported = done;
-        char line[160];
-        std::snprintf(line, sizeof line, "subtrees %zu/%zu (%zu cached), %.2f M triangles/s", cached_ + done, total_,
-                      cached_, 1e-6 * double(tris) / std::max(1e-3, seconds_since(t0)));
-        log_(line);
-      }
-      lock.lock();
-      if (!last) wake_.wait_for(lock, std::chrono::milliseconds(250), [this] { return stopping_; });
-    }
-  }
-
-  std::vector<std::filesystem::path> paths_;
-  std::vector<uint64_t> triangles_;
-  size_t total_, cached_;
-  HlodBakeLog log_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stopping_ = false;
-  std::thread thread_;
-};
 
 struct Job {
   const HlodDistributedSettings& settings;
@@ -297,13 +243,13 @@ std::vector<uint8_t> merge_checks(const Job& j, const std::vector<std::vector<ui
   return missing;
 }
 
-std::unique_ptr<ProgressWatch> watch_progress(const Job& j) {
+std::unique_ptr<CacheProgress> watch_progress(const Job& j) {
   std::vector<std::filesystem::path> paths;
   std::vector<uint64_t> tris;
   for (size_t i = 0; i < j.keys.size(); ++i)
     if (j.missing[i])
       paths.push_back(hlod_subtree_entry_path(j.settings.cache_dir, j.keys[i])), tris.push_back(j.specs()[i].triangles);
-  return std::make_unique<ProgressWatch>(std::move(paths), std::move(tris), j.keys.size(), j.r.cached, j.log);
+  return std::make_unique<CacheProgress>("subtrees", std::move(paths), std::move(tris), j.keys.size(), j.r.cached, j.log);
 }
 
 // Who writes each subtree's payloads: the rank that checked a cached entry, or bakes a missing
@@ -777,7 +723,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   const bool go = !mask.empty() && mask.back() == 1 && ready && mask.size() == j.keys.size() + 1;
   RankReport rep;
   rep.status = ready;
-  std::unique_ptr<ProgressWatch> watch;  // rank 0, until every rank has reported
+  std::unique_ptr<CacheProgress> watch;  // rank 0, until every rank has reported
   if (go) {
     mask.pop_back();
     j.missing = mask;

@@ -4,6 +4,7 @@
 // result depends only on the input.
 #include "preprocess/mesh_clean.h"
 
+#include "preprocess/first_of_equal.h"
 #include "preprocess/material_runs.h"
 
 #include <algorithm>
@@ -86,27 +87,6 @@ bool zero_area(const float* a, const float* b, const float* c) {
   return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
 }
 
-// first[i] = the smallest j with key(j) == key(i), for i < n; returns how many i have
-// first[i] != i. By sorting (key, index) pairs: the same answer as a hash map of first
-// occurrences, without its cache misses on millions of entries.
-template <class KeyOf>
-size_t first_of_equal(size_t n, KeyOf key_of_item, std::vector<uint32_t>& first) {
-  using Key = decltype(key_of_item(size_t(0)));
-  std::vector<std::pair<Key, uint32_t>> items(n);
-  for (size_t i = 0; i < n; ++i) items[i] = {key_of_item(i), uint32_t(i)};
-  std::sort(items.begin(), items.end());  // by key, then index: a group starts at its first
-  first.resize(n);
-  size_t repeats = 0;
-  for (size_t g = 0; g < n;) {
-    size_t e = g + 1;
-    while (e < n && items[e].first == items[g].first) ++e;
-    for (size_t k = g; k < e; ++k) first[items[k].second] = items[g].second;
-    repeats += e - g - 1;
-    g = e;
-  }
-  return repeats;
-}
-
 // Submesh ranges after faces were dropped: each keeps its surviving triangles, in order; an
 // emptied one goes.
 void resubmesh(std::vector<Submesh>& submeshes, const std::vector<uint32_t>& kept_before) {
@@ -140,18 +120,18 @@ CleanReport clean_mesh(MeshData& mesh) {
   // occurrence.
   std::vector<uint32_t> weld(nv);
   report.duplicate_vertices =
-      wide      ? first_of_equal(nv, [&](size_t v) { return wide_key(v, material[v]); }, weld)
-      : has_uvs ? first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], material[v]); }, weld)
-              : first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], material[v]); }, weld);
+      wide      ? detail::first_of_equal(nv, [&](size_t v) { return wide_key(v, material[v]); }, weld)
+      : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], material[v]); }, weld)
+              : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], material[v]); }, weld);
 
   // Faces repeat each other by their corners' positions (and uvs) whatever their materials:
   // the same face twice in two materials would fight for the same pixels.
   std::vector<uint32_t> same_place;
   const bool split = report.material_split_vertices > 0;
   if (split)
-    wide      ? first_of_equal(nv, [&](size_t v) { return wide_key(v, 0); }, same_place)
-    : has_uvs ? first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], 0); }, same_place)
-            : first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], 0); }, same_place);
+    wide      ? detail::first_of_equal(nv, [&](size_t v) { return wide_key(v, 0); }, same_place)
+    : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], 0); }, same_place)
+            : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], 0); }, same_place);
   const std::vector<uint32_t>& face_weld = split ? same_place : weld;
 
   std::vector<uint32_t> kept;
@@ -179,7 +159,7 @@ CleanReport clean_mesh(MeshData& mesh) {
       keys.push_back(key);
     }
     std::vector<uint32_t> first(live.size());
-    report.duplicate_faces = first_of_equal(live.size(), [&](size_t i) { return keys[i]; }, first);
+    report.duplicate_faces = detail::first_of_equal(live.size(), [&](size_t i) { return keys[i]; }, first);
     size_t next = 0;
     for (size_t t = 0; t < nt; ++t) {
       if (has_submeshes) kept_before[t] = uint32_t(kept.size() / 3);

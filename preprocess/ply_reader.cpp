@@ -102,6 +102,77 @@ int64_t load_int(const uint8_t* p, Type t, bool big) {
   }
 }
 
+
+Status truncated_in(const std::string& what, const Element& e, uint64_t row) {
+  return Status::error(what + ": truncated: the data ends inside " + quote_token(e.name) + " " + std::to_string(row) +
+                       " of " + std::to_string(e.count) + " declared");
+}
+
+// Binary vertex rows without lists: every row the same size, each coordinate at its offset.
+// The common scanner layout (little-endian float x, y, z first) is read without widening.
+Status binary_vertex_rows(const std::string& what, const uint8_t* data, size_t size, size_t& at, const Element& e,
+                          bool big, RawPolygons& raw) {
+  size_t row = 0, offset[3] = {0, 0, 0};
+  Type type[3] = {Type::none, Type::none, Type::none};
+  for (const Property& p : e.properties) {
+    if (p.role >= Role::x && p.role <= Role::z) offset[int(p.role) - int(Role::x)] = row, type[int(p.role) - int(Role::x)] = p.type;
+    row += type_size(p.type);
+  }
+  if (e.count > (size - at) / row) return truncated_in(what, e, (size - at) / row);
+  const bool plain = !big && type[0] == Type::f32 && type[1] == Type::f32 && type[2] == Type::f32 && offset[0] == 0 &&
+                     offset[1] == 4 && offset[2] == 8;
+  const size_t base = raw.positions.size();
+  raw.positions.resize(base + 3 * size_t(e.count));
+  float* out = raw.positions.data() + base;
+  for (uint64_t i = 0; i < e.count; ++i, at += row, out += 3) {
+    if (plain) std::memcpy(out, data + at, 12);
+    else
+      for (int k = 0; k < 3; ++k) out[k] = type[k] == Type::none ? 0.0f : float(load_real(data + at + offset[k], type[k], big));
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(out[k]))
+        return Status::error(what + ": vertex " + std::to_string(i) + " has a non-finite coordinate (" +
+                             describe_nonfinite(out[k]) + ")");
+  }
+  return Status::success();
+}
+
+// Binary face rows holding only their index list: count, then indices, row after row.
+Status binary_face_rows(const std::string& what, const uint8_t* data, size_t size, size_t& at, const Element& e,
+                        bool big, RawPolygons& raw) {
+  const Property& p = e.properties.front();
+  const size_t cs = type_size(p.count_type), s = type_size(p.type);
+  // Triangles, as far as the bytes left can hold them: never more than the file backs.
+  raw.corners.reserve(raw.corners.size() + std::min<uint64_t>(3 * e.count, (size - at) / s));
+  const bool plain = !big && cs == 1 && s == 4;
+  for (uint64_t i = 0; i < e.count; ++i) {
+    if (size - at < cs) return truncated_in(what, e, i);
+    const int64_t c = plain ? int64_t(data[at]) : load_int(data + at, p.count_type, big);
+    at += cs;
+    if (c < 0)
+      return Status::error(what + ": " + quote_token(e.name) + " " + std::to_string(i) + " has a negative list length (" +
+                           std::to_string(c) + ")");
+    if (uint64_t(c) > (size - at) / s) return truncated_in(what, e, i);
+    for (int64_t k = 0; k < c; ++k, at += s) {
+      if (!plain) {
+        raw.corners.push_back(load_int(data + at, p.type, big));
+        continue;
+      }
+      if (p.type == Type::u32) {
+        uint32_t v;
+        std::memcpy(&v, data + at, 4);
+        raw.corners.push_back(v);
+      } else {
+        int32_t v;
+        std::memcpy(&v, data + at, 4);
+        raw.corners.push_back(v);
+      }
+    }
+    if (raw.corners.size() > std::numeric_limits<uint32_t>::max()) return Status::error(what + ": more than 2^32-1 face corners");
+    raw.offsets.push_back(uint32_t(raw.corners.size()));
+  }
+  return Status::success();
+}
+
 }  // namespace
 
 Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw) {
@@ -250,6 +321,17 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
     }
     if (is_vertex) raw.positions.reserve(size_t(e.count) * 3);
     if (is_face) raw.offsets.reserve(size_t(e.count) + 1);
+    const bool lists = std::any_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.is_list; });
+    if (!ascii && is_vertex && !lists && min_row > 0) {
+      if (Status s = binary_vertex_rows(what, data, size, at, e, big, raw); !s) return s;
+      have_vertices = true;
+      continue;
+    }
+    if (!ascii && is_face && e.properties.size() == 1 && e.properties[0].role == Role::indices) {
+      if (Status s = binary_face_rows(what, data, size, at, e, big, raw); !s) return s;
+      have_faces = true;
+      continue;
+    }
     auto truncated = [&](uint64_t i) {
       return Status::error(what + ": truncated: the data ends inside " + quote_token(e.name) + " " + std::to_string(i) +
                            " of " + std::to_string(e.count) + " declared");

@@ -1,14 +1,17 @@
-// lod-bake-mpi: the HLOD bake of one mesh spread over MPI ranks (issue 16).
+// lod-bake-mpi: the HLOD bake of one mesh, or of a scene of many, spread over MPI ranks (issue 16).
 //
-//   mpirun -np 4 lod-bake-mpi MESH -o DIR --cache DIR [--min-verts N] [--threads N] [--subtrees N]
+//   mpirun -np 4 lod-bake-mpi MESH... -o DIR --cache DIR [--min-verts N] [--threads N] [--subtrees N]
 //
-// Every rank reads MESH itself (a path all ranks see) and bakes its share of the subtrees into
-// the cache folder (shared storage); rank 0 prints progress, assembles and writes DIR/<name>.hlod,
-// byte-identical to `lod bake MESH -o DIR --hlod`. A rerun bakes only what the cache lacks.
+// One mesh: every rank reads MESH itself (a path all ranks see) and bakes its share of the
+// subtrees into the cache folder (shared storage); rank 0 prints progress, assembles and writes
+// DIR/<name>.hlod, byte-identical to `lod bake MESH -o DIR --hlod`. Several meshes: the models
+// are handed out whole to the ranks (each baked by the local bake), a model too big for one
+// rank's share by all ranks as above; each DIR/<name>.hlod is the local bake's bytes and goes
+// through the cache (jobs/hlod_models_distributed.h). A rerun bakes only what the cache lacks.
 //
 // Fault injection for tests: LOD_MPI_FAIL_AFTER=N makes rank LOD_MPI_FAIL_RANK (default: the
-// last; -1: every rank) die without a word to MPI once it has stored N subtrees, as a killed
-// process would.
+// last; -1: every rank) die without a word to MPI once it has stored N cache entries (subtrees,
+// and with several meshes models too), as a killed process would.
 #include <mpi.h>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +22,7 @@
 #include <string>
 
 #include "jobs/hlod_distributed_bake.h"
+#include "jobs/hlod_models_distributed.h"
 
 namespace {
 
@@ -93,12 +97,88 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
           {"balance_cpu", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
 }
 
+const char* route_name(HlodModelRoute r) {
+  switch (r) {
+    case HlodModelRoute::cached: return "cached";
+    case HlodModelRoute::whole: return "whole";
+    case HlodModelRoute::split: return "split";
+    case HlodModelRoute::failed: break;
+  }
+  return "failed";
+}
+
+nlohmann::json to_json(const HlodModelsResult& r, int ranks) {
+  nlohmann::json models = nlohmann::json::array(), per_rank = nlohmann::json::array();
+  for (const HlodModelFigures& m : r.models) {
+    nlohmann::json one = {{"model", m.name}, {"mesh", m.mesh.string()}, {"route", route_name(m.route)},
+                          {"rank", m.rank}, {"estimated_triangles", m.estimated_triangles},
+                          {"source_triangles", m.source_triangles}, {"nodes", m.nodes}, {"bytes", m.bytes},
+                          // whole: its rank's bake; split: the distributed bake's wall and critical CPU
+                          {"bake_s", m.seconds}, {"bake_cpu_s", m.cpu_seconds}};
+    if (!m.error.empty()) one["error"] = m.error;
+    models.push_back(one);
+  }
+  for (const HlodModelsRankWork& w : r.ranks)
+    per_rank.push_back({{"baked", w.baked}, {"checked", w.checked}, {"failed", w.failed},
+                        {"triangles", w.triangles}, {"estimated_triangles", w.estimated},
+                        {"check_cpu_s", w.check_cpu_seconds}, {"bake_s", w.bake_seconds},
+                        {"bake_cpu_s", w.bake_cpu_seconds}, {"split_cpu_s", w.split_cpu_seconds},
+                        {"until_report_s", w.total_seconds}, {"cpu_until_report_s", w.cpu_seconds},
+                        {"bytes_stored", w.bytes_stored}});
+  return {{"ranks", ranks}, {"models_total", r.models.size()}, {"cached", r.cached}, {"whole", r.whole},
+          {"split", r.split}, {"failed", r.failed}, {"source_triangles", r.source_triangles},
+          {"total_s", r.total_seconds},
+          // The job on idle cores: the slowest rank's check and whole models + every split model's critical CPU.
+          {"critical_cpu_s", r.critical_cpu_seconds},
+          // The slowest rank's bake CPU / the mean: whole and split models; whole ones only.
+          {"balance_cpu", r.balance_cpu}, {"balance_whole_cpu", r.balance_whole_cpu},
+          {"models", models}, {"per_rank", per_rank}};
+}
+
+// Several meshes: one .hlod each, the models handed out to the ranks.
+int run_models(const std::vector<std::string>& meshes, const std::string& out_dir, HlodModelsSettings settings,
+               bool json, bool quiet, const HlodRankComm& comm) {
+  const long fail_after = env_number("LOD_MPI_FAIL_AFTER", -1);
+  const long fail_rank = env_number("LOD_MPI_FAIL_RANK", comm.size - 1);
+  if (fail_after >= 0 && (fail_rank == comm.rank || fail_rank < 0))
+    settings.before_store = [rank = comm.rank, fail_after](const std::string& what, size_t stored) {
+      if (long(stored) < fail_after) return;
+      std::fprintf(stderr, "lod-bake-mpi: rank %d: injected failure (LOD_MPI_FAIL_AFTER=%ld) at %s\n", rank, fail_after,
+                   what.c_str());
+      std::fflush(stderr);
+      std::_Exit(3);
+    };
+  const bool talk = !quiet && !json;
+  auto log = [&](const std::string& line) {
+    const bool progress = line.size() > 11 && line.compare(line.size() - 11, 11, "triangles/s") == 0;
+    if (talk || !progress) std::fprintf(stderr, "lod-bake-mpi: %s\n", line.c_str());
+  };
+  std::vector<std::filesystem::path> files(meshes.begin(), meshes.end());
+  if (Status names = hlod_model_names_unique(files); !names) {  // every rank refuses, rank 0 says so
+    if (comm.rank == 0) std::fprintf(stderr, "lod-bake-mpi: %s\n", names.message.c_str());
+    return 1;
+  }
+  HlodModelsResult r;
+  const Status st = bake_hlod_models_distributed(files, out_dir, settings, comm, log, &r);
+  if (comm.rank == 0 && json) std::printf("%s\n", to_json(r, comm.size).dump(1).c_str());
+  if (!st) {
+    std::fprintf(stderr, "lod-bake-mpi: %s\n", st.message.c_str());
+    return 1;
+  }
+  if (comm.rank != 0 || json || quiet) return 0;
+  std::printf("%zu models (%zu cached, %zu whole, %zu split over all ranks), %llu triangles on %d ranks in %s; total %.2f s\n",
+              r.models.size(), r.cached, r.whole, r.split, (unsigned long long)r.source_triangles, comm.size,
+              out_dir.c_str(), r.total_seconds);
+  return 0;
+}
+
 int run(int argc, char** argv, const HlodRankComm& comm) {
-  CLI::App app{"HLOD bake of one mesh over MPI ranks (byte-identical to lod bake --hlod)"};
-  std::string mesh, out_dir, cache_dir;
+  CLI::App app{"HLOD bake of one mesh or many over MPI ranks (byte-identical to lod bake --hlod)"};
+  std::vector<std::string> meshes;
+  std::string out_dir, cache_dir;
   int min_verts = 1000, threads = 0, subtrees = 0;
   bool json = false, quiet = false;
-  app.add_option("mesh", mesh, "mesh file, on a path every rank sees")->required();
+  app.add_option("mesh", meshes, "mesh files, on paths every rank sees (one .hlod each)")->required();
   app.add_option("-o,--out", out_dir, "output directory (rank 0 writes <name>.hlod there)")->required();
   app.add_option("--cache", cache_dir, "subtree cache directory on shared storage")->required();
   app.add_option("--min-verts", min_verts, "a cell with more vertices splits (default 1000)")->check(CLI::Range(3, 100000000));
@@ -116,6 +196,15 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   settings.threads = uint32_t(threads);
   settings.subtrees = uint32_t(subtrees);
   settings.cache_dir = cache_dir;
+  if (meshes.size() > 1) {
+    HlodModelsSettings models;
+    models.min_verts = settings.min_verts;
+    models.threads = settings.threads;
+    models.subtrees = settings.subtrees;
+    models.cache_dir = settings.cache_dir;
+    return run_models(meshes, out_dir, models, json, quiet, comm);
+  }
+  const std::string& mesh = meshes.front();
   const long fail_after = env_number("LOD_MPI_FAIL_AFTER", -1);
   const long fail_rank = env_number("LOD_MPI_FAIL_RANK", comm.size - 1);
   if (fail_after >= 0 && (fail_rank == comm.rank || fail_rank < 0))  // LOD_MPI_FAIL_RANK=-1: every rank

@@ -16,16 +16,7 @@ namespace {
 
 #if defined(LOD_BAKE_MPI_PATH) && defined(LOD_MPIEXEC)
 
-using test::run_shell;
-
-// Root may run mpirun here (containers, CI); loopback only; more ranks than cores is fine.
-// Under AddressSanitizer, OpenMPI's own allocations at exit are not reported as leaks.
-test::CliResult mpirun(int ranks, const std::string& args, const std::string& env = "") {
-  return run_shell("env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
-                   "ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:detect_leaks=0\" " +
-                   env + " " LOD_MPIEXEC " --oversubscribe --mca btl self,vader,tcp --mca btl_tcp_if_include lo" +
-                   " --mca oob_tcp_if_include lo -np " + std::to_string(ranks) + " " LOD_BAKE_MPI_PATH " " + args);
-}
+using test::run_mpi;
 
 // A closed sphere of 48,000 triangles, written by the test (no third-party mesh).
 struct Fixture {
@@ -68,7 +59,7 @@ TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
   ASSERT_FALSE(fixture().local.empty());
   for (int ranks : {1, 2, 4}) {
     const auto dir = test::temp_dir("lod_bake_mpi_np" + std::to_string(ranks));
-    const test::CliResult r = mpirun(ranks, bake_args(dir / "out", dir / "cache") + " --json");
+    const test::CliResult r = run_mpi(ranks, bake_args(dir / "out", dir / "cache") + " --json");
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local) << ranks << " ranks";
     const nlohmann::json j = summary(r);
@@ -82,14 +73,14 @@ TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
 
 TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes) {
   const auto dir = test::temp_dir("lod_bake_mpi_kill");
-  const test::CliResult killed = mpirun(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=4 LOD_MPI_FAIL_RANK=1");
+  const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=4 LOD_MPI_FAIL_RANK=1");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("injected failure"), std::string::npos) << killed.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "ball.hlod"));
   const size_t kept = entries(dir / "cache");
   EXPECT_GE(kept, 4u) << "the partial cache is kept";
 
-  const test::CliResult rerun = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
   const nlohmann::json j = summary(rerun);
   ASSERT_TRUE(j.is_object()) << rerun.out;
@@ -106,7 +97,7 @@ TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes)
 
 TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
   const auto dir = test::temp_dir("lod_bake_mpi_corrupt");
-  ASSERT_EQ(mpirun(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
+  ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
   std::vector<std::filesystem::path> files;
   for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
     if (e.path().extension() == ".hsub") files.push_back(e.path());
@@ -120,7 +111,7 @@ TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
   test::write_bytes(files[1], bytes);
   std::filesystem::remove(dir / "out" / "ball.hlod");
 
-  const test::CliResult r = mpirun(2, bake_args(dir / "out", dir / "cache") + " --json");
+  const test::CliResult r = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json j = summary(r);
   ASSERT_TRUE(j.is_object()) << r.out;
@@ -133,7 +124,7 @@ TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
 // An entry's place taken by a non-empty folder: the rank baking it cannot rename into place.
 TEST(LodBakeMpi, FailingRankNamesTheSubtreeAndTheJobFailsKeepingTheCache) {
   const auto dir = test::temp_dir("lod_bake_mpi_fail");
-  ASSERT_EQ(mpirun(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
+  ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
   std::vector<std::filesystem::path> files;
   for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
     if (e.path().extension() == ".hsub") files.push_back(e.path());
@@ -143,7 +134,7 @@ TEST(LodBakeMpi, FailingRankNamesTheSubtreeAndTheJobFailsKeepingTheCache) {
   std::filesystem::create_directories(blocked / "in-the-way");
   std::filesystem::remove(dir / "out" / "ball.hlod");
 
-  const test::CliResult r = mpirun(2, bake_args(dir / "out", dir / "cache"));
+  const test::CliResult r = run_mpi(2, bake_args(dir / "out", dir / "cache"));
   EXPECT_NE(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("subtree "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(blocked.filename().string()), std::string::npos) << r.out;

@@ -36,6 +36,18 @@ inline CliResult run_shell(const std::string& cmd) {
 
 inline CliResult run_lod(const std::string& args) { return run_shell(std::string(LOD_CLI_PATH) + " " + args); }
 
+#if defined(LOD_BAKE_MPI_PATH) && defined(LOD_MPIEXEC)
+// lod-bake-mpi on `ranks` ranks. Root may run mpirun here (containers, CI); loopback only; more
+// ranks than cores is fine. Under AddressSanitizer, OpenMPI's own allocations at exit are not
+// reported as leaks.
+inline CliResult run_mpi(int ranks, const std::string& args, const std::string& env = "") {
+  return run_shell("env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
+                   "ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:detect_leaks=0\" " +
+                   env + " " LOD_MPIEXEC " --oversubscribe --mca btl self,vader,tcp --mca btl_tcp_if_include lo" +
+                   " --mca oob_tcp_if_include lo -np " + std::to_string(ranks) + " " LOD_BAKE_MPI_PATH " " + args);
+}
+#endif
+
 inline nlohmann::json read_json(const std::filesystem::path& p) {
   std::ifstream f(p);
   return nlohmann::json::parse(f);

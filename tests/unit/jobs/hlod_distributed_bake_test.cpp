@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <barrier>
 #include <filesystem>
 #include <numeric>
 #include <random>
@@ -16,10 +15,13 @@
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_io.h"
 #include "test_support.h"
+#include "unit/jobs/thread_ranks.h"
 #include "vd_meshes.h"
 
 namespace lod {
 namespace {
+
+using test::ThreadRanks;
 
 TEST(HlodAssign, LongestFirstToTheLeastLoadedRank) {
   EXPECT_EQ(assign_subtrees({5, 4, 3, 3, 3}, 2), (std::vector<int>{0, 1, 1, 0, 1}));
@@ -146,34 +148,6 @@ TEST(HlodSubtreeCache, TruncatedFlippedOrMisplacedEntriesAreRefused) {
   EXPECT_EQ(load_hlod_subtree(dir, 2, m.vertex_count(), out, &why), CacheLookup::refused) << "stored under key 1";
   EXPECT_EQ(load_hlod_subtree(dir, 2, 10, out), CacheLookup::refused) << "vertices beyond a 10-vertex mesh";
 }
-
-// Ranks as threads: the two collectives over shared slots and a barrier.
-struct ThreadRanks {
-  explicit ThreadRanks(int n) : size(n), sync(n), slots(size_t(n)) {}
-  HlodRankComm comm(int rank) {
-    HlodRankComm c;
-    c.rank = rank;
-    c.size = size;
-    c.broadcast = [this, rank](std::vector<uint8_t>& bytes) {
-      if (rank == 0) slots[0] = bytes;
-      sync.arrive_and_wait();
-      if (rank != 0) bytes = slots[0];
-      sync.arrive_and_wait();
-    };
-    c.gather = [this, rank](const std::vector<uint8_t>& mine) {
-      slots[size_t(rank)] = mine;
-      sync.arrive_and_wait();
-      std::vector<std::vector<uint8_t>> all;
-      if (rank == 0) all = slots;
-      sync.arrive_and_wait();
-      return all;
-    };
-    return c;
-  }
-  int size;
-  std::barrier<> sync;
-  std::vector<std::vector<uint8_t>> slots;
-};
 
 struct RankRun {
   Status status;
