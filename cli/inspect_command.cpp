@@ -23,6 +23,7 @@ nlohmann::json materials_json(const LodChain& chain) {
   nlohmann::json out = nlohmann::json::array();
   for (const ChainMaterial& m : chain.materials)
     out.push_back({{"name", m.name},
+                   {"tex_coords", m.tex_coords},  // uv set per texture slot
                    {"base_color", {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]}},
                    {"metallic", m.metallic},
                    {"roughness", m.roughness},
@@ -64,6 +65,10 @@ void print_materials(const LodChain& chain) {
     if (!m.occlusion_texture.empty())
       std::printf(", occlusion texture %s (strength %.3g)", printable(m.occlusion_texture).c_str(), m.occlusion_strength);
     if (!m.emissive_texture.empty()) std::printf(", emissive texture %s", printable(m.emissive_texture).c_str());
+    const auto uris = texture_slots(m);
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (!uris[k]->empty() && m.tex_coords[k] != 0)
+        std::printf(", %s texture reads TEXCOORD_%u", kTextureSlotNames[k], unsigned(m.tex_coords[k]));
     std::printf("\n");
   }
   for (uint32_t k = 0; k < chain.levels.size(); ++k) {
@@ -89,6 +94,7 @@ void export_surfaces(const LodChain& chain, uint32_t k, GltfMeshView& view) {
     g.normal_scale = m.normal_scale;
     g.occlusion_strength = m.occlusion_strength;
     std::copy(m.emissive, m.emissive + 3, g.emissive);
+    g.tex_coords = m.tex_coords;
     const auto uris = texture_slots(m);
     const auto images = image_slots(g);
     for (size_t s = 0; s < kTextureSlots; ++s) *images[s] = texture_file(chain.texture_base, *uris[s]);
@@ -115,6 +121,8 @@ Status export_level(const std::filesystem::path& out, const std::string& format,
   const float* normals = chain.normals.size() == chain.positions.size() ? chain.normals.data() + size_t(l.first_vertex) * 3
                                                                         : nullptr;
   const float* uvs = chain.uvs.empty() ? nullptr : chain.uvs.data() + size_t(l.first_vertex) * 2;
+  const float* uvs1 = chain.uvs1.empty() ? nullptr : chain.uvs1.data() + size_t(l.first_vertex) * 2;
+  const float* colors = chain.colors.empty() ? nullptr : chain.colors.data() + size_t(l.first_vertex) * 4;
   const uint32_t* indices = chain.indices.data() + l.first_index;
   GltfMeshView view;
   view.notes = &notes;
@@ -127,6 +135,8 @@ Status export_level(const std::filesystem::path& out, const std::string& format,
     view.positions = positions;
     view.normals = normals;
     view.uvs = uvs;
+    view.uvs1 = uvs1;
+    view.colors = colors;
     view.vertex_count = l.vertex_count;
     view.indices = indices;
     view.index_count = l.index_count;
@@ -160,6 +170,8 @@ int inspect_command(const InspectArgs& args) {
     j["morph_targets"] = chain.morph_targets.size();  // 0 = level changes cannot blend
     j["hierarchy_nodes"] = chain.hierarchy.node_count();
     j["texcoords"] = !chain.uvs.empty();
+    j["texcoords1"] = !chain.uvs1.empty();
+    j["colors"] = !chain.colors.empty();
     j["materials"] = materials_json(chain);
     j["levels"] = nlohmann::json::array();
     for (size_t i = 0; i < chain.levels.size(); ++i) {
@@ -174,6 +186,8 @@ int inspect_command(const InspectArgs& args) {
                              {"bounds", {l.bounds.center[0], l.bounds.center[1], l.bounds.center[2], l.bounds.radius}},
                              {"bytes", l.vertex_count * 24ull + l.index_count * 4ull}});
       if (!chain.uvs.empty()) j["levels"].back()["uv_error"] = chain.uv_errors[i];
+      if (!chain.uvs1.empty()) j["levels"].back()["uv1_error"] = chain.uv1_errors[i];
+      if (!chain.colors.empty()) j["levels"].back()["color_error"] = chain.color_errors[i];
       if (!chain.materials.empty()) j["levels"].back()["submeshes"] = level_runs_json(chain, uint32_t(i));
     }
     // Names and paths are bytes: invalid UTF-8 is replaced (U+FFFD) rather than aborting the
@@ -200,6 +214,16 @@ int inspect_command(const InspectArgs& args) {
     if (!chain.uvs.empty()) {
       std::printf("texture coordinates: every level (uv seams kept); uv error per level:");
       for (float e : chain.uv_errors) std::printf(" %.4g", e);
+      std::printf("\n");
+    }
+    if (!chain.uvs1.empty()) {
+      std::printf("second texture coordinates (TEXCOORD_1): every level (seams kept); uv1 error per level:");
+      for (float e : chain.uv1_errors) std::printf(" %.4g", e);
+      std::printf("\n");
+    }
+    if (!chain.colors.empty()) {
+      std::printf("vertex colours (COLOR_0, linear RGBA): every level (colour seams kept); colour error per level:");
+      for (float e : chain.color_errors) std::printf(" %.4g", e);
       std::printf("\n");
     }
     if (!chain.materials.empty()) print_materials(chain);

@@ -72,9 +72,9 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   std::snprintf(ms, sizeof ms, "%.0f", ms_since(t0));
   log.line("bake " + model.name + ": vertex hierarchy of " + std::to_string(chain.hierarchy.node_count()) +
            " nodes in " + ms + " ms");
-  if (!chain.materials.empty() || !chain.uvs.empty())
+  if (!chain.materials.empty() || !chain.uvs.empty() || !chain.uvs1.empty() || !chain.colors.empty())
     log.line("bake " + model.name + ": the view-dependent mesh is one surface of positions: its " +
-             std::to_string(chain.materials.size()) + " materials and texture coordinates are kept in the levels only");
+             std::to_string(chain.materials.size()) + " materials, texture coordinates and colours are kept in the levels only");
   return rewrite ? write_lod_asset(*rewrite, chain) : Status::success();
 }
 

@@ -21,6 +21,8 @@ struct ChainLevel {
   std::vector<float> normals;     // xyz per vertex, area-weighted, unit length
   std::vector<uint32_t> indices;  // level-local, 3 per triangle
   std::vector<float> uvs;         // uv per vertex, or empty (the input had none, or they were dropped)
+  std::vector<float> uvs1;        // second uv set per vertex, or empty (likewise)
+  std::vector<float> colors;      // linear RGBA per vertex, or empty (likewise)
   size_t target_triangles = 0;    // what the ratio asked for
   size_t triangle_count() const { return indices.size() / 3; }
   size_t vertex_count() const { return positions.size() / 3; }

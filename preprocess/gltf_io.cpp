@@ -341,20 +341,26 @@ struct AccessorView {
   bool normalized = false;
 };
 
-enum class Role : uint8_t { position, normal, texcoord, indices };
+enum class Role : uint8_t { position, normal, texcoord, color, indices };
 
 const char* role_name(Role r) {
   switch (r) {
     case Role::position: return "POSITION";
     case Role::normal: return "NORMAL";
     case Role::texcoord: return "TEXCOORD";
+    case Role::color: return "COLOR";
     case Role::indices: return "indices";
   }
   return "?";
 }
 
-// Component types the core spec and KHR_mesh_quantization allow for each role.
+// Component types the core spec and KHR_mesh_quantization allow for each role (COLOR_n: float,
+// or normalized unsigned byte / short; quantization adds none).
 bool legal_component(Role role, int type, bool normalized) {
+  if (role == Role::color)
+    return type == TINYGLTF_COMPONENT_TYPE_FLOAT ? !normalized
+                                                 : normalized && (type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                                                  type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
   switch (type) {
     case TINYGLTF_COMPONENT_TYPE_FLOAT: return role != Role::indices && !normalized;
     case TINYGLTF_COMPONENT_TYPE_BYTE:
@@ -373,10 +379,15 @@ Status view_accessor(const std::string& where, const tinygltf::Model& m, int ind
                          std::to_string(m.accessors.size()));
   const tinygltf::Accessor& a = m.accessors[size_t(index)];
   if (a.sparse.isSparse) return Status::error(what + ": sparse accessors are not supported");
-  const int want = role == Role::indices ? TINYGLTF_TYPE_SCALAR : role == Role::texcoord ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
+  int want = role == Role::indices ? TINYGLTF_TYPE_SCALAR : role == Role::texcoord ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
+  if (role == Role::color && a.type == TINYGLTF_TYPE_VEC4) want = TINYGLTF_TYPE_VEC4;  // RGB or RGBA
   if (a.type != want)
     return Status::error(what + ": type " + std::to_string(a.type) + " (expected " +
-                         (want == TINYGLTF_TYPE_SCALAR ? "SCALAR" : want == TINYGLTF_TYPE_VEC2 ? "VEC2" : "VEC3") + ")");
+                         (want == TINYGLTF_TYPE_SCALAR ? "SCALAR"
+                          : want == TINYGLTF_TYPE_VEC2 ? "VEC2"
+                          : role == Role::color        ? "VEC3 or VEC4"
+                                                       : "VEC3") +
+                         ")");
   if (!legal_component(role, a.componentType, a.normalized))
     return Status::error(what + ": componentType " + std::to_string(a.componentType) + (a.normalized ? " normalized" : "") +
                          " is not allowed for " + role_name(role));
@@ -384,7 +395,7 @@ Status view_accessor(const std::string& where, const tinygltf::Model& m, int ind
   out = {};
   out.count = a.count;
   out.component_type = a.componentType;
-  out.components = want == TINYGLTF_TYPE_SCALAR ? 1 : want == TINYGLTF_TYPE_VEC2 ? 2 : 3;
+  out.components = want == TINYGLTF_TYPE_SCALAR ? 1 : want == TINYGLTF_TYPE_VEC2 ? 2 : want == TINYGLTF_TYPE_VEC4 ? 4 : 3;
   out.normalized = a.normalized;
   const size_t element = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType))) * size_t(out.components);
   if (a.bufferView < 0) {
@@ -505,8 +516,8 @@ struct PrimitivePlan {
   int mesh = -1, primitive = -1;
   int mode = TINYGLTF_MODE_TRIANGLES;
   int material = -1;
-  AccessorView position, normal, uv, indices;
-  bool has_normal = false, has_uv = false, indexed = false;
+  AccessorView position, normal, uv, uv1, color, indices;
+  bool has_normal = false, has_uv = false, has_uv1 = false, has_color = false, indexed = false;
   size_t triangles = 0;
   size_t vertices() const { return position.count; }
 };
@@ -561,6 +572,8 @@ Status plan_mesh(const std::string& what, const tinygltf::Model& m, int mesh, st
       if (name == "POSITION") s = view_accessor(where, m, accessor, Role::position, plan.position);
       else if (name == "NORMAL") s = view_accessor(where, m, accessor, Role::normal, plan.normal), plan.has_normal = true;
       else if (name == "TEXCOORD_0") s = view_accessor(where, m, accessor, Role::texcoord, plan.uv), plan.has_uv = true;
+      else if (name == "TEXCOORD_1") s = view_accessor(where, m, accessor, Role::texcoord, plan.uv1), plan.has_uv1 = true;
+      else if (name == "COLOR_0") s = view_accessor(where, m, accessor, Role::color, plan.color), plan.has_color = true;
       else if (name.rfind("TEXCOORD_", 0) == 0) {
         AccessorView unused;
         s = view_accessor(where, m, accessor, Role::texcoord, unused);
@@ -572,10 +585,12 @@ Status plan_mesh(const std::string& what, const tinygltf::Model& m, int mesh, st
     }
     if (plan.vertices() > std::numeric_limits<uint32_t>::max())
       return Status::error(where + ": " + std::to_string(plan.vertices()) + " vertices do not fit 32-bit indices");
-    for (const auto* attr : {&plan.normal, &plan.uv})
+    const std::pair<const AccessorView*, const char*> columns[] = {
+        {&plan.normal, "NORMAL"}, {&plan.uv, "TEXCOORD_0"}, {&plan.uv1, "TEXCOORD_1"}, {&plan.color, "COLOR_0"}};
+    for (const auto& [attr, attr_name] : columns)
       if (attr->count != 0 && attr->count != plan.vertices())
-        return Status::error(where + ": " + (attr == &plan.normal ? "NORMAL" : "TEXCOORD_0") + " has " +
-                             std::to_string(attr->count) + " elements, POSITION " + std::to_string(plan.vertices()));
+        return Status::error(where + ": " + attr_name + " has " + std::to_string(attr->count) + " elements, POSITION " +
+                             std::to_string(plan.vertices()));
     size_t corners = plan.vertices();
     if (prim.indices >= 0) {
       if (Status s = view_accessor(where, m, prim.indices, Role::indices, plan.indices); !s) return s;
@@ -615,7 +630,7 @@ Status check_budget(const std::string& what, size_t input_bytes, uint64_t vertic
 // ---- emitting --------------------------------------------------------------------------------
 
 struct Columns {
-  bool normals = false, uvs = false;
+  bool normals = false, uvs = false, uvs1 = false, colors = false;
 };
 
 // Every element of an accessor into out[0, count * components): floats copied as they are,
@@ -766,6 +781,32 @@ void triangles_from_corners(int mode, const uint32_t* c, size_t triangles, uint3
   }
 }
 
+// COLOR_0 as linear RGBA (an RGB one gets alpha 1; a primitive without gets white), refused
+// when not finite; float values outside [0, 1] are clamped (the spec keeps colours there).
+Status append_colors(const std::string& where, const PrimitivePlan& plan, size_t n, std::vector<float>& col) {
+  const size_t base = col.size();
+  if (!plan.has_color) {
+    col.resize(base + 4 * n, 1.0f);
+    return Status::success();
+  }
+  if (plan.color.components == 4) {
+    append_elements(plan.color, col);
+  } else {
+    col.resize(base + 4 * n);
+    float* q = col.data() + base;
+    decode_elements(plan.color, q);  // 3 per vertex at the front, spread out back to front
+    for (size_t v = n; v-- > 0;) {
+      const float r = q[3 * v], g = q[3 * v + 1], b = q[3 * v + 2];
+      q[4 * v] = r, q[4 * v + 1] = g, q[4 * v + 2] = b, q[4 * v + 3] = 1.0f;
+    }
+  }
+  float* q = col.data() + base;
+  if (const size_t bad = first_nonfinite(q, 4 * n); bad < 4 * n)
+    return Status::error(where + ": vertex " + std::to_string(bad / 4) + " has a non-finite COLOR_0");
+  for (size_t i = 0; i < 4 * n; ++i) q[i] = std::clamp(q[i], 0.0f, 1.0f);
+  return Status::success();
+}
+
 // Appends one primitive under one node's transform, as passes over its new ranges: decode,
 // transform, check finite, then corners -> triangles.
 Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const Instance& inst, Columns cols,
@@ -799,6 +840,16 @@ Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const 
     if (const size_t bad = suspect || transformed ? first_nonfinite(q, 2 * n) : 2 * n; bad < 2 * n)
       return Status::error(where + ": vertex " + std::to_string(bad / 2) + " has a non-finite TEXCOORD_0");
   }
+  if (cols.uvs1) {
+    suspect = false;
+    if (plan.has_uv1) suspect = append_elements(plan.uv1, out.uvs1);
+    else out.uvs1.resize(2 * (base + n), 0.0f);  // (0, 0) for a primitive without TEXCOORD_1
+    const float* q = out.uvs1.data() + 2 * base;
+    if (const size_t bad = suspect ? first_nonfinite(q, 2 * n) : 2 * n; bad < 2 * n)
+      return Status::error(where + ": vertex " + std::to_string(bad / 2) + " has a non-finite TEXCOORD_1");
+  }
+  if (cols.colors)
+    if (Status s = append_colors(where, plan, n, out.colors); !s) return s;
 
   const size_t first = out.triangle_count();
   const bool mirrored = glm::determinant(glm::dmat3(inst.world)) < 0;
@@ -836,7 +887,8 @@ AlphaMode alpha_mode_of(const std::string& s) {
 // exist; an image inside the file is marked embedded; one read through another TEXCOORD than
 // the imported TEXCOORD_0 is left out with a warning.
 Status read_texture(const std::string& what, const tinygltf::Model& m, size_t i, const char* slot, int index,
-                    int tex_coord, std::string& uri, bool& embedded, std::vector<std::string>& warnings) {
+                    int tex_coord, std::string& uri, bool& embedded, uint8_t& tex_coord_out,
+                    std::vector<std::string>& warnings) {
   if (index < 0) return Status::success();
   const std::string name = what + ": material " + std::to_string(i) + ": " + slot;
   if (size_t(index) >= m.textures.size())
@@ -846,11 +898,12 @@ Status read_texture(const std::string& what, const tinygltf::Model& m, size_t i,
   if (size_t(image) >= m.images.size())
     return Status::error(name + ": texture " + std::to_string(index) + " references image " + std::to_string(image) +
                          " of " + std::to_string(m.images.size()));
-  if (tex_coord != 0) {
+  if (tex_coord < 0 || tex_coord > kMaxTexCoord) {
     warnings.push_back(name + " reads TEXCOORD_" + std::to_string(tex_coord) +
-                       "; only TEXCOORD_0 is imported, so the texture is not kept");
+                       "; only TEXCOORD_0 and TEXCOORD_1 are imported, so the texture is not kept");
     return Status::success();
   }
+  tex_coord_out = uint8_t(tex_coord);
   uri = m.images[size_t(image)].uri;
   embedded = uri.empty();
   return Status::success();
@@ -885,7 +938,7 @@ Status read_materials(const std::string& what, const tinygltf::Model& m, std::ve
         {"emissiveTexture", src.emissiveTexture.index, src.emissiveTexture.texCoord}};
     for (size_t k = 0; k < kTextureSlots; ++k)
       if (Status s = read_texture(what, m, i, refs[k].name, refs[k].index, refs[k].tex_coord, *slots[k].uri,
-                                  *slots[k].embedded, warnings);
+                                  *slots[k].embedded, mat.tex_coords[k], warnings);
           !s)
         return s;
     out.push_back(std::move(mat));
@@ -958,6 +1011,8 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
       triangles += p.triangles;
       all_normals = all_normals && p.has_normal;
       cols.uvs = cols.uvs || p.has_uv;
+      cols.uvs1 = cols.uvs1 || p.has_uv1;
+      cols.colors = cols.colors || p.has_color;
     }
   }
   if (triangles == 0)
@@ -968,14 +1023,17 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
     warnings.push_back(first + ": attribute " + name + " is not imported" + (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0 ? " (skinning)" : ""));
   size_t input_bytes = src.file_bytes;
   for (const tinygltf::Buffer& b : m.buffers) input_bytes += b.data.size();
-  if (Status s = check_budget(what, input_bytes, vertices, triangles, 12 + (cols.normals ? 12 : 0) + (cols.uvs ? 8 : 0)); !s)
+  if (Status s = check_budget(what, input_bytes, vertices, triangles, 12 + (cols.normals ? 12 : 0) + (cols.uvs ? 8 : 0) + (cols.uvs1 ? 8 : 0) + (cols.colors ? 16 : 0));
+      !s)
     return s;
 
   mesh.positions.reserve(3 * vertices);
   if (cols.normals) mesh.normals.reserve(3 * vertices);
   if (cols.uvs) mesh.uvs.reserve(2 * vertices);
+  if (cols.uvs1) mesh.uvs1.reserve(2 * vertices);
+  if (cols.colors) mesh.colors.reserve(4 * vertices);
   mesh.indices.reserve(3 * triangles);
-  std::string missing_normals, missing_uvs;
+  std::string missing_normals, missing_uvs, missing_uvs1, missing_colors;
   std::vector<uint32_t> scratch;
   for (const Instance& inst : instances)
     for (const PrimitivePlan& p : plans[inst.mesh]) {
@@ -983,12 +1041,17 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
       const std::string name = "mesh " + std::to_string(p.mesh) + " primitive " + std::to_string(p.primitive);
       if (!p.has_normal && missing_normals.empty()) missing_normals = name;
       if (cols.uvs && !p.has_uv && missing_uvs.empty()) missing_uvs = name;
+      if (cols.uvs1 && !p.has_uv1 && missing_uvs1.empty()) missing_uvs1 = name;
+      if (cols.colors && !p.has_color && missing_colors.empty()) missing_colors = name;
     }
   if (!cols.normals && vertices > 0 && missing_normals.size() && std::any_of(plans.begin(), plans.end(), [](const auto& kv) {
         return std::any_of(kv.second.begin(), kv.second.end(), [](const PrimitivePlan& p) { return p.has_normal; });
       }))
     warnings.push_back(what + ": normals dropped: " + missing_normals + " has none (they are recomputed when baking)");
   if (!missing_uvs.empty()) warnings.push_back(what + ": " + missing_uvs + " has no TEXCOORD_0; its vertices get (0, 0)");
+  if (!missing_uvs1.empty()) warnings.push_back(what + ": " + missing_uvs1 + " has no TEXCOORD_1; its vertices get (0, 0)");
+  if (!missing_colors.empty())
+    warnings.push_back(what + ": " + missing_colors + " has no COLOR_0; its vertices get white (1, 1, 1, 1)");
   if (Status s = read_materials(what, m, mesh.materials, warnings); !s) return s;
   if (Status s = check_images(src, m); !s) return s;
   cap_warnings(mesh.warnings);

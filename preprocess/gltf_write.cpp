@@ -112,8 +112,10 @@ void load_images(const std::string& what, const GltfMeshView& m, std::vector<Ima
           m.notes->push_back(what + ": material " + std::to_string(i) + ": " + kTextureSlotNames[k] + " texture " +
                              file.string() + " " + why + "; written without it");
       };
-      if (!m.uvs) {
-        note("needs texture coordinates, and the mesh has none");
+      const uint8_t set = m.materials[i].tex_coords[k];
+      if (!(set == 0 ? m.uvs : set == 1 ? m.uvs1 : nullptr)) {
+        note("needs texture coordinates " + std::string(set == 0 ? "TEXCOORD_0" : "TEXCOORD_" + std::to_string(set)) +
+             ", and the mesh has none");
         continue;
       }
       const auto known = std::find(files.begin(), files.end(), file);
@@ -165,10 +167,18 @@ std::vector<float> unit_normals(const float* n, size_t count) {
   return out;
 }
 
+// The uv set a material's normal texture reads, or -1 without one.
+int normal_uv_set(const GltfMeshView& m, const std::vector<SlotImages>& image_of, int32_t material) {
+  if (material < 0 || image_of[size_t(material)][kNormalSlot] < 0) return -1;
+  return m.materials[size_t(material)].tex_coords[kNormalSlot];
+}
+
 // Tangents are written when a primitive's material has a normal texture (and there are normals
-// and uvs), and referenced by those primitives only (elsewhere they would go unused).
-bool wants_tangents(const GltfMeshView& m, const std::vector<SlotImages>& image_of, int32_t material) {
-  return m.normals && m.uvs && material >= 0 && image_of[size_t(material)][kNormalSlot] >= 0;
+// and uvs), and referenced by those primitives only (elsewhere they would go unused). They
+// follow one uv set (`set`: that of the first such primitive's normal texture); a primitive
+// whose normal texture reads the other gets none (a viewer generates them).
+bool wants_tangents(const GltfMeshView& m, const std::vector<SlotImages>& image_of, int32_t material, int set) {
+  return m.normals && set >= 0 && normal_uv_set(m, image_of, material) == set;
 }
 
 json pack_buffer(const GltfMeshView& m, const std::vector<SlotImages>& image_of, Packed& p, json& primitives) {
@@ -190,11 +200,22 @@ json pack_buffer(const GltfMeshView& m, const std::vector<SlotImages>& image_of,
     attributes["NORMAL"] = p.add(n.data(), 4 * n.size(), kArrayBuffer, kFloat, m.vertex_count, "VEC3");
   }
   if (m.uvs) attributes["TEXCOORD_0"] = p.add(m.uvs, 8 * m.vertex_count, kArrayBuffer, kFloat, m.vertex_count, "VEC2");
+  if (m.uvs1) attributes["TEXCOORD_1"] = p.add(m.uvs1, 8 * m.vertex_count, kArrayBuffer, kFloat, m.vertex_count, "VEC2");
+  if (m.colors) {
+    std::vector<float> c(m.colors, m.colors + 4 * m.vertex_count);  // the spec keeps float colours in [0, 1]
+    for (float& x : c) x = std::isfinite(x) ? std::clamp(x, 0.0f, 1.0f) : 1.0f;
+    attributes["COLOR_0"] = p.add(c.data(), 4 * c.size(), kArrayBuffer, kFloat, m.vertex_count, "VEC4");
+  }
   std::vector<GltfSubmeshView> runs = m.submeshes;
   if (runs.empty()) runs.push_back({0, m.index_count, -1});
-  if (std::any_of(runs.begin(), runs.end(), [&](const GltfSubmeshView& r) { return wants_tangents(m, image_of, r.material); })) {
+  int tangent_set = -1;
+  for (const GltfSubmeshView& r : runs)
+    if (tangent_set < 0) tangent_set = normal_uv_set(m, image_of, r.material);
+  if (std::any_of(runs.begin(), runs.end(),
+                  [&](const GltfSubmeshView& r) { return wants_tangents(m, image_of, r.material, tangent_set); })) {
     std::vector<float> t(4 * m.vertex_count);
-    compute_tangents(t.data(), m.positions, m.normals, m.uvs, m.vertex_count, m.indices, m.index_count);
+    compute_tangents(t.data(), m.positions, m.normals, tangent_set == 1 ? m.uvs1 : m.uvs, m.vertex_count, m.indices,
+                     m.index_count);
     attributes["TANGENT"] = p.add(t.data(), 4 * t.size(), kArrayBuffer, kFloat, m.vertex_count, "VEC4");
   }
   primitives = json::array();
@@ -208,7 +229,7 @@ json pack_buffer(const GltfMeshView& m, const std::vector<SlotImages>& image_of,
       indices = p.add(first, 4 * run.index_count, kElementArrayBuffer, kUInt, run.index_count, "SCALAR");
     }
     json prim = {{"attributes", attributes}, {"indices", indices}, {"mode", 4}};
-    if (!wants_tangents(m, image_of, run.material)) prim["attributes"].erase("TANGENT");
+    if (!wants_tangents(m, image_of, run.material, tangent_set)) prim["attributes"].erase("TANGENT");
     if (run.material >= 0) prim["material"] = run.material;
     primitives.push_back(std::move(prim));
   }
@@ -257,13 +278,25 @@ void describe_materials(const GltfMeshView& m, const std::vector<SlotImages>& im
                                      unit(src.base_color[3])}},
                 {"metallicFactor", unit(src.metallic)},
                 {"roughnessFactor", unit(src.roughness)}};
-    if (img[kBaseColorSlot] >= 0) pbr["baseColorTexture"] = {{"index", texture(img[kBaseColorSlot])}};
-    if (img[kMetallicRoughnessSlot] >= 0) pbr["metallicRoughnessTexture"] = {{"index", texture(img[kMetallicRoughnessSlot])}};
+    // textureInfo: the texture, and the uv set it reads when that is not TEXCOORD_0.
+    auto info = [&](size_t slot) {
+      json t = {{"index", texture(img[slot])}};
+      if (src.tex_coords[slot] != 0) t["texCoord"] = src.tex_coords[slot];
+      return t;
+    };
+    if (img[kBaseColorSlot] >= 0) pbr["baseColorTexture"] = info(kBaseColorSlot);
+    if (img[kMetallicRoughnessSlot] >= 0) pbr["metallicRoughnessTexture"] = info(kMetallicRoughnessSlot);
     json mat = {{"pbrMetallicRoughness", pbr}, {"alphaMode", alpha_mode_name(src.alpha_mode)},
                 {"doubleSided", src.double_sided}};
-    if (img[kNormalSlot] >= 0) mat["normalTexture"] = {{"index", texture(img[kNormalSlot])}, {"scale", std::max(0.0f, src.normal_scale)}};
-    if (img[kOcclusionSlot] >= 0) mat["occlusionTexture"] = {{"index", texture(img[kOcclusionSlot])}, {"strength", unit(src.occlusion_strength)}};
-    if (img[kEmissiveSlot] >= 0) mat["emissiveTexture"] = {{"index", texture(img[kEmissiveSlot])}};
+    if (img[kNormalSlot] >= 0) {
+      mat["normalTexture"] = info(kNormalSlot);
+      mat["normalTexture"]["scale"] = std::max(0.0f, src.normal_scale);
+    }
+    if (img[kOcclusionSlot] >= 0) {
+      mat["occlusionTexture"] = info(kOcclusionSlot);
+      mat["occlusionTexture"]["strength"] = unit(src.occlusion_strength);
+    }
+    if (img[kEmissiveSlot] >= 0) mat["emissiveTexture"] = info(kEmissiveSlot);
     // The factor alone emits too (glTF: emitted = factor x texture, the texture 1 when absent).
     if (src.emissive[0] > 0 || src.emissive[1] > 0 || src.emissive[2] > 0)
       mat["emissiveFactor"] = {unit(src.emissive[0]), unit(src.emissive[1]), unit(src.emissive[2])};

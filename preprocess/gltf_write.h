@@ -1,7 +1,7 @@
 // glTF 2.0 export of one triangle mesh: binary .glb, or .gltf with its buffer in a .bin next
 // to it (by the path's extension). Written by hand (tinygltf stays inside gltf_io.cpp): one
 // buffer, one tightly packed buffer view per attribute and for the indices (each 4-byte
-// aligned, with its target), POSITION with min/max, unit NORMALs, TEXCOORD_0, u16 indices
+// aligned, with its target), POSITION with min/max, unit NORMALs, TEXCOORD_0 and _1, COLOR_0, u16 indices
 // when the vertices fit, else u32; one node, one scene; one primitive per submesh (they share
 // the vertex attributes), each with its metallic-roughness material; its images (PNG or JPEG:
 // base colour, metallic-roughness, normal, occlusion, emissive) are embedded in the GLB's
@@ -41,6 +41,9 @@ struct GltfMaterialView {
   float normal_scale = 1;        // written as normalTexture.scale
   float occlusion_strength = 1;  // occlusionTexture.strength
   float emissive[3] = {0, 0, 0};  // emissiveFactor
+  // The uv set each texture reads, in kTextureSlots order (written as textureInfo.texCoord; a
+  // texture reading a set the mesh does not have is left out, said in `notes`).
+  std::array<uint8_t, kTextureSlots> tex_coords{};
 };
 
 // The images in kTextureSlots order (runtime/chain_material.h).
@@ -65,6 +68,8 @@ struct GltfMeshView {
   size_t vertex_count = 0;
   const float* normals = nullptr;    // xyz per vertex, or null; zero or non-finite ones are written as +z
   const float* uvs = nullptr;        // uv per vertex, or null
+  const float* uvs1 = nullptr;       // second uv set per vertex (TEXCOORD_1), or null
+  const float* colors = nullptr;     // linear RGBA per vertex (COLOR_0, written as float VEC4), or null
   const uint32_t* indices = nullptr;  // 3 per triangle, each < vertex_count
   size_t index_count = 0;
   std::vector<GltfMaterialView> materials;  // optional

@@ -26,7 +26,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 8;  // 8: normal, occlusion, emissive and metallic-roughness textures (MATL layout 1); 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
+constexpr uint32_t kBakeFormatVersion = 9;  // 9: vertex colours (COL0) and TEXCOORD_1 (TEX1) through the levels, texCoord per texture (MATL layout 2); 8: normal, occlusion, emissive and metallic-roughness textures (MATL layout 1); 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
                                              // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
@@ -115,6 +115,46 @@ Status resolve_ratios(const BakeSettings& settings, size_t triangles, const std:
   return Status::success();
 }
 
+// The vertex attributes the simplifiers carry, interleaved per vertex in this order: uv
+// (TEXCOORD_0), uv1 (TEXCOORD_1), RGBA colour, each only when the mesh has it. QEM interpolates
+// them along each collapse and weights every one in its cost; the aggressive simplifier averages
+// them per cell (only the colours are kept from it: it cannot keep uv seams).
+struct AttributeLayout {
+  static constexpr size_t kNone = SIZE_MAX;
+  size_t uv = kNone, uv1 = kNone, color = kNone;
+  size_t count = 0;
+};
+
+AttributeLayout attribute_layout(const MeshData& mesh) {
+  AttributeLayout a;
+  const size_t nv = mesh.vertex_count();
+  if (mesh.uvs.size() == 2 * nv) a.uv = a.count, a.count += 2;
+  if (mesh.uvs1.size() == 2 * nv) a.uv1 = a.count, a.count += 2;
+  if (mesh.colors.size() == 4 * nv) a.color = a.count, a.count += 4;
+  return a;
+}
+
+std::vector<float> interleave_attributes(const MeshData& mesh, const AttributeLayout& a) {
+  const size_t nv = mesh.vertex_count();
+  std::vector<float> out(a.count * nv);
+  auto put = [&](size_t at, const std::vector<float>& column, size_t per) {
+    if (at == AttributeLayout::kNone) return;
+    for (size_t v = 0; v < nv; ++v) std::copy_n(&column[per * v], per, &out[a.count * v + at]);
+  };
+  put(a.uv, mesh.uvs, 2);
+  put(a.uv1, mesh.uvs1, 2);
+  put(a.color, mesh.colors, 4);
+  return out;
+}
+
+// One attribute (at `at`, `per` floats) of every vertex of an interleaved array.
+std::vector<float> attribute_column(const std::vector<float>& interleaved, const AttributeLayout& a, size_t at, size_t per) {
+  const size_t nv = a.count ? interleaved.size() / a.count : 0;
+  std::vector<float> out(per * nv);
+  for (size_t v = 0; v < nv; ++v) std::copy_n(&interleaved[a.count * v + at], per, &out[per * v]);
+  return out;
+}
+
 // Levels by lodkit's own simplifiers: level 0 is the cleaned input, then one QEM run makes
 // every coarser level (both halves of the mesh as parts; run one after the other here, the
 // output is the same as in parallel), or the aggressive simplifier does. With method "auto",
@@ -128,21 +168,29 @@ void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_mat
                     std::vector<ChainLevel>& levels, std::vector<std::vector<uint32_t>>& sources,
                     std::vector<std::string>& notes) {
   const bool per_material = distinct_materials(vertex_material) > 1;
+  const AttributeLayout layout = attribute_layout(mesh);
+  const std::vector<float> attributes = interleave_attributes(mesh, layout);
   bool clustered = false;
   auto cluster = [&](ChainLevelOut* out, const size_t* targets, size_t count) {
     clustered = true;
+    // Only colours survive clustering: without them it carries no attributes (uvs are dropped).
+    ClusterOptions options;
+    if (layout.color != AttributeLayout::kNone) options.attributes = attributes.data(), options.attribute_count = layout.count;
     if (per_material)
-      cluster_simplify_per_material(out, mesh, vertex_material, targets, count);
+      cluster_simplify_per_material(out, mesh, vertex_material, targets, count, options.attributes,
+                                    options.attribute_count);
     else
       cluster_simplify_chain(out, mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size(),
-                             targets, count, ClusterOptions{});
+                             targets, count, options);
   };
   const size_t triangles = mesh.triangle_count();
   levels.assign(ratios.size(), ChainLevel{});
   ChainLevel& full = levels[0];
   full.positions = mesh.positions;
   full.indices = mesh.indices;
-  if (mesh.uvs.size() == 2 * mesh.vertex_count()) full.uvs = mesh.uvs;
+  if (layout.uv != AttributeLayout::kNone) full.uvs = mesh.uvs;
+  if (layout.uv1 != AttributeLayout::kNone) full.uvs1 = mesh.uvs1;
+  if (layout.color != AttributeLayout::kNone) full.colors = mesh.colors;
   full.target_triangles = triangles;
   full.normals.resize(mesh.positions.size());
   compute_vertex_normals(full.positions.data(), full.vertex_count(), full.indices.data(), full.indices.size(),
@@ -155,16 +203,17 @@ void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_mat
   std::vector<size_t> targets;
   for (size_t i = 1; i < ratios.size(); ++i) targets.push_back(size_t(std::llround(double(ratios[i]) * double(triangles))));
   std::vector<ChainLevelOut> out(targets.size());
-  bool keep_uvs = full.uvs.size() == 2 * full.vertex_count();
+  bool keep_uvs = layout.uv != AttributeLayout::kNone || layout.uv1 != AttributeLayout::kNone;
   if (method == SimplifyMethod::qem) {
     const ParallelFor one_by_one = [](size_t n, const std::function<void(size_t)>& body) {
       for (size_t i = 0; i < n; ++i) body(i);
     };
-    // Texture coordinates ride along as attributes: interpolated along each collapse; vertices
-    // sharing a position (uv seams) move only along their seam, both copies together, so the
-    // texture never tears or smears across a seam.
+    // Texture coordinates and colours ride along as attributes: interpolated along each
+    // collapse; vertices sharing a position (uv or colour seams) move only along their seam,
+    // both copies together, so the texture never tears or smears across a seam.
     QemOptions options;
-    if (keep_uvs) options.attributes = mesh.uvs.data(), options.attribute_count = 2, options.attribute_weight = uv_weight;
+    if (layout.count)
+      options.attributes = attributes.data(), options.attribute_count = layout.count, options.attribute_weight = uv_weight;
     qem_simplify_chain_split(out.data(), mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(),
                              mesh.indices.size(), targets.data(), targets.size(), options,
                              parallel_for ? ParallelFor(parallel_for) : one_by_one);
@@ -187,36 +236,52 @@ void simplify_chain(const MeshData& mesh, const std::vector<int32_t>& vertex_mat
   if (per_material && clustered)
     notes.push_back("the aggressive simplifier clustered each material's triangles on its own grid: where two "
                     "materials meet, their levels may leave hairline gaps");
-  if (!keep_uvs && !full.uvs.empty()) {
-    notes.push_back("texture coordinates of " + mesh.source +
+  if (!keep_uvs && (!full.uvs.empty() || !full.uvs1.empty())) {
+    notes.push_back(std::string(full.uvs1.empty() ? "texture coordinates" : "texture coordinates (both sets)") + " of " +
+                    mesh.source +
                     " dropped: the aggressive simplifier (vertex clustering) made a level, and it cannot keep uv seams");
     full.uvs.clear();
+    full.uvs1.clear();
   }
   for (size_t i = 0; i < out.size(); ++i) {
     ChainLevel& l = levels[i + 1];
     l.positions = std::move(out[i].positions);
     l.indices = std::move(out[i].indices);
     sources[i + 1] = std::move(out[i].source_vertex);
-    if (keep_uvs) l.uvs = std::move(out[i].attributes);
+    if (keep_uvs && layout.uv != AttributeLayout::kNone) l.uvs = attribute_column(out[i].attributes, layout, layout.uv, 2);
+    if (keep_uvs && layout.uv1 != AttributeLayout::kNone)
+      l.uvs1 = attribute_column(out[i].attributes, layout, layout.uv1, 2);
+    if (layout.color != AttributeLayout::kNone) l.colors = attribute_column(out[i].attributes, layout, layout.color, 4);
     l.target_triangles = targets[i];
     l.normals.resize(l.positions.size());
     compute_vertex_normals(l.positions.data(), l.vertex_count(), l.indices.data(), l.indices.size(), l.normals.data());
   }
 }
 
-// Every level's uvs, and how far each level's texture slid: the largest uv distance of a vertex
-// from the input vertex it descends from (the levels' `sources`).
-void add_uvs(const std::vector<ChainLevel>& levels, const std::vector<std::vector<uint32_t>>& sources, LodChain& chain) {
-  const std::vector<float>& input = levels[0].uvs;
+// Every level's values of one attribute (`per` floats a vertex: ChainLevel::*column), and how far
+// each level's slid: the largest distance of a vertex's value from that of the input vertex it
+// descends from (the levels' `sources`): for uvs, in texture units; for colours, in RGBA.
+void add_attribute(const std::vector<ChainLevel>& levels, const std::vector<std::vector<uint32_t>>& sources,
+                   std::vector<float> ChainLevel::*column, size_t per, std::vector<float>& values,
+                   std::vector<float>& errors) {
+  const std::vector<float>& input = levels[0].*column;
   for (size_t k = 0; k < levels.size(); ++k) {
     const ChainLevel& l = levels[k];
+    const std::vector<float>& mine = l.*column;
     float worst = 0;
     for (size_t v = 0; v < l.vertex_count() && v < sources[k].size(); ++v) {
-      const float* from = &input[2 * size_t(sources[k][v])];
-      worst = std::max(worst, std::hypot(l.uvs[2 * v] - from[0], l.uvs[2 * v + 1] - from[1]));
+      const float* from = &input[per * size_t(sources[k][v])];
+      const float* at = &mine[per * v];
+      if (per == 2) {
+        worst = std::max(worst, std::hypot(at[0] - from[0], at[1] - from[1]));
+      } else {
+        float sum = 0;
+        for (size_t c = 0; c < per; ++c) sum += (at[c] - from[c]) * (at[c] - from[c]);
+        worst = std::max(worst, std::sqrt(sum));
+      }
     }
-    chain.uvs.insert(chain.uvs.end(), l.uvs.begin(), l.uvs.end());
-    chain.uv_errors.push_back(worst);
+    values.insert(values.end(), mine.begin(), mine.end());
+    errors.push_back(worst);
   }
 }
 
@@ -389,7 +454,9 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
     chain.indices.insert(chain.indices.end(), l.indices.begin(), l.indices.end());
     chain.levels.push_back(level);
   }
-  if (!levels[0].uvs.empty()) add_uvs(levels, sources, chain);
+  if (!levels[0].uvs.empty()) add_attribute(levels, sources, &ChainLevel::uvs, 2, chain.uvs, chain.uv_errors);
+  if (!levels[0].uvs1.empty()) add_attribute(levels, sources, &ChainLevel::uvs1, 2, chain.uvs1, chain.uv1_errors);
+  if (!levels[0].colors.empty()) add_attribute(levels, sources, &ChainLevel::colors, 4, chain.colors, chain.color_errors);
   // Morph targets of each level into the next, from the simplifier's vertex mapping; levels
   // are independent, so they may run in parallel.
   if (levels.size() > 1) {
@@ -421,6 +488,8 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   if (culled) {
     chain.levels.push_back(culled_level(chain));
     if (!chain.uvs.empty()) chain.uv_errors.push_back(chain.uv_errors.back());
+    if (!chain.uvs1.empty()) chain.uv1_errors.push_back(chain.uv1_errors.back());
+    if (!chain.colors.empty()) chain.color_errors.push_back(chain.color_errors.back());
   }
   std::string problem;
   if (!validate_chain(chain, &problem)) return Status::error(what + ": baked chain is invalid: " + problem);

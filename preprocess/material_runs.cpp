@@ -26,6 +26,7 @@ size_t split_vertices_by_material(MeshData& mesh) {
   const size_t nv = mesh.vertex_count();
   const bool normals = mesh.normals.size() == mesh.positions.size();
   const bool uvs = mesh.uvs.size() == 2 * nv;
+  const bool uvs1 = mesh.uvs1.size() == 2 * nv, colors = mesh.colors.size() == 4 * nv;
   constexpr int64_t kNone = INT64_MIN;
   std::vector<int64_t> owner(nv, kNone);  // the material a vertex keeps
   std::unordered_map<uint64_t, uint32_t> copies;  // (vertex, material) -> copy
@@ -44,6 +45,10 @@ size_t split_vertices_by_material(MeshData& mesh) {
           for (int k = 0; k < 3; ++k) mesh.normals.push_back(mesh.normals[3 * size_t(from) + size_t(k)]);
         if (uvs)
           for (int k = 0; k < 2; ++k) mesh.uvs.push_back(mesh.uvs[2 * size_t(from) + size_t(k)]);
+        if (uvs1)
+          for (int k = 0; k < 2; ++k) mesh.uvs1.push_back(mesh.uvs1[2 * size_t(from) + size_t(k)]);
+        if (colors)
+          for (int k = 0; k < 4; ++k) mesh.colors.push_back(mesh.colors[4 * size_t(from) + size_t(k)]);
       }
       v = it->second;
     }
@@ -83,7 +88,9 @@ void group_by_material(std::vector<uint32_t>& indices, const std::vector<uint32_
 }
 
 void cluster_simplify_per_material(ChainLevelOut* levels, const MeshData& mesh, const std::vector<int32_t>& vertex_material,
-                                   const size_t* target_triangles, size_t level_count) {
+                                   const size_t* target_triangles, size_t level_count, const float* attributes,
+                                   size_t attribute_count) {
+  const size_t ac = attributes ? attribute_count : 0;
   // Each material's triangles as a mesh of its own vertices.
   std::map<int32_t, std::vector<uint32_t>> faces;  // material -> input faces' corners
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
@@ -95,12 +102,13 @@ void cluster_simplify_per_material(ChainLevelOut* levels, const MeshData& mesh, 
   float error = 0;
   for (const auto& [material, corners] : faces) {
     std::vector<uint32_t> local(mesh.vertex_count(), ~0u), inputs, part_indices;
-    std::vector<float> part_positions;
+    std::vector<float> part_positions, part_attributes;
     for (uint32_t v : corners) {
       if (local[v] == ~0u) {
         local[v] = uint32_t(inputs.size());
         inputs.push_back(v);
         part_positions.insert(part_positions.end(), &mesh.positions[3 * size_t(v)], &mesh.positions[3 * size_t(v)] + 3);
+        if (ac) part_attributes.insert(part_attributes.end(), attributes + ac * v, attributes + ac * (v + 1));
       }
       part_indices.push_back(local[v]);
     }
@@ -109,12 +117,15 @@ void cluster_simplify_per_material(ChainLevelOut* levels, const MeshData& mesh, 
     for (size_t l = 0; l < level_count; ++l)
       targets[l] = std::max<size_t>(1, size_t(std::llround(double(target_triangles[l]) * share)));
     std::vector<ChainLevelOut> part(level_count);
+    ClusterOptions options;
+    if (ac) options.attributes = part_attributes.data(), options.attribute_count = ac;
     cluster_simplify_chain(part.data(), part_positions.data(), inputs.size(), part_indices.data(), part_indices.size(),
-                           targets.data(), level_count, ClusterOptions{});
+                           targets.data(), level_count, options);
     for (size_t l = 0; l < level_count; ++l) {
       ChainLevelOut& out = levels[l];
       const uint32_t base = uint32_t(out.source_vertex.size());
       out.positions.insert(out.positions.end(), part[l].positions.begin(), part[l].positions.end());
+      out.attributes.insert(out.attributes.end(), part[l].attributes.begin(), part[l].attributes.end());
       for (uint32_t i : part[l].indices) out.indices.push_back(base + i);
       for (uint32_t s : part[l].source_vertex) out.source_vertex.push_back(inputs[s]);
       error = std::max(error, part[l].error);
@@ -212,7 +223,7 @@ void add_chain_materials(const MeshData& mesh, const std::filesystem::path& sour
       else if (chain.texture_base.empty() && !uri.empty())
         notes.push_back(at + ": the source's folder cannot be stored, so its " + slot + " texture '" + uri + "' is not kept");
       else
-        *to[k] = uri;
+        *to[k] = uri, c.tex_coords[k] = std::min(m.tex_coords[k], kMaxTexCoord);
     }
     chain.materials.push_back(std::move(c));
   }

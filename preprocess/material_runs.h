@@ -43,9 +43,12 @@ void group_by_material(std::vector<uint32_t>& indices, const std::vector<uint32_
 
 // cluster_simplify_chain on each material's triangles alone, each to its share of every
 // target; the parts are joined into one level each (source_vertex in input ids). Each cell
-// grid is a material's own, so neighbouring materials may no longer meet exactly.
+// grid is a material's own, so neighbouring materials may no longer meet exactly. Optional
+// per-vertex attributes (attribute_count floats per input vertex) are averaged per cell into
+// each level's `attributes`.
 void cluster_simplify_per_material(ChainLevelOut* levels, const MeshData& mesh, const std::vector<int32_t>& vertex_material,
-                                   const size_t* target_triangles, size_t level_count);
+                                   const size_t* target_triangles, size_t level_count, const float* attributes = nullptr,
+                                   size_t attribute_count = 0);
 
 // The mesh's materials as the chain stores them (chain.materials, chain.texture_base = the
 // source's folder, absolute). What cannot be kept is said in `notes`: textures embedded in the

@@ -2,6 +2,7 @@
 // OpenMesh-facing files. Positions and indices are always there; the other attributes are
 // optional (empty = the source had none), so readers that know only geometry leave them be.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <type_traits>
@@ -36,6 +37,9 @@ struct MeshMaterial {
   float normal_scale = 1;          // glTF normalTexture.scale (MTL: bump -bm); the bake keeps it >= 0
   float occlusion_strength = 1;    // glTF occlusionTexture.strength, [0, 1]
   float emissive[3] = {0, 0, 0};   // glTF emissiveFactor (MTL: Ke), linear RGB in [0, 1]
+  // The uv set each texture reads (glTF textureInfo.texCoord: 0 = TEXCOORD_0, 1 = TEXCOORD_1),
+  // in kTextureSlots order.
+  std::array<uint8_t, kTextureSlots> tex_coords{};
 };
 
 // A material's textures in kTextureSlots order (runtime/chain_material.h), for loops over them.
@@ -68,6 +72,8 @@ struct MeshData {
   std::vector<float> normals;      // xyz per vertex, or empty
   std::vector<uint32_t> indices;   // 3 per triangle
   std::vector<float> uvs;          // uv per vertex (glTF TEXCOORD_0: origin top left), or empty
+  std::vector<float> uvs1;         // second uv set per vertex (glTF TEXCOORD_1), or empty
+  std::vector<float> colors;       // linear RGBA per vertex (glTF COLOR_0; RGB gets alpha 1), or empty
   std::vector<Submesh> submeshes;  // cover every triangle in order, or empty (one surface)
   std::vector<MeshMaterial> materials;  // as numbered by the file, or empty
   std::vector<std::string> warnings;    // what the reader skipped, each naming the element

@@ -51,6 +51,30 @@ TexturedKey key_of(const float* p, const float* uv, int32_t material) {
   return k;
 }
 
+// With a second uv set or vertex colours: position, both uv sets and RGBA (absent ones as 0), so
+// a colour or TEXCOORD_1 seam stays two vertices as a uv one does. Meshes without them keep the
+// narrower keys above (fewer words to sort).
+struct AttributeKey {
+  std::array<uint32_t, 12> bits;
+  auto operator<=>(const AttributeKey&) const = default;
+};
+
+AttributeKey key_of(const float* p, const float* uv, const float* uv1, const float* rgba, int32_t material) {
+  AttributeKey k{};
+  const PositionKey pk = key_of(p, material);
+  std::copy(pk.bits.begin(), pk.bits.end(), k.bits.begin());
+  auto put = [&k](const float* values, int count, int at) {
+    for (int i = 0; values && i < count; ++i) {
+      const float v = values[i] == 0.0f ? 0.0f : values[i];
+      std::memcpy(&k.bits[size_t(at + i)], &v, 4);
+    }
+  };
+  put(uv, 2, 4);
+  put(uv1, 2, 6);
+  put(rgba, 4, 8);
+  return k;
+}
+
 struct FaceKey {
   std::array<uint32_t, 3> v;  // sorted
   auto operator<=>(const FaceKey&) const = default;
@@ -85,12 +109,19 @@ CleanReport clean_mesh(MeshData& mesh) {
   const size_t nv = mesh.vertex_count();
   const bool has_normals = mesh.normals.size() == mesh.positions.size();
   const bool has_uvs = mesh.uvs.size() == 2 * nv;
+  const bool has_uvs1 = mesh.uvs1.size() == 2 * nv, has_colors = mesh.colors.size() == 4 * nv;
+  const bool wide = has_uvs1 || has_colors;  // weld on every attribute (AttributeKey)
+  auto wide_key = [&](size_t v, int32_t m) {
+    return key_of(&mesh.positions[3 * v], has_uvs ? &mesh.uvs[2 * v] : nullptr, has_uvs1 ? &mesh.uvs1[2 * v] : nullptr,
+                  has_colors ? &mesh.colors[4 * v] : nullptr, m);
+  };
 
   // Pass 1: weld exactly duplicated positions (and uvs, when there are some) onto their first
   // occurrence.
   std::vector<uint32_t> weld(nv);
   report.duplicate_vertices =
-      has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], material[v]); }, weld)
+      wide      ? detail::first_of_equal(nv, [&](size_t v) { return wide_key(v, material[v]); }, weld)
+      : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], material[v]); }, weld)
               : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], material[v]); }, weld);
 
   // Faces repeat each other by their corners' positions (and uvs) whatever their materials:
@@ -98,7 +129,8 @@ CleanReport clean_mesh(MeshData& mesh) {
   std::vector<uint32_t> same_place;
   const bool split = report.material_split_vertices > 0;
   if (split)
-    has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], 0); }, same_place)
+    wide      ? detail::first_of_equal(nv, [&](size_t v) { return wide_key(v, 0); }, same_place)
+    : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], 0); }, same_place)
             : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], 0); }, same_place);
   const std::vector<uint32_t>& face_weld = split ? same_place : weld;
 
@@ -144,10 +176,12 @@ CleanReport clean_mesh(MeshData& mesh) {
   std::vector<uint8_t> used(nv, 0);
   for (uint32_t v : kept) used[v] = 1;
   std::vector<uint32_t> remap(nv, UINT32_MAX);
-  std::vector<float> positions, normals, uvs;
+  std::vector<float> positions, normals, uvs, uvs1, colors;
   positions.reserve(mesh.positions.size());
   if (has_normals) normals.reserve(mesh.normals.size());
   if (has_uvs) uvs.reserve(mesh.uvs.size());
+  if (has_uvs1) uvs1.reserve(mesh.uvs1.size());
+  if (has_colors) colors.reserve(mesh.colors.size());
   uint32_t next = 0;
   for (size_t v = 0; v < nv; ++v) {
     if (weld[v] != v) continue;
@@ -159,12 +193,16 @@ CleanReport clean_mesh(MeshData& mesh) {
     positions.insert(positions.end(), &mesh.positions[3 * v], &mesh.positions[3 * v] + 3);
     if (has_normals) normals.insert(normals.end(), &mesh.normals[3 * v], &mesh.normals[3 * v] + 3);
     if (has_uvs) uvs.insert(uvs.end(), &mesh.uvs[2 * v], &mesh.uvs[2 * v] + 2);
+    if (has_uvs1) uvs1.insert(uvs1.end(), &mesh.uvs1[2 * v], &mesh.uvs1[2 * v] + 2);
+    if (has_colors) colors.insert(colors.end(), &mesh.colors[4 * v], &mesh.colors[4 * v] + 4);
   }
   for (uint32_t& v : kept) v = remap[v];
 
   mesh.positions = std::move(positions);
   mesh.normals = has_normals ? std::move(normals) : std::vector<float>{};
   mesh.uvs = has_uvs ? std::move(uvs) : std::vector<float>{};
+  mesh.uvs1 = has_uvs1 ? std::move(uvs1) : std::vector<float>{};
+  mesh.colors = has_colors ? std::move(colors) : std::vector<float>{};
   mesh.indices = std::move(kept);
   if (has_submeshes) resubmesh(mesh.submeshes, kept_before);
   return report;

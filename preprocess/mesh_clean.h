@@ -10,7 +10,7 @@ struct CleanReport {
   size_t degenerate_faces = 0;      // repeated vertex index or zero area
   size_t duplicate_faces = 0;       // same vertex set as an earlier face
   size_t unreferenced_vertices = 0;
-  size_t duplicate_vertices = 0;    // bit-identical positions (and uvs) of one material welded together
+  size_t duplicate_vertices = 0;    // bit-identical positions (and uvs, colours) of one material welded together
   size_t material_split_vertices = 0;  // copies made where two materials shared a vertex (kept apart)
   bool changed() const {
     return degenerate_faces + duplicate_faces + unreferenced_vertices + duplicate_vertices > 0;
@@ -18,7 +18,8 @@ struct CleanReport {
 };
 
 // Cleans in place; deterministic; keeps the first occurrence of everything. With uvs, vertices
-// weld only when position and uv match, so uv seams stay; with several materials a vertex is
+// weld only when position and uv match, so uv seams stay (likewise TEXCOORD_1 and colours:
+// a colour seam stays two vertices); with several materials a vertex is
 // first split per material and vertices weld only within one, so material boundaries stay seams; a welded vertex keeps its first
 // normal (normal seams are not kept: level normals are recomputed from the geometry). Submeshes keep their surviving triangles.
 CleanReport clean_mesh(MeshData& mesh);

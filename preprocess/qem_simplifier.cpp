@@ -98,28 +98,54 @@ float quadric_cost(const Quadric& q, const float* p) {
 void attribute_add(AttributeQuadric& q, const AttributeQuadric& r) {
   q.a00 += r.a00, q.a11 += r.a11, q.a22 += r.a22, q.a01 += r.a01, q.a02 += r.a02, q.a12 += r.a12;
   q.b0 += r.b0, q.b1 += r.b1, q.b2 += r.b2, q.c += r.c, q.w += r.w;
-  for (size_t k = 0; k < kAttributeQuadricChannels; ++k) {
-    for (int j = 0; j < 3; ++j) q.g[k][j] += r.g[k][j];
-    q.d[k] += r.d[k];
-  }
 }
 
-// sum w (g.p + d - s_k)^2 at p with the merged vertex's attributes s (channels past
-// `channels` read nothing).
-double attribute_eval(const AttributeQuadric& q, const float* p, const float* s, size_t channels) {
+// A vertex's gradient sums (kGradientWords per channel), to read or add to.
+double* gradients_of(QemMesh& mesh, uint32_t v) {
+  return mesh.attribute_gradients.data() + kGradientWords * mesh.attribute_channels * v;
+}
+const double* gradients_of(const QemMesh& mesh, uint32_t v) {
+  return mesh.attribute_gradients.data() + kGradientWords * mesh.attribute_channels * v;
+}
+
+void gradients_add(double* g, const double* r, size_t channels) {
+  for (size_t i = 0; i < kGradientWords * channels; ++i) g[i] += r[i];
+}
+
+// Vertex b's attribute quadric plus a's (both parts), as one collapse merges them.
+void attribute_merge(QemMesh& mesh, uint32_t b, uint32_t a) {
+  attribute_add(mesh.attribute_quadrics[b], mesh.attribute_quadrics[a]);
+  gradients_add(gradients_of(mesh, b), gradients_of(mesh, a), mesh.attribute_channels);
+}
+
+// sum w (g.p + d - s_k)^2 at p with the merged vertex's attributes s (`channels` of them;
+// g: their gradient sums).
+double attribute_eval(const AttributeQuadric& q, const double* g, const float* p, const float* s, size_t channels) {
   const double x = p[0], y = p[1], z = p[2];
   double r = x * (q.a00 * x + q.a01 * y + q.a02 * z) + y * (q.a01 * x + q.a11 * y + q.a12 * z) +
              z * (q.a02 * x + q.a12 * y + q.a22 * z) + 2 * (q.b0 * x + q.b1 * y + q.b2 * z) + q.c;
-  for (size_t k = 0; k < channels; ++k)
-    r += -2 * double(s[k]) * (q.g[k][0] * x + q.g[k][1] * y + q.g[k][2] * z + q.d[k]) + double(s[k]) * s[k] * q.w;
+  for (size_t k = 0; k < channels; ++k, g += kGradientWords)
+    r += -2 * double(s[k]) * (g[0] * x + g[1] * y + g[2] * z + g[3]) + double(s[k]) * s[k] * q.w;
   return r;
+}
+
+// The attribute error at p of vertices a and b merged, with attributes s: their quadrics
+// summed on the stack (no vertex changes).
+double merged_attribute_eval(const QemMesh& mesh, uint32_t a, uint32_t b, const float* p, const float* s) {
+  const size_t channels = mesh.attribute_channels;
+  AttributeQuadric q = mesh.attribute_quadrics[a];
+  attribute_add(q, mesh.attribute_quadrics[b]);
+  double g[kGradientWords * kAttributeQuadricChannels];
+  std::memcpy(g, gradients_of(mesh, a), kGradientWords * channels * sizeof(double));
+  gradients_add(g, gradients_of(mesh, b), channels);
+  return attribute_eval(q, g, p, s, channels);
 }
 
 // Face (p0, p1, p2) with attributes s0, s1, s2 (`channels` each): for every channel the linear
 // function g.p + d over the face's plane through the corner values, added with weight w to the
 // three corners' attribute quadrics.
-void add_face_attributes(AttributeQuadric* corners[3], const float* p0, const float* p1, const float* p2,
-                         const float* s0, const float* s1, const float* s2, size_t channels, double w) {
+void add_face_attributes(AttributeQuadric* corners[3], double* corner_gradients[3], const float* p0, const float* p1,
+                         const float* p2, const float* s0, const float* s1, const float* s2, size_t channels, double w) {
   const double e1[3] = {double(p1[0]) - p0[0], double(p1[1]) - p0[1], double(p1[2]) - p0[2]};
   const double e2[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
   const double m11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2], m22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
@@ -127,6 +153,7 @@ void add_face_attributes(AttributeQuadric* corners[3], const float* p0, const fl
   const double det = m11 * m22 - m12 * m12;
   if (!(det > 1e-30 * m11 * m22) || !(w > 0)) return;
   AttributeQuadric f;
+  double fg[kGradientWords * kAttributeQuadricChannels];
   f.w = w;
   for (size_t k = 0; k < channels; ++k) {
     // g = alpha e1 + beta e2 with g.e1 = s1 - s0, g.e2 = s2 - s0 (in the face's plane).
@@ -138,10 +165,13 @@ void add_face_attributes(AttributeQuadric* corners[3], const float* p0, const fl
     f.a01 += w * g[0] * g[1], f.a02 += w * g[0] * g[2], f.a12 += w * g[1] * g[2];
     f.b0 += w * d * g[0], f.b1 += w * d * g[1], f.b2 += w * d * g[2];
     f.c += w * d * d;
-    for (int j = 0; j < 3; ++j) f.g[k][j] = w * g[j];
-    f.d[k] = w * d;
+    for (int j = 0; j < 3; ++j) fg[kGradientWords * k + size_t(j)] = w * g[j];
+    fg[kGradientWords * k + 3] = w * d;
   }
-  for (int c = 0; c < 3; ++c) attribute_add(*corners[c], f);
+  for (int c = 0; c < 3; ++c) {
+    attribute_add(*corners[c], f);
+    gradients_add(corner_gradients[c], fg, channels);
+  }
 }
 
 // Best point on the segment a-b (1D quadratic, clamped), midpoint when flat along it.
@@ -250,13 +280,9 @@ float seam_cost(const Work& w, const QemMesh& mesh, uint32_t f, uint32_t t) {
   const float* p = &mesh.positions[3 * size_t(t)];
   double e = quadric_eval(q, p[0], p[1], p[2]);
   if (!mesh.attribute_quadrics.empty()) {
-    const size_t ac = mesh.attribute_count, channels = std::min(ac, kAttributeQuadricChannels);
-    AttributeQuadric side = mesh.attribute_quadrics[f];
-    attribute_add(side, mesh.attribute_quadrics[t]);
-    e += std::max(0.0, attribute_eval(side, p, &mesh.attributes[ac * t], channels));
-    side = mesh.attribute_quadrics[g];
-    attribute_add(side, mesh.attribute_quadrics[tp]);
-    e += std::max(0.0, attribute_eval(side, p, &mesh.attributes[ac * tp], channels));
+    const size_t ac = mesh.attribute_count;
+    e += std::max(0.0, merged_attribute_eval(mesh, f, t, p, &mesh.attributes[ac * t]));
+    e += std::max(0.0, merged_attribute_eval(mesh, g, tp, p, &mesh.attributes[ac * tp]));
   }
   return q.w > 0 ? float(e / q.w) : float(e);
 }
@@ -578,7 +604,7 @@ void apply_collapse(Work& w, QemMesh& mesh, uint32_t a, uint32_t b, const float*
   }
   std::memcpy(pos + 3 * size_t(b), p, 3 * sizeof(float));
   quadric_add(mesh.quadrics[b], mesh.quadrics[a]);
-  if (!mesh.attribute_quadrics.empty()) attribute_add(mesh.attribute_quadrics[b], mesh.attribute_quadrics[a]);
+  if (!mesh.attribute_quadrics.empty()) attribute_merge(mesh, b, a);
   w.remap[a] = b;
   w.pass_lock[a] = w.pass_lock[b] = 1;
 }
@@ -652,14 +678,13 @@ size_t collapse_pass(Work& w, QemMesh& mesh, size_t target, double cost_limit, b
       if (weighted) {
         // The attribute the merged vertex gets (interpolated along the edge, as the collapse
         // does), against the faces' attribute functions of both ends.
-        AttributeQuadric aq = mesh.attribute_quadrics[a];
-        attribute_add(aq, mesh.attribute_quadrics[b]);
         const uint32_t f = c.from, to = c.to;
         const float t = edge_parameter(pos + 3 * size_t(f), pos + 3 * size_t(to), c.p);
         float s[kAttributeQuadricChannels];
         const float* at = mesh.attributes.data();
         for (size_t k = 0; k < channels; ++k) s[k] = at[f * ac + k] * (1 - t) + at[to * ac + k] * t;
-        const double e = quadric_eval(q, c.p[0], c.p[1], c.p[2]) + std::max(0.0, attribute_eval(aq, c.p, s, channels));
+        const double e =
+            quadric_eval(q, c.p[0], c.p[1], c.p[2]) + std::max(0.0, merged_attribute_eval(mesh, a, b, c.p, s));
         c.cost = q.w > 0 ? float(e / q.w) : float(e);
       }
       n++;
@@ -788,6 +813,8 @@ void compact_vertices(Work& w, QemMesh& mesh) {
   tmp.attributes.resize(ac * size_t(next));
   tmp.quadrics.resize(next);
   tmp.attribute_quadrics.resize(mesh.attribute_quadrics.empty() ? 0 : next);
+  const size_t gw = mesh.attribute_quadrics.empty() ? 0 : kGradientWords * mesh.attribute_channels;
+  tmp.attribute_gradients.resize(gw * next);
   tmp.source_vertex.resize(next);
   tmp.lock.resize(next);
   for (uint32_t n = 0; n < next; ++n) {
@@ -796,6 +823,7 @@ void compact_vertices(Work& w, QemMesh& mesh) {
     if (ac) std::memcpy(&tmp.attributes[ac * n], &mesh.attributes[ac * o], ac * sizeof(float));
     tmp.quadrics[n] = mesh.quadrics[o];
     if (!mesh.attribute_quadrics.empty()) tmp.attribute_quadrics[n] = mesh.attribute_quadrics[o];
+    if (gw) std::memcpy(&tmp.attribute_gradients[gw * n], &mesh.attribute_gradients[gw * o], gw * sizeof(double));
     tmp.source_vertex[n] = mesh.source_vertex[o];
     tmp.lock[n] = mesh.lock[o];
   }
@@ -817,6 +845,7 @@ void compact_vertices(Work& w, QemMesh& mesh) {
   mesh.attributes.swap(tmp.attributes);
   mesh.quadrics.swap(tmp.quadrics);
   mesh.attribute_quadrics.swap(tmp.attribute_quadrics);
+  mesh.attribute_gradients.swap(tmp.attribute_gradients);
   mesh.source_vertex.swap(tmp.source_vertex);
   mesh.lock.swap(tmp.lock);
 }
@@ -1012,7 +1041,10 @@ void build_part(QemMesh& out, const float* positions, size_t vertex_count, const
     const size_t channels = std::min(ac, kAttributeQuadricChannels);
     const double w2 = double(options.attribute_weight) * options.attribute_weight;
     out.attribute_quadrics.assign(nv, AttributeQuadric{});
+    out.attribute_channels = channels;
+    out.attribute_gradients.assign(kGradientWords * channels * nv, 0.0);
     AttributeQuadric unused;
+    double unused_gradients[kGradientWords * kAttributeQuadricChannels];
     for (size_t t = 0; t < nt; ++t) {
       const uint32_t* c = &out.indices[3 * t];
       const float* p0 = &out.positions[3 * size_t(c[0])];
@@ -1023,9 +1055,13 @@ void build_part(QemMesh& out, const float* positions, size_t vertex_count, const
       const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
       const double area = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
       AttributeQuadric* corners[3];
-      for (int k = 0; k < 3; ++k)
-        corners[k] = seam && (*seam)[c[k]] && !point_terms_on_seam ? &unused : &out.attribute_quadrics[c[k]];
-      add_face_attributes(corners, p0, p1, p2, &out.attributes[ac * c[0]], &out.attributes[ac * c[1]],
+      double* corner_gradients[3];
+      for (int k = 0; k < 3; ++k) {
+        const bool skip = seam && (*seam)[c[k]] && !point_terms_on_seam;
+        corners[k] = skip ? &unused : &out.attribute_quadrics[c[k]];
+        corner_gradients[k] = skip ? unused_gradients : gradients_of(out, c[k]);
+      }
+      add_face_attributes(corners, corner_gradients, p0, p1, p2, &out.attributes[ac * c[0]], &out.attributes[ac * c[1]],
                           &out.attributes[ac * c[2]], channels, w2 * area);
     }
   }
@@ -1173,6 +1209,7 @@ size_t qem_split(QemMesh* parts, const QemMesh& whole) {
     QemMesh& part = parts[p];
     part = QemMesh{};
     part.attribute_count = ac;
+    part.attribute_channels = whole.attribute_channels;
     part.input_vertex_count = whole.input_vertex_count;
     part.scale = whole.scale;
     part.error = whole.error;
@@ -1186,8 +1223,13 @@ size_t qem_split(QemMesh* parts, const QemMesh& whole) {
       if (ac) part.attributes.insert(part.attributes.end(), &whole.attributes[ac * v], &whole.attributes[ac * v] + ac);
       // A shared vertex's quadric goes to part 0 only, so merging can simply add them.
       part.quadrics.push_back(seam && p == 1 ? Quadric{} : whole.quadrics[v]);
-      if (!whole.attribute_quadrics.empty())
+      if (!whole.attribute_quadrics.empty()) {
         part.attribute_quadrics.push_back(seam && p == 1 ? AttributeQuadric{} : whole.attribute_quadrics[v]);
+        const double* g = gradients_of(whole, uint32_t(v));
+        const size_t gw = kGradientWords * whole.attribute_channels;
+        if (seam && p == 1) part.attribute_gradients.resize(part.attribute_gradients.size() + gw, 0.0);
+        else part.attribute_gradients.insert(part.attribute_gradients.end(), g, g + gw);
+      }
       part.source_vertex.push_back(whole.source_vertex[v]);
       part.lock.push_back(uint8_t(whole.lock[v] | (seam ? QemMesh::kLockSeam : 0)));
     }
@@ -1204,6 +1246,8 @@ void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
   if (part_count == 0) return;
   const size_t ac = parts[0].attribute_count;
   out.attribute_count = ac;
+  out.attribute_channels = parts[0].attribute_channels;
+  const size_t gw = kGradientWords * out.attribute_channels;
   out.input_vertex_count = parts[0].input_vertex_count;
   out.scale = parts[0].scale;
   std::vector<uint32_t> merged(out.input_vertex_count, ~0u);
@@ -1221,7 +1265,10 @@ void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
       if ((part.lock[v] & QemMesh::kLockSeam) && merged[src] != ~0u) {
         local[v] = merged[src];
         quadric_add(out.quadrics[merged[src]], part.quadrics[v]);
-        if (!part.attribute_quadrics.empty()) attribute_add(out.attribute_quadrics[merged[src]], part.attribute_quadrics[v]);
+        if (!part.attribute_quadrics.empty()) {
+          attribute_add(out.attribute_quadrics[merged[src]], part.attribute_quadrics[v]);
+          gradients_add(gradients_of(out, merged[src]), gradients_of(part, uint32_t(v)), out.attribute_channels);
+        }
         continue;
       }
       local[v] = uint32_t(out.source_vertex.size());
@@ -1229,7 +1276,11 @@ void qem_merge(QemMesh& out, const QemMesh* parts, size_t part_count) {
       out.positions.insert(out.positions.end(), &part.positions[3 * v], &part.positions[3 * v] + 3);
       if (ac) out.attributes.insert(out.attributes.end(), &part.attributes[ac * v], &part.attributes[ac * v] + ac);
       out.quadrics.push_back(part.quadrics[v]);
-      if (!part.attribute_quadrics.empty()) out.attribute_quadrics.push_back(part.attribute_quadrics[v]);
+      if (!part.attribute_quadrics.empty()) {
+        out.attribute_quadrics.push_back(part.attribute_quadrics[v]);
+        const double* g = gradients_of(part, uint32_t(v));
+        out.attribute_gradients.insert(out.attribute_gradients.end(), g, g + gw);
+      }
       out.source_vertex.push_back(src);
       out.lock.push_back(uint8_t(part.lock[v] & ~QemMesh::kLockSeam));
     }

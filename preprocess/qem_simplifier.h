@@ -57,7 +57,8 @@ struct QemOptions {
   float attribute_weight = 0;
 };
 
-inline constexpr size_t kAttributeQuadricChannels = 2;
+// At most this many attributes (the first ones) enter the cost: two uv sets and an RGBA colour.
+inline constexpr size_t kAttributeQuadricChannels = 8;
 
 // One simplified level. Its vertices are new (collapses move them to optimal positions);
 // source_vertex says which input vertex each descends from.
@@ -92,15 +93,16 @@ struct Quadric {
 };
 
 // The attribute part of a vertex's error (Hoppe 1999): sum over its faces of w (g.p + d - s)^2
-// per channel, s the vertex's attribute, with the p-only terms in a..c and the cross terms in
-// g, d (channel k: gradient sum g[k], offset sum d[k]); w = weight^2 x face area, summed in w.
+// per channel, s the vertex's attribute, with the p-only terms in a..c; w = weight^2 x face
+// area, summed in w. The cross terms (channel k: gradient sum g[k][3], offset sum d[k]) live in
+// QemMesh::attribute_gradients, kGradientWords per weighted channel, so a mesh that weights only
+// its uvs pays for two channels and one with colours and a second uv set for eight.
 struct AttributeQuadric {
   double a00 = 0, a11 = 0, a22 = 0, a01 = 0, a02 = 0, a12 = 0;
   double b0 = 0, b1 = 0, b2 = 0, c = 0;
-  double g[kAttributeQuadricChannels][3] = {};
-  double d[kAttributeQuadricChannels] = {};
   double w = 0;
 };
+inline constexpr size_t kGradientWords = 4;  // g[3], d of one channel
 
 // A mesh being simplified, with its quadrics. Positions are divided by a power-of-two scale of
 // the whole input (object = normalised * scale, exactly), so parts of one input share a frame.
@@ -109,6 +111,8 @@ struct QemMesh {
   std::vector<float> attributes;
   std::vector<Quadric> quadrics;
   std::vector<AttributeQuadric> attribute_quadrics;  // per vertex, or empty (no weighted attributes)
+  std::vector<double> attribute_gradients;  // kGradientWords x attribute_channels per vertex, with them
+  size_t attribute_channels = 0;            // weighted channels: min(attribute_count, kAttributeQuadricChannels)
   std::vector<uint32_t> indices;
   std::vector<uint32_t> source_vertex;  // input vertex id
   std::vector<uint8_t> lock;            // kLockUser | kLockSeam | kCopy bits per vertex

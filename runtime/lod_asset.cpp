@@ -15,6 +15,10 @@
 //       every level but the last (LodChain::morph_targets), checked like the levels' indices.
 // TEX0 (optional, flag 0; written only when the chain has texture coordinates): u32 level
 //       count, f32 uv error per level, then 2 f32 per vertex (LodChain::uvs).
+// TEX1 (optional, flag 0; since bake format 9, when the chain has a second uv set): TEX0's
+//       layout for LodChain::uvs1 / uv1_errors.
+// COL0 (optional, flag 0; since bake format 9, when the chain has vertex colours): u32 level
+//       count, f32 colour error per level, then 4 f32 (linear RGBA) per vertex (LodChain::colors).
 // MATL (optional, flag 0; written only when the chain has materials): u32 material count,
 //       u32 submesh count, u32 texture base bytes, u32 layout; the texture base (UTF-8); 16
 //       bytes per submesh (u32 level, u32 first index, u32 index count, i32 material); then per
@@ -23,7 +27,9 @@
 //       roughness, f32 alpha cutoff, u8 alpha mode, u8 double-sided, u16 0, u32 URI bytes of
 //       the metallic-roughness, normal, occlusion and emissive textures, f32 normal scale, f32
 //       occlusion strength, f32 emissive[3]), then its name and five URIs in that order.
-//       Layout 0 (bake format 7, read as before): the first 40 bytes only, name and base
+//       Layout 2 (since bake format 9): 84 bytes, layout 1's then u8 texCoord per texture slot
+//       (0 or 1, in the five slots' order) and 3 zero bytes. Layout 1 (bake format 8) reads as
+//       texCoord 0 everywhere. Layout 0 (bake format 7, read as before): the first 40 bytes only, name and base
 //       colour URI. Every count and length is checked against the section's bytes before
 //       anything is allocated or copied; the values by validate_chain.
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
@@ -74,11 +80,14 @@ constexpr uint32_t kVhie = fourcc("VHIE");
 constexpr uint32_t kMrph = fourcc("MRPH");
 constexpr uint32_t kTex0 = fourcc("TEX0");
 constexpr uint32_t kMatl = fourcc("MATL");
+constexpr uint32_t kTex1 = fourcc("TEX1");
+constexpr uint32_t kCol0 = fourcc("COL0");
 constexpr size_t kMatlFixedBytes = 16;
 constexpr size_t kSubmeshBytes = 16;
 constexpr size_t kMaterialFixedBytes = 40;     // layout 0's record
 constexpr size_t kMaterialTexturedBytes = 76;  // layout 1's
-constexpr uint32_t kMatlLayout = 1;
+constexpr size_t kMaterialTexCoordBytes = 84;  // layout 2's
+constexpr uint32_t kMatlLayout = 2;
 constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
@@ -264,6 +273,8 @@ void put_materials(Writer& w, const LodChain& c) {
     w.f32(m.normal_scale);
     w.f32(m.occlusion_strength);
     for (float f : m.emissive) w.f32(f);
+    for (uint8_t t : m.tex_coords) w.u8(t);
+    for (size_t k = kTextureSlots; k < 8; ++k) w.u8(0);
     w.raw(m.name.data(), m.name.size());
     for (const std::string* uri : uris) w.raw(uri->data(), uri->size());
   }
@@ -279,7 +290,7 @@ Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, L
   if (layout > kMatlLayout)
     return bad("layout " + std::to_string(layout) + " is newer than this build reads (" + std::to_string(kMatlLayout) +
                "); use a newer lodkit or re-bake it");
-  const uint64_t record = layout == 0 ? kMaterialFixedBytes : kMaterialTexturedBytes;
+  const uint64_t record = layout == 0 ? kMaterialFixedBytes : layout == 1 ? kMaterialTexturedBytes : kMaterialTexCoordBytes;
   if (materials > kMaxMaterials)
     return bad(std::to_string(materials) + " materials, at most " + std::to_string(kMaxMaterials));
   if (base_bytes > kMaxMaterialString) return bad("texture base of " + std::to_string(base_bytes) + " bytes is too long");
@@ -319,6 +330,11 @@ Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, L
       m.normal_scale = load_f32(p + at + 56);
       m.occlusion_strength = load_f32(p + at + 60);
       for (int c = 0; c < 3; ++c) m.emissive[c] = load_f32(p + at + 64 + 4 * c);
+    }
+    if (layout >= 2) {
+      for (size_t k = 0; k < kTextureSlots; ++k) m.tex_coords[k] = p[at + 76 + k];  // values: validate_chain
+      for (size_t k = kTextureSlots; k < 8; ++k)
+        if (p[at + 76 + k] != 0) return bad(where + " has non-zero padding byte " + std::to_string(76 + k));
     }
     at += record;
     // Each length bounded first, so their sum cannot overflow.
@@ -387,6 +403,8 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   if (!chain.hierarchy.empty()) tags.push_back(kVhie);
   if (!chain.morph_targets.empty()) tags.push_back(kMrph);
   if (!chain.uvs.empty()) tags.push_back(kTex0);
+  if (!chain.uvs1.empty()) tags.push_back(kTex1);
+  if (!chain.colors.empty()) tags.push_back(kCol0);
   if (!chain.materials.empty() || !chain.submeshes.empty()) tags.push_back(kMatl);
   const uint32_t section_count = static_cast<uint32_t>(tags.size());
   w.raw(kMagic, sizeof(kMagic));
@@ -395,7 +413,10 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   const size_t table = w.bytes.size();
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
-    w.u32(tags[s] == kVhie || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kMatl ? 0 : kFlagRequired);
+    w.u32(tags[s] == kVhie || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kTex1 || tags[s] == kCol0 ||
+                   tags[s] == kMatl
+               ? 0
+               : kFlagRequired);
     w.u64(0);  // offset, patched below
     w.u64(0);  // size
   }
@@ -435,6 +456,18 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
         w.u32(static_cast<uint32_t>(chain.uv_errors.size()));
         put_floats(w, chain.uv_errors);
         put_floats(w, chain.uvs);
+      });
+    if (tags[s] == kTex1)
+      section(s, [&] {
+        w.u32(static_cast<uint32_t>(chain.uv1_errors.size()));
+        put_floats(w, chain.uv1_errors);
+        put_floats(w, chain.uvs1);
+      });
+    if (tags[s] == kCol0)
+      section(s, [&] {
+        w.u32(static_cast<uint32_t>(chain.color_errors.size()));
+        put_floats(w, chain.color_errors);
+        put_floats(w, chain.colors);
       });
     if (tags[s] == kMatl) section(s, [&] { put_materials(w, chain); });
   }
@@ -482,7 +515,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     return refuse(what, "checksum mismatch (file is corrupted or truncated)");
 
   SectionRef sec[5];
-  SectionRef vhie, mrph, tex0, matl;
+  SectionRef vhie, mrph, tex0, tex1, col0, matl;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -505,6 +538,12 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     if (tag == kTex0) {
       if (tex0.present) return refuse(what, name + " appears twice");
       tex0 = {off, sz, true};
+      continue;
+    }
+    if (tag == kTex1 || tag == kCol0) {
+      SectionRef& ref = tag == kTex1 ? tex1 : col0;
+      if (ref.present) return refuse(what, name + " appears twice");
+      ref = {off, sz, true};
       continue;
     }
     if (tag == kMatl) {
@@ -566,15 +605,23 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
                               std::to_string(want) + " vertices (4 bytes each)");
     get_words(p + mrph.offset, want, chain.morph_targets);
   }
-  if (tex0.present) {
-    const uint64_t want = 4 + 4 * uint64_t{level_count} + 8 * vertices;
-    if (tex0.size != want || load_u32(p + tex0.offset) != level_count)
-      return refuse(what, "TEX0 section is " + std::to_string(tex0.size) + " bytes; " + std::to_string(level_count) +
-                              " levels and " + std::to_string(vertices) + " vertices need " + std::to_string(want) +
-                              " (u32 level count, f32 per level, 2 f32 per vertex)");
-    get_words(p + tex0.offset + 4, level_count, chain.uv_errors);
-    get_words(p + tex0.offset + 4 + 4 * uint64_t{level_count}, 2 * vertices, chain.uvs);
-  }
+  // TEX0, TEX1, COL0: u32 level count, f32 error per level, `per` f32 per vertex.
+  auto get_column = [&](const SectionRef& ref, const char* tag, size_t per, std::vector<float>& errors,
+                        std::vector<float>& values) -> Status {
+    if (!ref.present) return Status::success();
+    const uint64_t want = 4 + 4 * uint64_t{level_count} + 4 * per * vertices;  // vertices <= size / 12: no overflow
+    if (ref.size != want || load_u32(p + ref.offset) != level_count)
+      return refuse(what, std::string(tag) + " section is " + std::to_string(ref.size) + " bytes; " +
+                              std::to_string(level_count) + " levels and " + std::to_string(vertices) + " vertices need " +
+                              std::to_string(want) + " (u32 level count, f32 per level, " + std::to_string(per) +
+                              " f32 per vertex)");
+    get_words(p + ref.offset + 4, level_count, errors);
+    get_words(p + ref.offset + 4 + 4 * uint64_t{level_count}, per * vertices, values);
+    return Status::success();
+  };
+  if (Status st = get_column(tex0, "TEX0", 2, chain.uv_errors, chain.uvs); !st) return st;
+  if (Status st = get_column(tex1, "TEX1", 2, chain.uv1_errors, chain.uvs1); !st) return st;
+  if (Status st = get_column(col0, "COL0", 4, chain.color_errors, chain.colors); !st) return st;
   if (matl.present)
     if (Status st = get_materials(p + matl.offset, matl.size, what, chain); !st) return st;
   std::string message;

@@ -61,6 +61,10 @@ bool validate_materials(const LodChain& chain, std::string* message) {
     for (size_t k = 0; k < kTextureSlots; ++k)
       if (!printable_string(*uris[k]))
         return fail(message, at + " " + kTextureSlotNames[k] + " texture URI is too long or has control bytes");
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (m.tex_coords[k] > kMaxTexCoord)
+        return fail(message, at + " " + kTextureSlotNames[k] + " texture reads TEXCOORD_" +
+                                 std::to_string(m.tex_coords[k]) + " (only 0 and 1 are kept)");
     if (!(std::isfinite(m.normal_scale) && m.normal_scale >= 0 && m.normal_scale <= 1e6f))
       return fail(message, at + " has a normal texture scale outside [0, 1e6]");
     if (!unit_factor(m.occlusion_strength)) return fail(message, at + " has an occlusion strength outside [0, 1]");
@@ -137,20 +141,27 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
   if (!all_finite(chain.normals, &bad))
     return fail(message, "vertex " + std::to_string(bad / 3) + " has a " +
                              (std::isfinite(chain.normals[bad]) ? "huge (beyond 1e18)" : "non-finite") + " normal");
-  in("TEX0");
-  if (!chain.uvs.empty() || !chain.uv_errors.empty()) {
-    if (chain.uvs.size() != chain.positions.size() / 3 * 2)
-      return fail(message, "uvs hold " + std::to_string(chain.uvs.size()) + " floats for " +
-                               std::to_string(chain.positions.size() / 3) + " vertices (2 each)");
-    if (chain.uv_errors.size() != chain.levels.size())
-      return fail(message, std::to_string(chain.uv_errors.size()) + " uv errors for " +
+  // Per-vertex attribute columns: `per` floats a vertex, one error per level.
+  auto check_column = [&](const char* tag, const char* name, const std::vector<float>& values,
+                          const std::vector<float>& errors, size_t per) {
+    in(tag);
+    if (values.empty() && errors.empty()) return true;
+    if (values.size() != chain.positions.size() / 3 * per)
+      return fail(message, std::string(name) + "s hold " + std::to_string(values.size()) + " floats for " +
+                               std::to_string(chain.positions.size() / 3) + " vertices (" + std::to_string(per) + " each)");
+    if (errors.size() != chain.levels.size())
+      return fail(message, std::to_string(errors.size()) + " " + name + " errors for " +
                                std::to_string(chain.levels.size()) + " levels");
-    if (!all_finite(chain.uvs, &bad))
-      return fail(message, "vertex " + std::to_string(bad / 2) + " has a huge or non-finite uv");
-    for (size_t k = 0; k < chain.uv_errors.size(); ++k)
-      if (!(chain.uv_errors[k] >= 0 && chain.uv_errors[k] < 1e18f))
-        return fail(message, "level " + std::to_string(k) + " has an invalid uv error");
-  }
+    if (!all_finite(values, &bad))
+      return fail(message, "vertex " + std::to_string(bad / per) + " has a huge or non-finite " + name);
+    for (size_t k = 0; k < errors.size(); ++k)
+      if (!(errors[k] >= 0 && errors[k] < 1e18f))
+        return fail(message, "level " + std::to_string(k) + " has an invalid " + name + " error");
+    return true;
+  };
+  if (!check_column("TEX0", "uv", chain.uvs, chain.uv_errors, 2)) return false;
+  if (!check_column("TEX1", "uv1", chain.uvs1, chain.uv1_errors, 2)) return false;
+  if (!check_column("COL0", "colour", chain.colors, chain.color_errors, 4)) return false;
   in("LEVL");
 
   const uint64_t vertex_total = chain.positions.size() / 3;

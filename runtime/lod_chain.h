@@ -43,6 +43,13 @@ struct LodChain {
   // descends from (how far the texture slid). Stored in the asset's optional TEX0 section.
   std::vector<float> uvs;
   std::vector<float> uv_errors;
+  // Optional second uv set (glTF TEXCOORD_1) and vertex colours (glTF COLOR_0, linear RGBA), each
+  // laid out like uvs with its own per-level error (largest uv / RGBA distance from the input
+  // vertex a level's vertex descends from). Stored in the optional TEX1 and COL0 sections.
+  std::vector<float> uvs1;
+  std::vector<float> uv1_errors;
+  std::vector<float> colors;
+  std::vector<float> color_errors;
   // Optional materials (empty = one default surface): every drawn level's triangles grouped by
   // material, each group a LevelSubmesh (sorted by level; a level's runs cover its indices in
   // order). Texture URIs are relative to texture_base (the source's folder when baked, absolute).
@@ -67,7 +74,8 @@ int32_t level_of_triangles(uint64_t triangles);
 // non-increasing, errors non-decreasing, l = level_of_triangles, finite values, at most
 // kMaxLevels levels. On failure `message` names the element ("level 3 index 812 references
 // vertex 90211 of 35947"); callers prefix the file.
-// Texture coordinates, when present: two per vertex, finite, one uv error per level (>= 0).
+// Texture coordinates (either set), when present: two per vertex, finite, one uv error per
+// level (>= 0); colours likewise with four per vertex.
 // The culled level: an empty last level (0 triangles, 0 vertices) after level 0; no other level
 // may be empty.
 // With morph targets: one per vertex of every drawn level but the last, each < the next level's
@@ -78,7 +86,7 @@ int32_t level_of_triangles(uint64_t triangles);
 // level, each drawn level's runs non-empty, whole triangles, covering its indices in order,
 // each naming a material that exists (or -1); the culled level has none.
 // Values must be finite and at most kMaxTreeMagnitude in size. `section`, when given, is set
-// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH", "TEX0", "MATL") the failing
+// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH", "TEX0", "TEX1", "COL0", "MATL") the failing
 // element is in.
 bool validate_chain(const LodChain& chain, std::string* message, const char** section = nullptr);
 

@@ -144,4 +144,65 @@ inline std::filesystem::path write_two_material_gltf(const std::filesystem::path
   return file;
 }
 
+// The sphere of two_material_sphere as one surface with vertex colours and a second uv set:
+// the northern half red (1, v, 0, 1: green follows the latitude v), the southern half blue
+// (0, 0, 1, 0.5); the equator ring is doubled, one copy per half, so it is a colour seam (one
+// position, two colours) and nothing else; TEXCOORD_1 = (0.25 + u / 2, v / 2), a lightmap-style
+// set with TEXCOORD_0's seam.
+inline MeshData coloured_sphere(int rings, int segments) {
+  MeshData m = two_material_sphere(rings, segments);
+  m.submeshes.clear();
+  m.materials.clear();
+  const uint32_t row = uint32_t(segments + 1), equator = uint32_t(rings / 2) * row;
+  const uint32_t copies = uint32_t(m.vertex_count());
+  for (uint32_t v = equator; v < equator + row; ++v) {
+    m.positions.insert(m.positions.end(), {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]});
+    m.uvs.insert(m.uvs.end(), {m.uvs[2 * v], m.uvs[2 * v + 1]});
+  }
+  const size_t north = size_t(rings / 2) * size_t(segments) * 2;
+  for (size_t t = north; t < m.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      uint32_t& v = m.indices[3 * t + size_t(c)];
+      if (v >= equator && v < equator + row) v = copies + (v - equator);
+    }
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    const float vv = m.uvs[2 * v + 1];
+    const bool south = v >= copies || v > equator + row - 1;
+    if (south) m.colors.insert(m.colors.end(), {0, 0, 1, 0.5f});
+    else m.colors.insert(m.colors.end(), {1, vv, 0, 1});
+    m.uvs1.insert(m.uvs1.end(), {0.25f + m.uvs[2 * v] / 2, vv / 2});
+  }
+  return m;
+}
+
+// coloured_sphere as <dir>/<name>.gltf (+ .bin) with one material: base colour texture
+// <name>-image0.png on TEXCOORD_0, occlusion texture <name>-image1.png on TEXCOORD_1.
+inline std::filesystem::path write_coloured_gltf(const std::filesystem::path& dir, const std::string& name,
+                                                int rings = 24, int segments = 48) {
+  const MeshData m = coloured_sphere(rings, segments);
+  std::filesystem::create_directories(dir);
+  write_bytes(dir / "checker.png", checker_png(64, 8));
+  write_bytes(dir / "light.png", checker_png(16, 2));
+  GltfMeshView view;
+  view.name = name;
+  view.positions = m.positions.data();
+  view.vertex_count = m.vertex_count();
+  view.uvs = m.uvs.data();
+  view.uvs1 = m.uvs1.data();
+  view.colors = m.colors.data();
+  view.indices = m.indices.data();
+  view.index_count = m.indices.size();
+  GltfMaterialView g;
+  g.name = "painted";
+  g.base_color_image = dir / "checker.png";
+  g.occlusion_image = dir / "light.png";
+  g.occlusion_strength = 0.75f;
+  g.tex_coords[3] = 1;  // occlusion reads TEXCOORD_1
+  view.materials.push_back(g);
+  view.submeshes.push_back({0, m.indices.size(), 0});
+  const std::filesystem::path file = dir / (name + ".gltf");
+  if (!save_gltf(file, view).ok) return {};
+  return file;
+}
+
 }  // namespace lod::test

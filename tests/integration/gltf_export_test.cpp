@@ -333,6 +333,58 @@ TEST(GltfExport, EveryTextureSlotSurvivesBakeExportAndImport) {
   std::printf("%s", v.out.c_str());
 }
 
+// COLOR_0 and TEXCOORD_1 through `lod bake` and `lod inspect --export`: every level of both
+// formats has them (and the occlusion texture's texCoord 1), imports back with the level's
+// counts, and passes the validator with 0 errors.
+TEST(GltfExport, ColoursAndTexcoord1SurviveBakeExportAndImport) {
+  const fs::path dir = lod::test::temp_dir("gltf-colour");
+  const fs::path source = lod::test::write_coloured_gltf(dir / "src", "painted");
+  ASSERT_FALSE(source.empty());
+  auto r = run_lod("bake " + source.string() + " -o " + (dir / "out").string() + " --ratios 1 0.5 0.25 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path asset = baked_asset(dir / "out");
+  r = run_lod("inspect " + asset.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("vertex colours (COLOR_0, linear RGBA): every level"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("second texture coordinates (TEXCOORD_1): every level"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("occlusion texture reads TEXCOORD_1"), std::string::npos) << r.out;
+  std::vector<fs::path> exported;
+  for (const std::string format : {"glb", "gltf"}) {
+    r = run_lod("inspect " + asset.string() + " --json --export " + (dir / format).string() + " --format " + format);
+    ASSERT_EQ(r.code, 0) << r.out;
+    const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind('}') + 1));
+    EXPECT_TRUE(j["colors"].get<bool>());
+    EXPECT_TRUE(j["texcoords1"].get<bool>());
+    ASSERT_EQ(j["levels"].size(), 3u);
+    for (size_t i = 0; i < 3; ++i) {
+      SCOPED_TRACE(format + " level " + std::to_string(i));
+      EXPECT_TRUE(j["levels"][i].contains("color_error"));
+      EXPECT_TRUE(j["levels"][i].contains("uv1_error"));
+      const fs::path level = dir / format / ("painted-level" + std::to_string(i) + "." + format);
+      lod::MeshData back;
+      const lod::Status s = lod::load_mesh(level, back);
+      ASSERT_TRUE(s.ok) << s.message;
+      exported.push_back(level);
+      EXPECT_EQ(back.vertex_count(), j["levels"][i]["vertices"].get<size_t>());
+      EXPECT_EQ(back.triangle_count(), j["levels"][i]["triangles"].get<size_t>());
+      EXPECT_EQ(back.colors.size(), 4 * back.vertex_count());
+      EXPECT_EQ(back.uvs1.size(), 2 * back.vertex_count());
+      EXPECT_EQ(back.uvs.size(), 2 * back.vertex_count());
+      ASSERT_EQ(back.materials.size(), 1u);
+      EXPECT_EQ(back.materials[0].tex_coords[3], 1);
+      EXPECT_FALSE(back.materials[0].occlusion_texture.empty() && !back.materials[0].occlusion_texture_embedded);
+      for (float c : back.colors) {
+        EXPECT_GE(c, 0.f);
+        EXPECT_LE(c, 1.f);
+      }
+    }
+  }
+  const auto v = run_validator(exported);
+  EXPECT_EQ(v.code, 0) << v.out;
+  for (const fs::path& f : exported) EXPECT_NE(v.out.find(f.string() + ": errors 0 "), std::string::npos) << v.out;
+  std::printf("%s", v.out.c_str());
+}
+
 // A texture that is gone by export time: the level is written without it, and said so.
 TEST(GltfExport, AMissingTextureIsLeftOutAndSaid) {
   const fs::path dir = lod::test::temp_dir("gltf-materials-missing");

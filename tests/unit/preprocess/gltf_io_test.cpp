@@ -436,19 +436,188 @@ TEST(GltfImport, ReadsEveryTextureSlotWithItsFactors) {
   EXPECT_FLOAT_EQ(mat.emissive[2], 0.125f);
 }
 
-TEST(GltfImport, ATextureReadThroughTexcoord1IsLeftOutAndSaid) {
+TEST(GltfImport, ATextureReadThroughTexcoord1IsKeptWithItsSet) {
   GltfFixture f;
   f.add_float_mesh(kQuad, kQuadIndices);
   f.j["meshes"][0]["primitives"][0]["material"] = 0;
   f.j["images"] = json::array({{{"uri", "n.png"}}});
   f.j["textures"] = json::array({{{"source", 0}}});
-  f.j["materials"] = json::array({{{"normalTexture", {{"index", 0}, {"texCoord", 1}}}}});
+  f.j["materials"] = json::array({{{"normalTexture", {{"index", 0}, {"texCoord", 1}}},
+                                   {"occlusionTexture", {{"index", 0}, {"texCoord", 2}}}}});
   place_meshes(f);
   MeshData m;
   const Status s = load_glb(f, m);
   ASSERT_TRUE(s.ok) << s.message;
-  EXPECT_TRUE(m.materials[0].normal_texture.empty());
-  EXPECT_TRUE(has_warning(m, "t.glb: material 0: normalTexture reads TEXCOORD_1")) << (m.warnings.empty() ? "" : m.warnings[0]);
+  EXPECT_EQ(m.materials[0].normal_texture, "n.png");
+  EXPECT_EQ(m.materials[0].tex_coords[2], 1);  // normal slot
+  // TEXCOORD_2 and beyond are not imported: that texture is left out, and said.
+  EXPECT_TRUE(m.materials[0].occlusion_texture.empty());
+  EXPECT_TRUE(has_warning(m, "t.glb: material 0: occlusionTexture reads TEXCOORD_2")) << (m.warnings.empty() ? "" : m.warnings[0]);
+}
+
+// ---- COLOR_0 and TEXCOORD_1 -------------------------------------------------------------------
+
+// A triangle with COLOR_0 given by `color` (an accessor of 3 elements) and TEXCOORD_1 by `uv1`
+// (-1 = none).
+void add_attribute_triangle(GltfFixture& f, int color, int uv1) {
+  const int pos = f.add_accessor(f.add_view(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), kFloat, 3, "VEC3");
+  json attributes = {{"POSITION", pos}};
+  if (color >= 0) attributes["COLOR_0"] = color;
+  if (uv1 >= 0) attributes["TEXCOORD_1"] = uv1;
+  f.add_mesh({{{"attributes", attributes}}});
+}
+
+TEST(GltfImport, DecodesColour0InEveryComponentTypeAsLinearRgba) {
+  // Expected RGBA of the three vertices: (1, 0, 0.5, a), (0, 1, 0, a), (0.2, 0.4, 1, a) with
+  // a = 1 for VEC3 and (1, 0.5, 0) for VEC4 (normalized values at their exact quotients).
+  struct Case {
+    const char* what;
+    int type;
+    bool vec4;
+  };
+  for (const Case c : {Case{"float VEC3", kFloat, false}, Case{"float VEC4", kFloat, true},
+                       Case{"unorm8 VEC3", kUByte, false}, Case{"unorm8 VEC4", kUByte, true},
+                       Case{"unorm16 VEC3", kUShort, false}, Case{"unorm16 VEC4", kUShort, true}}) {
+    SCOPED_TRACE(c.what);
+    const std::vector<double> rgb = {1, 0, 0.5, 0, 1, 0, 0.2, 0.4, 1}, alpha = {1, 0.5, 0};
+    std::vector<double> values;
+    for (int v = 0; v < 3; ++v) {
+      values.insert(values.end(), rgb.begin() + 3 * v, rgb.begin() + 3 * v + 3);
+      if (c.vec4) values.push_back(alpha[size_t(v)]);
+    }
+    GltfFixture f;
+    int view;
+    const double scale = c.type == kUByte ? 255 : 65535;
+    if (c.type == kFloat) {
+      view = f.add_view(std::vector<float>(values.begin(), values.end()));
+    } else if (c.type == kUByte) {
+      std::vector<uint8_t> q;
+      for (int v = 0; v < 3; ++v) {
+        for (int k = 0; k < (c.vec4 ? 4 : 3); ++k) q.push_back(uint8_t(std::lround(values[size_t(v * (c.vec4 ? 4 : 3) + k)] * scale)));
+        if (!c.vec4) q.push_back(0);  // elements padded to 4 bytes
+      }
+      view = f.add_view(q.data(), q.size(), 4);
+    } else {
+      std::vector<uint16_t> q;
+      for (int v = 0; v < 3; ++v) {
+        for (int k = 0; k < (c.vec4 ? 4 : 3); ++k) q.push_back(uint16_t(std::lround(values[size_t(v * (c.vec4 ? 4 : 3) + k)] * scale)));
+        if (!c.vec4) q.push_back(0);  // elements padded to 8 bytes
+      }
+      view = f.add_view(q.data(), 2 * q.size(), c.vec4 ? 0 : 8);
+    }
+    const int color = f.add_accessor(view, c.type, 3, c.vec4 ? "VEC4" : "VEC3", c.type != kFloat);
+    add_attribute_triangle(f, color, -1);
+    place_meshes(f);
+    MeshData m;
+    const Status s = load_glb(f, m);
+    ASSERT_TRUE(s.ok) << s.message;
+    ASSERT_EQ(m.colors.size(), 12u);
+    const double tolerance = c.type == kFloat ? 1e-7 : 0.5 / scale + 1e-7;
+    for (int v = 0; v < 3; ++v) {
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(m.colors[size_t(4 * v + k)], rgb[size_t(3 * v + k)], tolerance) << v << " " << k;
+      EXPECT_NEAR(m.colors[size_t(4 * v + 3)], c.vec4 ? alpha[size_t(v)] : 1.0, tolerance) << v;
+    }
+  }
+}
+
+TEST(GltfImport, DecodesTexcoord1InEveryComponentType) {
+  struct Case {
+    const char* what;
+    int type;
+    bool normalized;
+  };
+  for (const Case c : {Case{"float", kFloat, false}, Case{"unorm8", kUByte, true}, Case{"unorm16", kUShort, true},
+                       Case{"snorm8", kByte, true}, Case{"snorm16", kShort, true}, Case{"uint8 (quantized)", kUByte, false},
+                       Case{"int16 (quantized)", kShort, false}}) {
+    SCOPED_TRACE(c.what);
+    GltfFixture f;
+    // uvs (0, 0), (1, 0), (0, 1) in the type's units; each element padded to 4 bytes.
+    const double one = !c.normalized ? 1 : c.type == kUByte ? 255 : c.type == kUShort ? 65535 : c.type == kByte ? 127 : 32767;
+    const std::vector<double> uv = {0, 0, 1, 0, 0, 1};
+    int view;
+    if (c.type == kFloat) {
+      view = f.add_view(std::vector<float>{0, 0, 1, 0, 0, 1});
+    } else if (c.type == kUByte || c.type == kByte) {
+      std::vector<uint8_t> q;
+      for (int v = 0; v < 3; ++v) q.insert(q.end(), {uint8_t(uv[size_t(2 * v)] * one), uint8_t(uv[size_t(2 * v + 1)] * one), 0, 0});
+      view = f.add_view(q.data(), q.size(), 4);
+    } else {
+      std::vector<uint16_t> q;
+      for (double x : uv) q.push_back(uint16_t(x * one));
+      view = f.add_view(q);
+    }
+    const int tex1 = f.add_accessor(view, c.type, 3, "VEC2", c.normalized);
+    add_attribute_triangle(f, -1, tex1);
+    place_meshes(f);
+    MeshData m;
+    const Status s = load_glb(f, m);
+    ASSERT_TRUE(s.ok) << s.message;
+    EXPECT_TRUE(m.uvs.empty());
+    ASSERT_EQ(m.uvs1.size(), 6u);
+    for (size_t i = 0; i < 6; ++i) EXPECT_FLOAT_EQ(m.uvs1[i], float(uv[i])) << i;
+  }
+}
+
+TEST(GltfImport, PrimitivesWithoutColoursOrTexcoord1GetDefaultsAndSaySo) {
+  GltfFixture f;
+  const int color = f.add_accessor(f.add_view(std::vector<float>{0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f}),
+                                   kFloat, 3, "VEC3");
+  const int tex1 = f.add_accessor(f.add_view(std::vector<float>{0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.75f}), kFloat, 3, "VEC2");
+  add_attribute_triangle(f, color, tex1);
+  add_attribute_triangle(f, -1, -1);
+  place_meshes(f);
+  MeshData m;
+  const Status s = load_glb(f, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(m.vertex_count(), 6u);
+  ASSERT_EQ(m.colors.size(), 24u);
+  ASSERT_EQ(m.uvs1.size(), 12u);
+  EXPECT_FLOAT_EQ(m.colors[0], 0.5f);
+  EXPECT_FLOAT_EQ(m.colors[3], 1.0f);  // RGB: alpha 1
+  for (size_t i = 12; i < 24; ++i) EXPECT_FLOAT_EQ(m.colors[i], 1.0f) << i;  // white
+  EXPECT_FLOAT_EQ(m.uvs1[1], 0.75f);
+  for (size_t i = 6; i < 12; ++i) EXPECT_FLOAT_EQ(m.uvs1[i], 0.0f) << i;
+  EXPECT_TRUE(has_warning(m, "mesh 1 primitive 0 has no COLOR_0; its vertices get white"));
+  EXPECT_TRUE(has_warning(m, "mesh 1 primitive 0 has no TEXCOORD_1; its vertices get (0, 0)"));
+}
+
+TEST(GltfMalformed, RefusesColourComponentTypesTheSpecForbids) {
+  struct Case {
+    int type;
+    bool normalized;
+    const char* type_name;
+  };
+  for (const Case c : {Case{kUByte, false, "VEC4"}, Case{kByte, true, "VEC4"}, Case{kShort, true, "VEC4"},
+                       Case{kUInt, false, "VEC4"}, Case{kFloat, false, "VEC2"}}) {
+    GltfFixture f;
+    const std::vector<uint32_t> raw(12, 0);
+    const int color = f.add_accessor(f.add_view(raw), c.type, 3, c.type_name, c.normalized);
+    add_attribute_triangle(f, color, -1);
+    place_meshes(f);
+    MeshData m;
+    const Status s = load_glb(f, m);
+    EXPECT_FALSE(s.ok) << c.type << " " << c.type_name;
+    EXPECT_NE(s.message.find("t.glb: mesh 0 primitive 0: COLOR accessor"), std::string::npos) << s.message;
+  }
+}
+
+TEST(GltfMalformed, RefusesNonFiniteColoursAndTexcoord1) {
+  {
+    GltfFixture f;
+    const int color = f.add_accessor(f.add_view(std::vector<float>{1, 1, 1, 1, std::nanf(""), 1, 1, 1, 1}), kFloat, 3, "VEC3");
+    add_attribute_triangle(f, color, -1);
+    place_meshes(f);
+    MeshData m;
+    expect_refused(load_glb(f, m), "t.glb: mesh 0 primitive 0: vertex 1 has a non-finite COLOR_0");
+  }
+  {
+    GltfFixture f;
+    const int tex1 = f.add_accessor(f.add_view(std::vector<float>{0, 0, 1, 0, 0, INFINITY}), kFloat, 3, "VEC2");
+    add_attribute_triangle(f, -1, tex1);
+    place_meshes(f);
+    MeshData m;
+    expect_refused(load_glb(f, m), "t.glb: mesh 0 primitive 0: vertex 2 has a non-finite TEXCOORD_1");
+  }
 }
 
 TEST(GltfImport, AppliesTheBaseColourTextureTransformToTexcoords) {

@@ -57,6 +57,45 @@ TEST(MeshClean, KeepsUvSeams) {
   EXPECT_EQ(clean_mesh(plain).duplicate_vertices, 1u) << "without uvs the same position welds";
 }
 
+// Vertex colours and a second uv set key the weld too: vertex 4 repeats vertex 1's position and
+// uv, and welds only when its colour and TEXCOORD_1 match as well (a colour or lightmap seam
+// stays two vertices); the survivors keep their colours and uv1s.
+TEST(MeshClean, KeepsColourAndTexcoord1Seams) {
+  auto quad = [] {
+    MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0}, {0, 1, 2, 4, 3, 2});
+    m.uvs = {0, 0, 0.1f, 0, 0, 1, 1, 1, 0.1f, 0};
+    m.uvs1 = {0, 0, 0.5f, 0, 0, 0.5f, 0.5f, 0.5f, 0.5f, 0};
+    m.colors = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1, 0, 1, 0, 1};
+    return m;
+  };
+  MeshData same = quad();
+  EXPECT_EQ(clean_mesh(same).duplicate_vertices, 1u) << "equal colour and uv1: welded";
+  EXPECT_EQ(same.vertex_count(), 4u);
+  EXPECT_EQ(same.colors, (std::vector<float>{1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1}));
+  EXPECT_EQ(same.uvs1, (std::vector<float>{0, 0, 0.5f, 0, 0, 0.5f, 0.5f, 0.5f}));
+
+  MeshData colour_seam = quad();
+  colour_seam.colors[4 * 4 + 2] = 0.5f;  // vertex 4: another blue
+  EXPECT_EQ(clean_mesh(colour_seam).duplicate_vertices, 0u);
+  EXPECT_EQ(colour_seam.vertex_count(), 5u);
+  EXPECT_EQ(colour_seam.colors.size(), 20u);
+  EXPECT_EQ(colour_seam.colors[4 * 4 + 2], 0.5f);
+
+  MeshData uv1_seam = quad();
+  uv1_seam.uvs1[2 * 4] = 0.75f;
+  EXPECT_EQ(clean_mesh(uv1_seam).duplicate_vertices, 0u);
+  EXPECT_EQ(uv1_seam.vertex_count(), 5u);
+  EXPECT_EQ(uv1_seam.uvs1[2 * 4], 0.75f);
+
+  // Without TEXCOORD_0, colours alone still key the weld.
+  MeshData colour_only = quad();
+  colour_only.uvs.clear();
+  colour_only.uvs1.clear();
+  colour_only.colors[4 * 4] = 0.25f;
+  EXPECT_EQ(clean_mesh(colour_only).duplicate_vertices, 0u);
+  EXPECT_TRUE(colour_only.uvs.empty());
+}
+
 TEST(MeshClean, DropsFacesWithARepeatedIndex) {
   MeshData m = make({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2, 0, 0, 1, 2, 1, 2});
   const CleanReport r = clean_mesh(m);

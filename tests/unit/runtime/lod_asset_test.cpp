@@ -421,7 +421,7 @@ TEST(LodAssetMaterials, HostileSectionsAreRefusedNamingWhatIsWrong) {
       {"MATL section: 4294967295 materials", 0, 0xffffffffu},
       {"MATL section: 2 materials and 268435456 submeshes need", 4, 1u << 28},
       {"MATL section: texture base of 4000000000 bytes is too long", 8, 4000000000u},
-      {"MATL section: layout 2 is newer than this build reads (1)", 12, 2},
+      {"MATL section: layout 3 is newer than this build reads (2)", 12, 3},
       {"MATL section: submesh 0 (level 0) names material 5 of 2", submeshes + 12, 5},
       {"MATL section: submesh 0 (level 0) starts at index 3", submeshes + 4, 3},
       {"MATL section: level 0's material runs cover 0 of its 27 indices", submeshes, 99},
@@ -448,7 +448,7 @@ TEST(LodAssetMaterials, HostileSectionsAreRefusedNamingWhatIsWrong) {
   }
   // A control byte in a name (terminal escapes) is refused too.
   std::vector<uint8_t> bytes = good;
-  bytes[matl + first_material + 76] = 0x1b;
+  bytes[matl + first_material + 84] = 0x1b;  // the name, after layout 2's 84-byte record
   reseal(bytes);
   LodChain out;
   const Status st = decode_lod_asset(bytes, "bunny.lod", out);
@@ -502,7 +502,7 @@ TEST(LodAssetMaterials, ReadsTheFormat7LayoutWithDefaultsForTheNewFields) {
   // Written again, it is the new layout, and reads back the same.
   const std::vector<uint8_t> again = encode_lod_asset(out);
   std::memcpy(&layout, again.data() + matl_offset(again) + 12, 4);
-  EXPECT_EQ(layout, 1u);
+  EXPECT_EQ(layout, 2u);
   LodChain back;
   ASSERT_TRUE(decode_lod_asset(again, "again.lod", back));
   EXPECT_EQ(encode_lod_asset(back), again);
@@ -518,6 +518,147 @@ TEST(LodAssetMaterials, TheLayout1SeedReadsWithEveryTexture) {
   EXPECT_EQ(out.materials[0].emissive_texture, "e.jpg");
   EXPECT_EQ(out.materials[0].normal_scale, 0.5f);
   EXPECT_EQ(out.materials[0].emissive[1], 0.5f);
+  for (uint8_t t : out.materials[0].tex_coords) EXPECT_EQ(t, 0) << "layout 1 reads TEXCOORD_0 everywhere";
+}
+
+// ---- TEX1, COL0 and MATL layout 2 (bake format 9) ------------------------------------------------
+
+LodChain chain_with_attributes() {
+  LodChain c = chain_with_materials();
+  const size_t nv = c.positions.size() / 3;
+  for (size_t v = 0; v < nv; ++v) {
+    const float a = float(v) / float(nv);
+    c.uvs1.insert(c.uvs1.end(), {a, 1 - a});
+    c.colors.insert(c.colors.end(), {a, 0.5f, 1 - a, 1});
+  }
+  c.uv1_errors.assign(c.levels.size(), 0.f);
+  c.color_errors.assign(c.levels.size(), 0.f);
+  for (size_t k = 1; k < c.levels.size(); ++k) c.uv1_errors[k] = 0.01f * float(k), c.color_errors[k] = 0.02f * float(k);
+  c.materials[0].tex_coords = {0, 1, 1, 0, 1};
+  return c;
+}
+
+// Offset and size of section `tag` in an encoded asset (size 0 when there is none).
+std::pair<uint64_t, uint64_t> section_of(const std::vector<uint8_t>& bytes, const char* tag) {
+  uint32_t count = 0;
+  std::memcpy(&count, bytes.data() + 12, 4);
+  for (uint32_t s = 0; s < count; ++s)
+    if (std::memcmp(bytes.data() + 16 + 24 * s, tag, 4) == 0) {
+      uint64_t off = 0, size = 0;
+      std::memcpy(&off, bytes.data() + 16 + 24 * s + 8, 8);
+      std::memcpy(&size, bytes.data() + 16 + 24 * s + 16, 8);
+      return {off, size};
+    }
+  return {0, 0};
+}
+
+TEST(LodAssetAttributes, RoundTripKeepsColoursTexcoord1AndTexCoordsPerSlot) {
+  const LodChain c = chain_with_attributes();
+  std::string why;
+  ASSERT_TRUE(validate_chain(c, &why)) << why;
+  const std::vector<uint8_t> bytes = encode_lod_asset(c);
+  EXPECT_NE(section_of(bytes, "TEX1").second, 0u);
+  EXPECT_NE(section_of(bytes, "COL0").second, 0u);
+  LodChain back;
+  const Status st = decode_lod_asset(bytes, "bunny.lod", back);
+  ASSERT_TRUE(st) << st.message;
+  EXPECT_TRUE(same_bits(back.uvs1, c.uvs1));
+  EXPECT_TRUE(same_bits(back.colors, c.colors));
+  EXPECT_EQ(back.uv1_errors, c.uv1_errors);
+  EXPECT_EQ(back.color_errors, c.color_errors);
+  EXPECT_EQ(back.materials[0].tex_coords, c.materials[0].tex_coords);
+  EXPECT_EQ(encode_lod_asset(back), bytes);
+  const std::vector<uint8_t> plain = encode_lod_asset(test::fan_chain("plain", {4}));
+  EXPECT_EQ(section_of(plain, "TEX1").second, 0u) << "no TEX1 without a second uv set";
+  EXPECT_EQ(section_of(plain, "COL0").second, 0u) << "no COL0 without colours";
+}
+
+// Truncated or forged sections are refused naming the section; nothing is half-loaded.
+TEST(LodAssetAttributes, RefusesForgedOrTruncatedTex1AndCol0) {
+  const std::vector<uint8_t> good = encode_lod_asset(chain_with_attributes());
+  struct Case {
+    const char* tag;
+    uint64_t at;      // byte within the section, or UINT64_MAX to shrink the section's size by 4
+    uint32_t value;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {"TEX1", 0, 7, "TEX1 section is"},            // level count forged
+      {"COL0", 0, 0xffffffffu, "COL0 section is"},  // level count forged
+      {"TEX1", UINT64_MAX, 0, "TEX1 section is"},   // a value short
+      {"COL0", UINT64_MAX, 0, "COL0 section is"},
+      {"COL0", 4 + 4 * 3 + 4 * 5, 0x7fc00000u, "COL0 section: vertex 1 has a huge or non-finite colour"},
+      {"TEX1", 4 + 4 * 3 + 8 * 2, 0x7f800000u, "TEX1 section: vertex 2 has a huge or non-finite uv1"},
+      {"COL0", 4 + 4, 0xbf800000u, "COL0 section: level 1 has an invalid colour error"},
+  };
+  for (const Case& k : cases) {
+    std::vector<uint8_t> bytes = good;
+    const auto [off, size] = section_of(bytes, k.tag);
+    ASSERT_NE(size, 0u);
+    if (k.at == UINT64_MAX) {
+      uint32_t count = 0;
+      std::memcpy(&count, bytes.data() + 12, 4);
+      for (uint32_t s = 0; s < count; ++s)
+        if (std::memcmp(bytes.data() + 16 + 24 * s, k.tag, 4) == 0) {
+          const uint64_t shorter = size - 4;
+          std::memcpy(bytes.data() + 16 + 24 * s + 16, &shorter, 8);
+        }
+    } else {
+      std::memcpy(bytes.data() + off + k.at, &k.value, 4);
+    }
+    reseal(bytes);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+    ASSERT_FALSE(st) << k.expect;
+    EXPECT_EQ(st.message.rfind(std::string("bunny.lod: ") + k.expect, 0), 0u) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+  // Cut anywhere in the new sections: refused (truncated, or the checksum).
+  const auto [col0, col0_size] = section_of(good, "COL0");
+  for (uint64_t cut = section_of(good, "TEX1").first; cut < col0 + col0_size; cut += 13) {
+    const std::vector<uint8_t> bytes(good.begin(), good.begin() + std::ptrdiff_t(cut));
+    LodChain out = sentinel();
+    EXPECT_FALSE(decode_lod_asset(bytes, "bunny.lod", out)) << cut;
+    EXPECT_EQ(out.name, "untouched");
+  }
+}
+
+TEST(LodAssetAttributes, RefusesATexCoordPastTexcoord1AndNonZeroPadding) {
+  const LodChain c = chain_with_attributes();
+  const std::vector<uint8_t> good = encode_lod_asset(c);
+  const uint64_t matl = matl_offset(good);
+  const size_t first_material = 16 + 12 + 16 * c.submeshes.size();
+  {
+    std::vector<uint8_t> bytes = good;
+    bytes[matl + first_material + 76 + 2] = 2;  // the normal slot reads TEXCOORD_2
+    reseal(bytes);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+    ASSERT_FALSE(st);
+    EXPECT_NE(st.message.find("MATL section: material 0 normal texture reads TEXCOORD_2"), std::string::npos) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+  {
+    std::vector<uint8_t> bytes = good;
+    bytes[matl + first_material + 82] = 1;
+    reseal(bytes);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+    ASSERT_FALSE(st);
+    EXPECT_NE(st.message.find("MATL section: material 0 has non-zero padding byte 82"), std::string::npos) << st.message;
+  }
+}
+
+// The layout 2 fuzz seed (materials1.lod's chain with colours, TEXCOORD_1 and a texture reading
+// it) reads with them.
+TEST(LodAssetAttributes, TheAttributesSeedReads) {
+  LodChain out;
+  const Status st = read_lod_asset(std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/lod/attributes2.lod", out);
+  ASSERT_TRUE(st) << st.message;
+  EXPECT_FALSE(out.colors.empty());
+  EXPECT_FALSE(out.uvs1.empty());
+  ASSERT_FALSE(out.materials.empty());
+  EXPECT_EQ(out.materials[0].tex_coords[1], 1);
 }
 
 }  // namespace
