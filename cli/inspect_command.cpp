@@ -169,6 +169,8 @@ int inspect_command(const InspectArgs& args) {
     j["source_hash"] = hash;
     j["morph_targets"] = chain.morph_targets.size();  // 0 = level changes cannot blend
     j["hierarchy_nodes"] = chain.hierarchy.node_count();
+    j["hierarchy_uvs"] = !chain.hierarchy.uvs.empty();
+    j["hierarchy_seams_pinned"] = chain.hierarchy.seams_pinned;
     j["texcoords"] = !chain.uvs.empty();
     j["texcoords1"] = !chain.uvs1.empty();
     j["colors"] = !chain.colors.empty();
@@ -210,7 +212,10 @@ int inspect_command(const InspectArgs& args) {
                   (unsigned long long)(chain.morph_targets.size() * 4ull));
     else if (chain.levels.size() > 1)
       std::printf("morph targets: none (level changes pop; re-bake to add them)\n");
-    if (!chain.hierarchy.empty()) std::printf("vertex hierarchy: %zu nodes\n", size_t(chain.hierarchy.node_count()));
+    if (!chain.hierarchy.empty())
+      std::printf("vertex hierarchy: %zu nodes%s%s\n", size_t(chain.hierarchy.node_count()),
+                  chain.hierarchy.uvs.empty() ? "" : ", uvs per node",
+                  chain.hierarchy.seams_pinned ? ", attribute seams pinned" : " (built before seams were pinned)");
     if (!chain.uvs.empty()) {
       std::printf("texture coordinates: every level (uv seams kept); uv error per level:");
       for (float e : chain.uv_errors) std::printf(" %.4g", e);

@@ -55,6 +55,27 @@ bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
       *why = "vd object " + std::to_string(o.object) + ": " + bad;
       return false;
     }
+    // Uvs for every vertex when it has them; material runs covering its indices in order.
+    if (o.has_uvs && f.vd_uvs.size() != 2 * (f.vd_positions.size() / 3)) {
+      std::snprintf(buf, sizeof buf, "vd object %u: %zu uv values for %zu vertices", o.object, f.vd_uvs.size(),
+                    f.vd_positions.size() / 3);
+      *why = buf;
+      return false;
+    }
+    uint64_t at = o.first_index;
+    for (uint32_t r = o.first_run; o.run_count && r < o.first_run + o.run_count; ++r) {
+      if (r >= f.vd_runs.size() || f.vd_runs[r].first_index != at) {
+        std::snprintf(buf, sizeof buf, "vd object %u: material run %u does not continue its indices", o.object, r);
+        *why = buf;
+        return false;
+      }
+      at += f.vd_runs[r].index_count;
+    }
+    if (o.run_count && at != uint64_t(o.first_index) + o.index_count) {
+      std::snprintf(buf, sizeof buf, "vd object %u: material runs do not cover its indices", o.object);
+      *why = buf;
+      return false;
+    }
     tris += o.index_count / 3;
     splits += o.splits;
     collapses += o.collapses;

@@ -11,6 +11,7 @@
 #include <mutex>
 
 #include "jobs/annotated_parallel_for.h"
+#include "preprocess/position_copies.h"
 #include "preprocess/vertex_hierarchy.h"
 #include "runtime/lod_asset.h"
 
@@ -48,6 +49,35 @@ struct BakeTask {
   Status status;
 };
 
+// Level 0 as the hierarchy's input: positions, indices, uvs and material runs.
+MeshData level0_mesh(const LodChain& chain, const std::string& source) {
+  const LodLevel& l0 = chain.levels.at(0);
+  MeshData mesh;
+  mesh.source = source;
+  mesh.positions.assign(chain.positions.begin() + 3 * size_t(l0.first_vertex),
+                        chain.positions.begin() + 3 * size_t(l0.first_vertex + l0.vertex_count));
+  mesh.indices.assign(chain.indices.begin() + l0.first_index,
+                      chain.indices.begin() + l0.first_index + l0.index_count);
+  if (!chain.uvs.empty())
+    mesh.uvs.assign(chain.uvs.begin() + 2 * size_t(l0.first_vertex),
+                    chain.uvs.begin() + 2 * size_t(l0.first_vertex + l0.vertex_count));
+  for (const LevelSubmesh& run : level_submeshes(chain, 0))
+    mesh.submeshes.push_back({run.first_index / 3, run.index_count / 3, run.material});  // level-local
+  return mesh;
+}
+
+// A tree built before attribute seams were pinned collapsed each side of a seam alone (cracks,
+// smeared uvs) and carries no uvs: rebuilt wherever level 0 has seams, uvs or materials.
+bool hierarchy_predates_seams(const LodChain& chain, const MeshData& level0) {
+  if (chain.hierarchy.seams_pinned) return false;
+  if (!level0.uvs.empty() || !chain.materials.empty()) return true;
+  std::vector<uint32_t> first(level0.vertex_count());
+  find_position_copies(first, {}, level0.positions.data(), first.size());
+  for (size_t v = 0; v < first.size(); ++v)
+    if (first[v] != v) return true;
+  return false;
+}
+
 // View-dependent models need level 0's vertex hierarchy (built once, then kept in the cached
 // asset); other models drop one a shared cache file may carry.
 Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* rewrite, LogLines& log,
@@ -56,14 +86,12 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
     chain.hierarchy = VertexTree{};
     return Status::success();
   }
-  if (!chain.hierarchy.empty()) return Status::success();
-  const LodLevel& l0 = chain.levels.at(0);
-  MeshData mesh;
-  mesh.source = model.file.string();
-  mesh.positions.assign(chain.positions.begin() + 3 * size_t(l0.first_vertex),
-                        chain.positions.begin() + 3 * size_t(l0.first_vertex + l0.vertex_count));
-  mesh.indices.assign(chain.indices.begin() + l0.first_index,
-                      chain.indices.begin() + l0.first_index + l0.index_count);
+  if (chain.hierarchy.seams_pinned) return Status::success();
+  const MeshData mesh = level0_mesh(chain, model.file.string());
+  if (!chain.hierarchy.empty()) {
+    if (!hierarchy_predates_seams(chain, mesh)) return Status::success();
+    log.line("bake " + model.name + ": vertex hierarchy built before attribute seams were pinned, rebuilding");
+  }
   const auto t0 = std::chrono::steady_clock::now();
   HierarchyOptions options;
   options.parts = model.vd_parts;
@@ -71,10 +99,10 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   char ms[32];
   std::snprintf(ms, sizeof ms, "%.0f", ms_since(t0));
   log.line("bake " + model.name + ": vertex hierarchy of " + std::to_string(chain.hierarchy.node_count()) +
-           " nodes in " + ms + " ms");
-  if (!chain.materials.empty() || !chain.uvs.empty() || !chain.uvs1.empty() || !chain.colors.empty())
-    log.line("bake " + model.name + ": the view-dependent mesh is one surface of positions: its " +
-             std::to_string(chain.materials.size()) + " materials, texture coordinates and colours are kept in the levels only");
+           " nodes in " + ms + " ms" + (chain.hierarchy.uvs.empty() ? "" : ", with uvs"));
+  if (!chain.uvs1.empty() || !chain.colors.empty())
+    log.line("bake " + model.name + ": the view-dependent mesh keeps uvs and materials; its colours and second " +
+             "texture coordinates are kept in the levels only");
   return rewrite ? write_lod_asset(*rewrite, chain) : Status::success();
 }
 

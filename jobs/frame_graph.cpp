@@ -149,6 +149,10 @@ struct FrameGraph::Impl {
     std::shared_ptr<const RegionNumbering> regions;
     uint32_t region_count = 1;
     uint32_t shared = 0;                   // nodes active in every region (seams)
+    // Per hierarchy face its material + 1 (0 = the default surface), when the chain has
+    // materials; the vd mesh groups each object's triangles by it.
+    std::vector<uint32_t> face_slot;
+    uint32_t slots = 0;
   };
   std::vector<VdModel> vd_models;  // per model with a hierarchy (else default)
   std::vector<uint8_t> has_vd;      // per model: has a hierarchy
@@ -229,6 +233,9 @@ struct FrameGraph::Impl {
     std::vector<uint32_t> node_index;  // fronts_compact_mesh scratch (several regions only)
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
+    std::vector<float> shown_uv;  // geomorphed uvs, 2 per node (trees with uvs)
+    std::vector<uint32_t> sorted, slot_count;  // material grouping scratch
+    std::vector<VdRunFrame> runs;              // this frame's runs (absolute first_index)
     FrontStats stats;          // summed over the regions
     uint32_t entry = 0;        // this frame's entry
   };
@@ -336,6 +343,19 @@ struct FrameGraph::Impl {
     VdModel v;
     const LodLevel& l0 = chain.levels[0];
     v.edges = edge_check_of(std::span(chain.indices.data() + l0.first_index, l0.index_count));
+    // The hierarchy's faces are level 0's triangles (cleaned levels have no degenerate ones the
+    // build would drop); anything else is drawn as one surface.
+    const VertexTree& t = chain.hierarchy;
+    const auto runs = level_submeshes(chain, 0);
+    if (!runs.empty() && t.face_count == l0.triangles() &&
+        std::equal(t.face_leaves.begin(), t.face_leaves.end(), chain.indices.begin() + l0.first_index)) {
+      v.face_slot.assign(t.face_count, 0);
+      for (const LevelSubmesh& r : runs) {
+        const uint32_t slot = uint32_t(r.material + 1);
+        v.slots = std::max(v.slots, slot + 1);
+        std::fill_n(v.face_slot.begin() + r.first_index / 3, r.index_count / 3, slot);  // level-local
+      }
+    }
     // Regions only pay off when the hierarchy was built in parts: a one-part tree's extra
     // regions are tiny components, kept together in one front.
     std::vector<uint8_t> region;
@@ -861,6 +881,7 @@ struct FrameGraph::Impl {
     p->region_caps.resize(p->fronts.size());
     vertex_morph_init(p->morph, tree, options.geomorph_seconds);
     p->shown = tree.positions;
+    p->shown_uv = tree.uvs;
     return *p;
   }
 
@@ -918,6 +939,7 @@ struct FrameGraph::Impl {
     Frame& f = *out;
     f.vd_objects.resize(vd_visible.size());
     uint32_t vertices = 0, indices = 0;
+    bool any_uvs = false;
     f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;
     for (size_t j = 0; j < vd_visible.size(); ++j) {
       const VdObject& o = *vd_visible[j];
@@ -937,6 +959,8 @@ struct FrameGraph::Impl {
       e.threshold = o.stats.threshold;
       e.closed = vm.edges == EdgeCheck::closed;
       e.oriented = vm.edges != EdgeCheck::corners;
+      e.has_uvs = !set->chains[o.model]->hierarchy.uvs.empty();
+      any_uvs |= e.has_uvs;
       vertices += e.vertex_count;
       indices += e.index_count;
       f.vd_active_tris += tris;
@@ -945,6 +969,7 @@ struct FrameGraph::Impl {
     }
     f.vd_positions.resize(3 * size_t(vertices));
     f.vd_indices.resize(indices);
+    f.vd_uvs.assign(any_uvs ? 2 * size_t(vertices) : 0, 0.f);
     for_items(Stage::vd_mesh, vd_visible.size(), [&](size_t j) {
       VdObject& o = *vd_visible[j];
       VdObjectFrame& e = f.vd_objects[j];
@@ -952,19 +977,59 @@ struct FrameGraph::Impl {
       const std::span positions(f.vd_positions.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count));
       const std::span tris(f.vd_indices.data() + e.first_index, e.index_count);
       e.moving = 0;
-      for (const VertexFront& fr : o.fronts)
+      for (const VertexFront& fr : o.fronts) {
         e.moving += static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, fr.vertices(), time));
-      if (o.fronts.size() == 1) {
-        front_compact_mesh(positions, tris, o.fronts[0], tree, o.shown);
-        return;
+        if (e.has_uvs) vertex_morph_uvs(o.shown_uv, o.morph, fr.vertices(), time);
       }
+      const std::span uvs = e.has_uvs ? std::span(f.vd_uvs.data() + 2 * size_t(e.first_vertex), 2 * size_t(e.vertex_count))
+                                      : std::span<float>();
       const VertexFront* fronts[kMaxVdRegions];
       for (size_t k = 0; k < o.fronts.size(); ++k) fronts[k] = &o.fronts[k];
-      uint32_t written = 0;
-      fronts_compact_mesh(positions, tris, o.node_index, std::span(fronts, o.fronts.size()), tree, o.shown,
-                          &written);
-      assert(written == e.vertex_count);
+      if (o.fronts.size() == 1) {
+        front_compact_mesh(positions, tris, o.fronts[0], tree, o.shown);
+        if (e.has_uvs) front_compact_uvs(uvs, o.fronts[0], tree, o.shown_uv);
+      } else {
+        uint32_t written = 0;
+        fronts_compact_mesh(positions, tris, o.node_index, std::span(fronts, o.fronts.size()), tree, o.shown,
+                            &written);
+        assert(written == e.vertex_count);
+        if (e.has_uvs) fronts_compact_uvs(uvs, std::span(fronts, o.fronts.size()), tree, o.shown_uv);
+      }
+      group_by_material(o, tris, std::span(fronts, o.fronts.size()), vd_models[o.model], e.first_index);
     });
+    // Runs into the frame, object by object.
+    f.vd_runs.clear();
+    for (size_t j = 0; j < vd_visible.size(); ++j) {
+      VdObjectFrame& e = f.vd_objects[j];
+      e.first_run = static_cast<uint32_t>(f.vd_runs.size());
+      e.run_count = static_cast<uint32_t>(vd_visible[j]->runs.size());
+      f.vd_runs.insert(f.vd_runs.end(), vd_visible[j]->runs.begin(), vd_visible[j]->runs.end());
+    }
+  }
+
+  // Reorders an object's compact triangles by material (a stable counting sort over the
+  // fronts' faces, in the order the compact mesh wrote them) and records its runs. Linear in
+  // its triangles; no allocation once the scratch has grown.
+  static void group_by_material(VdObject& o, std::span<uint32_t> tris, std::span<const VertexFront* const> fronts,
+                                const VdModel& vm, uint32_t first_index) {
+    o.runs.clear();
+    if (vm.face_slot.empty()) return;
+    const size_t count = tris.size() / 3;
+    o.slot_count.assign(vm.slots + 1, 0);
+    auto slot_of = [&](auto&& visit) {
+      size_t k = 0;
+      for (const VertexFront* fr : fronts)
+        for (uint32_t s = 0; s < fr->tri_count; ++s) visit(k++, vm.face_slot[fr->tri_face[s]]);
+    };
+    slot_of([&](size_t, uint32_t slot) { ++o.slot_count[slot + 1]; });
+    for (uint32_t m = 0; m < vm.slots; ++m) {
+      const uint32_t n = o.slot_count[m + 1];
+      if (n) o.runs.push_back({first_index + 3 * o.slot_count[m], 3 * n, int32_t(m) - 1});
+      o.slot_count[m + 1] += o.slot_count[m];
+    }
+    o.sorted.resize(3 * count);
+    slot_of([&](size_t k, uint32_t slot) { std::copy_n(&tris[3 * k], 3, &o.sorted[3 * size_t(o.slot_count[slot]++)]); });
+    std::copy(o.sorted.begin(), o.sorted.end(), tris.begin());
   }
 
   // The triangles M leaves after the discrete selection, split evenly over the HLOD models.

@@ -19,6 +19,9 @@
 #include <cstring>
 #include <limits>
 
+#include "preprocess/edge_parameter.h"
+#include "preprocess/position_copies.h"
+
 namespace lod {
 namespace {
 
@@ -572,15 +575,6 @@ bool sides_apart(const Work& w, uint32_t f, uint32_t t, uint32_t g, uint32_t tp)
   return true;
 }
 
-// Where p projects onto the edge from a to b, as a fraction of it in [0, 1] (1 for a point edge):
-// the weight of b's attribute in the one the collapse gives.
-float edge_parameter(const float* pa, const float* pb, const float* p) {
-  const float d[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
-  const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-  if (!(len2 > 0)) return 1;
-  return std::clamp(((p[0] - pa[0]) * d[0] + (p[1] - pa[1]) * d[1] + (p[2] - pa[2]) * d[2]) / len2, 0.f, 1.f);
-}
-
 // Collapses a onto b at p: b takes a's quadrics, its border loop place and its faces (through
 // the remap table), and the attribute at p interpolated along the edge a-b.
 void apply_collapse(Work& w, QemMesh& mesh, uint32_t a, uint32_t b, const float* p) {
@@ -932,38 +926,12 @@ void make_frame(Frame& f, const float* positions, size_t vertex_count, const uin
   // only together along its seam (classify decides where it may), and three or more at one
   // place (a branch of the seam) stay put, since moving one copy alone would tear the surface.
   {
-    size_t cap = 16;
-    while (cap < 2 * vertex_count) cap *= 2;
-    std::vector<uint32_t> table(cap, ~0u);
-    std::vector<uint32_t>& first = f.first_copy;
-    first.assign(vertex_count, ~0u);
-    std::vector<uint32_t> copies(vertex_count, 0);   // per first vertex: how many share it
+    f.first_copy.resize(vertex_count);
+    std::vector<uint32_t> copies(vertex_count);  // per vertex: how many share its position
+    find_position_copies(f.first_copy, copies, positions, vertex_count, f.finite.data());
     for (size_t v = 0; v < vertex_count; ++v) {
-      if (!f.finite[v]) continue;
-      const float* p = positions + 3 * v;
-      uint32_t h[3];
-      std::memcpy(h, p, 12);
-      size_t slot = (h[0] * 73856093u ^ h[1] * 19349663u ^ h[2] * 83492791u) & (cap - 1);
-      for (;;) {
-        const uint32_t o = table[slot];
-        if (o == ~0u) {
-          table[slot] = uint32_t(v);
-          first[v] = uint32_t(v);
-          break;
-        }
-        if (std::memcmp(positions + 3 * size_t(o), p, 12) == 0) {
-          first[v] = o;
-          break;
-        }
-        slot = (slot + 1) & (cap - 1);
-      }
-      copies[first[v]]++;
-    }
-    for (size_t v = 0; v < vertex_count; ++v) {
-      if (first[v] == ~0u) continue;
-      const uint32_t n = copies[first[v]];
-      if (n >= 2) f.lock[v] |= QemMesh::kCopy;
-      if (n >= 3) f.lock[v] |= QemMesh::kLockUser;
+      if (copies[v] >= 2) f.lock[v] |= QemMesh::kCopy;
+      if (copies[v] >= 3) f.lock[v] |= QemMesh::kLockUser;
     }
   }
 

@@ -12,9 +12,13 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <string>
 #include <vector>
+
+#include "preprocess/edge_parameter.h"
+#include "preprocess/position_copies.h"
 
 namespace lod {
 
@@ -105,12 +109,14 @@ class Builder {
   void finish(VertexTree& out);
   void mark_split_fans();
   void pin_part_seams();
+  void pin_attribute_seams(const MeshData& mesh, const std::vector<int32_t>& face_material);
   void renumber_passes();
   std::vector<uint32_t> pass_start_;  // first node id made by each pass
 
   HierarchyOptions opt_;
   uint32_t leaf_count_ = 0;
   std::vector<double> pos_;  // per node
+  std::vector<float> uv_;    // per node, 2 each, when the mesh has uvs
   std::vector<Quad> quad_;   // per node
   std::vector<Cone> cone_;   // per node
   std::vector<float> radius_, error_;
@@ -360,6 +366,16 @@ bool Builder::try_collapse(uint32_t a, uint32_t b) {
   parent_.push_back(kNoNode);
   parent_[a] = parent_[b] = p;
   pos_.insert(pos_.end(), cand[best], cand[best] + 3);
+  if (!uv_.empty()) {
+    // Both endpoints lie in one chart (seam copies never collapse), so their uvs interpolate.
+    const float fa[3] = {float(pa.x), float(pa.y), float(pa.z)}, fb[3] = {float(pb.x), float(pb.y), float(pb.z)};
+    const float fp[3] = {float(cand[best][0]), float(cand[best][1]), float(cand[best][2])};
+    const float t = edge_parameter(fa, fb, fp);
+    for (int k = 0; k < 2; ++k) {
+      const float ua = uv_[2 * size_t(a) + k], ub = uv_[2 * size_t(b) + k];
+      uv_.push_back(std::clamp((1 - t) * ua + t * ub, std::min(ua, ub), std::max(ua, ub)));
+    }
+  }
   quad_.push_back(q);
   cone_.push_back(merge_cones(cone_[a], cone_[b]));
   const Vec pp = pos(p);
@@ -448,6 +464,7 @@ void Builder::renumber_passes() {
   auto map = [&](uint32_t v) { return v == kNoNode ? kNoNode : new_of[v]; };
 
   std::vector<double> pos(pos_.size());
+  std::vector<float> uv(uv_.size());
   std::vector<Cone> cone(n);
   std::vector<float> radius(n), error(n);
   std::vector<uint32_t> parent(n);
@@ -459,6 +476,7 @@ void Builder::renumber_passes() {
   for (uint32_t v = 0; v < n; ++v) {
     const uint32_t o = old_of[v];
     for (int k = 0; k < 3; ++k) pos[3 * v + k] = pos_[3 * o + k];
+    if (!uv_.empty()) uv[2 * size_t(v)] = uv_[2 * size_t(o)], uv[2 * size_t(v) + 1] = uv_[2 * size_t(o) + 1];
     cone[v] = cone_[o];
     radius[v] = radius_[o];
     error[v] = error_[o];
@@ -477,6 +495,7 @@ void Builder::renumber_passes() {
   }
   for (uint32_t& owner : face_owner_) owner = map(owner);
   pos_.swap(pos);
+  uv_.swap(uv);
   cone_.swap(cone);
   radius_.swap(radius);
   error_.swap(error);
@@ -570,6 +589,28 @@ void Builder::pin_part_seams() {
     }
 }
 
+// Attribute seams are pinned (the simplest rule that keeps a texture whole; the discrete QEM
+// instead moves a seam pair along its seam, which a vertex split cannot express for two
+// vertices at once): copies at one position (find_position_copies, the test QEM uses) and
+// vertices between faces of two materials never collapse, so every collapse stays inside one
+// uv chart and one material, and both sides of a seam keep their shared vertices.
+void Builder::pin_attribute_seams(const MeshData& mesh, const std::vector<int32_t>& face_material) {
+  std::vector<uint32_t> first(leaf_count_), copies(leaf_count_);
+  find_position_copies(first, copies, mesh.positions.data(), leaf_count_);
+  for (uint32_t v = 0; v < leaf_count_; ++v)
+    if (copies[v] >= 2) nonmanifold_[v] = 1;
+  if (face_material.empty()) return;
+  std::vector<int64_t> seen(leaf_count_, INT64_MIN);
+  for (size_t f = 0; f < face_material.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = leaves_[3 * f + k];
+      if (seen[v] == INT64_MIN)
+        seen[v] = face_material[f];
+      else if (seen[v] != face_material[f])
+        nonmanifold_[v] = 1;
+    }
+}
+
 void Builder::finish(VertexTree& out) {
   const uint32_t n = static_cast<uint32_t>(parent_.size());
   out = VertexTree{};
@@ -577,6 +618,8 @@ void Builder::finish(VertexTree& out) {
   out.face_count = static_cast<uint32_t>(face_owner_.size());
   out.positions.resize(3 * size_t(n));
   for (size_t i = 0; i < 3 * size_t(n); ++i) out.positions[i] = static_cast<float>(pos_[i]);
+  out.uvs = std::move(uv_);
+  out.seams_pinned = true;
   out.parent = parent_;
   out.radius = radius_;
   out.error = error_;
@@ -633,7 +676,26 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
   for (size_t i = 0; i < mesh.positions.size(); ++i)
     if (!std::isfinite(mesh.positions[i]))
       return Status::error(mesh.source + ": vertex " + std::to_string(i / 3) + " has a non-finite position");
+  if (!mesh.uvs.empty() && mesh.uvs.size() != 2 * vc)
+    return Status::error(mesh.source + ": " + std::to_string(mesh.uvs.size()) + " uv values for " +
+                         std::to_string(vc) + " vertices (2 each)");
+  for (size_t i = 0; i < mesh.uvs.size(); ++i)
+    if (!std::isfinite(mesh.uvs[i]) || std::abs(mesh.uvs[i]) > kMaxTreeMagnitude)
+      return Status::error(mesh.source + ": vertex " + std::to_string(i / 2) + " has a non-finite or huge uv");
+  // Per input triangle its material (-1 = default), from the submesh runs.
+  std::vector<int32_t> input_material;
+  if (!mesh.submeshes.empty()) {
+    input_material.assign(mesh.triangle_count(), -1);
+    for (const Submesh& run : mesh.submeshes) {
+      if (run.first_triangle > mesh.triangle_count() || run.triangle_count > mesh.triangle_count() - run.first_triangle)
+        return Status::error(mesh.source + ": submesh at triangle " + std::to_string(run.first_triangle) + " of " +
+                             std::to_string(run.triangle_count) + " triangles runs past the " +
+                             std::to_string(mesh.triangle_count()));
+      std::fill_n(input_material.begin() + run.first_triangle, run.triangle_count, run.material);
+    }
+  }
   std::vector<uint32_t> leaves;
+  std::vector<int32_t> face_material;
   leaves.reserve(mesh.indices.size());
   for (size_t f = 0; f < mesh.triangle_count(); ++f) {
     const uint32_t* c = &mesh.indices[3 * f];
@@ -643,12 +705,17 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
                              std::to_string(c[k]) + " of " + std::to_string(vc));
     if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
     leaves.insert(leaves.end(), c, c + 3);
+    if (!input_material.empty()) face_material.push_back(input_material[f]);
   }
   leaf_count_ = static_cast<uint32_t>(vc);
   const size_t fc = leaves.size() / 3;
 
   pos_.reserve(6 * vc);
   pos_.assign(mesh.positions.begin(), mesh.positions.end());
+  if (!mesh.uvs.empty()) {
+    uv_.reserve(4 * vc);
+    uv_.assign(mesh.uvs.begin(), mesh.uvs.end());
+  }
   parent_.reserve(2 * vc);
   parent_.assign(vc, kNoNode);
   quad_.reserve(2 * vc);
@@ -697,6 +764,7 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
   build_adjacency();
   mark_split_fans();
   pin_part_seams();
+  pin_attribute_seams(mesh, face_material);
   collect_edges();
   // Border constraint planes (through the border edge, perpendicular to its face) hold the
   // outline of open meshes in place.

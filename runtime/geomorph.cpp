@@ -30,6 +30,8 @@ float morph_factor(double now, double start, float duration) {
 void vertex_morph_init(VertexMorph& m, const VertexTree& t, float duration) {
   m.from = t.positions;
   m.to = t.positions;
+  m.from_uv = t.uvs;
+  m.to_uv = t.uvs;
   m.start.assign(t.node_count(), -std::numeric_limits<double>::infinity());
   m.duration = duration;
 }
@@ -39,37 +41,47 @@ void vertex_morph_position(const VertexMorph& m, uint32_t v, double now, float o
   for (int k = 0; k < 3; ++k) out[k] = blend(m.from[3 * size_t(v) + k], m.to[3 * size_t(v) + k], t);
 }
 
+namespace {
+
+// Displayed uv of one node at `now` (the tree has uvs).
+void vertex_morph_uv(const VertexMorph& m, uint32_t v, double now, float out[2]) {
+  const float t = morph_factor(now, m.start[v], m.duration);
+  for (int k = 0; k < 2; ++k) out[k] = blend(m.from_uv[2 * size_t(v) + k], m.to_uv[2 * size_t(v) + k], t);
+}
+
+}  // namespace
+
 void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const FrontEvent> events, double now) {
-  auto retarget = [&](uint32_t v, const float* from, const float* to) {
-    for (int k = 0; k < 3; ++k) m.from[3 * size_t(v) + k] = from[k], m.to[3 * size_t(v) + k] = to[k];
+  const bool uvs = !m.to_uv.empty();
+  // Node v moves from what `shown` (a node) displays now to `target`'s own position and uv.
+  auto retarget = [&](uint32_t v, uint32_t shown, uint32_t target) {
+    float here[3], here_uv[2];
+    vertex_morph_position(m, shown, now, here);
+    if (uvs) vertex_morph_uv(m, shown, now, here_uv);
+    for (int k = 0; k < 3; ++k) m.from[3 * size_t(v) + k] = here[k], m.to[3 * size_t(v) + k] = t.positions[3 * size_t(target) + k];
+    if (uvs)
+      for (int k = 0; k < 2; ++k) m.from_uv[2 * size_t(v) + k] = here_uv[k], m.to_uv[2 * size_t(v) + k] = t.uvs[2 * size_t(target) + k];
     m.start[v] = now;
   };
   for (const FrontEvent& e : events) {
     const uint32_t i = e.node - t.leaf_count;
     const uint32_t c[2] = {t.children[2 * i], t.children[2 * i + 1]};
-    const float* own = &t.positions[3 * size_t(e.node)];
-    float here[3];
     switch (e.kind) {
       case FrontEventKind::split:
         // Both children appear where the parent is shown and move out to their own positions.
-        vertex_morph_position(m, e.node, now, here);
-        for (uint32_t ch : c) retarget(ch, here, &t.positions[3 * size_t(ch)]);
+        for (uint32_t ch : c) retarget(ch, e.node, ch);
         break;
       case FrontEventKind::collapse_begin:
-        for (uint32_t ch : c) {
-          vertex_morph_position(m, ch, now, here);
-          retarget(ch, here, own);
-        }
+        for (uint32_t ch : c) retarget(ch, ch, e.node);
         break;
       case FrontEventKind::collapse_cancel:
-        for (uint32_t ch : c) {
-          vertex_morph_position(m, ch, now, here);
-          retarget(ch, here, &t.positions[3 * size_t(ch)]);
-        }
+        for (uint32_t ch : c) retarget(ch, ch, ch);
         break;
       case FrontEventKind::collapse:
         // The children have arrived (deferred) or jump (no delay); the parent is settled.
-        retarget(e.node, own, own);
+        for (int k = 0; k < 3; ++k) m.from[3 * size_t(e.node) + k] = m.to[3 * size_t(e.node) + k] = t.positions[3 * size_t(e.node) + k];
+        if (uvs)
+          for (int k = 0; k < 2; ++k) m.from_uv[2 * size_t(e.node) + k] = m.to_uv[2 * size_t(e.node) + k] = t.uvs[2 * size_t(e.node) + k];
         m.start[e.node] = -std::numeric_limits<double>::infinity();
         break;
     }
@@ -87,6 +99,23 @@ size_t vertex_morph_positions(std::span<float> out, const VertexMorph& m, std::s
       out[3 * size_t(v) + k] = blend(m.from[3 * size_t(v) + k], m.to[3 * size_t(v) + k], t);
   }
   return moving;
+}
+
+void vertex_morph_uvs(std::span<float> out, const VertexMorph& m, std::span<const uint32_t> nodes, double now) {
+  assert(!m.to_uv.empty());
+  for (uint32_t v : nodes) {
+    assert(2 * size_t(v) + 1 < out.size());
+    vertex_morph_uv(m, v, now, &out[2 * size_t(v)]);
+  }
+}
+
+void level_morph_attributes(std::span<float> out, std::span<const float> fine, std::span<const float> coarse,
+                            std::span<const uint32_t> target, size_t components, float t) {
+  assert(out.size() == fine.size() && fine.size() == components * target.size());
+  t = std::clamp(t, 0.f, 1.f);
+  for (size_t v = 0; v < target.size(); ++v)
+    for (size_t k = 0; k < components; ++k)
+      out[components * v + k] = blend(fine[components * v + k], coarse[components * size_t(target[v]) + k], t);
 }
 
 namespace {

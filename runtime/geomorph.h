@@ -29,6 +29,10 @@ float morph_factor(double now, double start, float duration);
 struct VertexMorph {
   std::vector<float> from;    // xyz per node
   std::vector<float> to;      // xyz per node
+  // uv per node, when the tree has uvs (else empty): they travel with the positions, by the
+  // same factor, so a split child's texture coordinate starts at its parent's shown one.
+  std::vector<float> from_uv;
+  std::vector<float> to_uv;
   std::vector<double> start;  // per node, seconds
   float duration = 0.25f;     // seconds
 };
@@ -48,6 +52,10 @@ void vertex_morph_position(const VertexMorph& morph, uint32_t node, double now, 
 // moving. Sub-ranges of `nodes` give the same result.
 size_t vertex_morph_positions(std::span<float> out, const VertexMorph& morph, std::span<const uint32_t> nodes,
                               double now);
+
+// Displayed uvs of `nodes` at `now` into out (uv per node id, sized for every node), by the
+// factor their positions use. The tree must have uvs. Sub-ranges give the same result.
+void vertex_morph_uvs(std::span<float> out, const VertexMorph& morph, std::span<const uint32_t> nodes, double now);
 
 // ---- discrete levels --------------------------------------------------------------------------
 
@@ -85,6 +93,12 @@ size_t level_morph_misses(std::span<const uint32_t> target, std::span<const uint
 void level_morph_positions(std::span<float> out, std::span<const float> fine_positions,
                            std::span<const float> coarse_positions, std::span<const uint32_t> target,
                            float t);
+
+// Any per-vertex attribute of the finer level blended the same way, `components` floats per
+// vertex (2 for uvs, 3 for normals): out = (1 - t) fine + t coarse[target], exact at t = 0 and
+// 1, so the texture moves with the surface instead of sliding under it.
+void level_morph_attributes(std::span<float> out, std::span<const float> fine, std::span<const float> coarse,
+                            std::span<const uint32_t> target, size_t components, float t);
 
 // Per object: advance the morph factor towards 1 by dt / duration, restarting it at 0 where the
 // level changed since last frame. Returns the number of objects still morphing.

@@ -11,6 +11,14 @@
 //       leaf_hi (n each), leaf_rank (leaves), face leaves (3f), face owner (f), children,
 //       split faces, wings (2i each, i = n - leaves), dep offsets (i + 1), deps, incidence
 //       offsets (i + 1), incident faces. Readers that predate it skip it (version stays 1).
+// VHAT (optional, flag 0; written with VHIE when its tree pins attribute seams or has uvs):
+//       u32 layout (1), u32 flags (bit 0: VertexTree::seams_pinned; the rest 0), u64 uv nodes
+//       (0, or VHIE's node count), then 2 f32 per node (VertexTree::uvs). The count is checked
+//       against the section's bytes before anything is allocated, the layout and flags against
+//       what this build knows, the uvs by validate_vertex_tree and, at the leaves, against
+//       level 0's TEX0 uvs bit for bit. A reader that predates it skips it (a tree without
+//       uvs, as before); a tree without it was built before seams were pinned, which
+//       jobs/bake_jobs rebuilds when level 0 has seams or uvs.
 // MRPH (optional, flag 0; written only when the chain has morph targets): u32 per vertex of
 //       every level but the last (LodChain::morph_targets), checked like the levels' indices.
 // TEX0 (optional, flag 0; written only when the chain has texture coordinates): u32 level
@@ -89,6 +97,10 @@ constexpr size_t kMaterialTexturedBytes = 76;  // layout 1's
 constexpr size_t kMaterialTexCoordBytes = 84;  // layout 2's
 constexpr uint32_t kMatlLayout = 2;
 constexpr size_t kVhieFixedBytes = 32;
+constexpr uint32_t kVhat = fourcc("VHAT");
+constexpr size_t kVhatFixedBytes = 16;
+constexpr uint32_t kVhatLayout = 1;
+constexpr uint32_t kVhatSeamsPinned = 1;
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
 std::string tag_name(uint32_t tag) {
@@ -191,6 +203,13 @@ void put_hierarchy(Writer& w, const VertexTree& t) {
   put_words(w, t.inc_faces);
 }
 
+void put_hierarchy_attributes(Writer& w, const VertexTree& t) {
+  w.u32(kVhatLayout);
+  w.u32(t.seams_pinned ? kVhatSeamsPinned : 0);
+  w.u64(t.uvs.size() / 2);
+  put_words(w, t.uvs);
+}
+
 struct SectionRef {
   uint64_t offset = 0;
   uint64_t size = 0;
@@ -199,7 +218,46 @@ struct SectionRef {
 
 Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
 
-Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, VertexTree& out) {
+// VHAT: structure only (layout, flags, count against bytes); `nodes` is VHIE's node count.
+Status get_hierarchy_attributes(const uint8_t* p, uint64_t size, uint64_t nodes, const std::string& what,
+                                VertexTree& t) {
+  auto bad = [&](const std::string& why) { return refuse(what, "VHAT section: " + why); };
+  if (size < kVhatFixedBytes)
+    return bad(std::to_string(size) + " bytes, needs " + std::to_string(kVhatFixedBytes) + " at least");
+  const uint32_t layout = load_u32(p), flags = load_u32(p + 4);
+  const uint64_t count = load_u64(p + 8);
+  if (layout > kVhatLayout)
+    return bad("layout " + std::to_string(layout) + " is newer than this build reads (" + std::to_string(kVhatLayout) +
+               "); use a newer lodkit or re-bake it");
+  if (layout == 0) return bad("layout 0 does not exist");
+  if (flags & ~kVhatSeamsPinned) return bad("unknown flags " + std::to_string(flags));
+  if (count != 0 && count != nodes)
+    return bad("uvs for " + std::to_string(count) + " nodes, the hierarchy has " + std::to_string(nodes));
+  if (count > (size - kVhatFixedBytes) / 8 || size != kVhatFixedBytes + 8 * count)
+    return bad(std::to_string(size) + " bytes but " + std::to_string(count) + " nodes need " +
+               std::to_string(kVhatFixedBytes) + " + 8 each (truncated?)");
+  get_words(p + kVhatFixedBytes, 2 * count, t.uvs);
+  t.seams_pinned = (flags & kVhatSeamsPinned) != 0;
+  return Status::success();
+}
+
+// Leaves are level 0's vertices: their uvs must be its uvs, bit for bit.
+Status check_leaf_uvs(const LodChain& chain, const std::string& what) {
+  const VertexTree& t = chain.hierarchy;
+  if (t.uvs.empty()) return Status::success();
+  if (chain.uvs.empty() || chain.levels.empty())
+    return refuse(what, "VHAT section: the hierarchy has uvs but the levels have none (TEX0)");
+  const size_t first = 2 * size_t(chain.levels[0].first_vertex);
+  if (std::memcmp(t.uvs.data(), chain.uvs.data() + first, 8 * size_t(t.leaf_count)) == 0) return Status::success();
+  for (uint32_t v = 0; v < t.leaf_count; ++v)
+    if (std::memcmp(&t.uvs[2 * size_t(v)], &chain.uvs[first + 2 * size_t(v)], 8) != 0)
+      return refuse(what, "VHAT section: leaf " + std::to_string(v) + " uv differs from level 0 vertex " +
+                              std::to_string(v) + "'s");
+  return Status::success();
+}
+
+Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, VertexTree& out,
+                     const SectionRef* attributes, const uint8_t* file) {
   if (size < kVhieFixedBytes)
     return refuse(what, "VHIE section is " + std::to_string(size) + " bytes, needs " + std::to_string(kVhieFixedBytes));
   VertexTree t;
@@ -238,8 +296,15 @@ Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, V
   take(t.deps, deps);
   take(t.inc_offsets, inner + 1);
   take(t.inc_faces, inc);
+  if (attributes)
+    if (Status st = get_hierarchy_attributes(file + attributes->offset, attributes->size, nodes, what, t); !st)
+      return st;
   std::string message;
+  std::vector<float> uvs = std::move(t.uvs);
+  t.uvs.clear();
   if (!validate_vertex_tree(t, &message)) return refuse(what, "VHIE section: " + message);
+  t.uvs = std::move(uvs);
+  if (!t.uvs.empty() && !validate_vertex_tree_uvs(t, &message)) return refuse(what, "VHAT section: " + message);
   pack_vertex_bounds(t);
   out = std::move(t);
   return Status::success();
@@ -401,6 +466,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   Writer w;
   std::vector<uint32_t> tags = {kMeta, kLevl, kPosn, kNrml, kIndx};
   if (!chain.hierarchy.empty()) tags.push_back(kVhie);
+  if (!chain.hierarchy.empty() && (chain.hierarchy.seams_pinned || !chain.hierarchy.uvs.empty())) tags.push_back(kVhat);
   if (!chain.morph_targets.empty()) tags.push_back(kMrph);
   if (!chain.uvs.empty()) tags.push_back(kTex0);
   if (!chain.uvs1.empty()) tags.push_back(kTex1);
@@ -413,8 +479,8 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   const size_t table = w.bytes.size();
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
-    w.u32(tags[s] == kVhie || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kTex1 || tags[s] == kCol0 ||
-                   tags[s] == kMatl
+    w.u32(tags[s] == kVhie || tags[s] == kVhat || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kTex1 ||
+                   tags[s] == kCol0 || tags[s] == kMatl
                ? 0
                : kFlagRequired);
     w.u64(0);  // offset, patched below
@@ -450,6 +516,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   });
   for (uint32_t s = 5; s < section_count; ++s) {
     if (tags[s] == kVhie) section(s, [&] { put_hierarchy(w, chain.hierarchy); });
+    if (tags[s] == kVhat) section(s, [&] { put_hierarchy_attributes(w, chain.hierarchy); });
     if (tags[s] == kMrph) section(s, [&] { put_words(w, chain.morph_targets); });
     if (tags[s] == kTex0)
       section(s, [&] {
@@ -515,7 +582,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     return refuse(what, "checksum mismatch (file is corrupted or truncated)");
 
   SectionRef sec[5];
-  SectionRef vhie, mrph, tex0, tex1, col0, matl;
+  SectionRef vhie, vhat, mrph, tex0, tex1, col0, matl;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -528,6 +595,11 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     if (tag == kVhie) {
       if (vhie.present) return refuse(what, name + " appears twice");
       vhie = {off, sz, true};
+      continue;
+    }
+    if (tag == kVhat) {
+      if (vhat.present) return refuse(what, name + " appears twice");
+      vhat = {off, sz, true};
       continue;
     }
     if (tag == kMrph) {
@@ -627,14 +699,18 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
   std::string message;
   const char* section = "LEVL";
   if (!validate_chain(chain, &message, &section)) return refuse(what, std::string(section) + " section: " + message);
+  if (vhat.present && !vhie.present) return refuse(what, "VHAT section without a hierarchy (VHIE)");
   if (vhie.present) {
-    if (Status st = get_hierarchy(p + vhie.offset, vhie.size, what, chain.hierarchy); !st) return st;
+    if (Status st = get_hierarchy(p + vhie.offset, vhie.size, what, chain.hierarchy, vhat.present ? &vhat : nullptr, p);
+        !st)
+      return st;
     if (!chain.levels.empty() && chain.hierarchy.leaf_count != chain.levels[0].vertex_count) {
       const std::string leaves = std::to_string(chain.hierarchy.leaf_count);
       chain.hierarchy = VertexTree{};
       return refuse(what, "VHIE section: hierarchy has " + leaves + " leaves but level 0 has " +
                               std::to_string(chain.levels[0].vertex_count) + " vertices");
     }
+    if (Status st = check_leaf_uvs(chain, what); !st) return st;
   }
   out = std::move(chain);
   return Status::success();

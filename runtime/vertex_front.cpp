@@ -1164,6 +1164,32 @@ uint32_t fronts_compact_mesh(std::span<float> positions, std::span<uint32_t> ind
   return nt;
 }
 
+uint32_t front_compact_uvs(std::span<float> uvs, const VertexFront& f, const VertexTree& t,
+                           std::span<const float> shown_uvs) {
+  assert(!t.uvs.empty() && uvs.size() >= 2 * size_t(f.active_count));
+  const float* src = shown_uvs.empty() ? t.uvs.data() : shown_uvs.data();
+  for (uint32_t k = 0; k < f.active_count; ++k) std::copy_n(src + 2 * size_t(f.active[k]), 2, uvs.data() + 2 * size_t(k));
+  return f.active_count;
+}
+
+uint32_t fronts_compact_uvs(std::span<float> uvs, std::span<const VertexFront* const> fronts, const VertexTree& t,
+                            std::span<const float> shown_uvs) {
+  assert(!t.uvs.empty());
+  const float* src = shown_uvs.empty() ? t.uvs.data() : shown_uvs.data();
+  uint32_t nv = 0;
+  // The vertex order of fronts_compact_mesh: fixed leaves once, from the first front.
+  for (size_t r = 0; r < fronts.size(); ++r) {
+    const VertexFront& f = *fronts[r];
+    for (uint32_t k = 0; k < f.active_count; ++k) {
+      const uint32_t v = f.active[k];
+      if (r > 0 && f.numbering && f.numbering->region[v] == kSharedRegion) continue;
+      assert(uvs.size() >= 2 * size_t(nv + 1));
+      std::copy_n(src + 2 * size_t(v), 2, uvs.data() + 2 * size_t(nv++));
+    }
+  }
+  return nv;
+}
+
 bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges,
                      std::string* message) {
   auto fail = [&](std::string text) {

@@ -243,6 +243,14 @@ uint32_t fronts_compact_mesh(std::span<float> positions, std::span<uint32_t> ind
                              std::span<const VertexFront* const> fronts, const VertexTree& tree,
                              std::span<const float> shown, uint32_t* vertex_count);
 
+// Texture coordinates of the same compact meshes, in the same vertex order: uv per active vertex
+// from `shown_uvs` (uv per node id, e.g. geomorphed; the tree's own uvs when empty). The tree
+// must have uvs; `uvs` holds 2 floats per written vertex. Return the vertices written.
+uint32_t front_compact_uvs(std::span<float> uvs, const VertexFront& front, const VertexTree& tree,
+                           std::span<const float> shown_uvs);
+uint32_t fronts_compact_uvs(std::span<float> uvs, std::span<const VertexFront* const> fronts, const VertexTree& tree,
+                            std::span<const float> shown_uvs);
+
 // Checks a plain indexed triangle list: indices < vertex_count, no repeated corner; from
 // `oriented` on each directed edge at most once; with `closed` every edge also used the other
 // way round.

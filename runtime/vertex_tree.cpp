@@ -128,6 +128,30 @@ bool check_collapse_order(const VertexTree& t, std::string* message) {
 
 }  // namespace
 
+// Uvs: one pair per node, finite, and a parent's inside its children's box (what interpolating
+// along the collapse gives): so no node's texture coordinate leaves the range of its leaves'.
+bool validate_vertex_tree_uvs(const VertexTree& t, std::string* message) {
+  const size_t n = t.parent.size();
+  if (t.uvs.size() != 2 * n)
+    return fail(message, "hierarchy uvs hold " + num(t.uvs.size()) + " values, expected " + num(2 * n));
+  for (size_t i = 0; i < 2 * n; ++i)
+    if (!std::isfinite(t.uvs[i]) || std::abs(t.uvs[i]) > kMaxTreeMagnitude)
+      return fail(message, "node " + num(i / 2) + " has a non-finite or huge uv");
+  if (n < t.leaf_count || t.children.size() != 2 * (n - t.leaf_count))
+    return fail(message, "hierarchy children do not match its nodes");
+  for (size_t i = 0; i < n - t.leaf_count; ++i) {
+    const uint32_t a = t.children[2 * i], b = t.children[2 * i + 1];
+    if (a >= n || b >= n) return fail(message, "node " + num(t.leaf_count + i) + " has a child out of range");
+    for (int k = 0; k < 2; ++k) {
+      const float u = t.uvs[2 * (t.leaf_count + i) + k], ua = t.uvs[2 * size_t(a) + k], ub = t.uvs[2 * size_t(b) + k];
+      if (u < std::min(ua, ub) || u > std::max(ua, ub))
+        return fail(message, "node " + num(t.leaf_count + i) + " uv lies outside its children's (" + num(a) +
+                                 ", " + num(b) + ")");
+    }
+  }
+  return true;
+}
+
 bool validate_vertex_tree(const VertexTree& t, std::string* message) {
   const size_t n = t.parent.size();
   if (n < t.leaf_count) return fail(message, "hierarchy has fewer nodes than leaves");
@@ -226,6 +250,7 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
         return fail(message, "face " + num(f) + " owner " + num(o) + " does not list it");
     }
   }
+  if (!t.uvs.empty() && !validate_vertex_tree_uvs(t, message)) return false;
   return check_collapse_order(t, message);
 }
 

@@ -51,6 +51,17 @@ struct VertexTree {
   std::vector<uint32_t> leaf_lo;  // leaves below are leaf_order[leaf_lo, leaf_hi)
   std::vector<uint32_t> leaf_hi;
 
+  // Optional texture coordinates (empty = none): uv per node, leaves the input's bit for bit, a
+  // parent's interpolated along its collapse (edge_parameter) and so inside its children's
+  // range. Stored in the asset's optional VHAT section.
+  std::vector<float> uvs;
+  // Built with attribute seams pinned: every vertex that shares its position with another (one
+  // copy per side of a uv, normal or material seam) and every vertex between faces of two
+  // materials is a root, never collapsed, so no collapse smears a texture across a seam or
+  // moves a material boundary, and the copies stay together (no crack). Builds from before
+  // this rule collapsed each side alone; the bake rebuilds such a tree (VHAT section flag).
+  bool seams_pinned = false;
+
   // Per leaf: its rank in the depth-first leaf order.
   std::vector<uint32_t> leaf_rank;
 
@@ -94,9 +105,13 @@ inline constexpr float kMaxTreeMagnitude = 1e18f;
 // intervals (ranks a permutation), split faces owned by their node, finite values within
 // kMaxTreeMagnitude, and replays the collapses in node order: split faces, wings, incident
 // faces and dependencies must be exactly what each collapse makes (what front_update and its
-// forced splits rely on). Linear in the arrays. On failure `message` names the element
+// forced splits rely on). With uvs: two per node, finite, each parent's within the box of its
+// children's. Linear in the arrays. On failure `message` names the element
 // ("node 812 child 90211 of 35947"); callers prefix the file.
 bool validate_vertex_tree(const VertexTree& tree, std::string* message);
+// The uv part of it alone, for a tree whose other arrays passed (asset readers name the two
+// sections apart).
+bool validate_vertex_tree_uvs(const VertexTree& tree, std::string* message);
 
 // Fills tree.bounds from the per-node arrays. Builders and readers call it; fronts need it.
 void pack_vertex_bounds(VertexTree& tree);

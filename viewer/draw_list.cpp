@@ -56,10 +56,36 @@ bool vd_entry_ok(const Frame& f, const VdObjectFrame& v, size_t n, const std::ve
   return true;
 }
 
+// A vd object's material runs, when they cover its indices in order within the frame's runs
+// and name materials its model has; else none (drawn as one surface).
+void add_vd_runs(const Frame& f, const VdObjectFrame& v, uint32_t model, const MeshLayout& layout, DrawList& out,
+                 VdDraw& d) {
+  if (v.run_count == 0 || uint64_t(v.first_run) + v.run_count > f.vd_runs.size() || model >= layout.first_material.size())
+    return;
+  const uint32_t first = layout.first_material[model];
+  const uint32_t count =
+      (model + 1 < layout.first_material.size() ? layout.first_material[model + 1] : layout.material_count) - first;
+  uint64_t at = v.first_index;
+  for (uint32_t k = v.first_run; k < v.first_run + v.run_count; ++k) {
+    const VdRunFrame& r = f.vd_runs[k];
+    if (r.first_index != at || r.index_count % 3 != 0) return;
+    at += r.index_count;
+  }
+  if (at != uint64_t(v.first_index) + v.index_count) return;
+  d.first_run = static_cast<uint32_t>(out.vd_runs.size());
+  d.run_count = v.run_count;
+  for (uint32_t k = v.first_run; k < v.first_run + v.run_count; ++k) {
+    const VdRunFrame& r = f.vd_runs[k];
+    const bool known = r.material >= 0 && uint32_t(r.material) < count;
+    out.vd_runs.push_back({r.first_index, r.index_count, known ? int32_t(first + uint32_t(r.material)) : -1});
+  }
+}
+
 // View-dependent objects: their entry is not an instance; its level's triangles are what
 // tris_selected counted for it.
 void add_vd_draws(const Frame& f, size_t n, const MeshLayout& layout, DrawList& out) {
   out.is_vd.assign(n, 0);
+  out.vd_runs.clear();
   for (const VdObjectFrame& v : f.vd_objects) {
     InstanceData transform;
     if (!vd_entry_ok(f, v, n, out.is_vd) || !instance_of(f.transforms[v.entry], 1.f, 0.f, &transform)) {
@@ -70,8 +96,9 @@ void add_vd_draws(const Frame& f, size_t n, const MeshLayout& layout, DrawList& 
     const uint32_t model = f.models[v.entry];
     if (model < layout.level_count.size() && f.levels[v.entry] < layout.level_count[model])
       out.vd_level_triangles += level_triangles(layout, model, f.levels[v.entry]);
-    out.vd.push_back(
-        {v.object, v.entry, v.first_vertex, v.vertex_count, v.first_index, v.index_count, transform});
+    VdDraw d{v.object, v.entry, v.first_vertex, v.vertex_count, v.first_index, v.index_count, transform};
+    add_vd_runs(f, v, model, layout, out, d);
+    out.vd.push_back(d);
     out.vd_triangles += v.index_count / 3;
   }
 }

@@ -52,6 +52,13 @@ struct DrawBatch {
 
 // One view-dependent object's active mesh (Frame::vd_objects): drawn from the frame's own
 // vd_positions / vd_indices with the object's transform, never at its discrete level.
+// A material run of a vd object (Frame::vd_runs), its material scene-wide (MeshLayout).
+struct VdRunDraw {
+  uint32_t first_index = 0;  // into Frame::vd_indices
+  uint32_t index_count = 0;
+  int32_t material = -1;     // scene-wide material index, -1 = the default surface
+};
+
 struct VdDraw {
   uint32_t object = 0;        // Frame::objects value
   uint32_t entry = 0;         // its frame entry (transform, model)
@@ -60,6 +67,8 @@ struct VdDraw {
   uint32_t first_index = 0;   // into Frame::vd_indices; local to this object's vertices
   uint32_t index_count = 0;
   InstanceData transform;     // the same per-object transform the instances use, morph = 1
+  uint32_t first_run = 0;     // into DrawList::vd_runs; 0 runs: drawn as one surface
+  uint32_t run_count = 0;
 };
 
 struct DrawList {
@@ -73,6 +82,7 @@ struct DrawList {
   // model or level, a transform that is not finite; vd meshes out of range (drawn at their level).
   uint32_t rejected = 0;
   std::vector<VdDraw> vd;                 // view-dependent objects, in frame order
+  std::vector<VdRunDraw> vd_runs;         // their material runs (objects whose runs check out)
   uint64_t vd_triangles = 0;              // sum of vd index_count / 3
   uint64_t vd_level_triangles = 0;        // what Frame::tris_selected counts for those objects (their level)
   std::vector<uint32_t> per_batch_slot;   // scratch: instances per (model, level, target) (counting sort)

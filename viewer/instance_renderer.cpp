@@ -25,6 +25,7 @@ layout(location = 4) in vec2 i_morph_weight;
 layout(location = 5) in vec3 a_target_position;
 layout(location = 6) in vec3 a_target_normal;
 layout(location = 7) in vec2 a_uv;
+layout(location = 8) in vec2 a_target_uv;
 uniform mat4 u_view;
 uniform mat4 u_projection;
 uniform int u_blend;
@@ -47,7 +48,7 @@ void main() {
   v_position_view = view_pos.xyz;
   v_normal_view = mat3(u_view) * rotate(q, n);
   v_morph = i_morph_weight.x;
-  v_uv = a_uv;
+  v_uv = u_blend != 0 ? mix(a_uv, a_target_uv, w) : a_uv;
   gl_Position = u_projection * view_pos;
 }
 )";
@@ -233,6 +234,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   }
   glDisableVertexAttribArray(kAttribTargetPosition);
   glDisableVertexAttribArray(kAttribTargetNormal);
+  glDisableVertexAttribArray(kAttribTargetUv);
 
   glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
@@ -258,18 +260,22 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
       glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float),
                             reinterpret_cast<const void*>(size_t(r.base_vertex) * 2 * sizeof(float)));
       glBindBuffer(GL_ARRAY_BUFFER, morphs->buffer());
-      const size_t target = size_t(stream) * 6 * sizeof(float);
+      constexpr GLsizei kStride = MorphStreams::kFloatsPerVertex * sizeof(float);
+      const size_t target = size_t(stream) * kStride;
       glEnableVertexAttribArray(kAttribTargetPosition);
       glEnableVertexAttribArray(kAttribTargetNormal);
-      glVertexAttribPointer(kAttribTargetPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                            reinterpret_cast<const void*>(target));
-      glVertexAttribPointer(kAttribTargetNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+      glEnableVertexAttribArray(kAttribTargetUv);
+      glVertexAttribPointer(kAttribTargetPosition, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(target));
+      glVertexAttribPointer(kAttribTargetNormal, 3, GL_FLOAT, GL_FALSE, kStride,
                             reinterpret_cast<const void*>(target + 3 * sizeof(float)));
+      glVertexAttribPointer(kAttribTargetUv, 2, GL_FLOAT, GL_FALSE, kStride,
+                            reinterpret_cast<const void*>(target + 6 * sizeof(float)));
       glUniform1i(u_blend_, 1);
       draw_range(meshes, r, b.instance_count, 0, settings);
       glUniform1i(u_blend_, 0);
       glDisableVertexAttribArray(kAttribTargetPosition);
       glDisableVertexAttribArray(kAttribTargetNormal);
+      glDisableVertexAttribArray(kAttribTargetUv);
       glBindBuffer(GL_ARRAY_BUFFER, meshes.vbo());
       glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
       glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
@@ -296,13 +302,31 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
                     : settings.colour_by_level ? kViewDependentColour
                                                : kModelColour;
     set_plain_surface(c);
+    const auto& materials = meshes.materials().materials();
     for (const VdDraw& d : list.vd) {
       glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
       glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
       glVertexAttrib2f(kAttribInstanceMorph, d.transform.morph, 0.f);
-      glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(d.index_count), GL_UNSIGNED_INT,
-                               reinterpret_cast<const void*>(size_t(d.first_index) * sizeof(uint32_t)),
-                               GLint(d.first_vertex));
+      auto draw = [&](uint32_t first_index, uint32_t count) {
+        glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
+                                 reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)),
+                                 GLint(d.first_vertex));
+      };
+      if (!draws_materials(settings) || d.run_count == 0) {
+        draw(d.first_index, d.index_count);
+      } else {
+        // Run by run with its material, as the levels are drawn (the frame grouped them).
+        for (uint32_t k = d.first_run; k < d.first_run + d.run_count; ++k) {
+          const VdRunDraw& run = list.vd_runs[k];
+          if (run.material >= 0 && size_t(run.material) < materials.size()) {
+            set_material(materials[size_t(run.material)]);
+          } else {
+            set_plain_surface(kModelColour);
+          }
+          draw(run.first_index, run.index_count);
+        }
+        set_plain_surface(c);
+      }
       ++stats.draws;
       ++stats.vd_draws;
       stats.vd_triangles += d.index_count / 3;

@@ -21,6 +21,7 @@ inline constexpr GLuint kAttribInstanceMorph = 4;          // InstanceData morph
 inline constexpr GLuint kAttribTargetPosition = 5;         // morph target stream (MorphBuffers)
 inline constexpr GLuint kAttribTargetNormal = 6;
 inline constexpr GLuint kAttribUv = 7;
+inline constexpr GLuint kAttribTargetUv = 8;            // morph target stream (MorphBuffers)
 
 // A static mesh in its own VAO: positions then normals (when `normals` is not empty) in one
 // VBO, indices in an IBO; the per-object attributes stay disabled, so the instance shader reads

@@ -1,6 +1,6 @@
 // MorphStreams: the second vertex stream of blended draws. For a (model, finer level, coarser
-// level) pair, each vertex of the finer level gets the position and normal of its morph target
-// in the coarser level (targets composed through the levels in between). Made on first use
+// level) pair, each vertex of the finer level gets the position, normal and uv of its morph
+// target in the coarser level (targets composed through the levels in between). Made on first use
 // and kept: most level changes are one level, so few pairs are ever made. Pure CPU; the
 // renderer uploads what grew (MorphBuffers).
 #pragma once
@@ -22,7 +22,9 @@ class MorphStreams {
   // model cannot blend (no morph targets) or the pair is not finer < coarser.
   int64_t offset_of(uint32_t model, uint32_t fine, uint32_t coarse);
 
-  // Position + normal (6 floats) per vertex, all streams made so far, back to back.
+  // Position, normal and uv (kFloatsPerVertex) per vertex, all streams made so far, back to back;
+  // zero normals or uvs where the chain has none.
+  static constexpr size_t kFloatsPerVertex = 8;
   const std::vector<float>& vertices() const { return vertices_; }
   size_t stream_count() const { return offsets_.size(); }
 

@@ -18,6 +18,7 @@ void stream(GLenum target, size_t bytes, const void* data, size_t& capacity) {
 
 VdMeshBuffers::~VdMeshBuffers() {
   if (ibo_) glDeleteBuffers(1, &ibo_);
+  if (uv_vbo_) glDeleteBuffers(1, &uv_vbo_);
   if (vbo_) glDeleteBuffers(1, &vbo_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
@@ -26,6 +27,7 @@ void VdMeshBuffers::init() {
   glGenVertexArrays(1, &vao_);
   glGenBuffers(1, &vbo_);
   glGenBuffers(1, &ibo_);
+  glGenBuffers(1, &uv_vbo_);
   glBindVertexArray(vao_);
   glBindBuffer(GL_ARRAY_BUFFER, vbo_);
   glEnableVertexAttribArray(kAttribPosition);
@@ -43,6 +45,15 @@ void VdMeshBuffers::upload(const Frame& frame) {
   stream(GL_ARRAY_BUFFER, frame.vd_positions.size() * sizeof(float), frame.vd_positions.data(), vbo_capacity_);
   stream(GL_ELEMENT_ARRAY_BUFFER, frame.vd_indices.size() * sizeof(uint32_t), frame.vd_indices.data(),
          ibo_capacity_);
+  // Uvs only when the frame has one per vertex; otherwise the constant uv the renderer sets.
+  if (!frame.vd_uvs.empty() && 3 * frame.vd_uvs.size() == 2 * frame.vd_positions.size()) {
+    glBindBuffer(GL_ARRAY_BUFFER, uv_vbo_);
+    stream(GL_ARRAY_BUFFER, frame.vd_uvs.size() * sizeof(float), frame.vd_uvs.data(), uv_capacity_);
+    glEnableVertexAttribArray(kAttribUv);
+    glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+  } else {
+    glDisableVertexAttribArray(kAttribUv);
+  }
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 }

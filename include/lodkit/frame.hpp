@@ -23,6 +23,14 @@ inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = ro
 
 // One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
 // draws instead of a discrete level. Positions are object space and already geomorphed.
+// With uvs (has_uvs), Frame::vd_uvs holds one per vertex, geomorphed with the positions; with
+// materials, the object's triangles come grouped by material, run_count runs from first_run of
+// Frame::vd_runs (in material order), which cover its indices in order.
+struct VdRunFrame {
+  uint32_t first_index = 0;  // into Frame::vd_indices (the object's indices are among them)
+  uint32_t index_count = 0;  // 3 per triangle
+  int32_t material = -1;     // the chain's material, -1 = the default surface
+};
 struct VdObjectFrame {
   uint32_t object = 0;        // Frame::objects value of this object (its entry is `entry`)
   uint32_t entry = 0;         // index of its entry in the frame's per-entry columns
@@ -36,6 +44,9 @@ struct VdObjectFrame {
   float threshold = 0;        // pixel threshold after this frame's feedback
   bool closed = false;        // the object's full mesh is closed (every edge in two faces)
   bool oriented = false;      // ... consistently oriented (each directed edge once)
+  bool has_uvs = false;       // its vertices' uvs are in Frame::vd_uvs
+  uint32_t first_run = 0;     // into Frame::vd_runs; run_count == 0: no materials (one surface)
+  uint32_t run_count = 0;
 };
 
 // One node of an HLOD model's cut (models with hlod = true, numbered in config order among
@@ -120,6 +131,8 @@ struct Frame {
   std::vector<VdObjectFrame> vd_objects;
   std::vector<float> vd_positions;   // xyz per vertex, all vd objects back to back
   std::vector<uint32_t> vd_indices;  // all vd objects back to back
+  std::vector<float> vd_uvs;         // uv per vertex like vd_positions when any vd object has uvs (else empty; 0 for those without)
+  std::vector<VdRunFrame> vd_runs;   // material runs of the vd objects with materials
   uint64_t vd_active_tris = 0;
   uint64_t vd_splits = 0;
   uint64_t vd_collapses = 0;

@@ -9,6 +9,7 @@
 
 #include "preprocess/lod_bake.h"
 #include "test_support.h"
+#include "textured_fixture.h"
 #include "viewer/draw_list.h"
 #include "viewer/mesh_layout.h"
 #include "viewer/morph_streams.h"
@@ -156,7 +157,7 @@ std::vector<float> shader_positions(const LodChain& c, uint32_t fine, const std:
   for (size_t v = 0; v < l.vertex_count; ++v)
     for (int k = 0; k < 3; ++k) {
       const float own = c.positions[3 * (size_t(l.first_vertex) + v) + k];
-      const float target = stream[6 * (size_t(first) + v) + k];
+      const float target = stream[MorphStreams::kFloatsPerVertex * (size_t(first) + v) + k];
       out[3 * v + k] = (1 - w) * own + w * target;
     }
   return out;
@@ -179,7 +180,7 @@ TEST(MorphStreams, AtWeightOneTheFinerLevelIsDrawnAsTheCoarserOne) {
     const int64_t first = streams.offset_of(0, fine, coarse);
     ASSERT_GE(first, 0);
     const std::vector<float>& stream = streams.vertices();
-    ASSERT_GE(stream.size(), 6 * (size_t(first) + c.levels[fine].vertex_count));
+    ASSERT_GE(stream.size(), MorphStreams::kFloatsPerVertex * (size_t(first) + c.levels[fine].vertex_count));
     const LodLevel& f = c.levels[fine];
     const LodLevel& k = c.levels[coarse];
     // Weight 0: exactly the finer level.
@@ -219,6 +220,39 @@ TEST(MorphStreams, AtWeightOneTheFinerLevelIsDrawnAsTheCoarserOne) {
   EXPECT_EQ(streams.offset_of(1, 0, 1), -1);
   EXPECT_EQ(streams.offset_of(0, 0, uint32_t(c.levels.size())), -1);
   EXPECT_EQ(streams.stream_count(), 3u);
+}
+
+// The stream carries each fine vertex's target uv too (after its position and normal), which the
+// shader mixes with the vertex's own uv by the blend weight.
+TEST(MorphStreams, UvsBlendTowardsTheTargetVertexsUv) {
+  const auto dir = test::temp_dir("morph-streams-uv");
+  const auto file = test::write_two_material_gltf(dir, "globe");
+  ASSERT_FALSE(file.empty());
+  BakeSettings settings;
+  settings.method = SimplifyMethod::qem;
+  LodChain c;
+  const Status st = bake_model(file, "globe", settings, c, nullptr, nullptr);
+  ASSERT_TRUE(st) << st.message;
+  ASSERT_GE(c.levels.size(), 2u);
+  ASSERT_EQ(2 * c.positions.size(), 3 * c.uvs.size());
+  MorphStreams streams(std::span(&c, 1));
+  const int64_t first = streams.offset_of(0, 0, 1);
+  ASSERT_GE(first, 0);
+  const LodLevel& f = c.levels[0];
+  const LodLevel& k = c.levels[1];
+  std::vector<uint32_t> target(f.vertex_count);
+  compose_morph_targets(target, c, 0, 1);
+  const std::vector<float>& stream = streams.vertices();
+  size_t moved = 0;
+  for (size_t v = 0; v < f.vertex_count; ++v) {
+    const float* own = &c.uvs[2 * (size_t(f.first_vertex) + v)];
+    const float* to = &c.uvs[2 * (size_t(k.first_vertex) + target[v])];
+    const float* s = &stream[MorphStreams::kFloatsPerVertex * (size_t(first) + v) + 6];
+    ASSERT_EQ(s[0], to[0]) << "vertex " << v;
+    ASSERT_EQ(s[1], to[1]) << "vertex " << v;
+    moved += own[0] != to[0] || own[1] != to[1];
+  }
+  EXPECT_GT(moved, 0u);  // some uvs do move: the blend is not the identity
 }
 
 }  // namespace

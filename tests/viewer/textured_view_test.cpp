@@ -109,6 +109,31 @@ TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
   EXPECT_LE(c.any_base, 10) << "colour-by-level must not show the material factor";
 }
 
+// The same globe drawn view-dependently: the front carries uvs and its triangles come grouped
+// by material, so the picture shows the texture and the factor as the levels do.
+TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
+  LOD_REQUIRE_XVFB();
+  const std::string model = std::string(kModel) + "view_dependent = true\n";
+  const auto scene = lod::test::write_viewer_scene("textured-vd", kRun, kCamera, kInstance, model.c_str());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  const auto lit = scene.dir / "vd.png";
+  const auto stats = scene.dir / "vd.csv";
+  const auto r = lod::test::run_viewer(
+      scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" + stats.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << r.output;
+  lod::test::CsvTable t;
+  ASSERT_TRUE(lod::test::load_csv(stats, t));
+  ASSERT_FALSE(t.rows.empty());
+  EXPECT_EQ(t.get(t.rows.size() - 1, "vd_objects"), 1) << "drawn from its active front";
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  const HueCounts m = count_hues(img);
+  EXPECT_GE(m.light_above, 300) << "light checker squares on the view-dependent cap";
+  EXPECT_GE(m.dark_above, 300) << "dark checker squares on the view-dependent cap";
+  EXPECT_GE(m.base_below, 300) << "the untextured material's factor below the equator";
+}
+
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);

@@ -7,6 +7,7 @@
 
 #include "runtime/lod_asset.h"
 #include "test_support.h"
+#include "textured_fixture.h"
 
 namespace lod {
 namespace {
@@ -253,6 +254,44 @@ TEST(BakeJobsCulledLevel, ARatioOfZeroBakesAnEmptyLastLevel) {
   ASSERT_TRUE(s.ok) << s.message;
   EXPECT_EQ(second.cached, 1u);
   EXPECT_EQ(encode_lod_asset(again.at(0)), encode_lod_asset(c));
+}
+
+// A view-dependent textured model: its hierarchy carries uvs and pins its seams; a cached tree
+// from before that rule (no VHAT section) is rebuilt once, with a log line, and the cache
+// rewritten.
+TEST(BakeJobs, ViewDependentTexturedModelsGetUvsAndOldTreesAreRebuilt) {
+  BakeDir d;
+  const fs::path file = test::write_two_material_gltf(d.meshes / "globe", "globe", 12, 24);
+  ASSERT_FALSE(file.empty());
+  ModelConfig m{"globe", file, {}};
+  m.bake.ratios = {1.0f, 0.5f};
+  m.view_dependent = true;
+  std::vector<LodChain> chains;
+  BakeSummary summary;
+  Status s = bake_scene_models({m}, d.cache, 1, chains, summary, d.log);
+  ASSERT_TRUE(s.ok) << s.message;
+  const VertexTree& t = chains[0].hierarchy;
+  ASSERT_FALSE(t.empty());
+  EXPECT_TRUE(t.seams_pinned);
+  ASSERT_EQ(t.uvs.size(), 2 * size_t(t.node_count()));
+  EXPECT_TRUE(std::equal(t.uvs.begin(), t.uvs.begin() + 2 * t.leaf_count, chains[0].uvs.begin()));
+  ASSERT_EQ(d.cache_files().size(), 1u);
+  // Make the cached tree look like one from before (no uvs, seams not pinned).
+  const fs::path cached = d.cache_files()[0];
+  LodChain old;
+  ASSERT_TRUE(read_lod_asset(cached, old).ok);
+  old.hierarchy.uvs.clear();
+  old.hierarchy.seams_pinned = false;
+  ASSERT_TRUE(write_lod_asset(cached, old).ok);
+  s = bake_scene_models({m}, d.cache, 1, chains, summary, d.log);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(summary.cached, 1u);
+  EXPECT_EQ(d.lines_with("before attribute seams were pinned, rebuilding"), 1u);
+  EXPECT_EQ(chains[0].hierarchy.uvs.size(), 2 * size_t(chains[0].hierarchy.node_count()));
+  LodChain again;
+  ASSERT_TRUE(read_lod_asset(cached, again).ok);
+  EXPECT_TRUE(again.hierarchy.seams_pinned);  // rewritten: rebuilt once only
+  EXPECT_EQ(again.hierarchy.uvs, chains[0].hierarchy.uvs);
 }
 
 }  // namespace

@@ -177,5 +177,59 @@ TEST(Geomorph, LevelTargetsByCollapseKeepSurvivorsAndHandleAnEmptyCoarseLevel) {
   EXPECT_EQ(target, (std::vector<uint32_t>{5, 6, 7}));
 }
 
+// Texture coordinates travel with the positions: a split child's uv starts at its parent's
+// shown uv and reaches its own, halfway at half the duration; a collapse takes them to the
+// parent's and settles it there.
+TEST(GeomorphUv, VertexUvsMorphWithThePositions) {
+  VertexTree t = test::square_tree();
+  t.uvs = {0, 0, 1, 0, 1, 1, 0, 1, 0.5f, 0};  // node 4 between its children 0 and 1
+  std::string msg;
+  ASSERT_TRUE(validate_vertex_tree(t, &msg)) << msg;
+  VertexMorph m;
+  vertex_morph_init(m, t, 1.f);
+  const FrontEvent split[] = {{4, FrontEventKind::split}};
+  vertex_morph_apply(m, t, split, 10.0);
+  std::vector<float> uv(2 * size_t(t.node_count()), -1.f);
+  const uint32_t nodes[] = {0, 1, 2, 3};
+  vertex_morph_uvs(uv, m, nodes, 10.0);
+  EXPECT_EQ(uv[0], 0.5f);  // both children at the parent's uv
+  EXPECT_EQ(uv[2], 0.5f);
+  EXPECT_EQ(uv[4], 1.f);  // untouched nodes show their own
+  vertex_morph_uvs(uv, m, nodes, 10.5);
+  EXPECT_FLOAT_EQ(uv[0], 0.25f);  // halfway from 0.5 to 0
+  EXPECT_FLOAT_EQ(uv[2], 0.75f);  // halfway from 0.5 to 1
+  vertex_morph_uvs(uv, m, nodes, 11.0);
+  EXPECT_EQ(uv[0], 0.f);  // arrived, exactly
+  EXPECT_EQ(uv[2], 1.f);
+  const FrontEvent begin[] = {{4, FrontEventKind::collapse_begin}};
+  vertex_morph_apply(m, t, begin, 20.0);
+  vertex_morph_uvs(uv, m, nodes, 20.5);
+  EXPECT_FLOAT_EQ(uv[0], 0.25f);  // on the way to the parent's 0.5
+  EXPECT_FLOAT_EQ(uv[2], 0.75f);
+  const FrontEvent collapse[] = {{4, FrontEventKind::collapse}};
+  vertex_morph_apply(m, t, collapse, 21.0);
+  const uint32_t parent[] = {4};
+  vertex_morph_uvs(uv, m, parent, 21.0);
+  EXPECT_EQ(uv[8], 0.5f);
+  EXPECT_EQ(uv[9], 0.f);
+}
+
+// Discrete level blends: uvs (or any attribute) go from the level's own towards its morph
+// target's in the coarser level, halfway at t = 0.5, exact at both ends.
+TEST(GeomorphUv, LevelBlendPutsUvsHalfwayBetweenTheLevelsAndTheTargets) {
+  const std::vector<float> fine = {0.1f, 0.2f, 0.9f, 0.3f, 0.4f, 0.8f};  // three vertices
+  const std::vector<float> coarse = {0.f, 0.f, 1.f, 1.f};                // two
+  const std::vector<uint32_t> target = {1, 0, 1};
+  std::vector<float> out(fine.size());
+  level_morph_attributes(out, fine, coarse, target, 2, 0.f);
+  EXPECT_EQ(out, fine);
+  level_morph_attributes(out, fine, coarse, target, 2, 0.5f);
+  for (size_t v = 0; v < 3; ++v)
+    for (int k = 0; k < 2; ++k)
+      EXPECT_FLOAT_EQ(out[2 * v + k], 0.5f * (fine[2 * v + k] + coarse[2 * target[v] + k])) << v;
+  level_morph_attributes(out, fine, coarse, target, 2, 1.f);
+  EXPECT_EQ(out, (std::vector<float>{1, 1, 0, 0, 1, 1}));
+}
+
 }  // namespace
 }  // namespace lod
