@@ -26,7 +26,8 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out);
 Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
                              MeshData& out);
 
-// The files an OBJ's materials name (its mtllib files and their map_Kd images, next to it), so
+// The files an OBJ's materials name (its mtllib files and their map_Kd / map_Ke / map_Bump /
+// bump / norm / map_Pm / map_Pr images, next to it), so
 // a cache key can cover them too; missing ones are left out (the load says why).
 std::vector<std::filesystem::path> obj_external_files(const std::filesystem::path& path);
 
