@@ -66,6 +66,25 @@ struct Textures {
   const Solid* emissive = nullptr;
 };
 
+// The unit sphere (normals outward) with one material, as glTF.
+void write_ball(const fs::path& file, const lod::GltfMaterialView& material) {
+  lod::MeshData m = lod::test::two_material_sphere(24, 48);
+  const std::vector<float> normals = m.positions;  // a unit sphere's normals are its positions
+  lod::GltfMeshView view;
+  view.name = file.stem().string();
+  view.positions = m.positions.data();
+  view.vertex_count = m.vertex_count();
+  view.normals = normals.data();
+  view.uvs = m.uvs.data();
+  view.indices = m.indices.data();
+  view.index_count = m.indices.size();
+
+  view.materials = {material};
+  view.submeshes = {{0, m.indices.size(), 0}};
+  const lod::Status saved = lod::save_gltf(file, view);
+  EXPECT_TRUE(saved.ok) << saved.message;
+}
+
 // Renders the sphere with `material` (its image paths filled from `textures`).
 Image render(const std::string& tag, lod::GltfMaterialView material, const Textures& textures,
              const std::string& args = "") {
@@ -81,20 +100,7 @@ Image render(const std::string& tag, lod::GltfMaterialView material, const Textu
   image(textures.occlusion, "occlusion.png", material.occlusion_image);
   image(textures.emissive, "emissive.png", material.emissive_image);
 
-  lod::MeshData m = lod::test::two_material_sphere(24, 48);
-  const std::vector<float> normals = m.positions;  // a unit sphere's normals are its positions
-  lod::GltfMeshView view;
-  view.name = "ball";
-  view.positions = m.positions.data();
-  view.vertex_count = m.vertex_count();
-  view.normals = normals.data();
-  view.uvs = m.uvs.data();
-  view.indices = m.indices.data();
-  view.index_count = m.indices.size();
-  view.materials = {material};
-  view.submeshes = {{0, m.indices.size(), 0}};
-  const lod::Status saved = lod::save_gltf(dir / "ball.gltf", view);
-  EXPECT_TRUE(saved.ok) << saved.message;
+  write_ball(dir / "ball.gltf", material);
 
   const fs::path png = scene.dir / "ball.png";
   const auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300 " + args);
@@ -258,6 +264,57 @@ TEST(ViewerPbr, ColourByLevelIgnoresTheMaterial) {
   EXPECT_GT(px[0], 60) << "lit in level 0's colour";
   EXPECT_NEAR(float(px[1]) / float(px[0]), red[1] / red[0], 0.05) << "level 0's hue";
   EXPECT_NEAR(float(px[2]) / float(px[0]), red[2] / red[0], 0.05) << "level 0's hue";
+}
+
+// BLEND runs are drawn after the opaque ones: a half-transparent sphere in front of an opaque
+// red one, listed (and batched) first, still shows the red one through it; an opaque blue
+// sphere in its place hides it.
+TEST(ViewerPbr, BlendedMaterialsAreDrawnOverTheOpaqueOnesBehind) {
+  LOD_REQUIRE_XVFB();
+  const char* models = "[[model]]\nname = \"glass\"\nfile = \"balls/glass.gltf\"\nratios = [1.0]\n\n"
+                       "[[model]]\nname = \"red\"\nfile = \"balls/red.gltf\"\nratios = [1.0]\n";
+  const char* instances = R"([[instances]]
+model = "glass"
+count = 1
+placement = "grid"
+box_min = [0.0, 0.0, 10.0]
+box_max = [0.0, 0.0, 10.0]
+scale = 4.0
+[[instances]]
+model = "red"
+count = 1
+placement = "grid"
+box_min = [0.0, 0.0, -10.0]
+box_max = [0.0, 0.0, -10.0]
+scale = 9.0
+)";
+  auto centre = [&](const std::string& tag, float alpha, lod::AlphaMode mode) {
+    const auto scene = lod::test::write_viewer_scene("pbr-" + tag, kRun, kCamera, instances, models);
+    fs::create_directories(scene.dir / "balls");
+    lod::GltfMaterialView glass = grey(), red = grey();
+    glass.base_color[0] = glass.base_color[1] = 0.05f, glass.base_color[2] = 0.9f, glass.base_color[3] = alpha;
+    glass.alpha_mode = mode;
+    red.base_color[0] = 0.9f, red.base_color[1] = red.base_color[2] = 0.05f;
+    write_ball(scene.dir / "balls" / "glass.gltf", glass);
+    write_ball(scene.dir / "balls" / "red.gltf", red);
+    const fs::path png = scene.dir / "balls.png";
+    const auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    Image img;
+    EXPECT_TRUE(lod::test::load_png(png, img)) << png;
+    std::array<int, 3> c{};
+    if (img.rgb.empty()) return c;
+    const uint8_t* px = img.at(img.width / 2, img.height / 2);
+    for (int k = 0; k < 3; ++k) c[size_t(k)] = px[k];
+    return c;
+  };
+  const auto blended = centre("blend", 0.4f, lod::AlphaMode::blend);
+  const auto opaque = centre("blend-opaque", 1.f, lod::AlphaMode::opaque);
+  std::printf("centre pixel: blended glass %d %d %d, opaque glass %d %d %d\n", blended[0], blended[1], blended[2], opaque[0],
+              opaque[1], opaque[2]);
+  EXPECT_GT(blended[0], 80) << "the red sphere shows through the blended one";
+  EXPECT_GT(blended[2], 60) << "the blended sphere is drawn";
+  EXPECT_LT(opaque[0], blended[0] - 30) << "an opaque sphere hides the red one";
 }
 
 }  // namespace
