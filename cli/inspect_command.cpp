@@ -105,8 +105,21 @@ void export_surfaces(const LodChain& chain, uint32_t k, GltfMeshView& view) {
 
 ObjSurfaces obj_surfaces(const GltfMeshView& view) {
   ObjSurfaces s;
-  for (const GltfMaterialView& m : view.materials)
-    s.materials.push_back({m.name, {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]}, m.base_color_image});
+  for (const GltfMaterialView& m : view.materials) {
+    ObjMaterialView o;
+    o.name = m.name;
+    std::copy(m.base_color, m.base_color + 4, o.base_color);
+    o.base_color_image = m.base_color_image;
+    o.metallic = m.metallic;
+    o.roughness = m.roughness;
+    o.metallic_roughness_image = m.metallic_roughness_image;
+    o.normal_image = m.normal_image;
+    o.normal_scale = m.normal_scale;
+    o.occlusion_image = m.occlusion_image;
+    o.emissive_image = m.emissive_image;
+    std::copy(m.emissive, m.emissive + 3, o.emissive);
+    s.materials.push_back(std::move(o));
+  }
   for (const GltfSubmeshView& r : view.submeshes) s.submeshes.push_back({r.first_index, r.index_count, r.material});
   s.notes = view.notes;
   return s;

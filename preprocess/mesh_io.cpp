@@ -239,7 +239,7 @@ Status obj_materials(const std::string& name, const fs::path& base_dir, ObjAttri
     const auto it = std::find(found_names.begin(), found_names.end(), attr.material_names[m]);
     if (it != found_names.end()) {
       out.push_back(found[size_t(it - found_names.begin())]);
-      static const char* kStatement[kTextureSlots] = {"map_Kd", "", "map_Bump", "", "map_Ke"};
+      static const char* kStatement[kTextureSlots] = {"map_Kd", "map_Pm / map_Pr", "map_Bump", "", "map_Ke"};
       for (size_t k = 0; k < kTextureSlots; ++k) {
         const std::string& uri = *texture_slots(out.back())[k].uri;
         if (uri.empty() || base_dir.empty()) continue;
@@ -355,7 +355,8 @@ std::vector<std::filesystem::path> obj_external_files(const std::filesystem::pat
     std::vector<uint8_t> m;
     if (!detail::read_regular_file(mtl, m)) continue;
     out.push_back(mtl);
-    for (const std::string& image : statement_files(m, "map_Kd", false)) out.push_back(mtl.parent_path() / image);
+    for (const char* map : {"map_Kd", "map_Ke", "map_Bump", "map_bump", "bump", "norm", "map_Pm", "map_Pr"})
+      for (const std::string& image : statement_files(m, map, false)) out.push_back(mtl.parent_path() / image);
   }
   return out;
 }
@@ -417,33 +418,58 @@ Status check_surfaces(const std::string& what, const ObjSurfaces& s, size_t inde
 // <stem>.mtl and the images it names, copied next to it.
 Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
   std::string text = "# lodkit\nnewmtl lodkit_default\nKd 1 1 1\nd 1\n";
-  char line[160];
+  char line[200];
   std::vector<std::filesystem::path> copied;
+  // The copy's name next to the .mtl, empty when the image is missing or too large (said).
+  auto copy_image = [&](size_t i, const std::filesystem::path& image, std::string& name) -> Status {
+    name.clear();
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(image, ec);
+    if (ec || !std::filesystem::is_regular_file(image, ec) || size > (uintmax_t(256) << 20)) {
+      if (s.notes)
+        s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + image.string() +
+                           " is missing or larger than 256 MiB; written without it");
+      return Status::success();
+    }
+    auto known = std::find(copied.begin(), copied.end(), image);
+    const size_t k = size_t(known - copied.begin());
+    name = obj.stem().string() + "-image" + std::to_string(k) + image.extension().string();
+    if (known == copied.end()) {
+      std::vector<uint8_t> bytes;
+      if (Status r = detail::read_regular_file(image, bytes); !r) return r;
+      if (Status w = write_file_atomic(obj.parent_path() / name, bytes); !w) return w;
+      copied.push_back(image);
+    }
+    return Status::success();
+  };
   for (size_t i = 0; i < s.materials.size(); ++i) {
     const ObjMaterialView& m = s.materials[i];
     text += "newmtl " + obj_material_name(s.materials, int32_t(i)) + "\n";
-    std::snprintf(line, sizeof line, "Kd %.6g %.6g %.6g\nd %.6g\n", m.base_color[0], m.base_color[1], m.base_color[2],
-                  m.base_color[3]);
+    std::snprintf(line, sizeof line, "Kd %.6g %.6g %.6g\nd %.6g\nKe %.6g %.6g %.6g\nPm %.6g\nPr %.6g\n", m.base_color[0],
+                  m.base_color[1], m.base_color[2], m.base_color[3], m.emissive[0], m.emissive[1], m.emissive[2],
+                  m.metallic, m.roughness);
     text += line;
-    if (m.base_color_image.empty()) continue;
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(m.base_color_image, ec);
-    if (ec || !std::filesystem::is_regular_file(m.base_color_image, ec) || size > (uintmax_t(256) << 20)) {
-      if (s.notes)
-        s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + m.base_color_image.string() +
-                           " is missing or larger than 256 MiB; written without it");
-      continue;
+    std::string name;
+    if (!m.base_color_image.empty()) {
+      if (Status r = copy_image(i, m.base_color_image, name); !r) return r;
+      if (!name.empty()) text += "map_Kd " + name + "\n";
     }
-    auto known = std::find(copied.begin(), copied.end(), m.base_color_image);
-    const size_t k = size_t(known - copied.begin());
-    const std::string name = obj.stem().string() + "-image" + std::to_string(k) + m.base_color_image.extension().string();
-    if (known == copied.end()) {
-      std::vector<uint8_t> bytes;
-      if (Status r = detail::read_regular_file(m.base_color_image, bytes); !r) return r;
-      if (Status w = write_file_atomic(obj.parent_path() / name, bytes); !w) return w;
-      copied.push_back(m.base_color_image);
+    if (!m.normal_image.empty()) {
+      if (Status r = copy_image(i, m.normal_image, name); !r) return r;
+      std::snprintf(line, sizeof line, "map_Bump -bm %.6g ", m.normal_scale);
+      if (!name.empty()) text += line + name + "\n";
     }
-    text += "map_Kd " + name + "\n";
+    if (!m.emissive_image.empty()) {
+      if (Status r = copy_image(i, m.emissive_image, name); !r) return r;
+      if (!name.empty()) text += "map_Ke " + name + "\n";
+    }
+    if (!m.metallic_roughness_image.empty()) {
+      if (Status r = copy_image(i, m.metallic_roughness_image, name); !r) return r;
+      if (!name.empty()) text += "map_Pm -imfchan b " + name + "\nmap_Pr -imfchan g " + name + "\n";
+    }
+    if (!m.occlusion_image.empty() && s.notes)
+      s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": occlusion texture " +
+                         m.occlusion_image.string() + " not written (MTL has no occlusion statement)");
   }
   std::filesystem::path mtl = obj;
   mtl.replace_extension(".mtl");

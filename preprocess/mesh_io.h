@@ -26,7 +26,8 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out);
 Status load_mesh_from_memory(const std::string& name, const std::string& extension, const uint8_t* data, size_t size,
                              MeshData& out);
 
-// The files an OBJ's materials name (its mtllib files and their map_Kd images, next to it), so
+// The files an OBJ's materials name (its mtllib files and their map_Kd / map_Ke / map_Bump /
+// bump / norm / map_Pm / map_Pr images, next to it), so
 // a cache key can cover them too; missing ones are left out (the load says why).
 std::vector<std::filesystem::path> obj_external_files(const std::filesystem::path& path);
 
@@ -41,13 +42,23 @@ Status save_obj(const std::filesystem::path& path, const float* positions, const
                 const uint32_t* indices, size_t index_count, const float* uvs = nullptr);
 
 // Materials for save_obj: the faces of each submesh after a "usemtl", the materials in
-// <stem>.mtl next to the .obj ("mtllib"), each with Kd, d and, when it has an image, map_Kd
-// naming a copy of it, <stem>-image<k><ext>, next to the .mtl. An image that is missing or
-// larger than 256 MiB is left out and said in `notes`.
+// <stem>.mtl next to the .obj ("mtllib"), each with Kd, d, Ke, Pm, Pr and, for each image it
+// has, map_Kd, map_Bump -bm (normal scale), map_Ke, and map_Pm -imfchan b + map_Pr -imfchan g
+// (both naming the metallic-roughness image) naming a copy of it, <stem>-image<k><ext>, next to
+// the .mtl (one copy per image however many maps name it). MTL has no occlusion statement: an
+// occlusion image is not written, said in `notes`. An image that is missing or larger than
+// 256 MiB is left out and said in `notes`.
 struct ObjMaterialView {
   std::string name;
   float base_color[4] = {1, 1, 1, 1};
   std::filesystem::path base_color_image;
+  float metallic = 0, roughness = 1;
+  std::filesystem::path metallic_roughness_image;
+  std::filesystem::path normal_image;
+  float normal_scale = 1;
+  std::filesystem::path occlusion_image;
+  std::filesystem::path emissive_image;
+  float emissive[3] = {0, 0, 0};
 };
 struct ObjSubmeshView {
   size_t first_index = 0;

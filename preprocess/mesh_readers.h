@@ -55,7 +55,7 @@ Status read_stl(const std::string& what, const uint8_t* data, size_t size, RawPo
 // vt / vn / usemtl / mtllib go to `attributes`.
 Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPolygons& raw, ObjAttributes& attributes);
 
-// Wavefront MTL (newmtl, Kd, d, Tr, map_Kd) into materials named `names` (as the OBJ uses
+// Wavefront MTL (newmtl, Kd, d, Tr, Ke, Pm, Pr, map_Kd, map_Ke, map_Bump, map_Pm / map_Pr) into materials named `names` (as the OBJ uses
 // them); `what` is the .mtl file for messages. Texture file names become URIs relative to
 // the OBJ's folder (`prefix`: the .mtl's folder relative to it). Other statements are named
 // once in `warnings`.

@@ -11,6 +11,11 @@
 //                          normal texture (read as a tangent-space normal map, as glTF's
 //                          normalTexture; -bm gives its scale). A height-field bump map is
 //                          not converted: it is taken as a normal map.
+//   Pm m / Pr r            metallic / roughness factor (the PBR extension's statements)
+//   map_Pm [-imfchan b] FILE and map_Pr [-imfchan g] FILE
+//                          naming one image: glTF's metallic-roughness texture (metalness in B,
+//                          roughness in G; lodkit's OBJ export writes them so). Separate images
+//                          or other channels cannot be one glTF texture: not imported, said.
 // Ns, Ka, Ks, illum and the other maps have no place in the levels' material: each keyword is
 // named once in the warnings. Errors name the file and line.
 #include <algorithm>
@@ -19,6 +24,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "preprocess/mesh_readers.h"
 #include "preprocess/texture_uri.h"
@@ -39,8 +46,8 @@ std::string_view next_token(std::string_view line, size_t& at) {
 
 // The file a map statement names, after its options ("-s 1 1 1", "-clamp on", ...), each with
 // its values; the rest of the line is the file (names may hold spaces). The value of "-bm"
-// (bump multiplier) goes to `bm` when it is a number.
-std::string_view map_file(std::string_view line, size_t& at, std::string& number, float& bm) {
+// (bump multiplier) goes to `bm` when it is a number, the letter after "-imfchan" to `channel`.
+std::string_view map_file(std::string_view line, size_t& at, std::string& number, float& bm, std::string& channel) {
   for (;;) {
     size_t before = at;
     const std::string_view t = next_token(line, at);
@@ -50,6 +57,10 @@ std::string_view map_file(std::string_view line, size_t& at, std::string& number
       std::string_view file = line.substr(before);
       while (!file.empty() && blank(file.back())) file.remove_suffix(1);
       return file;
+    }
+    if (t == "-imfchan") {
+      channel = std::string(next_token(line, at));
+      continue;
     }
     for (size_t peek = at, values = 0;; ++values) {  // the option's values: numbers, on / off
       const std::string_view v = next_token(line, peek);
@@ -72,6 +83,12 @@ Status read_mtl(const std::string& what, const uint8_t* data, size_t size, const
   if (size >= 3 && data[0] == 0xEF && data[1] == 0xBB && data[2] == 0xBF) text += 3, size -= 3;
   std::set<std::string> skipped;
   MeshMaterial* current = nullptr;
+  // map_Pm / map_Pr per material of this file: {uri, channel}, joined at the end.
+  struct PbrMaps {
+    std::string metallic, metallic_channel, roughness, roughness_channel;
+    size_t line = 0;
+  };
+  std::vector<std::pair<size_t, PbrMaps>> pbr_maps;
   size_t pos = 0, line_no = 0;
   std::string number;
   while (pos < size) {
@@ -124,10 +141,26 @@ Status read_mtl(const std::string& what, const uint8_t* data, size_t size, const
       if (current->base_color[3] < 1) current->alpha_mode = AlphaMode::blend;
     } else if (key == "Ke") {
       if (Status s = numbers(current->emissive, 3, 1); !s) return s;
+    } else if (key == "Pm") {
+      if (Status s = numbers(&current->metallic, 1, 1); !s) return s;
+    } else if (key == "Pr") {
+      if (Status s = numbers(&current->roughness, 1, 1); !s) return s;
+    } else if (key == "map_Pm" || key == "map_Pr") {
+      float bm = 1;
+      std::string channel;
+      const std::string_view file = map_file(line, at, number, bm, channel);
+      if (file.empty()) return Status::error(here + ": " + std::string(key) + " without a file name");
+      const size_t index = materials.size() - 1;
+      if (pbr_maps.empty() || pbr_maps.back().first != index) pbr_maps.push_back({index, {}});
+      PbrMaps& maps = pbr_maps.back().second;
+      maps.line = line_no;
+      (key == "map_Pm" ? maps.metallic : maps.roughness) = path_to_uri(prefix + std::string(file));
+      (key == "map_Pm" ? maps.metallic_channel : maps.roughness_channel) = channel;
     } else if (key == "map_Kd" || key == "map_Ke" || key == "map_Bump" || key == "map_bump" || key == "bump" ||
                key == "norm") {
       float bm = 1;
-      const std::string_view file = map_file(line, at, number, bm);
+      std::string channel;
+      const std::string_view file = map_file(line, at, number, bm, channel);
       if (file.empty()) return Status::error(here + ": " + std::string(key) + " without a file name");
       const std::string uri = path_to_uri(prefix + std::string(file));
       if (key == "map_Kd") {
@@ -145,6 +178,17 @@ Status read_mtl(const std::string& what, const uint8_t* data, size_t size, const
     } else {
       skipped.insert(std::string(key));
     }
+  }
+  for (const auto& [index, maps] : pbr_maps) {
+    const bool packed = maps.metallic == maps.roughness && (maps.metallic_channel.empty() || maps.metallic_channel == "b") &&
+                        (maps.roughness_channel.empty() || maps.roughness_channel == "g");
+    if (packed) {
+      materials[index].metallic_roughness_texture = maps.metallic;
+      continue;
+    }
+    warnings.push_back(what + ":" + std::to_string(maps.line) + ": material '" + names[index] +
+                       "': map_Pm and map_Pr not imported: glTF's metallic-roughness texture is one image with "
+                       "metalness in B and roughness in G (map_Pm -imfchan b and map_Pr -imfchan g naming it)");
   }
   if (!skipped.empty()) {
     std::string list;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <utility>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "viewer/level_palette.h"
@@ -62,18 +63,36 @@ uniform vec3 u_colour;        // a material's base colour factor (rgb) or the mo
 uniform float u_alpha;        // the factor's alpha
 uniform float u_alpha_cutoff; // alpha mode MASK: fragments below are dropped; < 0 otherwise
 uniform int u_textured;
-uniform sampler2D u_texture;  // base colour, unit 0
+uniform sampler2D u_texture;  // base colour (sRGB, read as linear), unit 0
 uniform int u_normal_mapped;
 uniform sampler2D u_normal_texture;  // tangent-space normals, unit 1
 uniform float u_normal_scale;
 uniform int u_flat;
 uniform int u_show_morph;
+// Materials (u_pbr = 1): glTF's metallic-roughness model, lit by a sun and a sky/ground
+// hemisphere, in linear light, written sRGB-encoded. Plain draws keep the headlight term.
+uniform int u_pbr;
+uniform float u_metallic;
+uniform float u_roughness;
+uniform int u_mr_mapped;
+uniform sampler2D u_mr_texture;         // G = roughness, B = metallic, unit 2
+uniform int u_occlusion_mapped;
+uniform sampler2D u_occlusion_texture;  // R = occlusion, unit 3
+uniform float u_occlusion_strength;
+uniform vec3 u_emissive;
+uniform int u_emissive_mapped;
+uniform sampler2D u_emissive_texture;   // sRGB, unit 4
+uniform vec3 u_sun_view;  // unit vector towards the sun, view space
+uniform vec3 u_up_view;   // world up, view space
 out vec4 o_colour;
+const float kPi = 3.14159265;
+const vec3 kSun = vec3(3.0, 2.9, 2.75);  // irradiance of a surface facing the sun
+const vec3 kSkyAmbient = vec3(0.36);     // neutral, so that hues stay the material's
+const vec3 kGroundAmbient = vec3(0.14);
 // The normal texture's normal in view space, on the tangent frame the screen-space derivatives
 // of position and uv give (Schueler's cotangent frame: no tangent attribute needed). glTF's
 // +Y is up the image, i.e. towards decreasing v: hence -b.
-vec3 mapped_normal(vec3 n) {
-  vec3 m = texture(u_normal_texture, v_uv).xyz * 2.0 - 1.0;  // before any branch: implicit lod
+vec3 mapped_normal(vec3 n, vec3 m) {
   vec3 dp1 = dFdx(v_position_view), dp2 = dFdy(v_position_view);
   vec2 duv1 = dFdx(v_uv), duv2 = dFdy(v_uv);
   vec3 dp2perp = cross(dp2, n), dp1perp = cross(n, dp1);
@@ -85,15 +104,54 @@ vec3 mapped_normal(vec3 n) {
   m.xy *= u_normal_scale;
   return normalize(mat3(t * inv, -b * inv, n) * m);
 }
+vec3 srgb_encode(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
+// glTF 2.0 appendix B: Schlick Fresnel, GGX distribution, height-correlated Smith visibility,
+// Lambert diffuse for the dielectric part; the hemisphere ambient takes Fresnel's roughness-
+// aware average (no environment map) and is what occlusion darkens.
+vec3 shade_pbr(vec3 n, vec3 v, vec3 base, float metallic, float roughness, float ao) {
+  vec3 c_diff = mix(base, vec3(0.0), metallic);
+  vec3 f0 = mix(vec3(0.04), base, metallic);
+  float a = roughness * roughness, a2 = a * a;
+  vec3 l = u_sun_view, h = normalize(l + v);
+  float nl = max(dot(n, l), 0.0), nv = max(dot(n, v), 1e-4), nh = max(dot(n, h), 0.0), vh = max(dot(v, h), 0.0);
+  vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
+  float dd = nh * nh * (a2 - 1.0) + 1.0;
+  float d = a2 / (kPi * dd * dd);
+  float vis = 0.5 / max(nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2), 1e-6);
+  vec3 direct = ((1.0 - f) * c_diff / kPi + f * d * vis) * kSun * nl;
+  vec3 sky = mix(kGroundAmbient, kSkyAmbient, dot(n, u_up_view) * 0.5 + 0.5);
+  vec3 fa = f0 + (max(vec3(1.0 - roughness), f0) - f0) * pow(1.0 - nv, 5.0);
+  vec3 ambient = ((1.0 - fa) * c_diff + fa) * sky * ao;
+  return direct + ambient;
+}
 void main() {
+  // Every texture is sampled before any non-uniform branch, so mipmapping sees its derivatives.
+  vec4 base_texel = texture(u_texture, v_uv);
+  vec3 normal_texel = texture(u_normal_texture, v_uv).xyz * 2.0 - 1.0;
+  vec4 mr_texel = texture(u_mr_texture, v_uv);
+  float occlusion_texel = texture(u_occlusion_texture, v_uv).r;
+  vec3 emissive_texel = texture(u_emissive_texture, v_uv).rgb;
   vec3 face = normalize(cross(dFdx(v_position_view), dFdy(v_position_view)));
   vec3 n = (u_flat != 0 || dot(v_normal_view, v_normal_view) < 1e-12) ? face : normalize(v_normal_view);
-  if (u_normal_mapped != 0 && u_flat == 0) n = mapped_normal(n);
+  if (u_normal_mapped != 0 && u_flat == 0) n = mapped_normal(n, normal_texel);
   vec3 to_eye = normalize(-v_position_view);
-  float lambert = abs(dot(n, to_eye));  // headlight; abs so either winding is lit
   vec4 surface = vec4(u_colour, u_alpha);
-  if (u_textured != 0) surface *= texture(u_texture, v_uv);
+  if (u_textured != 0) surface *= base_texel;
   if (surface.a < u_alpha_cutoff) discard;
+  if (u_pbr != 0) {
+    if (dot(n, to_eye) < 0.0) n = -n;  // two-sided: the side seen is lit (no culling, mixed windings)
+    float metallic = u_metallic, roughness = u_roughness;
+    if (u_mr_mapped != 0) roughness *= mr_texel.g, metallic *= mr_texel.b;
+    float ao = u_occlusion_mapped != 0 ? 1.0 + u_occlusion_strength * (occlusion_texel - 1.0) : 1.0;
+    vec3 emissive = u_emissive * (u_emissive_mapped != 0 ? emissive_texel : vec3(1.0));
+    vec3 lit = shade_pbr(n, to_eye, surface.rgb, clamp(metallic, 0.0, 1.0), clamp(roughness, 0.03, 1.0), ao);
+    o_colour = vec4(srgb_encode(lit + emissive), surface.a);
+    return;
+  }
+  float lambert = abs(dot(n, to_eye));  // headlight; abs so either winding is lit
   vec3 base = surface.rgb;
   if (u_show_morph != 0) base = mix(base, vec3(1.0), 0.5 * clamp(1.0 - v_morph, 0.0, 1.0));
   o_colour = vec4(base * (0.25 + 0.75 * lambert), surface.a);
@@ -118,6 +176,22 @@ void point_instance_attributes(size_t offset) {
 // Material colours are drawn unless a mode colours the draws.
 bool draws_materials(const RenderSettings& settings) { return !settings.colour_override && !settings.colour_by_level; }
 
+RunPass run_pass(const MeshBuffers& meshes, const MaterialRun& run) {
+  const auto& materials = meshes.materials().materials();
+  const bool blend = run.material >= 0 && size_t(run.material) < materials.size() &&
+                     materials[size_t(run.material)].alpha_mode == AlphaMode::blend;
+  return blend ? RunPass::blend : RunPass::opaque;
+}
+
+bool has_blend_runs(const MeshBuffers& meshes, const LevelRange& r) {
+  for (uint32_t k = r.first_run; k < r.first_run + r.run_count; ++k)
+    if (run_pass(meshes, meshes.layout().runs[k]) == RunPass::blend) return true;
+  return false;
+}
+
+// The sun of the terrain's shading, in world space (y up).
+constexpr glm::vec3 kSunDirection = {0.45f, 0.8f, 0.35f};
+
 }  // namespace
 
 void InstanceRenderer::set_plain_surface(const std::array<float, 3>& c) {
@@ -126,11 +200,16 @@ void InstanceRenderer::set_plain_surface(const std::array<float, 3>& c) {
   glUniform1f(u_alpha_cutoff_, -1.f);
   glUniform1i(u_textured_, 0);
   glUniform1i(u_normal_mapped_, 0);
+  glUniform1i(u_pbr_, 0);
+  glUniform1i(u_mr_mapped_, 0);
+  glUniform1i(u_occlusion_mapped_, 0);
+  glUniform1i(u_emissive_mapped_, 0);
   glDisable(GL_BLEND);
 }
 
-// BLEND materials blend over what is drawn before them, in draw order (no sorting); MASK ones
-// drop the fragments below their cutoff.
+// BLEND materials blend over what is drawn before them (draw() draws them after the opaque
+// runs, without depth writes; no sorting among them); MASK ones drop the fragments below their
+// cutoff. Each texture the material has goes to its unit (0 base colour .. 4 emissive).
 void InstanceRenderer::set_material(const GpuMaterial& m) {
   glUniform3f(u_colour_, m.base_color[0], m.base_color[1], m.base_color[2]);
   glUniform1f(u_alpha_, m.base_color[3]);
@@ -144,6 +223,20 @@ void InstanceRenderer::set_material(const GpuMaterial& m) {
     glBindTexture(GL_TEXTURE_2D, m.normal_texture);
     glActiveTexture(GL_TEXTURE0);
   }
+  glUniform1i(u_pbr_, 1);
+  glUniform1f(u_metallic_, m.metallic);
+  glUniform1f(u_roughness_, m.roughness);
+  glUniform1f(u_occlusion_strength_, m.occlusion_strength);
+  glUniform3f(u_emissive_, m.emissive[0], m.emissive[1], m.emissive[2]);
+  const std::pair<GLuint, GLint> units[] = {
+      {m.metallic_roughness_texture, u_mr_mapped_}, {m.occlusion_texture, u_occlusion_mapped_}, {m.emissive_texture, u_emissive_mapped_}};
+  for (int k = 0; k < 3; ++k) {
+    glUniform1i(units[k].second, units[k].first ? 1 : 0);
+    if (!units[k].first) continue;
+    glActiveTexture(GLenum(GL_TEXTURE2 + k));
+    glBindTexture(GL_TEXTURE_2D, units[k].first);
+  }
+  glActiveTexture(GL_TEXTURE0);
   if (m.alpha_mode == AlphaMode::blend) {
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -154,21 +247,23 @@ void InstanceRenderer::set_material(const GpuMaterial& m) {
 
 // One level range: a draw per material run in material mode (when the chain has materials),
 // else one draw in the colour already set. `base_vertex` is 0 when the vertex attributes were
-// re-pointed at the level's first vertex.
+// re-pointed at the level's first vertex. `pass`: the runs of that pass only (the range without
+// materials belongs to the opaque pass).
 void InstanceRenderer::draw_range(const MeshBuffers& meshes, const LevelRange& r, uint32_t instances,
-                                  int32_t base_vertex, const RenderSettings& settings) {
+                                  int32_t base_vertex, const RenderSettings& settings, RunPass pass) {
   auto draw = [&](uint32_t first_index, uint32_t count) {
     glDrawElementsInstancedBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
                                       reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)),
                                       GLsizei(instances), base_vertex);
   };
   if (!draws_materials(settings) || r.run_count == 0) {
-    draw(r.first_index, r.index_count);
+    if (pass == RunPass::opaque) draw(r.first_index, r.index_count);
     return;
   }
   const auto& materials = meshes.materials().materials();
   for (uint32_t k = r.first_run; k < r.first_run + r.run_count; ++k) {
     const MaterialRun& run = meshes.layout().runs[k];
+    if (run_pass(meshes, run) != pass) continue;
     if (run.material >= 0 && size_t(run.material) < materials.size()) {
       set_material(materials[size_t(run.material)]);
     } else {
@@ -199,9 +294,22 @@ bool InstanceRenderer::init(std::string* message) {
   u_textured_ = glGetUniformLocation(program_, "u_textured");
   u_normal_mapped_ = glGetUniformLocation(program_, "u_normal_mapped");
   u_normal_scale_ = glGetUniformLocation(program_, "u_normal_scale");
+  u_pbr_ = glGetUniformLocation(program_, "u_pbr");
+  u_metallic_ = glGetUniformLocation(program_, "u_metallic");
+  u_roughness_ = glGetUniformLocation(program_, "u_roughness");
+  u_mr_mapped_ = glGetUniformLocation(program_, "u_mr_mapped");
+  u_occlusion_mapped_ = glGetUniformLocation(program_, "u_occlusion_mapped");
+  u_occlusion_strength_ = glGetUniformLocation(program_, "u_occlusion_strength");
+  u_emissive_ = glGetUniformLocation(program_, "u_emissive");
+  u_emissive_mapped_ = glGetUniformLocation(program_, "u_emissive_mapped");
+  u_sun_view_ = glGetUniformLocation(program_, "u_sun_view");
+  u_up_view_ = glGetUniformLocation(program_, "u_up_view");
   glUseProgram(program_);
   glUniform1i(glGetUniformLocation(program_, "u_texture"), 0);
   glUniform1i(glGetUniformLocation(program_, "u_normal_texture"), 1);
+  glUniform1i(glGetUniformLocation(program_, "u_mr_texture"), 2);
+  glUniform1i(glGetUniformLocation(program_, "u_occlusion_texture"), 3);
+  glUniform1i(glGetUniformLocation(program_, "u_emissive_texture"), 4);
   glUseProgram(0);
   glGenBuffers(1, &instance_vbo_);
   glGenQueries(1, &query_);
@@ -218,6 +326,10 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
   glUniform1i(u_show_morph_, settings.colour_by_level ? 1 : 0);
   glUniform1i(u_blend_, 0);
+  const glm::vec3 sun = glm::normalize(glm::mat3(view) * glm::normalize(kSunDirection));
+  const glm::vec3 up = glm::normalize(glm::mat3(view) * glm::vec3(0, 1, 0));
+  glUniform3f(u_sun_view_, sun.x, sun.y, sun.z);
+  glUniform3f(u_up_view_, up.x, up.y, up.z);
   glActiveTexture(GL_TEXTURE0);
   set_plain_surface(kModelColour);
 
@@ -239,7 +351,8 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
 
-  for (const DrawBatch& b : list.batches) {
+  // Opaque (and masked) runs first, then the blended ones over them without depth writes.
+  auto draw_batch = [&](const DrawBatch& b, RunPass pass) {
     // GL 3.3 has no base instance: point the instance attributes at the batch's first one.
     point_instance_attributes(size_t(b.first_instance) * sizeof(InstanceData));
     const auto& c = settings.colour_override ? settings.colour
@@ -271,7 +384,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
       glVertexAttribPointer(kAttribTargetUv, 2, GL_FLOAT, GL_FALSE, kStride,
                             reinterpret_cast<const void*>(target + 6 * sizeof(float)));
       glUniform1i(u_blend_, 1);
-      draw_range(meshes, r, b.instance_count, 0, settings);
+      draw_range(meshes, r, b.instance_count, 0, settings, pass);
       glUniform1i(u_blend_, 0);
       glDisableVertexAttribArray(kAttribTargetPosition);
       glDisableVertexAttribArray(kAttribTargetNormal);
@@ -283,13 +396,22 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
       glBindBuffer(GL_ARRAY_BUFFER, meshes.uv_vbo());
       glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
       glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
-      ++stats.morph_draws;
+      if (pass == RunPass::opaque) ++stats.morph_draws;
     } else {
-      draw_range(meshes, r, b.instance_count, r.base_vertex, settings);
+      draw_range(meshes, r, b.instance_count, r.base_vertex, settings, pass);
     }
+    if (pass != RunPass::opaque) return;
     ++stats.draws;
     stats.instances += b.instance_count;
     stats.triangles += uint64_t(r.index_count / 3) * b.instance_count;
+  };
+  for (const DrawBatch& b : list.batches) draw_batch(b, RunPass::opaque);
+  if (draws_materials(settings)) {
+    glDepthMask(GL_FALSE);
+    for (const DrawBatch& b : list.batches)
+      if (has_blend_runs(meshes, meshes.layout().ranges[b.range])) draw_batch(b, RunPass::blend);
+    glDepthMask(GL_TRUE);
+    set_plain_surface(kModelColour);
   }
 
   if (vd && !list.vd.empty()) {

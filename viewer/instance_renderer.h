@@ -1,9 +1,11 @@
 // InstanceRenderer: draws a DrawList with one instanced draw per (model, level, target level)
 // batch; per-instance position, scale, rotation quaternion, geomorph factor and blend weight are vertex
 // attributes with divisor 1. A blended batch adds the composed morph-target stream of its
-// (level, target level) pair as a second vertex stream. Lighting is a headlight Lambert term.
-// Unless a mode colours the draws (colour-by-level, an override colour), each level is drawn
-// run by run with its materials: base colour factor x base colour texture.
+// (level, target level) pair as a second vertex stream. Plain draws are lit by a headlight
+// Lambert term. Unless a mode colours the draws (colour-by-level, an override colour), each
+// level is drawn run by run with its materials, shaded with glTF's metallic-roughness BRDF
+// (base colour, metallic-roughness, normal, occlusion and emissive textures and factors) under
+// a sun and a sky/ground ambient; blended runs after the opaque ones.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -49,6 +51,9 @@ struct DrawStats {
   int64_t gpu_primitives = -1;   // what the GL counted, when count_primitives; else -1
 };
 
+// Which runs a draw_range call draws: opaque and masked ones, or blended ones.
+enum class RunPass { opaque, blend };
+
 class InstanceRenderer {
  public:
   InstanceRenderer() = default;
@@ -79,7 +84,7 @@ class InstanceRenderer {
   void set_plain_surface(const std::array<float, 3>& colour);
   void set_material(const GpuMaterial& material);
   void draw_range(const MeshBuffers& meshes, const LevelRange& r, uint32_t instances, int32_t base_vertex,
-                  const RenderSettings& settings);
+                  const RenderSettings& settings, RunPass pass);
 
   GLuint program_ = 0;
   GLuint instance_vbo_ = 0;
@@ -87,6 +92,8 @@ class InstanceRenderer {
   size_t instance_capacity_ = 0;
   GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1, u_blend_ = -1;
   GLint u_alpha_ = -1, u_alpha_cutoff_ = -1, u_textured_ = -1, u_normal_mapped_ = -1, u_normal_scale_ = -1;
+  GLint u_pbr_ = -1, u_metallic_ = -1, u_roughness_ = -1, u_mr_mapped_ = -1, u_occlusion_mapped_ = -1;
+  GLint u_occlusion_strength_ = -1, u_emissive_ = -1, u_emissive_mapped_ = -1, u_sun_view_ = -1, u_up_view_ = -1;
 };
 
 }  // namespace lod::viewer

@@ -1,7 +1,9 @@
 #include "viewer/material_textures.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
+#include <utility>
 
 #include <stb_image.h>  // Debian's libstb.so holds the implementation
 
@@ -36,12 +38,13 @@ std::vector<unsigned char> decode_image(const std::string& file, int& width, int
 
 // A mipmapped, repeating RGBA8 texture. The image's rows go up as stored: glTF's uv origin is
 // the image's top left, which is where GL's t = 0 row (the first uploaded) sits.
-GLuint make_texture(const std::vector<unsigned char>& rgba, int width, int height) {
+// `srgb`: colour images, decoded to linear by the GL when sampled (and when mipmapped).
+GLuint make_texture(const std::vector<unsigned char>& rgba, int width, int height, bool srgb) {
   GLuint t = 0;
   glGenTextures(1, &t);
   glBindTexture(GL_TEXTURE_2D, t);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  glTexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
   glGenerateMipmap(GL_TEXTURE_2D);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -58,10 +61,13 @@ MaterialTextures::~MaterialTextures() {
 }
 
 void MaterialTextures::upload(std::span<const LodChain> chains) {
-  std::map<std::string, GLuint> by_file;  // decoded once per file; 0 = could not be read
+  // Decoded once per (file, colour space); 0 = could not be read. A file that cannot be read is
+  // said once, whatever the slots naming it.
+  std::map<std::pair<std::string, bool>, GLuint> by_file;
+  std::map<std::string, bool> unreadable;
   for (const LodChain& chain : chains) {
     // The texture a URI names, decoded at its first use; 0 when it cannot be read (said once).
-    auto texture_of = [&](const ChainMaterial& m, const std::string& uri) -> GLuint {
+    auto texture_of = [&](const ChainMaterial& m, const std::string& uri, bool srgb) -> GLuint {
       if (uri.empty()) return 0;
       const std::string file = texture_file(chain.texture_base, uri).string();
       if (file.empty()) {
@@ -69,19 +75,21 @@ void MaterialTextures::upload(std::span<const LodChain> chains) {
                      chain.name.c_str(), m.name.c_str(), uri.c_str());
         return 0;
       }
-      if (auto it = by_file.find(file); it != by_file.end()) return it->second;
+      if (auto it = by_file.find({file, srgb}); it != by_file.end()) return it->second;
+      if (unreadable.count(file)) return 0;
       int w = 0, h = 0;
       std::string why;
       const std::vector<unsigned char> rgba = decode_image(file, w, h, why);
       GLuint t = 0;
       if (rgba.empty()) {
         std::fprintf(stderr, "lod-viewer: texture %s: %s; drawn without it\n", file.c_str(), why.c_str());
+        unreadable[file] = true;
       } else {
-        t = make_texture(rgba, w, h);
+        t = make_texture(rgba, w, h, srgb);
         textures_.push_back(t);
         bytes_ += rgba.size() * 4 / 3;  // with its mipmaps
       }
-      by_file[file] = t;
+      by_file[{file, srgb}] = t;
       return t;
     };
     for (const ChainMaterial& m : chain.materials) {
@@ -89,9 +97,17 @@ void MaterialTextures::upload(std::span<const LodChain> chains) {
       std::copy(m.base_color, m.base_color + 4, g.base_color);
       g.alpha_mode = m.alpha_mode;
       g.alpha_cutoff = m.alpha_cutoff;
-      g.texture = texture_of(m, m.base_color_texture);
-      g.normal_texture = texture_of(m, m.normal_texture);
+      g.double_sided = m.double_sided;
+      g.texture = texture_of(m, m.base_color_texture, true);
+      g.normal_texture = texture_of(m, m.normal_texture, false);
       g.normal_scale = m.normal_scale;
+      g.metallic = m.metallic;
+      g.roughness = m.roughness;
+      g.metallic_roughness_texture = texture_of(m, m.metallic_roughness_texture, false);
+      g.occlusion_texture = texture_of(m, m.occlusion_texture, false);
+      g.occlusion_strength = m.occlusion_strength;
+      g.emissive_texture = texture_of(m, m.emissive_texture, true);
+      std::copy(m.emissive, m.emissive + 3, g.emissive);
       materials_.push_back(g);
     }
   }

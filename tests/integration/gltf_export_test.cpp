@@ -385,6 +385,55 @@ TEST(GltfExport, ColoursAndTexcoord1SurviveBakeExportAndImport) {
   std::printf("%s", v.out.c_str());
 }
 
+// The same material through OBJ export: the .mtl names every map MTL has a statement for
+// (map_Kd, map_Bump -bm with the normal scale, map_Ke with Ke, map_Pm / map_Pr naming the
+// metallic-roughness image, Pm / Pr), each image copied next to it byte for byte, and imports
+// back with them; occlusion has no MTL statement: not written, and said.
+TEST(GltfExport, ObjKeepsEveryMapMtlHasAStatementFor) {
+  const fs::path dir = lod::test::temp_dir("obj-materials-every-slot");
+  const fs::path source = lod::test::write_two_material_gltf(dir / "src", "globe", 24, 48, /*every_texture=*/true);
+  ASSERT_FALSE(source.empty());
+  auto r = run_lod("bake " + source.string() + " -o " + (dir / "out").string() + " --ratios 1 0.5 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = run_lod("inspect " + baked_asset(dir / "out").string() + " --export " + (dir / "obj").string() + " --format obj");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("occlusion texture"), std::string::npos) << "the dropped occlusion map is said: " << r.out;
+  for (size_t i = 0; i < 2; ++i) {
+    SCOPED_TRACE("level " + std::to_string(i));
+    const fs::path level = dir / "obj" / ("globe-level" + std::to_string(i) + ".obj");
+    std::ifstream mtl(fs::path(level).replace_extension(".mtl"));
+    const std::string text{std::istreambuf_iterator<char>(mtl), std::istreambuf_iterator<char>()};
+    EXPECT_NE(text.find("map_Bump -bm 0.625 "), std::string::npos) << text;
+    EXPECT_NE(text.find("Ke 0.5 0.25 0.125"), std::string::npos) << text;
+    EXPECT_NE(text.find("map_Pm -imfchan b "), std::string::npos) << text;
+    EXPECT_NE(text.find("map_Pr -imfchan g "), std::string::npos) << text;
+    lod::MeshData back;
+    const lod::Status s = lod::load_mesh(level, back);
+    ASSERT_TRUE(s.ok) << s.message;
+    for (const std::string& w : back.warnings) EXPECT_EQ(w.find("not imported"), std::string::npos) << w;
+    ASSERT_EQ(back.materials.size(), 2u);
+    const lod::MeshMaterial& m = back.materials[0];
+    EXPECT_FLOAT_EQ(m.metallic, 0.0f);
+    EXPECT_FLOAT_EQ(m.roughness, 0.5f);
+    EXPECT_FLOAT_EQ(m.normal_scale, 0.625f);
+    EXPECT_FLOAT_EQ(m.emissive[0], 0.5f);
+    EXPECT_FLOAT_EQ(m.emissive[1], 0.25f);
+    EXPECT_FLOAT_EQ(m.emissive[2], 0.125f);
+    EXPECT_TRUE(m.occlusion_texture.empty());
+    const auto slots = lod::texture_slots(m);
+    for (size_t k : {0, 1, 2, 4}) {
+      SCOPED_TRACE("slot " + std::to_string(k));
+      ASSERT_FALSE(slots[k].uri->empty());
+      EXPECT_EQ(lod::test::read_bytes(dir / "obj" / *slots[k].uri),
+                lod::test::read_bytes(dir / "src" / ("globe-image" + std::to_string(k) + ".png")));
+    }
+    const lod::MeshMaterial& plain = back.materials[1];
+    EXPECT_TRUE(plain.normal_texture.empty() && plain.emissive_texture.empty() && plain.metallic_roughness_texture.empty());
+    EXPECT_FLOAT_EQ(plain.metallic, 1.0f) << "Pm keeps the glTF default";
+    EXPECT_FLOAT_EQ(plain.base_color[0], 0.8f);
+  }
+}
+
 // A texture that is gone by export time: the level is written without it, and said so.
 TEST(GltfExport, AMissingTextureIsLeftOutAndSaid) {
   const fs::path dir = lod::test::temp_dir("gltf-materials-missing");

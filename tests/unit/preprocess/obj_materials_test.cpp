@@ -156,6 +156,34 @@ TEST(ObjMaterials, BumpAndKeBecomeNormalAndEmissive) {
   EXPECT_TRUE(chain.materials[1].metallic_roughness_texture.empty());
 }
 
+// The PBR extension's Pm / Pr set the factors; map_Pm and map_Pr naming one image (B
+// metalness, G roughness, as lodkit's OBJ export writes them) become the metallic-roughness
+// texture; separate images cannot be one glTF texture: not imported, said naming the line.
+TEST(ObjMaterials, PmPrAndOnePackedMetallicRoughnessImage) {
+  const char* mtl = R"(newmtl left
+Pm 0.25
+Pr 0.75
+map_Pm -imfchan b tex dir/wood.png
+map_Pr -imfchan g tex dir/wood.png
+newmtl right
+map_Pm tex dir/wood.png
+map_Pr tex dir/other.png
+)";
+  const fs::path obj = write_quads("obj-pbr", kObj, mtl);
+  MeshData m;
+  const Status s = load_mesh(obj, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_FLOAT_EQ(m.materials[0].metallic, 0.25f);
+  EXPECT_FLOAT_EQ(m.materials[0].roughness, 0.75f);
+  EXPECT_EQ(m.materials[0].metallic_roughness_texture, "tex%20dir/wood.png");
+  EXPECT_TRUE(m.materials[1].metallic_roughness_texture.empty());
+  EXPECT_FLOAT_EQ(m.materials[1].metallic, 0.0f) << "OBJ's materials stay dielectric without Pm";
+  bool said = false;
+  for (const std::string& w : m.warnings) said |= w.find("quads.mtl:8: material 'right': map_Pm and map_Pr not imported") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 struct Hostile {
   const char* name;
   std::string obj, mtl;
