@@ -135,7 +135,7 @@ TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
   EXPECT_EQ(t.get(t.rows.size() - 1, "vd_objects"), 1) << "drawn from its active front";
   Image img;
   ASSERT_TRUE(lod::test::load_png(lit, img));
-  const HueCounts m = count_hues(img);
+  const HueCounts m = count_hues(img, kPresent);
   EXPECT_GE(m.light_above, 300) << "light checker squares on the view-dependent cap";
   EXPECT_GE(m.dark_above, 300) << "dark checker squares on the view-dependent cap";
   EXPECT_GE(m.base_below, 300) << "the untextured material's factor below the equator";
