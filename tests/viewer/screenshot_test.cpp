@@ -28,18 +28,7 @@ triangles = 1000000
 )";
 
 // Camera at z = 30 looking at the origin; sphere at x = -8, box at x = +8, nothing between.
-const char* kFrontCamera = R"([camera]
-fov_deg = 60
-width = 1280
-height = 720
-path = "keyframes"
-near = 0.5
-far = 500.0
-[[camera.keyframe]]
-frame = 0
-position = [0.0, 0.0, 30.0]
-look_at = [0.0, 0.0, 0.0]
-)";
+const std::string kFrontCamera = lod::test::front_camera(1280, 720);
 
 const char* kTwoObjects = R"([[instances]]
 model = "sphere"

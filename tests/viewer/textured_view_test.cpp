@@ -18,18 +18,7 @@ using lod::test::Image;
 
 const char* kRun = "[run]\nframes = 1\nthreads = 1\n[budget]\ntriangles = 1000000\n";
 
-const char* kCamera = R"([camera]
-fov_deg = 60
-width = 400
-height = 300
-path = "keyframes"
-near = 0.5
-far = 500.0
-[[camera.keyframe]]
-frame = 0
-position = [0.0, 0.0, 30.0]
-look_at = [0.0, 0.0, 0.0]
-)";
+const std::string kCamera = lod::test::front_camera(400, 300);
 
 const char* kModel = R"([[model]]
 name = "textured"

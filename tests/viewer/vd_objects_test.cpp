@@ -26,18 +26,7 @@ triangles = 1000000
 )";
 
 // Camera at z = 30 looking at the origin.
-const char* kFrontCamera = R"([camera]
-fov_deg = 60
-width = 1280
-height = 720
-path = "keyframes"
-near = 0.5
-far = 500.0
-[[camera.keyframe]]
-frame = 0
-position = [0.0, 0.0, 30.0]
-look_at = [0.0, 0.0, 0.0]
-)";
+const std::string kFrontCamera = lod::test::front_camera(1280, 720);
 
 // The generated sphere again, as a view-dependent model.
 const char* kVdModel = R"([[model]]

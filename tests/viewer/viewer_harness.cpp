@@ -13,6 +13,12 @@
 
 namespace lod::test {
 
+std::string front_camera(int width, int height) {
+  return "[camera]\nfov_deg = 60\nwidth = " + std::to_string(width) + "\nheight = " + std::to_string(height) +
+         "\npath = \"keyframes\"\nnear = 0.5\nfar = 500.0\n[[camera.keyframe]]\nframe = 0\n"
+         "position = [0.0, 0.0, 30.0]\nlook_at = [0.0, 0.0, 0.0]\n";
+}
+
 std::string box_off(int n) {
   // Vertices on the cube's surface lattice, keyed by integer coordinates so that the faces
   // share their edge vertices (a closed, welded mesh).

@@ -11,6 +11,9 @@ namespace lod::test {
 // Closed cube [-1, 1]^3 as OFF text, each face an n x n grid of quads (welded along edges).
 std::string box_off(int n);
 
+// A [camera] block of one keyframe at z = 30 looking at the origin (60 degrees, near 0.5, far 500).
+std::string front_camera(int width, int height);
+
 struct ViewerScene {
   std::filesystem::path dir;     // holds config.toml, the meshes, the cache and outputs
   std::filesystem::path config;
