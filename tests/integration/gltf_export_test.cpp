@@ -53,6 +53,15 @@ lod::test::CliResult run_validator(const std::vector<fs::path>& files) {
   return lod::test::run_shell(cmd);
 }
 
+// The validator on every exported file: exit 0 and "errors 0" for each; its output (printed).
+std::string expect_valid(const std::vector<fs::path>& exported) {
+  const auto v = run_validator(exported);
+  EXPECT_EQ(v.code, 0) << v.out;
+  for (const fs::path& f : exported) EXPECT_NE(v.out.find(f.string() + ": errors 0 "), std::string::npos) << v.out;
+  std::printf("%s", v.out.c_str());
+  return v.out;
+}
+
 fs::path baked_asset(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().extension() == ".lod") return e.path();
@@ -101,10 +110,7 @@ TEST(GltfExport, EveryExportedLevelPassesTheKhronosValidator) {
       }
     }
   }
-  const auto v = run_validator(exported);
-  EXPECT_EQ(v.code, 0) << v.out;
-  for (const fs::path& f : exported) EXPECT_NE(v.out.find(f.string() + ": errors 0 "), std::string::npos) << v.out;
-  std::printf("%s", v.out.c_str());
+  expect_valid(exported);
 }
 
 // The validator itself must catch a broken file, or the test above proves nothing.
@@ -245,10 +251,7 @@ TEST(GltfExport, MaterialsAndTexturesThroughEveryExportedLevel) {
       }
     }
   }
-  const auto v = run_validator(exported);
-  EXPECT_EQ(v.code, 0) << v.out;
-  for (const fs::path& f : exported) EXPECT_NE(v.out.find(f.string() + ": errors 0 "), std::string::npos) << v.out;
-  std::printf("%s", v.out.c_str());
+  expect_valid(exported);
 }
 
 // Every material field and texture slot through glTF -> bake -> export -> import: material 0
@@ -326,11 +329,8 @@ TEST(GltfExport, EveryTextureSlotSurvivesBakeExportAndImport) {
       }
     }
   }
-  const auto v = run_validator(exported);
-  EXPECT_EQ(v.code, 0) << v.out;
-  for (const fs::path& f : exported) EXPECT_NE(v.out.find(f.string() + ": errors 0 "), std::string::npos) << v.out;
-  EXPECT_EQ(v.out.find("MESH_PRIMITIVE_GENERATED_TANGENT_SPACE"), std::string::npos) << v.out;
-  std::printf("%s", v.out.c_str());
+  const std::string out = expect_valid(exported);
+  EXPECT_EQ(out.find("MESH_PRIMITIVE_GENERATED_TANGENT_SPACE"), std::string::npos) << out;
 }
 
 // COLOR_0 and TEXCOORD_1 through `lod bake` and `lod inspect --export`: every level of both
@@ -379,10 +379,7 @@ TEST(GltfExport, ColoursAndTexcoord1SurviveBakeExportAndImport) {
       }
     }
   }
-  const auto v = run_validator(exported);
-  EXPECT_EQ(v.code, 0) << v.out;
-  for (const fs::path& f : exported) EXPECT_NE(v.out.find(f.string() + ": errors 0 "), std::string::npos) << v.out;
-  std::printf("%s", v.out.c_str());
+  expect_valid(exported);
 }
 
 // The same material through OBJ export: the .mtl names every map MTL has a statement for
