@@ -147,7 +147,9 @@ Status commit_query_mesh(RTCDevice device, const std::string& what, QueryMesh& o
   std::memcpy(ib, out.indices.data(), out.indices.size() * sizeof(uint32_t));
   rtcCommitGeometry(geom);
   out.scene = rtcNewScene(device);
-  rtcSetSceneFlags(out.scene, RTC_SCENE_FLAG_ROBUST);
+  // Compact: half the BVH's memory, and on a 14M-triangle original a quarter less build time
+  // (memory-bound) at the same query speed (bench_mesh_input); the answers never depend on it.
+  rtcSetSceneFlags(out.scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT));
   rtcAttachGeometry(out.scene, geom);
   rtcReleaseGeometry(geom);
   rtcCommitScene(out.scene);
