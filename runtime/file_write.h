@@ -20,7 +20,8 @@ Status write_file_atomic(const std::filesystem::path& path, const std::string& t
 // A file written in pieces, possibly by several processes at once (issue 16: every rank writes
 // its own subtrees' payloads into the .hlod): create_sized_temporary makes a temporary of its
 // own beside `path` at the full size; write_pieces opens it by name, writes each piece at its
-// offset and flushes it to the disk; commit_temporary renames it over `path` once every writer
+// offset and flushes its own ranges to the disk; commit_temporary flushes the whole file (its
+// extents) and renames it over `path` once every writer
 // has succeeded (otherwise remove it).
 struct FilePiece {
   uint64_t offset = 0;
