@@ -1,5 +1,6 @@
 // lod run: the main job. Bake (cached) what the scene needs, then drive lod::Service frame by
 // frame along the config's camera path and report what every frame did.
+#include <cmath>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -28,9 +29,28 @@
 namespace lod::cli {
 namespace {
 
+// A normal per vertex, each of unit length or (0, 0, 0) (only degenerate faces around it).
+bool unit_or_zero_normals(const Frame& f, const VdObjectFrame& o, std::string* why) {
+  if (f.vd_normals.size() != f.vd_positions.size()) {
+    *why = std::to_string(f.vd_normals.size()) + " normal values for " + std::to_string(f.vd_positions.size()) +
+           " position values";
+    return false;
+  }
+  for (uint32_t v = o.first_vertex; v < o.first_vertex + o.vertex_count; ++v) {
+    const float* n = &f.vd_normals[3 * size_t(v)];
+    const float len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (len2 != 0.f && !(std::fabs(len2 - 1.f) < 1e-4f)) {
+      *why = "vertex " + std::to_string(v - o.first_vertex) + " has a normal of length " + std::to_string(std::sqrt(len2));
+      return false;
+    }
+  }
+  return true;
+}
+
 // --validate for view-dependent objects: every active mesh is a valid triangulation (indices in
 // range, no degenerate triangle, each directed edge once; closed inputs: every edge twice, so
-// no crack or T-junction), ranges inside the frame's arrays, totals adding up.
+// no crack or T-junction), ranges inside the frame's arrays, totals adding up, normals
+// unit or zero.
 bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
   char buf[256];
   uint64_t tris = 0, splits = 0, collapses = 0;
@@ -60,6 +80,10 @@ bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
       std::snprintf(buf, sizeof buf, "vd object %u: %zu uv values for %zu vertices", o.object, f.vd_uvs.size(),
                     f.vd_positions.size() / 3);
       *why = buf;
+      return false;
+    }
+    if (!unit_or_zero_normals(f, o, &bad)) {
+      *why = "vd object " + std::to_string(o.object) + ": " + bad;
       return false;
     }
     uint64_t at = o.first_index;

@@ -45,6 +45,7 @@
 #include "runtime/selection_quality.h"
 #include "runtime/vd_share.h"
 #include "runtime/vertex_front.h"
+#include "runtime/vertex_normals.h"
 #include "runtime/view_masks.h"
 #include "runtime/visibility.h"
 #include "runtime/world_bounds.h"
@@ -970,6 +971,7 @@ struct FrameGraph::Impl {
     f.vd_positions.resize(3 * size_t(vertices));
     f.vd_indices.resize(indices);
     f.vd_uvs.assign(any_uvs ? 2 * size_t(vertices) : 0, 0.f);
+    f.vd_normals.resize(3 * size_t(vertices));
     for_items(Stage::vd_mesh, vd_visible.size(), [&](size_t j) {
       VdObject& o = *vd_visible[j];
       VdObjectFrame& e = f.vd_objects[j];
@@ -995,6 +997,8 @@ struct FrameGraph::Impl {
         assert(written == e.vertex_count);
         if (e.has_uvs) fronts_compact_uvs(uvs, std::span(fronts, o.fronts.size()), tree, o.shown_uv);
       }
+      area_weighted_normals(std::span(f.vd_normals.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
+                            positions, tris);
       group_by_material(o, tris, std::span(fronts, o.fronts.size()), vd_models[o.model], e.first_index);
     });
     // Runs into the frame, object by object.

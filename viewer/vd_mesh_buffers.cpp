@@ -19,6 +19,7 @@ void stream(GLenum target, size_t bytes, const void* data, size_t& capacity) {
 VdMeshBuffers::~VdMeshBuffers() {
   if (ibo_) glDeleteBuffers(1, &ibo_);
   if (uv_vbo_) glDeleteBuffers(1, &uv_vbo_);
+  if (normal_vbo_) glDeleteBuffers(1, &normal_vbo_);
   if (vbo_) glDeleteBuffers(1, &vbo_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
@@ -28,11 +29,12 @@ void VdMeshBuffers::init() {
   glGenBuffers(1, &vbo_);
   glGenBuffers(1, &ibo_);
   glGenBuffers(1, &uv_vbo_);
+  glGenBuffers(1, &normal_vbo_);
   glBindVertexArray(vao_);
   glBindBuffer(GL_ARRAY_BUFFER, vbo_);
   glEnableVertexAttribArray(kAttribPosition);
   glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
-  // Normal and per-object attributes stay disabled: their current (constant) values are used.
+  // Per-object attributes stay disabled: their current (constant) values are used.
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
@@ -45,6 +47,15 @@ void VdMeshBuffers::upload(const Frame& frame) {
   stream(GL_ARRAY_BUFFER, frame.vd_positions.size() * sizeof(float), frame.vd_positions.data(), vbo_capacity_);
   stream(GL_ELEMENT_ARRAY_BUFFER, frame.vd_indices.size() * sizeof(uint32_t), frame.vd_indices.data(),
          ibo_capacity_);
+  // Normals likewise; without them the renderer's constant zero normal means face normals.
+  if (frame.vd_normals.size() == frame.vd_positions.size()) {
+    glBindBuffer(GL_ARRAY_BUFFER, normal_vbo_);
+    stream(GL_ARRAY_BUFFER, frame.vd_normals.size() * sizeof(float), frame.vd_normals.data(), normal_capacity_);
+    glEnableVertexAttribArray(kAttribNormal);
+    glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  } else {
+    glDisableVertexAttribArray(kAttribNormal);
+  }
   // Uvs only when the frame has one per vertex; otherwise the constant uv the renderer sets.
   if (!frame.vd_uvs.empty() && 3 * frame.vd_uvs.size() == 2 * frame.vd_positions.size()) {
     glBindBuffer(GL_ARRAY_BUFFER, uv_vbo_);

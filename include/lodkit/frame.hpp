@@ -23,6 +23,8 @@ inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = ro
 
 // One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
 // draws instead of a discrete level. Positions are object space and already geomorphed.
+// Frame::vd_normals holds a smooth normal per vertex computed from the shown (geomorphed) faces,
+// so shading morphs with the shape and hard edges (split vertex copies) stay hard.
 // With uvs (has_uvs), Frame::vd_uvs holds one per vertex, geomorphed with the positions; with
 // materials, the object's triangles come grouped by material, run_count runs from first_run of
 // Frame::vd_runs (in material order), which cover its indices in order.
@@ -132,6 +134,8 @@ struct Frame {
   std::vector<float> vd_positions;   // xyz per vertex, all vd objects back to back
   std::vector<uint32_t> vd_indices;  // all vd objects back to back
   std::vector<float> vd_uvs;         // uv per vertex like vd_positions when any vd object has uvs (else empty; 0 for those without)
+  std::vector<float> vd_normals;     // unit normal per vertex like vd_positions, from the shown faces
+                                     // (area weighted; (0, 0, 0) where every face is degenerate)
   std::vector<VdRunFrame> vd_runs;   // material runs of the vd objects with materials
   uint64_t vd_active_tris = 0;
   uint64_t vd_splits = 0;

@@ -15,6 +15,9 @@
 //   BM_FrontTeleport       a jump across the model under a triangle cap: frames to settle,
 //                          most triangles seen vs the cap
 //   BM_SplitCollapse       raw splits + collapses per second on one core (refine all, coarsen all)
+//   BM_CompactMesh         the vd_mesh stage's copy of a ~200k-triangle front into a frame (baseline)
+//   BM_CompactMeshNormals  the same plus the smooth normals the frame now carries
+//                          (runtime/vertex_normals.h); the ratio is the stage's cost of normals
 #include <benchmark/benchmark.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
@@ -31,6 +34,7 @@
 #include "preprocess/mesh_io.h"
 #include "preprocess/vertex_hierarchy.h"
 #include "runtime/vertex_front.h"
+#include "runtime/vertex_normals.h"
 #include "test_support.h"
 #include "vd_meshes.h"
 
@@ -167,6 +171,31 @@ BENCHMARK(BM_FrontSmooth)
     ->Arg(150)
     ->Arg(100);
 BENCHMARK(BM_FrontFullPass)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(30)->Arg(150);
+
+// The vd_mesh stage's work for one object: its front's vertices and triangles into the frame's
+// arrays, with or without the normals. Same settled front for both.
+void compact_front(benchmark::State& state, bool normals) {
+  Fixture& fx = fixture();
+  VertexFront front;
+  front_init(front, fx.tree, 1.f);
+  FrontParams p;
+  p.target_triangles = kTarget;
+  p.max_triangles = kTarget + kTarget / 10;
+  for (int i = 0; i < 60; ++i) front_update(front, fx.tree, orbit_view(fx, 0, 0.6f * fx.size), p);
+  std::vector<float> positions(3 * size_t(front.active_count)), n(positions.size());
+  std::vector<uint32_t> tris(3 * size_t(front.tri_count));
+  for (auto _ : state) {
+    front_compact_mesh(positions, tris, front, fx.tree, {});
+    if (normals) area_weighted_normals(n, positions, tris);
+    benchmark::DoNotOptimize(positions.data());
+    benchmark::DoNotOptimize(n.data());
+  }
+  state.counters["active_tris"] = double(front.tri_count);
+}
+void BM_CompactMesh(benchmark::State& state) { compact_front(state, false); }
+void BM_CompactMeshNormals(benchmark::State& state) { compact_front(state, true); }
+BENCHMARK(BM_CompactMesh)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+BENCHMARK(BM_CompactMeshNormals)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
 
 // Cost follows the changes (camera speed), not the active size (target triangles).
 void BM_FrontScaling(benchmark::State& state) {

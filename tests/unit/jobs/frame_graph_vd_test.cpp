@@ -2,6 +2,10 @@
 // triangulation, within its share of the budget, identical at 1 and 2 threads.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include <glm/glm.hpp>
+
 #include "jobs/frame_graph.h"
 #include "preprocess/vertex_hierarchy.h"
 #include "runtime/vertex_front.h"
@@ -116,6 +120,7 @@ void one_and_two_threads_agree(uint32_t balls, uint32_t parts) {
     ASSERT_EQ(a.vd_objects.size(), b.vd_objects.size());
     ASSERT_EQ(a.vd_indices, b.vd_indices) << "frame " << n;
     ASSERT_EQ(a.vd_positions, b.vd_positions) << "frame " << n;
+    ASSERT_EQ(a.vd_normals, b.vd_normals) << "frame " << n;
     ASSERT_EQ(a.morph, b.morph);
     seen = std::max(seen, a.vd_objects.size());
   }
@@ -130,6 +135,41 @@ TEST(FrameGraphVd, OneAndTwoThreadsGiveIdenticalFramesWithRegions) {
   one_and_two_threads_agree(2, 4);  // and each one's four regions too
 }
 
+// Smooth normals from the shown (geomorphed) faces: one per vertex; every corner of a face the
+// viewer can see (non-zero area) has a unit normal, and once the first burst of splits has
+// morphed out of the coarse base mesh (a tetrahedron-like hull whose faces are far from radial,
+// and folded-over faces for a few frames) every one points out of the ball. A vertex whose
+// faces are all degenerate (children still at their parent's place) gets (0, 0, 0): it draws
+// no pixel.
+void publishes_outward_unit_normals(uint32_t parts) {
+  const Scene scene = ball_scene(1, parts);
+  FrameGraph g(scene, options(2));
+  Frame f;
+  float settled_worst = 1;
+  for (uint32_t n = 0; n < 80; ++n) {
+    g.run(orbit(n < 60 ? 2 * n : 120), f);  // the last 20 frames hold still
+    ASSERT_EQ(f.vd_objects.size(), 1u);
+    ASSERT_EQ(f.vd_normals.size(), f.vd_positions.size()) << "frame " << n;
+    const VdObjectFrame& o = f.vd_objects[0];
+    auto at = [](const std::vector<float>& xyz, uint32_t v) { return glm::vec3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]); };
+    for (uint32_t i = o.first_index; i < o.first_index + o.index_count; i += 3) {
+      const uint32_t* c = &f.vd_indices[i];
+      const glm::vec3 a = at(f.vd_positions, c[0]), b = at(f.vd_positions, c[1]), d = at(f.vd_positions, c[2]);
+      if (glm::length(glm::cross(b - a, d - a)) < 1e-9f) continue;
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3 nv = at(f.vd_normals, c[k]);
+        ASSERT_NEAR(glm::length(nv), 1.f, 1e-4f) << "frame " << n << " vertex " << c[k];
+        const float cosine = glm::dot(nv, glm::normalize(at(f.vd_positions, c[k])));
+        if (n >= 40) settled_worst = std::min(settled_worst, cosine);
+      }
+    }
+  }
+  EXPECT_GT(settled_worst, 0.9f);  // within 26 degrees of radial
+}
+
+TEST(FrameGraphVd, PublishesOutwardUnitNormalsForEveryVertex) { publishes_outward_unit_normals(1); }
+TEST(FrameGraphVd, PublishesOutwardUnitNormalsAcrossRegions) { publishes_outward_unit_normals(4); }
+
 TEST(FrameGraphVd, ObjectsWithoutAHierarchyPublishNoVdMesh) {
   const Scene scene = test::synthetic_scene(500, 200);
   FrameGraph g(scene, options(2));
@@ -138,6 +178,7 @@ TEST(FrameGraphVd, ObjectsWithoutAHierarchyPublishNoVdMesh) {
   EXPECT_TRUE(f.vd_objects.empty());
   EXPECT_EQ(f.vd_active_tris, 0u);
   EXPECT_TRUE(f.vd_indices.empty());
+  EXPECT_TRUE(f.vd_normals.empty());
 }
 
 }  // namespace
