@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "runtime/chain_material.h"
+#include "runtime/embedded_image.h"
 #include "runtime/status.h"
 
 namespace lod {
@@ -38,6 +39,9 @@ struct GltfMaterialView {
   std::filesystem::path normal_image;
   std::filesystem::path occlusion_image;
   std::filesystem::path emissive_image;
+  // Images held in memory (a chain's embedded images), in kTextureSlots order; a slot with one
+  // uses its bytes and ignores its path (checked, embedded and copied like a file's).
+  std::array<const EmbeddedImage*, kTextureSlots> embedded_images{};
   float normal_scale = 1;        // written as normalTexture.scale
   float occlusion_strength = 1;  // occlusionTexture.strength
   float emissive[3] = {0, 0, 0};  // emissiveFactor
