@@ -205,11 +205,14 @@ void InstanceRenderer::set_plain_surface(const std::array<float, 3>& c) {
   glUniform1i(u_occlusion_mapped_, 0);
   glUniform1i(u_emissive_mapped_, 0);
   glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);  // plain surfaces (no material to say single-sided): both sides, as meshes from the wild need
 }
 
 // BLEND materials blend over what is drawn before them (draw() draws them after the opaque
-// runs, without depth writes; no sorting among them); MASK ones drop the fragments below their
-// cutoff. Each texture the material has goes to its unit (0 base colour .. 4 emissive).
+// runs, without depth writes, farthest object first); MASK ones drop the fragments below their
+// cutoff. Single-sided materials cull back faces, as glTF asks (no instance transform mirrors:
+// scale > 0 and a rotation, and the import turns mirrored nodes' winding back), double-sided ones
+// draw both. Each texture the material has goes to its unit (0 base colour .. 4 emissive).
 void InstanceRenderer::set_material(const GpuMaterial& m) {
   glUniform3f(u_colour_, m.base_color[0], m.base_color[1], m.base_color[2]);
   glUniform1f(u_alpha_, m.base_color[3]);
@@ -237,6 +240,12 @@ void InstanceRenderer::set_material(const GpuMaterial& m) {
     glBindTexture(GL_TEXTURE_2D, units[k].first);
   }
   glActiveTexture(GL_TEXTURE0);
+  if (m.double_sided) {
+    glDisable(GL_CULL_FACE);
+  } else {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  }
   if (m.alpha_mode == AlphaMode::blend) {
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -407,9 +416,18 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   };
   for (const DrawBatch& b : list.batches) draw_batch(b, RunPass::opaque);
   if (draws_materials(settings)) {
-    glDepthMask(GL_FALSE);
+    // Blended runs over everything opaque, one instance at a time, farthest first.
+    range_blends_.assign(meshes.layout().ranges.size(), 0);
     for (const DrawBatch& b : list.batches)
-      if (has_blend_runs(meshes, meshes.layout().ranges[b.range])) draw_batch(b, RunPass::blend);
+      range_blends_[b.range] = has_blend_runs(meshes, meshes.layout().ranges[b.range]) ? 1 : 0;
+    order_blended_draws(list, meshes.layout(), range_blends_, view, blend_order_);
+    glDepthMask(GL_FALSE);
+    for (const BlendDraw& d : blend_order_) {
+      DrawBatch one = list.batches[d.batch];
+      one.first_instance = d.instance;
+      one.instance_count = 1;
+      draw_batch(one, RunPass::blend);
+    }
     glDepthMask(GL_TRUE);
     set_plain_surface(kModelColour);
   }
