@@ -82,7 +82,8 @@ HueCounts count_hues(const Image& img, float tolerance) {
 TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto lit = scene.dir / "materials.png";
   const auto levels = scene.dir / "levels.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
@@ -111,7 +112,8 @@ TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
   LOD_REQUIRE_XVFB();
   const std::string model = std::string(kModel) + "view_dependent = true\n";
   const auto scene = lod::test::write_viewer_scene("textured-vd", kRun, kCamera, kInstance, model.c_str());
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto lit = scene.dir / "vd.png";
   const auto stats = scene.dir / "vd.csv";
   const auto r = lod::test::run_viewer(
@@ -133,7 +135,8 @@ TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   // Bake first (the texture is not read by the bake), then break the image.
   const auto png = scene.dir / "out.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
@@ -157,7 +160,8 @@ TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
 TEST(ViewerTextured, TheNormalTextureShadesItsMaterialOnly) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-normal", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/true).empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/true,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto mapped = scene.dir / "mapped.png";
   const auto plain = scene.dir / "plain.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + mapped.string() + "' --width 400 --height 300");
@@ -196,7 +200,8 @@ namespace {
 TEST(ViewerBackdrop, SkyGradientAboveGroundTilesBelowFlatWhenOff) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("backdrop", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto on = scene.dir / "backdrop.png";
   const auto off = scene.dir / "flat.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + on.string() + "' --width 400 --height 300 --backdrop on");
@@ -237,7 +242,8 @@ namespace {
 TEST(ViewerOverlay, CoversLessThanATenthOfThePicture) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("overlay", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto with = scene.dir / "overlay.png";
   const auto without = scene.dir / "plain.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + with.string() + "' --overlay --frames 3 --width 1280 --height 720");
