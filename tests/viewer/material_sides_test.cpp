@@ -54,10 +54,12 @@ std::string model(const std::string& name) {
   return "[[model]]\nname = \"" + name + "\"\nfile = \"quads/" + name + ".gltf\"\nratios = [1.0]\n\n";
 }
 
+// One object at (0, 0, z). Every placement turns its objects by a yaw drawn from the block's
+// seed; seed 1061's first draw is -0.1 degrees, so the quads face the camera squarely.
 std::string instance(const std::string& name, float z, float scale) {
   const std::string at = "[0.0, 0.0, " + std::to_string(z) + "]";
   return "[[instances]]\nmodel = \"" + name + "\"\ncount = 1\nplacement = \"grid\"\nbox_min = " + at +
-         "\nbox_max = " + at + "\nscale = " + std::to_string(scale) + "\n";
+         "\nbox_max = " + at + "\nscale = " + std::to_string(scale) + "\nseed = 1061\n";
 }
 
 // The centre pixel of the scene's picture (empty when the viewer failed).
