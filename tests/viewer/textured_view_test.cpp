@@ -6,6 +6,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <set>
 
 #include "textured_fixture.h"
@@ -104,6 +106,54 @@ TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
   const HueCounts c = count_hues(by_level, kAbsent);
   EXPECT_LE(c.any_checker, 10) << "colour-by-level must not show the texture";
   EXPECT_LE(c.any_base, 10) << "colour-by-level must not show the material factor";
+}
+
+// The globe as a GLB whose checker PNG lives in the GLB's buffer (lodkit's exporter embeds it),
+// the PNG file then deleted: the bake keeps the image in the asset (IMGS) and the viewer decodes
+// it from memory, so the cap still shows both checker colours.
+TEST(ViewerTextured, ATextureEmbeddedInTheGlbIsDecodedFromTheAsset) {
+  LOD_REQUIRE_XVFB();
+  const char* model = "[[model]]\nname = \"textured\"\nfile = \"textured/globe.glb\"\nratios = [1.0, 0.5]\n";
+  const auto scene = lod::test::write_viewer_scene("textured-glb", kRun, kCamera, kInstance, model);
+  const auto dir = scene.dir / "textured";
+  std::filesystem::create_directories(dir);
+  lod::MeshData m = lod::test::two_material_sphere(24, 48);
+  lod::test::turn_faces_outward(m);
+  lod::test::write_bytes(dir / "checker.png", lod::test::checker_png(64, 8));
+  lod::GltfMeshView view;
+  view.name = "globe";
+  view.positions = m.positions.data();
+  view.vertex_count = m.vertex_count();
+  view.uvs = m.uvs.data();
+  view.indices = m.indices.data();
+  view.index_count = m.indices.size();
+  for (const lod::MeshMaterial& src : m.materials) {
+    lod::GltfMaterialView g;
+    g.name = src.name;
+    std::copy(src.base_color, src.base_color + 4, g.base_color);
+    g.metallic = src.metallic;
+    g.roughness = src.roughness;
+    g.double_sided = src.double_sided;
+    view.materials.push_back(g);
+  }
+  view.materials[0].base_color_image = dir / "checker.png";
+  for (const lod::Submesh& sm : m.submeshes)
+    view.submeshes.push_back({3 * size_t(sm.first_triangle), 3 * size_t(sm.triangle_count), sm.material});
+  ASSERT_TRUE(lod::save_gltf(dir / "globe.glb", view).ok);
+  std::filesystem::remove(dir / "checker.png");
+  const auto lit = scene.dir / "embedded.png";
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "every texture was decoded: " << r.output;
+  EXPECT_EQ(r.output.find("drawn without it"), std::string::npos) << r.output;
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  const HueCounts c = count_hues(img, kPresent);
+  std::printf("embedded checker: %d light and %d dark pixels above the equator, %d base below\n", c.light_above,
+              c.dark_above, c.base_below);
+  EXPECT_GE(c.light_above, 300) << "light checker squares from the embedded image";
+  EXPECT_GE(c.dark_above, 300) << "dark checker squares from the embedded image";
+  EXPECT_GE(c.base_below, 300);
 }
 
 // The same globe drawn view-dependently: the front carries uvs and its triangles come grouped
