@@ -19,7 +19,7 @@ glm::vec3 world_of(const InstanceData& d, const float* p) {
 }  // namespace
 
 void order_blended_draws(const DrawList& list, const MeshLayout& layout, const std::vector<uint8_t>& blends,
-                         const glm::mat4& view, std::vector<BlendDraw>& out) {
+                         const std::vector<uint8_t>& vd_blends, const glm::mat4& view, std::vector<BlendDraw>& out) {
   out.clear();
   for (uint32_t b = 0; b < list.batches.size(); ++b) {
     const DrawBatch& batch = list.batches[b];
@@ -27,8 +27,13 @@ void order_blended_draws(const DrawList& list, const MeshLayout& layout, const s
     const LevelRange& r = layout.ranges[batch.range];
     for (uint32_t i = batch.first_instance; i < batch.first_instance + batch.instance_count; ++i) {
       const glm::vec4 eye = view * glm::vec4(world_of(list.instances[i], r.center), 1.f);
-      out.push_back({b, i, -eye.z});  // the eye looks down -z
+      out.push_back({b, i, kNotViewDependent, -eye.z});  // the eye looks down -z
     }
+  }
+  for (uint32_t v = 0; v < list.vd.size() && v < vd_blends.size(); ++v) {
+    if (!vd_blends[v]) continue;
+    const glm::vec4 eye = view * glm::vec4(world_of(list.vd[v].transform, list.vd[v].center), 1.f);
+    out.push_back({0, 0, v, -eye.z});
   }
   std::stable_sort(out.begin(), out.end(), [](const BlendDraw& a, const BlendDraw& c) { return a.depth > c.depth; });
 }

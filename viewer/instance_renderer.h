@@ -88,12 +88,16 @@ class InstanceRenderer {
   void set_material(const GpuMaterial& material);
   void draw_range(const MeshBuffers& meshes, const LevelRange& r, uint32_t instances, int32_t base_vertex,
                   const RenderSettings& settings, RunPass pass);
+  void bind_vd_meshes(const VdMeshBuffers& vd, const std::array<float, 3>& colour);
+  void draw_vd_object(const DrawList& list, const VdDraw& d, const MeshBuffers& meshes, const RenderSettings& settings,
+                      const std::array<float, 3>& colour, RunPass pass);
 
   GLuint program_ = 0;
   GLuint instance_vbo_ = 0;
   GLuint query_ = 0;
   size_t instance_capacity_ = 0;
   std::vector<uint8_t> range_blends_;    // scratch: per layout range, has a blended run (this frame's batches)
+  std::vector<uint8_t> vd_blends_;       // scratch: per DrawList::vd, has a blended run
   std::vector<BlendDraw> blend_order_;   // scratch: the blended pass, farthest first
   GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1, u_blend_ = -1;
   GLint u_alpha_ = -1, u_alpha_cutoff_ = -1, u_textured_ = -1, u_normal_mapped_ = -1, u_normal_scale_ = -1;

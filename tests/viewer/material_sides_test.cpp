@@ -128,9 +128,9 @@ TEST(ViewerMaterialSides, OverlappingBlendedQuadsComposeFarthestFirst) {
   EXPECT_GT(red_near[0], red_near[2] + 20) << "the nearer red quad is composited last";
 }
 
-// The CPU order: every instance of a batch with blended runs, farthest first by its level's
-// centre placed by the instance transform; batches without blended runs left out.
-TEST(BlendOrder, SortsInstancesFarthestFirstByTheirLevelsCentre) {
+// The CPU order: every instance of a batch with blended runs and every view-dependent object
+// with one, farthest first by its level's centre placed by its transform; the others left out.
+TEST(BlendOrder, SortsInstancesAndViewDependentObjectsFarthestFirstByTheirCentre) {
   lod::viewer::MeshLayout layout;
   layout.ranges.resize(2);
   layout.ranges[0].center[2] = 2;  // model-space centre off the origin
@@ -144,18 +144,27 @@ TEST(BlendOrder, SortsInstancesFarthestFirstByTheirLevelsCentre) {
   list.instances = {at(0, 1), at(-3, 1), at(-1, 4), at(-50, 1)};
   list.batches = {{0, 0, 0, 0, 0, 3}, {1, 1, 0, 0, 3, 1}};
   const std::vector<uint8_t> blends = {1, 0};
+  lod::viewer::VdDraw far_vd, plain_vd;  // a view-dependent object with a blended run, and one without
+  far_vd.transform = at(-10, 1);
+  far_vd.center[2] = 1;  // centre z = -9: 39 away
+  plain_vd.transform = at(-100, 1);
+  list.vd = {plain_vd, far_vd};
+  const std::vector<uint8_t> vd_blends = {0, 1};
   lod::View eye;
   eye.eye = {0, 0, 30};
   eye.target = {0, 0, 0};
   const glm::mat4 view = lod::view_matrix(eye);
   std::vector<lod::viewer::BlendDraw> order;
-  lod::viewer::order_blended_draws(list, layout, blends, view, order);
-  ASSERT_EQ(order.size(), 3u) << "batch 1 has no blended run";
-  EXPECT_EQ(order[0].instance, 1u);  // centre z = -1: 31 away
-  EXPECT_EQ(order[1].instance, 0u);  // z = 2: 28
-  EXPECT_EQ(order[2].instance, 2u);  // z = -1 + 4 * 2 = 7: 23
-  EXPECT_FLOAT_EQ(order[0].depth, 31.f);
-  EXPECT_FLOAT_EQ(order[2].depth, 23.f);
+  lod::viewer::order_blended_draws(list, layout, blends, vd_blends, view, order);
+  ASSERT_EQ(order.size(), 4u) << "batch 1 and view-dependent object 0 have no blended run";
+  EXPECT_EQ(order[0].vd, 1u);
+  EXPECT_FLOAT_EQ(order[0].depth, 39.f);
+  EXPECT_EQ(order[1].instance, 1u);  // centre z = -1: 31 away
+  EXPECT_EQ(order[2].instance, 0u);  // z = 2: 28
+  EXPECT_EQ(order[3].instance, 2u);  // z = -1 + 4 * 2 = 7: 23
+  for (size_t k = 1; k < 4; ++k) EXPECT_EQ(order[k].vd, lod::viewer::kNotViewDependent);
+  EXPECT_FLOAT_EQ(order[1].depth, 31.f);
+  EXPECT_FLOAT_EQ(order[3].depth, 23.f);
 }
 
 }  // namespace
