@@ -30,7 +30,8 @@ std::string embedded_image_uri(uint32_t k) { return kScheme + std::to_string(k);
 bool is_embedded_image_uri(const std::string& uri, uint32_t* k) {
   if (uri.compare(0, kSchemeBytes, kScheme) != 0) return false;
   uint64_t value = 0;
-  bool digits = uri.size() > kSchemeBytes && uri.size() <= kSchemeBytes + 5;  // kMaxEmbeddedImages has 4 digits
+  bool digits =
+      uri.size() > kSchemeBytes && uri.size() <= kSchemeBytes + 5;  // kMaxEmbeddedImages has 4 digits
   for (size_t i = kSchemeBytes; digits && i < uri.size(); ++i) {
     digits = uri[i] >= '0' && uri[i] <= '9';
     value = value * 10 + uint64_t(uri[i] - '0');

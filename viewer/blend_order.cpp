@@ -19,7 +19,8 @@ glm::vec3 world_of(const InstanceData& d, const float* p) {
 }  // namespace
 
 void order_blended_draws(const DrawList& list, const MeshLayout& layout, const std::vector<uint8_t>& blends,
-                         const std::vector<uint8_t>& vd_blends, const glm::mat4& view, std::vector<BlendDraw>& out) {
+                         const std::vector<uint8_t>& vd_blends, const glm::mat4& view,
+                         std::vector<BlendDraw>& out) {
   out.clear();
   for (uint32_t b = 0; b < list.batches.size(); ++b) {
     const DrawBatch& batch = list.batches[b];
@@ -35,7 +36,8 @@ void order_blended_draws(const DrawList& list, const MeshLayout& layout, const s
     const glm::vec4 eye = view * glm::vec4(world_of(list.vd[v].transform, list.vd[v].center), 1.f);
     out.push_back({0, 0, v, -eye.z});
   }
-  std::stable_sort(out.begin(), out.end(), [](const BlendDraw& a, const BlendDraw& c) { return a.depth > c.depth; });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const BlendDraw& a, const BlendDraw& c) { return a.depth > c.depth; });
 }
 
 }  // namespace lod::viewer

@@ -93,9 +93,10 @@ TEST(ViewerMaterialSides, ASingleSidedQuadSeenFromBehindDrawsNothingADoubleSided
   const auto a = centre("back-single", false, false, back_single);
   const auto b = centre("back-double", true, false, back_double);
   const auto c = centre("front-single", false, true, front_single);
-  std::printf("centre pixel: single-sided from behind %d %d %d, double-sided from behind %d %d %d, single-sided "
-              "from the front %d %d %d\n",
-              a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]);
+  std::printf(
+      "centre pixel: single-sided from behind %d %d %d, double-sided from behind %d %d %d, single-sided "
+      "from the front %d %d %d\n",
+      a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]);
   ASSERT_GE(a[0], 0);
   EXPECT_TRUE(back_single) << "a single-sided quad seen from behind is culled";
   EXPECT_FALSE(back_double) << "a double-sided quad is drawn from behind";
@@ -121,8 +122,8 @@ TEST(ViewerMaterialSides, OverlappingBlendedQuadsComposeFarthestFirst) {
   };
   const auto blue_near = centre("blue-near", 5, -5);
   const auto red_near = centre("red-near", -5, 5);
-  std::printf("centre pixel: blue in front %d %d %d, red in front %d %d %d\n", blue_near[0], blue_near[1], blue_near[2],
-              red_near[0], red_near[1], red_near[2]);
+  std::printf("centre pixel: blue in front %d %d %d, red in front %d %d %d\n", blue_near[0], blue_near[1],
+              blue_near[2], red_near[0], red_near[1], red_near[2]);
   ASSERT_GE(blue_near[0], 0);
   EXPECT_GT(blue_near[2], blue_near[0] + 20) << "the nearer blue quad is composited last";
   EXPECT_GT(red_near[0], red_near[2] + 20) << "the nearer red quad is composited last";
