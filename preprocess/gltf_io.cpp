@@ -955,9 +955,12 @@ Status read_texture(const std::string& what, const tinygltf::Model& m, size_t i,
     return Status::success();
   }
   if (fresh) {
-    if (images.size() >= kMaxEmbeddedImages) {
+    uint64_t total = bytes.size();
+    for (const EmbeddedImage& e : images) total += e.bytes.size();
+    if (images.size() >= kMaxEmbeddedImages || total > kMaxEmbeddedBytes) {
       warnings.push_back(name + ": embedded image " + std::to_string(image) + " is past the first " +
-                         std::to_string(kMaxEmbeddedImages) + " kept; the texture is not kept");
+                         std::to_string(kMaxEmbeddedImages) + " images or " + std::to_string(kMaxEmbeddedBytes) +
+                         " bytes kept; the texture is not kept");
       return Status::success();
     }
     at->second = int(images.size());
