@@ -41,6 +41,27 @@ nlohmann::json materials_json(const LodChain& chain) {
   return out;
 }
 
+// The images the asset carries (embedded in its source): index, type, size.
+nlohmann::json images_json(const LodChain& chain) {
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t k = 0; k < chain.images.size(); ++k)
+    out.push_back({{"index", k},
+                   {"uri", embedded_image_uri(uint32_t(k))},
+                   {"mime_type", mime_type(chain.images[k].type)},
+                   {"bytes", chain.images[k].bytes.size()}});
+  return out;
+}
+
+void print_images(const LodChain& chain) {
+  uint64_t total = 0;
+  for (const EmbeddedImage& img : chain.images) total += img.bytes.size();
+  std::printf("embedded images: %zu (%llu bytes, kept from the source file, PNG/JPEG undecoded)\n", chain.images.size(),
+              (unsigned long long)total);
+  for (size_t k = 0; k < chain.images.size(); ++k)
+    std::printf("  %s: %s, %zu bytes\n", embedded_image_uri(uint32_t(k)).c_str(), mime_type(chain.images[k].type),
+                chain.images[k].bytes.size());
+}
+
 // Level k's runs as {material, triangles} (material -1: the default).
 nlohmann::json level_runs_json(const LodChain& chain, uint32_t k) {
   nlohmann::json out = nlohmann::json::array();
@@ -97,7 +118,12 @@ void export_surfaces(const LodChain& chain, uint32_t k, GltfMeshView& view) {
     g.tex_coords = m.tex_coords;
     const auto uris = texture_slots(m);
     const auto images = image_slots(g);
-    for (size_t s = 0; s < kTextureSlots; ++s) *images[s] = texture_file(chain.texture_base, *uris[s]);
+    for (size_t s = 0; s < kTextureSlots; ++s) {
+      uint32_t image = 0;
+      if (is_embedded_image_uri(*uris[s], &image))
+        g.embedded_images[s] = image < chain.images.size() ? &chain.images[image] : nullptr;  // validate_chain checked it
+      else *images[s] = texture_file(chain.texture_base, *uris[s]);
+    }
     view.materials.push_back(std::move(g));
   }
   for (const LevelSubmesh& s : level_submeshes(chain, k)) view.submeshes.push_back({s.first_index, s.index_count, s.material});
@@ -117,6 +143,7 @@ ObjSurfaces obj_surfaces(const GltfMeshView& view) {
     o.normal_scale = m.normal_scale;
     o.occlusion_image = m.occlusion_image;
     o.emissive_image = m.emissive_image;
+    o.embedded_images = m.embedded_images;
     std::copy(m.emissive, m.emissive + 3, o.emissive);
     s.materials.push_back(std::move(o));
   }
@@ -188,6 +215,7 @@ int inspect_command(const InspectArgs& args) {
     j["texcoords1"] = !chain.uvs1.empty();
     j["colors"] = !chain.colors.empty();
     j["materials"] = materials_json(chain);
+    j["images"] = images_json(chain);
     j["levels"] = nlohmann::json::array();
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
@@ -245,6 +273,7 @@ int inspect_command(const InspectArgs& args) {
       std::printf("\n");
     }
     if (!chain.materials.empty()) print_materials(chain);
+    if (!chain.images.empty()) print_images(chain);
   }
   if (!args.export_dir.empty()) {
     std::error_code ec;

@@ -1,5 +1,6 @@
 // glTF 2.0 import (Khronos glTF 2.0 specification, KHR_mesh_quantization). tinygltf parses the
-// JSON and fills the buffers (images are never decoded: only their URIs matter here); then a
+// JSON and fills the buffers (images are never decoded: only their URIs, or for images inside
+// the file their PNG / JPEG bytes, matter here); then a
 // chain of passes checks and flattens what it gave, allocating only once the sizes are known:
 //
 //   check_glb_container -> parse_with_tinygltf -> check_extensions -> check_buffer_views
@@ -27,6 +28,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -35,6 +37,7 @@
 #include <limits>
 #include <map>
 #include <new>
+#include <span>
 
 #include "preprocess/mesh_readers.h"
 
@@ -100,9 +103,16 @@ Status check_glb_container(const std::string& what, const uint8_t* data, size_t&
 
 // ---- tinygltf callbacks: no image is decoded, no file outside base_dir is read ------------
 
+// A data-URI image's bytes exist only here (tinygltf decoded the base64 into a scratch
+// vector), so they are kept as they are, up to kMaxEmbeddedImageBytes (a larger one stays
+// empty and read_texture says so). A buffer view's bytes are not touched here: tinygltf hands
+// them over before check_buffer_views has checked the view lies inside its buffer.
 bool keep_image_undecoded(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
-                          const unsigned char*, int, void*) {
+                          const unsigned char* bytes, int size, void*) {
   image->image.clear();
+  image->as_is = true;
+  if (image->bufferView < 0 && image->uri.empty() && bytes && size > 0 && size_t(size) <= kMaxEmbeddedImageBytes)
+    image->image.assign(bytes, bytes + size);
   return true;
 }
 
@@ -883,12 +893,41 @@ AlphaMode alpha_mode_of(const std::string& s) {
   return AlphaMode::opaque;
 }
 
+// The PNG or JPEG bytes of an image the file holds itself (a buffer view, checked against its
+// buffer by check_buffer_views, or a data URI, kept by keep_image_undecoded), or a reason.
+std::string embedded_bytes(const tinygltf::Model& m, const tinygltf::Image& img, std::span<const uint8_t>& out) {
+  if (img.bufferView >= 0) {
+    if (size_t(img.bufferView) >= m.bufferViews.size())
+      return "names buffer view " + std::to_string(img.bufferView) + " of " + std::to_string(m.bufferViews.size());
+    const tinygltf::BufferView& view = m.bufferViews[size_t(img.bufferView)];
+    if (view.byteLength > kMaxEmbeddedImageBytes)
+      return "is " + std::to_string(view.byteLength) + " bytes, more than " + std::to_string(kMaxEmbeddedImageBytes);
+    out = {m.buffers[size_t(view.buffer)].data.data() + view.byteOffset, view.byteLength};
+  } else if (img.image.empty()) {
+    return "is an empty data URI or more than " + std::to_string(kMaxEmbeddedImageBytes) + " bytes";
+  } else {
+    out = img.image;
+  }
+  if (image_type_of(out) == ImageType::unknown) {
+    char head[32];
+    std::snprintf(head, sizeof head, "%02x %02x %02x %02x", out.size() > 0 ? out[0] : 0, out.size() > 1 ? out[1] : 0,
+                  out.size() > 2 ? out[2] : 0, out.size() > 3 ? out[3] : 0);
+    return "is neither PNG nor JPEG (its first bytes are " + std::string(head) + "; glTF 2.0 core allows no other image)";
+  }
+  return {};
+}
+
+// Images the file holds itself, kept once each however many slots name them: glTF image ->
+// MeshData::images index (-1 once refused, so it is said once per slot but copied never).
+using EmbeddedIndex = std::map<int, int>;
+
 // One texture reference (textureInfo) of material `i`: the texture and image it names must
-// exist; an image inside the file is marked embedded; one read through another TEXCOORD than
-// the imported TEXCOORD_0 is left out with a warning.
+// exist; an image inside the file is marked embedded and, when PNG or JPEG, kept in `images`
+// and named "embedded:<k>" (else left out, said naming the material and slot); one read
+// through another TEXCOORD than the imported TEXCOORD_0 / _1 is left out with a warning.
 Status read_texture(const std::string& what, const tinygltf::Model& m, size_t i, const char* slot, int index,
                     int tex_coord, std::string& uri, bool& embedded, uint8_t& tex_coord_out,
-                    std::vector<std::string>& warnings) {
+                    std::vector<EmbeddedImage>& images, EmbeddedIndex& kept, std::vector<std::string>& warnings) {
   if (index < 0) return Status::success();
   const std::string name = what + ": material " + std::to_string(i) + ": " + slot;
   if (size_t(index) >= m.textures.size())
@@ -904,13 +943,36 @@ Status read_texture(const std::string& what, const tinygltf::Model& m, size_t i,
     return Status::success();
   }
   tex_coord_out = uint8_t(tex_coord);
-  uri = m.images[size_t(image)].uri;
+  const tinygltf::Image& img = m.images[size_t(image)];
+  uri = img.uri;
   embedded = uri.empty();
+  if (!embedded) return Status::success();
+  auto [at, fresh] = kept.try_emplace(image, -1);
+  std::span<const uint8_t> bytes;
+  const std::string why = embedded_bytes(m, img, bytes);
+  if (!why.empty()) {
+    warnings.push_back(name + ": embedded image " + std::to_string(image) + " " + why + "; the texture is not kept");
+    return Status::success();
+  }
+  if (fresh) {
+    uint64_t total = bytes.size();
+    for (const EmbeddedImage& e : images) total += e.bytes.size();
+    if (images.size() >= kMaxEmbeddedImages || total > kMaxEmbeddedBytes) {
+      warnings.push_back(name + ": embedded image " + std::to_string(image) + " is past the first " +
+                         std::to_string(kMaxEmbeddedImages) + " images or " + std::to_string(kMaxEmbeddedBytes) +
+                         " bytes kept; the texture is not kept");
+      return Status::success();
+    }
+    at->second = int(images.size());
+    images.push_back({image_type_of(bytes), std::vector<uint8_t>(bytes.begin(), bytes.end())});
+  }
+  if (at->second >= 0) uri = embedded_image_uri(uint32_t(at->second));
   return Status::success();
 }
 
 Status read_materials(const std::string& what, const tinygltf::Model& m, std::vector<MeshMaterial>& out,
-                      std::vector<std::string>& warnings) {
+                      std::vector<EmbeddedImage>& images, std::vector<std::string>& warnings) {
+  EmbeddedIndex kept;
   for (size_t i = 0; i < m.materials.size(); ++i) {
     const tinygltf::Material& src = m.materials[i];
     const tinygltf::PbrMetallicRoughness& pbr = src.pbrMetallicRoughness;
@@ -938,7 +1000,7 @@ Status read_materials(const std::string& what, const tinygltf::Model& m, std::ve
         {"emissiveTexture", src.emissiveTexture.index, src.emissiveTexture.texCoord}};
     for (size_t k = 0; k < kTextureSlots; ++k)
       if (Status s = read_texture(what, m, i, refs[k].name, refs[k].index, refs[k].tex_coord, *slots[k].uri,
-                                  *slots[k].embedded, mat.tex_coords[k], warnings);
+                                  *slots[k].embedded, mat.tex_coords[k], images, kept, warnings);
           !s)
         return s;
     out.push_back(std::move(mat));
@@ -1052,7 +1114,7 @@ Status import_model(const GltfSource& src, const tinygltf::Model& m, MeshData& o
   if (!missing_uvs1.empty()) warnings.push_back(what + ": " + missing_uvs1 + " has no TEXCOORD_1; its vertices get (0, 0)");
   if (!missing_colors.empty())
     warnings.push_back(what + ": " + missing_colors + " has no COLOR_0; its vertices get white (1, 1, 1, 1)");
-  if (Status s = read_materials(what, m, mesh.materials, warnings); !s) return s;
+  if (Status s = read_materials(what, m, mesh.materials, mesh.images, warnings); !s) return s;
   if (Status s = check_images(src, m); !s) return s;
   cap_warnings(mesh.warnings);
   out = std::move(mesh);

@@ -9,8 +9,11 @@
 // honoured; the base colour texture's KHR_texture_transform is applied to TEXCOORD_0 (so
 // gltfpack's quantized UVs come out in texture space); COLOR_0 (VEC3 or VEC4, float or
 // normalized u8/u16) as linear RGBA, clamped to [0, 1]; a primitive lacking TEXCOORD_1 or COLOR_0
-// in a file where another has it gets (0, 0) / white, said in the warnings. Materials (metallic-roughness factors, base colour texture URI, alpha mode,
-// double-sided) become MeshData::materials, each primitive a Submesh.
+// in a file where another has it gets (0, 0) / white, said in the warnings. Materials (metallic-roughness factors, texture URIs, alpha mode,
+// double-sided) become MeshData::materials, each primitive a Submesh. Images held in the file
+// (buffer views, data URIs) are kept undecoded in MeshData::images when PNG or JPEG by their
+// signature and at most kMaxEmbeddedImageBytes (a material names one as "embedded:<k>");
+// another is left out with a warning naming the file, material and slot.
 //
 // Refused, with the file and the element named: Draco / meshopt compression when required,
 // sparse accessors, accessors or buffer views outside their buffer, strides shorter than an

@@ -91,7 +91,17 @@ std::string read_image(const fs::path& file, Image& out) {
   return {};
 }
 
-// Images of the materials, one per distinct file; image_of[material][slot] indexes `images`
+// An image the chain carries (embedded in its source): its bytes when PNG or JPEG, else a reason.
+std::string copy_image(const EmbeddedImage& embedded, Image& out) {
+  const ImageType type = image_type_of(embedded.bytes);
+  if (type == ImageType::unknown) return "neither PNG nor JPEG (glTF 2.0 core allows no other image)";
+  if (embedded.bytes.size() > kMaxImageBytes) return "larger than 256 MiB";
+  out.bytes = embedded.bytes;
+  out.mime = mime_type(type), out.extension = file_extension(type);
+  return {};
+}
+
+// Images of the materials, one per distinct file or embedded image; image_of[material][slot] indexes `images`
 // (-1 = none).
 using SlotImages = std::array<int, kTextureSlots>;
 // Slots by name, in kTextureSlots order (runtime/chain_material.h).
@@ -101,16 +111,19 @@ void load_images(const std::string& what, const GltfMeshView& m, std::vector<Ima
   SlotImages none;
   none.fill(-1);
   image_of.assign(m.materials.size(), none);
-  std::vector<fs::path> files;
+  // Where each of `images` came from: a file, or bytes in memory (then the pointer is set).
+  std::vector<std::pair<fs::path, const EmbeddedImage*>> sources;
   for (size_t i = 0; i < m.materials.size(); ++i) {
     const auto slots = image_slots(m.materials[i]);
     for (size_t k = 0; k < kTextureSlots; ++k) {
-      const fs::path& file = *slots[k];
-      if (file.empty()) continue;
+      const EmbeddedImage* embedded = m.materials[i].embedded_images[k];
+      const fs::path file = embedded ? fs::path() : *slots[k];
+      if (file.empty() && !embedded) continue;
       auto note = [&](const std::string& why) {
         if (m.notes)
           m.notes->push_back(what + ": material " + std::to_string(i) + ": " + kTextureSlotNames[k] + " texture " +
-                             file.string() + " " + why + "; written without it");
+                             (embedded ? std::string("(embedded image)") : file.string()) + " " + why +
+                             "; written without it");
       };
       const uint8_t set = m.materials[i].tex_coords[k];
       if (!(set == 0 ? m.uvs : set == 1 ? m.uvs1 : nullptr)) {
@@ -118,18 +131,18 @@ void load_images(const std::string& what, const GltfMeshView& m, std::vector<Ima
              ", and the mesh has none");
         continue;
       }
-      const auto known = std::find(files.begin(), files.end(), file);
-      if (known != files.end()) {
-        image_of[i][k] = int(known - files.begin());
+      const auto known = std::find(sources.begin(), sources.end(), std::pair(file, embedded));
+      if (known != sources.end()) {
+        image_of[i][k] = int(known - sources.begin());
         continue;
       }
       Image img;
-      if (const std::string why = read_image(file, img); !why.empty()) {
+      if (const std::string why = embedded ? copy_image(*embedded, img) : read_image(file, img); !why.empty()) {
         note("is " + why);
         continue;
       }
       image_of[i][k] = int(images.size());
-      files.push_back(file);
+      sources.emplace_back(file, embedded);
       images.push_back(std::move(img));
     }
   }

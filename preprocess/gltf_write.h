@@ -3,9 +3,9 @@
 // buffer, one tightly packed buffer view per attribute and for the indices (each 4-byte
 // aligned, with its target), POSITION with min/max, unit NORMALs, TEXCOORD_0 and _1, COLOR_0, u16 indices
 // when the vertices fit, else u32; one node, one scene; one primitive per submesh (they share
-// the vertex attributes), each with its metallic-roughness material; its images (PNG or JPEG:
-// base colour, metallic-roughness, normal, occlusion, emissive) are embedded in the GLB's
-// buffer, or copied next to a .gltf. With a normal texture (and normals and uvs) the mesh gets
+// the vertex attributes), each with its metallic-roughness material; its images (PNG or JPEG
+// files, or bytes in memory such as a chain's embedded images: base colour, metallic-roughness,
+// normal, occlusion, emissive) are embedded in the GLB's buffer, or copied next to a .gltf. With a normal texture (and normals and uvs) the mesh gets
 // TANGENTs computed here (per-triangle accumulation from positions and uvs, orthogonalised
 // against the normal, w the handedness), referenced by the primitives whose material has the
 // normal texture, so no viewer has to generate a tangent space. Output passes the Khronos
@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "runtime/chain_material.h"
+#include "runtime/embedded_image.h"
 #include "runtime/status.h"
 
 namespace lod {
@@ -38,6 +39,9 @@ struct GltfMaterialView {
   std::filesystem::path normal_image;
   std::filesystem::path occlusion_image;
   std::filesystem::path emissive_image;
+  // Images held in memory (a chain's embedded images), in kTextureSlots order; a slot with one
+  // uses its bytes and ignores its path (checked, embedded and copied like a file's).
+  std::array<const EmbeddedImage*, kTextureSlots> embedded_images{};
   float normal_scale = 1;        // written as normalTexture.scale
   float occlusion_strength = 1;  // occlusionTexture.strength
   float emissive[3] = {0, 0, 0};  // emissiveFactor

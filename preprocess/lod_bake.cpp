@@ -26,7 +26,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 9;  // 9: vertex colours (COL0) and TEXCOORD_1 (TEX1) through the levels, texCoord per texture (MATL layout 2); 8: normal, occlusion, emissive and metallic-roughness textures (MATL layout 1); 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
+constexpr uint32_t kBakeFormatVersion = 10;  // 10: textures embedded in a GLB or data URI kept (IMGS); 9: vertex colours (COL0) and TEXCOORD_1 (TEX1) through the levels, texCoord per texture (MATL layout 2); 8: normal, occlusion, emissive and metallic-roughness textures (MATL layout 1); 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
                                              // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).

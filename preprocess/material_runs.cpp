@@ -185,6 +185,17 @@ void keep_texture_factors(const MeshMaterial& m, const std::string& at, ChainMat
                     number_text(m.emissive[2]) + " outside [0, 1] or not finite, clamped");
 }
 
+// The chain's URI for mesh image `k`, copied into the chain at its first use (so images no
+// kept material names are not stored).
+std::string keep_embedded_image(const EmbeddedImage& image, uint32_t k, std::vector<int64_t>& kept,
+                                std::vector<EmbeddedImage>& out) {
+  if (kept[k] < 0) {
+    kept[k] = int64_t(out.size());
+    out.push_back(image);
+  }
+  return embedded_image_uri(uint32_t(kept[k]));
+}
+
 }  // namespace
 
 void add_chain_materials(const MeshData& mesh, const std::filesystem::path& source, LodChain& chain,
@@ -197,6 +208,7 @@ void add_chain_materials(const MeshData& mesh, const std::filesystem::path& sour
   if (count < mesh.materials.size())
     notes.push_back(std::to_string(mesh.materials.size() - count) + " materials past the first " +
                     std::to_string(kMaxMaterials) + " are drawn with the default material (not kept)");
+  std::vector<int64_t> kept(mesh.images.size(), -1);  // mesh image -> chain image
   for (size_t i = 0; i < count; ++i) {
     const MeshMaterial& m = mesh.materials[i];
     const std::string at = mesh.source + ": material " + std::to_string(i) + " ('" + (storable(m.name) ? m.name : "?") + "')";
@@ -216,10 +228,18 @@ void add_chain_materials(const MeshData& mesh, const std::filesystem::path& sour
     for (size_t k = 0; k < kTextureSlots; ++k) {
       const std::string& uri = *from[k].uri;
       const std::string slot = kTextureSlotNames[k];
-      if (*from[k].embedded || uri.rfind("data:", 0) == 0)
-        notes.push_back(at + ": its " + slot + " texture is embedded in the file; the levels reference no texture for it (not kept)");
+      uint32_t image = 0;
+      if (*from[k].embedded && is_embedded_image_uri(uri, &image) && image < mesh.images.size()) {
+        *to[k] = keep_embedded_image(mesh.images[image], image, kept, chain.images);
+        c.tex_coords[k] = std::min(m.tex_coords[k], kMaxTexCoord);
+      } else if (*from[k].embedded || uri.rfind("data:", 0) == 0)
+        notes.push_back(at + ": its " + slot + " texture is embedded in the file but was not kept (see the import warning); "
+                        "the levels reference no texture for it");
       else if (!storable(uri))
         notes.push_back(at + ": " + slot + " texture URI is too long or has control bytes (not kept)");
+      else if (is_embedded_image_uri(uri))
+        notes.push_back(at + ": " + slot + " texture URI '" + uri +
+                        "' has the scheme the asset keeps for its own images (not kept)");
       else if (chain.texture_base.empty() && !uri.empty())
         notes.push_back(at + ": the source's folder cannot be stored, so its " + slot + " texture '" + uri + "' is not kept");
       else

@@ -51,9 +51,10 @@ void cluster_simplify_per_material(ChainLevelOut* levels, const MeshData& mesh, 
                                    size_t attribute_count = 0);
 
 // The mesh's materials as the chain stores them (chain.materials, chain.texture_base = the
-// source's folder, absolute). What cannot be kept is said in `notes`: textures embedded in the
-// file (GLB buffers, data URIs), names or URIs too long or with control bytes, factors outside
-// [0, 1] (clamped).
+// source's folder, absolute) and the images they hold in themselves (chain.images, only those
+// a kept material names, each slot naming its copy as "embedded:<k>"). What cannot be kept is
+// said in `notes`: embedded images the import left out (not PNG/JPEG, too large), names or URIs
+// too long or with control bytes, factors outside [0, 1] (clamped).
 void add_chain_materials(const MeshData& mesh, const std::filesystem::path& source, LodChain& chain,
                          std::vector<std::string>& notes);
 

@@ -9,15 +9,18 @@
 #include <vector>
 
 #include "runtime/chain_material.h"  // AlphaMode
+#include "runtime/embedded_image.h"
 
 namespace lod {
 
 // A surface description as glTF's metallic-roughness material gives it; textures are named
-// by the URI the file uses (relative to the file), never loaded.
+// by the URI the file uses (relative to the file), never loaded. An image held in the file
+// itself (GLB buffer view, data URI) has its embedded flag set and, when its bytes were kept
+// (PNG or JPEG), the URI "embedded:<k>" naming MeshData::images[k]; else an empty URI.
 struct MeshMaterial {
   std::string name;
   float base_color[4] = {1, 1, 1, 1};  // linear RGBA factor
-  std::string base_color_texture;      // image URI; empty when none or embedded in the file
+  std::string base_color_texture;      // image URI ("embedded:<k>" when kept from inside the file); empty when none
   bool base_color_texture_embedded = false;  // the texture's image is inside the file (GLB or data URI)
   float metallic = 1;
   float roughness = 1;
@@ -76,6 +79,7 @@ struct MeshData {
   std::vector<float> colors;       // linear RGBA per vertex (glTF COLOR_0; RGB gets alpha 1), or empty
   std::vector<Submesh> submeshes;  // cover every triangle in order, or empty (one surface)
   std::vector<MeshMaterial> materials;  // as numbered by the file, or empty
+  std::vector<EmbeddedImage> images;    // PNG / JPEG bytes the file held itself, named "embedded:<k>" by materials
   std::vector<std::string> warnings;    // what the reader skipped, each naming the element
 
   size_t vertex_count() const { return positions.size() / 3; }

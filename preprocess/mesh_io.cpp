@@ -419,26 +419,40 @@ Status check_surfaces(const std::string& what, const ObjSurfaces& s, size_t inde
 Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
   std::string text = "# lodkit\nnewmtl lodkit_default\nKd 1 1 1\nd 1\n";
   char line[200];
-  std::vector<std::filesystem::path> copied;
+  // Where each copy came from: a file, or bytes in memory (then the pointer is set).
+  std::vector<std::pair<std::filesystem::path, const EmbeddedImage*>> copied;
   // The copy's name next to the .mtl, empty when the image is missing or too large (said).
-  auto copy_image = [&](size_t i, const std::filesystem::path& image, std::string& name) -> Status {
+  // `embedded`, when set, holds the image (`image` is then ignored).
+  auto copy_image = [&](size_t i, const std::filesystem::path& image, const EmbeddedImage* embedded,
+                        std::string& name) -> Status {
     name.clear();
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(image, ec);
-    if (ec || !std::filesystem::is_regular_file(image, ec) || size > (uintmax_t(256) << 20)) {
+    const std::pair source(embedded ? std::filesystem::path() : image, embedded);
+    if (embedded && (image_type_of(embedded->bytes) == ImageType::unknown || embedded->bytes.size() > kMaxEmbeddedImageBytes)) {
       if (s.notes)
-        s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + image.string() +
-                           " is missing or larger than 256 MiB; written without it");
+        s.notes->push_back(obj.string() + ": material " + std::to_string(i) +
+                           ": embedded texture is neither PNG nor JPEG or larger than 256 MiB; written without it");
       return Status::success();
     }
-    auto known = std::find(copied.begin(), copied.end(), image);
+    std::error_code ec;
+    if (!embedded) {
+      const auto size = std::filesystem::file_size(image, ec);
+      if (ec || !std::filesystem::is_regular_file(image, ec) || size > (uintmax_t(256) << 20)) {
+        if (s.notes)
+          s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + image.string() +
+                             " is missing or larger than 256 MiB; written without it");
+        return Status::success();
+      }
+    }
+    auto known = std::find(copied.begin(), copied.end(), source);
     const size_t k = size_t(known - copied.begin());
-    name = obj.stem().string() + "-image" + std::to_string(k) + image.extension().string();
+    const std::string extension = embedded ? file_extension(embedded->type) : image.extension().string();
+    name = obj.stem().string() + "-image" + std::to_string(k) + extension;
     if (known == copied.end()) {
       std::vector<uint8_t> bytes;
-      if (Status r = detail::read_regular_file(image, bytes); !r) return r;
+      if (embedded) bytes = embedded->bytes;
+      else if (Status r = detail::read_regular_file(image, bytes); !r) return r;
       if (Status w = write_file_atomic(obj.parent_path() / name, bytes); !w) return w;
-      copied.push_back(image);
+      copied.push_back(source);
     }
     return Status::success();
   };
@@ -450,26 +464,27 @@ Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
                   m.metallic, m.roughness);
     text += line;
     std::string name;
-    if (!m.base_color_image.empty()) {
-      if (Status r = copy_image(i, m.base_color_image, name); !r) return r;
+    if (!m.base_color_image.empty() || m.embedded_images[0]) {
+      if (Status r = copy_image(i, m.base_color_image, m.embedded_images[0], name); !r) return r;
       if (!name.empty()) text += "map_Kd " + name + "\n";
     }
-    if (!m.normal_image.empty()) {
-      if (Status r = copy_image(i, m.normal_image, name); !r) return r;
+    if (!m.normal_image.empty() || m.embedded_images[2]) {
+      if (Status r = copy_image(i, m.normal_image, m.embedded_images[2], name); !r) return r;
       std::snprintf(line, sizeof line, "map_Bump -bm %.6g ", m.normal_scale);
       if (!name.empty()) text += line + name + "\n";
     }
-    if (!m.emissive_image.empty()) {
-      if (Status r = copy_image(i, m.emissive_image, name); !r) return r;
+    if (!m.emissive_image.empty() || m.embedded_images[4]) {
+      if (Status r = copy_image(i, m.emissive_image, m.embedded_images[4], name); !r) return r;
       if (!name.empty()) text += "map_Ke " + name + "\n";
     }
-    if (!m.metallic_roughness_image.empty()) {
-      if (Status r = copy_image(i, m.metallic_roughness_image, name); !r) return r;
+    if (!m.metallic_roughness_image.empty() || m.embedded_images[1]) {
+      if (Status r = copy_image(i, m.metallic_roughness_image, m.embedded_images[1], name); !r) return r;
       if (!name.empty()) text += "map_Pm -imfchan b " + name + "\nmap_Pr -imfchan g " + name + "\n";
     }
-    if (!m.occlusion_image.empty() && s.notes)
+    if ((!m.occlusion_image.empty() || m.embedded_images[3]) && s.notes)
       s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": occlusion texture " +
-                         m.occlusion_image.string() + " not written (MTL has no occlusion statement)");
+                         (m.embedded_images[3] ? std::string("(embedded image)") : m.occlusion_image.string()) +
+                         " not written (MTL has no occlusion statement)");
   }
   std::filesystem::path mtl = obj;
   mtl.replace_extension(".mtl");

@@ -59,6 +59,10 @@ struct ObjMaterialView {
   std::filesystem::path occlusion_image;
   std::filesystem::path emissive_image;
   float emissive[3] = {0, 0, 0};
+  // Images held in memory, in kTextureSlots order (base colour, metallic-roughness, normal,
+  // occlusion, emissive): a slot with one copies its bytes (named by its type's extension)
+  // instead of the file its path names.
+  std::array<const EmbeddedImage*, kTextureSlots> embedded_images{};
 };
 struct ObjSubmeshView {
   size_t first_index = 0;

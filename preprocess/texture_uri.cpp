@@ -3,6 +3,8 @@
 
 #include <cctype>
 
+#include "runtime/embedded_image.h"
+
 namespace lod {
 
 std::string decode_uri(const std::string& uri) {
@@ -36,7 +38,8 @@ std::string path_to_uri(const std::string& path) {
 }
 
 std::filesystem::path texture_file(const std::string& base, const std::string& uri) {
-  if (uri.empty() || uri.rfind("data:", 0) == 0 || uri.find("://") != std::string::npos) return {};
+  if (uri.empty() || uri.rfind("data:", 0) == 0 || uri.find("://") != std::string::npos || is_embedded_image_uri(uri))
+    return {};
   return std::filesystem::path(base) / decode_uri(uri);
 }
 

@@ -13,7 +13,7 @@ std::string decode_uri(const std::string& uri);
 std::string path_to_uri(const std::string& path);
 
 // The file a texture URI names against `base` (a folder), or empty for data URIs, URLs
-// ("scheme://") or an empty URI. Nothing is checked on disk.
+// ("scheme://"), images embedded in the chain ("embedded:<k>") or an empty URI. Nothing is checked on disk.
 std::filesystem::path texture_file(const std::string& base, const std::string& uri);
 
 }  // namespace lod

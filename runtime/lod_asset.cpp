@@ -40,6 +40,16 @@
 //       texCoord 0 everywhere. Layout 0 (bake format 7, read as before): the first 40 bytes only, name and base
 //       colour URI. Every count and length is checked against the section's bytes before
 //       anything is allocated or copied; the values by validate_chain.
+// IMGS (optional, flag 0; since bake format 10, when the chain has embedded images): u32 image
+//       count, u32 layout (1), u64 image bytes in all; per image 16 bytes (u64 byte length, u8
+//       type: 1 PNG, 2 JPEG, 7 zero bytes); then every image's bytes back to back (the PNG or
+//       JPEG file as embedded, never decoded). The count, each length and their sum are checked
+//       against the section's bytes and kMaxEmbeddedImages / kMaxEmbeddedImageBytes /
+//       kMaxEmbeddedBytes before anything is allocated; each image's signature against its type
+//       by validate_chain. MATL names image k as the texture URI "embedded:<k>". This build
+//       refuses a chain whose "embedded:<k>" names an image it lacks (validate_chain); a reader
+//       that predates the section skips it and finds no file by that URI, so it draws and
+//       exports those textures' materials without them, saying so.
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
 //       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
@@ -96,6 +106,10 @@ constexpr size_t kMaterialFixedBytes = 40;     // layout 0's record
 constexpr size_t kMaterialTexturedBytes = 76;  // layout 1's
 constexpr size_t kMaterialTexCoordBytes = 84;  // layout 2's
 constexpr uint32_t kMatlLayout = 2;
+constexpr uint32_t kImgs = fourcc("IMGS");
+constexpr size_t kImgsFixedBytes = 16;
+constexpr size_t kImageEntryBytes = 16;
+constexpr uint32_t kImgsLayout = 1;
 constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kVhat = fourcc("VHAT");
 constexpr size_t kVhatFixedBytes = 16;
@@ -423,6 +437,67 @@ Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, L
   return Status::success();
 }
 
+void put_images(Writer& w, const std::vector<EmbeddedImage>& images) {
+  uint64_t total = 0;
+  for (const EmbeddedImage& img : images) total += img.bytes.size();
+  w.u32(static_cast<uint32_t>(images.size()));
+  w.u32(kImgsLayout);
+  w.u64(total);
+  for (const EmbeddedImage& img : images) {
+    w.u64(img.bytes.size());
+    w.u8(static_cast<uint8_t>(img.type));
+    for (int k = 0; k < 7; ++k) w.u8(0);
+  }
+  for (const EmbeddedImage& img : images) w.raw(img.bytes.data(), img.bytes.size());
+}
+
+// Structure only (counts and lengths against the bytes and the bounds); each image's signature
+// is validate_chain's.
+Status get_images(const uint8_t* p, uint64_t size, const std::string& what, std::vector<EmbeddedImage>& out) {
+  auto bad = [&](const std::string& why) { return refuse(what, "IMGS section: " + why); };
+  if (size < kImgsFixedBytes)
+    return bad(std::to_string(size) + " bytes, needs " + std::to_string(kImgsFixedBytes) + " at least");
+  const uint64_t count = load_u32(p), total = load_u64(p + 8);
+  const uint32_t layout = load_u32(p + 4);
+  if (layout > kImgsLayout)
+    return bad("layout " + std::to_string(layout) + " is newer than this build reads (" + std::to_string(kImgsLayout) +
+               "); use a newer lodkit or re-bake it");
+  if (layout == 0) return bad("layout 0 does not exist");
+  if (count > kMaxEmbeddedImages)
+    return bad(std::to_string(count) + " images, at most " + std::to_string(kMaxEmbeddedImages));
+  if (total > kMaxEmbeddedBytes)
+    return bad(std::to_string(total) + " image bytes, at most " + std::to_string(kMaxEmbeddedBytes));
+  const uint64_t table = kImgsFixedBytes + count * kImageEntryBytes;  // both bounded: no overflow
+  if (table > size || size - table != total)
+    return bad(std::to_string(size) + " bytes, but " + std::to_string(count) + " images of " + std::to_string(total) +
+               " bytes need " + std::to_string(table) + " + " + std::to_string(total) + " (truncated?)");
+  uint64_t sum = 0;
+  for (uint64_t k = 0; k < count; ++k) {
+    const uint8_t* e = p + kImgsFixedBytes + k * kImageEntryBytes;
+    const uint64_t length = load_u64(e);
+    const std::string where = "image " + std::to_string(k);
+    if (length > kMaxEmbeddedImageBytes)
+      return bad(where + " is " + std::to_string(length) + " bytes, at most " + std::to_string(kMaxEmbeddedImageBytes));
+    if (e[8] != uint8_t(ImageType::png) && e[8] != uint8_t(ImageType::jpeg))
+      return bad(where + " has type " + std::to_string(e[8]) + " (1 PNG, 2 JPEG)");
+    for (int b = 9; b < 16; ++b)
+      if (e[b] != 0) return bad(where + " has non-zero padding byte " + std::to_string(b));
+    sum += length;  // each <= 256 MiB, at most 4096 of them: no overflow
+  }
+  if (sum != total)
+    return bad("images' lengths add up to " + std::to_string(sum) + " bytes, the section says " + std::to_string(total));
+  std::vector<EmbeddedImage> images(count);
+  const uint8_t* at = p + table;
+  for (uint64_t k = 0; k < count; ++k) {
+    const uint8_t* e = p + kImgsFixedBytes + k * kImageEntryBytes;
+    images[k].type = static_cast<ImageType>(e[8]);
+    images[k].bytes.assign(at, at + load_u64(e));
+    at += load_u64(e);
+  }
+  out = std::move(images);
+  return Status::success();
+}
+
 }  // namespace
 
 uint64_t hash_bytes(const void* data, size_t size, uint64_t seed) {
@@ -472,6 +547,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   if (!chain.uvs1.empty()) tags.push_back(kTex1);
   if (!chain.colors.empty()) tags.push_back(kCol0);
   if (!chain.materials.empty() || !chain.submeshes.empty()) tags.push_back(kMatl);
+  if (!chain.images.empty()) tags.push_back(kImgs);
   const uint32_t section_count = static_cast<uint32_t>(tags.size());
   w.raw(kMagic, sizeof(kMagic));
   w.u32(kLodAssetVersion);
@@ -480,7 +556,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
     w.u32(tags[s] == kVhie || tags[s] == kVhat || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kTex1 ||
-                   tags[s] == kCol0 || tags[s] == kMatl
+                   tags[s] == kCol0 || tags[s] == kMatl || tags[s] == kImgs
                ? 0
                : kFlagRequired);
     w.u64(0);  // offset, patched below
@@ -537,6 +613,7 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
         put_floats(w, chain.colors);
       });
     if (tags[s] == kMatl) section(s, [&] { put_materials(w, chain); });
+    if (tags[s] == kImgs) section(s, [&] { put_images(w, chain.images); });
   }
   w.align8();
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
@@ -582,7 +659,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     return refuse(what, "checksum mismatch (file is corrupted or truncated)");
 
   SectionRef sec[5];
-  SectionRef vhie, vhat, mrph, tex0, tex1, col0, matl;
+  SectionRef vhie, vhat, mrph, tex0, tex1, col0, matl, imgs;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -618,9 +695,10 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
       ref = {off, sz, true};
       continue;
     }
-    if (tag == kMatl) {
-      if (matl.present) return refuse(what, name + " appears twice");
-      matl = {off, sz, true};
+    if (tag == kMatl || tag == kImgs) {
+      SectionRef& ref = tag == kMatl ? matl : imgs;
+      if (ref.present) return refuse(what, name + " appears twice");
+      ref = {off, sz, true};
       continue;
     }
     size_t known = 0;
@@ -696,6 +774,8 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
   if (Status st = get_column(col0, "COL0", 4, chain.color_errors, chain.colors); !st) return st;
   if (matl.present)
     if (Status st = get_materials(p + matl.offset, matl.size, what, chain); !st) return st;
+  if (imgs.present)
+    if (Status st = get_images(p + imgs.offset, imgs.size, what, chain.images); !st) return st;
   std::string message;
   const char* section = "LEVL";
   if (!validate_chain(chain, &message, &section)) return refuse(what, std::string(section) + " section: " + message);

@@ -47,6 +47,25 @@ bool printable_string(const std::string& s) {
 
 bool unit_factor(float x) { return std::isfinite(x) && x >= 0 && x <= 1; }
 
+bool validate_images(const LodChain& chain, std::string* message) {
+  if (chain.images.size() > kMaxEmbeddedImages)
+    return fail(message, std::to_string(chain.images.size()) + " embedded images, at most " + std::to_string(kMaxEmbeddedImages));
+  uint64_t total = 0;
+  for (size_t k = 0; k < chain.images.size(); ++k) {
+    const EmbeddedImage& img = chain.images[k];
+    const std::string at = "embedded image " + std::to_string(k);
+    if (img.bytes.size() > kMaxEmbeddedImageBytes)
+      return fail(message, at + " is " + std::to_string(img.bytes.size()) + " bytes, at most " +
+                               std::to_string(kMaxEmbeddedImageBytes));
+    total += img.bytes.size();
+    if (img.type == ImageType::unknown || image_type_of(img.bytes) != img.type)
+      return fail(message, at + " is not the PNG or JPEG its type says (signature checked)");
+  }
+  if (total > kMaxEmbeddedBytes)
+    return fail(message, "embedded images take " + std::to_string(total) + " bytes, at most " + std::to_string(kMaxEmbeddedBytes));
+  return true;
+}
+
 bool validate_materials(const LodChain& chain, std::string* message) {
   if (chain.materials.empty() && chain.submeshes.empty()) return true;
   if (chain.materials.size() > kMaxMaterials)
@@ -61,6 +80,10 @@ bool validate_materials(const LodChain& chain, std::string* message) {
     for (size_t k = 0; k < kTextureSlots; ++k)
       if (!printable_string(*uris[k]))
         return fail(message, at + " " + kTextureSlotNames[k] + " texture URI is too long or has control bytes");
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (uint32_t image = 0; is_embedded_image_uri(*uris[k], &image) && image >= chain.images.size())
+        return fail(message, at + " " + kTextureSlotNames[k] + " texture names embedded image '" + *uris[k] + "' of " +
+                                 std::to_string(chain.images.size()));
     for (size_t k = 0; k < kTextureSlots; ++k)
       if (m.tex_coords[k] > kMaxTexCoord)
         return fail(message, at + " " + kTextureSlotNames[k] + " texture reads TEXCOORD_" +
@@ -232,6 +255,8 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
                                    std::to_string(k + 1) + "'s " + std::to_string(next));
     }
   }
+  in("IMGS");
+  if (!validate_images(chain, message)) return false;
   in("MATL");
   if (!validate_materials(chain, message)) return false;
   return true;

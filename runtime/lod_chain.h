@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "runtime/chain_material.h"
+#include "runtime/embedded_image.h"
 #include "runtime/vertex_tree.h"
 
 namespace lod {
@@ -57,6 +58,10 @@ struct LodChain {
   std::vector<ChainMaterial> materials;
   std::vector<LevelSubmesh> submeshes;
   std::string texture_base;
+  // Optional images the source held in itself (GLB buffer views, data: URIs), PNG or JPEG bytes
+  // as embedded; a material's texture URI "embedded:<k>" names images[k]. Stored in the
+  // optional IMGS section.
+  std::vector<EmbeddedImage> images;
   // Optional geomorph targets (empty = none): per vertex of every level but the last, laid out
   // like positions (level k's at levels[k].first_vertex), the level-local index of the vertex
   // of level k + 1 it merges into. Stored in the asset's optional MRPH section.
@@ -84,9 +89,11 @@ int32_t level_of_triangles(uint64_t triangles);
 // [0, 1e6]), alpha mode known, names
 // and URIs at most kMaxMaterialString bytes without control characters; submeshes sorted by
 // level, each drawn level's runs non-empty, whole triangles, covering its indices in order,
-// each naming a material that exists (or -1); the culled level has none.
+// each naming a material that exists (or -1); the culled level has none. Embedded images: at
+// most kMaxEmbeddedImages, each PNG or JPEG by its signature (and typed so), at most
+// kMaxEmbeddedImageBytes, kMaxEmbeddedBytes together; every "embedded:<k>" URI names one.
 // Values must be finite and at most kMaxTreeMagnitude in size. `section`, when given, is set
-// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH", "TEX0", "TEX1", "COL0", "MATL") the failing
+// to the asset section ("LEVL", "POSN", "NRML", "INDX", "MRPH", "TEX0", "TEX1", "COL0", "MATL", "IMGS") the failing
 // element is in.
 bool validate_chain(const LodChain& chain, std::string* message, const char** section = nullptr);
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "preprocess/gltf_write.h"
@@ -97,14 +98,25 @@ inline MeshData two_material_sphere(int rings, int segments) {
   return m;
 }
 
+// two_material_sphere winds its triangles inward (clockwise seen from outside). The bake does
+// not care, but glTF's front faces are counter-clockwise, and a viewer culls the back faces of
+// single-sided materials: pictures of it need the faces turned outward.
+enum class SphereFaces { inward, outward };
+inline void turn_faces_outward(MeshData& m) {
+  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) std::swap(m.indices[t + 1], m.indices[t + 2]);
+}
+
 // The sphere as <dir>/<name>.gltf (+ .bin) with its texture as <name>-image0.png next to it
 // (material 0's base colour texture, named by URI); returns the .gltf, empty on failure.
 // With `every_texture`, material 0 also has metallic-roughness, normal (scale 0.625),
 // occlusion (strength 0.375) and emissive textures (<name>-image1..4.png, each a different
-// image) and emissive factor (0.5, 0.25, 0.125), and the sphere has normals.
+// image) and emissive factor (0.5, 0.25, 0.125), and the sphere has normals. `faces`: the
+// winding (SphereFaces above).
 inline std::filesystem::path write_two_material_gltf(const std::filesystem::path& dir, const std::string& name,
-                                                    int rings = 24, int segments = 48, bool every_texture = false) {
-  const MeshData m = two_material_sphere(rings, segments);
+                                                    int rings = 24, int segments = 48, bool every_texture = false,
+                                                    SphereFaces faces = SphereFaces::inward) {
+  MeshData m = two_material_sphere(rings, segments);
+  if (faces == SphereFaces::outward) turn_faces_outward(m);
   std::filesystem::create_directories(dir);
   write_bytes(dir / "checker.png", checker_png(64, 8));
   GltfMeshView view;

@@ -97,6 +97,10 @@ void add_vd_draws(const Frame& f, size_t n, const MeshLayout& layout, DrawList& 
     if (model < layout.level_count.size() && f.levels[v.entry] < layout.level_count[model])
       out.vd_level_triangles += level_triangles(layout, model, f.levels[v.entry]);
     VdDraw d{v.object, v.entry, v.first_vertex, v.vertex_count, v.first_index, v.index_count, transform};
+    if (model < layout.level_count.size() && layout.level_count[model] > 0) {
+      const float* c = layout.ranges[layout.range_of(model, 0)].center;
+      std::copy(c, c + 3, d.center);
+    }
     add_vd_runs(f, v, model, layout, out, d);
     out.vd.push_back(d);
     out.vd_triangles += v.index_count / 3;

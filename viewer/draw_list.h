@@ -69,6 +69,7 @@ struct VdDraw {
   InstanceData transform;     // the same per-object transform the instances use, morph = 1
   uint32_t first_run = 0;     // into DrawList::vd_runs; 0 runs: drawn as one surface
   uint32_t run_count = 0;
+  float center[3] = {0, 0, 0};  // model space: its model's level 0 centre, which blended draws sort by
 };
 
 struct DrawList {

@@ -189,6 +189,16 @@ bool has_blend_runs(const MeshBuffers& meshes, const LevelRange& r) {
   return false;
 }
 
+RunPass vd_run_pass(const MeshBuffers& meshes, const VdRunDraw& run) {
+  return run_pass(meshes, MaterialRun{run.first_index, run.index_count, run.material});
+}
+
+bool vd_has_blend_runs(const DrawList& list, const VdDraw& d, const MeshBuffers& meshes) {
+  for (uint32_t k = d.first_run; k < d.first_run + d.run_count; ++k)
+    if (vd_run_pass(meshes, list.vd_runs[k]) == RunPass::blend) return true;
+  return false;
+}
+
 // The sun of the terrain's shading, in world space (y up).
 constexpr glm::vec3 kSunDirection = {0.45f, 0.8f, 0.35f};
 
@@ -205,11 +215,14 @@ void InstanceRenderer::set_plain_surface(const std::array<float, 3>& c) {
   glUniform1i(u_occlusion_mapped_, 0);
   glUniform1i(u_emissive_mapped_, 0);
   glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);  // plain surfaces (no material to say single-sided): both sides, as meshes from the wild need
 }
 
 // BLEND materials blend over what is drawn before them (draw() draws them after the opaque
-// runs, without depth writes; no sorting among them); MASK ones drop the fragments below their
-// cutoff. Each texture the material has goes to its unit (0 base colour .. 4 emissive).
+// runs, without depth writes, farthest object first); MASK ones drop the fragments below their
+// cutoff. Single-sided materials cull back faces, as glTF asks (no instance transform mirrors:
+// scale > 0 and a rotation, and the import turns mirrored nodes' winding back), double-sided ones
+// draw both. Each texture the material has goes to its unit (0 base colour .. 4 emissive).
 void InstanceRenderer::set_material(const GpuMaterial& m) {
   glUniform3f(u_colour_, m.base_color[0], m.base_color[1], m.base_color[2]);
   glUniform1f(u_alpha_, m.base_color[3]);
@@ -237,6 +250,12 @@ void InstanceRenderer::set_material(const GpuMaterial& m) {
     glBindTexture(GL_TEXTURE_2D, units[k].first);
   }
   glActiveTexture(GL_TEXTURE0);
+  if (m.double_sided) {
+    glDisable(GL_CULL_FACE);
+  } else {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  }
   if (m.alpha_mode == AlphaMode::blend) {
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -314,6 +333,46 @@ bool InstanceRenderer::init(std::string* message) {
   glGenBuffers(1, &instance_vbo_);
   glGenQueries(1, &query_);
   return true;
+}
+
+// The view-dependent meshes' VAO, with the constants its disabled attributes take (a zero
+// normal makes the shader use face normals).
+void InstanceRenderer::bind_vd_meshes(const VdMeshBuffers& vd, const std::array<float, 3>& colour) {
+  glBindVertexArray(vd.vao());
+  glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);
+  glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  set_plain_surface(colour);
+}
+
+// One view-dependent object's runs of `pass` (its per-object attributes are constants in its
+// VAO); drawn as one surface in `colour` when it has no runs or a mode colours the draws
+// (opaque pass only).
+void InstanceRenderer::draw_vd_object(const DrawList& list, const VdDraw& d, const MeshBuffers& meshes,
+                                      const RenderSettings& settings, const std::array<float, 3>& colour, RunPass pass) {
+  glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
+  glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
+  glVertexAttrib2f(kAttribInstanceMorph, d.transform.morph, 0.f);
+  auto draw = [&](uint32_t first_index, uint32_t count) {
+    glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
+                             reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)), GLint(d.first_vertex));
+  };
+  if (!draws_materials(settings) || d.run_count == 0) {
+    if (pass == RunPass::opaque) draw(d.first_index, d.index_count);
+    return;
+  }
+  // Run by run with its material, as the levels are drawn (the frame grouped them).
+  const auto& materials = meshes.materials().materials();
+  for (uint32_t k = d.first_run; k < d.first_run + d.run_count; ++k) {
+    const VdRunDraw& run = list.vd_runs[k];
+    if (vd_run_pass(meshes, run) != pass) continue;
+    if (run.material >= 0 && size_t(run.material) < materials.size()) {
+      set_material(materials[size_t(run.material)]);
+    } else {
+      set_plain_surface(kModelColour);
+    }
+    draw(run.first_index, run.index_count);
+  }
+  set_plain_surface(colour);
 }
 
 DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, MorphBuffers* morphs,
@@ -406,54 +465,49 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
     stats.triangles += uint64_t(r.index_count / 3) * b.instance_count;
   };
   for (const DrawBatch& b : list.batches) draw_batch(b, RunPass::opaque);
-  if (draws_materials(settings)) {
-    glDepthMask(GL_FALSE);
-    for (const DrawBatch& b : list.batches)
-      if (has_blend_runs(meshes, meshes.layout().ranges[b.range])) draw_batch(b, RunPass::blend);
-    glDepthMask(GL_TRUE);
-    set_plain_surface(kModelColour);
-  }
-
+  // View-dependent objects' opaque runs too, before anything blends over them.
+  const auto& vd_colour = settings.colour_override ? settings.colour
+                          : settings.colour_by_level ? kViewDependentColour
+                                                     : kModelColour;
   if (vd && !list.vd.empty()) {
-    // Same shader: the per-object attributes are disabled in this VAO, so the constant values
-    // set below are the transform; a zero normal makes the shader use face normals.
-    glBindVertexArray(vd->vao());
-    glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);
-    glVertexAttrib2f(kAttribUv, 0.f, 0.f);
-    const auto& c = settings.colour_override ? settings.colour
-                    : settings.colour_by_level ? kViewDependentColour
-                                               : kModelColour;
-    set_plain_surface(c);
-    const auto& materials = meshes.materials().materials();
+    bind_vd_meshes(*vd, vd_colour);
     for (const VdDraw& d : list.vd) {
-      glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
-      glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
-      glVertexAttrib2f(kAttribInstanceMorph, d.transform.morph, 0.f);
-      auto draw = [&](uint32_t first_index, uint32_t count) {
-        glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
-                                 reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)),
-                                 GLint(d.first_vertex));
-      };
-      if (!draws_materials(settings) || d.run_count == 0) {
-        draw(d.first_index, d.index_count);
-      } else {
-        // Run by run with its material, as the levels are drawn (the frame grouped them).
-        for (uint32_t k = d.first_run; k < d.first_run + d.run_count; ++k) {
-          const VdRunDraw& run = list.vd_runs[k];
-          if (run.material >= 0 && size_t(run.material) < materials.size()) {
-            set_material(materials[size_t(run.material)]);
-          } else {
-            set_plain_surface(kModelColour);
-          }
-          draw(run.first_index, run.index_count);
-        }
-        set_plain_surface(c);
-      }
+      draw_vd_object(list, d, meshes, settings, vd_colour, RunPass::opaque);
       ++stats.draws;
       ++stats.vd_draws;
       stats.vd_triangles += d.index_count / 3;
       stats.triangles += d.index_count / 3;
     }
+  }
+  if (draws_materials(settings)) {
+    // Blended runs over everything opaque, one object at a time, farthest first.
+    range_blends_.assign(meshes.layout().ranges.size(), 0);
+    for (const DrawBatch& b : list.batches)
+      range_blends_[b.range] = has_blend_runs(meshes, meshes.layout().ranges[b.range]) ? 1 : 0;
+    vd_blends_.assign(vd ? list.vd.size() : 0, 0);
+    for (size_t v = 0; v < vd_blends_.size(); ++v) vd_blends_[v] = vd_has_blend_runs(list, list.vd[v], meshes) ? 1 : 0;
+    order_blended_draws(list, meshes.layout(), range_blends_, vd_blends_, view, blend_order_);
+    glDepthMask(GL_FALSE);
+    bool instanced_bound = false;
+    for (const BlendDraw& d : blend_order_) {
+      if (d.vd != kNotViewDependent) {
+        bind_vd_meshes(*vd, vd_colour);
+        instanced_bound = false;
+        draw_vd_object(list, list.vd[d.vd], meshes, settings, vd_colour, RunPass::blend);
+        continue;
+      }
+      if (!instanced_bound) {
+        glBindVertexArray(meshes.vao());
+        glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
+        instanced_bound = true;
+      }
+      DrawBatch one = list.batches[d.batch];
+      one.first_instance = d.instance;
+      one.instance_count = 1;
+      draw_batch(one, RunPass::blend);
+    }
+    glDepthMask(GL_TRUE);
+    set_plain_surface(kModelColour);
   }
 
   if (settings.count_primitives) {

@@ -5,15 +5,18 @@
 // Lambert term. Unless a mode colours the draws (colour-by-level, an override colour), each
 // level is drawn run by run with its materials, shaded with glTF's metallic-roughness BRDF
 // (base colour, metallic-roughness, normal, occlusion and emissive textures and factors) under
-// a sun and a sky/ground ambient; blended runs after the opaque ones.
+// a sun and a sky/ground ambient; single-sided materials cull back faces; blended runs after
+// the opaque ones, one instance at a time, farthest first (viewer/blend_order.h).
 #pragma once
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <epoxy/gl.h>
 #include <glm/glm.hpp>
 
+#include "viewer/blend_order.h"
 #include "viewer/draw_list.h"
 #include "viewer/hlod_draw_list.h"
 #include "viewer/hlod_node_buffers.h"
@@ -85,11 +88,17 @@ class InstanceRenderer {
   void set_material(const GpuMaterial& material);
   void draw_range(const MeshBuffers& meshes, const LevelRange& r, uint32_t instances, int32_t base_vertex,
                   const RenderSettings& settings, RunPass pass);
+  void bind_vd_meshes(const VdMeshBuffers& vd, const std::array<float, 3>& colour);
+  void draw_vd_object(const DrawList& list, const VdDraw& d, const MeshBuffers& meshes, const RenderSettings& settings,
+                      const std::array<float, 3>& colour, RunPass pass);
 
   GLuint program_ = 0;
   GLuint instance_vbo_ = 0;
   GLuint query_ = 0;
   size_t instance_capacity_ = 0;
+  std::vector<uint8_t> range_blends_;    // scratch: per layout range, has a blended run (this frame's batches)
+  std::vector<uint8_t> vd_blends_;       // scratch: per DrawList::vd, has a blended run
+  std::vector<BlendDraw> blend_order_;   // scratch: the blended pass, farthest first
   GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1, u_blend_ = -1;
   GLint u_alpha_ = -1, u_alpha_cutoff_ = -1, u_textured_ = -1, u_normal_mapped_ = -1, u_normal_scale_ = -1;
   GLint u_pbr_ = -1, u_metallic_ = -1, u_roughness_ = -1, u_mr_mapped_ = -1, u_occlusion_mapped_ = -1;

@@ -13,6 +13,24 @@ namespace lod::viewer {
 
 namespace {
 
+// Checks the size stb_image read from a header before anything is decoded.
+bool fits(int width, int height, std::string& why) {
+  if (width > 0 && height > 0 && width <= kMaxTextureSide && height <= kMaxTextureSide) return true;
+  why = std::to_string(width) + " x " + std::to_string(height) + " pixels, more than " + std::to_string(kMaxTextureSide) +
+        " on a side";
+  return false;
+}
+
+std::vector<unsigned char> take_pixels(unsigned char* pixels, int width, int height, std::string& why) {
+  if (!pixels) {
+    why = stbi_failure_reason() ? stbi_failure_reason() : "decoding failed";
+    return {};
+  }
+  std::vector<unsigned char> out(pixels, pixels + size_t(width) * size_t(height) * 4);
+  stbi_image_free(pixels);
+  return out;
+}
+
 // RGBA8 pixels of `file`, or empty with the reason in `why`; the size is checked from the
 // header before anything is decoded.
 std::vector<unsigned char> decode_image(const std::string& file, int& width, int& height, std::string& why) {
@@ -21,19 +39,21 @@ std::vector<unsigned char> decode_image(const std::string& file, int& width, int
     why = stbi_failure_reason() ? stbi_failure_reason() : "not an image stb_image reads";
     return {};
   }
-  if (width <= 0 || height <= 0 || width > kMaxTextureSide || height > kMaxTextureSide) {
-    why = std::to_string(width) + " x " + std::to_string(height) + " pixels, more than " +
-          std::to_string(kMaxTextureSide) + " on a side";
+  if (!fits(width, height, why)) return {};
+  return take_pixels(stbi_load(file.c_str(), &width, &height, &channels, 4), width, height, why);
+}
+
+// The same for an image the chain carries (PNG or JPEG bytes, at most kMaxEmbeddedImageBytes,
+// so the length fits stb_image's int).
+std::vector<unsigned char> decode_image(const EmbeddedImage& image, int& width, int& height, std::string& why) {
+  int channels = 0;
+  const int size = int(image.bytes.size());
+  if (!stbi_info_from_memory(image.bytes.data(), size, &width, &height, &channels)) {
+    why = stbi_failure_reason() ? stbi_failure_reason() : "not an image stb_image reads";
     return {};
   }
-  unsigned char* pixels = stbi_load(file.c_str(), &width, &height, &channels, 4);
-  if (!pixels) {
-    why = stbi_failure_reason() ? stbi_failure_reason() : "decoding failed";
-    return {};
-  }
-  std::vector<unsigned char> out(pixels, pixels + size_t(width) * size_t(height) * 4);
-  stbi_image_free(pixels);
-  return out;
+  if (!fits(width, height, why)) return {};
+  return take_pixels(stbi_load_from_memory(image.bytes.data(), size, &width, &height, &channels, 4), width, height, why);
 }
 
 // A mipmapped, repeating RGBA8 texture. The image's rows go up as stored: glTF's uv origin is
@@ -65,10 +85,33 @@ void MaterialTextures::upload(std::span<const LodChain> chains) {
   // said once, whatever the slots naming it.
   std::map<std::pair<std::string, bool>, GLuint> by_file;
   std::map<std::string, bool> unreadable;
+  std::map<std::pair<const EmbeddedImage*, bool>, GLuint> by_image;
   for (const LodChain& chain : chains) {
+    // An image the chain carries, decoded from memory at its first use; 0 when it cannot be.
+    auto embedded_texture = [&](const ChainMaterial& m, const std::string& uri, const EmbeddedImage& image,
+                                bool srgb) -> GLuint {
+      if (auto it = by_image.find({&image, srgb}); it != by_image.end()) return it->second;
+      int w = 0, h = 0;
+      std::string why;
+      const std::vector<unsigned char> rgba = decode_image(image, w, h, why);
+      GLuint t = 0;
+      if (rgba.empty()) {
+        std::fprintf(stderr, "lod-viewer: %s: material '%s' texture %s (%zu bytes in the asset): %s; drawn without it\n",
+                     chain.name.c_str(), m.name.c_str(), uri.c_str(), image.bytes.size(), why.c_str());
+      } else {
+        t = make_texture(rgba, w, h, srgb);
+        textures_.push_back(t);
+        bytes_ += rgba.size() * 4 / 3;  // with its mipmaps
+      }
+      by_image[{&image, srgb}] = t;
+      if (!t) by_image[{&image, !srgb}] = 0;  // an image that cannot be decoded is said once
+      return t;
+    };
     // The texture a URI names, decoded at its first use; 0 when it cannot be read (said once).
     auto texture_of = [&](const ChainMaterial& m, const std::string& uri, bool srgb) -> GLuint {
       if (uri.empty()) return 0;
+      if (uint32_t k = 0; is_embedded_image_uri(uri, &k))
+        return k < chain.images.size() ? embedded_texture(m, uri, chain.images[k], srgb) : 0;  // validate_chain checked k
       const std::string file = texture_file(chain.texture_base, uri).string();
       if (file.empty()) {
         std::fprintf(stderr, "lod-viewer: %s: material '%s' texture '%s' is not a file (data URI or URL); drawn without it\n",

@@ -1,5 +1,6 @@
 // MaterialTextures: every chain's materials as the shader needs them, scene-wide in
-// MeshLayout::first_material order; each image is decoded once per colour space (stb_image),
+// MeshLayout::first_material order; each image is decoded once per colour space (stb_image,
+// from its file, or from memory for the images the asset carries: LodChain::images),
 // however many materials name it, into one mipmapped GL texture: base colour and emissive
 // images as sRGB (the GL decodes them to linear), metallic-roughness, normal and occlusion
 // images as linear data, as glTF defines them.

@@ -37,6 +37,7 @@ MeshLayout layout_meshes(std::span<const LodChain> chains) {
       r.first_index = static_cast<uint32_t>(index_base + level.first_index);
       r.index_count = level.index_count;
       r.base_vertex = static_cast<int32_t>(vertex_base + level.first_vertex);
+      std::copy(level.bounds.center, level.bounds.center + 3, r.center);
       add_runs(chain, k, layout.material_count, r, layout);
       layout.ranges.push_back(r);
     }

@@ -16,6 +16,7 @@ struct LevelRange {
   int32_t base_vertex = 0;   // added to the level-local indices
   uint32_t first_run = 0;    // into MeshLayout::runs: the level's material runs
   uint32_t run_count = 0;    // 0 for a chain without materials
+  float center[3] = {0, 0, 0};  // the level's bounding sphere centre (model space): blended draws sort by it
 };
 
 // Part of a level drawn with one material: indices into the shared index buffer, and the

@@ -14,6 +14,7 @@
 
 #include "gltf_fixture.h"
 #include "preprocess/mesh_io.h"
+#include "runtime/lod_asset.h"
 #include "run_cli.h"
 #include "test_support.h"
 #include "textured_fixture.h"
@@ -481,6 +482,196 @@ TEST(GltfExport, SpotObjKeepsItsTextureThroughEveryLevel) {
   }
   const auto v = run_validator(exported);
   EXPECT_EQ(v.code, 0) << v.out;
+}
+
+// ---- textures embedded in the source (GLB buffer view, data URI): kept in the .lod (IMGS) ----
+
+// two_material_sphere written by hand as glTF (not by lodkit's exporter): one primitive per
+// material, material 0 ('cap') with base colour texture 0 whose image is `image` (a JSON image
+// object: a buffer view or a data URI), material 1 plain and double-sided.
+lod::test::GltfFixture embedded_texture_sphere(nlohmann::json image, const std::vector<uint8_t>* image_in_buffer) {
+  const lod::MeshData m = lod::test::two_material_sphere(16, 32);
+  lod::test::GltfFixture f;
+  const int pos = f.add_accessor(f.add_view(m.positions), lod::test::kFloat, m.vertex_count(), "VEC3");
+  const int uv = f.add_accessor(f.add_view(m.uvs), lod::test::kFloat, m.vertex_count(), "VEC2");
+  std::vector<nlohmann::json> primitives;
+  for (const lod::Submesh& s : m.submeshes) {
+    const std::vector<uint32_t> part(m.indices.begin() + 3 * std::ptrdiff_t(s.first_triangle),
+                                     m.indices.begin() + 3 * std::ptrdiff_t(s.first_triangle + s.triangle_count));
+    const int ind = f.add_accessor(f.add_view(part), lod::test::kUInt, part.size(), "SCALAR");
+    primitives.push_back({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"indices", ind}, {"material", s.material}});
+  }
+  f.add_mesh(primitives);
+  f.set_scene({f.add_node({{"mesh", 0}})});
+  if (image_in_buffer) image["bufferView"] = f.add_view(*image_in_buffer);
+  f.j["images"] = nlohmann::json::array({image});
+  f.j["textures"] = nlohmann::json::array({{{"source", 0}}});
+  f.j["materials"] = nlohmann::json::array(
+      {{{"name", "cap"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}}}},
+       {{"name", "base"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.2, 0.1, 1.0}}}}, {"doubleSided", true}}});
+  return f;
+}
+
+// `source` -> lod bake -> the .lod holds `png` -> inspect lists it -> GLB, glTF and OBJ export
+// of every level -> import: the image bytes identical in each; the validator: 0 errors.
+void expect_embedded_png_round_trip(const fs::path& dir, const fs::path& source, const std::vector<uint8_t>& png) {
+  auto r = run_lod("bake " + source.string() + " -o " + (dir / "out").string() + " --ratios 1 0.5 0.25 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path asset = baked_asset(dir / "out");
+  lod::LodChain chain;
+  ASSERT_TRUE(lod::read_lod_asset(asset, chain).ok);
+  ASSERT_EQ(chain.images.size(), 1u);
+  EXPECT_EQ(chain.images[0].type, lod::ImageType::png);
+  EXPECT_EQ(chain.images[0].bytes, png) << "the .lod holds the image byte for byte";
+  r = run_lod("inspect " + asset.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("embedded images: 1 (" + std::to_string(png.size()) + " bytes"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  embedded:0: image/png, " + std::to_string(png.size()) + " bytes"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("texture embedded:0"), std::string::npos) << r.out;
+  std::vector<fs::path> exported;
+  for (const std::string format : {"glb", "gltf", "obj"}) {
+    r = run_lod("inspect " + asset.string() + " --json --export " + (dir / format).string() + " --format " + format);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["images"].size(), 1u);
+    EXPECT_EQ(j["images"][0]["mime_type"], "image/png");
+    EXPECT_EQ(j["images"][0]["bytes"].get<size_t>(), png.size());
+    EXPECT_EQ(j["materials"][0]["base_color_texture"], "embedded:0");
+    ASSERT_EQ(j["levels"].size(), 3u);
+    for (size_t i = 0; i < 3; ++i) {
+      SCOPED_TRACE(format + " level " + std::to_string(i));
+      const std::string stem = "globe-level" + std::to_string(i);
+      const fs::path level = dir / format / (stem + "." + format);
+      if (format == "obj") {
+        std::ifstream mtl(fs::path(level).replace_extension(".mtl"));
+        const std::string text{std::istreambuf_iterator<char>(mtl), std::istreambuf_iterator<char>()};
+        EXPECT_NE(text.find("map_Kd " + stem + "-image0.png"), std::string::npos) << text;
+        EXPECT_EQ(lod::test::read_bytes(dir / format / (stem + "-image0.png")), png);
+        continue;
+      }
+      lod::MeshData back;
+      const lod::Status s = lod::load_mesh(level, back);
+      ASSERT_TRUE(s.ok) << s.message;
+      exported.push_back(level);
+      ASSERT_EQ(back.materials.size(), 2u);
+      if (format == "glb") {
+        EXPECT_TRUE(back.materials[0].base_color_texture_embedded);
+        EXPECT_EQ(back.materials[0].base_color_texture, "embedded:0");
+        ASSERT_EQ(back.images.size(), 1u);
+        EXPECT_EQ(back.images[0].bytes, png) << "the GLB's image is the source's, byte for byte";
+      } else {
+        EXPECT_EQ(back.materials[0].base_color_texture, stem + "-image0.png");
+        EXPECT_EQ(lod::test::read_bytes(dir / format / back.materials[0].base_color_texture), png);
+      }
+      EXPECT_TRUE(back.materials[1].base_color_texture.empty());
+    }
+  }
+  expect_valid(exported);
+}
+
+TEST(GltfExport, APngInsideAGlbIsKeptByTheBakeAndExportedByteForByte) {
+  const fs::path dir = lod::test::temp_dir("gltf-embedded-glb");
+  const std::vector<uint8_t> png = lod::test::checker_png(32, 4);
+  lod::test::GltfFixture f = embedded_texture_sphere({{"mimeType", "image/png"}}, &png);
+  lod::test::write_bytes(dir / "globe.glb", f.glb());
+  expect_embedded_png_round_trip(dir, dir / "globe.glb", png);
+}
+
+TEST(GltfExport, APngInADataUriIsKeptByTheBakeAndExportedByteForByte) {
+  const fs::path dir = lod::test::temp_dir("gltf-embedded-data-uri");
+  const std::vector<uint8_t> png = lod::test::checker_png(16, 2);
+  lod::test::GltfFixture f =
+      embedded_texture_sphere({{"uri", "data:image/png;base64," + lod::test::GltfFixture::base64(png)}}, nullptr);
+  lod::test::write_text(dir / "globe.gltf", f.gltf_data_uri());
+  expect_embedded_png_round_trip(dir, dir / "globe.gltf", png);
+}
+
+// Hostile embedded images: one that is not PNG/JPEG is dropped, said naming the file, material
+// and slot (the bake goes on without it); a buffer view past the buffer refuses the file and
+// writes nothing.
+TEST(GltfExport, AnEmbeddedImageThatIsNotPngOrJpegIsDroppedAndABrokenViewRefused) {
+  const fs::path dir = lod::test::temp_dir("gltf-embedded-hostile");
+  const std::string gif = "GIF89a\x01\x00\x01\x00\x80\x00\x00";
+  const std::vector<uint8_t> not_png(gif.begin(), gif.end());
+  lod::test::GltfFixture f = embedded_texture_sphere({{"mimeType", "image/png"}}, &not_png);
+  lod::test::write_bytes(dir / "gif.glb", f.glb());
+  auto r = run_lod("bake " + (dir / "gif.glb").string() + " -o " + (dir / "gif").string() + " --ratios 1 0.5");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find((dir / "gif.glb").string() +
+                       ": material 0: baseColorTexture: embedded image 0 is neither PNG nor JPEG (its first bytes are 47 49 "
+                       "46 38"),
+            std::string::npos)
+      << r.out;
+  lod::LodChain chain;
+  ASSERT_TRUE(lod::read_lod_asset(baked_asset(dir / "gif"), chain).ok);
+  EXPECT_TRUE(chain.images.empty());
+  EXPECT_TRUE(chain.materials[0].base_color_texture.empty());
+
+  const std::vector<uint8_t> png = lod::test::checker_png(8, 2);
+  lod::test::GltfFixture g = embedded_texture_sphere({{"mimeType", "image/png"}}, &png);
+  g.j["bufferViews"].back()["byteLength"] = uint64_t(1) << 40;  // a huge declared length
+  lod::test::write_bytes(dir / "huge.glb", g.glb());
+  r = run_lod("bake " + (dir / "huge.glb").string() + " -o " + (dir / "huge").string() + " --ratios 1 0.5");
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("huge.glb: buffer view 4 (bytes"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("runs past the end of buffer 0"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "huge") && !fs::is_empty(dir / "huge")) << "nothing written";
+}
+
+// ../shared's spot packed by gltfpack into a GLB (gltfpack 0.18 has no flag for it: a .glb
+// output embeds its images, here the PNG quantized textures keep as they are) keeps its
+// texture through every level: the .lod holds the PNG gltfpack embedded, each level's runs
+// name it, and every exported GLB embeds the same bytes and passes the validator.
+TEST(GltfExport, SpotPackedByGltfpackKeepsItsEmbeddedTextureThroughEveryLevel) {
+  LOD_REQUIRE_SHARED_MESH(spot, "spot.obj");
+  const fs::path texture = spot.parent_path() / "spot_texture.png";
+  if (!fs::exists(texture)) GTEST_SKIP() << "needs ../shared/data/meshes/spot_texture.png (absent on this machine)";
+  ASSERT_EQ(std::system("command -v gltfpack >/dev/null 2>&1"), 0) << "gltfpack missing: run scripts/install-deps.sh";
+  const fs::path dir = lod::test::temp_dir("gltf-spot-gltfpack");
+  const std::vector<uint8_t> obj = lod::test::read_bytes(spot);
+  std::string text = "mtllib spot.mtl\nusemtl spot\n";
+  text.append(obj.begin(), obj.end());
+  lod::test::write_text(dir / "spot.obj", text);
+  lod::test::write_text(dir / "spot.mtl", "newmtl spot\nKd 1 1 1\nmap_Kd spot_texture.png\n");
+  fs::copy_file(texture, dir / "spot_texture.png");
+  ASSERT_EQ(std::system(("cd " + dir.string() + " && gltfpack -i spot.obj -o spot.glb >/dev/null 2>&1").c_str()), 0);
+  fs::remove(dir / "spot_texture.png");  // the GLB must not need it
+  auto r = run_lod("bake " + (dir / "spot.glb").string() + " -o " + (dir / "out").string() + " --method qem");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("not kept"), std::string::npos) << r.out;
+  const fs::path asset = baked_asset(dir / "out");
+  lod::LodChain chain;
+  ASSERT_TRUE(lod::read_lod_asset(asset, chain).ok);
+  ASSERT_EQ(chain.images.size(), 1u);
+  const std::vector<uint8_t> original = lod::test::read_bytes(texture);
+  EXPECT_EQ(chain.images[0].bytes, original) << "gltfpack embeds the PNG as it is";
+  ASSERT_EQ(chain.materials.size(), 1u);
+  EXPECT_EQ(chain.materials[0].base_color_texture, "embedded:0");
+  r = run_lod("inspect " + asset.string() + " --json --export " + (dir / "glb").string() + " --format glb");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["texcoords"].get<bool>());
+  std::vector<fs::path> exported;
+  for (size_t i = 0; i < j["levels"].size(); ++i) {
+    if (j["levels"][i]["triangles"].get<size_t>() == 0) continue;  // the culled level
+    SCOPED_TRACE("level " + std::to_string(i));
+    const auto& runs = j["levels"][i]["submeshes"];
+    ASSERT_EQ(runs.size(), 1u);
+    EXPECT_EQ(runs[0]["material"], 0);
+    const fs::path level = dir / "glb" / ("spot-level" + std::to_string(i) + ".glb");
+    lod::MeshData back;
+    ASSERT_TRUE(lod::load_mesh(level, back).ok) << level;
+    EXPECT_EQ(back.uvs.size(), 2 * back.vertex_count());
+    ASSERT_EQ(back.materials.size(), 1u);
+    ASSERT_EQ(back.images.size(), 1u);
+    EXPECT_EQ(back.images[0].bytes, original);
+    std::printf("spot (gltfpack) level %zu: %zu triangles, uv error %.4g, image %zu bytes\n", i, back.triangle_count(),
+                j["levels"][i]["uv_error"].get<double>(), back.images[0].bytes.size());
+    exported.push_back(level);
+  }
+  EXPECT_GE(exported.size(), 3u);
+  expect_valid(exported);
 }
 
 // A scene's models may name a .glb (imported and baked) and a .lod (read as it is).

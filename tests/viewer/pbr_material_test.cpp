@@ -58,6 +58,7 @@ struct Textures {
 // The unit sphere (normals outward) with one material, as glTF.
 void write_ball(const fs::path& file, const lod::GltfMaterialView& material) {
   lod::MeshData m = lod::test::two_material_sphere(24, 48);
+  lod::test::turn_faces_outward(m);  // glTF's front faces, as single-sided materials are culled
   const std::vector<float> normals = m.positions;  // a unit sphere's normals are its positions
   lod::GltfMeshView view;
   view.name = file.stem().string();

@@ -6,6 +6,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <set>
 
 #include "textured_fixture.h"
@@ -82,7 +84,8 @@ HueCounts count_hues(const Image& img, float tolerance) {
 TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto lit = scene.dir / "materials.png";
   const auto levels = scene.dir / "levels.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
@@ -105,13 +108,62 @@ TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
   EXPECT_LE(c.any_base, 10) << "colour-by-level must not show the material factor";
 }
 
+// The globe as a GLB whose checker PNG lives in the GLB's buffer (lodkit's exporter embeds it),
+// the PNG file then deleted: the bake keeps the image in the asset (IMGS) and the viewer decodes
+// it from memory, so the cap still shows both checker colours.
+TEST(ViewerTextured, ATextureEmbeddedInTheGlbIsDecodedFromTheAsset) {
+  LOD_REQUIRE_XVFB();
+  const char* model = "[[model]]\nname = \"textured\"\nfile = \"textured/globe.glb\"\nratios = [1.0, 0.5]\n";
+  const auto scene = lod::test::write_viewer_scene("textured-glb", kRun, kCamera, kInstance, model);
+  const auto dir = scene.dir / "textured";
+  std::filesystem::create_directories(dir);
+  lod::MeshData m = lod::test::two_material_sphere(24, 48);
+  lod::test::turn_faces_outward(m);
+  lod::test::write_bytes(dir / "checker.png", lod::test::checker_png(64, 8));
+  lod::GltfMeshView view;
+  view.name = "globe";
+  view.positions = m.positions.data();
+  view.vertex_count = m.vertex_count();
+  view.uvs = m.uvs.data();
+  view.indices = m.indices.data();
+  view.index_count = m.indices.size();
+  for (const lod::MeshMaterial& src : m.materials) {
+    lod::GltfMaterialView g;
+    g.name = src.name;
+    std::copy(src.base_color, src.base_color + 4, g.base_color);
+    g.metallic = src.metallic;
+    g.roughness = src.roughness;
+    g.double_sided = src.double_sided;
+    view.materials.push_back(g);
+  }
+  view.materials[0].base_color_image = dir / "checker.png";
+  for (const lod::Submesh& sm : m.submeshes)
+    view.submeshes.push_back({3 * size_t(sm.first_triangle), 3 * size_t(sm.triangle_count), sm.material});
+  ASSERT_TRUE(lod::save_gltf(dir / "globe.glb", view).ok);
+  std::filesystem::remove(dir / "checker.png");
+  const auto lit = scene.dir / "embedded.png";
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "every texture was decoded: " << r.output;
+  EXPECT_EQ(r.output.find("drawn without it"), std::string::npos) << r.output;
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  const HueCounts c = count_hues(img, kPresent);
+  std::printf("embedded checker: %d light and %d dark pixels above the equator, %d base below\n", c.light_above,
+              c.dark_above, c.base_below);
+  EXPECT_GE(c.light_above, 300) << "light checker squares from the embedded image";
+  EXPECT_GE(c.dark_above, 300) << "dark checker squares from the embedded image";
+  EXPECT_GE(c.base_below, 300);
+}
+
 // The same globe drawn view-dependently: the front carries uvs and its triangles come grouped
 // by material, so the picture shows the texture and the factor as the levels do.
 TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
   LOD_REQUIRE_XVFB();
   const std::string model = std::string(kModel) + "view_dependent = true\n";
   const auto scene = lod::test::write_viewer_scene("textured-vd", kRun, kCamera, kInstance, model.c_str());
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto lit = scene.dir / "vd.png";
   const auto stats = scene.dir / "vd.csv";
   const auto r = lod::test::run_viewer(
@@ -133,7 +185,8 @@ TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   // Bake first (the texture is not read by the bake), then break the image.
   const auto png = scene.dir / "out.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
@@ -157,7 +210,8 @@ TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
 TEST(ViewerTextured, TheNormalTextureShadesItsMaterialOnly) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-normal", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/true).empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/true,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto mapped = scene.dir / "mapped.png";
   const auto plain = scene.dir / "plain.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + mapped.string() + "' --width 400 --height 300");
@@ -196,7 +250,8 @@ namespace {
 TEST(ViewerBackdrop, SkyGradientAboveGroundTilesBelowFlatWhenOff) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("backdrop", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto on = scene.dir / "backdrop.png";
   const auto off = scene.dir / "flat.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + on.string() + "' --width 400 --height 300 --backdrop on");
@@ -237,7 +292,8 @@ namespace {
 TEST(ViewerOverlay, CoversLessThanATenthOfThePicture) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("overlay", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe").empty());
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
+                                                     lod::test::SphereFaces::outward).empty());
   const auto with = scene.dir / "overlay.png";
   const auto without = scene.dir / "plain.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + with.string() + "' --overlay --frames 3 --width 1280 --height 720");

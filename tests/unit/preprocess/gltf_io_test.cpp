@@ -641,6 +641,62 @@ TEST(GltfImport, AppliesTheBaseColourTextureTransformToTexcoords) {
   EXPECT_FALSE(has_warning(m, "KHR_texture_transform"));
 }
 
+// Images inside the file are kept undecoded, once each however many slots name them: a PNG in a
+// buffer view, a JPEG in a data URI; one that is neither is left out, said naming the file,
+// material and slot; the slots name the kept ones "embedded:<k>".
+TEST(GltfImport, KeepsEmbeddedPngAndJpegBytesOnceEachAndDropsOtherImagesSayingWhere) {
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  f.j["meshes"][0]["primitives"][0]["material"] = 0;
+  const std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a, 1, 2, 3};
+  const std::vector<uint8_t> jpeg = {0xff, 0xd8, 0xff, 0xe0, 9, 9};
+  const std::vector<uint8_t> bmp = {'B', 'M', 0, 0, 0, 0};
+  const int png_view = f.add_view(png), bmp_view = f.add_view(bmp);
+  f.j["images"] = json::array({{{"bufferView", png_view}, {"mimeType", "image/png"}},
+                               {{"uri", "data:image/jpeg;base64," + GltfFixture::base64(jpeg)}},
+                               {{"bufferView", bmp_view}, {"mimeType", "image/png"}}});
+  f.j["textures"] = json::array({{{"source", 0}}, {{"source", 1}}, {{"source", 2}}});
+  f.j["materials"] = json::array(
+      {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}, {"metallicRoughnessTexture", {{"index", 0}}}}},
+        {"normalTexture", {{"index", 2}}},
+        {"emissiveTexture", {{"index", 1}}}}});
+  place_meshes(f);
+  MeshData m;
+  const Status s = load_glb(f, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(m.images.size(), 2u) << "the JPEG once for two slots, the PNG, not the BMP";
+  const MeshMaterial& mat = m.materials[0];
+  EXPECT_EQ(mat.base_color_texture, "embedded:0");
+  EXPECT_EQ(mat.emissive_texture, "embedded:0");
+  EXPECT_EQ(m.images[0].type, ImageType::jpeg);
+  EXPECT_EQ(m.images[0].bytes, jpeg);
+  EXPECT_EQ(mat.metallic_roughness_texture, "embedded:1");
+  EXPECT_EQ(m.images[1].bytes, png);
+  EXPECT_TRUE(mat.normal_texture_embedded);
+  EXPECT_TRUE(mat.normal_texture.empty());
+  EXPECT_TRUE(has_warning(m, "t.glb: material 0: normalTexture: embedded image 2 is neither PNG nor JPEG (its first bytes "
+                             "are 42 4d 00 00"))
+      << (m.warnings.empty() ? "" : m.warnings.back());
+}
+
+// An image's buffer view past its buffer refuses the whole file (nothing half-imported).
+TEST(GltfImport, RefusesAnEmbeddedImageWhoseBufferViewRunsPastTheBuffer) {
+  GltfFixture f;
+  f.add_float_mesh(kQuad, kQuadIndices);
+  f.j["meshes"][0]["primitives"][0]["material"] = 0;
+  const std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+  const int view = f.add_view(png);
+  f.j["bufferViews"][view]["byteLength"] = 4096;
+  f.j["images"] = json::array({{{"bufferView", view}, {"mimeType", "image/png"}}});
+  f.j["textures"] = json::array({{{"source", 0}}});
+  f.j["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
+  place_meshes(f);
+  MeshData m;
+  m.source = "untouched";
+  expect_refused(load_glb(f, m), "t.glb: buffer view 2 (bytes 72 + 4096) runs past the end of buffer 0");
+  EXPECT_EQ(m.source, "untouched");
+}
+
 // ../shared's spot.obj with its texture, converted at test time by Debian's gltfpack: once
 // quantized (KHR_mesh_quantization, UVs through KHR_texture_transform, texture embedded in
 // the GLB) and once not (.gltf + .bin, texture by URI). Both give the OBJ's triangles, bounds

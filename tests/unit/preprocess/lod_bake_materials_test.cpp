@@ -245,5 +245,46 @@ TEST(LodBakeMaterials, HostileTextureFactorsAreClampedAndSaid) {
   EXPECT_TRUE(validate_materials_only(chain, why)) << why;
 }
 
+// Images inside the source reach the chain once each, only when a kept material names them, the
+// slots renumbered to the chain's images; an embedded texture the import could not keep, and a
+// file URI that looks like the asset's own form, are said and left out.
+TEST(LodBakeMaterials, EmbeddedImagesAreCopiedOnceWhenAKeptSlotNamesThem) {
+  MeshData mesh;
+  mesh.source = "t.glb";
+  const auto image = [](uint8_t tag) {
+    EmbeddedImage img;
+    img.type = ImageType::png;
+    img.bytes = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a, tag};
+    return img;
+  };
+  mesh.images = {image(0), image(1), image(2)};
+  MeshMaterial a, b;
+  a.name = "a";
+  a.base_color_texture = "embedded:2", a.base_color_texture_embedded = true;
+  a.normal_texture_embedded = true;  // the import dropped it (not PNG/JPEG): no URI
+  b.name = "b";
+  b.emissive_texture = "embedded:2", b.emissive_texture_embedded = true;
+  b.occlusion_texture = "embedded:0";  // a file URI, not an image of the source
+  mesh.materials = {a, b};
+  LodChain chain = test::fan_chain("t", {9});
+  std::vector<std::string> notes;
+  add_chain_materials(mesh, "/data/t.glb", chain, notes);
+  ASSERT_EQ(chain.images.size(), 1u) << "images 0 and 1 are named by no kept slot";
+  EXPECT_EQ(chain.images[0].bytes, mesh.images[2].bytes);
+  EXPECT_EQ(chain.materials[0].base_color_texture, "embedded:0");
+  EXPECT_EQ(chain.materials[1].emissive_texture, "embedded:0");
+  EXPECT_TRUE(chain.materials[0].normal_texture.empty());
+  EXPECT_TRUE(chain.materials[1].occlusion_texture.empty());
+  auto said = [&](const std::string& needle) {
+    for (const std::string& n : notes)
+      if (n.find(needle) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(said("t.glb: material 0 ('a'): its normal texture is embedded in the file but was not kept"));
+  EXPECT_TRUE(said("t.glb: material 1 ('b'): occlusion texture URI 'embedded:0' has the scheme the asset keeps"));
+  std::string why;
+  EXPECT_TRUE(validate_materials_only(chain, why)) << why;
+}
+
 }  // namespace
 }  // namespace lod

@@ -661,5 +661,166 @@ TEST(LodAssetAttributes, TheAttributesSeedReads) {
   EXPECT_EQ(out.materials[0].tex_coords[1], 1);
 }
 
+
+// ---- IMGS: images embedded in the source, kept in the asset (bake format 10) ----------------
+
+// Enough of a PNG and a JPEG for the asset: their signatures, then bytes no reader here decodes.
+EmbeddedImage fake_image(ImageType type, size_t size) {
+  EmbeddedImage img;
+  img.type = type;
+  img.bytes = type == ImageType::png ? std::vector<uint8_t>{0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a}
+                                     : std::vector<uint8_t>{0xff, 0xd8, 0xff, 0xe0};
+  for (size_t i = img.bytes.size(); i < size; ++i) img.bytes.push_back(uint8_t(i * 7));
+  return img;
+}
+
+LodChain chain_with_images() {
+  LodChain c = chain_with_materials();
+  c.images = {fake_image(ImageType::png, 45), fake_image(ImageType::jpeg, 19)};
+  c.materials[0].base_color_texture = embedded_image_uri(1);
+  c.materials[0].emissive_texture = embedded_image_uri(0);
+  c.materials[1].normal_texture = embedded_image_uri(1);
+  return c;
+}
+
+// The section table entry of `tag`: its size is patched through it.
+size_t table_entry_of(const std::vector<uint8_t>& bytes, const char* tag) {
+  uint32_t count = 0;
+  std::memcpy(&count, bytes.data() + 12, 4);
+  for (uint32_t s = 0; s < count; ++s)
+    if (std::memcmp(bytes.data() + 16 + 24 * s, tag, 4) == 0) return 16 + 24 * size_t(s);
+  return 0;
+}
+
+TEST(LodAssetImages, RoundTripKeepsEveryImageByteForByteAndTheSlotsNamingThem) {
+  const LodChain c = chain_with_images();
+  std::string why;
+  ASSERT_TRUE(validate_chain(c, &why)) << why;
+  const std::vector<uint8_t> bytes = encode_lod_asset(c);
+  const auto [off, size] = section_of(bytes, "IMGS");
+  EXPECT_EQ(size, 16u + 2 * 16 + 45 + 19);
+  LodChain back;
+  const Status st = decode_lod_asset(bytes, "bunny.lod", back);
+  ASSERT_TRUE(st) << st.message;
+  ASSERT_EQ(back.images.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(back.images[k].type, c.images[k].type);
+    EXPECT_EQ(back.images[k].bytes, c.images[k].bytes);
+  }
+  EXPECT_EQ(back.materials[0].base_color_texture, "embedded:1");
+  EXPECT_EQ(back.materials[1].normal_texture, "embedded:1");
+  EXPECT_EQ(encode_lod_asset(back), bytes);
+  EXPECT_EQ(section_of(encode_lod_asset(chain_with_materials()), "IMGS").second, 0u) << "no IMGS without images";
+}
+
+TEST(LodAssetImages, RefusesForgedCountsLengthsTypesAndSignatures) {
+  const std::vector<uint8_t> good = encode_lod_asset(chain_with_images());
+  const uint64_t imgs = section_of(good, "IMGS").first;
+  struct Case {
+    uint64_t at;  // byte within the section
+    std::vector<uint8_t> value;
+    const char* expect;
+  };
+  const auto u32 = [](uint32_t v) { return std::vector<uint8_t>{uint8_t(v), uint8_t(v >> 8), uint8_t(v >> 16), uint8_t(v >> 24)}; };
+  const auto u64 = [&](uint64_t v) {
+    std::vector<uint8_t> b = u32(uint32_t(v)), hi = u32(uint32_t(v >> 32));
+    b.insert(b.end(), hi.begin(), hi.end());
+    return b;
+  };
+  const Case cases[] = {
+      {0, u32(0xffffffffu), "IMGS section: 4294967295 images, at most 4096"},
+      {0, u32(3), "IMGS section: 112 bytes, but 3 images of 64 bytes need 64 + 64"},
+      {4, u32(2), "IMGS section: layout 2 is newer than this build reads"},
+      {4, u32(0), "IMGS section: layout 0 does not exist"},
+      {8, u64(uint64_t(1) << 40), "IMGS section: 1099511627776 image bytes, at most 1073741824"},
+      {8, u64(63), "IMGS section: 112 bytes, but 2 images of 63 bytes need 48 + 63"},
+      {16, u64(uint64_t(1) << 62), "IMGS section: image 0 is 4611686018427387904 bytes, at most 268435456"},
+      {16, u64(44), "IMGS section: images' lengths add up to 63 bytes, the section says 64"},
+      {24, {3}, "IMGS section: image 0 has type 3 (1 PNG, 2 JPEG)"},
+      {24, {0}, "IMGS section: image 0 has type 0 (1 PNG, 2 JPEG)"},
+      {24 + 16 + 5, {1}, "IMGS section: image 1 has non-zero padding byte 13"},
+      {24, {2}, "IMGS section: embedded image 0 is not the PNG or JPEG its type says"},
+      {48, {0x88}, "IMGS section: embedded image 0 is not the PNG or JPEG its type says"},
+  };
+  for (const Case& k : cases) {
+    std::vector<uint8_t> bytes = good;
+    std::memcpy(bytes.data() + imgs + k.at, k.value.data(), k.value.size());
+    reseal(bytes);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+    ASSERT_FALSE(st) << k.expect;
+    EXPECT_EQ(st.message.rfind(std::string("bunny.lod: ") + k.expect, 0), 0u) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+}
+
+TEST(LodAssetImages, RefusesASlotNamingAnImageTheAssetLacks) {
+  LodChain c = chain_with_images();
+  c.materials[1].occlusion_texture = "embedded:2";
+  std::string why;
+  EXPECT_FALSE(validate_chain(c, &why));
+  LodChain out = sentinel();
+  const Status st = decode_lod_asset(encode_lod_asset(c), "bunny.lod", out);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.message, "bunny.lod: MATL section: material 1 occlusion texture names embedded image 'embedded:2' of 2");
+  c.images.clear();  // no IMGS section at all: every embedded slot is dangling
+  EXPECT_FALSE(decode_lod_asset(encode_lod_asset(c), "bunny.lod", out));
+  EXPECT_EQ(out.name, "untouched");
+}
+
+// Cut anywhere: the file (the checksum or the section table says so), and the section alone
+// (its size shortened to every length, the checksum made right again: IMGS's own checks).
+TEST(LodAssetImages, RefusesTruncationAtEveryOffsetOfTheFileAndOfTheSection) {
+  const std::vector<uint8_t> good = encode_lod_asset(chain_with_images());
+  for (size_t len = 0; len < good.size(); ++len) {
+    LodChain out = sentinel();
+    ASSERT_FALSE(decode_lod_asset(std::span(good).first(len), "bunny.lod", out)) << len;
+    EXPECT_EQ(out.name, "untouched");
+  }
+  const size_t entry = table_entry_of(good, "IMGS");
+  const uint64_t size = section_of(good, "IMGS").second;
+  for (uint64_t shorter = 0; shorter < size; ++shorter) {
+    std::vector<uint8_t> bytes = good;
+    std::memcpy(bytes.data() + entry + 16, &shorter, 8);
+    reseal(bytes);
+    LodChain out = sentinel();
+    const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+    ASSERT_FALSE(st) << shorter;
+    EXPECT_EQ(st.message.rfind("bunny.lod: IMGS section: ", 0), 0u) << st.message;
+    EXPECT_EQ(out.name, "untouched");
+  }
+}
+
+// The IMGS fuzz seed (attributes2.lod's chain with two embedded images that three slots name)
+// reads with them.
+TEST(LodAssetImages, TheImagesSeedReads) {
+  LodChain out;
+  const Status st = read_lod_asset(std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/lod/images10.lod", out);
+  ASSERT_TRUE(st) << st.message;
+  ASSERT_EQ(out.images.size(), 2u);
+  EXPECT_EQ(out.images[0].type, ImageType::png);
+  EXPECT_EQ(out.images[1].type, ImageType::jpeg);
+  EXPECT_EQ(out.materials[0].base_color_texture, "embedded:1");
+}
+
+TEST(EmbeddedImage, TypesBySignatureAndParsesItsUriForm) {
+  EXPECT_EQ(image_type_of(fake_image(ImageType::png, 8).bytes), ImageType::png);
+  EXPECT_EQ(image_type_of(fake_image(ImageType::jpeg, 3).bytes), ImageType::jpeg);
+  EXPECT_EQ(image_type_of(std::vector<uint8_t>{0x89, 'P', 'N', 'G'}), ImageType::unknown) << "a cut signature";
+  EXPECT_EQ(image_type_of(std::vector<uint8_t>{'G', 'I', 'F', '8', '9', 'a', 0, 0}), ImageType::unknown);
+  uint32_t k = 0;
+  EXPECT_TRUE(is_embedded_image_uri("embedded:17", &k));
+  EXPECT_EQ(k, 17u);
+  EXPECT_TRUE(is_embedded_image_uri("embedded:99999", &k));
+  EXPECT_EQ(k, UINT32_MAX) << "past kMaxEmbeddedImages";
+  EXPECT_TRUE(is_embedded_image_uri("embedded:", &k));
+  EXPECT_EQ(k, UINT32_MAX);
+  EXPECT_TRUE(is_embedded_image_uri("embedded:1x", &k));
+  EXPECT_EQ(k, UINT32_MAX);
+  EXPECT_FALSE(is_embedded_image_uri("tex/embedded:1.png"));
+  EXPECT_FALSE(is_embedded_image_uri("embedded%3A1"));
+  EXPECT_EQ(embedded_image_uri(3), "embedded:3");
+}
+
 }  // namespace
 }  // namespace lod
