@@ -110,7 +110,9 @@ TEST(HlodBuildSurfaces, TexturedSphereKeepsUvsAndMaterialsInEveryLayerAndPatch) 
   for (size_t i = 0; i < m.tree.nodes.size(); ++i) {
     expect_surfaces(m, i);
     const HlodNode& n = m.tree.nodes[i];
-    if (n.leaf()) EXPECT_EQ(n.layers[0].uv_error, 0.0f) << "a leaf's finest layer is the original";
+    if (n.leaf()) {
+      EXPECT_EQ(n.layers[0].uv_error, 0.0f) << "a leaf's finest layer is the original";
+    }
     coarsest_uv_error = std::max(coarsest_uv_error, n.layers[n.layer_count - 1].uv_error);
   }
   EXPECT_GT(coarsest_uv_error, 0.0f);
