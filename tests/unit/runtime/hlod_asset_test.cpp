@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <thread>
@@ -523,6 +524,35 @@ TEST(HlodAsset, ReadsRegularFilesOnlyAndNamesMissingOnes) {
   st = read_hlod_tree(dir, t);
   ASSERT_FALSE(st);
   EXPECT_NE(st.message.find("not a regular file"), std::string::npos) << st.message;
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+// The fuzz seeds (tests/fuzz/corpus/hlod: hs0 the sample, hs1 the textured sample) are files of
+// the current version, so the fuzzer starts from inputs the reader accepts; LOD_WRITE_FUZZ_SEEDS=1
+// rewrites them after a format change.
+TEST(HlodAsset, TheFuzzSeedsAreCurrent) {
+  const std::filesystem::path dir = std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/hlod";
+  if (std::getenv("LOD_WRITE_FUZZ_SEEDS")) {
+    const Sample plain = sample(), textured = textured_sample();
+    test::write_bytes(dir / "hs0.hlod", encode_hlod_asset(plain.tree, plain.payloads));
+    test::write_bytes(dir / "hs1.hlod", encode_hlod_asset(textured.tree, textured.payloads));
+  }
+  size_t seeds = 0, with_materials = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    HlodTree t;
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(test::read_bytes(e.path()), e.path().string(), t, p);
+    EXPECT_TRUE(st) << st.message;
+    ++seeds;
+    with_materials += !t.materials.empty();
+  }
+  EXPECT_GE(seeds, 2u);
+  EXPECT_GE(with_materials, 1u) << "a seed with uvs, materials and runs";
 }
 
 }  // namespace

@@ -2,7 +2,9 @@
 // truncation, flipped byte, forged count, wrong key and out-of-mesh vertex is refused.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <vector>
 
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include "runtime/hlod_asset.h"
 #include "runtime/hlod_subtree_entry.h"
 #include "runtime/lod_asset.h"  // hash_bytes
+#include "test_support.h"
 
 namespace lod {
 namespace {
@@ -302,6 +305,30 @@ TEST(HlodSubtreeEntry, TexturedSubtreeRoundTripsAndItsRootAlone) {
   const Status st = decode(fewer, t);
   ASSERT_FALSE(st);
   EXPECT_NE(st.message.find("names material 1 of 1"), std::string::npos) << st.message;
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+// The fuzz seeds (tests/fuzz/corpus/hsub: e0 the sample, e1 the textured one) are entries of
+// the current version; LOD_WRITE_FUZZ_SEEDS=1 rewrites them after a format change.
+TEST(HlodSubtreeEntry, TheFuzzSeedsAreCurrent) {
+  const std::filesystem::path dir = std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/hsub";
+  if (std::getenv("LOD_WRITE_FUZZ_SEEDS")) {
+    test::write_bytes(dir / "e0.hsub", encode_hlod_subtree(sample(), kKey));
+    test::write_bytes(dir / "e1.hsub", encode_hlod_subtree(textured(), kKey));
+  }
+  size_t seeds = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    HlodSubtree s;
+    const Status st = decode(test::read_bytes(e.path()), s);
+    EXPECT_TRUE(st) << st.message;
+    ++seeds;
+  }
+  EXPECT_GE(seeds, 2u);
 }
 
 }  // namespace
