@@ -368,8 +368,11 @@ TEST(Tiles3dExport, TexturedModelKeepsItsUvsMaterialsAndTextureInEveryTile) {
           const float* uv = &m.uvs[2 * size_t(m.indices[3 * size_t(t) + size_t(c)])];
           ASSERT_GE(uv[0], -1e-4f) << g.file;
           ASSERT_LE(uv[0], 1 + 1e-4f) << g.file;
-          if (cap) ASSERT_LE(uv[1], 0.5f + 1e-4f) << g.file << " triangle " << t;
-          else ASSERT_GE(uv[1], 0.5f - 1e-4f) << g.file << " triangle " << t;
+          if (cap) {
+            ASSERT_LE(uv[1], 0.5f + 1e-4f) << g.file << " triangle " << t;
+          } else {
+            ASSERT_GE(uv[1], 0.5f - 1e-4f) << g.file << " triangle " << t;
+          }
         }
     }
   }

@@ -84,11 +84,17 @@ void expect_surfaces(const HlodModel& m, size_t i) {
           umin = std::min(umin, u), umax = std::max(umax, u);
           ASSERT_GE(u, -1e-4f);
           ASSERT_LE(u, 1 + 1e-4f);
-          if (run.material == 0) ASSERT_LE(w, 0.5f + 1e-4f) << "node " << i << " range " << r;
-          else ASSERT_GE(w, 0.5f - 1e-4f) << "node " << i << " range " << r;
+          if (run.material == 0) {
+            ASSERT_LE(w, 0.5f + 1e-4f) << "node " << i << " range " << r;
+          } else {
+            ASSERT_GE(w, 0.5f - 1e-4f) << "node " << i << " range " << r;
+          }
         }
-        if (run.material == 0) EXPECT_GE(y, -0.02f) << "a cap triangle below the equator";
-        else EXPECT_LE(y, 0.02f) << "a base triangle above the equator";
+        if (run.material == 0) {
+          EXPECT_GE(y, -0.02f) << "a cap triangle below the equator";
+        } else {
+          EXPECT_LE(y, 0.02f) << "a base triangle above the equator";
+        }
         EXPECT_LT(umax - umin, 0.5f) << "a triangle smeared across the uv seam";
       }
       covered += run.index_count;
