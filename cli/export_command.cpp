@@ -18,6 +18,7 @@ int export_command(const ExportArgs& args) {
   }
   TilesetExportOptions options;
   options.replace = args.force;
+  options.shared_images = args.shared_images;
   TilesetExportReport rep;
   if (Status st = export_3d_tiles(args.file, args.tiles_dir, options, &rep); !st) {
     std::fprintf(stderr, "lod export: %s\n", printable(st.message).c_str());
@@ -31,7 +32,7 @@ int export_command(const ExportArgs& args) {
   if (args.json) {
     const nlohmann::json j = {{"dir", args.tiles_dir}, {"nodes", rep.nodes},       {"tiles", rep.tiles},
                               {"glb_files", rep.glb_files}, {"bytes", rep.bytes}, {"root_error", rep.root_error},
-                              {"notes", notes}};
+                              {"notes", notes}, {"shared_images", rep.shared_images}};
     std::printf("%s\n", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return 0;
   }

@@ -28,6 +28,27 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr const char* kTilesFolder = "tiles";
+constexpr const char* kTexturesFolder = "textures";
+
+// With shared images: each image file copied once into the staging folder's textures/, named
+// by the order it was first met, and the URI a tile's GLB names it by.
+struct SharedImages {
+  fs::path staging;
+  std::vector<std::pair<fs::path, std::string>> written;  // source file, URI from tiles/
+  TilesetExportReport* rep = nullptr;
+  std::string uri_of(const fs::path& file) {
+    for (const auto& [f, uri] : written)
+      if (f == file) return uri;
+    std::error_code ec;
+    fs::create_directories(staging / kTexturesFolder, ec);
+    const std::string name = "image" + std::to_string(written.size()) + file.extension().string();
+    if (ec || !fs::copy_file(file, staging / kTexturesFolder / name, ec) || ec) return {};  // embedded instead
+    rep->bytes += fs::file_size(staging / kTexturesFolder / name, ec);
+    ++rep->shared_images;
+    written.push_back({file, std::string("../") + kTexturesFolder + "/" + name});
+    return written.back().second;
+  }
+};
 
 // An axis-aligned box in the model's (glTF, y-up) coordinates, in double so that the written
 // centre and half sizes reproduce the float extremes.
@@ -219,8 +240,8 @@ Status add_surfaces(const std::string& what, const HlodTree& tree, std::span<con
 
 // One GLB of the range `r` (range index `range`): writes it (unless it has no triangles) and its box.
 Status write_range(const fs::path& staging, const std::string& file, const std::string& mesh_name, const HlodTree& tree,
-                   uint32_t range, const LodLevel& r, const HlodPayload& p, std::string& uri, Box& box,
-                   TilesetExportReport& rep) {
+                   uint32_t range, const LodLevel& r, const HlodPayload& p, SharedImages* shared, std::string& uri,
+                   Box& box, TilesetExportReport& rep) {
   if (r.index_count == 0) return Status::success();
   GltfMeshView view;
   view.name = mesh_name;
@@ -231,6 +252,7 @@ Status write_range(const fs::path& staging, const std::string& file, const std::
   view.indices = p.indices.data() + r.first_index;
   view.index_count = r.index_count;
   view.notes = &rep.notes;
+  if (shared) view.image_uri = [shared](const fs::path& image) { return shared->uri_of(image); };
   if (Status s = add_surfaces(mesh_name, tree, hlod_range_runs(p, range), view); !s) return s;
   const std::string rel = std::string(kTilesFolder) + "/" + file;
   if (Status s = save_gltf(staging / rel, view); !s) return s;
@@ -243,8 +265,9 @@ Status write_range(const fs::path& staging, const std::string& file, const std::
 }
 
 Status write_node_contents(const HlodFile& file, const HlodTree& tree, const std::string& what, const fs::path& staging,
-                           std::vector<NodeContent>& out, TilesetExportReport& rep) {
+                           bool shared_images, std::vector<NodeContent>& out, TilesetExportReport& rep) {
   out.assign(tree.nodes.size(), {});
+  SharedImages shared{staging, {}, &rep};
   for (size_t i = 0; i < tree.nodes.size(); ++i) {
     const HlodNode& n = tree.nodes[i];
     const std::string node_what = what + ": node " + std::to_string(i);
@@ -255,11 +278,12 @@ Status write_node_contents(const HlodFile& file, const HlodTree& tree, const std
     const std::string id = std::to_string(i);
     for (size_t k = 0; k < p.layers.size(); ++k)
       if (Status s = write_range(staging, id + "-" + std::to_string(k) + ".glb", "node " + id + " layer " + std::to_string(k),
-                                 tree, uint32_t(k), p.layers[k], p, c.layer_uri[k], c.layer_box[k], rep);
+                                 tree, uint32_t(k), p.layers[k], p, shared_images ? &shared : nullptr, c.layer_uri[k],
+                                 c.layer_box[k], rep);
           !s)
         return s;
     if (Status s = write_range(staging, id + "-boundary.glb", "node " + id + " boundary", tree, uint32_t(p.layers.size()),
-                               p.boundary, p, c.boundary_uri, c.boundary_box, rep);
+                               p.boundary, p, shared_images ? &shared : nullptr, c.boundary_uri, c.boundary_box, rep);
         !s)
       return s;
   }
@@ -333,7 +357,7 @@ json tileset_json(const HlodTree& tree, const std::vector<NodeContent>& contents
           {"root", std::move(root)}};
 }
 
-Status export_into(const fs::path& hlod_file, const fs::path& staging, TilesetExportReport& rep) {
+Status export_into(const fs::path& hlod_file, const fs::path& staging, bool shared_images, TilesetExportReport& rep) {
   const std::string what = hlod_file.string();
   HlodFile file;
   HlodTree tree;
@@ -341,7 +365,7 @@ Status export_into(const fs::path& hlod_file, const fs::path& staging, TilesetEx
   if (tree.nodes.empty()) return Status::error(what + ": the tree has no nodes");
   rep.nodes = tree.nodes.size();
   std::vector<NodeContent> contents;
-  if (Status s = write_node_contents(file, tree, what, staging, contents, rep); !s) return s;
+  if (Status s = write_node_contents(file, tree, what, staging, shared_images, contents, rep); !s) return s;
   if (Status s = subtree_boxes(tree, what, contents); !s) return s;
   if (contents[0].subtree.empty()) return Status::error(what + ": no node has any triangles");
   const std::string text = tileset_json(tree, contents, rep).dump(-1, ' ', false, json::error_handler_t::replace);
@@ -360,7 +384,7 @@ Status export_3d_tiles(const fs::path& hlod_file, const fs::path& dir, const Til
   fs::path staging;
   if (Status s = make_staging(target, staging); !s) return s;
   TilesetExportReport rep;
-  Status s = export_into(hlod_file, staging, rep);
+  Status s = export_into(hlod_file, staging, options.shared_images, rep);
   if (s) s = publish(staging, target, replaces_earlier);
   if (!s) {
     std::error_code ec;

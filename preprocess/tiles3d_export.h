@@ -34,6 +34,9 @@ struct TilesetExportOptions {
   // Replace a non-empty DIR when it holds an earlier export (a tileset.json); otherwise a
   // non-empty DIR is refused. Never replaces a folder without a tileset.json.
   bool replace = false;
+  // Write each texture image once, as DIR/textures/image<k>.png (or .jpg), and have the GLBs
+  // reference it (../textures/...) instead of embedding it in every tile that uses it.
+  bool shared_images = false;
 };
 
 struct TilesetExportReport {
@@ -43,6 +46,7 @@ struct TilesetExportReport {
   uint64_t bytes = 0;     // of every file written
   double root_error = 0;  // geometricError of the root tile
   std::vector<std::string> notes;  // what could not be written (a texture missing at export time), per GLB
+  size_t shared_images = 0;        // images written once under DIR/textures (shared_images)
 };
 
 Status export_3d_tiles(const std::filesystem::path& hlod_file, const std::filesystem::path& dir,

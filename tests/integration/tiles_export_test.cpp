@@ -384,6 +384,30 @@ TEST(Tiles3dExport, TexturedModelKeepsItsUvsMaterialsAndTextureInEveryTile) {
     const auto schemas = run_checker(dir / "tiles" / "tileset.json", schema_dir().string(), false);
     EXPECT_EQ(schemas.code, 0) << schemas.out;
   }
+
+  // --shared-images: the texture written once under textures/, every GLB naming it by a
+  // relative URI, still valid (the checker resolves it), and the tileset smaller.
+  r = run_lod("export --3dtiles '" + (dir / "shared").string() + "' '" + hlod.string() + "' --shared-images --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto shared_report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(shared_report["shared_images"], 1);
+  size_t images = 0;
+  for (const auto& e : fs::directory_iterator(dir / "shared" / "textures")) images += e.is_regular_file();
+  EXPECT_EQ(images, 1u);
+  EXPECT_LT(shared_report["bytes"].get<uint64_t>(), nlohmann::json::parse(run_lod("export --3dtiles '" +
+            (dir / "again").string() + "' '" + hlod.string() + "' --json").out)["bytes"].get<uint64_t>());
+  size_t referring = 0;
+  for (const TiledGlb& g : read_tiles(dir / "shared"))
+    for (const lod::MeshMaterial& m : g.mesh.materials)
+      if (m.name == "cap") {
+        EXPECT_FALSE(m.base_color_texture_embedded) << g.file;
+        EXPECT_EQ(m.base_color_texture, "../textures/image0.png") << g.file;
+        ++referring;
+      }
+  EXPECT_GT(referring, 0u);
+  const auto sv = run_checker(dir / "shared" / "tileset.json", fs::exists(schema_dir()) ? schema_dir().string() : "-");
+  EXPECT_EQ(sv.code, 0) << sv.out;
+  EXPECT_NE(sv.out.find("structure errors 0 gltf errors 0"), std::string::npos) << sv.out;
 }
 
 // ../shared's spot with its texture (a .mtl naming it) as an HLOD and a tileset: the figures
