@@ -52,6 +52,7 @@ struct ExportArgs {
   std::string file;       // the .hlod file
   std::string tiles_dir;  // --3dtiles DIR
   bool force = false;     // replace DIR when it holds an earlier export
+  bool shared_images = false;  // textures written once under DIR/textures, referenced by the GLBs
   bool json = false;
 };
 int export_command(const ExportArgs& args);  // cli/export_command.cpp

@@ -18,10 +18,43 @@ namespace {
 nlohmann::json node_json(const HlodTree& tree, size_t i) {
   const HlodNode& n = tree.nodes[i];
   nlohmann::json layers = nlohmann::json::array();
-  for (uint32_t k = 0; k < n.layer_count; ++k) layers.push_back({{"triangles", n.layers[k].triangles}, {"error", n.layers[k].error}});
+  for (uint32_t k = 0; k < n.layer_count; ++k)
+    layers.push_back({{"triangles", n.layers[k].triangles}, {"error", n.layers[k].error}, {"uv_error", n.layers[k].uv_error}});
   return {{"id", i},      {"parent", n.parent},
           {"depth", n.depth}, {"leaf", n.leaf()},
-          {"boundary_triangles", n.boundary_triangles}, {"layers", layers}};
+          {"boundary_triangles", n.boundary_triangles}, {"layers", layers}, {"material_runs", n.material_runs}};
+}
+
+// The header's materials (R1: the HLOD file's header holds them), texture URIs as stored.
+nlohmann::json materials_json(const HlodTree& tree) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ChainMaterial& m : tree.materials) {
+    nlohmann::json textures = nlohmann::json::object();
+    const auto uris = texture_slots(m);
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (!uris[k]->empty()) textures[kTextureSlotNames[k]] = *uris[k];
+    out.push_back({{"name", m.name},
+                   {"base_color", {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]}},
+                   {"metallic", m.metallic},
+                   {"roughness", m.roughness},
+                   {"double_sided", m.double_sided},
+                   {"textures", textures}});
+  }
+  return out;
+}
+
+void print_materials(const HlodTree& tree) {
+  std::printf("materials: %zu (texture base %s); texture coordinates: %s\n", tree.materials.size(),
+              printable(tree.texture_base).c_str(), tree.uvs ? "yes" : "no");
+  for (size_t i = 0; i < tree.materials.size(); ++i) {
+    const ChainMaterial& m = tree.materials[i];
+    std::printf("  %zu '%s': base colour %.3g %.3g %.3g %.3g, metallic %.3g, roughness %.3g", i, printable(m.name).c_str(),
+                m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3], m.metallic, m.roughness);
+    const auto uris = texture_slots(m);
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (!uris[k]->empty()) std::printf(", %s texture %s", kTextureSlotNames[k], printable(*uris[k]).c_str());
+    std::printf("\n");
+  }
 }
 
 void print_depth_table(const HlodTree& tree) {
@@ -94,6 +127,9 @@ int inspect_hlod_command(const InspectArgs& args) {
     j["source_triangles"] = tree.source_triangles;
     j["min_verts"] = tree.min_verts;
     j["box"] = {{"center", {tree.box_center[0], tree.box_center[1], tree.box_center[2]}}, {"half", tree.box_half}};
+    j["texcoords"] = tree.uvs;
+    j["texture_base"] = tree.texture_base;
+    j["materials"] = materials_json(tree);
     j["nodes"] = nlohmann::json::array();
     for (size_t i = 0; i < tree.nodes.size(); ++i) j["nodes"].push_back(node_json(tree, i));
     std::printf("%s\n", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
@@ -106,6 +142,7 @@ int inspect_hlod_command(const InspectArgs& args) {
               hash, (unsigned long long)tree.source_triangles, tree.min_verts);
   std::printf("%zu nodes, %zu leaves; root cube centre (%g, %g, %g), half size %g\n", tree.nodes.size(), leaves,
               tree.box_center[0], tree.box_center[1], tree.box_center[2], tree.box_half);
+  print_materials(tree);
   print_depth_table(tree);
   std::printf("top of the tree (layers: triangles/error):\n");
   print_tree_top(tree, 0, 2);

@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
   export_cmd->add_option("--3dtiles", exp.tiles_dir, "folder for tileset.json and tiles/*.glb")->required();
   export_cmd->add_option("file", exp.file, ".hlod file")->required();
   export_cmd->add_flag("--force", exp.force, "replace DIR when it holds an earlier export (a tileset.json)");
+  export_cmd->add_flag("--shared-images", exp.shared_images,
+                       "write each texture once under DIR/textures and reference it from the GLBs (default: embedded in each)");
   export_cmd->add_flag("--json", exp.json, "print JSON");
 
   CLI11_PARSE(app, argc, argv);

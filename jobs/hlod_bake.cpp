@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "jobs/annotated_parallel_for.h"
+#include "preprocess/gltf_io.h"  // gltf_external_files
+#include "preprocess/material_runs.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
 #include "runtime/file_write.h"
@@ -37,9 +39,60 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
   f.seekg(0);
   if (size < 0 || !f.read(bytes.data(), std::streamsize(bytes.size())))
     return Status::error(file.string() + ": read error");
-  const uint64_t settings[2] = {1 /* build version */, min_verts};
-  out = hash_bytes(settings, sizeof settings, hash_bytes(bytes.data(), bytes.size()));
+  uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  // The materials and uvs are in the tree since build version 2: what an OBJ's .mtl or a glTF's
+  // buffers and images hold is part of the source.
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
+    for (const auto& named : ext == ".obj" ? obj_external_files(file) : gltf_external_files(file)) {
+      std::ifstream g(named, std::ios::binary);
+      const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
+      content = hash_bytes(more.data(), more.size(), content);
+    }
+  const uint64_t settings[2] = {2 /* build version: 2 uvs and materials */, min_verts};
+  out = hash_bytes(settings, sizeof settings, content);
   return Status::success();
+}
+
+Status load_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
+                       std::vector<std::string>& notes, size_t* input_triangles) {
+  MeshData m;
+  if (Status s = load_mesh(mesh_file, m); !s) return s;
+  if (input_triangles) *input_triangles = m.triangle_count();
+  prepare_hlod_input(mesh_file, m, surfaces, notes);
+  mesh = std::move(m);
+  return Status::success();
+}
+
+void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& m, HlodSurfaces& surfaces,
+                        std::vector<std::string>& notes) {
+  // Nothing dropped silently: the tree keeps TEXCOORD_0 and the materials, nothing else.
+  if (!m.uvs1.empty() || !m.colors.empty())
+    notes.push_back(mesh_file.string() + ": " + (m.uvs1.empty() ? "" : "TEXCOORD_1") +
+                    (!m.uvs1.empty() && !m.colors.empty() ? " and " : "") + (m.colors.empty() ? "" : "vertex colours") +
+                    " are not kept in the HLOD tree (TEXCOORD_0 and the materials are)");
+  m.uvs1.clear();
+  m.colors.clear();
+  clean_mesh(m);
+  LodChain chain;
+  add_chain_materials(m, mesh_file, chain, notes);
+  for (size_t i = 0; i < chain.materials.size(); ++i) {
+    ChainMaterial& c = chain.materials[i];
+    const auto uris = texture_slots(c);
+    for (size_t k = 0; k < kTextureSlots; ++k)
+      if (!uris[k]->empty() && (c.tex_coords[k] != 0 || m.uvs.empty())) {
+        notes.push_back(mesh_file.string() + ": material " + std::to_string(i) + " ('" + c.name + "'): its " +
+                        kTextureSlotNames[k] + " texture reads " +
+                        (m.uvs.empty() ? std::string("texture coordinates the mesh does not have")
+                                       : "TEXCOORD_" + std::to_string(c.tex_coords[k])) +
+                        ", which the HLOD tree does not keep (left out)");
+        uris[k]->clear();
+        c.tex_coords[k] = 0;
+      }
+  }
+  surfaces.materials = std::move(chain.materials);
+  surfaces.texture_base = surfaces.materials.empty() ? std::string() : std::move(chain.texture_base);
 }
 
 ParallelFor tbb_parallel_for() {
@@ -52,14 +105,11 @@ Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string&
   HlodBakeResult r;
   auto t0 = std::chrono::steady_clock::now();
   MeshData mesh;
-  if (Status s = load_mesh(mesh_file, mesh); !s) return s;
-  r.input_triangles = mesh.triangle_count();
-  // Nothing dropped silently: the tree's nodes hold positions only.
-  if (log && (!mesh.materials.empty() || !mesh.uvs.empty()))
-    log("hlod " + name + ": " + std::to_string(mesh.materials.size()) + " materials and " +
-        (mesh.uvs.empty() ? "no" : "the") + " texture coordinates of " + mesh_file.string() +
-        " are not kept in the HLOD tree (one untextured surface)");
-  clean_mesh(mesh);
+  HlodBuildOptions options;
+  std::vector<std::string> notes;
+  if (Status s = load_hlod_input(mesh_file, mesh, options.surfaces, notes, &r.input_triangles); !s) return s;
+  if (log)
+    for (const std::string& note : notes) log("hlod " + name + ": note: " + note);
   HlodModel model;
   if (Status s = hlod_source_hash(mesh_file, settings.min_verts, model.tree.source_hash); !s) return s;
   const uint64_t hash = model.tree.source_hash;
@@ -68,7 +118,6 @@ Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string&
   t0 = std::chrono::steady_clock::now();
   std::mutex log_mutex;
   std::atomic<int> last_decile{0};
-  HlodBuildOptions options;
   options.min_verts = settings.min_verts;
   options.parallel_for = tbb_parallel_for();
   options.progress = [&](float fraction) {

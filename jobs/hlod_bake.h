@@ -4,8 +4,10 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "preprocess/hlod_build.h"
+#include "preprocess/mesh.h"
 #include "runtime/status.h"
 
 namespace lod {
@@ -29,9 +31,20 @@ using HlodBakeLog = std::function<void(const std::string&)>;
 // The tbb parallel_for the builder's subtrees run on (inside the caller's arena).
 ParallelFor tbb_parallel_for();
 
-// The content hash of a mesh file's bytes mixed with min_verts (and the build's version):
-// the source_hash of what bake_hlod_file writes, so a cached .hlod with it is current.
+// The content hash of a mesh file's bytes (and of the files it names: an OBJ's .mtl files and
+// images, a glTF's buffers and images) mixed with min_verts and the build's version: the
+// source_hash of what bake_hlod_file writes, so a cached .hlod with it is current.
 Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out);
+
+// The mesh as an HLOD build takes it: loaded and cleaned (uv seams and material boundaries stay
+// copies at one position), its materials converted for the tree (add_chain_materials). What the
+// tree does not keep (the second uv set, vertex colours, textures reading TEXCOORD_1, embedded
+// images) is said in `notes`, each naming the file.
+Status load_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
+                       std::vector<std::string>& notes, size_t* input_triangles = nullptr);
+// The same for a mesh already loaded from `mesh_file` (cleaned in place).
+void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
+                        std::vector<std::string>& notes);
 
 // Builds and writes `out_dir/<name>.hlod`; source_hash is the mesh file's content hash mixed
 // with min_verts. On failure the status names the file; nothing is written.

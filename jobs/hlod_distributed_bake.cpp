@@ -137,9 +137,14 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
   uint64_t input_triangles = 0;
   std::string why;
   const CacheLookup cached =
-      load_hlod_mesh(j.settings.cache_dir, j.source_hash, mesh_file.string(), j.mesh, input_triangles, &why);
+      load_hlod_mesh(j.settings.cache_dir, j.source_hash, mesh_file.string(), j.mesh, input_triangles, &why,
+                     &j.options.surfaces);
   if (cached == CacheLookup::refused) j.say(why + ": loading the mesh again");
   if (cached == CacheLookup::found) {
+    // The content is the source's; its folder is where it is now (add_chain_materials' base).
+    std::error_code ec;
+    if (!j.options.surfaces.materials.empty() && !j.options.surfaces.texture_base.empty())
+      j.options.surfaces.texture_base = std::filesystem::absolute(mesh_file, ec).lexically_normal().parent_path().string();
     j.r.input_triangles = size_t(input_triangles);
     j.r.mesh_cached = true;
     lap(j.work.load_cpu_seconds);
@@ -147,10 +152,13 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
     if (Status s = load_mesh(mesh_file, j.mesh); !s) return s;
     j.r.input_triangles = j.mesh.triangle_count();
     lap(j.work.load_cpu_seconds);
-    clean_mesh(j.mesh);
-    if (j.comm.rank == 0)
-      if (Status s = store_hlod_mesh(j.settings.cache_dir, j.source_hash, j.mesh, j.r.input_triangles); !s)
+    std::vector<std::string> notes;
+    prepare_hlod_input(mesh_file, j.mesh, j.options.surfaces, notes);
+    if (j.comm.rank == 0) {
+      for (const std::string& note : notes) j.say("note: " + note);
+      if (Status s = store_hlod_mesh(j.settings.cache_dir, j.source_hash, j.mesh, j.r.input_triangles, j.options.surfaces); !s)
         j.say(s.message + " (the cleaned mesh is not cached; the bake goes on)");
+    }
     lap(j.work.clean_cpu_seconds);
   }
   j.r.load_seconds = seconds_since(t0);

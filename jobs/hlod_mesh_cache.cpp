@@ -1,6 +1,9 @@
-// The cleaned mesh entry, version 1, little-endian:
-//   magic "LODHMSH\n" (8) | u32 version | u32 0 | u64 source hash | u64 input triangles |
-//   u64 vertices V | u64 indices I | V x 3 f32 positions | I u32 indices |
+// The cleaned mesh entry, version 2, little-endian:
+//   magic "LODHMSH\n" (8) | u32 version | u32 flags (bit 0: uvs) | u64 source hash |
+//   u64 input triangles | u64 vertices V | u64 indices I | u64 submeshes S | u64 materials bytes M |
+//   V x 3 f32 positions | I u32 indices | V x 2 f32 uvs (with the flag) |
+//   S x (u32 first triangle, u32 triangles, i32 material) | M bytes: the materials and texture
+//   base in the .lod's MATL layout (runtime/material_section.h) |
 //   u64 checksum = hash_bytes(everything before it)
 #include "jobs/hlod_mesh_cache.h"
 
@@ -17,12 +20,14 @@
 #include "runtime/byte_order.h"
 #include "runtime/file_write.h"
 #include "runtime/lod_asset.h"  // hash_bytes
+#include "runtime/material_section.h"
 
 namespace lod {
 namespace {
 
 constexpr char kMagic[8] = {'L', 'O', 'D', 'H', 'M', 'S', 'H', '\n'};
-constexpr uint64_t kFixedBytes = 48;
+constexpr uint64_t kFixedBytes = 64;
+constexpr uint32_t kFlagUvs = 1;
 
 bool read_whole(const std::filesystem::path& path, std::vector<uint8_t>& out) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -49,18 +54,32 @@ std::filesystem::path hlod_mesh_entry_path(const std::filesystem::path& dir, uin
 }
 
 Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const MeshData& mesh,
-                       uint64_t input_triangles) {
+                       uint64_t input_triangles, const HlodSurfaces& surfaces) {
+  const bool uvs = !mesh.uvs.empty() && mesh.uvs.size() == 2 * mesh.vertex_count();
+  LodChain chain;
+  chain.materials = surfaces.materials;
+  chain.texture_base = surfaces.texture_base;
+  const std::vector<uint8_t> materials = surfaces.materials.empty() ? std::vector<uint8_t>() : encode_material_section(chain);
   detail::ByteWriter w;
-  w.bytes.reserve(kFixedBytes + 4 * (mesh.positions.size() + mesh.indices.size()) + 8);
+  w.bytes.reserve(kFixedBytes + 4 * (mesh.positions.size() + mesh.indices.size() + mesh.uvs.size()) + 8);
   for (char c : kMagic) w.u8(uint8_t(c));
   w.u32(kHlodMeshEntryVersion);
-  w.u32(0);
+  w.u32(uvs ? kFlagUvs : 0);
   w.u64(source_hash);
   w.u64(input_triangles);
   w.u64(mesh.vertex_count());
   w.u64(mesh.indices.size());
+  w.u64(mesh.submeshes.size());
+  w.u64(materials.size());
   w.words(mesh.positions.data(), mesh.positions.size());
   w.words(mesh.indices.data(), mesh.indices.size());
+  if (uvs) w.words(mesh.uvs.data(), mesh.uvs.size());
+  for (const Submesh& sm : mesh.submeshes) {
+    w.u32(sm.first_triangle);
+    w.u32(sm.triangle_count);
+    w.u32(uint32_t(sm.material));
+  }
+  w.raw(materials.data(), materials.size());
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
   const std::filesystem::path path = hlod_mesh_entry_path(dir, source_hash);
   if (Status s = write_file_atomic(path, w.bytes); !s) return s;
@@ -68,7 +87,7 @@ Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, c
 }
 
 CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const std::string& source_name,
-                           MeshData& out, uint64_t& input_triangles, std::string* why) {
+                           MeshData& out, uint64_t& input_triangles, std::string* why, HlodSurfaces* surfaces) {
   const std::filesystem::path path = hlod_mesh_entry_path(dir, source_hash);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return CacheLookup::missing;
@@ -81,12 +100,18 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   if (b.size() < kFixedBytes + 8) return refuse("too short for a cleaned mesh entry (truncated?)");
   if (std::memcmp(b.data(), kMagic, 8) != 0) return refuse("not a cleaned mesh entry (bad magic bytes)");
   if (detail::load_u32(b.data() + 8) != kHlodMeshEntryVersion) return refuse("entry version is not supported");
+  const uint32_t flags = detail::load_u32(b.data() + 12);
   const uint64_t vertices = detail::load_u64(b.data() + 32), indices = detail::load_u64(b.data() + 40);
-  // Counts against the size before anything is allocated.
-  if (vertices >= UINT32_MAX || indices % 3 != 0 || indices > b.size() / 4 ||
-      b.size() != kFixedBytes + 12 * vertices + 4 * indices + 8)
-    return refuse("its counts (" + std::to_string(vertices) + " vertices, " + std::to_string(indices) +
-                  " indices) do not match its " + std::to_string(b.size()) + " bytes (truncated?)");
+  const uint64_t submeshes = detail::load_u64(b.data() + 48), material_bytes = detail::load_u64(b.data() + 56);
+  if ((flags & ~kFlagUvs) != 0) return refuse("unknown flags " + std::to_string(flags));
+  const uint64_t per_vertex = (flags & kFlagUvs) ? 20 : 12;
+  // Counts against the size before anything is allocated (each bounded first, so the sum cannot overflow).
+  if (vertices >= UINT32_MAX || indices % 3 != 0 || indices > b.size() / 4 || submeshes > b.size() / 12 ||
+      material_bytes > b.size() ||
+      b.size() != kFixedBytes + per_vertex * vertices + 4 * indices + 12 * submeshes + material_bytes + 8)
+    return refuse("its counts (" + std::to_string(vertices) + " vertices, " + std::to_string(indices) + " indices, " +
+                  std::to_string(submeshes) + " submeshes, " + std::to_string(material_bytes) +
+                  " bytes of materials) do not match its " + std::to_string(b.size()) + " bytes (truncated?)");
   const size_t body = b.size() - 8;
   if (detail::load_u64(b.data() + body) != hash_bytes(b.data(), body)) return refuse("checksum mismatch (corrupted)");
   if (detail::load_u64(b.data() + 16) != source_hash) return refuse("written for another source (a misplaced entry)");
@@ -97,10 +122,37 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   const uint8_t* p = b.data() + kFixedBytes;
   for (float& v : m.positions) v = detail::load_f32(p), p += 4;
   for (uint32_t& i : m.indices) i = detail::load_u32(p), p += 4;
+  if (flags & kFlagUvs) {
+    m.uvs.resize(size_t(2 * vertices));
+    for (float& v : m.uvs) v = detail::load_f32(p), p += 4;
+  }
+  m.submeshes.resize(size_t(submeshes));
+  for (Submesh& sm : m.submeshes) {
+    sm.first_triangle = detail::load_u32(p);
+    sm.triangle_count = detail::load_u32(p + 4);
+    sm.material = int32_t(detail::load_u32(p + 8));
+    p += 12;
+  }
+  LodChain chain;
+  if (material_bytes > 0)
+    if (Status s = decode_material_section({p, size_t(material_bytes)}, "materials", chain); !s) return refuse(s.message);
   for (uint32_t i : m.indices)
     if (i >= vertices) return refuse("an index names vertex " + std::to_string(i) + " of " + std::to_string(vertices));
   for (float v : m.positions)
     if (!std::isfinite(v)) return refuse("a position is not finite");
+  for (float v : m.uvs)
+    if (!std::isfinite(v)) return refuse("a texture coordinate is not finite");
+  // Submeshes in order inside the triangles, each naming a stored material (or the default).
+  uint64_t covered = 0;
+  for (const Submesh& sm : m.submeshes) {
+    if (sm.first_triangle < covered || sm.first_triangle > indices / 3 || sm.triangle_count > indices / 3 - sm.first_triangle ||
+        sm.material < -1 || (sm.material >= 0 && size_t(sm.material) >= chain.materials.size()))
+      return refuse("submesh at triangle " + std::to_string(sm.first_triangle) + " (" + std::to_string(sm.triangle_count) +
+                    " triangles, material " + std::to_string(sm.material) + ") does not continue the runs before it or "
+                    "names a material of the " + std::to_string(chain.materials.size()));
+    covered = uint64_t(sm.first_triangle) + sm.triangle_count;
+  }
+  if (surfaces) surfaces->materials = std::move(chain.materials), surfaces->texture_base = std::move(chain.texture_base);
   input_triangles = detail::load_u64(b.data() + 24);
   out = std::move(m);
   return CacheLookup::found;

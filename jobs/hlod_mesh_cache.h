@@ -1,6 +1,6 @@
 // The mesh as an HLOD build takes it (loaded and cleaned), kept in the distributed bake's cache
 // beside the subtrees under the source's content hash (issue 16): a rerun, and every rank of
-// it, reads two arrays instead of parsing and cleaning the file again. Written like a subtree
+// it, reads a few arrays instead of parsing and cleaning the file again. Written like a subtree
 // entry (temporary, read back, rename); read as hostile input (sizes, checksum, key, indices).
 #pragma once
 #include <cstdint>
@@ -8,22 +8,25 @@
 #include <string>
 
 #include "jobs/hlod_subtree_cache.h"  // CacheLookup
+#include "preprocess/hlod_build.h"    // HlodSurfaces
 #include "preprocess/mesh.h"
 #include "runtime/status.h"
 
 namespace lod {
 
-inline constexpr uint32_t kHlodMeshEntryVersion = 1;
+inline constexpr uint32_t kHlodMeshEntryVersion = 2;  // 2: uvs, submeshes, materials
 
 std::filesystem::path hlod_mesh_entry_path(const std::filesystem::path& dir, uint64_t source_hash);
 
-// Positions and indices of `mesh` (cleaned), and the triangle count it had before cleaning.
+// Positions, indices, uvs and submeshes of `mesh` (cleaned), its materials as the tree stores
+// them, and the triangle count it had before cleaning.
 Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const MeshData& mesh,
-                       uint64_t input_triangles);
+                       uint64_t input_triangles, const HlodSurfaces& surfaces = {});
 
-// `out` gets positions, indices and `source` (named `source_name`); `why` says why an entry was
-// refused.
+// `out` gets positions, indices, uvs, submeshes and `source` (named `source_name`), `surfaces`
+// (when given) the materials; `why` says why an entry was refused.
 CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const std::string& source_name,
-                           MeshData& out, uint64_t& input_triangles, std::string* why = nullptr);
+                           MeshData& out, uint64_t& input_triangles, std::string* why = nullptr,
+                           HlodSurfaces* surfaces = nullptr);
 
 }  // namespace lod

@@ -55,14 +55,15 @@ std::vector<uint8_t> read_all(const std::filesystem::path& path, bool& opened) {
 }  // namespace
 
 uint64_t hlod_subtree_key(uint64_t source_hash, const HlodBuildOptions& o, const HlodSubtreeSpec& spec) {
-  const uint64_t words[8] = {source_hash,
+  const uint64_t words[9] = {source_hash,
                              kHlodSubtreeEntryVersion,
                              o.min_verts,
                              std::bit_cast<uint32_t>(o.max_error_per_cell),
                              std::bit_cast<uint32_t>(o.layer_samples_per_triangle),
                              o.reference_samples,
                              spec.fingerprint,
-                             1 /* build version, as hlod_source_hash */};
+                             2 /* build version, as hlod_source_hash */,
+                             std::bit_cast<uint32_t>(o.uv_weight)};
   return hash_bytes(words, sizeof words, 0x68737562ull);
 }
 

@@ -38,8 +38,8 @@ struct StreamPagerConfig {
 // Reads one node's payload (any source: a .hlod file, memory, the network). Called on the
 // loader threads, possibly several at once (it must be safe to), for each node at most once
 // per issue; an error's message says why ("truncated at byte 812"); the pager names the
-// node. A payload larger than its node's resident_bytes (4 bytes per position, normal and
-// index value, as hlod_resident_bytes counts) is refused as a failure: the budget reserved
+// node. A payload larger than its node's resident_bytes (4 bytes per position, normal, uv and
+// index value, 16 per material run, as hlod_resident_bytes counts) is refused as a failure: the budget reserved
 // only that much.
 using NodeLoader = std::function<Status(uint32_t node, HlodPayload& out)>;
 

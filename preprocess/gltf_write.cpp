@@ -64,6 +64,7 @@ Status check_mesh(const std::string& what, const GltfMeshView& m) {
 
 // An image to embed or copy: its bytes and MIME type.
 struct Image {
+  std::filesystem::path file;
   std::vector<uint8_t> bytes;
   const char* mime = nullptr;
   const char* extension = nullptr;
@@ -141,6 +142,7 @@ void load_images(const std::string& what, const GltfMeshView& m, std::vector<Ima
         note("is " + why);
         continue;
       }
+      img.file = file;
       image_of[i][k] = int(images.size());
       sources.emplace_back(file, embedded);
       images.push_back(std::move(img));
@@ -250,10 +252,15 @@ json pack_buffer(const GltfMeshView& m, const std::vector<SlotImages>& image_of,
   return primitives;
 }
 
-// Embedded images (GLB): a buffer view each, without a target.
-void pack_images(const std::vector<Image>& images, Packed& p, json& out) {
+// Embedded images (GLB): a buffer view each, without a target; or, where `image_uri` names one,
+// a reference to the caller's copy.
+void pack_images(const std::vector<Image>& images, const GltfMeshView& m, Packed& p, json& out) {
   out = json::array();
   for (const Image& img : images) {
+    if (const std::string uri = m.image_uri ? m.image_uri(img.file) : std::string(); !uri.empty()) {
+      out.push_back({{"uri", uri}, {"mimeType", img.mime}});
+      continue;
+    }
     while (p.bin.size() % 4) p.bin.push_back(0);
     p.views.push_back({{"buffer", 0}, {"byteOffset", p.bin.size()}, {"byteLength", img.bytes.size()}});
     p.bin.insert(p.bin.end(), img.bytes.begin(), img.bytes.end());
@@ -423,7 +430,7 @@ Status save_gltf(const std::filesystem::path& path, const GltfMeshView& mesh) {
   Packed packed;
   json primitives, image_list = json::array();
   pack_buffer(mesh, image_of, packed, primitives);
-  if (ext == ".glb") pack_images(images, packed, image_list);
+  if (ext == ".glb") pack_images(images, mesh, packed, image_list);
   if (uint64_t(packed.bin.size()) + (uint64_t(1) << 20) > std::numeric_limits<uint32_t>::max())
     return Status::error(what + ": " + std::to_string(packed.bin.size()) + " bytes of buffer exceed what GLB holds (4 GiB)");
   if (ext == ".glb") {

@@ -26,7 +26,9 @@
 #include <string>
 
 #include "preprocess/decimater_chain.h"  // compute_vertex_normals
+#include "preprocess/material_runs.h"
 #include "preprocess/surface_error.h"
+#include "runtime/hlod_asset.h"  // hlod_resident_bytes
 #include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/lod_chain.h"
 
@@ -45,6 +47,7 @@ double thread_cpu_seconds() {
 
 struct Layer {
   std::vector<float> positions;
+  std::vector<float> uvs;        // uv per vertex, when the mesh has them
   std::vector<uint32_t> indices;
   std::vector<uint32_t> source;  // original vertex each vertex descends from
   float error = 0;
@@ -77,6 +80,8 @@ struct Context {
   const HlodBuildOptions& options;
   const float* positions = nullptr;
   const uint32_t* indices = nullptr;
+  const float* uvs = nullptr;          // of the original, uv per vertex, or null
+  std::vector<int32_t> vertex_material;  // of the original, per vertex; empty without materials
   std::vector<float> normals;          // of the original, per vertex
   std::vector<uint8_t> patch_depth;    // shallowest depth whose patch holds the vertex
   std::vector<uint32_t> stamp;         // per vertex: which node last visited it
@@ -147,6 +152,7 @@ uint32_t take_original(Context& c, Layer& layer, uint32_t v, uint32_t s) {
   c.stamp[v] = s;
   c.local[v] = uint32_t(layer.vertices());
   layer.positions.insert(layer.positions.end(), c.positions + 3 * size_t(v), c.positions + 3 * size_t(v) + 3);
+  if (c.uvs) layer.uvs.insert(layer.uvs.end(), c.uvs + 2 * size_t(v), c.uvs + 2 * size_t(v) + 2);
   layer.source.push_back(v);
   return c.local[v];
 }
@@ -170,6 +176,7 @@ Layer merged_children(Context& c, const BuildNode& n) {
     const Layer& coarse = child->layers.back();
     const uint32_t base = uint32_t(layer.vertices());
     layer.positions.insert(layer.positions.end(), coarse.positions.begin(), coarse.positions.end());
+    layer.uvs.insert(layer.uvs.end(), coarse.uvs.begin(), coarse.uvs.end());
     layer.source.insert(layer.source.end(), coarse.source.begin(), coarse.source.end());
     for (uint32_t i : coarse.indices) layer.indices.push_back(base + i);
     for (uint32_t i = 0; i < coarse.vertices(); ++i) {
@@ -180,6 +187,17 @@ Layer merged_children(Context& c, const BuildNode& n) {
   for (uint32_t t : n.patch)
     for (int k = 0; k < 3; ++k) layer.indices.push_back(take_original(c, layer, c.indices[3 * size_t(t) + k], s));
   return layer;
+}
+
+// The layer's triangles grouped by material (materials ascending, the default first; each
+// material's in their previous order), before anything reads their order, so that a node's
+// layers are the same whether its children were built in this step or stood in for by a baked
+// subtree's root. A triangle's material is its first corner's original vertex's (a material
+// boundary is a seam, so all three agree).
+void group_layer(const Context& c, Layer& l) {
+  if (c.vertex_material.empty()) return;
+  std::vector<LevelSubmesh> runs;
+  group_by_material(l.indices, l.source, c.vertex_material, 0, runs);
 }
 
 // Locks the tip of every tetrahedron glued into the surface: a vertex on exactly three faces
@@ -228,6 +246,10 @@ void simplify_layers(Context& c, Tally& tally, BuildNode& n) {
   // meets (Stanford's buddha: 80-150 open edges per cut otherwise).
   options.move_nonmanifold = false;
   options.vertex_lock = lock.data();
+  // Texture coordinates ride along (interpolated along each collapse, weighted in its cost);
+  // seams, uv or material, are copies at one position, moved only along the seam.
+  if (!finest.uvs.empty())
+    options.attributes = finest.uvs.data(), options.attribute_count = 2, options.attribute_weight = c.options.uv_weight;
   // Heavily locked cells otherwise reach their halves by ruinous collapses (on the bunny at
   // min_verts 500, one layer 10 % of the model off its surface, which the monotonic errors
   // then carry to the root).
@@ -244,10 +266,12 @@ void simplify_layers(Context& c, Tally& tally, BuildNode& n) {
     }
     Layer layer;
     layer.positions = std::move(out[k].positions);
+    if (!finest.uvs.empty()) layer.uvs = std::move(out[k].attributes);
     layer.indices = std::move(out[k].indices);
     layer.source.resize(out[k].source_vertex.size());
     const Layer& from = n.layers[0];
     for (size_t i = 0; i < layer.source.size(); ++i) layer.source[i] = from.source[out[k].source_vertex[i]];
+    group_layer(c, layer);
     n.layers.push_back(std::move(layer));
   }
 }
@@ -424,6 +448,7 @@ bool split_if_large(Context& c, BuildNode& n, size_t& vertices) {
 // reference samples and bounds.
 void build_layers(Context& c, Tally& tally, BuildNode& n) {
   n.layers.push_back(n.leaf() ? leaf_geometry(c, n) : merged_children(c, n));
+  group_layer(c, n.layers[0]);
   simplify_layers(c, tally, n);
   gather_reference(c, n);
   n.bounds = node_bounds(n);
@@ -491,15 +516,33 @@ void layer_normals(const Context& c, const BuildNode& n, const Layer& l, Normals
       for (int k = 0; k < 3; ++k) out[base + 3 * i + k] = c.normals[3 * size_t(l.source[i]) + k];
 }
 
-void append_range(HlodPayload& p, const std::vector<float>& positions, const std::vector<uint32_t>& indices,
-                  LodLevel& range) {
+void append_range(HlodPayload& p, const std::vector<float>& positions, const std::vector<float>& uvs,
+                  const std::vector<uint32_t>& indices, LodLevel& range) {
   range.first_index = uint32_t(p.indices.size());
   range.index_count = uint32_t(indices.size());
   range.first_vertex = uint32_t(p.positions.size() / 3);
   range.vertex_count = uint32_t(positions.size() / 3);
   range.level = level_of_triangles(indices.size() / 3);
   p.positions.insert(p.positions.end(), positions.begin(), positions.end());
+  p.uvs.insert(p.uvs.end(), uvs.begin(), uvs.end());
   p.indices.insert(p.indices.end(), indices.begin(), indices.end());
+}
+
+// Range `range`'s material runs, from its grouped triangles.
+void append_runs(const Context& c, const Layer& l, uint32_t range, HlodPayload& p) {
+  if (c.vertex_material.empty()) return;
+  std::vector<uint32_t> grouped = l.indices;  // already grouped: the order stays
+  group_by_material(grouped, l.source, c.vertex_material, range, p.runs);
+}
+
+// How far a layer's uvs slid from those of the original vertices they descend from, at most.
+float uv_error(const Context& c, const Layer& l) {
+  float worst = 0;
+  for (size_t i = 0; i < l.uvs.size() / 2; ++i) {
+    const float* from = c.uvs + 2 * size_t(l.source[i]);
+    worst = std::max(worst, std::hypot(l.uvs[2 * i] - from[0], l.uvs[2 * i + 1] - from[1]));
+  }
+  return worst;
 }
 
 HlodPayload make_payload(Context& c, const BuildNode& n) {
@@ -507,7 +550,8 @@ HlodPayload make_payload(Context& c, const BuildNode& n) {
   for (size_t k = 0; k < n.layers.size(); ++k) {
     const Layer& l = n.layers[k];
     LodLevel range;
-    append_range(p, l.positions, l.indices, range);
+    append_range(p, l.positions, l.uvs, l.indices, range);
+    append_runs(c, l, uint32_t(k), p);
     range.error = l.error;
     range.bounds = n.bounds;
     layer_normals(c, n, l, n.leaf() && k == 0 ? Normals::original : Normals::own_except_locked, p.normals);
@@ -517,7 +561,9 @@ HlodPayload make_payload(Context& c, const BuildNode& n) {
   const uint32_t s = c.new_stamp();
   for (uint32_t t : n.patch)
     for (int k = 0; k < 3; ++k) patch.indices.push_back(take_original(c, patch, c.indices[3 * size_t(t) + k], s));
-  append_range(p, patch.positions, patch.indices, p.boundary);
+  group_layer(c, patch);
+  append_range(p, patch.positions, patch.uvs, patch.indices, p.boundary);
+  append_runs(c, patch, uint32_t(n.layers.size()), p);
   p.boundary.bounds = n.bounds;
   for (uint32_t v : patch.source) p.normals.insert(p.normals.end(), &c.normals[3 * size_t(v)], &c.normals[3 * size_t(v)] + 3);
   return p;
@@ -536,10 +582,13 @@ HlodNode describe_node(Context& c, const BuildNode& b, HlodPayload& payload) {
   h.boundary_triangles = uint32_t(b.patch.size());
   h.layer_count = uint8_t(b.layers.size());
   for (size_t k = 0; k < b.layers.size(); ++k)
-    h.layers[k] = {uint32_t(b.layers[k].triangles()), uint32_t(b.layers[k].vertices()), b.layers[k].error};
+    h.layers[k] = {uint32_t(b.layers[k].triangles()), uint32_t(b.layers[k].vertices()), b.layers[k].error,
+                   c.uvs ? uv_error(c, b.layers[k]) : 0.0f};
   payload = make_payload(c, b);
   h.boundary_vertices = payload.boundary.vertex_count;
-  h.resident_bytes = 4 * (payload.positions.size() + payload.normals.size() + payload.indices.size());
+  h.uvs = c.uvs != nullptr;
+  h.material_runs = uint32_t(payload.runs.size());
+  h.resident_bytes = hlod_resident_bytes(h);
   return h;
 }
 
@@ -558,6 +607,7 @@ HlodSubtree flatten_subtree(Context& c, const std::vector<BuildNode*>& order) {
     s.nodes[i] = h;
   }
   const BuildNode& root = *order[0];
+  s.material_count = uint32_t(c.options.surfaces.materials.size());
   s.root_source = root.layers.back().source;
   s.root_reference = root.reference;
   return s;
@@ -575,6 +625,10 @@ void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
   Layer coarse;
   const auto* p = s.payloads[0].positions.data() + 3 * size_t(range.first_vertex);
   coarse.positions.assign(p, p + 3 * size_t(range.vertex_count));
+  if (!s.payloads[0].uvs.empty()) {
+    const auto* uv = s.payloads[0].uvs.data() + 2 * size_t(range.first_vertex);
+    coarse.uvs.assign(uv, uv + 2 * size_t(range.vertex_count));
+  }
   const auto* i = s.payloads[0].indices.data() + range.first_index;
   coarse.indices.assign(i, i + range.index_count);
   coarse.source = s.root_source;
@@ -586,16 +640,20 @@ void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
 }
 
 // A subtree result is checked against the mesh before any of it is used as an index.
-Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, const std::string& what) {
+Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, bool uvs, uint32_t materials,
+                     const std::string& what) {
   if (s.nodes.empty() || s.payloads.empty() || (s.payloads.size() != 1 && s.payloads.size() != s.nodes.size()))
     return Status::error(what + ": no nodes, or neither the root's payload alone nor one payload per node");
   const HlodNode& root = s.nodes[0];
+  if (root.uvs != uvs) return Status::error(what + ": it was baked " + (uvs ? "without" : "with") + " texture coordinates");
   if (root.depth != f.depth || root.box_half != f.half || root.box_center[0] != f.center[0] ||
       root.box_center[1] != f.center[1] || root.box_center[2] != f.center[2])
     return Status::error(what + ": its root is not the frontier node's cell");
   const HlodPayload& p = s.payloads[0];
   if (root.layer_count < 1 || p.layers.size() != root.layer_count) return Status::error(what + ": root layers do not match its record");
   const LodLevel& range = p.layers.back();
+  if (p.uvs.size() != (root.uvs ? 2 * (p.positions.size() / 3) : 0) || s.material_count != materials)
+    return Status::error(what + ": its texture coordinates or materials are not the mesh's");
   if (s.root_source.size() != range.vertex_count || size_t(range.first_vertex) + range.vertex_count > p.positions.size() / 3 ||
       size_t(range.first_index) + range.index_count > p.indices.size())
     return Status::error(what + ": root's coarsest layer does not match its vertex sources");
@@ -663,6 +721,12 @@ Status check_input(const MeshData& mesh) {
   for (size_t i = 0; i < mesh.positions.size(); ++i)
     if (!std::isfinite(mesh.positions[i]))
       return Status::error(what + ": vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+  if (!mesh.uvs.empty() && mesh.uvs.size() != 2 * mesh.vertex_count())
+    return Status::error(what + ": " + std::to_string(mesh.uvs.size() / 2) + " texture coordinates for " +
+                         std::to_string(mesh.vertex_count()) + " vertices");
+  for (size_t i = 0; i < mesh.uvs.size(); ++i)
+    if (!std::isfinite(mesh.uvs[i]))
+      return Status::error(what + ": vertex " + std::to_string(i / 2) + " has a non-finite texture coordinate");
   for (size_t i = 0; i < mesh.indices.size(); ++i)
     if (mesh.indices[i] >= mesh.vertex_count())
       return Status::error(what + ": face " + std::to_string(i / 3) + " references vertex " +
@@ -881,6 +945,9 @@ Status HlodBuilder::plan() {
   const MeshData& mesh = m.mesh;
   if (m.planned) return Status::error(m.what + ": HLOD build planned twice");
   if (Status s = check_input(mesh); !s) return s;
+  if (m.options.surfaces.materials.size() > kMaxMaterials)
+    return Status::error(m.what + ": " + std::to_string(m.options.surfaces.materials.size()) + " materials, at most " +
+                         std::to_string(kMaxMaterials));
   m.root = std::make_unique<BuildNode>();
   m.root->triangles.reserve(mesh.triangle_count());
   for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
@@ -897,6 +964,12 @@ Status HlodBuilder::plan() {
   c.patch_depth.assign(mesh.vertex_count(), kNoPatch);
   c.stamp.assign(mesh.vertex_count(), 0);
   c.local.assign(mesh.vertex_count(), 0);
+  c.uvs = mesh.uvs.empty() ? nullptr : mesh.uvs.data();
+  if (!m.options.surfaces.materials.empty()) {
+    c.vertex_material = vertex_materials(mesh);
+    for (int32_t& id : c.vertex_material)
+      if (id < -1 || id >= int32_t(m.options.surfaces.materials.size())) id = -1;
+  }
   c.normals.resize(mesh.positions.size());
   compute_vertex_normals(mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size(),
                          c.normals.data());
@@ -992,7 +1065,10 @@ Status HlodBuilder::build_top(const std::vector<HlodSubtree>& baked, std::vector
     return Status::error(m.what + ": " + std::to_string(baked.size()) + " subtree results for " +
                          std::to_string(m.frontier.size()) + " subtrees");
   for (size_t i = 0; i < baked.size(); ++i) {
-    if (Status s = check_subtree(*m.frontier[i], baked[i], m.mesh.vertex_count(), m.name(i)); !s) return s;
+    if (Status s = check_subtree(*m.frontier[i], baked[i], m.mesh.vertex_count(), m.c.uvs != nullptr,
+                                 uint32_t(m.options.surfaces.materials.size()), m.name(i));
+        !s)
+      return s;
     stand_for_subtree(*m.frontier[i], baked[i]);
   }
   m.assembled = true;
@@ -1167,6 +1243,10 @@ Status HlodBuilder::finish_top(const std::vector<HlodSubtree>& baked, const std:
   for (int k = 0; k < 3; ++k) assembly.model.tree.box_center[k] = m.root->center[k];
   assembly.model.tree.box_half = m.root->half;
   assembly.model.tree.source_triangles = m.mesh.triangle_count();
+  assembly.model.tree.uvs = m.c.uvs != nullptr;
+  assembly.model.tree.material_count = uint32_t(m.options.surfaces.materials.size());
+  assembly.model.tree.materials = m.options.surfaces.materials;
+  assembly.model.tree.texture_base = m.options.surfaces.texture_base;
   splice(m.c, *m.root, baked, assembly, report);
   report.short_layers += m.top_tally.short_layers.load();
   report.oversized_leaves += m.top_tally.oversized_leaves.load();

@@ -8,6 +8,10 @@
 //               twice like a leaf.
 //   locks:      in every node, the vertices of every ancestor's patch (and the mesh's own
 //               border) never move, so any mix of child layers meets the patches exactly.
+//   attributes: texture coordinates ride through QEM as attributes (seams kept: copies at one
+//               position move only along their seam) and material boundaries are seams, so each
+//               layer's triangle keeps the material of the original vertex it descends from;
+//               every layer and patch is grouped into material runs (preprocess/material_runs.h).
 //   errors:     each layer is measured against the original surface (Embree closest points,
 //               both directions) and made monotonic: never below the layer before it, and an
 //               inner node never below any child's coarsest layer.
@@ -30,10 +34,12 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "preprocess/mesh.h"
 #include "preprocess/qem_simplifier.h"  // ParallelFor
+#include "runtime/chain_material.h"
 #include "runtime/hlod_subtree.h"
 #include "runtime/hlod_tree.h"
 #include "runtime/status.h"
@@ -43,6 +49,13 @@ namespace lod {
 // fraction in [0, 1] of the original triangles whose node is finished. Called from whichever
 // thread finished a node, possibly from several at once: the callee serialises.
 using HlodBuildProgress = std::function<void(float fraction)>;
+
+// A model's materials as its tree stores them (jobs convert a mesh's with add_chain_materials):
+// texture URIs relative to texture_base, the source's folder, as a .lod's.
+struct HlodSurfaces {
+  std::vector<ChainMaterial> materials;
+  std::string texture_base;
+};
 
 struct HlodBuildOptions {
   uint32_t min_verts = 1000;  // a cell with more vertices splits (R1 Table I: 500-1000)
@@ -59,6 +72,11 @@ struct HlodBuildOptions {
   // About how many subtrees the top is split into (see the frontier rule). The output is the
   // same for any value; it only decides the units a distributed build hands out.
   uint32_t subtrees = 16;
+  // The materials the mesh's submeshes name, copied into the tree. A submesh id at or past their
+  // count is drawn with the default material. None: one surface, no runs.
+  HlodSurfaces surfaces;
+  // Weight of the uv error in QEM's collapse cost for a mesh with uvs (BakeSettings::uv_weight).
+  float uv_weight = 0.2f;
   ParallelFor parallel_for;     // optional; independent subtrees and children in parallel
   HlodBuildProgress progress;   // optional
 };
@@ -101,9 +119,10 @@ struct HlodBuildReport {
   size_t short_layers = 0;           // layers dropped: no fewer triangles than the one before
 };
 
-// Builds the HLOD of `mesh` (cleaned: see clean_mesh). Fails on an empty mesh, indices out of
-// range, non-finite coordinates, or a mesh with more than 2^32 - 1 vertices; `out` is only
-// written on success. tree.name and tree.source_hash are left for the caller.
+// Builds the HLOD of `mesh` (cleaned: see clean_mesh; its uvs (TEXCOORD_0) and submeshes'
+// materials are kept, its other attributes are not). Fails on an empty mesh, indices out of
+// range, non-finite coordinates or uvs, or a mesh with more than 2^32 - 1 vertices; `out` is
+// only written on success. tree.name and tree.source_hash are left for the caller.
 Status build_hlod(HlodModel& out, const MeshData& mesh, const HlodBuildOptions& options,
                   HlodBuildReport* report = nullptr);
 

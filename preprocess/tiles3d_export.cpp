@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "preprocess/gltf_write.h"
+#include "preprocess/texture_uri.h"
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
 
@@ -27,6 +28,27 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr const char* kTilesFolder = "tiles";
+constexpr const char* kTexturesFolder = "textures";
+
+// With shared images: each image file copied once into the staging folder's textures/, named
+// by the order it was first met, and the URI a tile's GLB names it by.
+struct SharedImages {
+  fs::path staging;
+  std::vector<std::pair<fs::path, std::string>> written;  // source file, URI from tiles/
+  TilesetExportReport* rep = nullptr;
+  std::string uri_of(const fs::path& file) {
+    for (const auto& [f, uri] : written)
+      if (f == file) return uri;
+    std::error_code ec;
+    fs::create_directories(staging / kTexturesFolder, ec);
+    const std::string name = "image" + std::to_string(written.size()) + file.extension().string();
+    if (ec || !fs::copy_file(file, staging / kTexturesFolder / name, ec) || ec) return {};  // embedded instead
+    rep->bytes += fs::file_size(staging / kTexturesFolder / name, ec);
+    ++rep->shared_images;
+    written.push_back({file, std::string("../") + kTexturesFolder + "/" + name});
+    return written.back().second;
+  }
+};
 
 // An axis-aligned box in the model's (glTF, y-up) coordinates, in double so that the written
 // centre and half sizes reproduce the float extremes.
@@ -163,24 +185,75 @@ Status check_payload(const std::string& what, const HlodNode& n, const HlodPaylo
   if (p.layers.size() != n.layer_count || p.layers.empty() || p.layers.size() > kHlodMaxLayers)
     return Status::error(what + ": " + std::to_string(p.layers.size()) + " layers, the tree says " +
                          std::to_string(n.layer_count));
-  if (p.positions.size() % 3 != 0 || p.normals.size() != p.positions.size())
-    return Status::error(what + ": positions and normals do not match");
+  if (p.positions.size() % 3 != 0 || p.normals.size() != p.positions.size() ||
+      (!p.uvs.empty() && p.uvs.size() != p.positions.size() / 3 * 2))
+    return Status::error(what + ": positions, normals and uvs do not match");
   for (size_t k = 0; k < p.layers.size(); ++k)
     if (Status s = check_range(what + " layer " + std::to_string(k), p.layers[k], p); !s) return s;
   return check_range(what + " boundary", p.boundary, p);
 }
 
-// One GLB of the range `r`: writes it (unless it has no triangles) and its box.
-Status write_range(const fs::path& staging, const std::string& file, const std::string& mesh_name,
-                   const LodLevel& r, const HlodPayload& p, std::string& uri, Box& box, TilesetExportReport& rep) {
+// A tree material for the GLB writer, its images resolved against the texture base (one
+// missing at export time is left out by the writer and said).
+GltfMaterialView gltf_material(const ChainMaterial& m, const std::string& texture_base) {
+  GltfMaterialView g;
+  g.name = m.name;
+  std::copy(m.base_color, m.base_color + 4, g.base_color);
+  g.metallic = m.metallic;
+  g.roughness = m.roughness;
+  g.alpha_mode = m.alpha_mode;
+  g.alpha_cutoff = m.alpha_cutoff;
+  g.double_sided = m.double_sided;
+  g.normal_scale = m.normal_scale;
+  g.occlusion_strength = m.occlusion_strength;
+  std::copy(m.emissive, m.emissive + 3, g.emissive);
+  g.tex_coords = m.tex_coords;
+  const auto uris = texture_slots(m);
+  const auto images = image_slots(g);
+  for (size_t s = 0; s < kTextureSlots; ++s) *images[s] = texture_file(texture_base, *uris[s]);
+  return g;
+}
+
+// The range's runs as primitives, with only the materials they use (renumbered in order of
+// first use, so that no GLB carries unused materials); ids were checked by the reader and are
+// checked again against the tree's materials here.
+Status add_surfaces(const std::string& what, const HlodTree& tree, std::span<const LevelSubmesh> runs,
+                    GltfMeshView& view) {
+  std::vector<int32_t> renumbered(tree.materials.size(), -1);
+  for (const LevelSubmesh& s : runs) {
+    int32_t id = -1;
+    if (s.material >= 0) {
+      if (size_t(s.material) >= tree.materials.size())
+        return Status::error(what + ": a material run names material " + std::to_string(s.material) + " of " +
+                             std::to_string(tree.materials.size()));
+      int32_t& slot = renumbered[size_t(s.material)];
+      if (slot < 0) {
+        slot = int32_t(view.materials.size());
+        view.materials.push_back(gltf_material(tree.materials[size_t(s.material)], tree.texture_base));
+      }
+      id = slot;
+    }
+    view.submeshes.push_back({s.first_index, s.index_count, id});
+  }
+  return Status::success();
+}
+
+// One GLB of the range `r` (range index `range`): writes it (unless it has no triangles) and its box.
+Status write_range(const fs::path& staging, const std::string& file, const std::string& mesh_name, const HlodTree& tree,
+                   uint32_t range, const LodLevel& r, const HlodPayload& p, SharedImages* shared, std::string& uri,
+                   Box& box, TilesetExportReport& rep) {
   if (r.index_count == 0) return Status::success();
   GltfMeshView view;
   view.name = mesh_name;
   view.positions = p.positions.data() + 3 * size_t(r.first_vertex);
   view.normals = p.normals.data() + 3 * size_t(r.first_vertex);
+  view.uvs = p.uvs.empty() ? nullptr : p.uvs.data() + 2 * size_t(r.first_vertex);
   view.vertex_count = r.vertex_count;
   view.indices = p.indices.data() + r.first_index;
   view.index_count = r.index_count;
+  view.notes = &rep.notes;
+  if (shared) view.image_uri = [shared](const fs::path& image) { return shared->uri_of(image); };
+  if (Status s = add_surfaces(mesh_name, tree, hlod_range_runs(p, range), view); !s) return s;
   const std::string rel = std::string(kTilesFolder) + "/" + file;
   if (Status s = save_gltf(staging / rel, view); !s) return s;
   for (size_t v = 0; v < r.vertex_count; ++v) box.add_point(view.positions + 3 * v);
@@ -192,8 +265,9 @@ Status write_range(const fs::path& staging, const std::string& file, const std::
 }
 
 Status write_node_contents(const HlodFile& file, const HlodTree& tree, const std::string& what, const fs::path& staging,
-                           std::vector<NodeContent>& out, TilesetExportReport& rep) {
+                           bool shared_images, std::vector<NodeContent>& out, TilesetExportReport& rep) {
   out.assign(tree.nodes.size(), {});
+  SharedImages shared{staging, {}, &rep};
   for (size_t i = 0; i < tree.nodes.size(); ++i) {
     const HlodNode& n = tree.nodes[i];
     const std::string node_what = what + ": node " + std::to_string(i);
@@ -204,11 +278,12 @@ Status write_node_contents(const HlodFile& file, const HlodTree& tree, const std
     const std::string id = std::to_string(i);
     for (size_t k = 0; k < p.layers.size(); ++k)
       if (Status s = write_range(staging, id + "-" + std::to_string(k) + ".glb", "node " + id + " layer " + std::to_string(k),
-                                 p.layers[k], p, c.layer_uri[k], c.layer_box[k], rep);
+                                 tree, uint32_t(k), p.layers[k], p, shared_images ? &shared : nullptr, c.layer_uri[k],
+                                 c.layer_box[k], rep);
           !s)
         return s;
-    if (Status s = write_range(staging, id + "-boundary.glb", "node " + id + " boundary", p.boundary, p, c.boundary_uri,
-                               c.boundary_box, rep);
+    if (Status s = write_range(staging, id + "-boundary.glb", "node " + id + " boundary", tree, uint32_t(p.layers.size()),
+                               p.boundary, p, shared_images ? &shared : nullptr, c.boundary_uri, c.boundary_box, rep);
         !s)
       return s;
   }
@@ -282,7 +357,7 @@ json tileset_json(const HlodTree& tree, const std::vector<NodeContent>& contents
           {"root", std::move(root)}};
 }
 
-Status export_into(const fs::path& hlod_file, const fs::path& staging, TilesetExportReport& rep) {
+Status export_into(const fs::path& hlod_file, const fs::path& staging, bool shared_images, TilesetExportReport& rep) {
   const std::string what = hlod_file.string();
   HlodFile file;
   HlodTree tree;
@@ -290,7 +365,7 @@ Status export_into(const fs::path& hlod_file, const fs::path& staging, TilesetEx
   if (tree.nodes.empty()) return Status::error(what + ": the tree has no nodes");
   rep.nodes = tree.nodes.size();
   std::vector<NodeContent> contents;
-  if (Status s = write_node_contents(file, tree, what, staging, contents, rep); !s) return s;
+  if (Status s = write_node_contents(file, tree, what, staging, shared_images, contents, rep); !s) return s;
   if (Status s = subtree_boxes(tree, what, contents); !s) return s;
   if (contents[0].subtree.empty()) return Status::error(what + ": no node has any triangles");
   const std::string text = tileset_json(tree, contents, rep).dump(-1, ' ', false, json::error_handler_t::replace);
@@ -309,7 +384,7 @@ Status export_3d_tiles(const fs::path& hlod_file, const fs::path& dir, const Til
   fs::path staging;
   if (Status s = make_staging(target, staging); !s) return s;
   TilesetExportReport rep;
-  Status s = export_into(hlod_file, staging, rep);
+  Status s = export_into(hlod_file, staging, options.shared_images, rep);
   if (s) s = publish(staging, target, replaces_earlier);
   if (!s) {
     std::error_code ec;

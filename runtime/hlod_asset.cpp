@@ -1,20 +1,28 @@
-// The .hlod file, version 1. All integers and floats little-endian; sections 8-byte aligned.
+// The .hlod file, version 2. All integers and floats little-endian; sections 8-byte aligned.
 //
 //   head:
 //     magic "LODHLOD\n" (8) | u32 version | u32 head bytes H (everything before the head checksum)
 //     u64 source_hash | u64 source_triangles | f32 box centre xyz, f32 box half (the root cube)
 //     u64 vertices (all nodes' layers and patches) | u64 boundary triangles (all patches)
-//     u32 materials (0 in version 1) | u32 min_verts | u32 node count | u32 inner node count
-//     u32 name bytes | u32 0 | name
+//     u32 material count | u32 min_verts | u32 node count | u32 inner node count
+//     u32 name bytes | u32 flags (bit 0: the payloads have uvs; the rest 0) |
+//     u32 materials section bytes M | u32 0 | name
+//     materials (M bytes, 0 = none described): the .lod's MATL section (runtime/material_section.h)
+//       with the texture base and no submeshes; when present, exactly `material count` of them
+//       (a subtree entry of the distributed bake carries the count alone)
 //     OctreeCode: one byte per inner node, breadth-first: bit i = octant i is non-empty
 //     NodeDescription: one bit per node but the root, breadth-first: 1 = leaf, 0 = inner
-//     node records: 64 bytes each (see put_record), breadth-first
+//     node records: 80 bytes each (see put_record), breadth-first
 //     offset table: u64 offset, u64 size per node
 //   u64 head checksum = hash_bytes(bytes [0, H))
-//   payloads, one per node in node order, back to back up to the end of the file: per layer positions (3 f32 per
-//   vertex), normals (same), indices (3 u32 per triangle, layer-local), then the boundary
-//   patch the same way, then u64 checksum = hash_bytes(the payload before it)
+//   payloads, one per node in node order, back to back up to the end of the file: per layer
+//   positions (3 f32 per vertex), normals (same), uvs (2 f32 per vertex, with the flag),
+//   indices (3 u32 per triangle, layer-local), then the boundary patch the same way, then the
+//   node's material runs (16 bytes each: u32 range (layer, or layer count for the patch),
+//   u32 first index (range-local), u32 index count, i32 material), then u64 checksum =
+//   hash_bytes(the payload before it)
 //
+// Version 1 (positions and normals only, no materials) is refused with a message to rebake.
 // The tree's structure (parents, child ranges, depths, cells) is not stored: it follows from
 // the bits and the root cube, as R1 rebuilds its octree from OctreeCode and NodeDescription.
 #include "runtime/hlod_asset.h"
@@ -32,14 +40,17 @@
 #include "runtime/file_write.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/lod_chain.h"
+#include "runtime/material_section.h"
 #include "runtime/vertex_tree.h"  // kMaxTreeMagnitude
 
 namespace lod {
 namespace {
 
 constexpr char kMagic[8] = {'L', 'O', 'D', 'H', 'L', 'O', 'D', '\n'};
-constexpr uint64_t kFixedBytes = 88;
-constexpr uint64_t kRecordBytes = 64;
+constexpr uint64_t kFixedBytes = 96;
+constexpr uint64_t kRecordBytes = 80;
+constexpr uint64_t kRunBytes = 16;
+constexpr uint32_t kFlagUvs = 1;
 constexpr uint64_t kOffsetBytes = 16;
 constexpr uint64_t kChecksumBytes = 8;
 
@@ -54,9 +65,10 @@ using Writer = detail::ByteWriter;
 Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
 
 // The head's size from its counts (all u32, so no overflow in u64).
-uint64_t head_bytes(uint64_t name_bytes, uint64_t nodes, uint64_t inner) {
+uint64_t head_bytes(uint64_t name_bytes, uint64_t material_bytes, uint64_t nodes, uint64_t inner) {
   const uint64_t description = nodes > 0 ? (nodes - 1 + 7) / 8 : 0;
-  return align8(kFixedBytes + name_bytes) + align8(inner) + align8(description) + nodes * (kRecordBytes + kOffsetBytes);
+  return align8(kFixedBytes + name_bytes) + align8(material_bytes) + align8(inner) + align8(description) +
+         nodes * (kRecordBytes + kOffsetBytes);
 }
 
 // A payload holds exactly what it takes in memory, plus its checksum.
@@ -74,6 +86,8 @@ void put_record(Writer& w, const HlodNode& n) {
     w.u32(used ? n.layers[k].vertices : 0);
     w.f32(used ? n.layers[k].error : 0.0f);
   }
+  for (uint32_t k = 0; k < kHlodMaxLayers; ++k) w.f32(k < n.layer_count ? n.layers[k].uv_error : 0.0f);
+  w.u32(n.material_runs);
 }
 
 bool finite_in_range(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxTreeMagnitude; }
@@ -111,6 +125,13 @@ bool get_record(const uint8_t* p, HlodNode& n, std::string& why) {
       return why = name + " has " + std::to_string(info.triangles) + " triangles, not fewer than the layer before", false;
     if (k > 0 && info.error < n.layers[k - 1].error) return why = name + " error is below the finer layer's", false;
   }
+  for (uint32_t k = 0; k < kHlodMaxLayers; ++k) {
+    const float uv_error = load_f32(p + 64 + 4 * k);
+    if (k >= n.layer_count ? std::bit_cast<uint32_t>(uv_error) != 0 : !(finite_in_range(uv_error) && uv_error >= 0))
+      return why = "layer " + std::to_string(k) + " uv error is not a finite distance (or set beyond the layer count)", false;
+    n.layers[k].uv_error = uv_error;
+  }
+  n.material_runs = load_u32(p + 76);
   if (n.boundary_vertices > 3ull * n.boundary_triangles || (n.boundary_triangles > 0 && n.boundary_vertices == 0))
     return why = "boundary has " + std::to_string(n.boundary_vertices) + " vertices for " +
                  std::to_string(n.boundary_triangles) + " triangles",
@@ -198,15 +219,16 @@ void get_words(const uint8_t* p, size_t count, T* out) {
   }
 }
 
-// One range (a layer or the patch): positions, normals, indices, each checked.
-bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, HlodPayload& out, LodLevel& range,
+// One range (a layer or the patch): positions, normals, uvs (when the node has them), indices,
+// each checked.
+bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, bool uvs, HlodPayload& out, LodLevel& range,
                std::string& why) {
   range.first_vertex = uint32_t(out.positions.size() / 3);
   range.vertex_count = vertices;
   range.first_index = uint32_t(out.indices.size());
   range.index_count = 3 * triangles;
   range.level = level_of_triangles(triangles);
-  const size_t v0 = out.positions.size(), i0 = out.indices.size();
+  const size_t v0 = out.positions.size(), i0 = out.indices.size(), u0 = out.uvs.size();
   out.positions.resize(v0 + 3 * size_t(vertices));
   out.normals.resize(v0 + 3 * size_t(vertices));
   out.indices.resize(i0 + 3 * size_t(triangles));
@@ -214,11 +236,18 @@ bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, HlodPay
   p += 12 * size_t(vertices);
   get_words(p, 3 * size_t(vertices), out.normals.data() + v0);
   p += 12 * size_t(vertices);
+  if (uvs) {
+    out.uvs.resize(u0 + 2 * size_t(vertices));
+    get_words(p, 2 * size_t(vertices), out.uvs.data() + u0);
+    p += 8 * size_t(vertices);
+  }
   get_words(p, 3 * size_t(triangles), out.indices.data() + i0);
   p += 12 * size_t(triangles);
   for (size_t i = v0; i < out.positions.size(); ++i)
     if (!finite_in_range(out.positions[i]) || !finite_in_range(out.normals[i]))
       return why = "vertex " + std::to_string((i - v0) / 3) + " is not finite", false;
+  for (size_t i = u0; i < out.uvs.size(); ++i)
+    if (!finite_in_range(out.uvs[i])) return why = "vertex " + std::to_string((i - u0) / 2) + " has a non-finite uv", false;
   for (size_t i = i0; i < out.indices.size(); ++i)
     if (out.indices[i] >= vertices)
       return why = "triangle " + std::to_string((i - i0) / 3) + " references vertex " + std::to_string(out.indices[i]) +
@@ -227,12 +256,53 @@ bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, HlodPay
   return true;
 }
 
+// The node's material runs: in range order, each range's covering its indices back to back in
+// whole triangles, every material below `materials` (or -1). A range with triangles has runs.
+bool get_runs(const uint8_t* p, const HlodNode& node, uint32_t materials, HlodPayload& out, std::string& why) {
+  out.runs.resize(node.material_runs);
+  const uint32_t ranges = uint32_t(out.layers.size()) + 1;
+  uint32_t range = 0;
+  uint64_t covered = 0;
+  auto range_count = [&](uint32_t r) { return r < out.layers.size() ? out.layers[r].index_count : out.boundary.index_count; };
+  auto close_ranges_before = [&](uint32_t r) {  // every range before r fully covered
+    for (; range < r; ++range, covered = 0)
+      if (covered != range_count(range))
+        return why = "material runs cover " + std::to_string(covered) + " of range " + std::to_string(range) + "'s " +
+                     std::to_string(range_count(range)) + " indices",
+               false;
+    return true;
+  };
+  for (uint32_t i = 0; i < node.material_runs; ++i) {
+    LevelSubmesh& s = out.runs[i];
+    s.level = load_u32(p + kRunBytes * i);
+    s.first_index = load_u32(p + kRunBytes * i + 4);
+    s.index_count = load_u32(p + kRunBytes * i + 8);
+    s.material = int32_t(load_u32(p + kRunBytes * i + 12));
+    const std::string at = "material run " + std::to_string(i);
+    if (s.level >= ranges || s.level < range)
+      return why = at + " names range " + std::to_string(s.level) + " out of order or of " + std::to_string(ranges), false;
+    if (!close_ranges_before(s.level)) return false;
+    if (s.first_index != covered || s.index_count == 0 || s.index_count % 3 != 0 ||
+        s.index_count > range_count(range) - covered)
+      return why = at + " (indices " + std::to_string(s.first_index) + "+" + std::to_string(s.index_count) +
+                   ") does not continue range " + std::to_string(range) + "'s runs in whole triangles",
+             false;
+    covered += s.index_count;
+    if (s.material < -1 || (s.material >= 0 && uint32_t(s.material) >= materials))
+      return why = at + " names material " + std::to_string(s.material) + " of " + std::to_string(materials), false;
+  }
+  if (materials == 0 && node.material_runs == 0) return true;
+  return close_ranges_before(ranges);
+}
+
 }  // namespace
 
 uint64_t hlod_resident_bytes(const HlodNode& n) {
+  const uint64_t per_vertex = n.uvs ? 32 : 24;
   uint64_t b = 0;
-  for (uint32_t k = 0; k < n.layer_count && k < kHlodMaxLayers; ++k) b += 24ull * n.layers[k].vertices + 12ull * n.layers[k].triangles;
-  return b + 24ull * n.boundary_vertices + 12ull * n.boundary_triangles;
+  for (uint32_t k = 0; k < n.layer_count && k < kHlodMaxLayers; ++k)
+    b += per_vertex * n.layers[k].vertices + 12ull * n.layers[k].triangles;
+  return b + per_vertex * n.boundary_vertices + 12ull * n.boundary_triangles + kRunBytes * n.material_runs;
 }
 
 uint64_t hlod_payload_bytes(const HlodNode& n) { return payload_data_bytes(n) + kChecksumBytes; }
@@ -256,13 +326,21 @@ std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint
   w.f32(tree.box_center[0]), w.f32(tree.box_center[1]), w.f32(tree.box_center[2]), w.f32(tree.box_half);
   w.u64(vertices);
   w.u64(boundary);
-  w.u32(0);  // materials
+  LodChain surfaces;  // the materials in the .lod's MATL layout, when the tree describes them
+  surfaces.materials = tree.materials;
+  surfaces.texture_base = tree.texture_base;
+  const std::vector<uint8_t> materials = tree.materials.empty() ? std::vector<uint8_t>() : encode_material_section(surfaces);
+  w.u32(tree.material_count);
   w.u32(tree.min_verts);
   w.u32(count);
   w.u32(inner);
   w.u32(uint32_t(tree.name.size()));
+  w.u32(tree.uvs ? kFlagUvs : 0);
+  w.u32(uint32_t(materials.size()));
   w.u32(0);
   w.bytes.insert(w.bytes.end(), tree.name.begin(), tree.name.end());
+  w.align8();
+  w.bytes.insert(w.bytes.end(), materials.begin(), materials.end());
   w.align8();
   for (const HlodNode& n : tree.nodes)
     if (!n.leaf()) w.u8(n.child_mask);
@@ -291,10 +369,17 @@ std::vector<uint8_t> encode_hlod_payload(const HlodPayload& p) {
   auto put_range = [&](const LodLevel& r) {
     w.words(p.positions.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
     w.words(p.normals.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
+    if (!p.uvs.empty()) w.words(p.uvs.data() + 2 * size_t(r.first_vertex), 2 * size_t(r.vertex_count));
     w.words(p.indices.data() + r.first_index, r.index_count);
   };
   for (const LodLevel& r : p.layers) put_range(r);
   put_range(p.boundary);
+  for (const LevelSubmesh& r : p.runs) {
+    w.u32(r.level);
+    w.u32(r.first_index);
+    w.u32(r.index_count);
+    w.u32(uint32_t(r.material));
+  }
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
 }
@@ -321,20 +406,25 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
   const uint32_t version = load_u32(p + 8);
   if (version != kHlodAssetVersion)
     return refuse(what, "hlod version " + std::to_string(version) + " is not supported (this build reads version " +
-                            std::to_string(kHlodAssetVersion) + "); re-bake it");
+                            std::to_string(kHlodAssetVersion) +
+                            (version < kHlodAssetVersion ? ", which adds texture coordinates and materials" : "") +
+                            "); rebake it with lod bake --hlod");
   const uint64_t head = load_u32(p + 12);
   const uint32_t materials = load_u32(p + 64), min_verts = load_u32(p + 68);
   const uint32_t count = load_u32(p + 72), inner = load_u32(p + 76), name_bytes = load_u32(p + 80);
+  const uint32_t flags = load_u32(p + 84), material_bytes = load_u32(p + 88);
   // Counts against the head size before anything is allocated.
   if (head + kChecksumBytes > file_size || head + kChecksumBytes > bytes.size())
     return refuse(what, "truncated: the head needs " + std::to_string(head + kChecksumBytes) + " bytes, the file has " +
                             std::to_string(file_size));
-  if (count == 0 || inner >= count || head != head_bytes(name_bytes, count, inner))
+  if (count == 0 || inner >= count || head != head_bytes(name_bytes, material_bytes, count, inner))
     return refuse(what, "head of " + std::to_string(head) + " bytes does not match its counts (" + std::to_string(count) +
                             " nodes, " + std::to_string(inner) + " inner, name of " + std::to_string(name_bytes) + ")");
   if (load_u64(p + head) != hash_bytes(p, head)) return refuse(what, "head checksum mismatch (file is corrupted)");
-  if (materials != 0) return refuse(what, std::to_string(materials) + " materials: version 1 stores none");
-  if (min_verts == 0 || load_u32(p + 84) != 0) return refuse(what, "header fields min_verts / reserved are invalid");
+  if (min_verts == 0 || (flags & ~kFlagUvs) != 0 || load_u32(p + 92) != 0)
+    return refuse(what, "header fields min_verts / flags / reserved are invalid");
+  if (materials > kMaxMaterials)
+    return refuse(what, std::to_string(materials) + " materials, at most " + std::to_string(kMaxMaterials));
 
   HlodTree t;
   t.source_hash = load_u64(p + 16);
@@ -346,7 +436,20 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
     if (!finite_in_range(t.box_center[k])) return refuse(what, "root box centre is not finite");
   if (!finite_in_range(t.box_half) || !(t.box_half > 0)) return refuse(what, "root box size is not positive");
   t.name.assign(reinterpret_cast<const char*>(p + kFixedBytes), name_bytes);
-  const uint64_t code_at = align8(kFixedBytes + name_bytes);
+  t.uvs = (flags & kFlagUvs) != 0;
+  t.material_count = materials;
+  const uint64_t materials_at = align8(kFixedBytes + name_bytes);
+  if (material_bytes > 0) {
+    LodChain surfaces;
+    if (Status s = decode_material_section({p + materials_at, material_bytes}, what, surfaces); !s) return s;
+    if (surfaces.materials.size() != materials || !surfaces.submeshes.empty())
+      return refuse(what, "the header counts " + std::to_string(materials) + " materials, its MATL section holds " +
+                              std::to_string(surfaces.materials.size()) + " (and " +
+                              std::to_string(surfaces.submeshes.size()) + " runs, which belong in the payloads)");
+    t.materials = std::move(surfaces.materials);
+    t.texture_base = std::move(surfaces.texture_base);
+  }
+  const uint64_t code_at = materials_at + align8(material_bytes);
   const uint64_t description_at = code_at + align8(inner);
   const uint64_t records_at = description_at + align8((uint64_t(count) - 1 + 7) / 8);
   const uint64_t table_at = records_at + kRecordBytes * count;
@@ -357,6 +460,18 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
       return refuse(what, "node " + std::to_string(i) + ": " + why);
   if (!rebuild_structure(p + code_at, inner, p + description_at, t, why)) return refuse(what, "octree: " + why);
   if (!check_tree(t, why)) return refuse(what, why);
+  for (uint32_t i = 0; i < count; ++i) {
+    HlodNode& n = t.nodes[i];
+    n.uvs = t.uvs;
+    // A tree with materials has runs over every range with triangles (at most one per
+    // triangle), one without has none.
+    uint64_t triangles = n.boundary_triangles, ranges = n.boundary_triangles > 0;
+    for (uint32_t k = 0; k < n.layer_count; ++k) triangles += n.layers[k].triangles, ++ranges;
+    if (materials == 0 ? n.material_runs != 0 : (n.material_runs < ranges || n.material_runs > triangles))
+      return refuse(what, "node " + std::to_string(i) + ": " + std::to_string(n.material_runs) +
+                              " material runs for " + std::to_string(ranges) + " ranges of " +
+                              std::to_string(triangles) + " triangles and " + std::to_string(materials) + " materials");
+  }
 
   uint64_t vertices = 0, boundary = 0, end = head + kChecksumBytes;
   for (uint32_t i = 0; i < count; ++i) {
@@ -390,8 +505,8 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
   return Status::success();
 }
 
-Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node, const std::string& what,
-                           HlodPayload& out) {
+Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node, uint32_t materials,
+                           const std::string& what, HlodPayload& out) {
   if (bytes.size() != node.payload_size || bytes.size() != payload_data_bytes(node) + kChecksumBytes)
     return refuse(what, "node payload is " + std::to_string(bytes.size()) + " bytes, its counts need " +
                             std::to_string(payload_data_bytes(node) + kChecksumBytes) + " (truncated?)");
@@ -403,15 +518,16 @@ Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node,
   std::string why;
   for (uint32_t k = 0; k < node.layer_count; ++k) {
     LodLevel range;
-    if (!get_range(q, node.layers[k].vertices, node.layers[k].triangles, p, range, why))
+    if (!get_range(q, node.layers[k].vertices, node.layers[k].triangles, node.uvs, p, range, why))
       return refuse(what, "layer " + std::to_string(k) + ": " + why);
     range.error = node.layers[k].error;
     range.bounds = node.bounds;
     p.layers.push_back(range);
   }
-  if (!get_range(q, node.boundary_vertices, node.boundary_triangles, p, p.boundary, why))
+  if (!get_range(q, node.boundary_vertices, node.boundary_triangles, node.uvs, p, p.boundary, why))
     return refuse(what, "boundary: " + why);
   p.boundary.bounds = node.bounds;
+  if (!get_runs(q, node, materials, p, why)) return refuse(what, why);
   out = std::move(p);
   return Status::success();
 }
@@ -423,7 +539,7 @@ Status decode_hlod_asset(std::span<const uint8_t> file, const std::string& what,
   std::vector<HlodPayload> all(t.nodes.size());
   for (size_t i = 0; i < t.nodes.size(); ++i) {
     const HlodNode& n = t.nodes[i];
-    if (Status s = decode_hlod_payload(file.subspan(n.payload_offset, n.payload_size), n,
+    if (Status s = decode_hlod_payload(file.subspan(n.payload_offset, n.payload_size), n, t.material_count,
                                        what + ": node " + std::to_string(i), all[i]);
         !s)
       return s;
@@ -461,13 +577,14 @@ Status read_exactly(int fd, uint64_t offset, uint64_t size, std::vector<uint8_t>
 HlodFile::~HlodFile() {
   if (fd_ >= 0) ::close(fd_);
 }
-HlodFile::HlodFile(HlodFile&& other) noexcept : fd_(other.fd_), size_(other.size_), path_(std::move(other.path_)) {
+HlodFile::HlodFile(HlodFile&& other) noexcept
+    : fd_(other.fd_), size_(other.size_), materials_(other.materials_), path_(std::move(other.path_)) {
   other.fd_ = -1;
 }
 HlodFile& HlodFile::operator=(HlodFile&& other) noexcept {
   if (this != &other) {
     if (fd_ >= 0) ::close(fd_);
-    fd_ = other.fd_, size_ = other.size_, path_ = std::move(other.path_);
+    fd_ = other.fd_, size_ = other.size_, materials_ = other.materials_, path_ = std::move(other.path_);
     other.fd_ = -1;
   }
   return *this;
@@ -498,6 +615,7 @@ Status HlodFile::open(const std::filesystem::path& path, HlodTree& tree) {
   }
   HlodTree t;
   if (Status s = decode_hlod_tree(bytes, f.size_, what, t); !s) return s;
+  f.materials_ = t.material_count;
   tree = std::move(t);
   *this = std::move(f);
   return Status::success();
@@ -509,7 +627,7 @@ Status HlodFile::read_node(const HlodNode& node, HlodPayload& out) const {
     return refuse(path_, "node payload lies outside the file");
   std::vector<uint8_t> bytes;
   if (Status s = read_exactly(fd_, node.payload_offset, node.payload_size, bytes, path_); !s) return s;
-  return decode_hlod_payload(bytes, node, path_, out);
+  return decode_hlod_payload(bytes, node, materials_, path_, out);
 }
 
 Status read_hlod_tree(const std::filesystem::path& path, HlodTree& out) {

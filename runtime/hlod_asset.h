@@ -19,7 +19,7 @@
 
 namespace lod {
 
-inline constexpr uint32_t kHlodAssetVersion = 1;
+inline constexpr uint32_t kHlodAssetVersion = 2;  // 2: uvs, materials and material runs
 
 // The whole file. Offsets and sizes in the written file are computed here (tree's own
 // payload_offset / payload_size are ignored); payloads[i] is node i's geometry.
@@ -38,9 +38,10 @@ uint64_t hlod_payload_bytes(const HlodNode& node);
 // the source in messages.
 Status decode_hlod_tree(std::span<const uint8_t> head, uint64_t file_size, const std::string& what, HlodTree& out);
 // One node's payload from its own bytes (exactly node.payload_size of them, read at
-// node.payload_offset), checked against `node` (a node of a tree decode_hlod_tree accepted).
-Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node, const std::string& what,
-                           HlodPayload& out);
+// node.payload_offset), checked against `node` (a node of a tree decode_hlod_tree accepted)
+// and its run's material ids against `materials` (the tree's material_count).
+Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node, uint32_t materials,
+                           const std::string& what, HlodPayload& out);
 // Everything, from the whole file in memory.
 Status decode_hlod_asset(std::span<const uint8_t> file, const std::string& what, HlodTree& tree,
                          std::vector<HlodPayload>& payloads);
@@ -67,6 +68,7 @@ class HlodFile {
  private:
   int fd_ = -1;
   uint64_t size_ = 0;
+  uint32_t materials_ = 0;  // the tree's material_count, for the runs' ids
   std::string path_;
 };
 
@@ -75,8 +77,8 @@ Status read_hlod_tree(const std::filesystem::path& path, HlodTree& out);
 // One node of the file at `path` (the node from read_hlod_tree of the same file).
 Status read_hlod_node(const std::filesystem::path& path, const HlodNode& node, HlodPayload& out);
 
-// Bytes a payload with these counts takes in memory (positions, normals, indices), as
-// HlodNode::resident_bytes counts them.
+// Bytes a payload with these counts takes in memory (positions, normals, uvs, indices, runs),
+// as HlodNode::resident_bytes counts them.
 uint64_t hlod_resident_bytes(const HlodNode& node);
 
 }  // namespace lod

@@ -21,6 +21,7 @@ struct HlodSubtree {
   // What the levels above need of the root besides its payload:
   std::vector<uint32_t> root_source;     // per vertex of the root's coarsest layer: the original vertex
   std::vector<uint32_t> root_reference;  // original vertices sampling the root's region
+  uint32_t material_count = 0;           // the bound its runs' material ids are checked against
   // The build's report, counted inside this subtree.
   uint64_t short_layers = 0;
   uint64_t oversized_leaves = 0;

@@ -1,11 +1,12 @@
-// The subtree entry, version 1; little-endian:
+// The subtree entry, version 2 (the embedded asset is .hlod version 2: uvs, material runs); little-endian:
 //
 //   magic "LODHSUB\n" (8) | u32 version | u32 root depth | u64 key | u64 short_layers |
 //   u64 oversized_leaves | u32 source count S | u32 reference count R | u64 asset bytes A
 //   S u32 root vertex sources | R u32 reference vertices
 //   u64 checksum = hash_bytes(everything before it)
 //   A bytes: the subtree as an .hlod asset (its root cell the asset's root cube, depths
-//            relative to the subtree's root, source_hash = key), with its own checksums
+//            relative to the subtree's root, source_hash = key, the material count without
+//            the materials), with its own checksums
 //
 // The asset reader already refuses every broken count, offset, tree or payload; the entry adds
 // what a spliced subtree needs on top: the key, the depth it sits at, the root's vertex sources.
@@ -35,6 +36,8 @@ HlodTree relative_tree(const HlodSubtree& s, uint64_t key) {
   for (int k = 0; k < 3; ++k) t.box_center[k] = root.box_center[k];
   t.box_half = root.box_half;
   t.nodes = s.nodes;
+  t.uvs = root.uvs;
+  t.material_count = s.material_count;
   for (HlodNode& n : t.nodes) n.depth = uint8_t(n.depth - root.depth);
   return t;
 }
@@ -132,6 +135,7 @@ Status decode_hlod_subtree(std::span<const uint8_t> bytes, uint64_t key, uint64_
   if (Status st = decode_hlod_asset(bytes.subspan(head + kChecksumBytes), what, tree, s.payloads); !st) return st;
   if (tree.source_hash != key) return refuse(what, "embedded subtree was written for another key");
   if (Status st = place_tree(tree, detail::load_u32(bytes.data() + 12), what); !st) return st;
+  s.material_count = tree.material_count;
   s.nodes = std::move(tree.nodes);
   if (Status st = take_header(bytes.data(), mesh_vertices, what, s); !st) return st;
   out = std::move(s);
@@ -151,7 +155,7 @@ uint64_t hlod_subtree_entry_root_bytes(std::span<const uint8_t> prefix, uint64_t
   if (prefix.size() < first_payload) return first_payload;
   // The root's payload follows the head; its size is the offset table's first entry, which
   // opens the table's last count * 16 bytes before H.
-  const uint64_t count = asset_head >= 80 ? load_u32(prefix.data() + asset + 72) : 0;
+  const uint64_t count = asset_head >= 96 ? load_u32(prefix.data() + asset + 72) : 0;
   if (count == 0 || 16 * count > asset_head) return 0;
   const uint64_t size = load_u64(prefix.data() + asset + asset_head - 16 * count + 8);
   if (size > entry_size - first_payload) return 0;
@@ -172,11 +176,12 @@ Status decode_hlod_subtree_root(std::span<const uint8_t> prefix, uint64_t entry_
   if (root.payload_offset + root.payload_size > asset.size()) return refuse(what, "entry's root not read whole (truncated?)");
   HlodSubtree s;
   s.payloads.resize(1);
-  if (Status st = decode_hlod_payload(asset.subspan(root.payload_offset, root.payload_size), root, what + ": root",
-                                      s.payloads[0]);
+  if (Status st = decode_hlod_payload(asset.subspan(root.payload_offset, root.payload_size), root, tree.material_count,
+                                      what + ": root", s.payloads[0]);
       !st)
     return st;
   if (Status st = place_tree(tree, detail::load_u32(prefix.data() + 12), what); !st) return st;
+  s.material_count = tree.material_count;
   s.nodes = std::move(tree.nodes);
   if (Status st = take_header(prefix.data(), mesh_vertices, what, s); !st) return st;
   out = std::move(s);

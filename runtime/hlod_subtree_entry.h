@@ -14,7 +14,7 @@
 
 namespace lod {
 
-inline constexpr uint32_t kHlodSubtreeEntryVersion = 1;
+inline constexpr uint32_t kHlodSubtreeEntryVersion = 2;  // 2: .hlod version 2 inside (uvs, material runs)
 
 // `key`: what the entry is stored under (the hash of its inputs); written into the entry.
 std::vector<uint8_t> encode_hlod_subtree(const HlodSubtree& subtree, uint64_t key);

@@ -9,10 +9,13 @@
 // children's geometry without a gap: boundary vertices are locked in every layer below the
 // node that owns the patch, so any mix of child layers meets it exactly.
 #pragma once
+#include <algorithm>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "runtime/chain_material.h"
 #include "runtime/lod_chain.h"  // Sphere
 
 namespace lod {
@@ -26,6 +29,9 @@ struct HlodLayerInfo {
   // Measured object-space distance to the original surface (max, as LodLevel::error). Never
   // less than any child's error at its coarsest layer, so errors grow monotonically up the tree.
   float error = 0;
+  // How far a vertex's uv slid from the original vertex it descends from, at most (texture
+  // units, as the .lod's TEX0 errors); 0 without texture coordinates. A report, not monotonic.
+  float uv_error = 0;
 };
 
 struct HlodNode {
@@ -49,6 +55,11 @@ struct HlodNode {
   uint64_t payload_offset = 0;
   uint64_t payload_size = 0;
   uint64_t resident_bytes = 0;
+
+  // Attributes (all nodes of a tree alike for uvs): the payload has texture coordinates, and
+  // this many material runs over its layers and patch (0 in a tree without materials).
+  bool uvs = false;
+  uint32_t material_runs = 0;
 };
 
 // One node's geometry. Layers are back to back like a LodChain's levels; the boundary patch
@@ -59,7 +70,21 @@ struct HlodPayload {
   std::vector<float> normals;            // same count as positions
   std::vector<uint32_t> indices;         // all layers then the boundary
   LodLevel boundary;                     // the patch's range (error 0)
+  std::vector<float> uvs;                // uv per vertex (TEXCOORD_0), or empty
+  // Each range's triangles grouped by material (as a .lod level's): runs sorted by range, a
+  // range's runs covering its indices in order; `level` is the layer index, or layers.size()
+  // for the boundary; first_index is range-local. Empty in a tree without materials.
+  std::vector<LevelSubmesh> runs;
 };
+
+// The runs of one range of `p` (a layer index, or p.layers.size() for the boundary).
+inline std::span<const LevelSubmesh> hlod_range_runs(const HlodPayload& p, uint32_t range) {
+  const auto lo = std::lower_bound(p.runs.begin(), p.runs.end(), range,
+                                   [](const LevelSubmesh& s, uint32_t r) { return s.level < r; });
+  auto hi = lo;
+  while (hi != p.runs.end() && hi->level == range) ++hi;
+  return {lo, hi};
+}
 
 struct HlodTree {
   std::string name;
@@ -68,6 +93,13 @@ struct HlodTree {
   float box_center[3] = {0, 0, 0};       // the root cell
   float box_half = 0;
   uint64_t source_triangles = 0;         // of the original mesh
+  // Materials (R1's header has them): run material ids are below material_count. `materials`
+  // holds them (texture URIs relative to texture_base, the source's folder, as a .lod's) or is
+  // empty where only the count travels (a subtree entry of the distributed bake).
+  uint32_t material_count = 0;
+  std::vector<ChainMaterial> materials;
+  std::string texture_base;
+  bool uvs = false;                      // the payloads have texture coordinates
   std::vector<HlodNode> nodes;           // breadth-first, nodes[0] is the root
 };
 

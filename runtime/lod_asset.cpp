@@ -71,6 +71,7 @@
 
 #include "runtime/byte_order.h"
 #include "runtime/file_write.h"
+#include "runtime/material_section.h"
 
 namespace lod {
 
@@ -835,6 +836,25 @@ Status read_lod_asset(const std::filesystem::path& path, LodChain& out) {
   }
   bytes.resize(got);
   return decode_lod_asset(bytes, path.string(), out);
+}
+
+// ---- the MATL layout for other files (runtime/material_section.h) ---------------------------
+
+std::vector<uint8_t> encode_material_section(const LodChain& chain) {
+  Writer w;
+  put_materials(w, chain);
+  return std::move(w.bytes);
+}
+
+Status decode_material_section(std::span<const uint8_t> bytes, const std::string& what, LodChain& out) {
+  LodChain c;
+  if (Status st = get_materials(bytes.data(), bytes.size(), what, c); !st) return st;
+  std::string message;
+  if (!validate_chain_materials(c, &message)) return refuse(what, "MATL section: " + message);
+  out.materials = std::move(c.materials);
+  out.texture_base = std::move(c.texture_base);
+  out.submeshes = std::move(c.submeshes);
+  return Status::success();
 }
 
 }  // namespace lod

@@ -97,6 +97,10 @@ int32_t level_of_triangles(uint64_t triangles);
 // element is in.
 bool validate_chain(const LodChain& chain, std::string* message, const char** section = nullptr);
 
+// The materials part of validate_chain alone (a chain's materials, texture base and runs
+// against its levels; the .hlod head's materials have no levels and no runs).
+bool validate_chain_materials(const LodChain& chain, std::string* message);
+
 // Level k's material runs (a subrange of chain.submeshes; empty for a chain without materials).
 std::span<const LevelSubmesh> level_submeshes(const LodChain& chain, uint32_t level);
 

@@ -7,16 +7,44 @@ namespace lod::viewer {
 namespace {
 
 void release(HlodNodeGpu& g) {
+  if (g.uv_vbo) glDeleteBuffers(1, &g.uv_vbo);
   release_static_mesh(g.gl);
   g = HlodNodeGpu{};
 }
 
-HlodNodeRange range_of(const LodLevel& l) { return {l.first_index, l.index_count, l.first_vertex}; }
+// A range and its runs (material ids of the model, checked by the reader, offset into the
+// scene-wide list; one the list lacks draws with the default surface).
+HlodNodeRange range_of(const HlodPayload& p, uint32_t range, uint32_t first_material, size_t materials,
+                       std::vector<HlodRunGpu>& runs) {
+  const LodLevel& l = range < p.layers.size() ? p.layers[range] : p.boundary;
+  HlodNodeRange r{l.first_index, l.index_count, l.first_vertex, uint32_t(runs.size()), 0};
+  for (const LevelSubmesh& s : hlod_range_runs(p, range)) {
+    const int64_t m = s.material < 0 ? -1 : int64_t(first_material) + s.material;
+    runs.push_back({l.first_index + s.first_index, s.index_count, m >= 0 && size_t(m) < materials ? int32_t(m) : -1});
+    ++r.run_count;
+  }
+  return r;
+}
 
-void fill(HlodNodeGpu& g, const HlodPayload& p) {
+// The payload's uvs in a VBO of their own, bound to kAttribUv in the node's VAO.
+size_t upload_uvs(HlodNodeGpu& g, const std::vector<float>& uvs) {
+  if (uvs.empty()) return 0;
+  glBindVertexArray(g.gl.vao);
+  glGenBuffers(1, &g.uv_vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, g.uv_vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(uvs.size() * sizeof(float)), uvs.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(kAttribUv);
+  glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  return uvs.size() * sizeof(float);
+}
+
+void fill(HlodNodeGpu& g, const HlodPayload& p, uint32_t first_material, size_t materials) {
   g.bytes = upload_static_mesh(g.gl, p.positions, p.normals, p.indices);
-  for (const LodLevel& l : p.layers) g.layers.push_back(range_of(l));
-  g.boundary = range_of(p.boundary);
+  if (p.uvs.size() == p.positions.size() / 3 * 2) g.bytes += upload_uvs(g, p.uvs);
+  for (uint32_t k = 0; k < p.layers.size(); ++k) g.layers.push_back(range_of(p, k, first_material, materials, g.runs));
+  g.boundary = range_of(p, uint32_t(p.layers.size()), first_material, materials, g.runs);
 }
 
 }  // namespace
@@ -29,13 +57,21 @@ bool HlodNodeBuffers::init(const HlodModels& models, uint64_t capacity_bytes, st
   models_ = &models;
   capacity_ = capacity_bytes;
   files_.resize(models.files.size());
+  std::vector<LodChain> surfaces(models.files.size());  // each model's materials, as the levels' are uploaded
+  first_material_.assign(models.files.size(), 0);
+  uint32_t next = 0;
   for (size_t m = 0; m < models.files.size(); ++m) {
     HlodTree tree;
     if (Status st = files_[m].open(models.files[m], tree); !st) {
       *message = st.message;
       return false;
     }
+    first_material_[m] = next;
+    next += uint32_t(tree.materials.size());
+    surfaces[m].materials = std::move(tree.materials);
+    surfaces[m].texture_base = std::move(tree.texture_base);
   }
+  materials_.upload(surfaces);
   return true;
 }
 
@@ -48,7 +84,7 @@ bool HlodNodeBuffers::upload(uint32_t model, uint32_t node) {
     return false;
   }
   HlodNodeGpu& g = nodes_[key(model, node)];
-  fill(g, scratch_);
+  fill(g, scratch_, model < first_material_.size() ? first_material_[model] : 0, materials_.materials().size());
   g.last_drawn = tick_;
   bytes_ += g.bytes;
   ++uploads_;

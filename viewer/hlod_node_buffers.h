@@ -1,7 +1,9 @@
 // HlodNodeBuffers: the GPU copies of the HLOD nodes a frame's cut draws. The service's pager
 // holds node payloads for the LOD thread; the renderer reads the nodes it is told to draw from
 // the same .hlod files itself (the pager has just read them, so they come from the page
-// cache) and keeps them, least recently drawn evicted first, under a byte capacity.
+// cache) and keeps them, least recently drawn evicted first, under a byte capacity. A node's
+// texture coordinates go in a VBO of their own, its material runs stay on the CPU (a draw per
+// run); every model's materials and their textures are uploaded once, at init.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -13,16 +15,27 @@
 #include "jobs/hlod_models.h"
 #include "runtime/hlod_asset.h"
 #include "viewer/hlod_draw_list.h"
+#include "viewer/material_textures.h"
 #include "viewer/mesh_buffers.h"
 
 namespace lod::viewer {
 
 struct HlodNodeRange {
   uint32_t first_index = 0, index_count = 0, first_vertex = 0;
+  uint32_t first_run = 0, run_count = 0;  // into HlodNodeGpu::runs (0: one surface)
+};
+
+// A material run of a range, its material already in HlodNodeBuffers::materials() numbering
+// (-1: the default surface).
+struct HlodRunGpu {
+  uint32_t first_index = 0, index_count = 0;  // node-wide
+  int32_t material = -1;
 };
 
 struct HlodNodeGpu {
   StaticMeshGl gl;
+  GLuint uv_vbo = 0;                     // 0: the node has no uvs
+  std::vector<HlodRunGpu> runs;
   uint64_t bytes = 0;
   uint64_t last_drawn = 0;               // prepare() call that last needed it
   std::vector<HlodNodeRange> layers;
@@ -44,6 +57,10 @@ class HlodNodeBuffers {
   // The node's GPU copy, or null when it could not be read.
   const HlodNodeGpu* find(uint32_t model, uint32_t node) const;
 
+  // Every model's materials, model after model (a node's run material m of model k is
+  // materials()[first_material(k) + m]).
+  const std::vector<GpuMaterial>& materials() const { return materials_.materials(); }
+
   uint64_t bytes() const { return bytes_; }
   uint64_t capacity() const { return capacity_; }
   uint64_t uploads() const { return uploads_; }      // so far
@@ -60,6 +77,8 @@ class HlodNodeBuffers {
   std::unordered_map<uint64_t, HlodNodeGpu> nodes_;
   std::unordered_map<uint64_t, bool> failed_;  // told once
   HlodPayload scratch_;
+  MaterialTextures materials_;
+  std::vector<uint32_t> first_material_;  // by model
   uint64_t capacity_ = 0, bytes_ = 0, tick_ = 0, uploads_ = 0, evictions_ = 0, failures_ = 0;
 };
 

@@ -564,13 +564,29 @@ void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers
     glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
     glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
     glVertexAttrib2f(kAttribInstanceMorph, 1.f, 0.f);
+    if (!g->uv_vbo) glVertexAttrib2f(kAttribUv, 0.f, 0.f);
     const auto& c = settings.colour_override ? settings.colour
                     : settings.colour_by_level ? level_colour(d.depth)
                                                : kModelColour;
-    set_plain_surface(c);
-    glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(r->index_count), GL_UNSIGNED_INT,
-                             reinterpret_cast<const void*>(size_t(r->first_index) * sizeof(uint32_t)),
-                             GLint(r->first_vertex));
+    auto draw = [&](uint32_t first_index, uint32_t count) {
+      glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
+                               reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)),
+                               GLint(r->first_vertex));
+    };
+    if (!draws_materials(settings) || r->run_count == 0) {
+      set_plain_surface(c);
+      draw(r->first_index, r->index_count);
+    } else {
+      // Run by run with its material, as a level's runs are drawn (blended ones in draw order).
+      const auto& materials = nodes.materials();
+      for (uint32_t k = r->first_run; k < r->first_run + r->run_count && k < g->runs.size(); ++k) {
+        const HlodRunGpu& run = g->runs[k];
+        if (run.material >= 0 && size_t(run.material) < materials.size()) set_material(materials[size_t(run.material)]);
+        else set_plain_surface(kModelColour);
+        draw(run.first_index, run.index_count);
+      }
+      set_plain_surface(kModelColour);
+    }
     ++stats.draws;
     ++stats.hlod_draws;
     stats.hlod_triangles += r->index_count / 3;

@@ -2,8 +2,9 @@
 // recomputes the head checksum and every payload checksum the (mutated) head points at, so
 // the fuzzer reaches the structure and range checks behind them: a checksum is not a defence.
 //
-// Checks beyond the sanitizers: a refusal names the input; an accepted file gives a cut that
-// validates, and the cut selection runs over it (everything resident, a view at the root).
+// Checks beyond the sanitizers: a refusal names the input; an accepted file has uvs for every
+// vertex or none and every run's material below the count; it gives a cut that validates, and
+// the cut selection runs over it (everything resident, a view at the root).
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -78,6 +79,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return 0;
   }
   if (payloads.size() != tree.nodes.size()) std::abort();
+  // Surfaces: uvs for every vertex or none, run materials below the count, the materials
+  // themselves all there or (a subtree entry's asset) none.
+  if (!tree.materials.empty() && tree.materials.size() != tree.material_count) std::abort();
+  for (const lod::HlodPayload& p : payloads) {
+    if (p.uvs.size() != (tree.uvs ? p.positions.size() / 3 * 2 : 0)) std::abort();
+    for (const lod::LevelSubmesh& r : p.runs)
+      if (r.material < -1 || r.material >= int32_t(tree.material_count) || r.level > p.layers.size()) std::abort();
+  }
   use_tree(tree);
   return 0;
 }

@@ -10,6 +10,7 @@
 
 #include "run_cli.h"
 #include "test_support.h"
+#include "textured_fixture.h"
 
 namespace lod {
 namespace {
@@ -68,6 +69,25 @@ TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
     EXPECT_GE(j["subtrees"].get<int>(), 16 * ranks);
     EXPECT_EQ(j["per_rank"].size(), size_t(ranks));
     for (const auto& w : j["per_rank"]) EXPECT_GT(w["subtrees"].get<int>(), 0) << "a rank without work";
+  }
+}
+
+// A textured, two-material model (issue 12): uvs, runs and materials, the same bytes at 1, 2
+// and 4 ranks as lod bake --hlod.
+TEST(LodBakeMpi, TexturedModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
+  const auto dir = test::temp_dir("lod_bake_mpi_textured");
+  const std::filesystem::path gltf = test::write_two_material_gltf(dir / "src", "globe", 60, 120);
+  ASSERT_FALSE(gltf.empty());
+  const test::CliResult local =
+      test::run_lod("bake " + gltf.string() + " -o " + (dir / "local").string() + " --hlod --min-verts 300 --quiet");
+  ASSERT_EQ(local.code, 0) << local.out;
+  const std::vector<uint8_t> bytes = test::read_bytes(dir / "local" / "globe.hlod");
+  for (int ranks : {1, 2, 4}) {
+    const auto out = dir / ("np" + std::to_string(ranks));
+    const test::CliResult r = run_mpi(ranks, gltf.string() + " -o " + (out / "out").string() + " --cache " +
+                                                 (out / "cache").string() + " --min-verts 300 --threads 1");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(test::read_bytes(out / "out" / "globe.hlod"), bytes) << ranks << " ranks";
   }
 }
 

@@ -9,6 +9,7 @@
 
 #include "run_cli.h"
 #include "test_support.h"
+#include "textured_fixture.h"
 
 namespace {
 
@@ -34,7 +35,7 @@ TEST(LodHlodCli, BakesWithProgressAndInspectsAsJson) {
   const nlohmann::json j = nlohmann::json::parse(json.out);
   ASSERT_TRUE(j["nodes"].is_array());
   ASSERT_GT(j["nodes"].size(), 8u);
-  const std::set<std::string> keys = {"id", "parent", "depth", "leaf", "boundary_triangles", "layers"};
+  const std::set<std::string> keys = {"id", "parent", "depth", "leaf", "boundary_triangles", "layers", "material_runs"};
   for (size_t i = 0; i < j["nodes"].size(); ++i) {
     const auto& n = j["nodes"][i];
     std::set<std::string> got;
@@ -46,7 +47,7 @@ TEST(LodHlodCli, BakesWithProgressAndInspectsAsJson) {
     for (const auto& l : n["layers"]) {
       std::set<std::string> lk;
       for (const auto& [k, v] : l.items()) lk.insert(k);
-      EXPECT_EQ(lk, (std::set<std::string>{"triangles", "error"}));
+      EXPECT_EQ(lk, (std::set<std::string>{"triangles", "error", "uv_error"}));
     }
   }
 }
@@ -64,6 +65,17 @@ TEST(LodHlodCli, SameFileAtOneAndTwoThreads) {
   const auto one = lod::test::read_bytes(dir / "1" / "ball.hlod");
   ASSERT_GT(one.size(), 100000u);
   EXPECT_TRUE(one == lod::test::read_bytes(dir / "2" / "ball.hlod"));
+  // A textured, two-material model too (uvs through QEM, layers grouped by material).
+  const fs::path gltf = lod::test::write_two_material_gltf(dir / "src", "globe", 48, 96);
+  ASSERT_FALSE(gltf.empty());
+  for (const char* threads : {"1", "2"})
+    ASSERT_EQ(run_lod("bake " + gltf.string() + " -o " + (dir / threads).string() + " --hlod --min-verts 200 --quiet --threads " +
+                      threads)
+                  .code,
+              0);
+  const auto globe = lod::test::read_bytes(dir / "1" / "globe.hlod");
+  ASSERT_GT(globe.size(), 100000u);
+  EXPECT_TRUE(globe == lod::test::read_bytes(dir / "2" / "globe.hlod")) << "the textured model at 1 and 2 threads";
 }
 
 TEST(LodHlodCli, RefusesACorruptedFileNamingIt) {

@@ -13,8 +13,10 @@
 #include <sstream>
 #include <string>
 
+#include "preprocess/mesh_io.h"
 #include "run_cli.h"
 #include "test_support.h"
+#include "textured_fixture.h"
 
 namespace {
 
@@ -297,6 +299,152 @@ TEST(Tiles3dExport, FilesAreNamedByNodeNeverByTheModelName) {
   }
   EXPECT_GT(files, 10u);
   EXPECT_EQ(read_json(dir / "tiles" / "tileset.json")["asset"]["extras"]["model"], "..;$(x) ba\\ll");
+}
+
+}  // namespace
+
+namespace {
+
+// Every GLB of a tileset read back (the glTF importer): uvs, materials by name, triangles by run.
+struct TiledGlb {
+  fs::path file;
+  lod::MeshData mesh;
+};
+std::vector<TiledGlb> read_tiles(const fs::path& tiles) {
+  std::vector<TiledGlb> out;
+  for (const auto& e : fs::directory_iterator(tiles / "tiles")) {
+    TiledGlb t{e.path(), {}};
+    const lod::Status st = lod::load_mesh(e.path(), t.mesh);
+    EXPECT_TRUE(st) << st.message;
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+// The two-material sphere (textured cap above the equator, uv v in [0, 0.5]; untextured base
+// below, v in [0.5, 1]) -> lod bake --hlod -> lod export --3dtiles: every GLB has TEXCOORD_0 and
+// its runs' materials, the cap's texture embedded, every uv in its chart, and passes the
+// validator with 0 errors; lod inspect lists the materials.
+TEST(Tiles3dExport, TexturedModelKeepsItsUvsMaterialsAndTextureInEveryTile) {
+  const fs::path dir = lod::test::temp_dir("tiles3d-textured");
+  const fs::path gltf = lod::test::write_two_material_gltf(dir / "src", "globe", 48, 96);
+  ASSERT_FALSE(gltf.empty());
+  auto r = run_lod("bake '" + gltf.string() + "' -o '" + (dir / "hlod").string() + "' --hlod --min-verts 300 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path hlod = dir / "hlod" / "globe.hlod";
+  const auto inspect = run_lod("inspect '" + hlod.string() + "' --json");
+  ASSERT_EQ(inspect.code, 0) << inspect.out;
+  const auto tree = nlohmann::json::parse(inspect.out);
+  EXPECT_TRUE(tree["texcoords"].get<bool>());
+  ASSERT_EQ(tree["materials"].size(), 2u);
+  EXPECT_EQ(tree["materials"][0]["name"], "cap");
+  EXPECT_EQ(tree["materials"][0]["textures"]["base colour"], "globe-image0.png");
+  EXPECT_EQ(tree["materials"][1]["name"], "base");
+  const auto shown = run_lod("inspect '" + hlod.string() + "'");
+  EXPECT_NE(shown.out.find("materials: 2"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("0 'cap'"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("base colour texture globe-image0.png"), std::string::npos) << shown.out;
+
+  r = run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + hlod.string() + "' --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::vector<TiledGlb> glbs = read_tiles(dir / "tiles");
+  ASSERT_GT(glbs.size(), 8u);
+  size_t textured = 0;
+  for (const TiledGlb& g : glbs) {
+    const lod::MeshData& m = g.mesh;
+    ASSERT_EQ(m.uvs.size(), 2 * m.vertex_count()) << g.file;
+    ASSERT_FALSE(m.materials.empty()) << g.file;
+    for (const lod::Submesh& s : m.submeshes) {
+      ASSERT_GE(s.material, 0) << g.file;
+      const lod::MeshMaterial& mat = m.materials[size_t(s.material)];
+      const bool cap = mat.name == "cap";
+      EXPECT_TRUE(cap || mat.name == "base") << mat.name;
+      if (cap) {
+        EXPECT_TRUE(mat.base_color_texture_embedded) << g.file;
+        ++textured;
+      }
+      for (uint32_t t = s.first_triangle; t < s.first_triangle + s.triangle_count; ++t)
+        for (int c = 0; c < 3; ++c) {
+          const float* uv = &m.uvs[2 * size_t(m.indices[3 * size_t(t) + size_t(c)])];
+          ASSERT_GE(uv[0], -1e-4f) << g.file;
+          ASSERT_LE(uv[0], 1 + 1e-4f) << g.file;
+          if (cap) {
+            ASSERT_LE(uv[1], 0.5f + 1e-4f) << g.file << " triangle " << t;
+          } else {
+            ASSERT_GE(uv[1], 0.5f - 1e-4f) << g.file << " triangle " << t;
+          }
+        }
+    }
+  }
+  EXPECT_GT(textured, 0u);
+  const auto v = run_checker(dir / "tiles" / "tileset.json", "-");
+  EXPECT_EQ(v.code, 0) << v.out;
+  EXPECT_NE(v.out.find("structure errors 0 gltf errors 0"), std::string::npos) << v.out;
+  if (fs::exists(schema_dir())) {
+    const auto schemas = run_checker(dir / "tiles" / "tileset.json", schema_dir().string(), false);
+    EXPECT_EQ(schemas.code, 0) << schemas.out;
+  }
+
+  // --shared-images: the texture written once under textures/, every GLB naming it by a
+  // relative URI, still valid (the checker resolves it), and the tileset smaller.
+  r = run_lod("export --3dtiles '" + (dir / "shared").string() + "' '" + hlod.string() + "' --shared-images --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto shared_report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(shared_report["shared_images"], 1);
+  size_t images = 0;
+  for (const auto& e : fs::directory_iterator(dir / "shared" / "textures")) images += e.is_regular_file();
+  EXPECT_EQ(images, 1u);
+  EXPECT_LT(shared_report["bytes"].get<uint64_t>(), nlohmann::json::parse(run_lod("export --3dtiles '" +
+            (dir / "again").string() + "' '" + hlod.string() + "' --json").out)["bytes"].get<uint64_t>());
+  size_t referring = 0;
+  for (const TiledGlb& g : read_tiles(dir / "shared"))
+    for (const lod::MeshMaterial& m : g.mesh.materials)
+      if (m.name == "cap") {
+        EXPECT_FALSE(m.base_color_texture_embedded) << g.file;
+        EXPECT_EQ(m.base_color_texture, "../textures/image0.png") << g.file;
+        ++referring;
+      }
+  EXPECT_GT(referring, 0u);
+  const auto sv = run_checker(dir / "shared" / "tileset.json", fs::exists(schema_dir()) ? schema_dir().string() : "-");
+  EXPECT_EQ(sv.code, 0) << sv.out;
+  EXPECT_NE(sv.out.find("structure errors 0 gltf errors 0"), std::string::npos) << sv.out;
+}
+
+// ../shared's spot with its texture (a .mtl naming it) as an HLOD and a tileset: the figures
+// README quotes, and every GLB valid with the texture embedded.
+TEST(Tiles3dExport, SpotHlodExportsWithItsTexture) {
+  LOD_REQUIRE_SHARED_MESH(spot, "spot.obj");
+  const fs::path dir = lod::test::temp_dir("tiles3d-spot");
+  const std::vector<uint8_t> obj = lod::test::read_bytes(spot);
+  std::string text = "mtllib spot.mtl\nusemtl spot\n";
+  text.append(obj.begin(), obj.end());
+  lod::test::write_text(dir / "spot.obj", text);
+  lod::test::write_text(dir / "spot.mtl", "newmtl spot\nKd 1 1 1\nmap_Kd spot_texture.png\n");
+  fs::copy_file(spot.parent_path() / "spot_texture.png", dir / "spot_texture.png");
+  auto r = run_lod("bake '" + (dir / "spot.obj").string() + "' -o '" + (dir / "hlod").string() + "' --hlod --min-verts 500 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path hlod = dir / "hlod" / "spot.hlod";
+  const auto inspect = run_lod("inspect '" + hlod.string() + "' --json");
+  ASSERT_EQ(inspect.code, 0) << inspect.out;
+  const auto tree = nlohmann::json::parse(inspect.out);
+  ASSERT_EQ(tree["materials"].size(), 1u);
+  EXPECT_EQ(tree["materials"][0]["textures"]["base colour"], "spot_texture.png");
+  double uv_error = 0;
+  for (const auto& n : tree["nodes"])
+    for (const auto& l : n["layers"]) uv_error = std::max(uv_error, l["uv_error"].get<double>());
+  r = run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + hlod.string() + "' --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto report = nlohmann::json::parse(r.out);
+  std::printf("spot hlod: %zu nodes, %zu bytes; largest layer uv error %.4g; tileset %zu GLBs, %.2f MB\n",
+              tree["nodes"].size(), tree["bytes"].get<size_t>(), uv_error, report["glb_files"].get<size_t>(),
+              double(report["bytes"].get<uint64_t>()) / 1e6);
+  for (const TiledGlb& g : read_tiles(dir / "tiles")) {
+    EXPECT_EQ(g.mesh.uvs.size(), 2 * g.mesh.vertex_count()) << g.file;
+    ASSERT_EQ(g.mesh.materials.size(), 1u) << g.file;
+    EXPECT_TRUE(g.mesh.materials[0].base_color_texture_embedded) << g.file;
+  }
+  const auto v = run_checker(dir / "tiles" / "tileset.json", fs::exists(schema_dir()) ? schema_dir().string() : "-");
+  EXPECT_EQ(v.code, 0) << v.out;
 }
 
 }  // namespace

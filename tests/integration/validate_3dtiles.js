@@ -78,6 +78,12 @@ function inside(p, box) {
 const boxInside = (inner, outer) => corners(inner).every((p) => inside(p, outer));
 
 // POSITION min/max of a GLB's meshes, in glTF coordinates.
+// The images a GLB names by URI (a shared texture), as files resolved against its folder.
+function glbImageFiles(bytes, glb) {
+  const json = JSON.parse(bytes.toString('utf8', 20, 20 + bytes.readUInt32LE(12)));
+  return (json.images || []).filter((i) => i.uri !== undefined).map((i) => i.uri);
+}
+
 function glbPositionBounds(bytes) {
   const u32 = (o) => bytes.readUInt32LE(o);
   if (bytes.length < 20 || bytes.toString('latin1', 0, 4) !== 'glTF') throw new Error('not a GLB');
@@ -98,6 +104,7 @@ function checkStructure(tileset, root) {
   if (tileset.root.refine !== 'REPLACE') structure(`root refine is ${JSON.stringify(tileset.root.refine)}, not "REPLACE"`);
   if (!(tileset.geometricError >= tileset.root.geometricError)) structure('tileset geometricError below the root\'s');
   const named = new Map();
+  const images = new Set();  // files the GLBs share by URI
   let tiles = 0;
   const visit = (tile, where, parent) => {
     tiles += 1;
@@ -121,6 +128,17 @@ function checkStructure(tileset, root) {
         structure(`${where}: ${uri} does not exist`);
       } else {
         named.set(file, where);
+        // Images a GLB shares by URI: relative, inside the tileset, existing; named by the GLB.
+        try {
+          for (const u of glbImageFiles(fs.readFileSync(file), file)) {
+            const img = path.resolve(path.dirname(file), decodeURIComponent(u));
+            if (/^[a-z][a-z0-9+.-]*:/i.test(u) || u.startsWith('/') || !img.startsWith(root + path.sep)) structure(`${where}: ${uri} names image ${JSON.stringify(u)} outside the tileset`);
+            else if (!fs.existsSync(img)) structure(`${where}: ${uri} names image ${u}, which does not exist`);
+            else images.add(img);
+          }
+        } catch (e) {
+          structure(`${where}: ${uri}: ${e.message}`);
+        }
         const cb = tile.content.boundingVolume && tile.content.boundingVolume.box;
         const contentBox = cb ? boxOf(cb) : box;
         if (cb && !boxInside(contentBox, box)) structure(`${where}: content box outside the tile's`);
@@ -142,7 +160,7 @@ function checkStructure(tileset, root) {
   const walk = (dir) => fs.readdirSync(dir, { withFileTypes: true }).flatMap((e) =>
     e.isDirectory() ? walk(path.join(dir, e.name)) : [path.join(dir, e.name)]);
   for (const f of walk(root))
-    if (f !== path.resolve(tilesetFile) && !named.has(f)) structure(`${path.relative(root, f)} is in the folder but no tile names it`);
+    if (f !== path.resolve(tilesetFile) && !named.has(f) && !images.has(f)) structure(`${path.relative(root, f)} is in the folder but no tile names it`);
   return { tiles, contents: [...named.keys()] };
 }
 
@@ -159,7 +177,14 @@ function checkStructure(tileset, root) {
   const { tiles, contents } = checkStructure(tileset, root);
   const validator = require(path.join(modules, 'gltf-validator'));
   for (const file of checkGltf ? contents : []) {
-    const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(file)), { uri: path.basename(file) });
+    const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(file)), {
+      uri: path.basename(file),
+      externalResourceFunction: (uri) =>
+        new Promise((resolve, reject) => {
+          fs.readFile(path.join(path.dirname(file), decodeURIComponent(uri)), (err, data) =>
+            err ? reject(err.toString()) : resolve(new Uint8Array(data)));
+        }),
+    });
     gltfErrors += report.issues.numErrors;
     for (const m of report.issues.messages)
       if (m.severity === 0) problems.push(`gltf: ${path.relative(root, file)} ${m.code} ${m.pointer || ''}: ${m.message}`);

@@ -182,6 +182,47 @@ TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
   EXPECT_GE(m.base_below, 300) << "the untextured material's factor below the equator";
 }
 
+// The same globe as an HLOD model (issue 12): its nodes carry uvs and material runs, so the
+// picture shows the texture and the factor as the levels do; colour-by-depth shows neither.
+TEST(ViewerTextured, HlodGlobeShowsTheTextureAndFactorColourByDepthDoesNot) {
+  LOD_REQUIRE_XVFB();
+  const char* model = R"([[model]]
+name = "textured"
+file = "textured/globe.gltf"
+hlod = true
+min_verts = 300
+)";
+  const char* run = "[run]\nframes = 3\nthreads = 1\n[budget]\ntriangles = 1000000\n[lod]\npixel_error = 1.0\n";
+  const auto scene = lod::test::write_viewer_scene("textured-hlod", run, kCamera, kInstance, model);
+  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 48, 96).empty());
+  const auto lit = scene.dir / "hlod.png";
+  const auto depth = scene.dir / "depth.png";
+  const auto stats = scene.dir / "hlod.csv";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" +
+                                            stats.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << r.output;
+  lod::test::CsvTable t;
+  ASSERT_TRUE(lod::test::load_csv(stats, t));
+  ASSERT_FALSE(t.rows.empty());
+  EXPECT_GT(t.get(t.rows.size() - 1, "hlod_draws"), 0) << "drawn through its HLOD cut";
+  EXPECT_EQ(t.get(t.rows.size() - 1, "hlod_missing"), 0);
+  r = lod::test::run_viewer(scene, "--screenshot '" + depth.string() + "' --frames 3 --color-by-level --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  const HueCounts m = count_hues(img, kPresent);
+  EXPECT_GE(m.light_above, 300) << "light checker squares on the HLOD's textured cap";
+  EXPECT_GE(m.dark_above, 300) << "dark checker squares on the HLOD's textured cap";
+  EXPECT_GE(m.base_below, 300) << "the untextured material's factor below the equator";
+  Image by_depth;
+  ASSERT_TRUE(lod::test::load_png(depth, by_depth));
+  const HueCounts c = count_hues(by_depth, kAbsent);
+  EXPECT_LE(c.any_checker, 10) << "colour-by-depth must not show the texture";
+  EXPECT_LE(c.any_base, 10) << "colour-by-depth must not show the material factor";
+}
+
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);

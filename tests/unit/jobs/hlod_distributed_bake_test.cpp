@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <numeric>
 #include <random>
@@ -14,7 +15,10 @@
 #include "jobs/hlod_mesh_cache.h"
 #include "jobs/hlod_subtree_cache.h"
 #include "preprocess/mesh_io.h"
+#include "runtime/hlod_asset.h"
+#include "runtime/lod_asset.h"  // hash_bytes
 #include "test_support.h"
+#include "textured_fixture.h"
 #include "unit/jobs/thread_ranks.h"
 #include "vd_meshes.h"
 
@@ -237,6 +241,67 @@ TEST(HlodDistributedBake, OneRankRebakesOnlyTheCorruptedAndMissingEntries) {
   EXPECT_EQ(r.ranks[0].subtrees, 2u);
   EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("baking it again") != std::string::npos; }));
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+}
+
+// A textured, two-material sphere (issue 12): the distributed bake writes the local bake's
+// bytes with its uvs, runs and materials, at 1, 2 and 3 ranks, and again from the cleaned mesh
+// (uvs, submeshes and materials) and the subtrees in the cache.
+TEST(HlodDistributedBake, TexturedModelGivesTheLocalBytesAtEveryRankCountAndFromTheCache) {
+  const auto dir = test::temp_dir("hlod_dist_textured");
+  const auto mesh = test::write_two_material_gltf(dir, "mixed", 48, 96);
+  ASSERT_FALSE(mesh.empty());
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  HlodTree tree;
+  std::vector<HlodPayload> payloads;
+  ASSERT_TRUE(decode_hlod_asset(local, "mixed.hlod", tree, payloads));
+  ASSERT_EQ(tree.materials.size(), 2u);
+  EXPECT_TRUE(tree.uvs);
+  EXPECT_EQ(tree.materials[0].base_color_texture, "mixed-image0.png");
+  EXPECT_GT(tree.nodes.size(), 8u);
+  for (int ranks : {1, 2, 3}) {
+    const auto cache = dir / ("cache" + std::to_string(ranks));
+    std::vector<RankRun> runs = run_ranks(ranks, mesh, dir / "out", cache);
+    for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << ranks << " ranks";
+    std::filesystem::remove(dir / "out" / "mixed.hlod");
+    runs = run_ranks(ranks, mesh, dir / "out", cache);
+    ASSERT_TRUE(runs[0].status) << runs[0].status.message;
+    EXPECT_TRUE(runs[0].result.mesh_cached);
+    EXPECT_EQ(runs[0].result.cached, runs[0].result.subtrees);
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << ranks << " ranks, from the cache";
+  }
+}
+
+TEST(HlodMeshCache, TexturedMeshKeepsUvsSubmeshesAndMaterials) {
+  const auto dir = test::temp_dir("hlod_mesh_cache_textured");
+  const MeshData m = test::two_material_sphere(8, 12);
+  HlodSurfaces surfaces;
+  surfaces.materials.resize(2);
+  surfaces.materials[0].name = "cap";
+  surfaces.materials[0].base_color_texture = "checker.png";
+  surfaces.texture_base = "/textures";
+  ASSERT_TRUE(store_hlod_mesh(dir, 9, m, 99, surfaces));
+  MeshData back;
+  HlodSurfaces got;
+  uint64_t input = 0;
+  ASSERT_EQ(load_hlod_mesh(dir, 9, "ball.gltf", back, input, nullptr, &got), CacheLookup::found);
+  EXPECT_EQ(back.uvs, m.uvs);
+  ASSERT_EQ(back.submeshes.size(), m.submeshes.size());
+  EXPECT_EQ(back.submeshes[1].material, 1);
+  ASSERT_EQ(got.materials.size(), 2u);
+  EXPECT_EQ(got.materials[0].base_color_texture, "checker.png");
+  EXPECT_EQ(got.texture_base, "/textures");
+  // A submesh naming a material the entry does not hold is refused, under a forged checksum.
+  const auto path = hlod_mesh_entry_path(dir, 9);
+  std::vector<uint8_t> bad = test::read_bytes(path);
+  const size_t submeshes = 64 + 20 * m.vertex_count() + 4 * m.indices.size();
+  bad[submeshes + 12 + 8] = 5;
+  const uint64_t sum = hash_bytes(bad.data(), bad.size() - 8);
+  std::memcpy(bad.data() + bad.size() - 8, &sum, 8);
+  test::write_bytes(path, bad);
+  std::string why;
+  EXPECT_EQ(load_hlod_mesh(dir, 9, "ball.gltf", back, input, &why, &got), CacheLookup::refused);
+  EXPECT_NE(why.find("names a material of the 2"), std::string::npos) << why;
 }
 
 TEST(HlodMeshCache, CleanedMeshRoundTripsAndBrokenEntriesAreRefused) {

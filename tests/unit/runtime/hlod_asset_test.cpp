@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <thread>
@@ -83,6 +84,44 @@ Sample sample() {
   return s;
 }
 
+// The sample with texture coordinates, two materials (one textured) and each range's triangles
+// in two material runs (its first third the default material, the rest alternating 0 and 1).
+Sample textured_sample() {
+  Sample s = sample();
+  s.tree.uvs = true;
+  s.tree.material_count = 2;
+  s.tree.texture_base = "/data/models";
+  ChainMaterial a, b;
+  a.name = "bark";
+  a.base_color_texture = "bark%20diffuse.png";
+  a.base_color[1] = 0.5f;
+  b.name = "leaf";
+  b.roughness = 0.25f;
+  b.double_sided = true;
+  s.tree.materials = {a, b};
+  for (size_t i = 0; i < s.payloads.size(); ++i) {
+    HlodPayload& p = s.payloads[i];
+    HlodNode& n = s.tree.nodes[i];
+    for (size_t v = 0; v < p.positions.size() / 3; ++v) p.uvs.insert(p.uvs.end(), {0.125f * float(v % 9), 1 - 0.0625f * float(v % 5)});
+    const uint32_t ranges = uint32_t(p.layers.size()) + 1;
+    for (uint32_t r = 0; r < ranges; ++r) {
+      const LodLevel& range = r < p.layers.size() ? p.layers[r] : p.boundary;
+      const uint32_t tris = range.index_count / 3, first = tris / 3;
+      if (first) p.runs.push_back({r, 0, 3 * first, -1});
+      if (tris > first) p.runs.push_back({r, 3 * first, 3 * (tris - first), int32_t((i + r) % 2)});
+    }
+    n.uvs = true;
+    n.material_runs = uint32_t(p.runs.size());
+    n.layers[0].uv_error = 0.0f;
+    if (n.layer_count > 1) n.layers[1].uv_error = 0.03125f * float(i + 1);
+    n.resident_bytes = hlod_resident_bytes(n);
+  }
+  return s;
+}
+
+// Both samples, for the tests every file must pass.
+std::vector<Sample> samples() { return {sample(), textured_sample()}; }
+
 HlodTree sentinel() {
   HlodTree t;
   t.name = "untouched";
@@ -95,6 +134,17 @@ void expect_same(const Sample& a, const HlodTree& t, const std::vector<HlodPaylo
   EXPECT_EQ(t.min_verts, a.tree.min_verts);
   EXPECT_EQ(t.source_triangles, a.tree.source_triangles);
   EXPECT_EQ(std::memcmp(t.box_center, a.tree.box_center, sizeof t.box_center), 0);
+  EXPECT_EQ(t.uvs, a.tree.uvs);
+  EXPECT_EQ(t.material_count, a.tree.material_count);
+  EXPECT_EQ(t.texture_base, a.tree.texture_base);
+  ASSERT_EQ(t.materials.size(), a.tree.materials.size());
+  for (size_t m = 0; m < t.materials.size(); ++m) {
+    EXPECT_EQ(t.materials[m].name, a.tree.materials[m].name);
+    EXPECT_EQ(t.materials[m].base_color_texture, a.tree.materials[m].base_color_texture);
+    EXPECT_EQ(t.materials[m].base_color[1], a.tree.materials[m].base_color[1]);
+    EXPECT_EQ(t.materials[m].roughness, a.tree.materials[m].roughness);
+    EXPECT_EQ(t.materials[m].double_sided, a.tree.materials[m].double_sided);
+  }
   ASSERT_EQ(t.nodes.size(), a.tree.nodes.size());
   for (size_t i = 0; i < t.nodes.size(); ++i) {
     const HlodNode &x = t.nodes[i], &y = a.tree.nodes[i];
@@ -110,6 +160,16 @@ void expect_same(const Sample& a, const HlodTree& t, const std::vector<HlodPaylo
     for (uint32_t k = 0; k < x.layer_count; ++k) {
       EXPECT_EQ(x.layers[k].triangles, y.layers[k].triangles);
       EXPECT_EQ(x.layers[k].error, y.layers[k].error);
+      EXPECT_EQ(x.layers[k].uv_error, y.layers[k].uv_error);
+    }
+    EXPECT_EQ(x.material_runs, y.material_runs) << i;
+    EXPECT_EQ(p[i].uvs, a.payloads[i].uvs) << i;
+    ASSERT_EQ(p[i].runs.size(), a.payloads[i].runs.size()) << i;
+    for (size_t r = 0; r < p[i].runs.size(); ++r) {
+      EXPECT_EQ(p[i].runs[r].level, a.payloads[i].runs[r].level);
+      EXPECT_EQ(p[i].runs[r].first_index, a.payloads[i].runs[r].first_index);
+      EXPECT_EQ(p[i].runs[r].index_count, a.payloads[i].runs[r].index_count);
+      EXPECT_EQ(p[i].runs[r].material, a.payloads[i].runs[r].material);
     }
     ASSERT_EQ(p[i].layers.size(), a.payloads[i].layers.size());
     EXPECT_EQ(std::memcmp(p[i].positions.data(), a.payloads[i].positions.data(), 4 * p[i].positions.size()), 0);
@@ -120,7 +180,7 @@ void expect_same(const Sample& a, const HlodTree& t, const std::vector<HlodPaylo
 }
 
 TEST(HlodAsset, RoundTripIsBitExact) {
-  const Sample s = sample();
+  for (const Sample& s : samples()) {
   const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
   HlodTree t;
   std::vector<HlodPayload> p;
@@ -131,10 +191,33 @@ TEST(HlodAsset, RoundTripIsBitExact) {
   EXPECT_EQ(t.nodes[3].box_center[0], 0.5f - 2 + 1);  // octant 6 of the root, then octant 3
   EXPECT_EQ(t.nodes[3].box_center[1], -2.0f + 2 + 1);
   EXPECT_EQ(encode_hlod_asset(t, p), bytes);
+  }
+}
+
+TEST(HlodAsset, TexturedPayloadsCarryUvsAndRunsPerRange) {
+  const Sample s = textured_sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  HlodTree t;
+  std::vector<HlodPayload> p;
+  ASSERT_TRUE(decode_hlod_asset(bytes, "tree.hlod", t, p));
+  ASSERT_EQ(t.materials.size(), 2u);
+  for (size_t i = 0; i < p.size(); ++i) {
+    EXPECT_EQ(p[i].uvs.size(), p[i].positions.size() / 3 * 2);
+    for (uint32_t r = 0; r <= p[i].layers.size(); ++r) {
+      const LodLevel& range = r < p[i].layers.size() ? p[i].layers[r] : p[i].boundary;
+      uint32_t covered = 0;
+      for (const LevelSubmesh& run : hlod_range_runs(p[i], r)) covered += run.index_count;
+      EXPECT_EQ(covered, range.index_count) << "node " << i << " range " << r;
+    }
+  }
+  // Textured payloads cost 8 bytes a vertex and 16 a run more, the positions-only ones nothing.
+  const Sample plain = sample();
+  EXPECT_EQ(hlod_payload_bytes(t.nodes[0]) - hlod_payload_bytes(plain.tree.nodes[0]),
+            8 * (p[0].positions.size() / 3) + 16 * p[0].runs.size());
 }
 
 TEST(HlodAsset, HeadAndPayloadsInPiecesAreTheWholeFile) {
-  const Sample s = sample();
+  for (const Sample& s : samples()) {
   const std::vector<uint8_t> whole = encode_hlod_asset(s.tree, s.payloads);
   std::vector<uint64_t> sizes;
   std::vector<uint8_t> pieces;
@@ -147,6 +230,7 @@ TEST(HlodAsset, HeadAndPayloadsInPiecesAreTheWholeFile) {
   std::vector<uint8_t> bytes = encode_hlod_head(s.tree, sizes);
   bytes.insert(bytes.end(), pieces.begin(), pieces.end());
   EXPECT_EQ(bytes, whole);
+  }
 }
 
 TEST(HlodAsset, ReadsTheTreeThenOneNodeAtATime) {
@@ -175,7 +259,7 @@ TEST(HlodAsset, ReadsTheTreeThenOneNodeAtATime) {
 }
 
 TEST(HlodAsset, RefusesTruncationAtEveryLength) {
-  const Sample s = sample();
+  for (const Sample& s : samples()) {
   const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
   const auto dir = test::temp_dir("hlod_trunc");
   for (size_t len = 0; len < bytes.size(); ++len) {
@@ -195,10 +279,11 @@ TEST(HlodAsset, RefusesTruncationAtEveryLength) {
     ASSERT_FALSE(read_hlod_tree(file, u)) << len;
     EXPECT_EQ(u.name, "untouched");
   }
+  }
 }
 
 TEST(HlodAsset, RefusesEverySingleFlippedByte) {
-  const Sample s = sample();
+  for (const Sample& s : samples()) {
   const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
   for (size_t at = 0; at < bytes.size(); ++at)
     for (uint8_t mask : {0x01, 0x80, 0xff}) {
@@ -209,6 +294,7 @@ TEST(HlodAsset, RefusesEverySingleFlippedByte) {
       ASSERT_FALSE(decode_hlod_asset(bad, "bunny.hlod", t, p)) << "byte " << at << " ^ " << int(mask);
       EXPECT_EQ(t.name, "untouched");
     }
+  }
 }
 
 // Where each checksum sits and what it covers, so a test can forge it.
@@ -239,7 +325,7 @@ void forge_checksum(std::vector<uint8_t>& b, const Layout& l, uint64_t at) {
 // clean refusal or a file that decodes into something valid (a flipped mantissa bit of a
 // position is still a position); nothing crashes or allocates wildly (ASan in CI).
 TEST(HlodAsset, ValidatesEveryFlippedByteUnderAForgedChecksum) {
-  const Sample s = sample();
+  for (const Sample& s : samples()) {
   const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
   const Layout l = layout_of(bytes);
   size_t refused = 0, accepted = 0;
@@ -277,10 +363,14 @@ TEST(HlodAsset, ValidatesEveryFlippedByteUnderAForgedChecksum) {
         for (const LodLevel& r : p[i].layers)
           for (uint32_t k = 0; k < r.index_count; ++k) ASSERT_LT(p[i].indices[r.first_index + k], r.vertex_count);
         for (float v : p[i].positions) ASSERT_TRUE(std::isfinite(v));
+        for (float v : p[i].uvs) ASSERT_TRUE(std::isfinite(v));
+        for (const LevelSubmesh& r : p[i].runs) ASSERT_LT(r.material, int32_t(t.material_count));
+        ASSERT_EQ(p[i].uvs.size(), t.uvs ? p[i].positions.size() / 3 * 2 : 0);
       }
     }
   EXPECT_GT(refused, 0u);
   EXPECT_GT(accepted, 0u) << "flipped position bits are still positions: the forged checksums took";
+  }
 }
 
 TEST(HlodAsset, RefusesHostileFieldsNamingThem) {
@@ -318,24 +408,96 @@ TEST(HlodAsset, RefusesHostileFieldsNamingThem) {
   }, "does not match its counts");
   // A NaN error.
   refuse([&](std::vector<uint8_t>& b) {
-    const uint64_t records = l.head - 16 * l.payloads.size() - 64 * l.payloads.size();
+    const uint64_t records = l.head - 16 * l.payloads.size() - 80 * l.payloads.size();
     const float nan = NAN;
-    std::memcpy(b.data() + records + 64 * 2 + 28 + 8, &nan, 4);
+    std::memcpy(b.data() + records + 80 * 2 + 28 + 8, &nan, 4);
     return records;
   }, "not a finite distance");
   // A child coarser than its parent (node 3's coarsest error above node 2's finest).
   refuse([&](std::vector<uint8_t>& b) {
-    const uint64_t records = l.head - 16 * l.payloads.size() - 64 * l.payloads.size();
+    const uint64_t records = l.head - 16 * l.payloads.size() - 80 * l.payloads.size();
     const float big = 0.4f;
-    std::memcpy(b.data() + records + 64 * 3 + 28 + 24 + 8, &big, 4);
+    std::memcpy(b.data() + records + 80 * 3 + 28 + 24 + 8, &big, 4);
     return records;
   }, "errors must grow upwards");
   // An OctreeCode naming more children than there are nodes.
   refuse([&](std::vector<uint8_t>& b) {
-    const uint64_t code = 88 + 8;  // after the name "bunny", 8-aligned
+    const uint64_t code = 96 + 8;  // after the name "bunny", 8-aligned
     b[code] = 0xff;
     return code;
   }, "octree");
+}
+
+TEST(HlodAsset, RefusesHostileSurfacesNamingThem) {
+  const Sample s = textured_sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  const Layout l = layout_of(bytes);
+  auto refuse = [&](auto&& edit, const char* expected) {
+    std::vector<uint8_t> bad = bytes;
+    const uint64_t at = edit(bad);
+    forge_checksum(bad, l, at);
+    HlodTree t = sentinel();
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(bad, "tree.hlod", t, p);
+    ASSERT_FALSE(st) << expected;
+    EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
+    EXPECT_EQ(t.name, "untouched");
+  };
+  // Node 0's runs are the last 16 bytes of each before its checksum.
+  const uint64_t runs = l.payloads[0].first + l.payloads[0].second - 8 - 16 * s.payloads[0].runs.size();
+  refuse([&](std::vector<uint8_t>& b) {
+    const int32_t m = 2;
+    std::memcpy(b.data() + runs + 16 * 1 + 12, &m, 4);
+    return runs;
+  }, "names material 2 of 2");
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint32_t count = 6;  // run 1 of range 0 shortened: the range is not covered
+    std::memcpy(b.data() + runs + 16 * 1 + 8, &count, 4);
+    return runs;
+  }, "material runs cover");
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint32_t range = 7;
+    std::memcpy(b.data() + runs + 16 * 0, &range, 4);
+    return runs;
+  }, "out of order");
+  // A NaN uv: node 0's layer 0 uvs follow its 8 positions and 8 normals.
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t at = l.payloads[0].first + 2 * 8 * 12 + 4;
+    const float nan = NAN;
+    std::memcpy(b.data() + at, &nan, 4);
+    return at;
+  }, "non-finite uv");
+  // A material count the MATL section does not hold, and one past the limit.
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint32_t v = 3;
+    std::memcpy(b.data() + 64, &v, 4);
+    return uint64_t{64};
+  }, "its MATL section holds 2");
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint32_t v = 0x7fffffff;
+    std::memcpy(b.data() + 64, &v, 4);
+    return uint64_t{64};
+  }, "materials, at most");
+  // A material's factor out of range, in the head's MATL section (its first record's base
+  // colour follows the 16-byte section header and the 12-byte texture base).
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t at = 96 + 8 + 16 + 12 + 8;
+    const float v = 2;
+    std::memcpy(b.data() + at, &v, 4);
+    return at;
+  }, "base colour factor outside [0, 1]");
+}
+
+TEST(HlodAsset, RefusesVersionOneAskingForARebake) {
+  const Sample s = sample();
+  std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  bytes[8] = 1;
+  HlodTree t;
+  std::vector<HlodPayload> p;
+  const Status st = decode_hlod_asset(bytes, "old.hlod", t, p);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("hlod version 1 is not supported"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("rebake it"), std::string::npos) << st.message;
 }
 
 TEST(HlodAsset, RefusesWrongMagicAndVersionSayingSo) {
@@ -362,6 +524,35 @@ TEST(HlodAsset, ReadsRegularFilesOnlyAndNamesMissingOnes) {
   st = read_hlod_tree(dir, t);
   ASSERT_FALSE(st);
   EXPECT_NE(st.message.find("not a regular file"), std::string::npos) << st.message;
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+// The fuzz seeds (tests/fuzz/corpus/hlod: hs0 the sample, hs1 the textured sample) are files of
+// the current version, so the fuzzer starts from inputs the reader accepts; LOD_WRITE_FUZZ_SEEDS=1
+// rewrites them after a format change.
+TEST(HlodAsset, TheFuzzSeedsAreCurrent) {
+  const std::filesystem::path dir = std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/hlod";
+  if (std::getenv("LOD_WRITE_FUZZ_SEEDS")) {
+    const Sample plain = sample(), textured = textured_sample();
+    test::write_bytes(dir / "hs0.hlod", encode_hlod_asset(plain.tree, plain.payloads));
+    test::write_bytes(dir / "hs1.hlod", encode_hlod_asset(textured.tree, textured.payloads));
+  }
+  size_t seeds = 0, with_materials = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    HlodTree t;
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(test::read_bytes(e.path()), e.path().string(), t, p);
+    EXPECT_TRUE(st) << st.message;
+    ++seeds;
+    with_materials += !t.materials.empty();
+  }
+  EXPECT_GE(seeds, 2u);
+  EXPECT_GE(with_materials, 1u) << "a seed with uvs, materials and runs";
 }
 
 }  // namespace

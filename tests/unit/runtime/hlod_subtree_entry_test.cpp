@@ -2,7 +2,9 @@
 // truncation, flipped byte, forged count, wrong key and out-of-mesh vertex is refused.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <vector>
 
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include "runtime/hlod_asset.h"
 #include "runtime/hlod_subtree_entry.h"
 #include "runtime/lod_asset.h"  // hash_bytes
+#include "test_support.h"
 
 namespace lod {
 namespace {
@@ -174,7 +177,8 @@ TEST(HlodSubtreeEntry, RefusesForgedCountsUnderARecomputedChecksum) {
   EXPECT_FALSE(decode(forge(40, 0xffffffffu), t)) << "huge source count";
   EXPECT_FALSE(decode(forge(44, 0x40000000u), t)) << "huge reference count";
   EXPECT_FALSE(decode(forge(48, 1), t)) << "asset size";
-  EXPECT_FALSE(decode(forge(8, 2), t)) << "version";
+  EXPECT_FALSE(decode(forge(8, 1), t)) << "version 1 (before uvs and materials)";
+  EXPECT_FALSE(decode(forge(8, 3), t)) << "version 3";
   EXPECT_TRUE(decode(forge(12, 3), t)) << "the forger itself";
 }
 
@@ -246,6 +250,85 @@ TEST(HlodSubtreeEntry, PayloadSpansAreTheFilesPayloadBytes) {
   }
   EXPECT_FALSE(hlod_subtree_entry_payloads(std::vector<uint8_t>(bytes.begin(), bytes.begin() + 40), "e", spans))
       << "a truncated entry";
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+// The sample with texture coordinates and every range one run of material 1 of 2: the entry
+// carries the material count (not the materials: the .hlod's head has those) and checks the
+// runs against it.
+HlodSubtree textured() {
+  HlodSubtree s = sample();
+  s.material_count = 2;
+  for (size_t i = 0; i < s.nodes.size(); ++i) {
+    HlodPayload& p = s.payloads[i];
+    for (size_t v = 0; v < p.positions.size() / 3; ++v) p.uvs.insert(p.uvs.end(), {0.5f, 0.25f * float(v % 4)});
+    for (uint32_t r = 0; r <= p.layers.size(); ++r) {
+      const LodLevel& range = r < p.layers.size() ? p.layers[r] : p.boundary;
+      if (range.index_count) p.runs.push_back({r, 0, range.index_count, 1});
+    }
+    s.nodes[i].uvs = true;
+    s.nodes[i].material_runs = uint32_t(p.runs.size());
+    s.nodes[i].resident_bytes = hlod_resident_bytes(s.nodes[i]);
+  }
+  return s;
+}
+
+TEST(HlodSubtreeEntry, TexturedSubtreeRoundTripsAndItsRootAlone) {
+  const HlodSubtree s = textured();
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(s, kKey);
+  HlodSubtree t, root;
+  ASSERT_TRUE(decode(bytes, t));
+  EXPECT_EQ(t.material_count, 2u);
+  for (size_t i = 0; i < t.nodes.size(); ++i) {
+    EXPECT_TRUE(t.nodes[i].uvs);
+    EXPECT_EQ(t.payloads[i].uvs, s.payloads[i].uvs);
+    ASSERT_EQ(t.payloads[i].runs.size(), s.payloads[i].runs.size());
+    for (const LevelSubmesh& r : t.payloads[i].runs) EXPECT_EQ(r.material, 1);
+  }
+  ASSERT_TRUE(decode_root(bytes, root));
+  EXPECT_EQ(root.payloads[0].uvs, s.payloads[0].uvs);
+  EXPECT_EQ(root.material_count, 2u);
+  // Every truncation refused.
+  for (size_t len = 0; len < bytes.size(); len += 7) {
+    const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + std::ptrdiff_t(len));
+    ASSERT_FALSE(decode(cut, t)) << len;
+  }
+  // A run naming a material past the count is refused, even with its checksums forged.
+  HlodSubtree bad = s;
+  bad.material_count = 1;
+  const std::vector<uint8_t> fewer = encode_hlod_subtree(bad, kKey);
+  const Status st = decode(fewer, t);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("names material 1 of 1"), std::string::npos) << st.message;
+}
+
+}  // namespace
+}  // namespace lod
+
+namespace lod {
+namespace {
+
+// The fuzz seeds (tests/fuzz/corpus/hsub: e0 the sample, e1 the textured one) are entries of
+// the current version; LOD_WRITE_FUZZ_SEEDS=1 rewrites them after a format change.
+TEST(HlodSubtreeEntry, TheFuzzSeedsAreCurrent) {
+  const std::filesystem::path dir = std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/hsub";
+  if (std::getenv("LOD_WRITE_FUZZ_SEEDS")) {
+    test::write_bytes(dir / "e0.hsub", encode_hlod_subtree(sample(), kKey));
+    test::write_bytes(dir / "e1.hsub", encode_hlod_subtree(textured(), kKey));
+  }
+  size_t seeds = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    HlodSubtree s;
+    const Status st = decode(test::read_bytes(e.path()), s);
+    EXPECT_TRUE(st) << st.message;
+    ++seeds;
+  }
+  EXPECT_GE(seeds, 2u);
 }
 
 }  // namespace
