@@ -17,6 +17,7 @@
 #include "preprocess/material_runs.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
+#include "runtime/embedded_image.h"
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/lod_asset.h"  // hash_bytes
@@ -81,7 +82,14 @@ void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& m, Hlo
     ChainMaterial& c = chain.materials[i];
     const auto uris = texture_slots(c);
     for (size_t k = 0; k < kTextureSlots; ++k)
-      if (!uris[k]->empty() && (c.tex_coords[k] != 0 || m.uvs.empty())) {
+      if (is_embedded_image_uri(*uris[k])) {
+        // The .hlod names texture files only: an image inside the source is not carried.
+        notes.push_back(mesh_file.string() + ": material " + std::to_string(i) + " ('" + c.name + "'): its " +
+                        kTextureSlotNames[k] + " texture is embedded in the file, which the HLOD tree does not keep " +
+                        "(left out; the .lod bake keeps it)");
+        uris[k]->clear();
+        c.tex_coords[k] = 0;
+      } else if (!uris[k]->empty() && (c.tex_coords[k] != 0 || m.uvs.empty())) {
         notes.push_back(mesh_file.string() + ": material " + std::to_string(i) + " ('" + c.name + "'): its " +
                         kTextureSlotNames[k] + " texture reads " +
                         (m.uvs.empty() ? std::string("texture coordinates the mesh does not have")

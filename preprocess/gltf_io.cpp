@@ -865,14 +865,14 @@ Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const 
   const bool mirrored = glm::determinant(glm::dmat3(inst.world)) < 0;
   const size_t corners = plan.indexed ? plan.indices.count : n;
   if (plan.mode == TINYGLTF_MODE_TRIANGLES && !mirrored) {  // the common case: corners are the triangles
-    const bool suspect = append_corners(plan, out.indices);
-    if (Status s = check_corners(where, out.indices.data() + 3 * first, corners, suspect, n, uint32_t(base)); !s)
+    const bool corners_suspect = append_corners(plan, out.indices);
+    if (Status s = check_corners(where, out.indices.data() + 3 * first, corners, corners_suspect, n, uint32_t(base)); !s)
       return s;
     out.indices.resize(3 * (first + plan.triangles));  // a stray last corner or two
   } else {
     scratch.clear();
-    const bool suspect = append_corners(plan, scratch);
-    if (Status s = check_corners(where, scratch.data(), corners, suspect, n, 0); !s) return s;
+    const bool corners_suspect = append_corners(plan, scratch);
+    if (Status s = check_corners(where, scratch.data(), corners, corners_suspect, n, 0); !s) return s;
     out.indices.resize(3 * (first + plan.triangles));
     triangles_from_corners(plan.mode, scratch.data(), plan.triangles, uint32_t(base),
                            mirrored ? Winding::flip : Winding::keep, out.indices.data() + 3 * first);

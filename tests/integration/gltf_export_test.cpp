@@ -587,6 +587,29 @@ TEST(GltfExport, APngInADataUriIsKeptByTheBakeAndExportedByteForByte) {
   expect_embedded_png_round_trip(dir, dir / "globe.gltf", png);
 }
 
+// The .hlod names texture files only: an HLOD bake of a GLB whose texture is inside it says it
+// leaves the texture out (naming file, material and slot), writes a file its own reader and the
+// 3D Tiles export accept, and keeps the material's other values.
+TEST(GltfExport, AnHlodBakeOfAGlbWithAnEmbeddedTextureSaysItLeavesItOut) {
+  const fs::path dir = lod::test::temp_dir("gltf-embedded-hlod");
+  const std::vector<uint8_t> png = lod::test::checker_png(32, 4);
+  lod::test::GltfFixture f = embedded_texture_sphere({{"mimeType", "image/png"}}, &png);
+  lod::test::write_bytes(dir / "globe.glb", f.glb());
+  auto r = run_lod("bake " + (dir / "globe.glb").string() + " -o " + (dir / "h").string() + " --hlod");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find((dir / "globe.glb").string() + ": material 0 ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("base colour texture is embedded in the file, which the HLOD tree does not keep"), std::string::npos)
+      << r.out;
+  auto inspect = run_lod("inspect " + (dir / "h" / "globe.hlod").string());
+  ASSERT_EQ(inspect.code, 0) << inspect.out;
+  EXPECT_NE(inspect.out.find("materials: 2"), std::string::npos) << inspect.out;
+  EXPECT_NE(inspect.out.find("0 'cap': base colour 1 1 1 1"), std::string::npos) << inspect.out;
+  EXPECT_EQ(inspect.out.find("embedded:"), std::string::npos) << inspect.out;
+  auto tiles = run_lod("export --3dtiles " + (dir / "t").string() + " " + (dir / "h" / "globe.hlod").string());
+  ASSERT_EQ(tiles.code, 0) << tiles.out;
+  EXPECT_TRUE(fs::exists(dir / "t" / "tileset.json"));
+}
+
 // Hostile embedded images: one that is not PNG/JPEG is dropped, said naming the file, material
 // and slot (the bake goes on without it); a buffer view past the buffer refuses the file and
 // writes nothing.
