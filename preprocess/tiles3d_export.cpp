@@ -31,8 +31,8 @@ using nlohmann::json;
 constexpr const char* kTilesFolder = "tiles";
 constexpr const char* kTexturesFolder = "textures";
 
-// With shared images: each image file copied once into the staging folder's textures/, named
-// by the order it was first met, and the URI a tile's GLB names it by.
+// With shared images: each image (a file, or one the tree carries) written once into the staging
+// folder's textures/, named by the order it was first met, and the URI a tile's GLB names it by.
 struct SharedImages {
   struct Written {
     fs::path file;                       // the source file, or empty for
@@ -203,8 +203,8 @@ Status check_payload(const std::string& what, const HlodNode& n, const HlodPaylo
   return check_range(what + " boundary", p.boundary, p);
 }
 
-// A tree material for the GLB writer, its images the tree's own or files resolved against the texture base (one
-// missing at export time is left out by the writer and said).
+// A tree material for the GLB writer, its images the tree's own (embedded:<k>) or files resolved
+// against the texture base (one missing at export time is left out by the writer and said).
 GltfMaterialView gltf_material(const ChainMaterial& m, const HlodTree& tree) {
   GltfMaterialView g;
   g.name = m.name;
