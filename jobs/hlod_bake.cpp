@@ -56,7 +56,8 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
     return Status::error(file.string() + ": read error");
   uint64_t content = hash_bytes(bytes.data(), bytes.size());
   // The materials and uvs are in the tree since build version 2: what an OBJ's .mtl or a glTF's
-  // buffers and images hold is part of the source.
+  // buffers and images hold is part of the source. Version 3 keeps embedded images, so a tree
+  // cached before (its embedded textures left out) is not taken for current.
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
@@ -65,7 +66,7 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
       const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
       content = hash_bytes(more.data(), more.size(), content);
     }
-  const uint64_t settings[2] = {2 /* build version: 2 uvs and materials */, min_verts};
+  const uint64_t settings[2] = {3 /* build version: 3 embedded images, 2 uvs and materials */, min_verts};
   out = hash_bytes(settings, sizeof settings, content);
   return Status::success();
 }
