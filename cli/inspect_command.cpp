@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/embedded_images_report.h"
 #include "cli/names.h"
 #include "preprocess/gltf_write.h"
 #include "preprocess/mesh_io.h"
@@ -39,27 +40,6 @@ nlohmann::json materials_json(const LodChain& chain) {
                    {"emissive", {m.emissive[0], m.emissive[1], m.emissive[2]}},
                    {"emissive_texture", m.emissive_texture}});
   return out;
-}
-
-// The images the asset carries (embedded in its source): index, type, size.
-nlohmann::json images_json(const LodChain& chain) {
-  nlohmann::json out = nlohmann::json::array();
-  for (size_t k = 0; k < chain.images.size(); ++k)
-    out.push_back({{"index", k},
-                   {"uri", embedded_image_uri(uint32_t(k))},
-                   {"mime_type", mime_type(chain.images[k].type)},
-                   {"bytes", chain.images[k].bytes.size()}});
-  return out;
-}
-
-void print_images(const LodChain& chain) {
-  uint64_t total = 0;
-  for (const EmbeddedImage& img : chain.images) total += img.bytes.size();
-  std::printf("embedded images: %zu (%llu bytes, kept from the source file, PNG/JPEG undecoded)\n", chain.images.size(),
-              (unsigned long long)total);
-  for (size_t k = 0; k < chain.images.size(); ++k)
-    std::printf("  %s: %s, %zu bytes\n", embedded_image_uri(uint32_t(k)).c_str(), mime_type(chain.images[k].type),
-                chain.images[k].bytes.size());
 }
 
 // Level k's runs as {material, triangles} (material -1: the default).
@@ -215,7 +195,7 @@ int inspect_command(const InspectArgs& args) {
     j["texcoords1"] = !chain.uvs1.empty();
     j["colors"] = !chain.colors.empty();
     j["materials"] = materials_json(chain);
-    j["images"] = images_json(chain);
+    j["images"] = images_json(chain.images);
     j["levels"] = nlohmann::json::array();
     for (size_t i = 0; i < chain.levels.size(); ++i) {
       const auto& l = chain.levels[i];
@@ -273,7 +253,7 @@ int inspect_command(const InspectArgs& args) {
       std::printf("\n");
     }
     if (!chain.materials.empty()) print_materials(chain);
-    if (!chain.images.empty()) print_images(chain);
+    if (!chain.images.empty()) print_images(chain.images);
   }
   if (!args.export_dir.empty()) {
     std::error_code ec;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/embedded_images_report.h"
 #include "cli/names.h"
 #include "runtime/hlod_asset.h"
 
@@ -130,6 +131,7 @@ int inspect_hlod_command(const InspectArgs& args) {
     j["texcoords"] = tree.uvs;
     j["texture_base"] = tree.texture_base;
     j["materials"] = materials_json(tree);
+    j["images"] = images_json(tree.images);
     j["nodes"] = nlohmann::json::array();
     for (size_t i = 0; i < tree.nodes.size(); ++i) j["nodes"].push_back(node_json(tree, i));
     std::printf("%s\n", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
@@ -143,6 +145,7 @@ int inspect_hlod_command(const InspectArgs& args) {
   std::printf("%zu nodes, %zu leaves; root cube centre (%g, %g, %g), half size %g\n", tree.nodes.size(), leaves,
               tree.box_center[0], tree.box_center[1], tree.box_center[2], tree.box_half);
   print_materials(tree);
+  if (!tree.images.empty()) print_images(tree.images);
   print_depth_table(tree);
   std::printf("top of the tree (layers: triangles/error):\n");
   print_tree_top(tree, 0, 2);

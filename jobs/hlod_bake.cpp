@@ -29,6 +29,20 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The images a slot of `materials` still names, renumbered in order of first use (a texture that
+// prepare_hlod_input left out may have been an image's only user; the .hlod keeps no unnamed image).
+std::vector<EmbeddedImage> kept_embedded_images(std::vector<ChainMaterial>& materials, std::vector<EmbeddedImage> images) {
+  std::vector<int64_t> renumbered(images.size(), -1);
+  std::vector<EmbeddedImage> kept;
+  for (ChainMaterial& c : materials)
+    for (std::string* uri : texture_slots(c))
+      if (uint32_t k = 0; is_embedded_image_uri(*uri, &k) && k < images.size()) {
+        if (renumbered[k] < 0) renumbered[k] = int64_t(kept.size()), kept.push_back(std::move(images[k]));
+        *uri = embedded_image_uri(uint32_t(renumbered[k]));
+      }
+  return kept;
+}
+
 }  // namespace
 
 // Content hash of the mesh file's bytes, mixed with what else decides the output.
@@ -42,7 +56,8 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
     return Status::error(file.string() + ": read error");
   uint64_t content = hash_bytes(bytes.data(), bytes.size());
   // The materials and uvs are in the tree since build version 2: what an OBJ's .mtl or a glTF's
-  // buffers and images hold is part of the source.
+  // buffers and images hold is part of the source. Version 3 keeps embedded images, so a tree
+  // cached before (its embedded textures left out) is not taken for current.
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
@@ -51,7 +66,7 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
       const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
       content = hash_bytes(more.data(), more.size(), content);
     }
-  const uint64_t settings[2] = {2 /* build version: 2 uvs and materials */, min_verts};
+  const uint64_t settings[2] = {3 /* build version: 3 embedded images, 2 uvs and materials */, min_verts};
   out = hash_bytes(settings, sizeof settings, content);
   return Status::success();
 }
@@ -82,14 +97,7 @@ void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& m, Hlo
     ChainMaterial& c = chain.materials[i];
     const auto uris = texture_slots(c);
     for (size_t k = 0; k < kTextureSlots; ++k)
-      if (is_embedded_image_uri(*uris[k])) {
-        // The .hlod names texture files only: an image inside the source is not carried.
-        notes.push_back(mesh_file.string() + ": material " + std::to_string(i) + " ('" + c.name + "'): its " +
-                        kTextureSlotNames[k] + " texture is embedded in the file, which the HLOD tree does not keep " +
-                        "(left out; the .lod bake keeps it)");
-        uris[k]->clear();
-        c.tex_coords[k] = 0;
-      } else if (!uris[k]->empty() && (c.tex_coords[k] != 0 || m.uvs.empty())) {
+      if (!uris[k]->empty() && (c.tex_coords[k] != 0 || m.uvs.empty())) {
         notes.push_back(mesh_file.string() + ": material " + std::to_string(i) + " ('" + c.name + "'): its " +
                         kTextureSlotNames[k] + " texture reads " +
                         (m.uvs.empty() ? std::string("texture coordinates the mesh does not have")
@@ -99,6 +107,7 @@ void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& m, Hlo
         c.tex_coords[k] = 0;
       }
   }
+  surfaces.images = kept_embedded_images(chain.materials, std::move(chain.images));
   surfaces.materials = std::move(chain.materials);
   surfaces.texture_base = surfaces.materials.empty() ? std::string() : std::move(chain.texture_base);
 }

@@ -37,9 +37,10 @@ ParallelFor tbb_parallel_for();
 Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out);
 
 // The mesh as an HLOD build takes it: loaded and cleaned (uv seams and material boundaries stay
-// copies at one position), its materials converted for the tree (add_chain_materials). What the
-// tree does not keep (the second uv set, vertex colours, textures reading TEXCOORD_1, embedded
-// images) is said in `notes`, each naming the file.
+// copies at one position), its materials converted for the tree (add_chain_materials) with the
+// images they embed (only those a kept slot names, renumbered). What the tree does not keep (the
+// second uv set, vertex colours, textures reading TEXCOORD_1) is said in `notes`, each naming
+// the file.
 Status load_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
                        std::vector<std::string>& notes, size_t* input_triangles = nullptr);
 // The same for a mesh already loaded from `mesh_file` (cleaned in place).

@@ -1,9 +1,11 @@
-// The cleaned mesh entry, version 2, little-endian:
+// The cleaned mesh entry, version 3, little-endian:
 //   magic "LODHMSH\n" (8) | u32 version | u32 flags (bit 0: uvs) | u64 source hash |
 //   u64 input triangles | u64 vertices V | u64 indices I | u64 submeshes S | u64 materials bytes M |
+//   u64 images bytes G |
 //   V x 3 f32 positions | I u32 indices | V x 2 f32 uvs (with the flag) |
 //   S x (u32 first triangle, u32 triangles, i32 material) | M bytes: the materials and texture
-//   base in the .lod's MATL layout (runtime/material_section.h) |
+//   base in the .lod's MATL layout (runtime/material_section.h) | G bytes: the images the
+//   materials embed in the .lod's IMGS layout (0 = none) |
 //   u64 checksum = hash_bytes(everything before it)
 #include "jobs/hlod_mesh_cache.h"
 
@@ -26,7 +28,7 @@ namespace lod {
 namespace {
 
 constexpr char kMagic[8] = {'L', 'O', 'D', 'H', 'M', 'S', 'H', '\n'};
-constexpr uint64_t kFixedBytes = 64;
+constexpr uint64_t kFixedBytes = 72;
 constexpr uint32_t kFlagUvs = 1;
 
 bool read_whole(const std::filesystem::path& path, std::vector<uint8_t>& out) {
@@ -60,6 +62,7 @@ Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, c
   chain.materials = surfaces.materials;
   chain.texture_base = surfaces.texture_base;
   const std::vector<uint8_t> materials = surfaces.materials.empty() ? std::vector<uint8_t>() : encode_material_section(chain);
+  const std::vector<uint8_t> images = surfaces.images.empty() ? std::vector<uint8_t>() : encode_image_section(surfaces.images);
   detail::ByteWriter w;
   w.bytes.reserve(kFixedBytes + 4 * (mesh.positions.size() + mesh.indices.size() + mesh.uvs.size()) + 8);
   for (char c : kMagic) w.u8(uint8_t(c));
@@ -71,6 +74,7 @@ Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, c
   w.u64(mesh.indices.size());
   w.u64(mesh.submeshes.size());
   w.u64(materials.size());
+  w.u64(images.size());
   w.words(mesh.positions.data(), mesh.positions.size());
   w.words(mesh.indices.data(), mesh.indices.size());
   if (uvs) w.words(mesh.uvs.data(), mesh.uvs.size());
@@ -80,6 +84,7 @@ Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, c
     w.u32(uint32_t(sm.material));
   }
   w.raw(materials.data(), materials.size());
+  w.raw(images.data(), images.size());
   w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
   const std::filesystem::path path = hlod_mesh_entry_path(dir, source_hash);
   if (Status s = write_file_atomic(path, w.bytes); !s) return s;
@@ -103,15 +108,16 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   const uint32_t flags = detail::load_u32(b.data() + 12);
   const uint64_t vertices = detail::load_u64(b.data() + 32), indices = detail::load_u64(b.data() + 40);
   const uint64_t submeshes = detail::load_u64(b.data() + 48), material_bytes = detail::load_u64(b.data() + 56);
+  const uint64_t image_bytes = detail::load_u64(b.data() + 64);
   if ((flags & ~kFlagUvs) != 0) return refuse("unknown flags " + std::to_string(flags));
   const uint64_t per_vertex = (flags & kFlagUvs) ? 20 : 12;
   // Counts against the size before anything is allocated (each bounded first, so the sum cannot overflow).
   if (vertices >= UINT32_MAX || indices % 3 != 0 || indices > b.size() / 4 || submeshes > b.size() / 12 ||
-      material_bytes > b.size() ||
-      b.size() != kFixedBytes + per_vertex * vertices + 4 * indices + 12 * submeshes + material_bytes + 8)
+      material_bytes > b.size() || image_bytes > b.size() ||
+      b.size() != kFixedBytes + per_vertex * vertices + 4 * indices + 12 * submeshes + material_bytes + image_bytes + 8)
     return refuse("its counts (" + std::to_string(vertices) + " vertices, " + std::to_string(indices) + " indices, " +
                   std::to_string(submeshes) + " submeshes, " + std::to_string(material_bytes) +
-                  " bytes of materials) do not match its " + std::to_string(b.size()) + " bytes (truncated?)");
+                  " bytes of materials, " + std::to_string(image_bytes) + " of images) do not match its " + std::to_string(b.size()) + " bytes (truncated?)");
   const size_t body = b.size() - 8;
   if (detail::load_u64(b.data() + body) != hash_bytes(b.data(), body)) return refuse("checksum mismatch (corrupted)");
   if (detail::load_u64(b.data() + 16) != source_hash) return refuse("written for another source (a misplaced entry)");
@@ -133,7 +139,11 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
     sm.material = int32_t(detail::load_u32(p + 8));
     p += 12;
   }
-  LodChain chain;
+  LodChain chain;  // images first: the materials' embedded:<k> are checked against them
+  if (image_bytes > 0 && material_bytes == 0) return refuse("it has images but no materials");
+  if (image_bytes > 0)
+    if (Status s = decode_image_section({p + material_bytes, size_t(image_bytes)}, "images", chain.images); !s)
+      return refuse(s.message);
   if (material_bytes > 0)
     if (Status s = decode_material_section({p, size_t(material_bytes)}, "materials", chain); !s) return refuse(s.message);
   for (uint32_t i : m.indices)
@@ -152,7 +162,11 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
                     "names a material of the " + std::to_string(chain.materials.size()));
     covered = uint64_t(sm.first_triangle) + sm.triangle_count;
   }
-  if (surfaces) surfaces->materials = std::move(chain.materials), surfaces->texture_base = std::move(chain.texture_base);
+  if (surfaces) {
+    surfaces->materials = std::move(chain.materials);
+    surfaces->texture_base = std::move(chain.texture_base);
+    surfaces->images = std::move(chain.images);
+  }
   input_triangles = detail::load_u64(b.data() + 24);
   out = std::move(m);
   return CacheLookup::found;

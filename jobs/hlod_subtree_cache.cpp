@@ -62,7 +62,7 @@ uint64_t hlod_subtree_key(uint64_t source_hash, const HlodBuildOptions& o, const
                              std::bit_cast<uint32_t>(o.layer_samples_per_triangle),
                              o.reference_samples,
                              spec.fingerprint,
-                             2 /* build version, as hlod_source_hash */,
+                             3 /* build version, as hlod_source_hash */,
                              std::bit_cast<uint32_t>(o.uv_weight)};
   return hash_bytes(words, sizeof words, 0x68737562ull);
 }

@@ -65,6 +65,7 @@ Status check_mesh(const std::string& what, const GltfMeshView& m) {
 // An image to embed or copy: its bytes and MIME type.
 struct Image {
   std::filesystem::path file;
+  const EmbeddedImage* embedded = nullptr;  // where the bytes came from when not a file
   std::vector<uint8_t> bytes;
   const char* mime = nullptr;
   const char* extension = nullptr;
@@ -143,6 +144,7 @@ void load_images(const std::string& what, const GltfMeshView& m, std::vector<Ima
         continue;
       }
       img.file = file;
+      img.embedded = embedded;
       image_of[i][k] = int(images.size());
       sources.emplace_back(file, embedded);
       images.push_back(std::move(img));
@@ -257,7 +259,7 @@ json pack_buffer(const GltfMeshView& m, const std::vector<SlotImages>& image_of,
 void pack_images(const std::vector<Image>& images, const GltfMeshView& m, Packed& p, json& out) {
   out = json::array();
   for (const Image& img : images) {
-    if (const std::string uri = m.image_uri ? m.image_uri(img.file) : std::string(); !uri.empty()) {
+    if (const std::string uri = m.image_uri ? m.image_uri(img.file, img.embedded) : std::string(); !uri.empty()) {
       out.push_back({{"uri", uri}, {"mimeType", img.mime}});
       continue;
     }

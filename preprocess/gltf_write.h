@@ -80,10 +80,11 @@ struct GltfMeshView {
   std::vector<GltfMaterialView> materials;  // optional
   std::vector<GltfSubmeshView> submeshes;   // optional: cover the indices in order; empty = one primitive
   std::vector<std::string>* notes = nullptr;  // optional: what could not be written (a texture left out)
-  // Optional, GLB only: an image is referenced by the URI this returns for its file (relative to
-  // the GLB; the caller has put the file there) instead of being embedded, so that files sharing
-  // an image (a 3D Tiles export's tiles) hold it once; an empty URI embeds it after all.
-  std::function<std::string(const std::filesystem::path& image)> image_uri;
+  // Optional, GLB only: an image is referenced by the URI this returns for its file, or for the
+  // material's image in memory (`embedded` set, `image` empty) (relative to the GLB; the caller
+  // has put the file there) instead of being embedded, so that files sharing an image (a 3D
+  // Tiles export's tiles) hold it once; an empty URI embeds it after all.
+  std::function<std::string(const std::filesystem::path& image, const EmbeddedImage* embedded)> image_uri;
 };
 
 // Checks everything first (indices in range, a multiple of 3, at least one triangle, finite

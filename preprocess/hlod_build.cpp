@@ -1247,6 +1247,7 @@ Status HlodBuilder::finish_top(const std::vector<HlodSubtree>& baked, const std:
   assembly.model.tree.material_count = uint32_t(m.options.surfaces.materials.size());
   assembly.model.tree.materials = m.options.surfaces.materials;
   assembly.model.tree.texture_base = m.options.surfaces.texture_base;
+  assembly.model.tree.images = m.options.surfaces.images;
   splice(m.c, *m.root, baked, assembly, report);
   report.short_layers += m.top_tally.short_layers.load();
   report.oversized_leaves += m.top_tally.oversized_leaves.load();

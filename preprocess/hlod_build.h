@@ -40,6 +40,7 @@
 #include "preprocess/mesh.h"
 #include "preprocess/qem_simplifier.h"  // ParallelFor
 #include "runtime/chain_material.h"
+#include "runtime/embedded_image.h"
 #include "runtime/hlod_subtree.h"
 #include "runtime/hlod_tree.h"
 #include "runtime/status.h"
@@ -55,6 +56,7 @@ using HlodBuildProgress = std::function<void(float fraction)>;
 struct HlodSurfaces {
   std::vector<ChainMaterial> materials;
   std::string texture_base;
+  std::vector<EmbeddedImage> images;  // what the materials' "embedded:<k>" slots name
 };
 
 struct HlodBuildOptions {

@@ -18,6 +18,7 @@
 
 #include "preprocess/gltf_write.h"
 #include "preprocess/texture_uri.h"
+#include "runtime/embedded_image.h"
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
 
@@ -30,23 +31,32 @@ using nlohmann::json;
 constexpr const char* kTilesFolder = "tiles";
 constexpr const char* kTexturesFolder = "textures";
 
-// With shared images: each image file copied once into the staging folder's textures/, named
-// by the order it was first met, and the URI a tile's GLB names it by.
+// With shared images: each image (a file, or one the tree carries) written once into the staging
+// folder's textures/, named by the order it was first met, and the URI a tile's GLB names it by.
 struct SharedImages {
+  struct Written {
+    fs::path file;                       // the source file, or empty for
+    const EmbeddedImage* embedded;       // one of the tree's own images
+    std::string uri;                     // from tiles/
+  };
   fs::path staging;
-  std::vector<std::pair<fs::path, std::string>> written;  // source file, URI from tiles/
+  std::vector<Written> written;
   TilesetExportReport* rep = nullptr;
-  std::string uri_of(const fs::path& file) {
-    for (const auto& [f, uri] : written)
-      if (f == file) return uri;
+  std::string uri_of(const fs::path& file, const EmbeddedImage* embedded) {
+    for (const Written& w : written)
+      if (w.file == file && w.embedded == embedded) return w.uri;
     std::error_code ec;
     fs::create_directories(staging / kTexturesFolder, ec);
-    const std::string name = "image" + std::to_string(written.size()) + file.extension().string();
-    if (ec || !fs::copy_file(file, staging / kTexturesFolder / name, ec) || ec) return {};  // embedded instead
-    rep->bytes += fs::file_size(staging / kTexturesFolder / name, ec);
+    // A tree's image is written with the extension of its type (its bytes were checked).
+    const std::string name = "image" + std::to_string(written.size()) +
+                             (embedded ? std::string(file_extension(embedded->type)) : file.extension().string());
+    const fs::path to = staging / kTexturesFolder / name;
+    if (ec) return {};  // embedded instead
+    if (embedded ? !write_file_atomic(to, embedded->bytes) : (!fs::copy_file(file, to, ec) || ec)) return {};
+    rep->bytes += fs::file_size(to, ec);
     ++rep->shared_images;
-    written.push_back({file, std::string("../") + kTexturesFolder + "/" + name});
-    return written.back().second;
+    written.push_back({file, embedded, std::string("../") + kTexturesFolder + "/" + name});
+    return written.back().uri;
   }
 };
 
@@ -193,9 +203,9 @@ Status check_payload(const std::string& what, const HlodNode& n, const HlodPaylo
   return check_range(what + " boundary", p.boundary, p);
 }
 
-// A tree material for the GLB writer, its images resolved against the texture base (one
-// missing at export time is left out by the writer and said).
-GltfMaterialView gltf_material(const ChainMaterial& m, const std::string& texture_base) {
+// A tree material for the GLB writer, its images the tree's own (embedded:<k>) or files resolved
+// against the texture base (one missing at export time is left out by the writer and said).
+GltfMaterialView gltf_material(const ChainMaterial& m, const HlodTree& tree) {
   GltfMaterialView g;
   g.name = m.name;
   std::copy(m.base_color, m.base_color + 4, g.base_color);
@@ -210,7 +220,12 @@ GltfMaterialView gltf_material(const ChainMaterial& m, const std::string& textur
   g.tex_coords = m.tex_coords;
   const auto uris = texture_slots(m);
   const auto images = image_slots(g);
-  for (size_t s = 0; s < kTextureSlots; ++s) *images[s] = texture_file(texture_base, *uris[s]);
+  for (size_t s = 0; s < kTextureSlots; ++s) {
+    uint32_t image = 0;
+    if (is_embedded_image_uri(*uris[s], &image))
+      g.embedded_images[s] = image < tree.images.size() ? &tree.images[image] : nullptr;  // the reader checked it
+    else *images[s] = texture_file(tree.texture_base, *uris[s]);
+  }
   return g;
 }
 
@@ -229,7 +244,7 @@ Status add_surfaces(const std::string& what, const HlodTree& tree, std::span<con
       int32_t& slot = renumbered[size_t(s.material)];
       if (slot < 0) {
         slot = int32_t(view.materials.size());
-        view.materials.push_back(gltf_material(tree.materials[size_t(s.material)], tree.texture_base));
+        view.materials.push_back(gltf_material(tree.materials[size_t(s.material)], tree));
       }
       id = slot;
     }
@@ -252,7 +267,9 @@ Status write_range(const fs::path& staging, const std::string& file, const std::
   view.indices = p.indices.data() + r.first_index;
   view.index_count = r.index_count;
   view.notes = &rep.notes;
-  if (shared) view.image_uri = [shared](const fs::path& image) { return shared->uri_of(image); };
+  if (shared) view.image_uri = [shared](const fs::path& image, const EmbeddedImage* embedded) {
+      return shared->uri_of(image, embedded);
+    };
   if (Status s = add_surfaces(mesh_name, tree, hlod_range_runs(p, range), view); !s) return s;
   const std::string rel = std::string(kTilesFolder) + "/" + file;
   if (Status s = save_gltf(staging / rel, view); !s) return s;

@@ -6,10 +6,12 @@
 //     u64 vertices (all nodes' layers and patches) | u64 boundary triangles (all patches)
 //     u32 material count | u32 min_verts | u32 node count | u32 inner node count
 //     u32 name bytes | u32 flags (bit 0: the payloads have uvs; the rest 0) |
-//     u32 materials section bytes M | u32 0 | name
+//     u32 materials section bytes M | u32 images section bytes I | name
 //     materials (M bytes, 0 = none described): the .lod's MATL section (runtime/material_section.h)
 //       with the texture base and no submeshes; when present, exactly `material count` of them
 //       (a subtree entry of the distributed bake carries the count alone)
+//     images (I bytes, 0 = none; only with materials): the .lod's IMGS section, the PNG/JPEG
+//       files the materials embed ("embedded:<k>" names image k), 8-byte aligned after M
 //     OctreeCode: one byte per inner node, breadth-first: bit i = octant i is non-empty
 //     NodeDescription: one bit per node but the root, breadth-first: 1 = leaf, 0 = inner
 //     node records: 80 bytes each (see put_record), breadth-first
@@ -65,9 +67,10 @@ using Writer = detail::ByteWriter;
 Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
 
 // The head's size from its counts (all u32, so no overflow in u64).
-uint64_t head_bytes(uint64_t name_bytes, uint64_t material_bytes, uint64_t nodes, uint64_t inner) {
+uint64_t head_bytes(uint64_t name_bytes, uint64_t material_bytes, uint64_t image_bytes, uint64_t nodes, uint64_t inner) {
   const uint64_t description = nodes > 0 ? (nodes - 1 + 7) / 8 : 0;
-  return align8(kFixedBytes + name_bytes) + align8(material_bytes) + align8(inner) + align8(description) +
+  return align8(kFixedBytes + name_bytes) + align8(material_bytes) + align8(image_bytes) + align8(inner) +
+         align8(description) +
          nodes * (kRecordBytes + kOffsetBytes);
 }
 
@@ -330,6 +333,7 @@ std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint
   surfaces.materials = tree.materials;
   surfaces.texture_base = tree.texture_base;
   const std::vector<uint8_t> materials = tree.materials.empty() ? std::vector<uint8_t>() : encode_material_section(surfaces);
+  const std::vector<uint8_t> images = tree.images.empty() ? std::vector<uint8_t>() : encode_image_section(tree.images);
   w.u32(tree.material_count);
   w.u32(tree.min_verts);
   w.u32(count);
@@ -337,10 +341,12 @@ std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint
   w.u32(uint32_t(tree.name.size()));
   w.u32(tree.uvs ? kFlagUvs : 0);
   w.u32(uint32_t(materials.size()));
-  w.u32(0);
+  w.u32(uint32_t(images.size()));
   w.bytes.insert(w.bytes.end(), tree.name.begin(), tree.name.end());
   w.align8();
   w.bytes.insert(w.bytes.end(), materials.begin(), materials.end());
+  w.align8();
+  w.bytes.insert(w.bytes.end(), images.begin(), images.end());
   w.align8();
   for (const HlodNode& n : tree.nodes)
     if (!n.leaf()) w.u8(n.child_mask);
@@ -412,17 +418,17 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
   const uint64_t head = load_u32(p + 12);
   const uint32_t materials = load_u32(p + 64), min_verts = load_u32(p + 68);
   const uint32_t count = load_u32(p + 72), inner = load_u32(p + 76), name_bytes = load_u32(p + 80);
-  const uint32_t flags = load_u32(p + 84), material_bytes = load_u32(p + 88);
+  const uint32_t flags = load_u32(p + 84), material_bytes = load_u32(p + 88), image_bytes = load_u32(p + 92);
   // Counts against the head size before anything is allocated.
   if (head + kChecksumBytes > file_size || head + kChecksumBytes > bytes.size())
     return refuse(what, "truncated: the head needs " + std::to_string(head + kChecksumBytes) + " bytes, the file has " +
                             std::to_string(file_size));
-  if (count == 0 || inner >= count || head != head_bytes(name_bytes, material_bytes, count, inner))
+  if (count == 0 || inner >= count || head != head_bytes(name_bytes, material_bytes, image_bytes, count, inner))
     return refuse(what, "head of " + std::to_string(head) + " bytes does not match its counts (" + std::to_string(count) +
                             " nodes, " + std::to_string(inner) + " inner, name of " + std::to_string(name_bytes) + ")");
   if (load_u64(p + head) != hash_bytes(p, head)) return refuse(what, "head checksum mismatch (file is corrupted)");
-  if (min_verts == 0 || (flags & ~kFlagUvs) != 0 || load_u32(p + 92) != 0)
-    return refuse(what, "header fields min_verts / flags / reserved are invalid");
+  if (min_verts == 0 || (flags & ~kFlagUvs) != 0 || (image_bytes != 0 && material_bytes == 0))
+    return refuse(what, "header fields min_verts / flags / image bytes are invalid");
   if (materials > kMaxMaterials)
     return refuse(what, std::to_string(materials) + " materials, at most " + std::to_string(kMaxMaterials));
 
@@ -439,8 +445,11 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
   t.uvs = (flags & kFlagUvs) != 0;
   t.material_count = materials;
   const uint64_t materials_at = align8(kFixedBytes + name_bytes);
+  const uint64_t images_at = materials_at + align8(material_bytes);
   if (material_bytes > 0) {
-    LodChain surfaces;
+    LodChain surfaces;  // images first: the materials' embedded:<k> are checked against them
+    if (image_bytes > 0)
+      if (Status s = decode_image_section({p + images_at, image_bytes}, what, surfaces.images); !s) return s;
     if (Status s = decode_material_section({p + materials_at, material_bytes}, what, surfaces); !s) return s;
     if (surfaces.materials.size() != materials || !surfaces.submeshes.empty())
       return refuse(what, "the header counts " + std::to_string(materials) + " materials, its MATL section holds " +
@@ -448,8 +457,9 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
                               std::to_string(surfaces.submeshes.size()) + " runs, which belong in the payloads)");
     t.materials = std::move(surfaces.materials);
     t.texture_base = std::move(surfaces.texture_base);
+    t.images = std::move(surfaces.images);
   }
-  const uint64_t code_at = materials_at + align8(material_bytes);
+  const uint64_t code_at = images_at + align8(image_bytes);
   const uint64_t description_at = code_at + align8(inner);
   const uint64_t records_at = description_at + align8((uint64_t(count) - 1 + 7) / 8);
   const uint64_t table_at = records_at + kRecordBytes * count;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "runtime/chain_material.h"
+#include "runtime/embedded_image.h"
 #include "runtime/lod_chain.h"  // Sphere
 
 namespace lod {
@@ -99,6 +100,9 @@ struct HlodTree {
   uint32_t material_count = 0;
   std::vector<ChainMaterial> materials;
   std::string texture_base;
+  // The images the materials embed ("embedded:<k>" names images[k]), as LodChain::images; empty
+  // with the materials in a subtree entry.
+  std::vector<EmbeddedImage> images;
   bool uvs = false;                      // the payloads have texture coordinates
   std::vector<HlodNode> nodes;           // breadth-first, nodes[0] is the root
 };

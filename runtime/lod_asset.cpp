@@ -438,7 +438,7 @@ Status get_materials(const uint8_t* p, uint64_t size, const std::string& what, L
   return Status::success();
 }
 
-void put_images(Writer& w, const std::vector<EmbeddedImage>& images) {
+void put_images(Writer& w, std::span<const EmbeddedImage> images) {
   uint64_t total = 0;
   for (const EmbeddedImage& img : images) total += img.bytes.size();
   w.u32(static_cast<uint32_t>(images.size()));
@@ -849,11 +849,30 @@ std::vector<uint8_t> encode_material_section(const LodChain& chain) {
 Status decode_material_section(std::span<const uint8_t> bytes, const std::string& what, LodChain& out) {
   LodChain c;
   if (Status st = get_materials(bytes.data(), bytes.size(), what, c); !st) return st;
+  // The embedded:<k> checks count out.images; they are lent, not copied (they may be large).
+  c.images = std::move(out.images);
   std::string message;
-  if (!validate_chain_materials(c, &message)) return refuse(what, "MATL section: " + message);
+  const bool valid = validate_chain_materials(c, &message);
+  out.images = std::move(c.images);
+  if (!valid) return refuse(what, "MATL section: " + message);
   out.materials = std::move(c.materials);
   out.texture_base = std::move(c.texture_base);
   out.submeshes = std::move(c.submeshes);
+  return Status::success();
+}
+
+std::vector<uint8_t> encode_image_section(std::span<const EmbeddedImage> images) {
+  Writer w;
+  put_images(w, images);
+  return std::move(w.bytes);
+}
+
+Status decode_image_section(std::span<const uint8_t> bytes, const std::string& what, std::vector<EmbeddedImage>& out) {
+  LodChain c;
+  if (Status st = get_images(bytes.data(), bytes.size(), what, c.images); !st) return st;
+  std::string message;
+  if (!validate_chain_images(c, &message)) return refuse(what, "IMGS section: " + message);
+  out = std::move(c.images);
   return Status::success();
 }
 

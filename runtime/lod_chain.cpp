@@ -264,6 +264,8 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
 
 bool validate_chain_materials(const LodChain& chain, std::string* message) { return validate_materials(chain, message); }
 
+bool validate_chain_images(const LodChain& chain, std::string* message) { return validate_images(chain, message); }
+
 std::span<const LevelSubmesh> level_submeshes(const LodChain& chain, uint32_t level) {
   const auto by_level = [](const LevelSubmesh& s, uint32_t k) { return s.level < k; };
   const auto lo = std::lower_bound(chain.submeshes.begin(), chain.submeshes.end(), level, by_level);

@@ -101,6 +101,9 @@ bool validate_chain(const LodChain& chain, std::string* message, const char** se
 // against its levels; the .hlod head's materials have no levels and no runs).
 bool validate_chain_materials(const LodChain& chain, std::string* message);
 
+// The images part of validate_chain alone (chain.images: bounds, and each signature against its type).
+bool validate_chain_images(const LodChain& chain, std::string* message);
+
 // Level k's material runs (a subrange of chain.submeshes; empty for a chain without materials).
 std::span<const LevelSubmesh> level_submeshes(const LodChain& chain, uint32_t level);
 

@@ -70,6 +70,7 @@ bool HlodNodeBuffers::init(const HlodModels& models, uint64_t capacity_bytes, st
     next += uint32_t(tree.materials.size());
     surfaces[m].materials = std::move(tree.materials);
     surfaces[m].texture_base = std::move(tree.texture_base);
+    surfaces[m].images = std::move(tree.images);  // "embedded:<k>" textures decode from these
   }
   materials_.upload(surfaces);
   return true;

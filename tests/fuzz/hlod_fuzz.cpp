@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/embedded_image.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/hlod_cut_check.h"
 #include "runtime/hlod_select.h"
@@ -82,6 +83,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Surfaces: uvs for every vertex or none, run materials below the count, the materials
   // themselves all there or (a subtree entry's asset) none.
   if (!tree.materials.empty() && tree.materials.size() != tree.material_count) std::abort();
+  // Embedded images: only beside materials, each the PNG or JPEG its type says, every
+  // "embedded:<k>" naming one of them.
+  if (!tree.images.empty() && tree.materials.empty()) std::abort();
+  for (const lod::EmbeddedImage& img : tree.images)
+    if (img.type == lod::ImageType::unknown || lod::image_type_of(img.bytes) != img.type) std::abort();
+  for (const lod::ChainMaterial& m : tree.materials)
+    for (const std::string* uri : lod::texture_slots(m))
+      if (uint32_t k = 0; lod::is_embedded_image_uri(*uri, &k) && k >= tree.images.size()) std::abort();
   for (const lod::HlodPayload& p : payloads) {
     if (p.uvs.size() != (tree.uvs ? p.positions.size() / 3 * 2 : 0)) std::abort();
     for (const lod::LevelSubmesh& r : p.runs)

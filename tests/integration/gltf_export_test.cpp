@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "embedded_texture_fixture.h"
 #include "gltf_fixture.h"
 #include "preprocess/mesh_io.h"
 #include "runtime/lod_asset.h"
@@ -486,31 +487,7 @@ TEST(GltfExport, SpotObjKeepsItsTextureThroughEveryLevel) {
 
 // ---- textures embedded in the source (GLB buffer view, data URI): kept in the .lod (IMGS) ----
 
-// two_material_sphere written by hand as glTF (not by lodkit's exporter): one primitive per
-// material, material 0 ('cap') with base colour texture 0 whose image is `image` (a JSON image
-// object: a buffer view or a data URI), material 1 plain and double-sided.
-lod::test::GltfFixture embedded_texture_sphere(nlohmann::json image, const std::vector<uint8_t>* image_in_buffer) {
-  const lod::MeshData m = lod::test::two_material_sphere(16, 32);
-  lod::test::GltfFixture f;
-  const int pos = f.add_accessor(f.add_view(m.positions), lod::test::kFloat, m.vertex_count(), "VEC3");
-  const int uv = f.add_accessor(f.add_view(m.uvs), lod::test::kFloat, m.vertex_count(), "VEC2");
-  std::vector<nlohmann::json> primitives;
-  for (const lod::Submesh& s : m.submeshes) {
-    const std::vector<uint32_t> part(m.indices.begin() + 3 * std::ptrdiff_t(s.first_triangle),
-                                     m.indices.begin() + 3 * std::ptrdiff_t(s.first_triangle + s.triangle_count));
-    const int ind = f.add_accessor(f.add_view(part), lod::test::kUInt, part.size(), "SCALAR");
-    primitives.push_back({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"indices", ind}, {"material", s.material}});
-  }
-  f.add_mesh(primitives);
-  f.set_scene({f.add_node({{"mesh", 0}})});
-  if (image_in_buffer) image["bufferView"] = f.add_view(*image_in_buffer);
-  f.j["images"] = nlohmann::json::array({image});
-  f.j["textures"] = nlohmann::json::array({{{"source", 0}}});
-  f.j["materials"] = nlohmann::json::array(
-      {{{"name", "cap"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}}}},
-       {{"name", "base"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.2, 0.1, 1.0}}}}, {"doubleSided", true}}});
-  return f;
-}
+using lod::test::embedded_texture_sphere;
 
 // `source` -> lod bake -> the .lod holds `png` -> inspect lists it -> GLB, glTF and OBJ export
 // of every level -> import: the image bytes identical in each; the validator: 0 errors.
@@ -587,27 +564,67 @@ TEST(GltfExport, APngInADataUriIsKeptByTheBakeAndExportedByteForByte) {
   expect_embedded_png_round_trip(dir, dir / "globe.gltf", png);
 }
 
-// The .hlod names texture files only: an HLOD bake of a GLB whose texture is inside it says it
-// leaves the texture out (naming file, material and slot), writes a file its own reader and the
-// 3D Tiles export accept, and keeps the material's other values.
-TEST(GltfExport, AnHlodBakeOfAGlbWithAnEmbeddedTextureSaysItLeavesItOut) {
+// A GLB whose texture is inside it through the HLOD path: lod bake --hlod keeps the PNG in the
+// .hlod (no note of anything left out), lod inspect lists it (text and --json), and lod export
+// --3dtiles puts it, byte for byte, into every GLB whose tile draws the textured material (or
+// once under textures/ with --shared-images); every GLB passes the Khronos validator.
+TEST(GltfExport, AnHlodBakeOfAGlbWithAnEmbeddedTextureKeepsItThroughTheTiles) {
   const fs::path dir = lod::test::temp_dir("gltf-embedded-hlod");
   const std::vector<uint8_t> png = lod::test::checker_png(32, 4);
   lod::test::GltfFixture f = embedded_texture_sphere({{"mimeType", "image/png"}}, &png);
   lod::test::write_bytes(dir / "globe.glb", f.glb());
-  auto r = run_lod("bake " + (dir / "globe.glb").string() + " -o " + (dir / "h").string() + " --hlod");
+  auto r = run_lod("bake " + (dir / "globe.glb").string() + " -o " + (dir / "h").string() + " --hlod --min-verts 300");
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find((dir / "globe.glb").string() + ": material 0 ("), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("base colour texture is embedded in the file, which the HLOD tree does not keep"), std::string::npos)
-      << r.out;
-  auto inspect = run_lod("inspect " + (dir / "h" / "globe.hlod").string());
+  EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
+  const fs::path hlod = dir / "h" / "globe.hlod";
+  auto inspect = run_lod("inspect " + hlod.string());
   ASSERT_EQ(inspect.code, 0) << inspect.out;
   EXPECT_NE(inspect.out.find("materials: 2"), std::string::npos) << inspect.out;
   EXPECT_NE(inspect.out.find("0 'cap': base colour 1 1 1 1"), std::string::npos) << inspect.out;
-  EXPECT_EQ(inspect.out.find("embedded:"), std::string::npos) << inspect.out;
-  auto tiles = run_lod("export --3dtiles " + (dir / "t").string() + " " + (dir / "h" / "globe.hlod").string());
-  ASSERT_EQ(tiles.code, 0) << tiles.out;
-  EXPECT_TRUE(fs::exists(dir / "t" / "tileset.json"));
+  EXPECT_NE(inspect.out.find("base colour texture embedded:0"), std::string::npos) << inspect.out;
+  EXPECT_NE(inspect.out.find("embedded images: 1 (" + std::to_string(png.size()) + " bytes"), std::string::npos)
+      << inspect.out;
+  EXPECT_NE(inspect.out.find("  embedded:0: image/png, " + std::to_string(png.size()) + " bytes"), std::string::npos)
+      << inspect.out;
+  inspect = run_lod("inspect " + hlod.string() + " --json");
+  ASSERT_EQ(inspect.code, 0) << inspect.out;
+  const auto j = nlohmann::json::parse(inspect.out);
+  ASSERT_EQ(j["images"].size(), 1u);
+  EXPECT_EQ(j["images"][0]["mime_type"], "image/png");
+  EXPECT_EQ(j["images"][0]["bytes"].get<size_t>(), png.size());
+
+  for (const bool shared : {false, true}) {
+    SCOPED_TRACE(shared ? "--shared-images" : "embedded in each GLB");
+    const fs::path out = dir / (shared ? "shared" : "tiles");
+    auto tiles = run_lod("export --3dtiles " + out.string() + " " + hlod.string() + (shared ? " --shared-images" : ""));
+    ASSERT_EQ(tiles.code, 0) << tiles.out;
+    EXPECT_EQ(tiles.out.find("note:"), std::string::npos) << tiles.out;
+    std::vector<fs::path> glbs;
+    for (const auto& e : fs::directory_iterator(out / "tiles"))
+      if (e.path().extension() == ".glb") glbs.push_back(e.path());
+    ASSERT_GT(glbs.size(), 2u);
+    size_t textured = 0;
+    for (const fs::path& glb : glbs) {
+      lod::MeshData back;
+      const lod::Status s = lod::load_mesh(glb, back);
+      ASSERT_TRUE(s.ok) << s.message;
+      for (const lod::MeshMaterial& m : back.materials) {
+        if (m.name != "cap") continue;
+        ++textured;
+        if (shared) {
+          EXPECT_FALSE(m.base_color_texture_embedded) << glb;
+          EXPECT_EQ(m.base_color_texture, "../textures/image0.png") << glb;
+        } else {
+          EXPECT_TRUE(m.base_color_texture_embedded) << glb;
+          ASSERT_EQ(back.images.size(), 1u) << glb;
+          EXPECT_EQ(back.images[0].bytes, png) << glb << ": the tile's image is the source's, byte for byte";
+        }
+      }
+    }
+    EXPECT_GT(textured, 0u) << "some tile draws the textured cap";
+    if (shared) EXPECT_EQ(lod::test::read_bytes(out / "textures" / "image0.png"), png);
+    expect_valid(glbs);
+  }
 }
 
 // Hostile embedded images: one that is not PNG/JPEG is dropped, said naming the file, material

@@ -108,16 +108,11 @@ TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
   EXPECT_LE(c.any_base, 10) << "colour-by-level must not show the material factor";
 }
 
-// The globe as a GLB whose checker PNG lives in the GLB's buffer (lodkit's exporter embeds it),
-// the PNG file then deleted: the bake keeps the image in the asset (IMGS) and the viewer decodes
-// it from memory, so the cap still shows both checker colours.
-TEST(ViewerTextured, ATextureEmbeddedInTheGlbIsDecodedFromTheAsset) {
-  LOD_REQUIRE_XVFB();
-  const char* model = "[[model]]\nname = \"textured\"\nfile = \"textured/globe.glb\"\nratios = [1.0, 0.5]\n";
-  const auto scene = lod::test::write_viewer_scene("textured-glb", kRun, kCamera, kInstance, model);
-  const auto dir = scene.dir / "textured";
+// The globe written by lodkit's GLB exporter with the checker inside it (dir/globe.glb; no
+// checker.png left beside it, so the picture's texture can only come from the embedded image).
+void write_embedded_globe(const std::filesystem::path& dir, int rings, int segments) {
   std::filesystem::create_directories(dir);
-  lod::MeshData m = lod::test::two_material_sphere(24, 48);
+  lod::MeshData m = lod::test::two_material_sphere(rings, segments);
   lod::test::turn_faces_outward(m);
   lod::test::write_bytes(dir / "checker.png", lod::test::checker_png(64, 8));
   lod::GltfMeshView view;
@@ -141,6 +136,16 @@ TEST(ViewerTextured, ATextureEmbeddedInTheGlbIsDecodedFromTheAsset) {
     view.submeshes.push_back({3 * size_t(sm.first_triangle), 3 * size_t(sm.triangle_count), sm.material});
   ASSERT_TRUE(lod::save_gltf(dir / "globe.glb", view).ok);
   std::filesystem::remove(dir / "checker.png");
+}
+
+// The globe as a GLB whose checker PNG lives in the GLB's buffer (lodkit's exporter embeds it),
+// the PNG file then deleted: the bake keeps the image in the asset (IMGS) and the viewer decodes
+// it from memory, so the cap still shows both checker colours.
+TEST(ViewerTextured, ATextureEmbeddedInTheGlbIsDecodedFromTheAsset) {
+  LOD_REQUIRE_XVFB();
+  const char* model = "[[model]]\nname = \"textured\"\nfile = \"textured/globe.glb\"\nratios = [1.0, 0.5]\n";
+  const auto scene = lod::test::write_viewer_scene("textured-glb", kRun, kCamera, kInstance, model);
+  write_embedded_globe(scene.dir / "textured", 24, 48);
   const auto lit = scene.dir / "embedded.png";
   const auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -221,6 +226,40 @@ min_verts = 300
   const HueCounts c = count_hues(by_depth, kAbsent);
   EXPECT_LE(c.any_checker, 10) << "colour-by-depth must not show the texture";
   EXPECT_LE(c.any_base, 10) << "colour-by-depth must not show the material factor";
+}
+
+// The embedded-texture GLB as an HLOD model: the .hlod carries the PNG, and the nodes are drawn
+// with it, decoded from the tree's images as a .lod's are from its chain's.
+TEST(ViewerTextured, HlodOfAGlbShowsTheTextureEmbeddedInIt) {
+  LOD_REQUIRE_XVFB();
+  const char* model = R"([[model]]
+name = "textured"
+file = "textured/globe.glb"
+hlod = true
+min_verts = 300
+)";
+  const char* run = "[run]\nframes = 3\nthreads = 1\n[budget]\ntriangles = 1000000\n[lod]\npixel_error = 1.0\n";
+  const auto scene = lod::test::write_viewer_scene("textured-hlod-glb", run, kCamera, kInstance, model);
+  write_embedded_globe(scene.dir / "textured", 48, 96);
+  const auto lit = scene.dir / "hlod.png";
+  const auto stats = scene.dir / "hlod.csv";
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" +
+                                                  stats.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "every texture was decoded: " << r.output;
+  EXPECT_EQ(r.output.find("left out"), std::string::npos) << r.output;
+  lod::test::CsvTable t;
+  ASSERT_TRUE(lod::test::load_csv(stats, t));
+  ASSERT_FALSE(t.rows.empty());
+  EXPECT_GT(t.get(t.rows.size() - 1, "hlod_draws"), 0) << "drawn through its HLOD cut";
+  Image img;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  const HueCounts c = count_hues(img, kPresent);
+  std::printf("HLOD embedded checker: %d light and %d dark pixels above the equator, %d base below\n", c.light_above,
+              c.dark_above, c.base_below);
+  EXPECT_GE(c.light_above, 300) << "light checker squares from the .hlod's embedded image";
+  EXPECT_GE(c.dark_above, 300) << "dark checker squares from the .hlod's embedded image";
+  EXPECT_GE(c.base_below, 300);
 }
 
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {

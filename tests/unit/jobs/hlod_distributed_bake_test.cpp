@@ -17,6 +17,7 @@
 #include "preprocess/mesh_io.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/lod_asset.h"  // hash_bytes
+#include "embedded_texture_fixture.h"
 #include "test_support.h"
 #include "textured_fixture.h"
 #include "unit/jobs/thread_ranks.h"
@@ -272,6 +273,38 @@ TEST(HlodDistributedBake, TexturedModelGivesTheLocalBytesAtEveryRankCountAndFrom
   }
 }
 
+// A GLB with its texture inside (most real glTF inputs): the tree keeps the PNG byte for byte,
+// and the distributed bake writes the local bake's bytes at 1, 2 and 3 ranks, and again from
+// the cleaned mesh entry (which stores the image) and the subtrees in the cache.
+TEST(HlodDistributedBake, EmbeddedTextureGivesTheLocalBytesAtEveryRankCountAndFromTheCache) {
+  const auto dir = test::temp_dir("hlod_dist_embedded");
+  const std::vector<uint8_t> png = test::checker_png(32, 4);
+  const auto mesh = dir / "globe.glb";
+  test::write_bytes(mesh, test::embedded_texture_sphere({{"mimeType", "image/png"}}, &png, 48, 96).glb());
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  HlodTree tree;
+  std::vector<HlodPayload> payloads;
+  ASSERT_TRUE(decode_hlod_asset(local, "mixed.hlod", tree, payloads));
+  ASSERT_EQ(tree.materials.size(), 2u);
+  EXPECT_EQ(tree.materials[0].base_color_texture, "embedded:0");
+  ASSERT_EQ(tree.images.size(), 1u);
+  EXPECT_EQ(tree.images[0].type, ImageType::png);
+  EXPECT_EQ(tree.images[0].bytes, png);
+  EXPECT_GT(tree.nodes.size(), 8u);
+  for (int ranks : {1, 2, 3}) {
+    const auto cache = dir / ("cache" + std::to_string(ranks));
+    std::vector<RankRun> runs = run_ranks(ranks, mesh, dir / "out", cache);
+    for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << ranks << " ranks";
+    std::filesystem::remove(dir / "out" / "mixed.hlod");
+    runs = run_ranks(ranks, mesh, dir / "out", cache);
+    ASSERT_TRUE(runs[0].status) << runs[0].status.message;
+    EXPECT_TRUE(runs[0].result.mesh_cached);
+    EXPECT_EQ(runs[0].result.cached, runs[0].result.subtrees);
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << ranks << " ranks, from the cache";
+  }
+}
+
 TEST(HlodMeshCache, TexturedMeshKeepsUvsSubmeshesAndMaterials) {
   const auto dir = test::temp_dir("hlod_mesh_cache_textured");
   const MeshData m = test::two_material_sphere(8, 12);
@@ -280,6 +313,8 @@ TEST(HlodMeshCache, TexturedMeshKeepsUvsSubmeshesAndMaterials) {
   surfaces.materials[0].name = "cap";
   surfaces.materials[0].base_color_texture = "checker.png";
   surfaces.texture_base = "/textures";
+  surfaces.materials[1].emissive_texture = "embedded:0";
+  surfaces.images.push_back({ImageType::png, test::checker_png(8, 2)});
   ASSERT_TRUE(store_hlod_mesh(dir, 9, m, 99, surfaces));
   MeshData back;
   HlodSurfaces got;
@@ -291,17 +326,33 @@ TEST(HlodMeshCache, TexturedMeshKeepsUvsSubmeshesAndMaterials) {
   ASSERT_EQ(got.materials.size(), 2u);
   EXPECT_EQ(got.materials[0].base_color_texture, "checker.png");
   EXPECT_EQ(got.texture_base, "/textures");
-  // A submesh naming a material the entry does not hold is refused, under a forged checksum.
+  EXPECT_EQ(got.materials[1].emissive_texture, "embedded:0");
+  ASSERT_EQ(got.images.size(), 1u);
+  EXPECT_EQ(got.images[0].bytes, surfaces.images[0].bytes);
+  // Each edit under a forged checksum: refused, saying why.
   const auto path = hlod_mesh_entry_path(dir, 9);
-  std::vector<uint8_t> bad = test::read_bytes(path);
-  const size_t submeshes = 64 + 20 * m.vertex_count() + 4 * m.indices.size();
-  bad[submeshes + 12 + 8] = 5;
-  const uint64_t sum = hash_bytes(bad.data(), bad.size() - 8);
-  std::memcpy(bad.data() + bad.size() - 8, &sum, 8);
-  test::write_bytes(path, bad);
-  std::string why;
-  EXPECT_EQ(load_hlod_mesh(dir, 9, "ball.gltf", back, input, &why, &got), CacheLookup::refused);
-  EXPECT_NE(why.find("names a material of the 2"), std::string::npos) << why;
+  const std::vector<uint8_t> good = test::read_bytes(path);
+  const auto refused = [&](size_t at, uint8_t value, const char* expected) {
+    std::vector<uint8_t> bad = good;
+    bad[at] = value;
+    const uint64_t sum = hash_bytes(bad.data(), bad.size() - 8);
+    std::memcpy(bad.data() + bad.size() - 8, &sum, 8);
+    test::write_bytes(path, bad);
+    std::string why;
+    EXPECT_EQ(load_hlod_mesh(dir, 9, "ball.gltf", back, input, &why, &got), CacheLookup::refused) << expected;
+    EXPECT_NE(why.find(expected), std::string::npos) << why;
+  };
+  // A submesh naming a material the entry does not hold.
+  const size_t submeshes = 72 + 20 * m.vertex_count() + 4 * m.indices.size();
+  refused(submeshes + 12 + 8, 5, "names a material of the 2");
+  // The image's PNG signature broken (its bytes end where the checksum starts; its 16-byte entry,
+  // u64 length then u8 type, comes just before them).
+  const size_t image = good.size() - 8 - surfaces.images[0].bytes.size();
+  refused(image + 1, 'Q', "is not the PNG or JPEG its type says");
+  // Its type byte neither PNG nor JPEG.
+  refused(image - 16 + 8, 9, "has type 9");
+  // More images bytes than the entry holds (the count field at 64).
+  refused(64, uint8_t(good[64] + 8), "do not match");
 }
 
 TEST(HlodMeshCache, CleanedMeshRoundTripsAndBrokenEntriesAreRefused) {

@@ -84,8 +84,9 @@ Sample sample() {
   return s;
 }
 
-// The sample with texture coordinates, two materials (one textured) and each range's triangles
-// in two material runs (its first third the default material, the rest alternating 0 and 1).
+// The sample with texture coordinates, two materials (one textured from a file, one from an
+// image embedded in the tree) and each range's triangles in two material runs (its first third
+// the default material, the rest alternating 0 and 1).
 Sample textured_sample() {
   Sample s = sample();
   s.tree.uvs = true;
@@ -98,7 +99,13 @@ Sample textured_sample() {
   b.name = "leaf";
   b.roughness = 0.25f;
   b.double_sided = true;
+  b.base_color_texture = embedded_image_uri(0);
   s.tree.materials = {a, b};
+  // A PNG signature and a few bytes: the reader checks signatures, not pixels.
+  EmbeddedImage png;
+  png.type = ImageType::png;
+  png.bytes = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+  s.tree.images = {png};
   for (size_t i = 0; i < s.payloads.size(); ++i) {
     HlodPayload& p = s.payloads[i];
     HlodNode& n = s.tree.nodes[i];
@@ -144,6 +151,11 @@ void expect_same(const Sample& a, const HlodTree& t, const std::vector<HlodPaylo
     EXPECT_EQ(t.materials[m].base_color[1], a.tree.materials[m].base_color[1]);
     EXPECT_EQ(t.materials[m].roughness, a.tree.materials[m].roughness);
     EXPECT_EQ(t.materials[m].double_sided, a.tree.materials[m].double_sided);
+  }
+  ASSERT_EQ(t.images.size(), a.tree.images.size());
+  for (size_t k = 0; k < t.images.size(); ++k) {
+    EXPECT_EQ(t.images[k].type, a.tree.images[k].type);
+    EXPECT_EQ(t.images[k].bytes, a.tree.images[k].bytes);
   }
   ASSERT_EQ(t.nodes.size(), a.tree.nodes.size());
   for (size_t i = 0; i < t.nodes.size(); ++i) {
@@ -486,6 +498,45 @@ TEST(HlodAsset, RefusesHostileSurfacesNamingThem) {
     std::memcpy(b.data() + at, &v, 4);
     return at;
   }, "base colour factor outside [0, 1]");
+}
+
+// The embedded images: each one's type against its signature, and every "embedded:<k>" of the
+// materials against their count, before anything is kept.
+TEST(HlodAsset, RefusesHostileEmbeddedImagesNamingThem) {
+  const auto refused = [](const Sample& s, auto&& edit, const char* expected) {
+    std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+    const Layout l = layout_of(bytes);
+    forge_checksum(bytes, l, edit(bytes));
+    HlodTree t = sentinel();
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(bytes, "tree.hlod", t, p);
+    ASSERT_FALSE(st) << expected;
+    EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
+    EXPECT_EQ(t.name, "untouched");
+  };
+  const Sample s = textured_sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  uint32_t material_bytes = 0, image_bytes = 0;
+  std::memcpy(&material_bytes, bytes.data() + 88, 4);
+  std::memcpy(&image_bytes, bytes.data() + 92, 4);
+  ASSERT_GT(image_bytes, 0u);
+  const uint64_t images = 96 + 8 + ((uint64_t{material_bytes} + 7) & ~uint64_t{7});
+  // The image's signature broken: its bytes follow the 16-byte section header and its 16-byte entry.
+  refused(s, [&](std::vector<uint8_t>& b) { return b[images + 32 + 1] ^= 0x20, images + 32 + 1; },
+          "is not the PNG or JPEG its type says");
+  // Its type byte (entry offset 8) neither PNG nor JPEG.
+  refused(s, [&](std::vector<uint8_t>& b) { return b[images + 16 + 8] = 7, images + 16 + 8; }, "has type 7");
+  // A length past the section's bytes.
+  refused(s, [&](std::vector<uint8_t>& b) { return b[images + 16] = 200, images + 16; }, "IMGS section");
+  // A material naming an image the tree does not hold.
+  Sample missing = textured_sample();
+  missing.tree.materials[1].base_color_texture = embedded_image_uri(1);
+  HlodTree t = sentinel();
+  std::vector<HlodPayload> p;
+  const Status st = decode_hlod_asset(encode_hlod_asset(missing.tree, missing.payloads), "tree.hlod", t, p);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("names embedded image 'embedded:1' of 1"), std::string::npos) << st.message;
+  EXPECT_EQ(t.name, "untouched");
 }
 
 TEST(HlodAsset, RefusesVersionOneAskingForARebake) {
