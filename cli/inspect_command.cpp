@@ -83,29 +83,8 @@ void print_materials(const LodChain& chain) {
 
 // The level's materials and runs for the writers; images resolved against the texture base.
 void export_surfaces(const LodChain& chain, uint32_t k, GltfMeshView& view) {
-  for (const ChainMaterial& m : chain.materials) {
-    GltfMaterialView g;
-    g.name = m.name;
-    std::copy(m.base_color, m.base_color + 4, g.base_color);
-    g.metallic = m.metallic;
-    g.roughness = m.roughness;
-    g.alpha_mode = m.alpha_mode;
-    g.alpha_cutoff = m.alpha_cutoff;
-    g.double_sided = m.double_sided;
-    g.normal_scale = m.normal_scale;
-    g.occlusion_strength = m.occlusion_strength;
-    std::copy(m.emissive, m.emissive + 3, g.emissive);
-    g.tex_coords = m.tex_coords;
-    const auto uris = texture_slots(m);
-    const auto images = image_slots(g);
-    for (size_t s = 0; s < kTextureSlots; ++s) {
-      uint32_t image = 0;
-      if (is_embedded_image_uri(*uris[s], &image))
-        g.embedded_images[s] = image < chain.images.size() ? &chain.images[image] : nullptr;  // validate_chain checked it
-      else *images[s] = texture_file(chain.texture_base, *uris[s]);
-    }
-    view.materials.push_back(std::move(g));
-  }
+  for (const ChainMaterial& m : chain.materials)
+    view.materials.push_back(gltf_material_view(m, chain.images, chain.texture_base));
   for (const LevelSubmesh& s : level_submeshes(chain, k)) view.submeshes.push_back({s.first_index, s.index_count, s.material});
 }
 

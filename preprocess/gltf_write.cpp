@@ -5,6 +5,7 @@
 #include "preprocess/gltf_write.h"
 
 #include "preprocess/tangents.h"
+#include "preprocess/texture_uri.h"
 
 #include <algorithm>
 #include <bit>
@@ -453,6 +454,31 @@ Status save_gltf(const std::filesystem::path& path, const GltfMeshView& mesh) {
   if (!images.empty()) j["images"] = image_list;
   const std::string text = j.dump(1, ' ', false, json::error_handler_t::replace);
   return write_atomically(path, std::vector<uint8_t>(text.begin(), text.end()));
+}
+
+GltfMaterialView gltf_material_view(const ChainMaterial& m, const std::vector<EmbeddedImage>& images,
+                                    const std::string& texture_base) {
+  GltfMaterialView g;
+  g.name = m.name;
+  std::copy(m.base_color, m.base_color + 4, g.base_color);
+  g.metallic = m.metallic;
+  g.roughness = m.roughness;
+  g.alpha_mode = m.alpha_mode;
+  g.alpha_cutoff = m.alpha_cutoff;
+  g.double_sided = m.double_sided;
+  g.normal_scale = m.normal_scale;
+  g.occlusion_strength = m.occlusion_strength;
+  std::copy(m.emissive, m.emissive + 3, g.emissive);
+  g.tex_coords = m.tex_coords;
+  const auto uris = texture_slots(m);
+  const auto files = image_slots(g);
+  for (size_t s = 0; s < kTextureSlots; ++s) {
+    uint32_t image = 0;
+    if (is_embedded_image_uri(*uris[s], &image))
+      g.embedded_images[s] = image < images.size() ? &images[image] : nullptr;
+    else *files[s] = texture_file(texture_base, *uris[s]);
+  }
+  return g;
 }
 
 }  // namespace lod

@@ -51,6 +51,12 @@ struct GltfMaterialView {
   std::array<uint8_t, kTextureSlots> tex_coords{};
 };
 
+// A baked material for the writer: factors copied, each texture slot either one of `images`
+// (an "embedded:<k>" URI, k checked by the asset readers; out of range: no image) or the file
+// its URI names under `texture_base` (a missing file is left out by the writer and said).
+GltfMaterialView gltf_material_view(const ChainMaterial& m, const std::vector<EmbeddedImage>& images,
+                                    const std::string& texture_base);
+
 // The images in kTextureSlots order (runtime/chain_material.h).
 inline std::array<const std::filesystem::path*, kTextureSlots> image_slots(const GltfMaterialView& m) {
   return {&m.base_color_image, &m.metallic_roughness_image, &m.normal_image, &m.occlusion_image, &m.emissive_image};

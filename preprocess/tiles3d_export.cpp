@@ -206,27 +206,7 @@ Status check_payload(const std::string& what, const HlodNode& n, const HlodPaylo
 // A tree material for the GLB writer, its images the tree's own (embedded:<k>) or files resolved
 // against the texture base (one missing at export time is left out by the writer and said).
 GltfMaterialView gltf_material(const ChainMaterial& m, const HlodTree& tree) {
-  GltfMaterialView g;
-  g.name = m.name;
-  std::copy(m.base_color, m.base_color + 4, g.base_color);
-  g.metallic = m.metallic;
-  g.roughness = m.roughness;
-  g.alpha_mode = m.alpha_mode;
-  g.alpha_cutoff = m.alpha_cutoff;
-  g.double_sided = m.double_sided;
-  g.normal_scale = m.normal_scale;
-  g.occlusion_strength = m.occlusion_strength;
-  std::copy(m.emissive, m.emissive + 3, g.emissive);
-  g.tex_coords = m.tex_coords;
-  const auto uris = texture_slots(m);
-  const auto images = image_slots(g);
-  for (size_t s = 0; s < kTextureSlots; ++s) {
-    uint32_t image = 0;
-    if (is_embedded_image_uri(*uris[s], &image))
-      g.embedded_images[s] = image < tree.images.size() ? &tree.images[image] : nullptr;  // the reader checked it
-    else *images[s] = texture_file(tree.texture_base, *uris[s]);
-  }
-  return g;
+  return gltf_material_view(m, tree.images, tree.texture_base);
 }
 
 // The range's runs as primitives, with only the materials they use (renumbered in order of
