@@ -26,6 +26,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -494,35 +495,83 @@ struct UvTransform {
   bool identity = true;
 };
 
-// The base colour texture's KHR_texture_transform, when it maps TEXCOORD_0 (gltfpack stores
-// quantized UVs this way). Other textures' transforms do not change the one uv per vertex.
-UvTransform uv_transform_of(const tinygltf::Model& m, int material) {
+// A material's five texture references in kTextureSlots order, with the texCoord each reads
+// (KHR_texture_transform's texCoord overrides the texture info's, as that extension says).
+struct TextureRef {
+  const char* name = "";
+  int index = -1, tex_coord = 0;
+  const tinygltf::Value* transform = nullptr;  // the KHR_texture_transform object, or null
+};
+
+TextureRef texture_ref(const char* name, int index, int tex_coord, const tinygltf::ExtensionMap& extensions) {
+  TextureRef r{name, index, tex_coord, nullptr};
+  const auto it = extensions.find("KHR_texture_transform");
+  if (it == extensions.end() || !it->second.IsObject()) return r;
+  r.transform = &it->second;
+  const tinygltf::Value& tc = it->second.Get("texCoord");
+  if (tc.IsNumber() && std::isfinite(tc.GetNumberAsDouble()) && std::abs(tc.GetNumberAsDouble()) < 1e6)
+    r.tex_coord = int(tc.GetNumberAsDouble());
+  return r;
+}
+
+std::array<TextureRef, kTextureSlots> texture_refs(const tinygltf::Material& src) {
+  const tinygltf::PbrMetallicRoughness& pbr = src.pbrMetallicRoughness;
+  return {texture_ref("baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                      pbr.baseColorTexture.extensions),
+          texture_ref("metallicRoughnessTexture", pbr.metallicRoughnessTexture.index,
+                      pbr.metallicRoughnessTexture.texCoord, pbr.metallicRoughnessTexture.extensions),
+          texture_ref("normalTexture", src.normalTexture.index, src.normalTexture.texCoord, src.normalTexture.extensions),
+          texture_ref("occlusionTexture", src.occlusionTexture.index, src.occlusionTexture.texCoord,
+                      src.occlusionTexture.extensions),
+          texture_ref("emissiveTexture", src.emissiveTexture.index, src.emissiveTexture.texCoord,
+                      src.emissiveTexture.extensions)};
+}
+
+UvTransform uv_transform_of(const TextureRef& r) {
   UvTransform t;
-  if (material < 0 || size_t(material) >= m.materials.size()) return t;
-  const tinygltf::TextureInfo& info = m.materials[size_t(material)].pbrMetallicRoughness.baseColorTexture;
-  const auto it = info.extensions.find("KHR_texture_transform");
-  if (info.index < 0 || info.texCoord != 0 || it == info.extensions.end() || !it->second.IsObject()) return t;
-  const tinygltf::Value& v = it->second;
+  if (!r.transform) return t;
+  const tinygltf::Value& v = *r.transform;
   auto number = [](const tinygltf::Value& x, int i, double fallback) {
     if (!x.IsArray() || int(x.ArrayLen()) <= i || !x.Get(i).IsNumber()) return fallback;
     const double d = x.Get(i).GetNumberAsDouble();
     return std::isfinite(d) ? d : fallback;
   };
-  if (v.Get("texCoord").IsNumber() && v.Get("texCoord").GetNumberAsDouble() != 0) return t;
   const double ox = number(v.Get("offset"), 0, 0), oy = number(v.Get("offset"), 1, 0);
   const double sx = number(v.Get("scale"), 0, 1), sy = number(v.Get("scale"), 1, 1);
-  const double r = v.Get("rotation").IsNumber() && std::isfinite(v.Get("rotation").GetNumberAsDouble())
-                       ? v.Get("rotation").GetNumberAsDouble()
-                       : 0.0;
-  const double c = std::cos(r), s = std::sin(r);
+  const double angle = v.Get("rotation").IsNumber() && std::isfinite(v.Get("rotation").GetNumberAsDouble())
+                        ? v.Get("rotation").GetNumberAsDouble()
+                        : 0.0;
+  const double c = std::cos(angle), s = std::sin(angle);
   const double mat[6] = {c * sx, s * sy, ox, -s * sx, c * sy, oy};
   std::copy(mat, mat + 6, t.m);
-  t.identity = false;
+  t.identity = std::equal(mat, mat + 6, UvTransform{}.m);
   return t;
 }
 
+// One uv per vertex and set: the transform of the first texture (in slot order, so the base
+// colour's first) reading that set is applied to it (gltfpack stores quantized uvs this way).
+// A texture on the same set with another transform cannot be kept exactly: `conflict` names it.
+std::array<UvTransform, 2> uv_transforms_of(const tinygltf::Model& m, int material, std::string* conflict = nullptr) {
+  std::array<UvTransform, 2> out;
+  if (material < 0 || size_t(material) >= m.materials.size()) return out;
+  const std::array<TextureRef, kTextureSlots> refs = texture_refs(m.materials[size_t(material)]);
+  for (int set = 0; set < 2; ++set) {
+    const TextureRef* first = nullptr;
+    for (const TextureRef& r : refs) {
+      if (r.index < 0 || r.tex_coord != set) continue;
+      const UvTransform t = uv_transform_of(r);
+      if (!first) first = &r, out[size_t(set)] = t;
+      else if (conflict && conflict->empty() && !std::equal(t.m, t.m + 6, out[size_t(set)].m))
+        *conflict = std::string(r.name) + " has another KHR_texture_transform than " + first->name + " on TEXCOORD_" +
+                    std::to_string(set) + "; " + first->name + "'s is applied to the uvs, so " + r.name +
+                    " is sampled without its own";
+    }
+  }
+  return out;
+}
+
 struct PrimitivePlan {
-  UvTransform uv_transform;
+  std::array<UvTransform, 2> uv_transforms;  // TEXCOORD_0, TEXCOORD_1
   int mesh = -1, primitive = -1;
   int mode = TINYGLTF_MODE_TRIANGLES;
   int material = -1;
@@ -574,7 +623,7 @@ Status plan_mesh(const std::string& what, const tinygltf::Model& m, int mesh, st
     if (plan.material >= 0 && size_t(plan.material) >= m.materials.size())
       return Status::error(where + ": material " + std::to_string(plan.material) + " of " +
                            std::to_string(m.materials.size()));
-    plan.uv_transform = uv_transform_of(m, plan.material);
+    plan.uv_transforms = uv_transforms_of(m, plan.material);
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) return Status::error(where + ": has no POSITION attribute");
     for (const auto& [name, accessor] : prim.attributes) {
@@ -845,8 +894,8 @@ Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const 
     if (plan.has_uv) suspect = append_elements(plan.uv, out.uvs);
     else out.uvs.resize(2 * (base + n), 0.0f);  // (0, 0) for a primitive without TEXCOORD_0
     float* q = out.uvs.data() + 2 * base;
-    const bool transformed = plan.has_uv && !plan.uv_transform.identity;
-    if (transformed) transform_uvs(plan.uv_transform, q, n);
+    const bool transformed = plan.has_uv && !plan.uv_transforms[0].identity;
+    if (transformed) transform_uvs(plan.uv_transforms[0], q, n);
     if (const size_t bad = suspect || transformed ? first_nonfinite(q, 2 * n) : 2 * n; bad < 2 * n)
       return Status::error(where + ": vertex " + std::to_string(bad / 2) + " has a non-finite TEXCOORD_0");
   }
@@ -854,8 +903,10 @@ Status emit_primitive(const std::string& what, const PrimitivePlan& plan, const 
     suspect = false;
     if (plan.has_uv1) suspect = append_elements(plan.uv1, out.uvs1);
     else out.uvs1.resize(2 * (base + n), 0.0f);  // (0, 0) for a primitive without TEXCOORD_1
-    const float* q = out.uvs1.data() + 2 * base;
-    if (const size_t bad = suspect ? first_nonfinite(q, 2 * n) : 2 * n; bad < 2 * n)
+    float* q = out.uvs1.data() + 2 * base;
+    const bool transformed = plan.has_uv1 && !plan.uv_transforms[1].identity;
+    if (transformed) transform_uvs(plan.uv_transforms[1], q, n);
+    if (const size_t bad = suspect || transformed ? first_nonfinite(q, 2 * n) : 2 * n; bad < 2 * n)
       return Status::error(where + ": vertex " + std::to_string(bad / 2) + " has a non-finite TEXCOORD_1");
   }
   if (cols.colors)
@@ -989,20 +1040,15 @@ Status read_materials(const std::string& what, const tinygltf::Model& m, std::ve
     mat.occlusion_strength = float(src.occlusionTexture.strength);
     for (size_t c = 0; c < 3 && c < src.emissiveFactor.size(); ++c) mat.emissive[c] = float(src.emissiveFactor[c]);
     const auto slots = texture_slots(mat);
-    const struct {
-      const char* name;
-      int index, tex_coord;
-    } refs[kTextureSlots] = {
-        {"baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord},
-        {"metallicRoughnessTexture", pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord},
-        {"normalTexture", src.normalTexture.index, src.normalTexture.texCoord},
-        {"occlusionTexture", src.occlusionTexture.index, src.occlusionTexture.texCoord},
-        {"emissiveTexture", src.emissiveTexture.index, src.emissiveTexture.texCoord}};
+    const std::array<TextureRef, kTextureSlots> refs = texture_refs(src);
     for (size_t k = 0; k < kTextureSlots; ++k)
       if (Status s = read_texture(what, m, i, refs[k].name, refs[k].index, refs[k].tex_coord, *slots[k].uri,
                                   *slots[k].embedded, mat.tex_coords[k], images, kept, warnings);
           !s)
         return s;
+    std::string conflict;
+    uv_transforms_of(m, int(i), &conflict);
+    if (!conflict.empty()) warnings.push_back(what + ": material " + std::to_string(i) + ": " + conflict);
     out.push_back(std::move(mat));
   }
   return Status::success();

@@ -641,6 +641,36 @@ TEST(GltfImport, AppliesTheBaseColourTextureTransformToTexcoords) {
   EXPECT_FALSE(has_warning(m, "KHR_texture_transform"));
 }
 
+// Each uv set takes the transform of the first texture reading it: the occlusion texture's on
+// TEXCOORD_1 (its texCoord given by the extension, which overrides the texture info's), the base
+// colour's on TEXCOORD_0; an emissive texture on TEXCOORD_0 with another transform is said.
+TEST(GltfImport, AppliesEachUvSetsTextureTransformAndSaysWhereTwoDisagree) {
+  GltfFixture f;
+  const int pos = f.add_accessor(f.add_view(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), kFloat, 3, "VEC3");
+  const int tex0 = f.add_accessor(f.add_view(std::vector<float>{0, 0, 1, 0, 1, 1}), kFloat, 3, "VEC2");
+  const int tex1 = f.add_accessor(f.add_view(std::vector<float>{0, 0, 1, 0, 0, 1}), kFloat, 3, "VEC2");
+  f.add_mesh({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", tex0}, {"TEXCOORD_1", tex1}}}, {"material", 0}}});
+  f.j["images"] = json::array({{{"uri", "a.png"}}});
+  f.j["textures"] = json::array({{{"source", 0}}});
+  auto transform = [](json t) { return json{{"KHR_texture_transform", t}}; };
+  f.j["materials"] = json::array(
+      {{{"pbrMetallicRoughness",
+         {{"baseColorTexture", {{"index", 0}, {"extensions", transform({{"offset", {0.5, 0}}})}}}}},
+        {"occlusionTexture", {{"index", 0}, {"extensions", transform({{"scale", {2, 3}}, {"texCoord", 1}})}}},
+        {"emissiveTexture", {{"index", 0}, {"extensions", transform({{"offset", {0, 0.5}}})}}}}});
+  f.j["extensionsUsed"] = {"KHR_texture_transform"};
+  place_meshes(f);
+  MeshData m;
+  const Status s = load_glb(f, m);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_EQ(m.uvs, (std::vector<float>{0.5f, 0, 1.5f, 0, 1.5f, 1}));
+  EXPECT_EQ(m.uvs1, (std::vector<float>{0, 0, 2, 0, 0, 3}));
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_EQ(m.materials[0].tex_coords[3], 1);  // occlusion, through the extension's texCoord
+  EXPECT_TRUE(has_warning(m, "t.glb: material 0: emissiveTexture has another KHR_texture_transform than "
+                             "baseColorTexture on TEXCOORD_0"));
+}
+
 // Images inside the file are kept undecoded, once each however many slots name them: a PNG in a
 // buffer view, a JPEG in a data URI; one that is neither is left out, said naming the file,
 // material and slot; the slots name the kept ones "embedded:<k>".
