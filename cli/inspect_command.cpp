@@ -126,9 +126,11 @@ Status export_level(const std::filesystem::path& out, const std::string& format,
   GltfMeshView view;
   view.notes = &notes;
   if (!chain.materials.empty()) export_surfaces(chain, k, view);
+  if (format == "obj" && uvs1) notes.push_back(out.string() + ": OBJ has one uv set; TEXCOORD_1 is not written (glb or gltf keep it)");
   if (format == "obj" && view.submeshes.empty())
-    return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs);
-  if (format == "obj") return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs, obj_surfaces(view));
+    return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs, colors);
+  if (format == "obj")
+    return save_obj(out, positions, normals, l.vertex_count, indices, l.index_count, uvs, obj_surfaces(view), colors);
   if (format == "glb" || format == "gltf") {
     view.name = name;
     view.positions = positions;

@@ -491,9 +491,15 @@ Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
   return write_file_atomic(mtl, text);
 }
 
+// The OBJ colour extension is sRGB as displayed (MeshLab); MeshData::colors are linear.
+float linear_to_srgb(float c) {
+  c = std::clamp(c, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1 / 2.4f) - 0.055f;
+}
+
 Status save_obj_text(const std::filesystem::path& path, const float* positions, const float* normals,
                      size_t vertex_count, const uint32_t* indices, size_t index_count, const float* uvs,
-                     const ObjSurfaces* surfaces) {
+                     const float* colors, const ObjSurfaces* surfaces) {
   const std::string what = path.string();
   if (index_count % 3 != 0) return Status::error(what + ": index count " + std::to_string(index_count) + " is not a multiple of 3");
   for (size_t i = 0; i < index_count; ++i)
@@ -511,7 +517,13 @@ Status save_obj_text(const std::filesystem::path& path, const float* positions, 
   char line[160];
   for (size_t v = 0; v < vertex_count; ++v) {
     const float* p = positions + 3 * v;
-    std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+    if (colors) {
+      const float* c = colors + 4 * v;
+      std::snprintf(line, sizeof line, "v %.9g %.9g %.9g %.6g %.6g %.6g\n", p[0], p[1], p[2], linear_to_srgb(c[0]),
+                    linear_to_srgb(c[1]), linear_to_srgb(c[2]));
+    } else {
+      std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+    }
     text += line;
   }
   if (uvs)
@@ -550,13 +562,14 @@ Status save_obj_text(const std::filesystem::path& path, const float* positions, 
 }  // namespace
 
 Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count, const float* uvs) {
-  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, nullptr);
+                const uint32_t* indices, size_t index_count, const float* uvs, const float* colors) {
+  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, colors, nullptr);
 }
 
 Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count, const float* uvs, const ObjSurfaces& surfaces) {
-  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, &surfaces);
+                const uint32_t* indices, size_t index_count, const float* uvs, const ObjSurfaces& surfaces,
+                const float* colors) {
+  return save_obj_text(path, positions, normals, vertex_count, indices, index_count, uvs, colors, &surfaces);
 }
 
 }  // namespace lod

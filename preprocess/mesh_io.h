@@ -37,9 +37,10 @@ Status save_ply(const std::filesystem::path& path, const float* positions, size_
 
 // Writes positions (+ normals and uvs when given, else null) + triangles as Wavefront OBJ text
 // ("v", "vt", "vn", "f a/a/a ..." numbered from 1). uvs are glTF's (origin top left); OBJ's vt
-// has its origin bottom left, so v is written as 1 - v.
+// has its origin bottom left, so v is written as 1 - v. colors (linear RGBA per vertex, or null)
+// go on the "v" lines as sRGB "v x y z r g b", the extension MeshLab reads (alpha is not written).
 Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count, const float* uvs = nullptr);
+                const uint32_t* indices, size_t index_count, const float* uvs = nullptr, const float* colors = nullptr);
 
 // Materials for save_obj: the faces of each submesh after a "usemtl", the materials in
 // <stem>.mtl next to the .obj ("mtllib"), each with Kd, d, Ke, Pm, Pr and, for each image it
@@ -75,6 +76,7 @@ struct ObjSurfaces {
   std::vector<std::string>* notes = nullptr;
 };
 Status save_obj(const std::filesystem::path& path, const float* positions, const float* normals, size_t vertex_count,
-                const uint32_t* indices, size_t index_count, const float* uvs, const ObjSurfaces& surfaces);
+                const uint32_t* indices, size_t index_count, const float* uvs, const ObjSurfaces& surfaces,
+                const float* colors = nullptr);
 
 }  // namespace lod

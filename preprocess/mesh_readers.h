@@ -33,6 +33,8 @@ struct RawPolygons {
 struct ObjAttributes {
   std::vector<float> texcoords;          // "vt u v", 2 per entry, as written (origin bottom left)
   std::vector<float> normals;            // "vn x y z", 3 per entry
+  std::vector<float> colors;             // "v x y z r g b": RGB per vertex as written, from the first coloured
+                                         // vertex on (earlier ones and later uncoloured ones: NaN), or empty
   std::vector<int64_t> corner_uv;        // per corner: 0-based vt, -1 none (range-checked later)
   std::vector<int64_t> corner_normal;    // per corner: 0-based vn, -1 none
   std::vector<uint32_t> polygon_line;    // per polygon: its line, for messages
@@ -42,7 +44,7 @@ struct ObjAttributes {
   std::vector<std::string> mtllibs;         // mtllib file names, as written
   std::vector<uint32_t> mtllib_lines;
   std::vector<std::string> warnings;        // what reading the .mtl files skipped
-  bool any() const { return !texcoords.empty() || !normals.empty() || !material_names.empty() || !mtllibs.empty(); }
+  bool any() const { return !texcoords.empty() || !normals.empty() || !colors.empty() || !material_names.empty() || !mtllibs.empty(); }
 };
 
 // Readers: `what` is the name used in messages (the path). On success `raw` holds at least

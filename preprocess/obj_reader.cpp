@@ -5,7 +5,8 @@
 // it cannot parse (shifting every later index), opens whatever file a "mtllib" line names (a
 // FIFO blocks) and turns an out-of-range relative index into handle arithmetic.
 //
-// Read: "v x y z" (anything after the three numbers, such as w or a colour, is ignored) and
+// Read: "v x y z" (a fourth number, w, is ignored; three more are a vertex colour, RGB as
+// MeshLab writes them, from 0 to 1, or 0 to 255 when some value is above 1) and
 // "f c0 c1 c2 ..." with corners "v", "v/vt", "v//vn" or "v/vt/vn"; a negative v counts back
 // from the last vertex before the face (-1 = that vertex). "vt u [v [w]]", "vn x y z",
 // "usemtl NAME" and "mtllib FILE..." go to ObjAttributes (corners' vt / vn numbers likewise,
@@ -15,6 +16,7 @@
 // A UTF-8 byte-order mark before the first line is skipped; UTF-16 is refused. A vertex
 // repeated within one face is dropped after its first corner (as OpenMesh's reader did).
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -27,6 +29,39 @@ namespace lod::detail {
 namespace {
 
 bool blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// How many numbers follow `at` on a 'v' line (up to 4 read; the first 3 into rgb): 3 is
+// "v x y z r g b", the vertex colour extension MeshLab, ZBrush and Open3D write; 1 is w.
+int trailing_numbers(std::string_view line, size_t at, std::string& number, float rgb[3]) {
+  int n = 0;
+  for (; n < 4; ++n) {
+    while (at < line.size() && blank(line[at])) ++at;
+    size_t e = at;
+    while (e < line.size() && !blank(line[e])) ++e;
+    if (e == at) break;
+    number.assign(line.substr(at, std::min<size_t>(e - at, 64)));
+    char* stop = nullptr;
+    const double v = std::strtod(number.c_str(), &stop);
+    if (stop == number.c_str()) break;
+    if (n < 3) rgb[n] = float(v);
+    at = e;
+  }
+  return n;
+}
+
+// A vertex without a colour in a file where others have one (a file cannot write NaN: refused).
+constexpr float kNoColour = std::numeric_limits<float>::quiet_NaN();
+
+// Vertex `v`'s colour (earlier vertices without one are marked kNoColour).
+Status add_vertex_colour(const std::string& where, size_t v, const float rgb[3], ObjAttributes& attr) {
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(rgb[c]))
+      return Status::error(where + ": vertex " + std::to_string(v) + " has a non-finite colour component (" +
+                           describe_nonfinite(rgb[c]) + ")");
+  if (attr.colors.empty()) attr.colors.assign(3 * v, kNoColour);
+  attr.colors.insert(attr.colors.end(), rgb, rgb + 3);
+  return Status::success();
+}
 
 }  // namespace
 
@@ -119,6 +154,12 @@ Status read_obj(const std::string& what, const uint8_t* data, size_t size, RawPo
                                describe_nonfinite(xyz[d]) + ")");
       if (raw.vertex_count() >= std::numeric_limits<uint32_t>::max())
         return Status::error(what + ": more than 2^32-1 vertices");
+      float rgb[3];
+      if (const int extra = trailing_numbers(line, at, number, rgb); extra == 3) {
+        if (Status c = add_vertex_colour(at_line(first_line), raw.vertex_count(), rgb, attr); !c) return c;
+      } else if (!attr.colors.empty()) {
+        attr.colors.insert(attr.colors.end(), 3, kNoColour);  // white, said in finish_obj
+      }
       raw.positions.insert(raw.positions.end(), xyz, xyz + 3);
     } else if (keyword == "vt" || keyword == "vn") {
       track();
@@ -254,6 +295,37 @@ struct CornerHash {
   }
 };
 
+float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+
+// The 'v' lines' colours as linear RGBA per vertex (MeshData::colors), or empty. They are sRGB as
+// written; a file with a value above 1 wrote 0-255; vertices without one get white. Said.
+std::vector<float> linear_vertex_colours(const std::string& what, const std::vector<float>& rgb, size_t vertices,
+                                         std::vector<std::string>& warnings) {
+  if (rgb.empty()) return {};
+  float top = 0;  // NaN (no colour) compares false
+  for (float x : rgb) top = x > top ? x : top;
+  const float scale = top > 1 ? 1.0f / 255 : 1.0f;
+  if (top > 1) warnings.push_back(what + ": vertex colours above 1: read as 0-255");
+  std::vector<float> out(4 * vertices, 1.0f);
+  size_t missing = 0, clamped = 0;
+  for (size_t v = 0; v < vertices; ++v) {
+    if (3 * v + 2 >= rgb.size() || std::isnan(rgb[3 * v])) {
+      ++missing;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      const float x = rgb[3 * v + size_t(c)] * scale;
+      clamped += x < 0 || x > 1;
+      out[4 * v + size_t(c)] = srgb_to_linear(std::clamp(x, 0.0f, 1.0f));
+    }
+  }
+  if (missing)
+    warnings.push_back(what + ": " + std::to_string(missing) + " of " + std::to_string(vertices) +
+                       " vertices have no colour where others have one; they get white");
+  if (clamped) warnings.push_back(what + ": " + std::to_string(clamped) + " vertex colour values outside 0..1 clamped");
+  return out;
+}
+
 // Every corner's three numbers within their lists, the message naming file:line.
 Status check_corners(const std::string& what, const RawPolygons& raw, const ObjAttributes& a) {
   const int64_t counts[3] = {int64_t(raw.vertex_count()), int64_t(a.texcoords.size() / 2), int64_t(a.normals.size() / 3)};
@@ -291,6 +363,7 @@ Status finish_obj(const std::string& what, RawPolygons& raw, ObjAttributes& a, s
   if (!a.normals.empty() && without_normal > 0)
     mesh.warnings.push_back(what + ": normals dropped: " + std::to_string(without_normal) +
                             " face corners have none (they are recomputed when baking)");
+  const std::vector<float> colors = linear_vertex_colours(what, a.colors, raw.vertex_count(), mesh.warnings);
   // One vertex per distinct (v, vt, vn) the faces use, in order of first use.
   std::unordered_map<CornerKey, uint32_t, CornerHash> ids;
   std::vector<uint32_t> corner_vertex(raw.corners.size());
@@ -305,6 +378,7 @@ Status finish_obj(const std::string& what, RawPolygons& raw, ObjAttributes& a, s
         mesh.uvs.insert(mesh.uvs.end(), {t ? t[0] : 0.0f, t ? 1.0f - t[1] : 0.0f});  // OBJ: origin bottom left
       }
       if (normals) mesh.normals.insert(mesh.normals.end(), &a.normals[3 * size_t(key.n)], &a.normals[3 * size_t(key.n)] + 3);
+      if (!colors.empty()) mesh.colors.insert(mesh.colors.end(), &colors[4 * size_t(key.v)], &colors[4 * size_t(key.v)] + 4);
     }
     corner_vertex[i] = it->second;
   }
