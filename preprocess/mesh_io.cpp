@@ -101,6 +101,39 @@ bool parse_real(std::string_view tok, double& out) {
   return end == buf + tok.size();
 }
 
+namespace {
+
+// A reader's per-vertex attributes into MeshData's conventions (linear colours, uv origin top
+// left), each checked finite; the reader's warnings with them.
+Status take_vertex_attributes(const std::string& what, RawPolygons& raw, MeshData& mesh) {
+  const struct {
+    const std::vector<float>* values;
+    size_t width;
+    const char* name;
+  } columns[] = {{&raw.normals, 3, "normal"}, {&raw.colors, 4, "colour"}, {&raw.uvs, 2, "texture coordinate"}};
+  for (const auto& c : columns)
+    for (size_t i = 0; i < c.values->size(); ++i)
+      if (!std::isfinite((*c.values)[i]))
+        return Status::error(what + ": vertex " + std::to_string(i / c.width) + " has a non-finite " + c.name + " (" +
+                             describe_nonfinite((*c.values)[i]) + ")");
+  size_t clamped = 0;
+  for (size_t i = 0; i < raw.colors.size(); ++i) {
+    float& c = raw.colors[i];
+    clamped += c < 0 || c > 1;
+    c = std::clamp(c, 0.0f, 1.0f);
+    if (i % 4 != 3) c = srgb_to_linear(c);
+  }
+  if (clamped) raw.warnings.push_back(what + ": " + std::to_string(clamped) + " vertex colour values outside 0..1 clamped");
+  for (size_t v = 0; v < raw.uvs.size() / 2; ++v) raw.uvs[2 * v + 1] = 1.0f - raw.uvs[2 * v + 1];  // PLY: origin bottom left
+  mesh.normals = std::move(raw.normals);
+  mesh.colors = std::move(raw.colors);
+  mesh.uvs = std::move(raw.uvs);
+  mesh.warnings = std::move(raw.warnings);
+  return Status::success();
+}
+
+}  // namespace
+
 Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out, bool obj_numbering) {
   const size_t nv = raw.vertex_count();
   const size_t nf = raw.polygon_count();
@@ -123,6 +156,7 @@ Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out,
     return Status::error(what + ": has no triangles (" + std::to_string(nf) + " faces with fewer than 3 corners)");
   MeshData mesh;
   mesh.source = what;
+  if (Status s = take_vertex_attributes(what, raw, mesh); !s) return s;
   if (triangles * 3 == raw.corners.size() && triangles == nf) {  // all triangles: copy and free
     mesh.indices.assign(raw.corners.begin(), raw.corners.end());
     std::vector<int64_t>().swap(raw.corners);

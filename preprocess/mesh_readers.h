@@ -23,6 +23,10 @@ namespace lod::detail {
 // (range-checked by finish_polygons, so the message can quote the file's own number).
 struct RawPolygons {
   std::vector<float> positions;          // xyz per vertex
+  // PLY vertex attributes, each per vertex or empty: normals xyz, colours RGBA from 0 to 1 as
+  // stored (sRGB; alpha 1 when absent), texture coordinates as stored (origin bottom left).
+  std::vector<float> normals, colors, uvs;
+  std::vector<std::string> warnings;     // what the reader skipped
   std::vector<int64_t> corners;          // vertex numbers as written in the file
   std::vector<uint32_t> offsets{0};      // polygon p is corners[offsets[p], offsets[p+1])
   size_t vertex_count() const { return positions.size() / 3; }
@@ -81,6 +85,9 @@ Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out,
 Status read_regular_file(const std::filesystem::path& path, std::vector<uint8_t>& bytes);
 
 // ---- helpers shared by the text readers ------------------------------------------------
+
+// Vertex colours in OBJ and PLY files are sRGB as displayed; MeshData::colors are linear.
+inline float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
 
 inline std::string describe_nonfinite(float v) {
   if (std::isnan(v)) return "nan";

@@ -295,8 +295,6 @@ struct CornerHash {
   }
 };
 
-float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
-
 // The 'v' lines' colours as linear RGBA per vertex (MeshData::colors), or empty. They are sRGB as
 // written; a file with a value above 1 wrote 0-255; vertices without one get white. Said.
 std::vector<float> linear_vertex_colours(const std::string& what, const std::vector<float>& rgb, size_t vertices,

@@ -40,7 +40,28 @@ size_t type_size(Type t) {
 }
 bool is_real(Type t) { return t == Type::f32 || t == Type::f64; }
 
-enum class Role { skip, x, y, z, indices };
+// Vertex roles x..t index a row's values (slot = role - x); indices is the face list.
+enum class Role { skip, x, y, z, nx, ny, nz, red, green, blue, alpha, s, t, indices };
+constexpr int kSlots = int(Role::t) - int(Role::x) + 1;
+int slot(Role r) { return int(r) - int(Role::x); }
+bool is_vertex_role(Role r) { return r >= Role::x && r <= Role::t; }
+
+// The names scanners and MeshLab write for each vertex attribute.
+Role vertex_role(std::string_view n) {
+  if (n == "x") return Role::x;
+  if (n == "y") return Role::y;
+  if (n == "z") return Role::z;
+  if (n == "nx") return Role::nx;
+  if (n == "ny") return Role::ny;
+  if (n == "nz") return Role::nz;
+  if (n == "red" || n == "diffuse_red" || n == "r") return Role::red;
+  if (n == "green" || n == "diffuse_green" || n == "g") return Role::green;
+  if (n == "blue" || n == "diffuse_blue" || n == "b") return Role::blue;
+  if (n == "alpha" || n == "diffuse_alpha" || n == "a") return Role::alpha;
+  if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s") return Role::s;
+  if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t") return Role::t;
+  return Role::skip;
+}
 
 struct Property {
   std::string name;
@@ -48,7 +69,35 @@ struct Property {
   bool is_list = false;
   Type count_type = Type::none;
   Role role = Role::skip;
+  double scale = 1;  // a colour's divisor: the largest value of its integer type (1 for reals)
 };
+
+// Which attribute groups the vertex rows carry (each kept only whole: nx ny nz, red green blue
+// [alpha], s t), and appending one row's values to them.
+struct VertexGroups {
+  bool normals = false, colors = false, alpha = false, uvs = false;
+  bool any() const { return normals || colors || uvs; }
+};
+
+double colour_scale(Type t) {
+  switch (t) {
+    case Type::u8: return 255;
+    case Type::i8: return 127;
+    case Type::u16: return 65535;
+    case Type::i16: return 32767;
+    case Type::u32: return 4294967295.0;
+    case Type::i32: return 2147483647.0;
+    default: return 1;
+  }
+}
+
+void append_attributes(const VertexGroups& g, const double* v, RawPolygons& raw) {
+  auto at = [v](Role r) { return float(v[slot(r)]); };
+  if (g.normals) raw.normals.insert(raw.normals.end(), {at(Role::nx), at(Role::ny), at(Role::nz)});
+  if (g.colors)
+    raw.colors.insert(raw.colors.end(), {at(Role::red), at(Role::green), at(Role::blue), g.alpha ? at(Role::alpha) : 1.0f});
+  if (g.uvs) raw.uvs.insert(raw.uvs.end(), {at(Role::s), at(Role::t)});
+}
 struct Element {
   std::string name;
   uint64_t count = 0;
@@ -111,11 +160,14 @@ Status truncated_in(const std::string& what, const Element& e, uint64_t row) {
 // Binary vertex rows without lists: every row the same size, each coordinate at its offset.
 // The common scanner layout (little-endian float x, y, z first) is read without widening.
 Status binary_vertex_rows(const std::string& what, const uint8_t* data, size_t size, size_t& at, const Element& e,
-                          bool big, RawPolygons& raw) {
+                          bool big, const VertexGroups& groups, RawPolygons& raw) {
   size_t row = 0, offset[3] = {0, 0, 0};
   Type type[3] = {Type::none, Type::none, Type::none};
+  struct Column { size_t offset; const Property* p; };
+  std::vector<Column> attributes;  // the kept groups' columns
   for (const Property& p : e.properties) {
     if (p.role >= Role::x && p.role <= Role::z) offset[int(p.role) - int(Role::x)] = row, type[int(p.role) - int(Role::x)] = p.type;
+    else if (is_vertex_role(p.role)) attributes.push_back({row, &p});
     row += type_size(p.type);
   }
   if (e.count > (size - at) / row) return truncated_in(what, e, (size - at) / row);
@@ -132,6 +184,10 @@ Status binary_vertex_rows(const std::string& what, const uint8_t* data, size_t s
       if (!std::isfinite(out[k]))
         return Status::error(what + ": vertex " + std::to_string(i) + " has a non-finite coordinate (" +
                              describe_nonfinite(out[k]) + ")");
+    if (attributes.empty()) continue;
+    double v[kSlots] = {};
+    for (const Column& c : attributes) v[slot(c.p->role)] = load_real(data + at + c.offset, c.p->type, big) / c.p->scale;
+    append_attributes(groups, v, raw);
   }
   return Status::success();
 }
@@ -171,6 +227,36 @@ Status binary_face_rows(const std::string& what, const uint8_t* data, size_t siz
     raw.offsets.push_back(uint32_t(raw.corners.size()));
   }
   return Status::success();
+}
+
+// Roles for the vertex element's properties: positions, and each attribute group only when
+// whole (a lone 'nx' or 'red' is skipped); what is skipped is said in `warnings`.
+VertexGroups assign_vertex_roles(const std::string& what, Element& vertex, std::vector<std::string>& warnings) {
+  bool seen[kSlots] = {};
+  for (Property& p : vertex.properties) {
+    const Role r = p.is_list ? Role::skip : vertex_role(p.name);
+    if (r == Role::skip || seen[slot(r)]) continue;  // a second name for one role: the first wins
+    p.role = r;
+    seen[slot(r)] = true;
+    if (r >= Role::red && r <= Role::alpha) p.scale = colour_scale(p.type);
+  }
+  VertexGroups g;
+  g.normals = seen[slot(Role::nx)] && seen[slot(Role::ny)] && seen[slot(Role::nz)];
+  g.colors = seen[slot(Role::red)] && seen[slot(Role::green)] && seen[slot(Role::blue)];
+  g.alpha = g.colors && seen[slot(Role::alpha)];
+  g.uvs = seen[slot(Role::s)] && seen[slot(Role::t)];
+  std::string skipped;
+  for (Property& p : vertex.properties) {
+    const bool kept = (p.role >= Role::x && p.role <= Role::z) || (g.normals && p.role >= Role::nx && p.role <= Role::nz) ||
+                      (g.colors && p.role >= Role::red && p.role <= Role::alpha) || (g.uvs && p.role >= Role::s && p.role <= Role::t);
+    if (kept) continue;
+    p.role = Role::skip;
+    if (skipped.size() < 200) skipped += (skipped.empty() ? "'" : ", '") + quote_token(p.name) + "'";
+  }
+  if (!skipped.empty())
+    warnings.push_back(what + ": vertex properties " + skipped + " are not imported (positions, nx ny nz, red green blue "
+                       "[alpha] and s t / u v are)");
+  return g;
 }
 
 }  // namespace
@@ -268,13 +354,11 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
     if (e.name == "tristrips") has_tristrips = true;
   }
   if (!vertex) return Status::error(what + ": PLY header declares no 'vertex' element");
+  const VertexGroups groups = assign_vertex_roles(what, *vertex, raw.warnings);
   {
     bool seen[3] = {false, false, false};
-    for (Property& p : vertex->properties)
-      if (!p.is_list && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z') {
-        p.role = Role(int(Role::x) + (p.name[0] - 'x'));
-        seen[p.name[0] - 'x'] = true;
-      }
+    for (const Property& p : vertex->properties)
+      if (p.role >= Role::x && p.role <= Role::z) seen[slot(p.role)] = true;
     if (vertex->count > 0 && !(seen[0] && seen[1] && seen[2]))
       return Status::error(what + ": PLY element 'vertex' lacks an 'x', 'y' or 'z' property");
   }
@@ -323,7 +407,7 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
     if (is_face) raw.offsets.reserve(size_t(e.count) + 1);
     const bool lists = std::any_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.is_list; });
     if (!ascii && is_vertex && !lists && min_row > 0) {
-      if (Status s = binary_vertex_rows(what, data, size, at, e, big, raw); !s) return s;
+      if (Status s = binary_vertex_rows(what, data, size, at, e, big, groups, raw); !s) return s;
       have_vertices = true;
       continue;
     }
@@ -338,6 +422,7 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
     };
     for (uint64_t i = 0; i < e.count; ++i) {
       float xyz[3] = {0, 0, 0};
+      double values[kSlots] = {};
       size_t row_line = tokens.line();
       for (const Property& p : e.properties) {
         if (ascii) {
@@ -362,6 +447,7 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
                                      std::to_string(tokens.line()) + ") has a value that is not a number ('" +
                                      quote_token(tok) + "')");
               if (p.role >= Role::x && p.role <= Role::z) xyz[int(p.role) - int(Role::x)] = float(v);
+              else if (is_vertex_role(p.role)) values[slot(p.role)] = v / p.scale;
             } else {
               int64_t v = 0;
               if (!parse_int(tok, v))
@@ -369,6 +455,7 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
                                      std::to_string(tokens.line()) + ") has a value that is not an integer ('" +
                                      quote_token(tok) + "')");
               if (p.role >= Role::x && p.role <= Role::z) xyz[int(p.role) - int(Role::x)] = float(v);
+              else if (is_vertex_role(p.role)) values[slot(p.role)] = double(v) / p.scale;
               if (p.role == Role::indices) raw.corners.push_back(v);
             }
           }
@@ -377,6 +464,7 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
             const size_t s = type_size(p.type);
             if (size - at < s) return truncated(i);
             if (p.role >= Role::x && p.role <= Role::z) xyz[int(p.role) - int(Role::x)] = float(load_real(data + at, p.type, big));
+            else if (is_vertex_role(p.role)) values[slot(p.role)] = load_real(data + at, p.type, big) / p.scale;
             at += s;
             continue;
           }
@@ -400,6 +488,7 @@ Status read_ply(const std::string& what, const uint8_t* data, size_t size, RawPo
                                  (ascii ? " (line " + std::to_string(row_line) + ")" : std::string()) +
                                  " has a non-finite coordinate (" + describe_nonfinite(xyz[k]) + ")");
         raw.positions.insert(raw.positions.end(), xyz, xyz + 3);
+        if (groups.any()) append_attributes(groups, values, raw);
       }
       if (is_face) {
         if (raw.corners.size() > std::numeric_limits<uint32_t>::max())
