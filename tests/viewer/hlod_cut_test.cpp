@@ -33,6 +33,7 @@ lod::HlodModels two_leaf_model() {
   lod::HlodModels m;
   lod::HlodTree t;
   t.nodes = {node(-1, 0, 1, 2, 400), node(0, 1, 0, 0, 200), node(0, 1, 0, 0, 100)};
+  t.nodes[1].bounds.center[1] = -1.5f;
   m.trees.push_back(t);
   lod::Transform tr;
   tr.position[0] = 1;
@@ -64,6 +65,7 @@ TEST(ViewerHlodDrawList, DrawsLayersAndOpenedPatchesAndRefusesWhatTheTreesDoNotH
   EXPECT_EQ(list.triangles, 235u);
   EXPECT_FLOAT_EQ(list.draws[0].transform.position_scale[0], 1.f);
   EXPECT_FLOAT_EQ(list.draws[0].transform.position_scale[3], 2.f);
+  EXPECT_FLOAT_EQ(list.draws[0].center[1], -1.5f) << "the node's bounding sphere centre, for the blend order";
 
   f.hlod_drawn.clear();  // reused: nothing of the last frame stays
   f.hlod_opened.clear();
