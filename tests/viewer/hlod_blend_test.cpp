@@ -52,31 +52,20 @@ void write_pane_over_quad(const fs::path& file) {
 
 const char* kRun = "[run]\nframes = 3\nthreads = 1\n[budget]\ntriangles = 1000000\n[lod]\npixel_error = 1.0\n";
 const char* kModel = "[[model]]\nname = \"pane\"\nfile = \"quads/pane.gltf\"\nhlod = true\n";
-// Seed 1061's first yaw is -0.1 degrees: the quads face the camera squarely.
-const char* kInstance = R"([[instances]]
-model = "pane"
-count = 1
-placement = "grid"
-box_min = [0.0, 0.0, 0.0]
-box_max = [0.0, 0.0, 0.0]
-scale = 4.0
-seed = 1061
-)";
 
 TEST(ViewerHlodBlend, ABlendedHlodPaneShowsTheOpaqueQuadBehindIt) {
   LOD_REQUIRE_XVFB();
-  const auto scene = lod::test::write_viewer_scene("hlod-blend", kRun, lod::test::front_camera(320, 240), kInstance, kModel);
+  // The quads face the camera squarely (seed 1061).
+  const auto scene = lod::test::write_viewer_scene("hlod-blend", kRun, lod::test::front_camera(320, 240),
+                                                   lod::test::one_object_at_origin("pane", 4, 1061), kModel);
   write_pane_over_quad(scene.dir / "quads" / "pane.gltf");
-  const fs::path png = scene.dir / "pane.png", stats = scene.dir / "pane.csv";
-  const auto r = lod::test::run_viewer(
-      scene, "--screenshot '" + png.string() + "' --frames 3 --width 320 --height 240 --stats '" + stats.string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  lod::test::CsvTable t;
-  ASSERT_TRUE(lod::test::load_csv(stats, t));
-  ASSERT_FALSE(t.rows.empty());
-  EXPECT_GT(t.get(t.rows.size() - 1, "hlod_draws"), 0) << "drawn through its HLOD cut";
-  Image img;
-  ASSERT_TRUE(lod::test::load_png(png, img));
+  const auto shot = lod::test::take_screenshot(scene, "pane", "--frames 3 --width 320 --height 240");
+  ASSERT_EQ(shot.run.exit_code, 0) << shot.run.output;
+  ASSERT_TRUE(shot.stats_read);
+  ASSERT_FALSE(shot.stats.rows.empty());
+  EXPECT_GT(shot.stats.last("hlod_draws"), 0) << "drawn through its HLOD cut";
+  ASSERT_TRUE(shot.image_read);
+  const Image& img = shot.image;
   // World: the pane at z = 4 spans +-8, the quad at z = -4 spans +-4. The centre sees the
   // quad through the pane; (6, 0, 4) the pane over the background only.
   const auto centre = lod::test::project({0, 0, 4}, img.width, img.height);
