@@ -146,6 +146,9 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
       return refuse(s.message);
   if (material_bytes > 0)
     if (Status s = decode_material_section({p, size_t(material_bytes)}, "materials", chain); !s) return refuse(s.message);
+  // The writer stores the section only with materials: one without (its texture base and
+  // images lost on the next store) is not one it wrote.
+  if (material_bytes > 0 && chain.materials.empty()) return refuse("its materials section holds no materials");
   for (uint32_t i : m.indices)
     if (i >= vertices) return refuse("an index names vertex " + std::to_string(i) + " of " + std::to_string(vertices));
   for (float v : m.positions)

@@ -21,6 +21,12 @@ glm::vec3 world_of(const InstanceData& d, const float* p) {
 void order_blended_draws(const DrawList& list, const MeshLayout& layout, const std::vector<uint8_t>& blends,
                          const std::vector<uint8_t>& vd_blends, const glm::mat4& view,
                          std::vector<BlendDraw>& out) {
+  order_blended_draws(list, layout, blends, vd_blends, HlodDrawList{}, {}, view, out);
+}
+
+void order_blended_draws(const DrawList& list, const MeshLayout& layout, const std::vector<uint8_t>& blends,
+                         const std::vector<uint8_t>& vd_blends, const HlodDrawList& hlod,
+                         const std::vector<uint8_t>& hlod_blends, const glm::mat4& view, std::vector<BlendDraw>& out) {
   out.clear();
   for (uint32_t b = 0; b < list.batches.size(); ++b) {
     const DrawBatch& batch = list.batches[b];
@@ -28,13 +34,18 @@ void order_blended_draws(const DrawList& list, const MeshLayout& layout, const s
     const LevelRange& r = layout.ranges[batch.range];
     for (uint32_t i = batch.first_instance; i < batch.first_instance + batch.instance_count; ++i) {
       const glm::vec4 eye = view * glm::vec4(world_of(list.instances[i], r.center), 1.f);
-      out.push_back({b, i, kNotViewDependent, -eye.z});  // the eye looks down -z
+      out.push_back({b, i, kNotViewDependent, kNotHlod, -eye.z});  // the eye looks down -z
     }
   }
   for (uint32_t v = 0; v < list.vd.size() && v < vd_blends.size(); ++v) {
     if (!vd_blends[v]) continue;
     const glm::vec4 eye = view * glm::vec4(world_of(list.vd[v].transform, list.vd[v].center), 1.f);
-    out.push_back({0, 0, v, -eye.z});
+    out.push_back({0, 0, v, kNotHlod, -eye.z});
+  }
+  for (uint32_t h = 0; h < hlod.draws.size() && h < hlod_blends.size(); ++h) {
+    if (!hlod_blends[h]) continue;
+    const glm::vec4 eye = view * glm::vec4(world_of(hlod.draws[h].transform, hlod.draws[h].center), 1.f);
+    out.push_back({0, 0, kNotViewDependent, h, -eye.z});
   }
   std::stable_sort(out.begin(), out.end(),
                    [](const BlendDraw& a, const BlendDraw& c) { return a.depth > c.depth; });

@@ -60,6 +60,10 @@ DrawStats FrameRenderer::render(const Frame& frame, const View& viewing, const R
     instances_.draw_proxies(proxy_list_, proxies_, view_matrix(viewing), projection_matrix(viewing), settings, stats);
   }
   terrain_.draw(frame, view_matrix(viewing), projection_matrix(viewing), settings, stats);
+  // Blended runs last, over all of the above.
+  instances_.draw_blended(list_, meshes_, &morphs_, &vd_meshes_, hlod_ ? &hlod_list_ : nullptr,
+                          hlod_ ? &hlod_nodes_ : nullptr, view_matrix(viewing), projection_matrix(viewing), settings,
+                          stats);
   return stats;
 }
 

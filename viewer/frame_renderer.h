@@ -1,7 +1,8 @@
 // FrameRenderer: one published Frame drawn from one viewing camera into the bound framebuffer:
 // clear, sky and ground (the backdrop), build the draw list, one instanced draw per (model, level, target level), then one draw per
 // view-dependent object from the active mesh the frame carries, then one per node layer or
-// boundary patch of the HLOD cuts, one per scene HLOD proxy, and the terrain's mesh.
+// boundary patch of the HLOD cuts, one per scene HLOD proxy, and the terrain's mesh; last the
+// alpha-blended runs of the instances, view-dependent objects and HLOD nodes, farthest first.
 #pragma once
 #include <span>
 #include <string>

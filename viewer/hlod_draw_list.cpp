@@ -17,7 +17,9 @@ bool add_draw(const HlodModels& models, uint32_t model, uint32_t node, uint8_t l
   d.model = model;
   d.node = node;
   d.layer = layer;
-  d.depth = models.trees[model].nodes[node].depth;
+  const HlodNode& n = models.trees[model].nodes[node];
+  d.depth = n.depth;
+  for (int k = 0; k < 3; ++k) d.center[k] = n.bounds.center[k];
   d.triangles = triangles;
   if (!instance_of(models.transforms[model], 1.f, 0.f, &d.transform)) return false;
   out.draws.push_back(d);

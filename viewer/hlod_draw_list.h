@@ -21,6 +21,7 @@ struct HlodDraw {
   uint8_t layer = 0;    // 0 = finest, kHlodBoundary = the node's boundary patch
   uint8_t depth = 0;    // the node's octree depth
   uint32_t triangles = 0;
+  float center[3] = {0, 0, 0};  // the node's bounding sphere centre, object space (blend order)
   InstanceData transform;  // the model's, morph = 1
 };
 

@@ -176,11 +176,18 @@ void point_instance_attributes(size_t offset) {
 // Material colours are drawn unless a mode colours the draws.
 bool draws_materials(const RenderSettings& settings) { return !settings.colour_override && !settings.colour_by_level; }
 
-RunPass run_pass(const MeshBuffers& meshes, const MaterialRun& run) {
-  const auto& materials = meshes.materials().materials();
-  const bool blend = run.material >= 0 && size_t(run.material) < materials.size() &&
-                     materials[size_t(run.material)].alpha_mode == AlphaMode::blend;
+const std::array<float, 3>& vd_colour_of(const RenderSettings& settings) {
+  return settings.colour_override ? settings.colour : settings.colour_by_level ? kViewDependentColour : kModelColour;
+}
+
+RunPass material_pass(const std::vector<GpuMaterial>& materials, int32_t material) {
+  const bool blend = material >= 0 && size_t(material) < materials.size() &&
+                     materials[size_t(material)].alpha_mode == AlphaMode::blend;
   return blend ? RunPass::blend : RunPass::opaque;
+}
+
+RunPass run_pass(const MeshBuffers& meshes, const MaterialRun& run) {
+  return material_pass(meshes.materials().materials(), run.material);
 }
 
 bool has_blend_runs(const MeshBuffers& meshes, const LevelRange& r) {
@@ -196,6 +203,21 @@ RunPass vd_run_pass(const MeshBuffers& meshes, const VdRunDraw& run) {
 bool vd_has_blend_runs(const DrawList& list, const VdDraw& d, const MeshBuffers& meshes) {
   for (uint32_t k = d.first_run; k < d.first_run + d.run_count; ++k)
     if (vd_run_pass(meshes, list.vd_runs[k]) == RunPass::blend) return true;
+  return false;
+}
+
+// The node range an HLOD draw uses (its node in `*node`), or null when the node could not be
+// read or has no such layer.
+const HlodNodeRange* hlod_range(const HlodNodeBuffers& nodes, const HlodDraw& d, const HlodNodeGpu** node) {
+  const HlodNodeGpu* g = nodes.find(d.model, d.node);
+  *node = g;
+  if (!g) return nullptr;
+  return d.layer == kHlodBoundary ? &g->boundary : d.layer < g->layers.size() ? &g->layers[d.layer] : nullptr;
+}
+
+bool hlod_has_blend_runs(const HlodNodeBuffers& nodes, const HlodNodeGpu& g, const HlodNodeRange& r) {
+  for (uint32_t k = r.first_run; k < r.first_run + r.run_count && k < g.runs.size(); ++k)
+    if (material_pass(nodes.materials(), g.runs[k].material) == RunPass::blend) return true;
   return false;
 }
 
@@ -375,21 +397,87 @@ void InstanceRenderer::draw_vd_object(const DrawList& list, const VdDraw& d, con
   set_plain_surface(colour);
 }
 
-DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, MorphBuffers* morphs,
-                                 const VdMeshBuffers* vd, const glm::mat4& view, const glm::mat4& projection,
-                                 const RenderSettings& settings) {
-  DrawStats stats;
+// Program state every pass of a frame starts from: matrices, modes, the sun and sky.
+void InstanceRenderer::set_frame_uniforms(const glm::mat4& view, const glm::mat4& projection,
+                                          const RenderSettings& settings) {
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_, 1, GL_FALSE, glm::value_ptr(view));
   glUniformMatrix4fv(u_projection_, 1, GL_FALSE, glm::value_ptr(projection));
   glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
-  glUniform1i(u_show_morph_, settings.colour_by_level ? 1 : 0);
+  glUniform1i(u_show_morph_, 0);
   glUniform1i(u_blend_, 0);
   const glm::vec3 sun = glm::normalize(glm::mat3(view) * glm::normalize(kSunDirection));
   const glm::vec3 up = glm::normalize(glm::mat3(view) * glm::vec3(0, 1, 0));
   glUniform3f(u_sun_view_, sun.x, sun.y, sun.z);
   glUniform3f(u_up_view_, up.x, up.y, up.z);
   glActiveTexture(GL_TEXTURE0);
+  glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
+}
+
+// One batch's runs of `pass`, its instances' attributes pointed at from the bound instance
+// buffer; a blended batch (morphing towards a coarser level) with its target stream. The
+// opaque pass counts it in `stats`.
+void InstanceRenderer::draw_batch(const DrawBatch& b, const MeshBuffers& meshes, MorphBuffers* morphs,
+                                  const RenderSettings& settings, RunPass pass, DrawStats& stats) {
+  // GL 3.3 has no base instance: point the instance attributes at the batch's first one.
+  point_instance_attributes(size_t(b.first_instance) * sizeof(InstanceData));
+  const auto& c = settings.colour_override ? settings.colour
+                  : settings.colour_by_level ? level_colour(b.level)
+                                             : kModelColour;
+  set_plain_surface(c);
+  const LevelRange& r = meshes.layout().ranges[b.range];
+  const int64_t stream = b.target_level != b.level && morphs ? morphs->stream(b.model, b.level, b.target_level) : -1;
+  if (stream >= 0) {
+    // Both streams start at the level's first vertex (the target stream has no room before
+    // it for a base vertex), so the level's own attributes are re-pointed there too.
+    glBindBuffer(GL_ARRAY_BUFFER, meshes.vbo());
+    const size_t own = size_t(r.base_vertex) * 6 * sizeof(float);
+    glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<const void*>(own));
+    glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                          reinterpret_cast<const void*>(own + 3 * sizeof(float)));
+    glBindBuffer(GL_ARRAY_BUFFER, meshes.uv_vbo());
+    glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float),
+                          reinterpret_cast<const void*>(size_t(r.base_vertex) * 2 * sizeof(float)));
+    glBindBuffer(GL_ARRAY_BUFFER, morphs->buffer());
+    constexpr GLsizei kStride = MorphStreams::kFloatsPerVertex * sizeof(float);
+    const size_t target = size_t(stream) * kStride;
+    glEnableVertexAttribArray(kAttribTargetPosition);
+    glEnableVertexAttribArray(kAttribTargetNormal);
+    glEnableVertexAttribArray(kAttribTargetUv);
+    glVertexAttribPointer(kAttribTargetPosition, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(target));
+    glVertexAttribPointer(kAttribTargetNormal, 3, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<const void*>(target + 3 * sizeof(float)));
+    glVertexAttribPointer(kAttribTargetUv, 2, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<const void*>(target + 6 * sizeof(float)));
+    glUniform1i(u_blend_, 1);
+    draw_range(meshes, r, b.instance_count, 0, settings, pass);
+    glUniform1i(u_blend_, 0);
+    glDisableVertexAttribArray(kAttribTargetPosition);
+    glDisableVertexAttribArray(kAttribTargetNormal);
+    glDisableVertexAttribArray(kAttribTargetUv);
+    glBindBuffer(GL_ARRAY_BUFFER, meshes.vbo());
+    glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+    glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                          reinterpret_cast<const void*>(3 * sizeof(float)));
+    glBindBuffer(GL_ARRAY_BUFFER, meshes.uv_vbo());
+    glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+    glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
+    if (pass == RunPass::opaque) ++stats.morph_draws;
+  } else {
+    draw_range(meshes, r, b.instance_count, r.base_vertex, settings, pass);
+  }
+  if (pass != RunPass::opaque) return;
+  ++stats.draws;
+  stats.instances += b.instance_count;
+  stats.triangles += uint64_t(r.index_count / 3) * b.instance_count;
+}
+
+DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes, MorphBuffers* morphs,
+                                 const VdMeshBuffers* vd, const glm::mat4& view, const glm::mat4& projection,
+                                 const RenderSettings& settings) {
+  DrawStats stats;
+  set_frame_uniforms(view, projection, settings);
+  glUniform1i(u_show_morph_, settings.colour_by_level ? 1 : 0);
   set_plain_surface(kModelColour);
 
   glBindVertexArray(meshes.vao());
@@ -397,6 +485,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   const size_t bytes = list.instances.size() * sizeof(InstanceData);
   if (bytes > instance_capacity_) instance_capacity_ = bytes + bytes / 2;
   // Fresh (orphaned) storage every frame, so the driver never waits for last frame's draws.
+  // draw_blended() reads the same records later in the frame.
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(instance_capacity_), nullptr, GL_STREAM_DRAW);
   if (bytes) glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), list.instances.data());
   for (GLuint a : {kAttribInstancePositionScale, kAttribInstanceRotation, kAttribInstanceMorph}) {
@@ -407,69 +496,11 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   glDisableVertexAttribArray(kAttribTargetNormal);
   glDisableVertexAttribArray(kAttribTargetUv);
 
-  glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
-
-  // Opaque (and masked) runs first, then the blended ones over them without depth writes.
-  auto draw_batch = [&](const DrawBatch& b, RunPass pass) {
-    // GL 3.3 has no base instance: point the instance attributes at the batch's first one.
-    point_instance_attributes(size_t(b.first_instance) * sizeof(InstanceData));
-    const auto& c = settings.colour_override ? settings.colour
-                    : settings.colour_by_level ? level_colour(b.level)
-                                               : kModelColour;
-    set_plain_surface(c);
-    const LevelRange& r = meshes.layout().ranges[b.range];
-    const int64_t stream = b.target_level != b.level && morphs ? morphs->stream(b.model, b.level, b.target_level) : -1;
-    if (stream >= 0) {
-      // Both streams start at the level's first vertex (the target stream has no room before
-      // it for a base vertex), so the level's own attributes are re-pointed there too.
-      glBindBuffer(GL_ARRAY_BUFFER, meshes.vbo());
-      const size_t own = size_t(r.base_vertex) * 6 * sizeof(float);
-      glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<const void*>(own));
-      glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                            reinterpret_cast<const void*>(own + 3 * sizeof(float)));
-      glBindBuffer(GL_ARRAY_BUFFER, meshes.uv_vbo());
-      glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float),
-                            reinterpret_cast<const void*>(size_t(r.base_vertex) * 2 * sizeof(float)));
-      glBindBuffer(GL_ARRAY_BUFFER, morphs->buffer());
-      constexpr GLsizei kStride = MorphStreams::kFloatsPerVertex * sizeof(float);
-      const size_t target = size_t(stream) * kStride;
-      glEnableVertexAttribArray(kAttribTargetPosition);
-      glEnableVertexAttribArray(kAttribTargetNormal);
-      glEnableVertexAttribArray(kAttribTargetUv);
-      glVertexAttribPointer(kAttribTargetPosition, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<const void*>(target));
-      glVertexAttribPointer(kAttribTargetNormal, 3, GL_FLOAT, GL_FALSE, kStride,
-                            reinterpret_cast<const void*>(target + 3 * sizeof(float)));
-      glVertexAttribPointer(kAttribTargetUv, 2, GL_FLOAT, GL_FALSE, kStride,
-                            reinterpret_cast<const void*>(target + 6 * sizeof(float)));
-      glUniform1i(u_blend_, 1);
-      draw_range(meshes, r, b.instance_count, 0, settings, pass);
-      glUniform1i(u_blend_, 0);
-      glDisableVertexAttribArray(kAttribTargetPosition);
-      glDisableVertexAttribArray(kAttribTargetNormal);
-      glDisableVertexAttribArray(kAttribTargetUv);
-      glBindBuffer(GL_ARRAY_BUFFER, meshes.vbo());
-      glVertexAttribPointer(kAttribPosition, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
-      glVertexAttribPointer(kAttribNormal, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                            reinterpret_cast<const void*>(3 * sizeof(float)));
-      glBindBuffer(GL_ARRAY_BUFFER, meshes.uv_vbo());
-      glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
-      glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
-      if (pass == RunPass::opaque) ++stats.morph_draws;
-    } else {
-      draw_range(meshes, r, b.instance_count, r.base_vertex, settings, pass);
-    }
-    if (pass != RunPass::opaque) return;
-    ++stats.draws;
-    stats.instances += b.instance_count;
-    stats.triangles += uint64_t(r.index_count / 3) * b.instance_count;
-  };
-  for (const DrawBatch& b : list.batches) draw_batch(b, RunPass::opaque);
-  // View-dependent objects' opaque runs too, before anything blends over them.
-  const auto& vd_colour = settings.colour_override ? settings.colour
-                          : settings.colour_by_level ? kViewDependentColour
-                                                     : kModelColour;
+  // Opaque (and masked) runs only: the blended ones wait for draw_blended().
+  for (const DrawBatch& b : list.batches) draw_batch(b, meshes, morphs, settings, RunPass::opaque, stats);
   if (vd && !list.vd.empty()) {
+    const auto& vd_colour = vd_colour_of(settings);
     bind_vd_meshes(*vd, vd_colour);
     for (const VdDraw& d : list.vd) {
       draw_vd_object(list, d, meshes, settings, vd_colour, RunPass::opaque);
@@ -479,37 +510,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
       stats.triangles += d.index_count / 3;
     }
   }
-  if (draws_materials(settings)) {
-    // Blended runs over everything opaque, one object at a time, farthest first.
-    range_blends_.assign(meshes.layout().ranges.size(), 0);
-    for (const DrawBatch& b : list.batches)
-      range_blends_[b.range] = has_blend_runs(meshes, meshes.layout().ranges[b.range]) ? 1 : 0;
-    vd_blends_.assign(vd ? list.vd.size() : 0, 0);
-    for (size_t v = 0; v < vd_blends_.size(); ++v) vd_blends_[v] = vd_has_blend_runs(list, list.vd[v], meshes) ? 1 : 0;
-    order_blended_draws(list, meshes.layout(), range_blends_, vd_blends_, view, blend_order_);
-    glDepthMask(GL_FALSE);
-    bool instanced_bound = false;
-    for (const BlendDraw& d : blend_order_) {
-      if (d.vd != kNotViewDependent) {
-        bind_vd_meshes(*vd, vd_colour);
-        instanced_bound = false;
-        draw_vd_object(list, list.vd[d.vd], meshes, settings, vd_colour, RunPass::blend);
-        continue;
-      }
-      if (!instanced_bound) {
-        glBindVertexArray(meshes.vao());
-        glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
-        instanced_bound = true;
-      }
-      DrawBatch one = list.batches[d.batch];
-      one.first_instance = d.instance;
-      one.instance_count = 1;
-      draw_batch(one, RunPass::blend);
-    }
-    glDepthMask(GL_TRUE);
-    set_plain_surface(kModelColour);
-  }
-
+  set_plain_surface(kModelColour);
   if (settings.count_primitives) {
     glEndQuery(GL_PRIMITIVES_GENERATED);
     GLuint64 generated = 0;
@@ -522,15 +523,63 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   return stats;
 }
 
+void InstanceRenderer::draw_blended(const DrawList& list, const MeshBuffers& meshes, MorphBuffers* morphs,
+                                    const VdMeshBuffers* vd, const HlodDrawList* hlod, const HlodNodeBuffers* nodes,
+                                    const glm::mat4& view, const glm::mat4& projection, const RenderSettings& settings,
+                                    DrawStats& stats) {
+  if (!draws_materials(settings)) return;
+  range_blends_.assign(meshes.layout().ranges.size(), 0);
+  for (const DrawBatch& b : list.batches)
+    range_blends_[b.range] = has_blend_runs(meshes, meshes.layout().ranges[b.range]) ? 1 : 0;
+  vd_blends_.assign(vd ? list.vd.size() : 0, 0);
+  for (size_t v = 0; v < vd_blends_.size(); ++v) vd_blends_[v] = vd_has_blend_runs(list, list.vd[v], meshes) ? 1 : 0;
+  static const HlodDrawList kNoHlod;
+  const HlodDrawList& cut = hlod && nodes ? *hlod : kNoHlod;
+  hlod_blends_.assign(cut.draws.size(), 0);
+  for (size_t h = 0; h < cut.draws.size(); ++h) {
+    const HlodNodeGpu* g = nullptr;
+    const HlodNodeRange* r = hlod_range(*nodes, cut.draws[h], &g);
+    hlod_blends_[h] = r && hlod_has_blend_runs(*nodes, *g, *r) ? 1 : 0;
+  }
+  order_blended_draws(list, meshes.layout(), range_blends_, vd_blends_, cut, hlod_blends_, view, blend_order_);
+  if (blend_order_.empty()) return;
+
+  set_frame_uniforms(view, projection, settings);
+  if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
+  // Over everything opaque: tested against its depth, writing none, farthest first.
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  bool instanced_bound = false;
+  for (const BlendDraw& d : blend_order_) {
+    instanced_bound = instanced_bound && d.vd == kNotViewDependent && d.hlod == kNotHlod;
+    if (d.hlod != kNotHlod) {
+      const HlodNodeGpu* g = nullptr;
+      const HlodNodeRange* r = hlod_range(*nodes, cut.draws[d.hlod], &g);
+      draw_hlod_node(cut.draws[d.hlod], *g, *r, nodes->materials(), settings, RunPass::blend);
+    } else if (d.vd != kNotViewDependent) {
+      bind_vd_meshes(*vd, vd_colour_of(settings));
+      draw_vd_object(list, list.vd[d.vd], meshes, settings, vd_colour_of(settings), RunPass::blend);
+    } else {
+      if (!instanced_bound) {
+        glBindVertexArray(meshes.vao());
+        glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
+        instanced_bound = true;
+      }
+      DrawBatch one = list.batches[d.batch];
+      one.first_instance = d.instance;
+      one.instance_count = 1;
+      draw_batch(one, meshes, morphs, settings, RunPass::blend, stats);
+    }
+  }
+  glDepthMask(GL_TRUE);
+  set_plain_surface(kModelColour);
+  end_mesh_draws(settings, stats);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
 void InstanceRenderer::begin_mesh_draws(const glm::mat4& view, const glm::mat4& projection,
                                         const RenderSettings& settings) {
-  glUseProgram(program_);
-  glUniformMatrix4fv(u_view_, 1, GL_FALSE, glm::value_ptr(view));
-  glUniformMatrix4fv(u_projection_, 1, GL_FALSE, glm::value_ptr(projection));
-  glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
-  glUniform1i(u_show_morph_, 0);
-  glUniform1i(u_blend_, 0);
-  glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
+  set_frame_uniforms(view, projection, settings);
   glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // meshes without normals: face normals
   glVertexAttrib2f(kAttribUv, 0.f, 0.f);
   set_plain_surface(kModelColour);
@@ -548,45 +597,54 @@ void InstanceRenderer::end_mesh_draws(const RenderSettings& settings, DrawStats&
   glBindVertexArray(0);
 }
 
+// One HLOD node range's runs of `pass` under its model's transform (the node's VAO has the
+// per-object attributes disabled: the constants set here hold); drawn as one surface in the
+// mode's colour when it has no runs or a mode colours the draws (opaque pass only).
+void InstanceRenderer::draw_hlod_node(const HlodDraw& d, const HlodNodeGpu& g, const HlodNodeRange& r,
+                                      const std::vector<GpuMaterial>& materials, const RenderSettings& settings,
+                                      RunPass pass) {
+  glBindVertexArray(g.gl.vao);
+  glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // meshes without normals: face normals
+  glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
+  glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
+  glVertexAttrib2f(kAttribInstanceMorph, 1.f, 0.f);
+  if (!g.uv_vbo) glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  auto draw = [&](uint32_t first_index, uint32_t count) {
+    glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
+                             reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)), GLint(r.first_vertex));
+  };
+  if (!draws_materials(settings) || r.run_count == 0) {
+    if (pass != RunPass::opaque) return;
+    set_plain_surface(settings.colour_override ? settings.colour
+                      : settings.colour_by_level ? level_colour(d.depth)
+                                                 : kModelColour);
+    draw(r.first_index, r.index_count);
+    return;
+  }
+  // Run by run with its material, as a level's runs are drawn.
+  for (uint32_t k = r.first_run; k < r.first_run + r.run_count && k < g.runs.size(); ++k) {
+    const HlodRunGpu& run = g.runs[k];
+    if (material_pass(materials, run.material) != pass) continue;
+    if (run.material >= 0 && size_t(run.material) < materials.size()) set_material(materials[size_t(run.material)]);
+    else set_plain_surface(kModelColour);
+    draw(run.first_index, run.index_count);
+  }
+  set_plain_surface(kModelColour);
+}
+
 void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers& nodes, const glm::mat4& view,
                                  const glm::mat4& projection, const RenderSettings& settings, DrawStats& stats) {
   if (list.draws.empty()) return;
   begin_mesh_draws(view, projection, settings);
   for (const HlodDraw& d : list.draws) {
-    const HlodNodeGpu* g = nodes.find(d.model, d.node);
-    const HlodNodeRange* r = !g ? nullptr : d.layer == kHlodBoundary ? &g->boundary
-                                           : d.layer < g->layers.size() ? &g->layers[d.layer] : nullptr;
+    const HlodNodeGpu* g = nullptr;
+    const HlodNodeRange* r = hlod_range(nodes, d, &g);
     if (!r) {
       ++stats.hlod_missing;
       continue;
     }
-    glBindVertexArray(g->gl.vao);  // per-object attributes disabled here: the constants below hold
-    glVertexAttrib4fv(kAttribInstancePositionScale, d.transform.position_scale);
-    glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
-    glVertexAttrib2f(kAttribInstanceMorph, 1.f, 0.f);
-    if (!g->uv_vbo) glVertexAttrib2f(kAttribUv, 0.f, 0.f);
-    const auto& c = settings.colour_override ? settings.colour
-                    : settings.colour_by_level ? level_colour(d.depth)
-                                               : kModelColour;
-    auto draw = [&](uint32_t first_index, uint32_t count) {
-      glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
-                               reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)),
-                               GLint(r->first_vertex));
-    };
-    if (!draws_materials(settings) || r->run_count == 0) {
-      set_plain_surface(c);
-      draw(r->first_index, r->index_count);
-    } else {
-      // Run by run with its material, as a level's runs are drawn (blended ones in draw order).
-      const auto& materials = nodes.materials();
-      for (uint32_t k = r->first_run; k < r->first_run + r->run_count && k < g->runs.size(); ++k) {
-        const HlodRunGpu& run = g->runs[k];
-        if (run.material >= 0 && size_t(run.material) < materials.size()) set_material(materials[size_t(run.material)]);
-        else set_plain_surface(kModelColour);
-        draw(run.first_index, run.index_count);
-      }
-      set_plain_surface(kModelColour);
-    }
+    // Opaque (and masked) runs only: the blended ones wait for draw_blended().
+    draw_hlod_node(d, *g, *r, nodes.materials(), settings, RunPass::opaque);
     ++stats.draws;
     ++stats.hlod_draws;
     stats.hlod_triangles += r->index_count / 3;

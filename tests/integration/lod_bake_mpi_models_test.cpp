@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "bake_cache_files.h"
 #include "run_cli.h"
 #include "test_support.h"
 
@@ -58,20 +59,7 @@ void expect_local_bytes(const std::filesystem::path& out, const std::string& wha
     EXPECT_EQ(test::read_bytes(out / (std::string(kNames[k]) + ".hlod")), fixture().local[k]) << kNames[k] << ", " << what;
 }
 
-std::vector<std::filesystem::path> entries(const std::filesystem::path& cache, const std::string& ext) {
-  std::vector<std::filesystem::path> files;
-  if (std::filesystem::exists(cache))
-    for (const auto& e : std::filesystem::directory_iterator(cache))
-      if (e.is_regular_file() && e.path().extension() == ext) files.push_back(e.path());
-  std::sort(files.begin(), files.end());
-  return files;
-}
 
-nlohmann::json summary(const test::CliResult& r) {
-  const size_t at = r.out.find("{\n");
-  if (at == std::string::npos) return {};
-  return nlohmann::json::parse(r.out.substr(at, r.out.rfind('}') + 1 - at), nullptr, false);
-}
 
 size_t baked(const nlohmann::json& j) {
   size_t n = j["split"].get<size_t>();
@@ -86,7 +74,7 @@ TEST(LodBakeMpiModels, EveryModelHasTheLocalBakesBytesAtOneTwoAndFourRanks) {
     const test::CliResult r = run_mpi(ranks, bake_args(dir / "out", dir / "cache") + " --json");
     ASSERT_EQ(r.code, 0) << r.out;
     expect_local_bytes(dir / "out", std::to_string(ranks) + " ranks");
-    const nlohmann::json j = summary(r);
+    const nlohmann::json j = test::printed_json(r);
     ASSERT_TRUE(j.is_object()) << r.out;
     EXPECT_EQ(j["ranks"], ranks);
     EXPECT_EQ(j["models_total"], 5);
@@ -95,7 +83,7 @@ TEST(LodBakeMpiModels, EveryModelHasTheLocalBakesBytesAtOneTwoAndFourRanks) {
     EXPECT_EQ(j["models"][4]["route"], ranks == 1 ? "whole" : "split");
     EXPECT_EQ(j["per_rank"].size(), size_t(ranks));
     for (const auto& w : j["per_rank"]) EXPECT_GT(w["baked"].get<int>(), 0) << "a rank without a whole model";
-    EXPECT_EQ(entries(dir / "cache", ".hlod").size(), 5u) << "every model in the cache";
+    EXPECT_EQ(test::cache_entries(dir / "cache", ".hlod").size(), 5u) << "every model in the cache";
   }
 }
 
@@ -104,13 +92,13 @@ TEST(LodBakeMpiModels, KilledRankThenRerunBakesOnlyTheMissingModelsIntoTheSameBy
   const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=1 LOD_MPI_FAIL_RANK=1");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("injected failure"), std::string::npos) << killed.out;
-  const size_t kept = entries(dir / "cache", ".hlod").size();
+  const size_t kept = test::cache_entries(dir / "cache", ".hlod").size();
   EXPECT_GE(kept, 1u) << "the killed rank's first model is kept";
   ASSERT_LT(kept, 5u);
 
   const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
-  const nlohmann::json j = summary(rerun);
+  const nlohmann::json j = test::printed_json(rerun);
   ASSERT_TRUE(j.is_object()) << rerun.out;
   EXPECT_EQ(j["cached"].get<size_t>(), kept);
   EXPECT_EQ(baked(j), 5 - kept) << "only the missing models are baked";
@@ -124,13 +112,13 @@ TEST(LodBakeMpiModels, KilledInASplitModelThenRerunKeepsItsSubtrees) {
   const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=3 LOD_MPI_FAIL_RANK=0");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("subtree"), std::string::npos) << killed.out;
-  EXPECT_EQ(entries(dir / "cache", ".hlod").size(), 4u) << "the four whole models are finished before the split one";
-  const size_t subtrees = entries(dir / "cache", ".hsub").size();
+  EXPECT_EQ(test::cache_entries(dir / "cache", ".hlod").size(), 4u) << "the four whole models are finished before the split one";
+  const size_t subtrees = test::cache_entries(dir / "cache", ".hsub").size();
   EXPECT_GE(subtrees, 2u);
 
   const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
-  const nlohmann::json j = summary(rerun);
+  const nlohmann::json j = test::printed_json(rerun);
   ASSERT_TRUE(j.is_object()) << rerun.out;
   EXPECT_EQ(j["cached"], 4);
   EXPECT_EQ(j["split"], 1) << "the one model missing is baked by both ranks";
@@ -140,19 +128,15 @@ TEST(LodBakeMpiModels, KilledInASplitModelThenRerunKeepsItsSubtrees) {
 TEST(LodBakeMpiModels, CorruptedAndTruncatedModelEntriesAreRebaked) {
   const auto dir = test::temp_dir("lod_bake_mpi_models_corrupt");
   ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
-  const std::vector<std::filesystem::path> files = entries(dir / "cache", ".hlod");
+  const std::vector<std::filesystem::path> files = test::cache_entries(dir / "cache", ".hlod");
   ASSERT_EQ(files.size(), 5u);
-  std::vector<uint8_t> bytes = test::read_bytes(files[0]);
-  bytes[bytes.size() / 2] ^= 0x10;
-  test::write_bytes(files[0], bytes);
-  bytes = test::read_bytes(files[1]);
-  bytes.resize(bytes.size() - 1);
-  test::write_bytes(files[1], bytes);
+  test::corrupt_entry(files[0]);
+  test::truncate_entry(files[1]);
   std::filesystem::remove_all(dir / "out");
 
   const test::CliResult r = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(r.code, 0) << r.out;
-  const nlohmann::json j = summary(r);
+  const nlohmann::json j = test::printed_json(r);
   ASSERT_TRUE(j.is_object()) << r.out;
   EXPECT_EQ(j["cached"], 3);
   EXPECT_EQ(baked(j), 2u);
@@ -170,14 +154,14 @@ TEST(LodBakeMpiModels, FailingRankNamesTheModelAndTheJobFailsKeepingTheCache) {
   EXPECT_NE(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("model rock ("), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("run again"), std::string::npos) << r.out;
-  EXPECT_EQ(entries(dir / "cache", ".hlod").size(), 5u) << "the rock's entry was stored before its copy failed";
+  EXPECT_EQ(test::cache_entries(dir / "cache", ".hlod").size(), 5u) << "the rock's entry was stored before its copy failed";
   for (const char* name : {"pebble", "stone", "crag", "boulder"})
     EXPECT_TRUE(std::filesystem::is_regular_file(dir / "out" / (std::string(name) + ".hlod"))) << name;
 
   std::filesystem::remove_all(dir / "out" / "rock.hlod");
   const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
-  EXPECT_EQ(summary(rerun)["cached"], 5);
+  EXPECT_EQ(test::printed_json(rerun)["cached"], 5);
   expect_local_bytes(dir / "out", "after the rerun");
 }
 

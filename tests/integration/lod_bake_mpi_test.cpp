@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "bake_cache_files.h"
 #include "run_cli.h"
 #include "test_support.h"
 #include "textured_fixture.h"
@@ -44,17 +45,8 @@ std::string bake_args(const std::filesystem::path& out, const std::filesystem::p
   return fixture().mesh.string() + " -o " + out.string() + " --cache " + cache.string() + " --min-verts 300 --threads 1";
 }
 
-size_t entries(const std::filesystem::path& cache) {
-  size_t n = 0;
-  for (const auto& e : std::filesystem::directory_iterator(cache)) n += e.is_regular_file() && e.path().extension() == ".hsub";
-  return n;
-}
+size_t entries(const std::filesystem::path& cache) { return test::cache_entries(cache, ".hsub").size(); }
 
-nlohmann::json summary(const test::CliResult& r) {
-  const size_t at = r.out.find("{\n");
-  if (at == std::string::npos) return {};
-  return nlohmann::json::parse(r.out.substr(at, r.out.rfind('}') + 1 - at), nullptr, false);
-}
 
 TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
   ASSERT_FALSE(fixture().local.empty());
@@ -63,7 +55,7 @@ TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
     const test::CliResult r = run_mpi(ranks, bake_args(dir / "out", dir / "cache") + " --json");
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local) << ranks << " ranks";
-    const nlohmann::json j = summary(r);
+    const nlohmann::json j = test::printed_json(r);
     ASSERT_TRUE(j.is_object()) << r.out;
     EXPECT_EQ(j["ranks"], ranks);
     EXPECT_GE(j["subtrees"].get<int>(), 16 * ranks);
@@ -102,7 +94,7 @@ TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes)
 
   const test::CliResult rerun = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(rerun.code, 0) << rerun.out;
-  const nlohmann::json j = summary(rerun);
+  const nlohmann::json j = test::printed_json(rerun);
   ASSERT_TRUE(j.is_object()) << rerun.out;
   const size_t total = j["subtrees"].get<size_t>();
   ASSERT_LT(kept, total);
@@ -118,22 +110,15 @@ TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes)
 TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
   const auto dir = test::temp_dir("lod_bake_mpi_corrupt");
   ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
-  std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
-    if (e.path().extension() == ".hsub") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::filesystem::path> files = test::cache_entries(dir / "cache", ".hsub");
   ASSERT_GE(files.size(), 2u);
-  std::vector<uint8_t> bytes = test::read_bytes(files[0]);
-  bytes[bytes.size() / 2] ^= 0x10;
-  test::write_bytes(files[0], bytes);
-  bytes = test::read_bytes(files[1]);
-  bytes.resize(bytes.size() - 1);
-  test::write_bytes(files[1], bytes);
+  test::corrupt_entry(files[0]);
+  test::truncate_entry(files[1]);
   std::filesystem::remove(dir / "out" / "ball.hlod");
 
   const test::CliResult r = run_mpi(2, bake_args(dir / "out", dir / "cache") + " --json");
   ASSERT_EQ(r.code, 0) << r.out;
-  const nlohmann::json j = summary(r);
+  const nlohmann::json j = test::printed_json(r);
   ASSERT_TRUE(j.is_object()) << r.out;
   EXPECT_EQ(j["cached"].get<size_t>(), files.size() - 2);
   EXPECT_NE(r.out.find("corrupted"), std::string::npos) << r.out;
@@ -145,10 +130,7 @@ TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
 TEST(LodBakeMpi, FailingRankNamesTheSubtreeAndTheJobFailsKeepingTheCache) {
   const auto dir = test::temp_dir("lod_bake_mpi_fail");
   ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);
-  std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
-    if (e.path().extension() == ".hsub") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::filesystem::path> files = test::cache_entries(dir / "cache", ".hsub");
   const auto blocked = files[files.size() / 2];
   std::filesystem::remove(blocked);
   std::filesystem::create_directories(blocked / "in-the-way");

@@ -48,6 +48,14 @@ inline CliResult run_mpi(int ranks, const std::string& args, const std::string& 
 }
 #endif
 
+// The JSON object a command printed after its other output (`--json` to stdout: the first
+// line that is "{" to the last "}"); null when there is none or it does not parse.
+inline nlohmann::json printed_json(const CliResult& r) {
+  const size_t at = r.out.find("{\n");
+  if (at == std::string::npos) return {};
+  return nlohmann::json::parse(r.out.substr(at, r.out.rfind('}') + 1 - at), nullptr, false);
+}
+
 inline nlohmann::json read_json(const std::filesystem::path& p) {
   std::ifstream f(p);
   return nlohmann::json::parse(f);

@@ -33,6 +33,7 @@ lod::HlodModels two_leaf_model() {
   lod::HlodModels m;
   lod::HlodTree t;
   t.nodes = {node(-1, 0, 1, 2, 400), node(0, 1, 0, 0, 200), node(0, 1, 0, 0, 100)};
+  t.nodes[1].bounds.center[1] = -1.5f;
   m.trees.push_back(t);
   lod::Transform tr;
   tr.position[0] = 1;
@@ -64,6 +65,7 @@ TEST(ViewerHlodDrawList, DrawsLayersAndOpenedPatchesAndRefusesWhatTheTreesDoNotH
   EXPECT_EQ(list.triangles, 235u);
   EXPECT_FLOAT_EQ(list.draws[0].transform.position_scale[0], 1.f);
   EXPECT_FLOAT_EQ(list.draws[0].transform.position_scale[3], 2.f);
+  EXPECT_FLOAT_EQ(list.draws[0].center[1], -1.5f) << "the node's bounding sphere centre, for the blend order";
 
   f.hlod_drawn.clear();  // reused: nothing of the last frame stays
   f.hlod_opened.clear();
@@ -114,27 +116,16 @@ file = "ball.off"
 hlod = true
 min_verts = 400
 )";
-const char* kBall = R"([[instances]]
-model = "ball"
-count = 1
-placement = "grid"
-box_min = [0, 0, 0]
-box_max = [0, 0, 0]
-scale = 10.0
-)";
 
 TEST(ViewerHlod, DrawsEveryFramesCutAndRefinesItOnTheWayIn) {
   LOD_REQUIRE_XVFB();
-  const auto scene = lod::test::write_viewer_scene("hlod", kRun, kFlight, kBall, kBallModel);
+  const auto scene = lod::test::write_viewer_scene("hlod", kRun, kFlight, lod::test::one_object_at_origin("ball", 10),
+                                                   kBallModel);
   std::ofstream(scene.dir / "ball.off") << lod::test::sphere_off(60, 120);
-  const auto stats = scene.dir / "hlod.csv";
-  const auto png = scene.dir / "hlod.png";
-  const auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() +
-                                                  "' --frames 40 --width 320 --height 180 --colour-by-level --stats '" +
-                                                  stats.string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  lod::test::CsvTable t;
-  ASSERT_TRUE(lod::test::load_csv(stats, t));
+  const auto shot = lod::test::take_screenshot(scene, "hlod", "--frames 40 --width 320 --height 180 --colour-by-level");
+  ASSERT_EQ(shot.run.exit_code, 0) << shot.run.output;
+  ASSERT_TRUE(shot.stats_read);
+  const lod::test::CsvTable& t = shot.stats;
   ASSERT_EQ(t.rows.size(), 40u);
   double most_draws = 0;
   for (size_t i = 0; i < t.rows.size(); ++i) {
@@ -152,9 +143,8 @@ TEST(ViewerHlod, DrawsEveryFramesCutAndRefinesItOnTheWayIn) {
   EXPECT_GT(t.get(39, "drawn"), t.get(0, "drawn")) << "close by, the cut is finer";
   EXPECT_GT(most_draws, 1) << "the root alone was drawn all the way in";
 
-  lod::test::Image img;
-  ASSERT_TRUE(lod::test::load_png(png, img));
-  EXPECT_FALSE(lod::test::is_background(img.at(img.width / 2, img.height / 2))) << "the ball is drawn";
+  ASSERT_TRUE(shot.image_read);
+  EXPECT_FALSE(lod::test::is_background(shot.image.at(shot.image.width / 2, shot.image.height / 2))) << "the ball is drawn";
 }
 
 }  // namespace

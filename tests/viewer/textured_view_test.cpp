@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <set>
+#include <string>
 
 #include "textured_fixture.h"
 #include "viewer/picture_checks.h"
@@ -28,14 +29,7 @@ file = "textured/globe.gltf"
 ratios = [1.0, 0.5]
 )";
 
-const char* kInstance = R"([[instances]]
-model = "textured"
-count = 1
-placement = "grid"
-box_min = [0.0, 0.0, 0.0]
-box_max = [0.0, 0.0, 0.0]
-scale = 9.0
-)";
+const std::string kInstance = lod::test::one_object_at_origin("textured", 9);
 
 float srgb(float linear) { return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1 / 2.4f) - 0.055f; }
 
@@ -81,11 +75,26 @@ HueCounts count_hues(const Image& img, float tolerance) {
   return n;
 }
 
+// The lit globe's three colours where they belong: both checker colours on the textured cap
+// above the equator, the second material's factor below it; `where` names the picture.
+void expect_checker_and_factor(const HueCounts& m, const std::string& where) {
+  EXPECT_GE(m.light_above, 300) << "light checker squares " << where;
+  EXPECT_GE(m.dark_above, 300) << "dark checker squares " << where;
+  EXPECT_GE(m.base_below, 300) << "the untextured material's factor below the equator " << where;
+}
+
+// The two-material globe (24 x 48, faces outward) in the scene's textured/ folder; false when
+// it could not be written.
+bool write_globe(const lod::test::ViewerScene& scene, bool every_texture = false) {
+  return !lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, every_texture,
+                                             lod::test::SphereFaces::outward)
+              .empty();
+}
+
 TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
-                                                     lod::test::SphereFaces::outward).empty());
+  ASSERT_TRUE(write_globe(scene));
   const auto lit = scene.dir / "materials.png";
   const auto levels = scene.dir / "levels.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --width 400 --height 300");
@@ -96,10 +105,7 @@ TEST(ViewerTextured, MaterialsShowTheTextureAndFactorColourByLevelDoesNot) {
 
   Image img;
   ASSERT_TRUE(lod::test::load_png(lit, img));
-  const HueCounts m = count_hues(img, kPresent);
-  EXPECT_GE(m.light_above, 300) << "light checker squares on the textured cap";
-  EXPECT_GE(m.dark_above, 300) << "dark checker squares on the textured cap";
-  EXPECT_GE(m.base_below, 300) << "the untextured material's base colour factor below the equator";
+  expect_checker_and_factor(count_hues(img, kPresent), "on the textured cap");
 
   Image by_level;
   ASSERT_TRUE(lod::test::load_png(levels, by_level));
@@ -156,9 +162,7 @@ TEST(ViewerTextured, ATextureEmbeddedInTheGlbIsDecodedFromTheAsset) {
   const HueCounts c = count_hues(img, kPresent);
   std::printf("embedded checker: %d light and %d dark pixels above the equator, %d base below\n", c.light_above,
               c.dark_above, c.base_below);
-  EXPECT_GE(c.light_above, 300) << "light checker squares from the embedded image";
-  EXPECT_GE(c.dark_above, 300) << "dark checker squares from the embedded image";
-  EXPECT_GE(c.base_below, 300);
+  expect_checker_and_factor(c, "from the embedded image");
 }
 
 // The same globe drawn view-dependently: the front carries uvs and its triangles come grouped
@@ -167,24 +171,15 @@ TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
   LOD_REQUIRE_XVFB();
   const std::string model = std::string(kModel) + "view_dependent = true\n";
   const auto scene = lod::test::write_viewer_scene("textured-vd", kRun, kCamera, kInstance, model.c_str());
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
-                                                     lod::test::SphereFaces::outward).empty());
-  const auto lit = scene.dir / "vd.png";
-  const auto stats = scene.dir / "vd.csv";
-  const auto r = lod::test::run_viewer(
-      scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" + stats.string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << r.output;
-  lod::test::CsvTable t;
-  ASSERT_TRUE(lod::test::load_csv(stats, t));
-  ASSERT_FALSE(t.rows.empty());
-  EXPECT_EQ(t.get(t.rows.size() - 1, "vd_objects"), 1) << "drawn from its active front";
-  Image img;
-  ASSERT_TRUE(lod::test::load_png(lit, img));
-  const HueCounts m = count_hues(img, kPresent);
-  EXPECT_GE(m.light_above, 300) << "light checker squares on the view-dependent cap";
-  EXPECT_GE(m.dark_above, 300) << "dark checker squares on the view-dependent cap";
-  EXPECT_GE(m.base_below, 300) << "the untextured material's factor below the equator";
+  ASSERT_TRUE(write_globe(scene));
+  const auto shot = lod::test::take_screenshot(scene, "vd", "--frames 3 --width 400 --height 300");
+  ASSERT_EQ(shot.run.exit_code, 0) << shot.run.output;
+  EXPECT_EQ(shot.run.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << shot.run.output;
+  ASSERT_TRUE(shot.stats_read);
+  ASSERT_FALSE(shot.stats.rows.empty());
+  EXPECT_EQ(shot.stats.last("vd_objects"), 1) << "drawn from its active front";
+  ASSERT_TRUE(shot.image_read);
+  expect_checker_and_factor(count_hues(shot.image, kPresent), "on the view-dependent cap");
 }
 
 // The same globe as an HLOD model (issue 12): its nodes carry uvs and material runs, so the
@@ -200,27 +195,20 @@ min_verts = 300
   const char* run = "[run]\nframes = 3\nthreads = 1\n[budget]\ntriangles = 1000000\n[lod]\npixel_error = 1.0\n";
   const auto scene = lod::test::write_viewer_scene("textured-hlod", run, kCamera, kInstance, model);
   ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 48, 96).empty());
-  const auto lit = scene.dir / "hlod.png";
   const auto depth = scene.dir / "depth.png";
-  const auto stats = scene.dir / "hlod.csv";
-  auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" +
-                                            stats.string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << r.output;
-  lod::test::CsvTable t;
-  ASSERT_TRUE(lod::test::load_csv(stats, t));
-  ASSERT_FALSE(t.rows.empty());
-  EXPECT_GT(t.get(t.rows.size() - 1, "hlod_draws"), 0) << "drawn through its HLOD cut";
-  EXPECT_EQ(t.get(t.rows.size() - 1, "hlod_missing"), 0);
-  r = lod::test::run_viewer(scene, "--screenshot '" + depth.string() + "' --frames 3 --color-by-level --width 400 --height 300");
+  const auto shot = lod::test::take_screenshot(scene, "hlod", "--frames 3 --width 400 --height 300");
+  ASSERT_EQ(shot.run.exit_code, 0) << shot.run.output;
+  EXPECT_EQ(shot.run.output.find("lod-viewer: texture"), std::string::npos) << "the texture was not read: " << shot.run.output;
+  ASSERT_TRUE(shot.stats_read);
+  ASSERT_FALSE(shot.stats.rows.empty());
+  EXPECT_GT(shot.stats.last("hlod_draws"), 0) << "drawn through its HLOD cut";
+  EXPECT_EQ(shot.stats.last("hlod_missing"), 0);
+  const auto r =
+      lod::test::run_viewer(scene, "--screenshot '" + depth.string() + "' --frames 3 --color-by-level --width 400 --height 300");
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
-  Image img;
-  ASSERT_TRUE(lod::test::load_png(lit, img));
-  const HueCounts m = count_hues(img, kPresent);
-  EXPECT_GE(m.light_above, 300) << "light checker squares on the HLOD's textured cap";
-  EXPECT_GE(m.dark_above, 300) << "dark checker squares on the HLOD's textured cap";
-  EXPECT_GE(m.base_below, 300) << "the untextured material's factor below the equator";
+  ASSERT_TRUE(shot.image_read);
+  expect_checker_and_factor(count_hues(shot.image, kPresent), "on the HLOD's textured cap");
   Image by_depth;
   ASSERT_TRUE(lod::test::load_png(depth, by_depth));
   const HueCounts c = count_hues(by_depth, kAbsent);
@@ -241,32 +229,24 @@ min_verts = 300
   const char* run = "[run]\nframes = 3\nthreads = 1\n[budget]\ntriangles = 1000000\n[lod]\npixel_error = 1.0\n";
   const auto scene = lod::test::write_viewer_scene("textured-hlod-glb", run, kCamera, kInstance, model);
   write_embedded_globe(scene.dir / "textured", 48, 96);
-  const auto lit = scene.dir / "hlod.png";
-  const auto stats = scene.dir / "hlod.csv";
-  const auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" +
-                                                  stats.string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(r.output.find("lod-viewer: texture"), std::string::npos) << "every texture was decoded: " << r.output;
-  EXPECT_EQ(r.output.find("left out"), std::string::npos) << r.output;
-  lod::test::CsvTable t;
-  ASSERT_TRUE(lod::test::load_csv(stats, t));
-  ASSERT_FALSE(t.rows.empty());
-  EXPECT_GT(t.get(t.rows.size() - 1, "hlod_draws"), 0) << "drawn through its HLOD cut";
-  Image img;
-  ASSERT_TRUE(lod::test::load_png(lit, img));
-  const HueCounts c = count_hues(img, kPresent);
+  const auto shot = lod::test::take_screenshot(scene, "hlod", "--frames 3 --width 400 --height 300");
+  ASSERT_EQ(shot.run.exit_code, 0) << shot.run.output;
+  EXPECT_EQ(shot.run.output.find("lod-viewer: texture"), std::string::npos) << "every texture was decoded: " << shot.run.output;
+  EXPECT_EQ(shot.run.output.find("left out"), std::string::npos) << shot.run.output;
+  ASSERT_TRUE(shot.stats_read);
+  ASSERT_FALSE(shot.stats.rows.empty());
+  EXPECT_GT(shot.stats.last("hlod_draws"), 0) << "drawn through its HLOD cut";
+  ASSERT_TRUE(shot.image_read);
+  const HueCounts c = count_hues(shot.image, kPresent);
   std::printf("HLOD embedded checker: %d light and %d dark pixels above the equator, %d base below\n", c.light_above,
               c.dark_above, c.base_below);
-  EXPECT_GE(c.light_above, 300) << "light checker squares from the .hlod's embedded image";
-  EXPECT_GE(c.dark_above, 300) << "dark checker squares from the .hlod's embedded image";
-  EXPECT_GE(c.base_below, 300);
+  expect_checker_and_factor(c, "from the .hlod's embedded image");
 }
 
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
-                                                     lod::test::SphereFaces::outward).empty());
+  ASSERT_TRUE(write_globe(scene));
   // Bake first (the texture is not read by the bake), then break the image.
   const auto png = scene.dir / "out.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() + "' --width 400 --height 300");
@@ -290,8 +270,7 @@ TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
 TEST(ViewerTextured, TheNormalTextureShadesItsMaterialOnly) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-normal", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/true,
-                                                     lod::test::SphereFaces::outward).empty());
+  ASSERT_TRUE(write_globe(scene, /*every_texture=*/true));
   const auto mapped = scene.dir / "mapped.png";
   const auto plain = scene.dir / "plain.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + mapped.string() + "' --width 400 --height 300");
@@ -330,8 +309,7 @@ namespace {
 TEST(ViewerBackdrop, SkyGradientAboveGroundTilesBelowFlatWhenOff) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("backdrop", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
-                                                     lod::test::SphereFaces::outward).empty());
+  ASSERT_TRUE(write_globe(scene));
   const auto on = scene.dir / "backdrop.png";
   const auto off = scene.dir / "flat.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + on.string() + "' --width 400 --height 300 --backdrop on");
@@ -372,8 +350,7 @@ namespace {
 TEST(ViewerOverlay, CoversLessThanATenthOfThePicture) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("overlay", kRun, kCamera, kInstance, kModel);
-  ASSERT_FALSE(lod::test::write_two_material_gltf(scene.dir / "textured", "globe", 24, 48, /*every_texture=*/false,
-                                                     lod::test::SphereFaces::outward).empty());
+  ASSERT_TRUE(write_globe(scene));
   const auto with = scene.dir / "overlay.png";
   const auto without = scene.dir / "plain.png";
   auto r = lod::test::run_viewer(scene, "--screenshot '" + with.string() + "' --overlay --frames 3 --width 1280 --height 720");

@@ -19,6 +19,14 @@ std::string front_camera(int width, int height) {
          "position = [0.0, 0.0, 30.0]\nlook_at = [0.0, 0.0, 0.0]\n";
 }
 
+std::string one_object_at_origin(const std::string& model, float scale, int seed) {
+  std::ostringstream s;
+  s << "[[instances]]\nmodel = \"" << model << "\"\ncount = 1\nplacement = \"grid\"\nbox_min = [0.0, 0.0, 0.0]\n"
+    << "box_max = [0.0, 0.0, 0.0]\nscale = " << std::to_string(scale) << "\n";
+  if (seed >= 0) s << "seed = " << seed << "\n";
+  return s.str();
+}
+
 std::string box_off(int n) {
   // Vertices on the cube's surface lattice, keyed by integer coordinates so that the faces
   // share their edge vertices (a closed, welded mesh).
@@ -137,6 +145,16 @@ bool load_csv(const std::filesystem::path& path, CsvTable& out) {
     out.rows.push_back(std::move(row));
   }
   return true;
+}
+
+Screenshot take_screenshot(const ViewerScene& scene, const std::string& name, const std::string& args) {
+  Screenshot shot;
+  const std::filesystem::path png = scene.dir / (name + ".png"), csv = scene.dir / (name + ".csv");
+  shot.run = run_viewer(scene, "--screenshot '" + png.string() + "' --stats '" + csv.string() + "' " + args);
+  if (shot.run.exit_code != 0) return shot;
+  shot.image_read = load_png(png, shot.image);
+  shot.stats_read = load_csv(csv, shot.stats);
+  return shot;
 }
 
 }  // namespace lod::test

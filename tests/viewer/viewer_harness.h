@@ -14,6 +14,10 @@ std::string box_off(int n);
 // A [camera] block of one keyframe at z = 30 looking at the origin (60 degrees, near 0.5, far 500).
 std::string front_camera(int width, int height);
 
+// An [[instances]] block of one `model` object at the origin, `scale` times its size; `seed`
+// (when >= 0) picks the placement's yaw draw (seed 1061's first is -0.1 degrees: square on).
+std::string one_object_at_origin(const std::string& model, float scale, int seed = -1);
+
 struct ViewerScene {
   std::filesystem::path dir;     // holds config.toml, the meshes, the cache and outputs
   std::filesystem::path config;
@@ -49,8 +53,19 @@ struct CsvTable {
   std::vector<std::string> columns;
   std::vector<std::vector<double>> rows;
   double get(size_t row, const std::string& column) const;
+  double last(const std::string& column) const { return get(rows.size() - 1, column); }
 };
 bool load_csv(const std::filesystem::path& path, CsvTable& out);
+
+// A run with --screenshot DIR/<name>.png and --stats DIR/<name>.csv (DIR the scene's folder)
+// and `args`; the picture and the table read back when the run succeeded.
+struct Screenshot {
+  RunResult run;
+  Image image;
+  CsvTable stats;
+  bool image_read = false, stats_read = false;
+};
+Screenshot take_screenshot(const ViewerScene& scene, const std::string& name, const std::string& args);
 
 }  // namespace lod::test
 

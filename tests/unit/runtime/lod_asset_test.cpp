@@ -11,6 +11,7 @@
 #include "runtime/lod_asset.h"
 #include "test_support.h"
 #include "unit/runtime/runtime_fixtures.h"
+#include "unit/runtime/truncation_checks.h"
 
 namespace lod {
 namespace {
@@ -104,15 +105,18 @@ TEST(LodAsset, ConcurrentWritersOfOneAssetAllSucceed) {
   EXPECT_EQ(files, 1u) << "no temporary file is left behind";
 }
 
-TEST(LodAsset, RefusesTruncationAtEveryOffset) {
-  const std::vector<uint8_t> bytes = encode_lod_asset(sample_chain());
-  for (size_t len = 0; len < bytes.size(); ++len) {
-    LodChain out = sentinel();
-    const Status st = decode_lod_asset(std::span(bytes).first(len), "bunny.lod", out);
-    ASSERT_FALSE(st) << "accepted a file cut to " << len << " of " << bytes.size() << " bytes";
-    EXPECT_EQ(st.message.rfind("bunny.lod: ", 0), 0u) << st.message;
+// Decodes `bytes` as bunny.lod into a sentinel chain, which a refusal must leave untouched.
+Status decode_untouched(std::span<const uint8_t> bytes) {
+  LodChain out = sentinel();
+  const Status st = decode_lod_asset(bytes, "bunny.lod", out);
+  if (!st) {
     EXPECT_EQ(out.name, "untouched");
   }
+  return st;
+}
+
+TEST(LodAsset, RefusesTruncationAtEveryOffset) {
+  test::expect_every_truncation_refused(encode_lod_asset(sample_chain()), "bunny.lod", decode_untouched);
 }
 
 TEST(LodAsset, RefusesEverySingleFlippedByte) {
@@ -247,13 +251,7 @@ TEST(LodAsset, RoundTripsMorphTargetsInTheirOwnSection) {
 
 TEST(LodAsset, RefusesTruncatedOrFlippedMorphTargets) {
   const std::vector<uint8_t> bytes = encode_lod_asset(chain_with_targets());
-  for (size_t len = 0; len < bytes.size(); ++len) {
-    LodChain out = sentinel();
-    const Status st = decode_lod_asset(std::span(bytes).first(len), "bunny.lod", out);
-    ASSERT_FALSE(st) << "accepted a file cut to " << len << " of " << bytes.size() << " bytes";
-    EXPECT_EQ(st.message.rfind("bunny.lod: ", 0), 0u) << st.message;
-    EXPECT_EQ(out.name, "untouched");
-  }
+  test::expect_every_truncation_refused(bytes, "bunny.lod", decode_untouched);
   for (size_t at = 0; at < bytes.size(); ++at) {
     std::vector<uint8_t> bad = bytes;
     bad[at] ^= 0x10;
@@ -772,11 +770,7 @@ TEST(LodAssetImages, RefusesASlotNamingAnImageTheAssetLacks) {
 // (its size shortened to every length, the checksum made right again: IMGS's own checks).
 TEST(LodAssetImages, RefusesTruncationAtEveryOffsetOfTheFileAndOfTheSection) {
   const std::vector<uint8_t> good = encode_lod_asset(chain_with_images());
-  for (size_t len = 0; len < good.size(); ++len) {
-    LodChain out = sentinel();
-    ASSERT_FALSE(decode_lod_asset(std::span(good).first(len), "bunny.lod", out)) << len;
-    EXPECT_EQ(out.name, "untouched");
-  }
+  test::expect_every_truncation_refused(good, "bunny.lod", decode_untouched);
   const size_t entry = table_entry_of(good, "IMGS");
   const uint64_t size = section_of(good, "IMGS").second;
   for (uint64_t shorter = 0; shorter < size; ++shorter) {
