@@ -7,6 +7,14 @@
 
 namespace lod::test {
 
+// Whether one of `x.warnings` (a MeshData, a bake report...) contains `part`.
+template <class WithWarnings>
+bool has_warning(const WithWarnings& x, const std::string& part) {
+  for (const std::string& w : x.warnings)
+    if (w.find(part) != std::string::npos) return true;
+  return false;
+}
+
 // ../shared/data/meshes, or empty when this machine does not have it.
 std::filesystem::path shared_meshes();
 // Debian CGAL meshes extracted by the build (cow.off, bunny00.off, ...), or empty.

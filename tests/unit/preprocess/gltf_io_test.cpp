@@ -39,11 +39,7 @@ void expect_refused(const Status& s, const std::string& needle) {
   EXPECT_NE(s.message.find(needle), std::string::npos) << s.message;
 }
 
-bool has_warning(const MeshData& m, const std::string& needle) {
-  for (const std::string& w : m.warnings)
-    if (w.find(needle) != std::string::npos) return true;
-  return false;
-}
+using test::has_warning;
 
 // One node per mesh, all in scene 0.
 void place_meshes(GltfFixture& f) {

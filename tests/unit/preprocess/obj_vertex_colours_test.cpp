@@ -8,6 +8,7 @@
 #include <string>
 
 #include "preprocess/mesh_io.h"
+#include "test_support.h"
 
 namespace lod {
 namespace {
@@ -17,11 +18,7 @@ Status load_obj(const std::string& text, MeshData& out) {
                                reinterpret_cast<const uint8_t*>(text.data()), text.size(), out);
 }
 
-bool has_warning(const MeshData& m, const std::string& part) {
-  for (const std::string& w : m.warnings)
-    if (w.find(part) != std::string::npos) return true;
-  return false;
-}
+using test::has_warning;
 
 float linear(float srgb) { return srgb <= 0.04045f ? srgb / 12.92f : std::pow((srgb + 0.055f) / 1.055f, 2.4f); }
 
@@ -78,11 +75,10 @@ TEST(ObjVertexColours, SaveObjWritesThemAndTheyReadBack) {
   const std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const std::vector<float> colors = {0.2f, 0.4f, 0.6f, 1, 1, 0, 0, 0.5f, 0, 0.01f, 1, 1};
   const std::vector<uint32_t> indices = {0, 1, 2};
-  const std::filesystem::path file = std::filesystem::temp_directory_path() / "lod-obj-colours-test.obj";
+  const std::filesystem::path file = test::temp_dir("obj-colours") / "c.obj";
   ASSERT_TRUE(save_obj(file, positions.data(), nullptr, 3, indices.data(), 3, nullptr, colors.data()).ok);
   MeshData m;
   const Status s = load_mesh(file, m);
-  std::filesystem::remove(file);
   ASSERT_TRUE(s.ok) << s.message;
   ASSERT_EQ(m.colors.size(), 12u);
   for (size_t v = 0; v < 3; ++v)

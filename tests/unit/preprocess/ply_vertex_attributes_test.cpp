@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "preprocess/mesh_io.h"
+#include "test_support.h"
 
 namespace lod {
 namespace {
@@ -18,11 +19,7 @@ Status load_ply(const std::string& bytes, MeshData& out) {
   return load_mesh_from_memory("a.ply", ".ply", reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), out);
 }
 
-bool has_warning(const MeshData& m, const std::string& part) {
-  for (const std::string& w : m.warnings)
-    if (w.find(part) != std::string::npos) return true;
-  return false;
-}
+using test::has_warning;
 
 float linear(float srgb) { return srgb <= 0.04045f ? srgb / 12.92f : std::pow((srgb + 0.055f) / 1.055f, 2.4f); }
 
