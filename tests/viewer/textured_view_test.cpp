@@ -262,6 +262,77 @@ min_verts = 300
   EXPECT_GE(c.base_below, 300);
 }
 
+// The coloured sphere (north red shading to yellow, south blue) as one untextured surface,
+// faces outward: COLOR_0 only, so glTF's default material (white) times the vertex colours.
+std::filesystem::path write_coloured_globe(const std::filesystem::path& dir) {
+  lod::MeshData m = lod::test::coloured_sphere(48, 96);
+  lod::test::turn_faces_outward(m);
+  std::filesystem::create_directories(dir);
+  lod::GltfMeshView view;
+  view.name = "painted";
+  view.positions = m.positions.data();
+  view.vertex_count = m.vertex_count();
+  view.colors = m.colors.data();
+  view.indices = m.indices.data();
+  view.index_count = m.indices.size();
+  const auto file = dir / "painted.gltf";
+  return lod::save_gltf(file, view).ok ? file : std::filesystem::path();
+}
+
+// Pixels whose hue is red-to-yellow (no blue) above the equator and blue (no red) below.
+std::pair<int, int> count_painted(const Image& img) {
+  const int centre_row = lod::test::project({0, 0, 0}, img.width, img.height)[1];
+  int warm_above = 0, blue_below = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* px = img.at(x, y);
+      const float pm = float(std::max({px[0], px[1], px[2]}));
+      if (pm < 60) continue;
+      const float r = px[0] / pm, b = px[2] / pm;
+      warm_above += r > 0.9f && b < 0.25f && y < centre_row;
+      blue_below += b > 0.9f && r < 0.25f && y > centre_row;
+    }
+  return {warm_above, blue_below};
+}
+
+// An HLOD model with vertex colours (issue 12): its nodes are drawn with COLOR_0 multiplied into
+// the base colour, so the picture shows the red north and the blue south; colour-by-depth
+// shows neither.
+TEST(ViewerTextured, HlodNodesShowTheirVertexColoursColourByDepthDoesNot) {
+  LOD_REQUIRE_XVFB();
+  const char* model = R"([[model]]
+name = "textured"
+file = "textured/painted.gltf"
+hlod = true
+min_verts = 300
+)";
+  const char* run = "[run]\nframes = 3\nthreads = 1\n[budget]\ntriangles = 1000000\n[lod]\npixel_error = 1.0\n";
+  const auto scene = lod::test::write_viewer_scene("coloured-hlod", run, kCamera, kInstance, model);
+  ASSERT_FALSE(write_coloured_globe(scene.dir / "textured").empty());
+  const auto lit = scene.dir / "hlod.png";
+  const auto depth = scene.dir / "depth.png";
+  const auto stats = scene.dir / "hlod.csv";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" +
+                                            stats.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  lod::test::CsvTable t;
+  ASSERT_TRUE(lod::test::load_csv(stats, t));
+  ASSERT_FALSE(t.rows.empty());
+  EXPECT_GT(t.get(t.rows.size() - 1, "hlod_draws"), 0) << "drawn through its HLOD cut";
+  EXPECT_EQ(t.get(t.rows.size() - 1, "hlod_missing"), 0);
+  r = lod::test::run_viewer(scene, "--screenshot '" + depth.string() + "' --frames 3 --color-by-level --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image img, by_depth;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  ASSERT_TRUE(lod::test::load_png(depth, by_depth));
+  const auto [warm, blue] = count_painted(img);
+  std::printf("HLOD vertex colours: %d red-to-yellow pixels above the equator, %d blue below\n", warm, blue);
+  EXPECT_GE(warm, 1000) << "the red north from COLOR_0";
+  EXPECT_GE(blue, 1000) << "the blue south from COLOR_0";
+  const auto [warm_depth, blue_depth] = count_painted(by_depth);
+  EXPECT_LE(warm_depth + blue_depth, 50) << "colour-by-depth must not show the vertex colours";
+}
+
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);
