@@ -279,20 +279,25 @@ std::filesystem::path write_coloured_globe(const std::filesystem::path& dir) {
   return lod::save_gltf(file, view).ok ? file : std::filesystem::path();
 }
 
-// Pixels whose hue is red-to-yellow (no blue) above the equator and blue (no red) below.
-std::pair<int, int> count_painted(const Image& img) {
+// Pixels of the sphere's two vertex colours, above and below the equator: warm (red to orange:
+// red full, some green, no blue) and pure blue (no red, no green).
+struct Painted {
+  int warm_above = 0, warm_below = 0, blue_above = 0, blue_below = 0;
+};
+Painted count_painted(const Image& img) {
   const int centre_row = lod::test::project({0, 0, 0}, img.width, img.height)[1];
-  int warm_above = 0, blue_below = 0;
+  Painted n;
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) {
       const uint8_t* px = img.at(x, y);
       const float pm = float(std::max({px[0], px[1], px[2]}));
       if (pm < 60) continue;
-      const float r = px[0] / pm, b = px[2] / pm;
-      warm_above += r > 0.9f && b < 0.25f && y < centre_row;
-      blue_below += b > 0.9f && r < 0.25f && y > centre_row;
+      const float r = px[0] / pm, g = px[1] / pm, b = px[2] / pm;
+      const bool warm = r > 0.95f && g > 0.2f && g < 0.95f && b < 0.08f, blue = b > 0.95f && r < 0.08f && g < 0.08f;
+      (y < centre_row ? n.warm_above : n.warm_below) += warm;
+      (y < centre_row ? n.blue_above : n.blue_below) += blue;
     }
-  return {warm_above, blue_below};
+  return n;
 }
 
 // An HLOD model with vertex colours (issue 12): its nodes are drawn with COLOR_0 multiplied into
@@ -325,12 +330,14 @@ min_verts = 300
   Image img, by_depth;
   ASSERT_TRUE(lod::test::load_png(lit, img));
   ASSERT_TRUE(lod::test::load_png(depth, by_depth));
-  const auto [warm, blue] = count_painted(img);
-  std::printf("HLOD vertex colours: %d red-to-yellow pixels above the equator, %d blue below\n", warm, blue);
-  EXPECT_GE(warm, 1000) << "the red north from COLOR_0";
-  EXPECT_GE(blue, 1000) << "the blue south from COLOR_0";
-  const auto [warm_depth, blue_depth] = count_painted(by_depth);
-  EXPECT_LE(warm_depth + blue_depth, 50) << "colour-by-depth must not show the vertex colours";
+  const Painted lit_counts = count_painted(img), depth_counts = count_painted(by_depth);
+  std::printf("HLOD vertex colours: warm %d above / %d below, blue %d above / %d below; by depth: %d %d %d %d\n",
+              lit_counts.warm_above, lit_counts.warm_below, lit_counts.blue_above, lit_counts.blue_below,
+              depth_counts.warm_above, depth_counts.warm_below, depth_counts.blue_above, depth_counts.blue_below);
+  EXPECT_GE(lit_counts.warm_above, 1000) << "the red-to-orange north from COLOR_0";
+  EXPECT_GE(lit_counts.blue_below, 1000) << "the blue south from COLOR_0";
+  EXPECT_LE(lit_counts.warm_below + lit_counts.blue_above, 50) << "each half its own colour (the seam holds)";
+  EXPECT_LE(depth_counts.warm_above + depth_counts.blue_below, 50) << "colour-by-depth must not show the vertex colours";
 }
 
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
