@@ -19,8 +19,11 @@ namespace {
 nlohmann::json node_json(const HlodTree& tree, size_t i) {
   const HlodNode& n = tree.nodes[i];
   nlohmann::json layers = nlohmann::json::array();
-  for (uint32_t k = 0; k < n.layer_count; ++k)
+  for (uint32_t k = 0; k < n.layer_count; ++k) {
     layers.push_back({{"triangles", n.layers[k].triangles}, {"error", n.layers[k].error}, {"uv_error", n.layers[k].uv_error}});
+    if (tree.uvs1) layers.back()["uv1_error"] = n.layers[k].uv1_error;
+    if (tree.colors) layers.back()["color_error"] = n.layers[k].color_error;
+  }
   return {{"id", i},      {"parent", n.parent},
           {"depth", n.depth}, {"leaf", n.leaf()},
           {"boundary_triangles", n.boundary_triangles}, {"layers", layers}, {"material_runs", n.material_runs}};
@@ -45,8 +48,9 @@ nlohmann::json materials_json(const HlodTree& tree) {
 }
 
 void print_materials(const HlodTree& tree) {
-  std::printf("materials: %zu (texture base %s); texture coordinates: %s\n", tree.materials.size(),
-              printable(tree.texture_base).c_str(), tree.uvs ? "yes" : "no");
+  std::printf("materials: %zu (texture base %s); texture coordinates: %s; TEXCOORD_1: %s; vertex colours: %s\n",
+              tree.materials.size(), printable(tree.texture_base).c_str(), tree.uvs ? "yes" : "no",
+              tree.uvs1 ? "yes" : "no", tree.colors ? "yes" : "no");
   for (size_t i = 0; i < tree.materials.size(); ++i) {
     const ChainMaterial& m = tree.materials[i];
     std::printf("  %zu '%s': base colour %.3g %.3g %.3g %.3g, metallic %.3g, roughness %.3g", i, printable(m.name).c_str(),
@@ -129,6 +133,8 @@ int inspect_hlod_command(const InspectArgs& args) {
     j["min_verts"] = tree.min_verts;
     j["box"] = {{"center", {tree.box_center[0], tree.box_center[1], tree.box_center[2]}}, {"half", tree.box_half}};
     j["texcoords"] = tree.uvs;
+    j["texcoords1"] = tree.uvs1;
+    j["colors"] = tree.colors;
     j["texture_base"] = tree.texture_base;
     j["materials"] = materials_json(tree);
     j["images"] = images_json(tree.images);

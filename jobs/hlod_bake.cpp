@@ -57,7 +57,8 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
   uint64_t content = hash_bytes(bytes.data(), bytes.size());
   // The materials and uvs are in the tree since build version 2: what an OBJ's .mtl or a glTF's
   // buffers and images hold is part of the source. Version 3 keeps embedded images, so a tree
-  // cached before (its embedded textures left out) is not taken for current.
+  // cached before (its embedded textures left out) is not taken for current; version 4 keeps
+  // colours and TEXCOORD_1 (and the textures that read it).
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
@@ -66,7 +67,7 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
       const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
       content = hash_bytes(more.data(), more.size(), content);
     }
-  const uint64_t settings[2] = {3 /* build version: 3 embedded images, 2 uvs and materials */, min_verts};
+  const uint64_t settings[2] = {kHlodBuildVersion, min_verts};
   out = hash_bytes(settings, sizeof settings, content);
   return Status::success();
 }
@@ -83,13 +84,8 @@ Status load_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, H
 
 void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& m, HlodSurfaces& surfaces,
                         std::vector<std::string>& notes) {
-  // Nothing dropped silently: the tree keeps TEXCOORD_0 and the materials, nothing else.
-  if (!m.uvs1.empty() || !m.colors.empty())
-    notes.push_back(mesh_file.string() + ": " + (m.uvs1.empty() ? "" : "TEXCOORD_1") +
-                    (!m.uvs1.empty() && !m.colors.empty() ? " and " : "") + (m.colors.empty() ? "" : "vertex colours") +
-                    " are not kept in the HLOD tree (TEXCOORD_0 and the materials are)");
-  m.uvs1.clear();
-  m.colors.clear();
+  // Nothing dropped silently: the tree keeps TEXCOORD_0 and _1, COLOR_0 and the materials; the
+  // file's own normals are recomputed (as the .lod bake's), and what a reader skipped it said.
   clean_mesh(m);
   LodChain chain;
   add_chain_materials(m, mesh_file, chain, notes);
@@ -97,12 +93,11 @@ void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& m, Hlo
     ChainMaterial& c = chain.materials[i];
     const auto uris = texture_slots(c);
     for (size_t k = 0; k < kTextureSlots; ++k)
-      if (!uris[k]->empty() && (c.tex_coords[k] != 0 || m.uvs.empty())) {
+      if (const std::vector<float>& set = c.tex_coords[k] == 0 ? m.uvs : m.uvs1;
+          !uris[k]->empty() && (c.tex_coords[k] > 1 || set.empty())) {
         notes.push_back(mesh_file.string() + ": material " + std::to_string(i) + " ('" + c.name + "'): its " +
-                        kTextureSlotNames[k] + " texture reads " +
-                        (m.uvs.empty() ? std::string("texture coordinates the mesh does not have")
-                                       : "TEXCOORD_" + std::to_string(c.tex_coords[k])) +
-                        ", which the HLOD tree does not keep (left out)");
+                        kTextureSlotNames[k] + " texture reads TEXCOORD_" + std::to_string(c.tex_coords[k]) +
+                        ", which the mesh does not have (left out)");
         uris[k]->clear();
         c.tex_coords[k] = 0;
       }

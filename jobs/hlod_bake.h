@@ -28,6 +28,11 @@ struct HlodBakeResult {
 // Lines like "hlod dragon 40%" (every 10 %), from one thread at a time.
 using HlodBakeLog = std::function<void(const std::string&)>;
 
+// The build's version, in hlod_source_hash and the subtree cache's key, so that a tree or subtree
+// cached by an older build is rebaked: 4 colours and TEXCOORD_1, 3 embedded images, 2 uvs and
+// materials.
+inline constexpr uint64_t kHlodBuildVersion = 4;
+
 // The tbb parallel_for the builder's subtrees run on (inside the caller's arena).
 ParallelFor tbb_parallel_for();
 
@@ -38,9 +43,9 @@ Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_ver
 
 // The mesh as an HLOD build takes it: loaded and cleaned (uv seams and material boundaries stay
 // copies at one position), its materials converted for the tree (add_chain_materials) with the
-// images they embed (only those a kept slot names, renumbered). What the tree does not keep (the
-// second uv set, vertex colours, textures reading TEXCOORD_1) is said in `notes`, each naming
-// the file.
+// images they embed (only those a kept slot names, renumbered). The uvs (both sets) and colours
+// stay; what the tree does not keep (a texture reading a uv set the mesh lacks) is said in
+// `notes`, each naming the file.
 Status load_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
                        std::vector<std::string>& notes, size_t* input_triangles = nullptr);
 // The same for a mesh already loaded from `mesh_file` (cleaned in place).

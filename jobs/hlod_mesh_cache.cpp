@@ -1,8 +1,9 @@
-// The cleaned mesh entry, version 3, little-endian:
-//   magic "LODHMSH\n" (8) | u32 version | u32 flags (bit 0: uvs) | u64 source hash |
-//   u64 input triangles | u64 vertices V | u64 indices I | u64 submeshes S | u64 materials bytes M |
-//   u64 images bytes G |
-//   V x 3 f32 positions | I u32 indices | V x 2 f32 uvs (with the flag) |
+// The cleaned mesh entry, version 4, little-endian:
+//   magic "LODHMSH\n" (8) | u32 version | u32 flags (bit 0: uvs, bit 1: colours, bit 2: uv1) |
+//   u64 source hash | u64 input triangles | u64 vertices V | u64 indices I | u64 submeshes S |
+//   u64 materials bytes M | u64 images bytes G |
+//   V x 3 f32 positions | I u32 indices | V x 2 f32 uvs (with the flag) | V x 2 f32 uv1 (with
+//   its flag) | V x 4 f32 linear RGBA colours (with theirs) |
 //   S x (u32 first triangle, u32 triangles, i32 material) | M bytes: the materials and texture
 //   base in the .lod's MATL layout (runtime/material_section.h) | G bytes: the images the
 //   materials embed in the .lod's IMGS layout (0 = none) |
@@ -30,6 +31,8 @@ namespace {
 constexpr char kMagic[8] = {'L', 'O', 'D', 'H', 'M', 'S', 'H', '\n'};
 constexpr uint64_t kFixedBytes = 72;
 constexpr uint32_t kFlagUvs = 1;
+constexpr uint32_t kFlagColors = 2;
+constexpr uint32_t kFlagUvs1 = 4;
 
 bool read_whole(const std::filesystem::path& path, std::vector<uint8_t>& out) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -58,16 +61,19 @@ std::filesystem::path hlod_mesh_entry_path(const std::filesystem::path& dir, uin
 Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const MeshData& mesh,
                        uint64_t input_triangles, const HlodSurfaces& surfaces) {
   const bool uvs = !mesh.uvs.empty() && mesh.uvs.size() == 2 * mesh.vertex_count();
+  const bool uvs1 = !mesh.uvs1.empty() && mesh.uvs1.size() == 2 * mesh.vertex_count();
+  const bool colors = !mesh.colors.empty() && mesh.colors.size() == 4 * mesh.vertex_count();
   LodChain chain;
   chain.materials = surfaces.materials;
   chain.texture_base = surfaces.texture_base;
   const std::vector<uint8_t> materials = surfaces.materials.empty() ? std::vector<uint8_t>() : encode_material_section(chain);
   const std::vector<uint8_t> images = surfaces.images.empty() ? std::vector<uint8_t>() : encode_image_section(surfaces.images);
   detail::ByteWriter w;
-  w.bytes.reserve(kFixedBytes + 4 * (mesh.positions.size() + mesh.indices.size() + mesh.uvs.size()) + 8);
+  w.bytes.reserve(kFixedBytes + 4 * (mesh.positions.size() + mesh.indices.size() + mesh.uvs.size() + mesh.uvs1.size() +
+                                     mesh.colors.size()) + 8);
   for (char c : kMagic) w.u8(uint8_t(c));
   w.u32(kHlodMeshEntryVersion);
-  w.u32(uvs ? kFlagUvs : 0);
+  w.u32((uvs ? kFlagUvs : 0) | (colors ? kFlagColors : 0) | (uvs1 ? kFlagUvs1 : 0));
   w.u64(source_hash);
   w.u64(input_triangles);
   w.u64(mesh.vertex_count());
@@ -78,6 +84,8 @@ Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, c
   w.words(mesh.positions.data(), mesh.positions.size());
   w.words(mesh.indices.data(), mesh.indices.size());
   if (uvs) w.words(mesh.uvs.data(), mesh.uvs.size());
+  if (uvs1) w.words(mesh.uvs1.data(), mesh.uvs1.size());
+  if (colors) w.words(mesh.colors.data(), mesh.colors.size());
   for (const Submesh& sm : mesh.submeshes) {
     w.u32(sm.first_triangle);
     w.u32(sm.triangle_count);
@@ -109,8 +117,8 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   const uint64_t vertices = detail::load_u64(b.data() + 32), indices = detail::load_u64(b.data() + 40);
   const uint64_t submeshes = detail::load_u64(b.data() + 48), material_bytes = detail::load_u64(b.data() + 56);
   const uint64_t image_bytes = detail::load_u64(b.data() + 64);
-  if ((flags & ~kFlagUvs) != 0) return refuse("unknown flags " + std::to_string(flags));
-  const uint64_t per_vertex = (flags & kFlagUvs) ? 20 : 12;
+  if ((flags & ~(kFlagUvs | kFlagColors | kFlagUvs1)) != 0) return refuse("unknown flags " + std::to_string(flags));
+  const uint64_t per_vertex = 12 + ((flags & kFlagUvs) ? 8 : 0) + ((flags & kFlagUvs1) ? 8 : 0) + ((flags & kFlagColors) ? 16 : 0);
   // Counts against the size before anything is allocated (each bounded first, so the sum cannot overflow).
   if (vertices >= UINT32_MAX || indices % 3 != 0 || indices > b.size() / 4 || submeshes > b.size() / 12 ||
       material_bytes > b.size() || image_bytes > b.size() ||
@@ -128,10 +136,14 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   const uint8_t* p = b.data() + kFixedBytes;
   for (float& v : m.positions) v = detail::load_f32(p), p += 4;
   for (uint32_t& i : m.indices) i = detail::load_u32(p), p += 4;
-  if (flags & kFlagUvs) {
-    m.uvs.resize(size_t(2 * vertices));
-    for (float& v : m.uvs) v = detail::load_f32(p), p += 4;
-  }
+  auto column = [&](uint32_t flag, size_t per, std::vector<float>& out) {
+    if (!(flags & flag)) return;
+    out.resize(size_t(per * vertices));
+    for (float& v : out) v = detail::load_f32(p), p += 4;
+  };
+  column(kFlagUvs, 2, m.uvs);
+  column(kFlagUvs1, 2, m.uvs1);
+  column(kFlagColors, 4, m.colors);
   m.submeshes.resize(size_t(submeshes));
   for (Submesh& sm : m.submeshes) {
     sm.first_triangle = detail::load_u32(p);
@@ -155,6 +167,10 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
     if (!std::isfinite(v)) return refuse("a position is not finite");
   for (float v : m.uvs)
     if (!std::isfinite(v)) return refuse("a texture coordinate is not finite");
+  for (float v : m.uvs1)
+    if (!std::isfinite(v)) return refuse("a TEXCOORD_1 value is not finite");
+  for (float v : m.colors)
+    if (!std::isfinite(v)) return refuse("a colour is not finite");
   // Submeshes in order inside the triangles, each naming a stored material (or the default).
   uint64_t covered = 0;
   for (const Submesh& sm : m.submeshes) {

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "jobs/hlod_bake.h"  // kHlodBuildVersion
 #include "runtime/file_write.h"
 #include "runtime/hlod_subtree_entry.h"
 #include "runtime/lod_asset.h"  // hash_bytes
@@ -62,7 +63,7 @@ uint64_t hlod_subtree_key(uint64_t source_hash, const HlodBuildOptions& o, const
                              std::bit_cast<uint32_t>(o.layer_samples_per_triangle),
                              o.reference_samples,
                              spec.fingerprint,
-                             3 /* build version, as hlod_source_hash */,
+                             kHlodBuildVersion /* as hlod_source_hash */,
                              std::bit_cast<uint32_t>(o.uv_weight)};
   return hash_bytes(words, sizeof words, 0x68737562ull);
 }

@@ -64,9 +64,10 @@ std::string node_message(uint32_t node, const std::string& why) {
 }
 
 // What a payload takes in memory, counted as HlodNode::resident_bytes counts it (positions,
-// normals, uvs, indices, material runs).
+// normals, uvs, uv1, colours, indices, material runs).
 uint64_t payload_bytes(const HlodPayload& p) {
-  return 4ull * (p.positions.size() + p.normals.size() + p.uvs.size() + p.indices.size()) +
+  return 4ull * (p.positions.size() + p.normals.size() + p.uvs.size() + p.uvs1.size() + p.colors.size() +
+                 p.indices.size()) +
          uint64_t(sizeof(LevelSubmesh)) * p.runs.size();
 }
 

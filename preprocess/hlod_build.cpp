@@ -47,7 +47,7 @@ double thread_cpu_seconds() {
 
 struct Layer {
   std::vector<float> positions;
-  std::vector<float> uvs;        // uv per vertex, when the mesh has them
+  std::vector<float> attributes;  // Attributes::count per vertex (uv, uv1, colour as the mesh has them)
   std::vector<uint32_t> indices;
   std::vector<uint32_t> source;  // original vertex each vertex descends from
   float error = 0;
@@ -76,11 +76,30 @@ struct Tally {
   std::atomic<size_t> oversized_leaves{0};
 };
 
+// The vertex attributes QEM carries, interleaved per vertex in this order: uv (TEXCOORD_0), uv1
+// (TEXCOORD_1), RGBA colour (COLOR_0), each only when the mesh has it (as the .lod bake's).
+struct Attributes {
+  static constexpr size_t kNone = SIZE_MAX;
+  size_t uv = kNone, uv1 = kNone, color = kNone;
+  size_t count = 0;
+  bool has(size_t at) const { return at != kNone; }
+};
+
+Attributes attribute_layout(const MeshData& mesh) {
+  Attributes a;
+  if (!mesh.uvs.empty()) a.uv = a.count, a.count += 2;
+  if (!mesh.uvs1.empty()) a.uv1 = a.count, a.count += 2;
+  if (!mesh.colors.empty()) a.color = a.count, a.count += 4;
+  return a;
+}
+
 struct Context {
   const HlodBuildOptions& options;
   const float* positions = nullptr;
   const uint32_t* indices = nullptr;
-  const float* uvs = nullptr;          // of the original, uv per vertex, or null
+  Attributes layout;
+  const float* attributes = nullptr;   // of the original, layout.count per vertex, or null
+  std::vector<float> interleaved;      // what `attributes` points to when the mesh has more than one
   std::vector<int32_t> vertex_material;  // of the original, per vertex; empty without materials
   std::vector<float> normals;          // of the original, per vertex
   std::vector<uint8_t> patch_depth;    // shallowest depth whose patch holds the vertex
@@ -152,7 +171,8 @@ uint32_t take_original(Context& c, Layer& layer, uint32_t v, uint32_t s) {
   c.stamp[v] = s;
   c.local[v] = uint32_t(layer.vertices());
   layer.positions.insert(layer.positions.end(), c.positions + 3 * size_t(v), c.positions + 3 * size_t(v) + 3);
-  if (c.uvs) layer.uvs.insert(layer.uvs.end(), c.uvs + 2 * size_t(v), c.uvs + 2 * size_t(v) + 2);
+  const size_t n = c.layout.count;
+  if (n) layer.attributes.insert(layer.attributes.end(), c.attributes + n * size_t(v), c.attributes + n * size_t(v) + n);
   layer.source.push_back(v);
   return c.local[v];
 }
@@ -176,7 +196,7 @@ Layer merged_children(Context& c, const BuildNode& n) {
     const Layer& coarse = child->layers.back();
     const uint32_t base = uint32_t(layer.vertices());
     layer.positions.insert(layer.positions.end(), coarse.positions.begin(), coarse.positions.end());
-    layer.uvs.insert(layer.uvs.end(), coarse.uvs.begin(), coarse.uvs.end());
+    layer.attributes.insert(layer.attributes.end(), coarse.attributes.begin(), coarse.attributes.end());
     layer.source.insert(layer.source.end(), coarse.source.begin(), coarse.source.end());
     for (uint32_t i : coarse.indices) layer.indices.push_back(base + i);
     for (uint32_t i = 0; i < coarse.vertices(); ++i) {
@@ -246,10 +266,11 @@ void simplify_layers(Context& c, Tally& tally, BuildNode& n) {
   // meets (Stanford's buddha: 80-150 open edges per cut otherwise).
   options.move_nonmanifold = false;
   options.vertex_lock = lock.data();
-  // Texture coordinates ride along (interpolated along each collapse, weighted in its cost);
-  // seams, uv or material, are copies at one position, moved only along the seam.
-  if (!finest.uvs.empty())
-    options.attributes = finest.uvs.data(), options.attribute_count = 2, options.attribute_weight = c.options.uv_weight;
+  // Texture coordinates and colours ride along (interpolated along each collapse, weighted in its
+  // cost); seams, uv, colour or material, are copies at one position, moved only along the seam.
+  if (c.layout.count)
+    options.attributes = finest.attributes.data(), options.attribute_count = c.layout.count,
+    options.attribute_weight = c.options.uv_weight;
   // Heavily locked cells otherwise reach their halves by ruinous collapses (on the bunny at
   // min_verts 500, one layer 10 % of the model off its surface, which the monotonic errors
   // then carry to the root).
@@ -266,7 +287,7 @@ void simplify_layers(Context& c, Tally& tally, BuildNode& n) {
     }
     Layer layer;
     layer.positions = std::move(out[k].positions);
-    if (!finest.uvs.empty()) layer.uvs = std::move(out[k].attributes);
+    if (c.layout.count) layer.attributes = std::move(out[k].attributes);
     layer.indices = std::move(out[k].indices);
     layer.source.resize(out[k].source_vertex.size());
     const Layer& from = n.layers[0];
@@ -516,15 +537,25 @@ void layer_normals(const Context& c, const BuildNode& n, const Layer& l, Normals
       for (int k = 0; k < 3; ++k) out[base + 3 * i + k] = c.normals[3 * size_t(l.source[i]) + k];
 }
 
-void append_range(HlodPayload& p, const std::vector<float>& positions, const std::vector<float>& uvs,
-                  const std::vector<uint32_t>& indices, LodLevel& range) {
+// One attribute (at `at`, `per` floats a vertex) of interleaved `attributes`, appended to `out`.
+void append_column(const Attributes& a, const std::vector<float>& attributes, size_t at, size_t per, std::vector<float>& out) {
+  if (!a.has(at)) return;
+  const size_t n = attributes.size() / a.count;
+  out.reserve(out.size() + per * n);
+  for (size_t v = 0; v < n; ++v) out.insert(out.end(), &attributes[a.count * v + at], &attributes[a.count * v + at] + per);
+}
+
+void append_range(const Context& c, HlodPayload& p, const std::vector<float>& positions,
+                  const std::vector<float>& attributes, const std::vector<uint32_t>& indices, LodLevel& range) {
   range.first_index = uint32_t(p.indices.size());
   range.index_count = uint32_t(indices.size());
   range.first_vertex = uint32_t(p.positions.size() / 3);
   range.vertex_count = uint32_t(positions.size() / 3);
   range.level = level_of_triangles(indices.size() / 3);
   p.positions.insert(p.positions.end(), positions.begin(), positions.end());
-  p.uvs.insert(p.uvs.end(), uvs.begin(), uvs.end());
+  append_column(c.layout, attributes, c.layout.uv, 2, p.uvs);
+  append_column(c.layout, attributes, c.layout.uv1, 2, p.uvs1);
+  append_column(c.layout, attributes, c.layout.color, 4, p.colors);
   p.indices.insert(p.indices.end(), indices.begin(), indices.end());
 }
 
@@ -535,12 +566,23 @@ void append_runs(const Context& c, const Layer& l, uint32_t range, HlodPayload& 
   group_by_material(grouped, l.source, c.vertex_material, range, p.runs);
 }
 
-// How far a layer's uvs slid from those of the original vertices they descend from, at most.
-float uv_error(const Context& c, const Layer& l) {
+// How far one attribute (at `at`, `per` floats) of a layer's vertices slid from that of the
+// original vertices they descend from, at most (Euclidean: texture units for uvs, linear RGBA
+// for colours); 0 when the mesh has none.
+float attribute_error(const Context& c, const Layer& l, size_t at, size_t per) {
+  if (!c.layout.has(at)) return 0.0f;
+  const size_t n = c.layout.count;
   float worst = 0;
-  for (size_t i = 0; i < l.uvs.size() / 2; ++i) {
-    const float* from = c.uvs + 2 * size_t(l.source[i]);
-    worst = std::max(worst, std::hypot(l.uvs[2 * i] - from[0], l.uvs[2 * i + 1] - from[1]));
+  for (size_t i = 0; i < l.vertices(); ++i) {
+    const float* from = c.attributes + n * size_t(l.source[i]) + at;
+    const float* mine = &l.attributes[n * i + at];
+    if (per == 2) {  // uvs: as the tree measured them before it carried colours (same bytes)
+      worst = std::max(worst, std::hypot(mine[0] - from[0], mine[1] - from[1]));
+      continue;
+    }
+    double d2 = 0;
+    for (size_t k = 0; k < per; ++k) d2 += double(mine[k] - from[k]) * double(mine[k] - from[k]);
+    worst = std::max(worst, float(std::sqrt(d2)));
   }
   return worst;
 }
@@ -550,7 +592,7 @@ HlodPayload make_payload(Context& c, const BuildNode& n) {
   for (size_t k = 0; k < n.layers.size(); ++k) {
     const Layer& l = n.layers[k];
     LodLevel range;
-    append_range(p, l.positions, l.uvs, l.indices, range);
+    append_range(c, p, l.positions, l.attributes, l.indices, range);
     append_runs(c, l, uint32_t(k), p);
     range.error = l.error;
     range.bounds = n.bounds;
@@ -562,7 +604,7 @@ HlodPayload make_payload(Context& c, const BuildNode& n) {
   for (uint32_t t : n.patch)
     for (int k = 0; k < 3; ++k) patch.indices.push_back(take_original(c, patch, c.indices[3 * size_t(t) + k], s));
   group_layer(c, patch);
-  append_range(p, patch.positions, patch.uvs, patch.indices, p.boundary);
+  append_range(c, p, patch.positions, patch.attributes, patch.indices, p.boundary);
   append_runs(c, patch, uint32_t(n.layers.size()), p);
   p.boundary.bounds = n.bounds;
   for (uint32_t v : patch.source) p.normals.insert(p.normals.end(), &c.normals[3 * size_t(v)], &c.normals[3 * size_t(v)] + 3);
@@ -583,10 +625,13 @@ HlodNode describe_node(Context& c, const BuildNode& b, HlodPayload& payload) {
   h.layer_count = uint8_t(b.layers.size());
   for (size_t k = 0; k < b.layers.size(); ++k)
     h.layers[k] = {uint32_t(b.layers[k].triangles()), uint32_t(b.layers[k].vertices()), b.layers[k].error,
-                   c.uvs ? uv_error(c, b.layers[k]) : 0.0f};
+                   attribute_error(c, b.layers[k], c.layout.uv, 2), attribute_error(c, b.layers[k], c.layout.uv1, 2),
+                   attribute_error(c, b.layers[k], c.layout.color, 4)};
   payload = make_payload(c, b);
   h.boundary_vertices = payload.boundary.vertex_count;
-  h.uvs = c.uvs != nullptr;
+  h.uvs = c.layout.has(c.layout.uv);
+  h.uvs1 = c.layout.has(c.layout.uv1);
+  h.colors = c.layout.has(c.layout.color);
   h.material_runs = uint32_t(payload.runs.size());
   h.resident_bytes = hlod_resident_bytes(h);
   return h;
@@ -615,7 +660,7 @@ HlodSubtree flatten_subtree(Context& c, const std::vector<BuildNode*>& order) {
 
 // What a frontier node is to the levels above once its subtree is baked: its coarsest layer,
 // reference samples and bounds, as the subtree's root had them.
-void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
+void stand_for_subtree(const Context& c, BuildNode& n, const HlodSubtree& s) {
   for (auto& child : n.children) child.reset();
   n.child_mask = 0;
   std::vector<uint32_t>().swap(n.triangles);
@@ -625,10 +670,17 @@ void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
   Layer coarse;
   const auto* p = s.payloads[0].positions.data() + 3 * size_t(range.first_vertex);
   coarse.positions.assign(p, p + 3 * size_t(range.vertex_count));
-  if (!s.payloads[0].uvs.empty()) {
-    const auto* uv = s.payloads[0].uvs.data() + 2 * size_t(range.first_vertex);
-    coarse.uvs.assign(uv, uv + 2 * size_t(range.vertex_count));
-  }
+  // The payload's columns interleaved again (check_subtree checked they are the mesh's).
+  const size_t a = c.layout.count;
+  coarse.attributes.resize(a * size_t(range.vertex_count));
+  auto take = [&](size_t at, size_t per, const std::vector<float>& column) {
+    if (!c.layout.has(at)) return;
+    for (size_t v = 0; v < range.vertex_count; ++v)
+      std::copy_n(&column[per * (size_t(range.first_vertex) + v)], per, &coarse.attributes[a * v + at]);
+  };
+  take(c.layout.uv, 2, s.payloads[0].uvs);
+  take(c.layout.uv1, 2, s.payloads[0].uvs1);
+  take(c.layout.color, 4, s.payloads[0].colors);
   const auto* i = s.payloads[0].indices.data() + range.first_index;
   coarse.indices.assign(i, i + range.index_count);
   coarse.source = s.root_source;
@@ -640,20 +692,25 @@ void stand_for_subtree(BuildNode& n, const HlodSubtree& s) {
 }
 
 // A subtree result is checked against the mesh before any of it is used as an index.
-Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, bool uvs, uint32_t materials,
-                     const std::string& what) {
+Status check_subtree(const BuildNode& f, const HlodSubtree& s, size_t vertices, const Attributes& layout,
+                     uint32_t materials, const std::string& what) {
+  const bool uvs = layout.has(layout.uv), uvs1 = layout.has(layout.uv1), colors = layout.has(layout.color);
   if (s.nodes.empty() || s.payloads.empty() || (s.payloads.size() != 1 && s.payloads.size() != s.nodes.size()))
     return Status::error(what + ": no nodes, or neither the root's payload alone nor one payload per node");
   const HlodNode& root = s.nodes[0];
   if (root.uvs != uvs) return Status::error(what + ": it was baked " + (uvs ? "without" : "with") + " texture coordinates");
+  if (root.uvs1 != uvs1) return Status::error(what + ": it was baked " + (uvs1 ? "without" : "with") + " TEXCOORD_1");
+  if (root.colors != colors) return Status::error(what + ": it was baked " + (colors ? "without" : "with") + " vertex colours");
   if (root.depth != f.depth || root.box_half != f.half || root.box_center[0] != f.center[0] ||
       root.box_center[1] != f.center[1] || root.box_center[2] != f.center[2])
     return Status::error(what + ": its root is not the frontier node's cell");
   const HlodPayload& p = s.payloads[0];
   if (root.layer_count < 1 || p.layers.size() != root.layer_count) return Status::error(what + ": root layers do not match its record");
   const LodLevel& range = p.layers.back();
-  if (p.uvs.size() != (root.uvs ? 2 * (p.positions.size() / 3) : 0) || s.material_count != materials)
-    return Status::error(what + ": its texture coordinates or materials are not the mesh's");
+  const size_t pv = p.positions.size() / 3;
+  if (p.uvs.size() != (uvs ? 2 * pv : 0) || p.uvs1.size() != (uvs1 ? 2 * pv : 0) || p.colors.size() != (colors ? 4 * pv : 0) ||
+      s.material_count != materials)
+    return Status::error(what + ": its texture coordinates, colours or materials are not the mesh's");
   if (s.root_source.size() != range.vertex_count || size_t(range.first_vertex) + range.vertex_count > p.positions.size() / 3 ||
       size_t(range.first_index) + range.index_count > p.indices.size())
     return Status::error(what + ": root's coarsest layer does not match its vertex sources");
@@ -727,6 +784,18 @@ Status check_input(const MeshData& mesh) {
   for (size_t i = 0; i < mesh.uvs.size(); ++i)
     if (!std::isfinite(mesh.uvs[i]))
       return Status::error(what + ": vertex " + std::to_string(i / 2) + " has a non-finite texture coordinate");
+  if (!mesh.uvs1.empty() && mesh.uvs1.size() != 2 * mesh.vertex_count())
+    return Status::error(what + ": " + std::to_string(mesh.uvs1.size() / 2) + " TEXCOORD_1 values for " +
+                         std::to_string(mesh.vertex_count()) + " vertices");
+  for (size_t i = 0; i < mesh.uvs1.size(); ++i)
+    if (!std::isfinite(mesh.uvs1[i]))
+      return Status::error(what + ": vertex " + std::to_string(i / 2) + " has a non-finite TEXCOORD_1");
+  if (!mesh.colors.empty() && mesh.colors.size() != 4 * mesh.vertex_count())
+    return Status::error(what + ": " + std::to_string(mesh.colors.size() / 4) + " vertex colours for " +
+                         std::to_string(mesh.vertex_count()) + " vertices");
+  for (size_t i = 0; i < mesh.colors.size(); ++i)
+    if (!std::isfinite(mesh.colors[i]))
+      return Status::error(what + ": vertex " + std::to_string(i / 4) + " has a non-finite colour");
   for (size_t i = 0; i < mesh.indices.size(); ++i)
     if (mesh.indices[i] >= mesh.vertex_count())
       return Status::error(what + ": face " + std::to_string(i / 3) + " references vertex " +
@@ -964,7 +1033,21 @@ Status HlodBuilder::plan() {
   c.patch_depth.assign(mesh.vertex_count(), kNoPatch);
   c.stamp.assign(mesh.vertex_count(), 0);
   c.local.assign(mesh.vertex_count(), 0);
-  c.uvs = mesh.uvs.empty() ? nullptr : mesh.uvs.data();
+  c.layout = attribute_layout(mesh);
+  if (c.layout.count == 2 && c.layout.has(c.layout.uv)) {
+    c.attributes = mesh.uvs.data();  // uvs alone: no copy
+  } else if (c.layout.count) {
+    c.interleaved.resize(c.layout.count * mesh.vertex_count());
+    auto put = [&](size_t at, const std::vector<float>& column, size_t per) {
+      if (!c.layout.has(at)) return;
+      for (size_t v = 0; v < mesh.vertex_count(); ++v)
+        std::copy_n(&column[per * v], per, &c.interleaved[c.layout.count * v + at]);
+    };
+    put(c.layout.uv, mesh.uvs, 2);
+    put(c.layout.uv1, mesh.uvs1, 2);
+    put(c.layout.color, mesh.colors, 4);
+    c.attributes = c.interleaved.data();
+  }
   if (!m.options.surfaces.materials.empty()) {
     c.vertex_material = vertex_materials(mesh);
     for (int32_t& id : c.vertex_material)
@@ -1065,11 +1148,11 @@ Status HlodBuilder::build_top(const std::vector<HlodSubtree>& baked, std::vector
     return Status::error(m.what + ": " + std::to_string(baked.size()) + " subtree results for " +
                          std::to_string(m.frontier.size()) + " subtrees");
   for (size_t i = 0; i < baked.size(); ++i) {
-    if (Status s = check_subtree(*m.frontier[i], baked[i], m.mesh.vertex_count(), m.c.uvs != nullptr,
+    if (Status s = check_subtree(*m.frontier[i], baked[i], m.mesh.vertex_count(), m.c.layout,
                                  uint32_t(m.options.surfaces.materials.size()), m.name(i));
         !s)
       return s;
-    stand_for_subtree(*m.frontier[i], baked[i]);
+    stand_for_subtree(m.c, *m.frontier[i], baked[i]);
   }
   m.assembled = true;
   m.build_top(*m.root);
@@ -1243,7 +1326,9 @@ Status HlodBuilder::finish_top(const std::vector<HlodSubtree>& baked, const std:
   for (int k = 0; k < 3; ++k) assembly.model.tree.box_center[k] = m.root->center[k];
   assembly.model.tree.box_half = m.root->half;
   assembly.model.tree.source_triangles = m.mesh.triangle_count();
-  assembly.model.tree.uvs = m.c.uvs != nullptr;
+  assembly.model.tree.uvs = m.c.layout.has(m.c.layout.uv);
+  assembly.model.tree.uvs1 = m.c.layout.has(m.c.layout.uv1);
+  assembly.model.tree.colors = m.c.layout.has(m.c.layout.color);
   assembly.model.tree.material_count = uint32_t(m.options.surfaces.materials.size());
   assembly.model.tree.materials = m.options.surfaces.materials;
   assembly.model.tree.texture_base = m.options.surfaces.texture_base;

@@ -8,8 +8,9 @@
 //               twice like a leaf.
 //   locks:      in every node, the vertices of every ancestor's patch (and the mesh's own
 //               border) never move, so any mix of child layers meets the patches exactly.
-//   attributes: texture coordinates ride through QEM as attributes (seams kept: copies at one
-//               position move only along their seam) and material boundaries are seams, so each
+//   attributes: texture coordinates (TEXCOORD_0 and _1) and vertex colours (COLOR_0) ride
+//               through QEM as attributes, weighted in its collapse cost (seams kept: copies at
+//               one position move only along their seam) and material boundaries are seams, so each
 //               layer's triangle keeps the material of the original vertex it descends from;
 //               every layer and patch is grouped into material runs (preprocess/material_runs.h).
 //   errors:     each layer is measured against the original surface (Embree closest points,
@@ -77,7 +78,8 @@ struct HlodBuildOptions {
   // The materials the mesh's submeshes name, copied into the tree. A submesh id at or past their
   // count is drawn with the default material. None: one surface, no runs.
   HlodSurfaces surfaces;
-  // Weight of the uv error in QEM's collapse cost for a mesh with uvs (BakeSettings::uv_weight).
+  // Weight of the attribute error (uvs, uv1, colours) in QEM's collapse cost for a mesh with
+  // them (BakeSettings::uv_weight, which the .lod bake applies to the same attributes).
   float uv_weight = 0.2f;
   ParallelFor parallel_for;     // optional; independent subtrees and children in parallel
   HlodBuildProgress progress;   // optional
@@ -121,10 +123,11 @@ struct HlodBuildReport {
   size_t short_layers = 0;           // layers dropped: no fewer triangles than the one before
 };
 
-// Builds the HLOD of `mesh` (cleaned: see clean_mesh; its uvs (TEXCOORD_0) and submeshes'
-// materials are kept, its other attributes are not). Fails on an empty mesh, indices out of
-// range, non-finite coordinates or uvs, or a mesh with more than 2^32 - 1 vertices; `out` is
-// only written on success. tree.name and tree.source_hash are left for the caller.
+// Builds the HLOD of `mesh` (cleaned: see clean_mesh; its uvs (TEXCOORD_0), second uvs
+// (TEXCOORD_1), colours (COLOR_0) and submeshes' materials are kept, its normals are recomputed).
+// Fails on an empty mesh, indices out of range, non-finite coordinates, uvs or colours, an
+// attribute whose count is not the vertices', or a mesh with more than 2^32 - 1 vertices; `out`
+// is only written on success. tree.name and tree.source_hash are left for the caller.
 Status build_hlod(HlodModel& out, const MeshData& mesh, const HlodBuildOptions& options,
                   HlodBuildReport* report = nullptr);
 

@@ -195,9 +195,11 @@ Status check_payload(const std::string& what, const HlodNode& n, const HlodPaylo
   if (p.layers.size() != n.layer_count || p.layers.empty() || p.layers.size() > kHlodMaxLayers)
     return Status::error(what + ": " + std::to_string(p.layers.size()) + " layers, the tree says " +
                          std::to_string(n.layer_count));
+  const size_t vertices = p.positions.size() / 3;
   if (p.positions.size() % 3 != 0 || p.normals.size() != p.positions.size() ||
-      (!p.uvs.empty() && p.uvs.size() != p.positions.size() / 3 * 2))
-    return Status::error(what + ": positions, normals and uvs do not match");
+      (!p.uvs.empty() && p.uvs.size() != 2 * vertices) || (!p.uvs1.empty() && p.uvs1.size() != 2 * vertices) ||
+      (!p.colors.empty() && p.colors.size() != 4 * vertices))
+    return Status::error(what + ": positions, normals, uvs and colours do not match");
   for (size_t k = 0; k < p.layers.size(); ++k)
     if (Status s = check_range(what + " layer " + std::to_string(k), p.layers[k], p); !s) return s;
   return check_range(what + " boundary", p.boundary, p);
@@ -243,6 +245,8 @@ Status write_range(const fs::path& staging, const std::string& file, const std::
   view.positions = p.positions.data() + 3 * size_t(r.first_vertex);
   view.normals = p.normals.data() + 3 * size_t(r.first_vertex);
   view.uvs = p.uvs.empty() ? nullptr : p.uvs.data() + 2 * size_t(r.first_vertex);
+  view.uvs1 = p.uvs1.empty() ? nullptr : p.uvs1.data() + 2 * size_t(r.first_vertex);
+  view.colors = p.colors.empty() ? nullptr : p.colors.data() + 4 * size_t(r.first_vertex);
   view.vertex_count = r.vertex_count;
   view.indices = p.indices.data() + r.first_index;
   view.index_count = r.index_count;

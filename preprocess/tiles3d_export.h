@@ -11,7 +11,8 @@
 // and a 3D Tiles client applies the specification's y-up to z-up rotation to glTF content, so
 // the bounding volumes are written in the tileset's z-up frame: (x, y, z) -> (x, -z, y).
 //
-// Surfaces: a tree with uvs writes TEXCOORD_0, and one with materials one primitive per material
+// Surfaces: a tree with uvs writes TEXCOORD_0 (with a second set TEXCOORD_1, with colours
+// COLOR_0), and one with materials one primitive per material
 // run with its metallic-roughness material and textures (each GLB embeds the images its
 // materials use, so every tile stands alone).
 //

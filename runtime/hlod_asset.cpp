@@ -1,11 +1,12 @@
-// The .hlod file, version 2. All integers and floats little-endian; sections 8-byte aligned.
+// The .hlod file, version 3. All integers and floats little-endian; sections 8-byte aligned.
 //
 //   head:
 //     magic "LODHLOD\n" (8) | u32 version | u32 head bytes H (everything before the head checksum)
 //     u64 source_hash | u64 source_triangles | f32 box centre xyz, f32 box half (the root cube)
 //     u64 vertices (all nodes' layers and patches) | u64 boundary triangles (all patches)
 //     u32 material count | u32 min_verts | u32 node count | u32 inner node count
-//     u32 name bytes | u32 flags (bit 0: the payloads have uvs; the rest 0) |
+//     u32 name bytes | u32 flags (bit 0: the payloads have uvs (TEXCOORD_0), bit 1: colours
+//     (COLOR_0), bit 2: a second uv set (TEXCOORD_1); the rest 0) |
 //     u32 materials section bytes M | u32 images section bytes I | name
 //     materials (M bytes, 0 = none described): the .lod's MATL section (runtime/material_section.h)
 //       with the texture base and no submeshes; when present, exactly `material count` of them
@@ -14,17 +15,21 @@
 //       files the materials embed ("embedded:<k>" names image k), 8-byte aligned after M
 //     OctreeCode: one byte per inner node, breadth-first: bit i = octant i is non-empty
 //     NodeDescription: one bit per node but the root, breadth-first: 1 = leaf, 0 = inner
-//     node records: 80 bytes each (see put_record), breadth-first
+//     node records: 80 bytes each, 12 more with uv1 and 12 more with colours (see put_record),
+//       breadth-first
 //     offset table: u64 offset, u64 size per node
 //   u64 head checksum = hash_bytes(bytes [0, H))
 //   payloads, one per node in node order, back to back up to the end of the file: per layer
-//   positions (3 f32 per vertex), normals (same), uvs (2 f32 per vertex, with the flag),
+//   positions (3 f32 per vertex), normals (same), uvs (2 f32 per vertex, with the flag), uv1
+//   (2 f32 per vertex, with its flag), colours (4 f32 linear RGBA per vertex, with theirs),
 //   indices (3 u32 per triangle, layer-local), then the boundary patch the same way, then the
 //   node's material runs (16 bytes each: u32 range (layer, or layer count for the patch),
 //   u32 first index (range-local), u32 index count, i32 material), then u64 checksum =
 //   hash_bytes(the payload before it)
 //
-// Version 1 (positions and normals only, no materials) is refused with a message to rebake.
+// Version 2 is version 3 without the colour and uv1 flags (a file without them differs only in
+// its version word) and is read as such. Version 1 (positions and normals only, no materials) is
+// refused with a message to rebake.
 // The tree's structure (parents, child ranges, depths, cells) is not stored: it follows from
 // the bits and the root cube, as R1 rebuilds its octree from OctreeCode and NodeDescription.
 #include "runtime/hlod_asset.h"
@@ -53,6 +58,9 @@ constexpr uint64_t kFixedBytes = 96;
 constexpr uint64_t kRecordBytes = 80;
 constexpr uint64_t kRunBytes = 16;
 constexpr uint32_t kFlagUvs = 1;
+constexpr uint32_t kFlagColors = 2;
+constexpr uint32_t kFlagUvs1 = 4;
+constexpr uint32_t kOldestReadable = 2;  // version 2: no colour or uv1 flags
 constexpr uint64_t kOffsetBytes = 16;
 constexpr uint64_t kChecksumBytes = 8;
 
@@ -66,12 +74,22 @@ using Writer = detail::ByteWriter;
 
 Status refuse(const std::string& what, const std::string& why) { return Status::error(what + ": " + why); }
 
+// A record's size: the per-layer errors of each attribute the tree has follow the 80 bytes.
+uint64_t record_bytes(uint32_t flags) {
+  return kRecordBytes + ((flags & kFlagUvs1) ? 4 * kHlodMaxLayers : 0) + ((flags & kFlagColors) ? 4 * kHlodMaxLayers : 0);
+}
+
+uint32_t tree_flags(const HlodTree& t) {
+  return (t.uvs ? kFlagUvs : 0) | (t.colors ? kFlagColors : 0) | (t.uvs1 ? kFlagUvs1 : 0);
+}
+
 // The head's size from its counts (all u32, so no overflow in u64).
-uint64_t head_bytes(uint64_t name_bytes, uint64_t material_bytes, uint64_t image_bytes, uint64_t nodes, uint64_t inner) {
+uint64_t head_bytes(uint64_t name_bytes, uint64_t material_bytes, uint64_t image_bytes, uint64_t nodes, uint64_t inner,
+                    uint32_t flags) {
   const uint64_t description = nodes > 0 ? (nodes - 1 + 7) / 8 : 0;
   return align8(kFixedBytes + name_bytes) + align8(material_bytes) + align8(image_bytes) + align8(inner) +
          align8(description) +
-         nodes * (kRecordBytes + kOffsetBytes);
+         nodes * (record_bytes(flags) + kOffsetBytes);
 }
 
 // A payload holds exactly what it takes in memory, plus its checksum.
@@ -91,12 +109,30 @@ void put_record(Writer& w, const HlodNode& n) {
   }
   for (uint32_t k = 0; k < kHlodMaxLayers; ++k) w.f32(k < n.layer_count ? n.layers[k].uv_error : 0.0f);
   w.u32(n.material_runs);
+  if (n.uvs1)
+    for (uint32_t k = 0; k < kHlodMaxLayers; ++k) w.f32(k < n.layer_count ? n.layers[k].uv1_error : 0.0f);
+  if (n.colors)
+    for (uint32_t k = 0; k < kHlodMaxLayers; ++k) w.f32(k < n.layer_count ? n.layers[k].color_error : 0.0f);
 }
 
 bool finite_in_range(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxTreeMagnitude; }
 
-// One record's own fields; "node N: ..." on failure.
-bool get_record(const uint8_t* p, HlodNode& n, std::string& why) {
+// Per-layer attribute errors (`name`: uv, uv1, colour) at p: finite distances within the layer
+// count, zero beyond it.
+bool get_attribute_errors(const uint8_t* p, HlodNode& n, float HlodLayerInfo::*error, const char* name, std::string& why) {
+  for (uint32_t k = 0; k < kHlodMaxLayers; ++k) {
+    const float e = load_f32(p + 4 * k);
+    if (k >= n.layer_count ? std::bit_cast<uint32_t>(e) != 0 : !(finite_in_range(e) && e >= 0))
+      return why = "layer " + std::to_string(k) + " " + name +
+                   " error is not a finite distance (or set beyond the layer count)",
+             false;
+    n.layers[k].*error = e;
+  }
+  return true;
+}
+
+// One record's own fields (the attribute errors that `flags` says follow); "node N: ..." on failure.
+bool get_record(const uint8_t* p, uint32_t flags, HlodNode& n, std::string& why) {
   n.layer_count = p[0];
   if (p[1] || p[2] || p[3]) return why = "reserved bytes are not zero", false;
   n.boundary_triangles = load_u32(p + 4);
@@ -128,13 +164,14 @@ bool get_record(const uint8_t* p, HlodNode& n, std::string& why) {
       return why = name + " has " + std::to_string(info.triangles) + " triangles, not fewer than the layer before", false;
     if (k > 0 && info.error < n.layers[k - 1].error) return why = name + " error is below the finer layer's", false;
   }
-  for (uint32_t k = 0; k < kHlodMaxLayers; ++k) {
-    const float uv_error = load_f32(p + 64 + 4 * k);
-    if (k >= n.layer_count ? std::bit_cast<uint32_t>(uv_error) != 0 : !(finite_in_range(uv_error) && uv_error >= 0))
-      return why = "layer " + std::to_string(k) + " uv error is not a finite distance (or set beyond the layer count)", false;
-    n.layers[k].uv_error = uv_error;
-  }
+  if (!get_attribute_errors(p + 64, n, &HlodLayerInfo::uv_error, "uv", why)) return false;
   n.material_runs = load_u32(p + 76);
+  const uint8_t* more = p + kRecordBytes;
+  if (flags & kFlagUvs1) {
+    if (!get_attribute_errors(more, n, &HlodLayerInfo::uv1_error, "uv1", why)) return false;
+    more += 4 * kHlodMaxLayers;
+  }
+  if ((flags & kFlagColors) && !get_attribute_errors(more, n, &HlodLayerInfo::color_error, "colour", why)) return false;
   if (n.boundary_vertices > 3ull * n.boundary_triangles || (n.boundary_triangles > 0 && n.boundary_vertices == 0))
     return why = "boundary has " + std::to_string(n.boundary_vertices) + " vertices for " +
                  std::to_string(n.boundary_triangles) + " triangles",
@@ -222,16 +259,30 @@ void get_words(const uint8_t* p, size_t count, T* out) {
   }
 }
 
-// One range (a layer or the patch): positions, normals, uvs (when the node has them), indices,
-// each checked.
-bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, bool uvs, HlodPayload& out, LodLevel& range,
-               std::string& why) {
+// One per-vertex attribute column (`per` floats a vertex) of a range, appended to `out` and
+// checked finite.
+bool get_column(const uint8_t*& p, uint32_t vertices, size_t per, const char* name, std::vector<float>& out,
+                std::string& why) {
+  const size_t at = out.size();
+  out.resize(at + per * size_t(vertices));
+  get_words(p, per * size_t(vertices), out.data() + at);
+  p += 4 * per * size_t(vertices);
+  for (size_t i = at; i < out.size(); ++i)
+    if (!finite_in_range(out[i]))
+      return why = "vertex " + std::to_string((i - at) / per) + " has a non-finite " + name, false;
+  return true;
+}
+
+// One range (a layer or the patch): positions, normals, uvs, uv1, colours (each when the node
+// has them), indices, each checked. The caller checked the payload's size against the counts.
+bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, const HlodNode& node, HlodPayload& out,
+               LodLevel& range, std::string& why) {
   range.first_vertex = uint32_t(out.positions.size() / 3);
   range.vertex_count = vertices;
   range.first_index = uint32_t(out.indices.size());
   range.index_count = 3 * triangles;
   range.level = level_of_triangles(triangles);
-  const size_t v0 = out.positions.size(), i0 = out.indices.size(), u0 = out.uvs.size();
+  const size_t v0 = out.positions.size(), i0 = out.indices.size();
   out.positions.resize(v0 + 3 * size_t(vertices));
   out.normals.resize(v0 + 3 * size_t(vertices));
   out.indices.resize(i0 + 3 * size_t(triangles));
@@ -239,18 +290,14 @@ bool get_range(const uint8_t*& p, uint32_t vertices, uint32_t triangles, bool uv
   p += 12 * size_t(vertices);
   get_words(p, 3 * size_t(vertices), out.normals.data() + v0);
   p += 12 * size_t(vertices);
-  if (uvs) {
-    out.uvs.resize(u0 + 2 * size_t(vertices));
-    get_words(p, 2 * size_t(vertices), out.uvs.data() + u0);
-    p += 8 * size_t(vertices);
-  }
-  get_words(p, 3 * size_t(triangles), out.indices.data() + i0);
-  p += 12 * size_t(triangles);
   for (size_t i = v0; i < out.positions.size(); ++i)
     if (!finite_in_range(out.positions[i]) || !finite_in_range(out.normals[i]))
       return why = "vertex " + std::to_string((i - v0) / 3) + " is not finite", false;
-  for (size_t i = u0; i < out.uvs.size(); ++i)
-    if (!finite_in_range(out.uvs[i])) return why = "vertex " + std::to_string((i - u0) / 2) + " has a non-finite uv", false;
+  if (node.uvs && !get_column(p, vertices, 2, "uv", out.uvs, why)) return false;
+  if (node.uvs1 && !get_column(p, vertices, 2, "uv1", out.uvs1, why)) return false;
+  if (node.colors && !get_column(p, vertices, 4, "colour", out.colors, why)) return false;
+  get_words(p, 3 * size_t(triangles), out.indices.data() + i0);
+  p += 12 * size_t(triangles);
   for (size_t i = i0; i < out.indices.size(); ++i)
     if (out.indices[i] >= vertices)
       return why = "triangle " + std::to_string((i - i0) / 3) + " references vertex " + std::to_string(out.indices[i]) +
@@ -301,7 +348,7 @@ bool get_runs(const uint8_t* p, const HlodNode& node, uint32_t materials, HlodPa
 }  // namespace
 
 uint64_t hlod_resident_bytes(const HlodNode& n) {
-  const uint64_t per_vertex = n.uvs ? 32 : 24;
+  const uint64_t per_vertex = 24 + (n.uvs ? 8 : 0) + (n.uvs1 ? 8 : 0) + (n.colors ? 16 : 0);
   uint64_t b = 0;
   for (uint32_t k = 0; k < n.layer_count && k < kHlodMaxLayers; ++k)
     b += per_vertex * n.layers[k].vertices + 12ull * n.layers[k].triangles;
@@ -339,7 +386,7 @@ std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint
   w.u32(count);
   w.u32(inner);
   w.u32(uint32_t(tree.name.size()));
-  w.u32(tree.uvs ? kFlagUvs : 0);
+  w.u32(tree_flags(tree));
   w.u32(uint32_t(materials.size()));
   w.u32(uint32_t(images.size()));
   w.bytes.insert(w.bytes.end(), tree.name.begin(), tree.name.end());
@@ -356,7 +403,10 @@ std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint
     if (tree.nodes[i].leaf()) description[(i - 1) / 8] |= uint8_t(1u << ((i - 1) % 8));
   w.bytes.insert(w.bytes.end(), description.begin(), description.end());
   w.align8();
-  for (const HlodNode& n : tree.nodes) put_record(w, n);
+  for (HlodNode n : tree.nodes) {
+    n.uvs1 = tree.uvs1, n.colors = tree.colors;  // the records' size follows the tree's flags
+    put_record(w, n);
+  }
   const uint64_t head = w.bytes.size() + kOffsetBytes * count;
   w.patch_u32(12, uint32_t(head));
   uint64_t at = head + kChecksumBytes;
@@ -376,6 +426,8 @@ std::vector<uint8_t> encode_hlod_payload(const HlodPayload& p) {
     w.words(p.positions.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
     w.words(p.normals.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
     if (!p.uvs.empty()) w.words(p.uvs.data() + 2 * size_t(r.first_vertex), 2 * size_t(r.vertex_count));
+    if (!p.uvs1.empty()) w.words(p.uvs1.data() + 2 * size_t(r.first_vertex), 2 * size_t(r.vertex_count));
+    if (!p.colors.empty()) w.words(p.colors.data() + 4 * size_t(r.first_vertex), 4 * size_t(r.vertex_count));
     w.words(p.indices.data() + r.first_index, r.index_count);
   };
   for (const LodLevel& r : p.layers) put_range(r);
@@ -410,10 +462,10 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
                             " bytes, too short for an .hlod file (truncated?)");
   if (std::memcmp(p, kMagic, 8) != 0) return refuse(what, "not an .hlod file (bad magic bytes)");
   const uint32_t version = load_u32(p + 8);
-  if (version != kHlodAssetVersion)
-    return refuse(what, "hlod version " + std::to_string(version) + " is not supported (this build reads version " +
-                            std::to_string(kHlodAssetVersion) +
-                            (version < kHlodAssetVersion ? ", which adds texture coordinates and materials" : "") +
+  if (version < kOldestReadable || version > kHlodAssetVersion)
+    return refuse(what, "hlod version " + std::to_string(version) + " is not supported (this build reads versions " +
+                            std::to_string(kOldestReadable) + " to " + std::to_string(kHlodAssetVersion) +
+                            (version < kOldestReadable ? ", which add texture coordinates and materials" : "") +
                             "); rebake it with lod bake --hlod");
   const uint64_t head = load_u32(p + 12);
   const uint32_t materials = load_u32(p + 64), min_verts = load_u32(p + 68);
@@ -423,11 +475,13 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
   if (head + kChecksumBytes > file_size || head + kChecksumBytes > bytes.size())
     return refuse(what, "truncated: the head needs " + std::to_string(head + kChecksumBytes) + " bytes, the file has " +
                             std::to_string(file_size));
-  if (count == 0 || inner >= count || head != head_bytes(name_bytes, material_bytes, image_bytes, count, inner))
+  const uint32_t known_flags = version >= 3 ? kFlagUvs | kFlagColors | kFlagUvs1 : kFlagUvs;
+  if (count == 0 || inner >= count ||
+      head != head_bytes(name_bytes, material_bytes, image_bytes, count, inner, flags & known_flags))
     return refuse(what, "head of " + std::to_string(head) + " bytes does not match its counts (" + std::to_string(count) +
                             " nodes, " + std::to_string(inner) + " inner, name of " + std::to_string(name_bytes) + ")");
   if (load_u64(p + head) != hash_bytes(p, head)) return refuse(what, "head checksum mismatch (file is corrupted)");
-  if (min_verts == 0 || (flags & ~kFlagUvs) != 0 || (image_bytes != 0 && material_bytes == 0))
+  if (min_verts == 0 || (flags & ~known_flags) != 0 || (image_bytes != 0 && material_bytes == 0))
     return refuse(what, "header fields min_verts / flags / image bytes are invalid");
   if (materials > kMaxMaterials)
     return refuse(what, std::to_string(materials) + " materials, at most " + std::to_string(kMaxMaterials));
@@ -443,6 +497,8 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
   if (!finite_in_range(t.box_half) || !(t.box_half > 0)) return refuse(what, "root box size is not positive");
   t.name.assign(reinterpret_cast<const char*>(p + kFixedBytes), name_bytes);
   t.uvs = (flags & kFlagUvs) != 0;
+  t.uvs1 = (flags & kFlagUvs1) != 0;
+  t.colors = (flags & kFlagColors) != 0;
   t.material_count = materials;
   const uint64_t materials_at = align8(kFixedBytes + name_bytes);
   const uint64_t images_at = materials_at + align8(material_bytes);
@@ -462,17 +518,18 @@ Status decode_hlod_tree(std::span<const uint8_t> bytes, uint64_t file_size, cons
   const uint64_t code_at = images_at + align8(image_bytes);
   const uint64_t description_at = code_at + align8(inner);
   const uint64_t records_at = description_at + align8((uint64_t(count) - 1 + 7) / 8);
-  const uint64_t table_at = records_at + kRecordBytes * count;
+  const uint64_t record = record_bytes(flags);
+  const uint64_t table_at = records_at + record * count;
   t.nodes.resize(count);
   std::string why;
   for (uint32_t i = 0; i < count; ++i)
-    if (!get_record(p + records_at + kRecordBytes * i, t.nodes[i], why))
+    if (!get_record(p + records_at + record * i, flags, t.nodes[i], why))
       return refuse(what, "node " + std::to_string(i) + ": " + why);
   if (!rebuild_structure(p + code_at, inner, p + description_at, t, why)) return refuse(what, "octree: " + why);
   if (!check_tree(t, why)) return refuse(what, why);
   for (uint32_t i = 0; i < count; ++i) {
     HlodNode& n = t.nodes[i];
-    n.uvs = t.uvs;
+    n.uvs = t.uvs, n.uvs1 = t.uvs1, n.colors = t.colors;
     // A tree with materials has runs over every range with triangles (at most one per
     // triangle), one without has none.
     uint64_t triangles = n.boundary_triangles, ranges = n.boundary_triangles > 0;
@@ -528,13 +585,13 @@ Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node,
   std::string why;
   for (uint32_t k = 0; k < node.layer_count; ++k) {
     LodLevel range;
-    if (!get_range(q, node.layers[k].vertices, node.layers[k].triangles, node.uvs, p, range, why))
+    if (!get_range(q, node.layers[k].vertices, node.layers[k].triangles, node, p, range, why))
       return refuse(what, "layer " + std::to_string(k) + ": " + why);
     range.error = node.layers[k].error;
     range.bounds = node.bounds;
     p.layers.push_back(range);
   }
-  if (!get_range(q, node.boundary_vertices, node.boundary_triangles, node.uvs, p, p.boundary, why))
+  if (!get_range(q, node.boundary_vertices, node.boundary_triangles, node, p, p.boundary, why))
     return refuse(what, "boundary: " + why);
   p.boundary.bounds = node.bounds;
   if (!get_runs(q, node, materials, p, why)) return refuse(what, why);

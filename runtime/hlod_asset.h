@@ -19,7 +19,9 @@
 
 namespace lod {
 
-inline constexpr uint32_t kHlodAssetVersion = 2;  // 2: uvs, materials and material runs
+// 3: colours (COLOR_0) and a second uv set (TEXCOORD_1); 2: uvs, materials and material runs.
+// Version 2 files are still read (3 only adds flags); version 1 is refused.
+inline constexpr uint32_t kHlodAssetVersion = 3;
 
 // The whole file. Offsets and sizes in the written file are computed here (tree's own
 // payload_offset / payload_size are ignored); payloads[i] is node i's geometry.
@@ -77,7 +79,8 @@ Status read_hlod_tree(const std::filesystem::path& path, HlodTree& out);
 // One node of the file at `path` (the node from read_hlod_tree of the same file).
 Status read_hlod_node(const std::filesystem::path& path, const HlodNode& node, HlodPayload& out);
 
-// Bytes a payload with these counts takes in memory (positions, normals, uvs, indices, runs),
+// Bytes a payload with these counts takes in memory (positions, normals, uvs, uv1, colours,
+// indices, runs),
 // as HlodNode::resident_bytes counts them.
 uint64_t hlod_resident_bytes(const HlodNode& node);
 

@@ -1,4 +1,5 @@
-// The subtree entry, version 2 (the embedded asset is .hlod version 2: uvs, material runs); little-endian:
+// The subtree entry, version 3 (the embedded asset is .hlod version 3: uvs, uv1, colours, material
+// runs); little-endian:
 //
 //   magic "LODHSUB\n" (8) | u32 version | u32 root depth | u64 key | u64 short_layers |
 //   u64 oversized_leaves | u32 source count S | u32 reference count R | u64 asset bytes A
@@ -37,6 +38,8 @@ HlodTree relative_tree(const HlodSubtree& s, uint64_t key) {
   t.box_half = root.box_half;
   t.nodes = s.nodes;
   t.uvs = root.uvs;
+  t.uvs1 = root.uvs1;
+  t.colors = root.colors;
   t.material_count = s.material_count;
   for (HlodNode& n : t.nodes) n.depth = uint8_t(n.depth - root.depth);
   return t;

@@ -14,7 +14,8 @@
 
 namespace lod {
 
-inline constexpr uint32_t kHlodSubtreeEntryVersion = 2;  // 2: .hlod version 2 inside (uvs, material runs)
+// 3: .hlod version 3 inside (colours, uv1); 2: version 2 (uvs, material runs)
+inline constexpr uint32_t kHlodSubtreeEntryVersion = 3;
 
 // `key`: what the entry is stored under (the hash of its inputs); written into the entry.
 std::vector<uint8_t> encode_hlod_subtree(const HlodSubtree& subtree, uint64_t key);

@@ -33,6 +33,10 @@ struct HlodLayerInfo {
   // How far a vertex's uv slid from the original vertex it descends from, at most (texture
   // units, as the .lod's TEX0 errors); 0 without texture coordinates. A report, not monotonic.
   float uv_error = 0;
+  // The same for TEXCOORD_1 (texture units) and COLOR_0 (distance in linear RGBA, as the .lod's
+  // COL0 errors); 0 without them.
+  float uv1_error = 0;
+  float color_error = 0;
 };
 
 struct HlodNode {
@@ -57,9 +61,12 @@ struct HlodNode {
   uint64_t payload_size = 0;
   uint64_t resident_bytes = 0;
 
-  // Attributes (all nodes of a tree alike for uvs): the payload has texture coordinates, and
-  // this many material runs over its layers and patch (0 in a tree without materials).
+  // Attributes (all nodes of a tree alike for uvs, uvs1 and colors): the payload has texture
+  // coordinates (TEXCOORD_0), a second uv set (TEXCOORD_1), vertex colours (COLOR_0), and this
+  // many material runs over its layers and patch (0 in a tree without materials).
   bool uvs = false;
+  bool uvs1 = false;
+  bool colors = false;
   uint32_t material_runs = 0;
 };
 
@@ -72,6 +79,8 @@ struct HlodPayload {
   std::vector<uint32_t> indices;         // all layers then the boundary
   LodLevel boundary;                     // the patch's range (error 0)
   std::vector<float> uvs;                // uv per vertex (TEXCOORD_0), or empty
+  std::vector<float> uvs1;               // second uv per vertex (TEXCOORD_1), or empty
+  std::vector<float> colors;             // linear RGBA per vertex (COLOR_0), or empty
   // Each range's triangles grouped by material (as a .lod level's): runs sorted by range, a
   // range's runs covering its indices in order; `level` is the layer index, or layers.size()
   // for the boundary; first_index is range-local. Empty in a tree without materials.
@@ -104,6 +113,8 @@ struct HlodTree {
   // with the materials in a subtree entry.
   std::vector<EmbeddedImage> images;
   bool uvs = false;                      // the payloads have texture coordinates
+  bool uvs1 = false;                     // ... a second uv set
+  bool colors = false;                   // ... vertex colours
   std::vector<HlodNode> nodes;           // breadth-first, nodes[0] is the root
 };
 

@@ -8,6 +8,7 @@ namespace {
 
 void release(HlodNodeGpu& g) {
   if (g.uv_vbo) glDeleteBuffers(1, &g.uv_vbo);
+  if (g.color_vbo) glDeleteBuffers(1, &g.color_vbo);
   release_static_mesh(g.gl);
   g = HlodNodeGpu{};
 }
@@ -26,23 +27,25 @@ HlodNodeRange range_of(const HlodPayload& p, uint32_t range, uint32_t first_mate
   return r;
 }
 
-// The payload's uvs in a VBO of their own, bound to kAttribUv in the node's VAO.
-size_t upload_uvs(HlodNodeGpu& g, const std::vector<float>& uvs) {
-  if (uvs.empty()) return 0;
+// One per-vertex column of the payload (`per` floats a vertex) in a VBO of its own, bound to
+// `attribute` in the node's VAO.
+size_t upload_column(HlodNodeGpu& g, const std::vector<float>& values, GLuint attribute, GLint per, GLuint& vbo) {
+  if (values.empty()) return 0;
   glBindVertexArray(g.gl.vao);
-  glGenBuffers(1, &g.uv_vbo);
-  glBindBuffer(GL_ARRAY_BUFFER, g.uv_vbo);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(uvs.size() * sizeof(float)), uvs.data(), GL_STATIC_DRAW);
-  glEnableVertexAttribArray(kAttribUv);
-  glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+  glGenBuffers(1, &vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(values.size() * sizeof(float)), values.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(attribute);
+  glVertexAttribPointer(attribute, per, GL_FLOAT, GL_FALSE, GLsizei(per * sizeof(float)), nullptr);
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
-  return uvs.size() * sizeof(float);
+  return values.size() * sizeof(float);
 }
 
 void fill(HlodNodeGpu& g, const HlodPayload& p, uint32_t first_material, size_t materials) {
   g.bytes = upload_static_mesh(g.gl, p.positions, p.normals, p.indices);
-  if (p.uvs.size() == p.positions.size() / 3 * 2) g.bytes += upload_uvs(g, p.uvs);
+  if (p.uvs.size() == p.positions.size() / 3 * 2) g.bytes += upload_column(g, p.uvs, kAttribUv, 2, g.uv_vbo);
+  if (p.colors.size() == p.positions.size() / 3 * 4) g.bytes += upload_column(g, p.colors, kAttribColor, 4, g.color_vbo);
   for (uint32_t k = 0; k < p.layers.size(); ++k) g.layers.push_back(range_of(p, k, first_material, materials, g.runs));
   g.boundary = range_of(p, uint32_t(p.layers.size()), first_material, materials, g.runs);
 }

@@ -2,7 +2,7 @@
 // holds node payloads for the LOD thread; the renderer reads the nodes it is told to draw from
 // the same .hlod files itself (the pager has just read them, so they come from the page
 // cache) and keeps them, least recently drawn evicted first, under a byte capacity. A node's
-// texture coordinates go in a VBO of their own, its material runs stay on the CPU (a draw per
+// texture coordinates and vertex colours go in VBOs of their own, its material runs stay on the CPU (a draw per
 // run); every model's materials and their textures are uploaded once, at init.
 #pragma once
 #include <cstdint>
@@ -35,6 +35,7 @@ struct HlodRunGpu {
 struct HlodNodeGpu {
   StaticMeshGl gl;
   GLuint uv_vbo = 0;                     // 0: the node has no uvs
+  GLuint color_vbo = 0;                  // 0: the node has no vertex colours
   std::vector<HlodRunGpu> runs;
   uint64_t bytes = 0;
   uint64_t last_drawn = 0;               // prepare() call that last needed it

@@ -27,6 +27,7 @@ layout(location = 5) in vec3 a_target_position;
 layout(location = 6) in vec3 a_target_normal;
 layout(location = 7) in vec2 a_uv;
 layout(location = 8) in vec2 a_target_uv;
+layout(location = 9) in vec4 a_color;  // COLOR_0 (HLOD nodes that have them), linear RGBA
 uniform mat4 u_view;
 uniform mat4 u_projection;
 uniform int u_blend;
@@ -34,6 +35,7 @@ out vec3 v_position_view;
 out vec3 v_normal_view;
 out float v_morph;
 out vec2 v_uv;
+out vec4 v_color;
 // q v q* for a unit quaternion, without building a matrix.
 vec3 rotate(vec4 q, vec3 v) {
   vec3 t = 2.0 * cross(q.xyz, v);
@@ -50,6 +52,7 @@ void main() {
   v_normal_view = mat3(u_view) * rotate(q, n);
   v_morph = i_morph_weight.x;
   v_uv = u_blend != 0 ? mix(a_uv, a_target_uv, w) : a_uv;
+  v_color = a_color;
   gl_Position = u_projection * view_pos;
 }
 )";
@@ -59,10 +62,12 @@ in vec3 v_position_view;
 in vec3 v_normal_view;
 in float v_morph;
 in vec2 v_uv;
+in vec4 v_color;
 uniform vec3 u_colour;        // a material's base colour factor (rgb) or the mode's colour
 uniform float u_alpha;        // the factor's alpha
 uniform float u_alpha_cutoff; // alpha mode MASK: fragments below are dropped; < 0 otherwise
 uniform int u_textured;
+uniform int u_vertex_colours;  // glTF: base colour = factor x texture x COLOR_0
 uniform sampler2D u_texture;  // base colour (sRGB, read as linear), unit 0
 uniform int u_normal_mapped;
 uniform sampler2D u_normal_texture;  // tangent-space normals, unit 1
@@ -140,6 +145,7 @@ void main() {
   vec3 to_eye = normalize(-v_position_view);
   vec4 surface = vec4(u_colour, u_alpha);
   if (u_textured != 0) surface *= base_texel;
+  if (u_vertex_colours != 0) surface *= v_color;
   if (surface.a < u_alpha_cutoff) discard;
   if (u_pbr != 0) {
     if (dot(n, to_eye) < 0.0) n = -n;  // two-sided: the side seen is lit (no culling, mixed windings)
@@ -223,6 +229,7 @@ bool hlod_has_blend_runs(const HlodNodeBuffers& nodes, const HlodNodeGpu& g, con
 
 // The sun of the terrain's shading, in world space (y up).
 constexpr glm::vec3 kSunDirection = {0.45f, 0.8f, 0.35f};
+constexpr std::array<float, 3> kWhite = {1.f, 1.f, 1.f};  // glTF's default material
 
 }  // namespace
 
@@ -333,6 +340,7 @@ bool InstanceRenderer::init(std::string* message) {
   u_alpha_ = glGetUniformLocation(program_, "u_alpha");
   u_alpha_cutoff_ = glGetUniformLocation(program_, "u_alpha_cutoff");
   u_textured_ = glGetUniformLocation(program_, "u_textured");
+  u_vertex_colours_ = glGetUniformLocation(program_, "u_vertex_colours");
   u_normal_mapped_ = glGetUniformLocation(program_, "u_normal_mapped");
   u_normal_scale_ = glGetUniformLocation(program_, "u_normal_scale");
   u_pbr_ = glGetUniformLocation(program_, "u_pbr");
@@ -406,6 +414,7 @@ void InstanceRenderer::set_frame_uniforms(const glm::mat4& view, const glm::mat4
   glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
   glUniform1i(u_show_morph_, 0);
   glUniform1i(u_blend_, 0);
+  glUniform1i(u_vertex_colours_, 0);
   const glm::vec3 sun = glm::normalize(glm::mat3(view) * glm::normalize(kSunDirection));
   const glm::vec3 up = glm::normalize(glm::mat3(view) * glm::vec3(0, 1, 0));
   glUniform3f(u_sun_view_, sun.x, sun.y, sun.z);
@@ -609,26 +618,34 @@ void InstanceRenderer::draw_hlod_node(const HlodDraw& d, const HlodNodeGpu& g, c
   glVertexAttrib4fv(kAttribInstanceRotation, d.transform.rotation);
   glVertexAttrib2f(kAttribInstanceMorph, 1.f, 0.f);
   if (!g.uv_vbo) glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  // Vertex colours multiply the base colour when materials are drawn; the default surface is
+  // then glTF's default material (white), so the colours show as they are.
+  const bool coloured = g.color_vbo && draws_materials(settings);
+  const auto& plain = coloured ? kWhite : kModelColour;
   auto draw = [&](uint32_t first_index, uint32_t count) {
     glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)), GLint(r.first_vertex));
   };
   if (!draws_materials(settings) || r.run_count == 0) {
     if (pass != RunPass::opaque) return;
+    glUniform1i(u_vertex_colours_, coloured ? 1 : 0);
     set_plain_surface(settings.colour_override ? settings.colour
                       : settings.colour_by_level ? level_colour(d.depth)
-                                                 : kModelColour);
+                                                 : plain);
     draw(r.first_index, r.index_count);
+    glUniform1i(u_vertex_colours_, 0);
     return;
   }
   // Run by run with its material, as a level's runs are drawn.
+  glUniform1i(u_vertex_colours_, coloured ? 1 : 0);
   for (uint32_t k = r.first_run; k < r.first_run + r.run_count && k < g.runs.size(); ++k) {
     const HlodRunGpu& run = g.runs[k];
     if (material_pass(materials, run.material) != pass) continue;
     if (run.material >= 0 && size_t(run.material) < materials.size()) set_material(materials[size_t(run.material)]);
-    else set_plain_surface(kModelColour);
+    else set_plain_surface(plain);
     draw(run.first_index, run.index_count);
   }
+  glUniform1i(u_vertex_colours_, 0);
   set_plain_surface(kModelColour);
 }
 
@@ -650,6 +667,7 @@ void InstanceRenderer::draw_hlod(const HlodDrawList& list, const HlodNodeBuffers
     stats.hlod_triangles += r->index_count / 3;
     stats.triangles += r->index_count / 3;
   }
+  glUniform1i(u_vertex_colours_, 0);
   end_mesh_draws(settings, stats);
 }
 

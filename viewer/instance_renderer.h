@@ -117,6 +117,7 @@ class InstanceRenderer {
   std::vector<BlendDraw> blend_order_;   // scratch: the blended pass, farthest first
   GLint u_view_ = -1, u_projection_ = -1, u_colour_ = -1, u_flat_ = -1, u_show_morph_ = -1, u_blend_ = -1;
   GLint u_alpha_ = -1, u_alpha_cutoff_ = -1, u_textured_ = -1, u_normal_mapped_ = -1, u_normal_scale_ = -1;
+  GLint u_vertex_colours_ = -1;
   GLint u_pbr_ = -1, u_metallic_ = -1, u_roughness_ = -1, u_mr_mapped_ = -1, u_occlusion_mapped_ = -1;
   GLint u_occlusion_strength_ = -1, u_emissive_ = -1, u_emissive_mapped_ = -1, u_sun_view_ = -1, u_up_view_ = -1;
 };

@@ -2,9 +2,11 @@
 // recomputes the head checksum and every payload checksum the (mutated) head points at, so
 // the fuzzer reaches the structure and range checks behind them: a checksum is not a defence.
 //
-// Checks beyond the sanitizers: a refusal names the input; an accepted file has uvs for every
-// vertex or none and every run's material below the count; it gives a cut that validates, and
+// Checks beyond the sanitizers: a refusal names the input; an accepted file has uvs, uv1 and
+// colours each for every vertex or none (as its flags say), all finite, attribute errors finite
+// and non-negative, and every run's material below the count; it gives a cut that validates, and
 // the cut selection runs over it (everything resident, a view at the root).
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -92,9 +94,23 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (const std::string* uri : lod::texture_slots(m))
       if (uint32_t k = 0; lod::is_embedded_image_uri(*uri, &k) && k >= tree.images.size()) std::abort();
   for (const lod::HlodPayload& p : payloads) {
-    if (p.uvs.size() != (tree.uvs ? p.positions.size() / 3 * 2 : 0)) std::abort();
+    const size_t vertices = p.positions.size() / 3;
+    if (p.uvs.size() != (tree.uvs ? vertices * 2 : 0)) std::abort();
+    if (p.uvs1.size() != (tree.uvs1 ? vertices * 2 : 0)) std::abort();
+    if (p.colors.size() != (tree.colors ? vertices * 4 : 0)) std::abort();
+    for (float v : p.uvs1)
+      if (!std::isfinite(v)) std::abort();
+    for (float v : p.colors)
+      if (!std::isfinite(v)) std::abort();
     for (const lod::LevelSubmesh& r : p.runs)
       if (r.material < -1 || r.material >= int32_t(tree.material_count) || r.level > p.layers.size()) std::abort();
+  }
+  for (const lod::HlodNode& n : tree.nodes) {
+    if (n.uvs1 != tree.uvs1 || n.colors != tree.colors) std::abort();
+    for (uint32_t k = 0; k < n.layer_count; ++k)
+      if (!(n.layers[k].uv1_error >= 0 && n.layers[k].color_error >= 0) || !std::isfinite(n.layers[k].uv1_error) ||
+          !std::isfinite(n.layers[k].color_error))
+        std::abort();
   }
   use_tree(tree);
   return 0;

@@ -93,6 +93,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // What the full decode accepts, the partial readers accept alike.
   if (!first.ok || !placed.ok || root.nodes.size() != full.nodes.size() || spans.size() != full.nodes.size()) std::abort();
   if (root.payloads.size() != 1 || root.payloads[0].positions != full.payloads[0].positions) std::abort();
+  if (root.payloads[0].uvs1 != full.payloads[0].uvs1 || root.payloads[0].colors != full.payloads[0].colors) std::abort();
   for (size_t i = 0; i < spans.size(); ++i)
     if (spans[i].size() != lod::hlod_payload_bytes(full.nodes[i])) std::abort();
   // Fields the reader does not keep (the embedded head's name, min_verts) may differ; what it

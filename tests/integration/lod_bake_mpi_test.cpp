@@ -10,6 +10,7 @@
 
 #include "bake_cache_files.h"
 #include "run_cli.h"
+#include "runtime/hlod_asset.h"
 #include "test_support.h"
 #include "textured_fixture.h"
 
@@ -80,6 +81,29 @@ TEST(LodBakeMpi, TexturedModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
                                                  (out / "cache").string() + " --min-verts 300 --threads 1");
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_EQ(test::read_bytes(out / "out" / "globe.hlod"), bytes) << ranks << " ranks";
+  }
+}
+
+// Vertex colours and a second uv set (issue 12), with a texture reading TEXCOORD_1: the same
+// bytes at 1, 2 and 4 ranks as lod bake --hlod, and the tree has both attributes.
+TEST(LodBakeMpi, ColouredModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
+  const auto dir = test::temp_dir("lod_bake_mpi_coloured");
+  const std::filesystem::path gltf = test::write_coloured_gltf(dir / "src", "painted", 60, 120);
+  ASSERT_FALSE(gltf.empty());
+  const test::CliResult local =
+      test::run_lod("bake " + gltf.string() + " -o " + (dir / "local").string() + " --hlod --min-verts 300 --quiet");
+  ASSERT_EQ(local.code, 0) << local.out;
+  const std::vector<uint8_t> bytes = test::read_bytes(dir / "local" / "painted.hlod");
+  HlodTree tree;
+  ASSERT_TRUE(read_hlod_tree(dir / "local" / "painted.hlod", tree));
+  EXPECT_TRUE(tree.colors && tree.uvs1 && tree.uvs);
+  for (int ranks : {1, 2, 4}) {
+    const auto out = dir / ("np" + std::to_string(ranks));
+    const test::CliResult r = run_mpi(ranks, gltf.string() + " -o " + (out / "out").string() + " --cache " +
+                                                 (out / "cache").string() + " --min-verts 300 --threads 1");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(r.out.find("not kept"), std::string::npos) << r.out;
+    EXPECT_EQ(test::read_bytes(out / "out" / "painted.hlod"), bytes) << ranks << " ranks";
   }
 }
 

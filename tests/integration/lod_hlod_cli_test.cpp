@@ -2,6 +2,7 @@
 // progress, the JSON has exactly the keys outside programs read, bad files are refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -76,6 +77,34 @@ TEST(LodHlodCli, SameFileAtOneAndTwoThreads) {
   const auto globe = lod::test::read_bytes(dir / "1" / "globe.hlod");
   ASSERT_GT(globe.size(), 100000u);
   EXPECT_TRUE(globe == lod::test::read_bytes(dir / "2" / "globe.hlod")) << "the textured model at 1 and 2 threads";
+  // Vertex colours and a second uv set (issue 12): kept, nothing said dropped, the same file.
+  const fs::path painted = lod::test::write_coloured_gltf(dir / "src", "painted", 48, 96);
+  ASSERT_FALSE(painted.empty());
+  for (const char* threads : {"1", "2"}) {
+    const auto r = run_lod("bake " + painted.string() + " -o " + (dir / threads).string() +
+                           " --hlod --min-verts 200 --threads " + threads);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(r.out.find("not kept"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("does not keep"), std::string::npos) << r.out;
+  }
+  const auto coloured = lod::test::read_bytes(dir / "1" / "painted.hlod");
+  EXPECT_TRUE(coloured == lod::test::read_bytes(dir / "2" / "painted.hlod")) << "the coloured model at 1 and 2 threads";
+  const auto json = run_lod("inspect " + (dir / "1" / "painted.hlod").string() + " --json");
+  ASSERT_EQ(json.code, 0) << json.out;
+  const nlohmann::json j = nlohmann::json::parse(json.out);
+  EXPECT_EQ(j["version"], 3);
+  EXPECT_EQ(j["texcoords"], true);
+  EXPECT_EQ(j["texcoords1"], true);
+  EXPECT_EQ(j["colors"], true);
+  ASSERT_EQ(j["materials"].size(), 1u);
+  EXPECT_TRUE(j["materials"][0]["textures"].contains("occlusion")) << "the texture reading TEXCOORD_1 is kept";
+  float worst = 0;
+  for (const auto& n : j["nodes"])
+    for (const auto& l : n["layers"]) {
+      ASSERT_TRUE(l.contains("uv1_error") && l.contains("color_error"));
+      worst = std::max(worst, l["color_error"].get<float>());
+    }
+  EXPECT_GT(worst, 0.0f);
 }
 
 TEST(LodHlodCli, RefusesACorruptedFileNamingIt) {

@@ -410,6 +410,59 @@ TEST(Tiles3dExport, TexturedModelKeepsItsUvsMaterialsAndTextureInEveryTile) {
   EXPECT_NE(sv.out.find("structure errors 0 gltf errors 0"), std::string::npos) << sv.out;
 }
 
+// The coloured sphere (north red, green following the latitude; south blue at alpha 0.5; a
+// colour seam on the equator; TEXCOORD_1 with an occlusion texture reading it) -> lod bake --hlod
+// -> lod export --3dtiles: every GLB has COLOR_0 and TEXCOORD_1 (and TEXCOORD_0), each vertex
+// its half's colour, the occlusion texture on texCoord 1, and the validator and the schemas
+// report 0 errors.
+TEST(Tiles3dExport, ColouredModelWritesColor0AndTexcoord1InEveryTile) {
+  const fs::path dir = lod::test::temp_dir("tiles3d-coloured");
+  const fs::path gltf = lod::test::write_coloured_gltf(dir / "src", "painted", 48, 96);
+  ASSERT_FALSE(gltf.empty());
+  auto r = run_lod("bake '" + gltf.string() + "' -o '" + (dir / "hlod").string() + "' --hlod --min-verts 300 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path hlod = dir / "hlod" / "painted.hlod";
+  r = run_lod("export --3dtiles '" + (dir / "tiles").string() + "' '" + hlod.string() + "' --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::vector<TiledGlb> glbs = read_tiles(dir / "tiles");
+  ASSERT_GT(glbs.size(), 8u);
+  size_t red = 0, blue = 0;
+  for (const TiledGlb& g : glbs) {
+    const lod::MeshData& m = g.mesh;
+    ASSERT_EQ(m.uvs.size(), 2 * m.vertex_count()) << g.file;
+    ASSERT_EQ(m.uvs1.size(), 2 * m.vertex_count()) << g.file << ": TEXCOORD_1";
+    ASSERT_EQ(m.colors.size(), 4 * m.vertex_count()) << g.file << ": COLOR_0";
+    ASSERT_EQ(m.materials.size(), 1u) << g.file;
+    EXPECT_FALSE(m.materials[0].occlusion_texture.empty()) << g.file;
+    EXPECT_EQ(m.materials[0].tex_coords[3], 1) << g.file << ": occlusion reads TEXCOORD_1";
+    for (size_t v = 0; v < m.vertex_count(); ++v) {
+      const float* c = &m.colors[4 * v];
+      const float y = m.positions[3 * v + 1];
+      if (c[0] > 0.5f) {
+        ++red;
+        ASSERT_GE(y, -0.02f) << g.file;
+        ASSERT_NEAR(c[3], 1.0f, 1e-5f) << g.file;
+      } else {
+        ++blue;
+        ASSERT_LE(y, 0.02f) << g.file;
+        ASSERT_NEAR(c[2], 1.0f, 1e-5f) << g.file;
+        ASSERT_NEAR(c[3], 0.5f, 1e-5f) << g.file;
+      }
+      ASSERT_GE(m.uvs1[2 * v], 0.25f - 1e-4f) << g.file;
+      ASSERT_LE(m.uvs1[2 * v], 0.75f + 1e-4f) << g.file;
+    }
+  }
+  EXPECT_GT(red, 0u);
+  EXPECT_GT(blue, 0u);
+  const auto v = run_checker(dir / "tiles" / "tileset.json", "-");
+  EXPECT_EQ(v.code, 0) << v.out;
+  EXPECT_NE(v.out.find("structure errors 0 gltf errors 0"), std::string::npos) << v.out;
+  if (fs::exists(schema_dir())) {
+    const auto schemas = run_checker(dir / "tiles" / "tileset.json", schema_dir().string(), false);
+    EXPECT_EQ(schemas.code, 0) << schemas.out;
+  }
+}
+
 // ../shared's spot with its texture (a .mtl naming it) as an HLOD and a tileset: the figures
 // README quotes, and every GLB valid with the texture embedded.
 TEST(Tiles3dExport, SpotHlodExportsWithItsTexture) {

@@ -243,6 +243,84 @@ min_verts = 300
   expect_checker_and_factor(c, "from the .hlod's embedded image");
 }
 
+// The coloured sphere (north red shading to yellow, south blue) as one untextured surface,
+// faces outward: COLOR_0 only, so glTF's default material (white) times the vertex colours.
+std::filesystem::path write_coloured_globe(const std::filesystem::path& dir) {
+  lod::MeshData m = lod::test::coloured_sphere(48, 96);
+  lod::test::turn_faces_outward(m);
+  std::filesystem::create_directories(dir);
+  lod::GltfMeshView view;
+  view.name = "painted";
+  view.positions = m.positions.data();
+  view.vertex_count = m.vertex_count();
+  view.colors = m.colors.data();
+  view.indices = m.indices.data();
+  view.index_count = m.indices.size();
+  const auto file = dir / "painted.gltf";
+  return lod::save_gltf(file, view).ok ? file : std::filesystem::path();
+}
+
+// Pixels of the sphere's two vertex colours, above and below the equator: warm (red to orange:
+// red full, some green, no blue) and pure blue (no red, no green).
+struct Painted {
+  int warm_above = 0, warm_below = 0, blue_above = 0, blue_below = 0;
+};
+Painted count_painted(const Image& img) {
+  const int centre_row = lod::test::project({0, 0, 0}, img.width, img.height)[1];
+  Painted n;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* px = img.at(x, y);
+      const float pm = float(std::max({px[0], px[1], px[2]}));
+      if (pm < 60) continue;
+      const float r = px[0] / pm, g = px[1] / pm, b = px[2] / pm;
+      const bool warm = r > 0.95f && g > 0.2f && g < 0.95f && b < 0.08f, blue = b > 0.95f && r < 0.08f && g < 0.08f;
+      (y < centre_row ? n.warm_above : n.warm_below) += warm;
+      (y < centre_row ? n.blue_above : n.blue_below) += blue;
+    }
+  return n;
+}
+
+// An HLOD model with vertex colours (issue 12): its nodes are drawn with COLOR_0 multiplied into
+// the base colour, so the picture shows the red north and the blue south; colour-by-depth
+// shows neither.
+TEST(ViewerTextured, HlodNodesShowTheirVertexColoursColourByDepthDoesNot) {
+  LOD_REQUIRE_XVFB();
+  const char* model = R"([[model]]
+name = "textured"
+file = "textured/painted.gltf"
+hlod = true
+min_verts = 300
+)";
+  const char* run = "[run]\nframes = 3\nthreads = 1\n[budget]\ntriangles = 1000000\n[lod]\npixel_error = 1.0\n";
+  const auto scene = lod::test::write_viewer_scene("coloured-hlod", run, kCamera, kInstance, model);
+  ASSERT_FALSE(write_coloured_globe(scene.dir / "textured").empty());
+  const auto lit = scene.dir / "hlod.png";
+  const auto depth = scene.dir / "depth.png";
+  const auto stats = scene.dir / "hlod.csv";
+  auto r = lod::test::run_viewer(scene, "--screenshot '" + lit.string() + "' --frames 3 --width 400 --height 300 --stats '" +
+                                            stats.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  lod::test::CsvTable t;
+  ASSERT_TRUE(lod::test::load_csv(stats, t));
+  ASSERT_FALSE(t.rows.empty());
+  EXPECT_GT(t.get(t.rows.size() - 1, "hlod_draws"), 0) << "drawn through its HLOD cut";
+  EXPECT_EQ(t.get(t.rows.size() - 1, "hlod_missing"), 0);
+  r = lod::test::run_viewer(scene, "--screenshot '" + depth.string() + "' --frames 3 --color-by-level --width 400 --height 300");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image img, by_depth;
+  ASSERT_TRUE(lod::test::load_png(lit, img));
+  ASSERT_TRUE(lod::test::load_png(depth, by_depth));
+  const Painted lit_counts = count_painted(img), depth_counts = count_painted(by_depth);
+  std::printf("HLOD vertex colours: warm %d above / %d below, blue %d above / %d below; by depth: %d %d %d %d\n",
+              lit_counts.warm_above, lit_counts.warm_below, lit_counts.blue_above, lit_counts.blue_below,
+              depth_counts.warm_above, depth_counts.warm_below, depth_counts.blue_above, depth_counts.blue_below);
+  EXPECT_GE(lit_counts.warm_above, 1000) << "the red-to-orange north from COLOR_0";
+  EXPECT_GE(lit_counts.blue_below, 1000) << "the blue south from COLOR_0";
+  EXPECT_LE(lit_counts.warm_below + lit_counts.blue_above, 50) << "each half its own colour (the seam holds)";
+  EXPECT_LE(depth_counts.warm_above + depth_counts.blue_below, 50) << "colour-by-depth must not show the vertex colours";
+}
+
 TEST(ViewerTextured, UnreadableTextureIsNamedOnceAndTheModelStillDrawn) {
   LOD_REQUIRE_XVFB();
   const auto scene = lod::test::write_viewer_scene("textured-bad", kRun, kCamera, kInstance, kModel);

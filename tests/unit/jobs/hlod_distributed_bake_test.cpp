@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <numeric>
@@ -303,6 +304,90 @@ TEST(HlodDistributedBake, EmbeddedTextureGivesTheLocalBytesAtEveryRankCountAndFr
     EXPECT_EQ(runs[0].result.cached, runs[0].result.subtrees);
     EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << ranks << " ranks, from the cache";
   }
+}
+
+// Vertex colours and a second uv set (issue 12) with a material whose occlusion texture reads
+// TEXCOORD_1: the tree keeps both attributes and the texture, and the distributed bake writes the
+// local bake's bytes at 1, 2 and 3 ranks, and again from the cache (the cleaned mesh keeps them).
+TEST(HlodDistributedBake, ColouredModelGivesTheLocalBytesAtEveryRankCountAndFromTheCache) {
+  const auto dir = test::temp_dir("hlod_dist_coloured");
+  const auto mesh = test::write_coloured_gltf(dir, "painted", 48, 96);
+  ASSERT_FALSE(mesh.empty());
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  HlodTree tree;
+  std::vector<HlodPayload> payloads;
+  ASSERT_TRUE(decode_hlod_asset(local, "mixed.hlod", tree, payloads));
+  EXPECT_TRUE(tree.uvs && tree.uvs1 && tree.colors);
+  ASSERT_EQ(tree.materials.size(), 1u);
+  EXPECT_FALSE(tree.materials[0].occlusion_texture.empty()) << "the texture reading TEXCOORD_1 is kept";
+  EXPECT_EQ(tree.materials[0].tex_coords[3], 1);
+  EXPECT_GT(tree.nodes.size(), 8u);
+  for (const HlodPayload& p : payloads) EXPECT_EQ(p.colors.size(), p.positions.size() / 3 * 4);
+  for (int ranks : {1, 2, 3}) {
+    const auto cache = dir / ("cache" + std::to_string(ranks));
+    std::vector<RankRun> runs = run_ranks(ranks, mesh, dir / "out", cache);
+    for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << ranks << " ranks";
+    std::filesystem::remove(dir / "out" / "mixed.hlod");
+    runs = run_ranks(ranks, mesh, dir / "out", cache);
+    ASSERT_TRUE(runs[0].status) << runs[0].status.message;
+    EXPECT_TRUE(runs[0].result.mesh_cached);
+    EXPECT_EQ(runs[0].result.cached, runs[0].result.subtrees);
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << ranks << " ranks, from the cache";
+  }
+}
+
+// The cleaned mesh entry keeps colours and uv1; hostile ones are refused: a flag set with no
+// data (or cleared with data) no longer matches the size, an unknown flag and a non-finite
+// colour or uv1 are named.
+TEST(HlodMeshCache, ColouredMeshKeepsColoursAndUv1AndHostileOnesAreRefused) {
+  const auto dir = test::temp_dir("hlod_mesh_cache_coloured");
+  const MeshData m = test::coloured_sphere(8, 12);
+  ASSERT_TRUE(store_hlod_mesh(dir, 5, m, 77));
+  MeshData back;
+  uint64_t input = 0;
+  ASSERT_EQ(load_hlod_mesh(dir, 5, "painted.gltf", back, input), CacheLookup::found);
+  EXPECT_EQ(back.uvs, m.uvs);
+  EXPECT_EQ(back.uvs1, m.uvs1);
+  EXPECT_EQ(back.colors, m.colors);
+  const auto path = hlod_mesh_entry_path(dir, 5);
+  const std::vector<uint8_t> good = test::read_bytes(path);
+  EXPECT_EQ(good[12], 7) << "uvs, colours and uv1 flagged";
+  const auto refused = [&](auto&& edit, const char* expected) {
+    std::vector<uint8_t> bad = good;
+    edit(bad);
+    const uint64_t sum = hash_bytes(bad.data(), bad.size() - 8);
+    std::memcpy(bad.data() + bad.size() - 8, &sum, 8);
+    test::write_bytes(path, bad);
+    std::string why;
+    MeshData out;
+    out.source = "untouched";
+    EXPECT_EQ(load_hlod_mesh(dir, 5, "painted.gltf", out, input, &why), CacheLookup::refused) << expected;
+    EXPECT_NE(why.find(expected), std::string::npos) << why;
+    EXPECT_EQ(out.source, "untouched");
+  };
+  refused([](std::vector<uint8_t>& b) { b[12] = 5; }, "do not match");  // colours cleared, their bytes still there
+  refused([](std::vector<uint8_t>& b) { b[12] = 3; }, "do not match");  // uv1 cleared
+  refused([](std::vector<uint8_t>& b) { b[12] = 15; }, "unknown flags 15");
+  const size_t nv = m.vertex_count();
+  const size_t colours = 72 + 12 * nv + 4 * m.indices.size() + 8 * nv + 8 * nv;
+  refused([&](std::vector<uint8_t>& b) {
+    const float nan = NAN;
+    std::memcpy(b.data() + colours + 4 * 6, &nan, 4);
+  }, "a colour is not finite");
+  refused([&](std::vector<uint8_t>& b) {
+    const float inf = -INFINITY;
+    std::memcpy(b.data() + colours - 8 * nv + 4, &inf, 4);
+  }, "a TEXCOORD_1 value is not finite");
+  // Flags set, the data missing: the entry is shorter than its counts say.
+  std::vector<uint8_t> short_entry(good.begin(), good.begin() + std::ptrdiff_t(colours));
+  short_entry.insert(short_entry.end(), good.begin() + std::ptrdiff_t(colours + 16 * nv), good.end());
+  const uint64_t sum = hash_bytes(short_entry.data(), short_entry.size() - 8);
+  std::memcpy(short_entry.data() + short_entry.size() - 8, &sum, 8);
+  test::write_bytes(path, short_entry);
+  std::string why;
+  EXPECT_EQ(load_hlod_mesh(dir, 5, "painted.gltf", back, input, &why), CacheLookup::refused);
+  EXPECT_NE(why.find("do not match"), std::string::npos) << why;
 }
 
 TEST(HlodMeshCache, TexturedMeshKeepsUvsSubmeshesAndMaterials) {

@@ -127,8 +127,30 @@ Sample textured_sample() {
   return s;
 }
 
-// Both samples, for the tests every file must pass.
-std::vector<Sample> samples() { return {sample(), textured_sample()}; }
+// The textured sample with a second uv set and vertex colours (linear RGBA), and their errors.
+Sample coloured_sample() {
+  Sample s = textured_sample();
+  s.tree.uvs1 = true;
+  s.tree.colors = true;
+  for (size_t i = 0; i < s.payloads.size(); ++i) {
+    HlodPayload& p = s.payloads[i];
+    HlodNode& n = s.tree.nodes[i];
+    for (size_t v = 0; v < p.positions.size() / 3; ++v) {
+      p.uvs1.insert(p.uvs1.end(), {0.5f + 0.0625f * float(v % 3), 0.25f * float(v % 4)});
+      p.colors.insert(p.colors.end(), {0.125f * float(v % 8), 1 - 0.25f * float(v % 4), 0.5f, v % 2 ? 1.0f : 0.75f});
+    }
+    n.uvs1 = n.colors = true;
+    for (uint32_t k = 1; k < n.layer_count; ++k) {
+      n.layers[k].uv1_error = 0.015625f * float(i + k);
+      n.layers[k].color_error = 0.0625f * float(k);
+    }
+    n.resident_bytes = hlod_resident_bytes(n);
+  }
+  return s;
+}
+
+// Every sample, for the tests every file must pass.
+std::vector<Sample> samples() { return {sample(), textured_sample(), coloured_sample()}; }
 
 HlodTree sentinel() {
   HlodTree t;
@@ -143,6 +165,8 @@ void expect_same(const Sample& a, const HlodTree& t, const std::vector<HlodPaylo
   EXPECT_EQ(t.source_triangles, a.tree.source_triangles);
   EXPECT_EQ(std::memcmp(t.box_center, a.tree.box_center, sizeof t.box_center), 0);
   EXPECT_EQ(t.uvs, a.tree.uvs);
+  EXPECT_EQ(t.uvs1, a.tree.uvs1);
+  EXPECT_EQ(t.colors, a.tree.colors);
   EXPECT_EQ(t.material_count, a.tree.material_count);
   EXPECT_EQ(t.texture_base, a.tree.texture_base);
   ASSERT_EQ(t.materials.size(), a.tree.materials.size());
@@ -174,9 +198,15 @@ void expect_same(const Sample& a, const HlodTree& t, const std::vector<HlodPaylo
       EXPECT_EQ(x.layers[k].triangles, y.layers[k].triangles);
       EXPECT_EQ(x.layers[k].error, y.layers[k].error);
       EXPECT_EQ(x.layers[k].uv_error, y.layers[k].uv_error);
+      EXPECT_EQ(x.layers[k].uv1_error, y.layers[k].uv1_error);
+      EXPECT_EQ(x.layers[k].color_error, y.layers[k].color_error);
     }
+    EXPECT_EQ(x.uvs1, y.uvs1) << i;
+    EXPECT_EQ(x.colors, y.colors) << i;
     EXPECT_EQ(x.material_runs, y.material_runs) << i;
     EXPECT_EQ(p[i].uvs, a.payloads[i].uvs) << i;
+    EXPECT_EQ(p[i].uvs1, a.payloads[i].uvs1) << i;
+    EXPECT_EQ(p[i].colors, a.payloads[i].colors) << i;
     ASSERT_EQ(p[i].runs.size(), a.payloads[i].runs.size()) << i;
     for (size_t r = 0; r < p[i].runs.size(); ++r) {
       EXPECT_EQ(p[i].runs[r].level, a.payloads[i].runs[r].level);
@@ -227,6 +257,50 @@ TEST(HlodAsset, TexturedPayloadsCarryUvsAndRunsPerRange) {
   const Sample plain = sample();
   EXPECT_EQ(hlod_payload_bytes(t.nodes[0]) - hlod_payload_bytes(plain.tree.nodes[0]),
             8 * (p[0].positions.size() / 3) + 16 * p[0].runs.size());
+}
+
+TEST(HlodAsset, ColouredPayloadsCarryUv1AndColoursAndTheirErrors) {
+  const Sample s = coloured_sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  HlodTree t;
+  std::vector<HlodPayload> p;
+  const Status st = decode_hlod_asset(bytes, "tree.hlod", t, p);
+  ASSERT_TRUE(st) << st.message;
+  EXPECT_TRUE(t.uvs && t.uvs1 && t.colors);
+  uint32_t flags = 0;
+  std::memcpy(&flags, bytes.data() + 84, 4);
+  EXPECT_EQ(flags, 7u) << "uvs, colours and uv1 flagged";
+  for (size_t i = 0; i < p.size(); ++i) {
+    EXPECT_EQ(p[i].uvs1.size(), p[i].positions.size() / 3 * 2);
+    EXPECT_EQ(p[i].colors.size(), p[i].positions.size() / 3 * 4);
+    EXPECT_EQ(t.nodes[i].layers[1].color_error, 0.0625f);
+  }
+  EXPECT_EQ(p[2].colors[4 * 5 + 1], 0.75f) << "vertex 5 of node 2's first layer: 1 - 0.25 x 1";
+  // 24 bytes a vertex more than the textured payload (2 + 4 floats), 24 a record (two errors a layer).
+  const Sample textured = textured_sample();
+  EXPECT_EQ(hlod_payload_bytes(t.nodes[0]) - hlod_payload_bytes(textured.tree.nodes[0]), 24 * (p[0].positions.size() / 3));
+  EXPECT_EQ(bytes.size() - encode_hlod_asset(textured.tree, textured.payloads).size(),
+            24 * t.nodes.size() + 24 * [&] {
+              size_t v = 0;
+              for (const HlodPayload& q : p) v += q.positions.size() / 3;
+              return v;
+            }());
+  // Either attribute alone is a file too.
+  for (int which = 0; which < 2; ++which) {
+    Sample one = coloured_sample();
+    one.tree.uvs1 = which == 0, one.tree.colors = which == 1;
+    for (size_t i = 0; i < one.payloads.size(); ++i) {
+      (which == 0 ? one.payloads[i].colors : one.payloads[i].uvs1).clear();
+      one.tree.nodes[i].uvs1 = one.tree.uvs1, one.tree.nodes[i].colors = one.tree.colors;
+      for (HlodLayerInfo& l : one.tree.nodes[i].layers) (which == 0 ? l.color_error : l.uv1_error) = 0;
+      one.tree.nodes[i].resident_bytes = hlod_resident_bytes(one.tree.nodes[i]);
+    }
+    HlodTree u;
+    std::vector<HlodPayload> q;
+    const Status got = decode_hlod_asset(encode_hlod_asset(one.tree, one.payloads), "one.hlod", u, q);
+    ASSERT_TRUE(got) << got.message;
+    expect_same(one, u, q);
+  }
 }
 
 TEST(HlodAsset, HeadAndPayloadsInPiecesAreTheWholeFile) {
@@ -376,6 +450,10 @@ TEST(HlodAsset, ValidatesEveryFlippedByteUnderAForgedChecksum) {
           for (uint32_t k = 0; k < r.index_count; ++k) ASSERT_LT(p[i].indices[r.first_index + k], r.vertex_count);
         for (float v : p[i].positions) ASSERT_TRUE(std::isfinite(v));
         for (float v : p[i].uvs) ASSERT_TRUE(std::isfinite(v));
+        for (float v : p[i].uvs1) ASSERT_TRUE(std::isfinite(v));
+        for (float v : p[i].colors) ASSERT_TRUE(std::isfinite(v));
+        ASSERT_EQ(p[i].uvs1.size(), t.uvs1 ? p[i].positions.size() / 3 * 2 : 0);
+        ASSERT_EQ(p[i].colors.size(), t.colors ? p[i].positions.size() / 3 * 4 : 0);
         for (const LevelSubmesh& r : p[i].runs) ASSERT_LT(r.material, int32_t(t.material_count));
         ASSERT_EQ(p[i].uvs.size(), t.uvs ? p[i].positions.size() / 3 * 2 : 0);
       }
@@ -539,6 +617,105 @@ TEST(HlodAsset, RefusesHostileEmbeddedImagesNamingThem) {
   EXPECT_EQ(t.name, "untouched");
 }
 
+// Version 3 only adds flags: a version 2 file (no colour or uv1 flag) reads as it did, and one
+// claiming the new flags is refused.
+TEST(HlodAsset, ReadsVersionTwoFilesAndRefusesTheNewFlagsInThem) {
+  for (const Sample& s : {sample(), textured_sample()}) {
+    std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+    const Layout l = layout_of(bytes);
+    bytes[8] = 2;
+    forge_checksum(bytes, l, 8);
+    HlodTree t;
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(bytes, "v2.hlod", t, p);
+    ASSERT_TRUE(st) << st.message;
+    expect_same(s, t, p);
+  }
+  const Sample c = coloured_sample();
+  std::vector<uint8_t> bytes = encode_hlod_asset(c.tree, c.payloads);
+  const Layout l = layout_of(bytes);
+  bytes[8] = 2;
+  forge_checksum(bytes, l, 8);
+  HlodTree t = sentinel();
+  std::vector<HlodPayload> p;
+  const Status st = decode_hlod_asset(bytes, "v2.hlod", t, p);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(t.name, "untouched");
+}
+
+// Hostile colour and uv1 fields: a flag set without its data (or data without its flag), a
+// non-finite colour or uv1, an error that is not a distance or set beyond the layer count.
+TEST(HlodAsset, RefusesHostileColoursAndUv1NamingThem) {
+  const Sample s = coloured_sample();
+  const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
+  const Layout l = layout_of(bytes);
+  auto refuse = [&](auto&& edit, const char* expected) {
+    std::vector<uint8_t> bad = bytes;
+    const uint64_t at = edit(bad);
+    forge_checksum(bad, l, at);
+    HlodTree t = sentinel();
+    std::vector<HlodPayload> p;
+    const Status st = decode_hlod_asset(bad, "tree.hlod", t, p);
+    ASSERT_FALSE(st) << expected;
+    EXPECT_NE(st.message.find(expected), std::string::npos) << st.message;
+    EXPECT_EQ(t.name, "untouched");
+  };
+  // Node 0's layer 0 has 8 vertices: positions, normals (2 x 96 bytes), uvs (64), uv1 (64), colours (128).
+  const uint64_t layer0 = l.payloads[0].first;
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t at = layer0 + 2 * 96 + 64 + 4 * 3;
+    const float inf = INFINITY;
+    std::memcpy(b.data() + at, &inf, 4);
+    return at;
+  }, "vertex 1 has a non-finite uv1");
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t at = layer0 + 2 * 96 + 64 + 64 + 4 * 6;
+    const float nan = NAN;
+    std::memcpy(b.data() + at, &nan, 4);
+    return at;
+  }, "vertex 1 has a non-finite colour");
+  refuse([&](std::vector<uint8_t>& b) {
+    const uint64_t at = layer0 + 2 * 96 + 64 + 64 + 4 * 9;
+    const float huge = 1e30f;
+    std::memcpy(b.data() + at, &huge, 4);
+    return at;
+  }, "vertex 2 has a non-finite colour");
+  // The records grow by 24 bytes (3 uv1 errors, then 3 colour errors) after the 80 of version 2.
+  const uint64_t records = l.head - 16 * l.payloads.size() - 104 * l.payloads.size();
+  refuse([&](std::vector<uint8_t>& b) {
+    const float nan = NAN;
+    std::memcpy(b.data() + records + 104 * 1 + 80 + 4, &nan, 4);
+    return records;
+  }, "layer 1 uv1 error is not a finite distance");
+  refuse([&](std::vector<uint8_t>& b) {
+    const float negative = -0.5f;
+    std::memcpy(b.data() + records + 104 * 0 + 92 + 4, &negative, 4);
+    return records;
+  }, "layer 1 colour error is not a finite distance");
+  refuse([&](std::vector<uint8_t>& b) {  // node 1 has two layers: its third colour error must be 0
+    const float set = 0.5f;
+    std::memcpy(b.data() + records + 104 * 1 + 92 + 8, &set, 4);
+    return records;
+  }, "set beyond the layer count");
+  // A flag cleared (its data and errors still there) or set anew: the head no longer matches its
+  // counts, so the payloads are never read with the wrong stride.
+  for (uint32_t flags : {5u, 3u, 1u, 15u})
+    refuse([&](std::vector<uint8_t>& b) {
+      std::memcpy(b.data() + 84, &flags, 4);
+      return uint64_t{84};
+    }, flags == 15 ? "flags" : "does not match its counts");
+  // Flags set with no data in the payloads: a writer that says colours and gives none makes
+  // payloads shorter than the records promise.
+  Sample empty = coloured_sample();
+  for (HlodPayload& p : empty.payloads) p.colors.clear();
+  HlodTree t = sentinel();
+  std::vector<HlodPayload> p;
+  const Status st = decode_hlod_asset(encode_hlod_asset(empty.tree, empty.payloads), "tree.hlod", t, p);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("should be"), std::string::npos) << st.message;
+  EXPECT_EQ(t.name, "untouched");
+}
+
 TEST(HlodAsset, RefusesVersionOneAskingForARebake) {
   const Sample s = sample();
   std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
@@ -589,11 +766,12 @@ namespace {
 TEST(HlodAsset, TheFuzzSeedsAreCurrent) {
   const std::filesystem::path dir = std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/hlod";
   if (std::getenv("LOD_WRITE_FUZZ_SEEDS")) {
-    const Sample plain = sample(), textured = textured_sample();
+    const Sample plain = sample(), textured = textured_sample(), coloured = coloured_sample();
     test::write_bytes(dir / "hs0.hlod", encode_hlod_asset(plain.tree, plain.payloads));
     test::write_bytes(dir / "hs1.hlod", encode_hlod_asset(textured.tree, textured.payloads));
+    test::write_bytes(dir / "hs2.hlod", encode_hlod_asset(coloured.tree, coloured.payloads));
   }
-  size_t seeds = 0, with_materials = 0;
+  size_t seeds = 0, with_materials = 0, with_colours = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir)) {
     HlodTree t;
     std::vector<HlodPayload> p;
@@ -601,8 +779,10 @@ TEST(HlodAsset, TheFuzzSeedsAreCurrent) {
     EXPECT_TRUE(st) << st.message;
     ++seeds;
     with_materials += !t.materials.empty();
+    with_colours += t.colors && t.uvs1;
   }
-  EXPECT_GE(seeds, 2u);
+  EXPECT_GE(seeds, 3u);
+  EXPECT_GE(with_colours, 1u) << "a seed with colours and a second uv set";
   EXPECT_GE(with_materials, 1u) << "a seed with uvs, materials and runs";
 }
 

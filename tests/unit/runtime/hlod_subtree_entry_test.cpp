@@ -178,7 +178,8 @@ TEST(HlodSubtreeEntry, RefusesForgedCountsUnderARecomputedChecksum) {
   EXPECT_FALSE(decode(forge(44, 0x40000000u), t)) << "huge reference count";
   EXPECT_FALSE(decode(forge(48, 1), t)) << "asset size";
   EXPECT_FALSE(decode(forge(8, 1), t)) << "version 1 (before uvs and materials)";
-  EXPECT_FALSE(decode(forge(8, 3), t)) << "version 3";
+  EXPECT_FALSE(decode(forge(8, 2), t)) << "version 2 (before colours and uv1)";
+  EXPECT_FALSE(decode(forge(8, 4), t)) << "version 4";
   EXPECT_TRUE(decode(forge(12, 3), t)) << "the forger itself";
 }
 
@@ -278,6 +279,49 @@ HlodSubtree textured() {
   return s;
 }
 
+// The textured subtree with a second uv set and vertex colours (issue 12).
+HlodSubtree coloured() {
+  HlodSubtree s = textured();
+  for (size_t i = 0; i < s.nodes.size(); ++i) {
+    HlodPayload& p = s.payloads[i];
+    for (size_t v = 0; v < p.positions.size() / 3; ++v) {
+      p.uvs1.insert(p.uvs1.end(), {0.75f, 0.125f * float(v % 8)});
+      p.colors.insert(p.colors.end(), {0.25f * float(v % 4), 0.5f, 1, 1});
+    }
+    s.nodes[i].uvs1 = s.nodes[i].colors = true;
+    if (s.nodes[i].layer_count > 1) s.nodes[i].layers[1].color_error = 0.125f, s.nodes[i].layers[1].uv1_error = 0.0625f;
+    s.nodes[i].resident_bytes = hlod_resident_bytes(s.nodes[i]);
+  }
+  return s;
+}
+
+TEST(HlodSubtreeEntry, ColouredSubtreeRoundTripsAndItsRootAlone) {
+  const HlodSubtree s = coloured();
+  const std::vector<uint8_t> bytes = encode_hlod_subtree(s, kKey);
+  HlodSubtree t, root;
+  ASSERT_TRUE(decode(bytes, t));
+  for (size_t i = 0; i < t.nodes.size(); ++i) {
+    EXPECT_TRUE(t.nodes[i].uvs1 && t.nodes[i].colors);
+    EXPECT_EQ(t.payloads[i].uvs1, s.payloads[i].uvs1);
+    EXPECT_EQ(t.payloads[i].colors, s.payloads[i].colors);
+    EXPECT_EQ(t.nodes[i].layers[1].color_error, s.nodes[i].layers[1].color_error);
+    EXPECT_EQ(t.nodes[i].resident_bytes, s.nodes[i].resident_bytes);
+  }
+  ASSERT_TRUE(decode_root(bytes, root));
+  EXPECT_EQ(root.payloads[0].colors, s.payloads[0].colors);
+  EXPECT_EQ(root.payloads[0].uvs1, s.payloads[0].uvs1);
+  for (size_t len = 0; len < bytes.size(); len += 5) {
+    const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + std::ptrdiff_t(len));
+    ASSERT_FALSE(decode(cut, t)) << len;
+  }
+  // A colour flag set with no colours in the payloads: the entry's asset is refused.
+  HlodSubtree empty = coloured();
+  for (HlodPayload& p : empty.payloads) p.colors.clear();
+  const Status st = decode(encode_hlod_subtree(empty, kKey), t);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message.find("should be"), std::string::npos) << st.message;
+}
+
 TEST(HlodSubtreeEntry, TexturedSubtreeRoundTripsAndItsRootAlone) {
   const HlodSubtree s = textured();
   const std::vector<uint8_t> bytes = encode_hlod_subtree(s, kKey);
@@ -320,6 +364,7 @@ TEST(HlodSubtreeEntry, TheFuzzSeedsAreCurrent) {
   if (std::getenv("LOD_WRITE_FUZZ_SEEDS")) {
     test::write_bytes(dir / "e0.hsub", encode_hlod_subtree(sample(), kKey));
     test::write_bytes(dir / "e1.hsub", encode_hlod_subtree(textured(), kKey));
+    test::write_bytes(dir / "e2.hsub", encode_hlod_subtree(coloured(), kKey));
   }
   size_t seeds = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir)) {
@@ -328,7 +373,7 @@ TEST(HlodSubtreeEntry, TheFuzzSeedsAreCurrent) {
     EXPECT_TRUE(st) << st.message;
     ++seeds;
   }
-  EXPECT_GE(seeds, 2u);
+  EXPECT_GE(seeds, 3u);
 }
 
 }  // namespace
