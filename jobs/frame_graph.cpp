@@ -235,6 +235,8 @@ struct FrameGraph::Impl {
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
     std::vector<float> shown_uv;  // geomorphed uvs, 2 per node (trees with uvs)
+    // Likewise the tree's second uvs, colours and authored normals (2, 4, 3 per node), when it has them.
+    std::vector<float> shown_uv1, shown_color, shown_normal;
     std::vector<uint32_t> sorted, slot_count;  // material grouping scratch
     std::vector<VdRunFrame> runs;              // this frame's runs (absolute first_index)
     FrontStats stats;          // summed over the regions
@@ -883,6 +885,9 @@ struct FrameGraph::Impl {
     vertex_morph_init(p->morph, tree, options.geomorph_seconds);
     p->shown = tree.positions;
     p->shown_uv = tree.uvs;
+    p->shown_uv1 = tree.uvs1;
+    p->shown_color = tree.colors;
+    p->shown_normal = tree.normals;
     return *p;
   }
 
@@ -940,7 +945,7 @@ struct FrameGraph::Impl {
     Frame& f = *out;
     f.vd_objects.resize(vd_visible.size());
     uint32_t vertices = 0, indices = 0;
-    bool any_uvs = false;
+    bool any_uvs = false, any_uvs1 = false, any_colors = false;
     f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;
     for (size_t j = 0; j < vd_visible.size(); ++j) {
       const VdObject& o = *vd_visible[j];
@@ -960,8 +965,14 @@ struct FrameGraph::Impl {
       e.threshold = o.stats.threshold;
       e.closed = vm.edges == EdgeCheck::closed;
       e.oriented = vm.edges != EdgeCheck::corners;
-      e.has_uvs = !set->chains[o.model]->hierarchy.uvs.empty();
+      const VertexTree& tree = set->chains[o.model]->hierarchy;
+      e.has_uvs = !tree.uvs.empty();
+      e.has_uvs1 = !tree.uvs1.empty();
+      e.has_colors = !tree.colors.empty();
+      e.has_authored_normals = !tree.normals.empty();
       any_uvs |= e.has_uvs;
+      any_uvs1 |= e.has_uvs1;
+      any_colors |= e.has_colors;
       vertices += e.vertex_count;
       indices += e.index_count;
       f.vd_active_tris += tris;
@@ -971,6 +982,8 @@ struct FrameGraph::Impl {
     f.vd_positions.resize(3 * size_t(vertices));
     f.vd_indices.resize(indices);
     f.vd_uvs.assign(any_uvs ? 2 * size_t(vertices) : 0, 0.f);
+    f.vd_uvs1.assign(any_uvs1 ? 2 * size_t(vertices) : 0, 0.f);
+    f.vd_colors.assign(any_colors ? 4 * size_t(vertices) : 0, 1.f);
     f.vd_normals.resize(3 * size_t(vertices));
     for_items(Stage::vd_mesh, vd_visible.size(), [&](size_t j) {
       VdObject& o = *vd_visible[j];
@@ -982,6 +995,9 @@ struct FrameGraph::Impl {
       for (const VertexFront& fr : o.fronts) {
         e.moving += static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, fr.vertices(), time));
         if (e.has_uvs) vertex_morph_uvs(o.shown_uv, o.morph, fr.vertices(), time);
+        if (e.has_uvs1) vertex_morph_column(o.shown_uv1, o.morph, o.morph.uv1, fr.vertices(), time);
+        if (e.has_colors) vertex_morph_column(o.shown_color, o.morph, o.morph.color, fr.vertices(), time);
+        if (e.has_authored_normals) vertex_morph_column(o.shown_normal, o.morph, o.morph.normal, fr.vertices(), time);
       }
       const std::span uvs = e.has_uvs ? std::span(f.vd_uvs.data() + 2 * size_t(e.first_vertex), 2 * size_t(e.vertex_count))
                                       : std::span<float>();
@@ -997,8 +1013,22 @@ struct FrameGraph::Impl {
         assert(written == e.vertex_count);
         if (e.has_uvs) fronts_compact_uvs(uvs, std::span(fronts, o.fronts.size()), tree, o.shown_uv);
       }
-      area_weighted_normals(std::span(f.vd_normals.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
-                            positions, tris);
+      // The other per-node columns, in the compact meshes' vertex order.
+      auto compact = [&](std::vector<float>& frame_column, size_t width, const std::vector<float>& shown) {
+        const std::span out(frame_column.data() + width * size_t(e.first_vertex), width * size_t(e.vertex_count));
+        if (o.fronts.size() == 1)
+          front_compact_column(out, width, o.fronts[0], shown);
+        else
+          fronts_compact_column(out, width, std::span(fronts, o.fronts.size()), shown);
+        return out;
+      };
+      if (e.has_uvs1) compact(f.vd_uvs1, 2, o.shown_uv1);
+      if (e.has_colors) compact(f.vd_colors, 4, o.shown_color);
+      if (e.has_authored_normals)
+        renormalise(compact(f.vd_normals, 3, o.shown_normal));
+      else
+        area_weighted_normals(std::span(f.vd_normals.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
+                              positions, tris);
       group_by_material(o, tris, std::span(fronts, o.fronts.size()), vd_models[o.model], e.first_index);
     });
     // Runs into the frame, object by object.

@@ -26,6 +26,14 @@ void geomorph_lerp(std::span<float> out, std::span<const float> from, std::span<
 // 1 when duration <= 0.
 float morph_factor(double now, double start, float duration);
 
+// One more per-node attribute travelling with the positions (width floats per node; empty when
+// the tree has none of it).
+struct MorphColumn {
+  std::vector<float> from, to;
+  uint32_t width = 0;
+  bool empty() const { return to.empty(); }
+};
+
 struct VertexMorph {
   std::vector<float> from;    // xyz per node
   std::vector<float> to;      // xyz per node
@@ -33,6 +41,9 @@ struct VertexMorph {
   // same factor, so a split child's texture coordinate starts at its parent's shown one.
   std::vector<float> from_uv;
   std::vector<float> to_uv;
+  // Likewise VertexTree::uvs1, colors and normals, when the tree has them (normals blend
+  // linearly here; whoever publishes them renormalises).
+  MorphColumn uv1, color, normal;
   std::vector<double> start;  // per node, seconds
   float duration = 0.25f;     // seconds
 };
@@ -56,6 +67,10 @@ size_t vertex_morph_positions(std::span<float> out, const VertexMorph& morph, st
 // Displayed uvs of `nodes` at `now` into out (uv per node id, sized for every node), by the
 // factor their positions use. The tree must have uvs. Sub-ranges give the same result.
 void vertex_morph_uvs(std::span<float> out, const VertexMorph& morph, std::span<const uint32_t> nodes, double now);
+// The same for one of morph's columns (uv1, color, normal; must not be empty): column.width
+// floats per node id.
+void vertex_morph_column(std::span<float> out, const VertexMorph& morph, const MorphColumn& column,
+                         std::span<const uint32_t> nodes, double now);
 
 // ---- discrete levels --------------------------------------------------------------------------
 

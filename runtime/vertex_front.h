@@ -250,6 +250,13 @@ uint32_t front_compact_uvs(std::span<float> uvs, const VertexFront& front, const
                            std::span<const float> shown_uvs);
 uint32_t fronts_compact_uvs(std::span<float> uvs, std::span<const VertexFront* const> fronts, const VertexTree& tree,
                             std::span<const float> shown_uvs);
+// The same for any per-node column of `width` floats (VertexTree::uvs1, colors, normals, or
+// their geomorphed copies): `per_node` holds width floats per node id, `out` width per written
+// vertex. Return the vertices written.
+uint32_t front_compact_column(std::span<float> out, size_t width, const VertexFront& front,
+                              std::span<const float> per_node);
+uint32_t fronts_compact_column(std::span<float> out, size_t width, std::span<const VertexFront* const> fronts,
+                               std::span<const float> per_node);
 
 // Checks a plain indexed triangle list: indices < vertex_count, no repeated corner; from
 // `oriented` on each directed edge at most once; with `closed` every edge also used the other

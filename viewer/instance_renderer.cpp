@@ -27,6 +27,7 @@ layout(location = 5) in vec3 a_target_position;
 layout(location = 6) in vec3 a_target_normal;
 layout(location = 7) in vec2 a_uv;
 layout(location = 8) in vec2 a_target_uv;
+layout(location = 9) in vec4 a_colour;  // vertex colour (glTF COLOR_0), white when a mesh has none
 uniform mat4 u_view;
 uniform mat4 u_projection;
 uniform int u_blend;
@@ -34,6 +35,7 @@ out vec3 v_position_view;
 out vec3 v_normal_view;
 out float v_morph;
 out vec2 v_uv;
+out vec4 v_colour;
 // q v q* for a unit quaternion, without building a matrix.
 vec3 rotate(vec4 q, vec3 v) {
   vec3 t = 2.0 * cross(q.xyz, v);
@@ -50,6 +52,7 @@ void main() {
   v_normal_view = mat3(u_view) * rotate(q, n);
   v_morph = i_morph_weight.x;
   v_uv = u_blend != 0 ? mix(a_uv, a_target_uv, w) : a_uv;
+  v_colour = a_colour;
   gl_Position = u_projection * view_pos;
 }
 )";
@@ -59,6 +62,7 @@ in vec3 v_position_view;
 in vec3 v_normal_view;
 in float v_morph;
 in vec2 v_uv;
+in vec4 v_colour;
 uniform vec3 u_colour;        // a material's base colour factor (rgb) or the mode's colour
 uniform float u_alpha;        // the factor's alpha
 uniform float u_alpha_cutoff; // alpha mode MASK: fragments below are dropped; < 0 otherwise
@@ -138,7 +142,7 @@ void main() {
   vec3 n = (u_flat != 0 || dot(v_normal_view, v_normal_view) < 1e-12) ? face : normalize(v_normal_view);
   if (u_normal_mapped != 0 && u_flat == 0) n = mapped_normal(n, normal_texel);
   vec3 to_eye = normalize(-v_position_view);
-  vec4 surface = vec4(u_colour, u_alpha);
+  vec4 surface = vec4(u_colour, u_alpha) * v_colour;  // glTF: COLOR_0 multiplies the base colour
   if (u_textured != 0) surface *= base_texel;
   if (surface.a < u_alpha_cutoff) discard;
   if (u_pbr != 0) {
@@ -341,6 +345,7 @@ void InstanceRenderer::bind_vd_meshes(const VdMeshBuffers& vd, const std::array<
   glBindVertexArray(vd.vao());
   glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);
   glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  glVertexAttrib4f(kAttribColor, 1.f, 1.f, 1.f, 1.f);
   set_plain_surface(colour);
 }
 
@@ -385,6 +390,7 @@ DrawStats InstanceRenderer::draw(const DrawList& list, const MeshBuffers& meshes
   glUniform1i(u_flat_, settings.flat_normals ? 1 : 0);
   glUniform1i(u_show_morph_, settings.colour_by_level ? 1 : 0);
   glUniform1i(u_blend_, 0);
+  glVertexAttrib4f(kAttribColor, 1.f, 1.f, 1.f, 1.f);  // level meshes carry no colour stream: white
   const glm::vec3 sun = glm::normalize(glm::mat3(view) * glm::normalize(kSunDirection));
   const glm::vec3 up = glm::normalize(glm::mat3(view) * glm::vec3(0, 1, 0));
   glUniform3f(u_sun_view_, sun.x, sun.y, sun.z);
@@ -533,6 +539,7 @@ void InstanceRenderer::begin_mesh_draws(const glm::mat4& view, const glm::mat4& 
   glPolygonMode(GL_FRONT_AND_BACK, settings.wireframe ? GL_LINE : GL_FILL);
   glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // meshes without normals: face normals
   glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  glVertexAttrib4f(kAttribColor, 1.f, 1.f, 1.f, 1.f);  // meshes without colours: white
   set_plain_surface(kModelColour);
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
 }
