@@ -324,5 +324,19 @@ TEST(VertexHierarchyAttributesAsset, TruncatedOrForgedColumnsAreRefusedNamingThe
   refused(encode_lod_asset(bare), "the levels have none (COL0)");
 }
 
+// The fuzz seed for layout 2 (tests/fuzz/corpus/lod/vd2.lod: a small coloured sphere with
+// TEXCOORD_1 and authored normals) reads with every column.
+TEST(VertexHierarchyAttributesAsset, TheLayoutTwoFuzzSeedReads) {
+  LodChain c;
+  const Status s = read_lod_asset(std::filesystem::path(LOD_SOURCE_DIR) / "tests/fuzz/corpus/lod/vd2.lod", c);
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_TRUE(c.authored_normals);
+  const size_t n = c.hierarchy.node_count();
+  EXPECT_GT(n, c.hierarchy.leaf_count);
+  EXPECT_EQ(c.hierarchy.uvs1.size(), 2 * n);
+  EXPECT_EQ(c.hierarchy.colors.size(), 4 * n);
+  EXPECT_EQ(c.hierarchy.normals.size(), 3 * n);
+}
+
 }  // namespace
 }  // namespace lod
