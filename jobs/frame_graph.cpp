@@ -235,8 +235,7 @@ struct FrameGraph::Impl {
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
     std::vector<float> shown_uv;  // geomorphed uvs, 2 per node (trees with uvs)
-    // Likewise the tree's second uvs, colours and authored normals (2, 4, 3 per node), when it has them.
-    std::vector<float> shown_uv1, shown_color, shown_normal;
+    std::vector<uint32_t> compact_nodes;  // several regions: the compact meshes' vertex order
     std::vector<uint32_t> sorted, slot_count;  // material grouping scratch
     std::vector<VdRunFrame> runs;              // this frame's runs (absolute first_index)
     FrontStats stats;          // summed over the regions
@@ -885,9 +884,6 @@ struct FrameGraph::Impl {
     vertex_morph_init(p->morph, tree, options.geomorph_seconds);
     p->shown = tree.positions;
     p->shown_uv = tree.uvs;
-    p->shown_uv1 = tree.uvs1;
-    p->shown_color = tree.colors;
-    p->shown_normal = tree.normals;
     return *p;
   }
 
@@ -995,9 +991,6 @@ struct FrameGraph::Impl {
       for (const VertexFront& fr : o.fronts) {
         e.moving += static_cast<uint32_t>(vertex_morph_positions(o.shown, o.morph, fr.vertices(), time));
         if (e.has_uvs) vertex_morph_uvs(o.shown_uv, o.morph, fr.vertices(), time);
-        if (e.has_uvs1) vertex_morph_column(o.shown_uv1, o.morph, o.morph.uv1, fr.vertices(), time);
-        if (e.has_colors) vertex_morph_column(o.shown_color, o.morph, o.morph.color, fr.vertices(), time);
-        if (e.has_authored_normals) vertex_morph_column(o.shown_normal, o.morph, o.morph.normal, fr.vertices(), time);
       }
       const std::span uvs = e.has_uvs ? std::span(f.vd_uvs.data() + 2 * size_t(e.first_vertex), 2 * size_t(e.vertex_count))
                                       : std::span<float>();
@@ -1013,22 +1006,29 @@ struct FrameGraph::Impl {
         assert(written == e.vertex_count);
         if (e.has_uvs) fronts_compact_uvs(uvs, std::span(fronts, o.fronts.size()), tree, o.shown_uv);
       }
-      // The other per-node columns, in the compact meshes' vertex order.
-      auto compact = [&](std::vector<float>& frame_column, size_t width, const std::vector<float>& shown) {
-        const std::span out(frame_column.data() + width * size_t(e.first_vertex), width * size_t(e.vertex_count));
-        if (o.fronts.size() == 1)
-          front_compact_column(out, width, o.fronts[0], shown);
-        else
-          fronts_compact_column(out, width, std::span(fronts, o.fronts.size()), shown);
-        return out;
-      };
-      if (e.has_uvs1) compact(f.vd_uvs1, 2, o.shown_uv1);
-      if (e.has_colors) compact(f.vd_colors, 4, o.shown_color);
+      // Second uvs, colours and authored normals geomorphed straight into the frame, in the
+      // compact meshes' vertex order (one pass, no per-node copy to compact afterwards).
+      const std::span normals(f.vd_normals.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count));
+      MorphOutput extra[3];
+      size_t extras = 0;
+      if (e.has_uvs1)
+        extra[extras++] = {&o.morph.uv1, std::span(f.vd_uvs1.data() + 2 * size_t(e.first_vertex), 2 * size_t(e.vertex_count))};
+      if (e.has_colors)
+        extra[extras++] = {&o.morph.color, std::span(f.vd_colors.data() + 4 * size_t(e.first_vertex), 4 * size_t(e.vertex_count))};
+      if (e.has_authored_normals) extra[extras++] = {&o.morph.normal, normals};
+      if (extras) {
+        std::span<const uint32_t> order = o.fronts[0].vertices();
+        if (o.fronts.size() > 1) {
+          o.compact_nodes.resize(e.vertex_count);
+          fronts_compact_nodes(o.compact_nodes, std::span(fronts, o.fronts.size()));
+          order = o.compact_nodes;
+        }
+        vertex_morph_compact(std::span(extra, extras), o.morph, order, time);
+      }
       if (e.has_authored_normals)
-        renormalise(compact(f.vd_normals, 3, o.shown_normal));
+        renormalise(normals);
       else
-        area_weighted_normals(std::span(f.vd_normals.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
-                              positions, tris);
+        area_weighted_normals(normals, positions, tris);
       group_by_material(o, tris, std::span(fronts, o.fronts.size()), vd_models[o.model], e.first_index);
     });
     // Runs into the frame, object by object.

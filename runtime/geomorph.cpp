@@ -33,7 +33,13 @@ void vertex_morph_init(VertexMorph& m, const VertexTree& t, float duration) {
   m.from_uv = t.uvs;
   m.to_uv = t.uvs;
   auto init = [](MorphColumn& c, const std::vector<float>& values, uint32_t width) {
-    c.from = values, c.to = values, c.width = values.empty() ? 0 : width;
+    const size_t nodes = values.size() / width;
+    c.width = values.empty() ? 0 : width;
+    c.ends.resize(2 * values.size());
+    for (size_t v = 0; v < nodes; ++v) {
+      std::copy_n(&values[width * v], width, &c.ends[2 * width * v]);
+      std::copy_n(&values[width * v], width, &c.ends[2 * width * v + width]);
+    }
   };
   init(m.uv1, t.uvs1, 2);
   init(m.color, t.colors, 4);
@@ -56,10 +62,10 @@ void vertex_morph_uv(const VertexMorph& m, uint32_t v, double now, float out[2])
 }
 
 // Displayed value of one node's column at `now`.
-void vertex_morph_value(const VertexMorph& m, const MorphColumn& c, uint32_t v, double now, float* out) {
-  const float t = morph_factor(now, m.start[v], m.duration);
+void vertex_morph_value(const MorphColumn& c, uint32_t v, float t, float* out) {
   const size_t w = c.width;
-  for (size_t k = 0; k < w; ++k) out[k] = blend(c.from[w * v + k], c.to[w * v + k], t);
+  const float* e = &c.ends[2 * w * v];
+  for (size_t k = 0; k < w; ++k) out[k] = blend(e[k], e[w + k], t);
 }
 
 }  // namespace
@@ -79,9 +85,10 @@ void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const Fro
       MorphColumn& col = *extra[c];
       if (col.empty()) continue;
       float value[4];
-      vertex_morph_value(m, col, shown, now, value);
+      vertex_morph_value(col, shown, morph_factor(now, m.start[shown], m.duration), value);
       const size_t w = col.width;
-      for (size_t k = 0; k < w; ++k) col.from[w * v + k] = value[k], col.to[w * v + k] = (*extra_tree[c])[w * target + k];
+      float* e = &col.ends[2 * w * v];
+      for (size_t k = 0; k < w; ++k) e[k] = value[k], e[w + k] = (*extra_tree[c])[w * target + k];
     }
     for (int k = 0; k < 3; ++k) m.from[3 * size_t(v) + k] = here[k], m.to[3 * size_t(v) + k] = t.positions[3 * size_t(target) + k];
     if (uvs)
@@ -110,7 +117,8 @@ void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const Fro
         for (int c = 0; extras && c < 3; ++c) {
           MorphColumn& col = *extra[c];
           const size_t w = col.width;
-          for (size_t k = 0; k < w; ++k) col.from[w * e.node + k] = col.to[w * e.node + k] = (*extra_tree[c])[w * e.node + k];
+          float* ends = col.ends.data() + 2 * w * e.node;
+          for (size_t k = 0; k < w; ++k) ends[k] = ends[w + k] = (*extra_tree[c])[w * e.node + k];
         }
         m.start[e.node] = -std::numeric_limits<double>::infinity();
         break;
@@ -136,7 +144,25 @@ void vertex_morph_column(std::span<float> out, const VertexMorph& m, const Morph
   assert(!c.empty());
   for (uint32_t v : nodes) {
     assert(c.width * size_t(v) + c.width <= out.size());
-    vertex_morph_value(m, c, v, now, &out[c.width * size_t(v)]);
+    vertex_morph_value(c, v, morph_factor(now, m.start[v], m.duration), &out[c.width * size_t(v)]);
+  }
+}
+
+void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorph& m, std::span<const uint32_t> nodes,
+                          double now) {
+  for (const MorphOutput& o : outputs) assert(!o.column->empty() && o.out.size() >= o.column->width * nodes.size());
+  // Nodes are scattered over the tree's arrays: ask for a later node's lines ahead (the loop is
+  // bound by those misses, not by its arithmetic).
+  constexpr size_t kAhead = 16;
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    if (k + kAhead < nodes.size()) {
+      const uint32_t w = nodes[k + kAhead];
+      __builtin_prefetch(&m.start[w]);
+      for (const MorphOutput& o : outputs) __builtin_prefetch(&o.column->ends[2 * size_t(o.column->width) * w]);
+    }
+    const uint32_t v = nodes[k];
+    const float t = morph_factor(now, m.start[v], m.duration);
+    for (const MorphOutput& o : outputs) vertex_morph_value(*o.column, v, t, &o.out[o.column->width * k]);
   }
 }
 

@@ -26,12 +26,13 @@ void geomorph_lerp(std::span<float> out, std::span<const float> from, std::span<
 // 1 when duration <= 0.
 float morph_factor(double now, double start, float duration);
 
-// One more per-node attribute travelling with the positions (width floats per node; empty when
-// the tree has none of it).
+// One more per-node attribute travelling with the positions (empty when the tree has none of
+// it): per node its `width` start values, then its `width` end values, side by side so that a
+// node's morph is one cache line.
 struct MorphColumn {
-  std::vector<float> from, to;
+  std::vector<float> ends;
   uint32_t width = 0;
-  bool empty() const { return to.empty(); }
+  bool empty() const { return ends.empty(); }
 };
 
 struct VertexMorph {
@@ -71,6 +72,17 @@ void vertex_morph_uvs(std::span<float> out, const VertexMorph& morph, std::span<
 // floats per node id.
 void vertex_morph_column(std::span<float> out, const VertexMorph& morph, const MorphColumn& column,
                          std::span<const uint32_t> nodes, double now);
+
+// Displayed values of several columns for `nodes` at `now`, written compactly in the order of
+// `nodes` (out holds column->width floats per node): what a frame publishes, without a per-node
+// copy to compact afterwards. The factor is computed once per node. Sub-ranges give the same
+// result.
+struct MorphOutput {
+  const MorphColumn* column = nullptr;
+  std::span<float> out;
+};
+void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorph& morph,
+                          std::span<const uint32_t> nodes, double now);
 
 // ---- discrete levels --------------------------------------------------------------------------
 

@@ -1200,6 +1200,20 @@ uint32_t front_compact_column(std::span<float> out, size_t width, const VertexFr
   return f.active_count;
 }
 
+uint32_t fronts_compact_nodes(std::span<uint32_t> nodes, std::span<const VertexFront* const> fronts) {
+  uint32_t nv = 0;
+  for (size_t r = 0; r < fronts.size(); ++r) {
+    const VertexFront& f = *fronts[r];
+    for (uint32_t k = 0; k < f.active_count; ++k) {
+      const uint32_t v = f.active[k];
+      if (r > 0 && f.numbering && f.numbering->region[v] == kSharedRegion) continue;
+      assert(nv < nodes.size());
+      nodes[nv++] = v;
+    }
+  }
+  return nv;
+}
+
 uint32_t fronts_compact_column(std::span<float> out, size_t width, std::span<const VertexFront* const> fronts,
                                std::span<const float> per_node) {
   uint32_t nv = 0;

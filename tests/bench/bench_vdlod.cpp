@@ -19,8 +19,8 @@
 //   BM_CompactMeshNormals  the same plus the smooth normals the frame now carries
 //                          (runtime/vertex_normals.h); the ratio is the stage's cost of normals
 //   BM_CompactMeshAttributes  the same copy plus what a tree with TEXCOORD_1, colours and
-//                          authored normals adds: each geomorphed for the active vertices,
-//                          compacted, the normals renormalised (instead of computed from faces);
+//                          authored normals adds: each geomorphed straight into the frame's
+//                          arrays, the normals renormalised (instead of computed from faces);
 //                          ratio to BM_CompactMeshNormals = the stage's cost of those columns
 #include <benchmark/benchmark.h>
 #include <oneapi/tbb/parallel_for.h>
@@ -222,18 +222,13 @@ void BM_CompactMeshAttributes(benchmark::State& state) {
   for (size_t v = 0; v < nodes; ++v) columns.normals[3 * v + 2] = 1;
   VertexMorph morph;
   vertex_morph_init(morph, columns, 0.25f);
-  std::vector<float> shown_uv1 = columns.uvs1, shown_color = columns.colors, shown_normal = columns.normals;
   const size_t nv = front.active_count;
   std::vector<float> positions(3 * nv), uv1(2 * nv), color(4 * nv), n(3 * nv);
   std::vector<uint32_t> tris(3 * size_t(front.tri_count));
+  const MorphOutput outputs[] = {{&morph.uv1, uv1}, {&morph.color, color}, {&morph.normal, n}};
   for (auto _ : state) {
     front_compact_mesh(positions, tris, front, fx.tree, {});
-    vertex_morph_column(shown_uv1, morph, morph.uv1, front.vertices(), 1.0);
-    vertex_morph_column(shown_color, morph, morph.color, front.vertices(), 1.0);
-    vertex_morph_column(shown_normal, morph, morph.normal, front.vertices(), 1.0);
-    front_compact_column(uv1, 2, front, shown_uv1);
-    front_compact_column(color, 4, front, shown_color);
-    front_compact_column(n, 3, front, shown_normal);
+    vertex_morph_compact(outputs, morph, front.vertices(), 1.0);
     renormalise(n);
     benchmark::DoNotOptimize(positions.data());
     benchmark::DoNotOptimize(color.data());

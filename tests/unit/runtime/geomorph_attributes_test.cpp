@@ -74,6 +74,27 @@ TEST(GeomorphAttributes, SecondUvsColoursAndNormalsMorphWithThePositions) {
   EXPECT_EQ(normal[14], 1.f);
 }
 
+// The compact form writes the same values as the per-node one, in the order of the nodes given.
+TEST(GeomorphAttributes, CompactMorphEqualsThePerNodeValuesInNodeOrder) {
+  const VertexTree t = attributed_square();
+  VertexMorph m;
+  vertex_morph_init(m, t, 1.f);
+  const FrontEvent split[] = {{4, FrontEventKind::split}};
+  vertex_morph_apply(m, t, split, 10.0);
+  const uint32_t nodes[] = {3, 1, 0, 2};
+  std::vector<float> color(4 * 5), normal(3 * 5);
+  vertex_morph_column(color, m, m.color, nodes, 10.25);
+  vertex_morph_column(normal, m, m.normal, nodes, 10.25);
+  std::vector<float> compact_color(4 * 4), compact_normal(3 * 4);
+  const MorphOutput outputs[] = {{&m.color, compact_color}, {&m.normal, compact_normal}};
+  vertex_morph_compact(outputs, m, nodes, 10.25);
+  for (size_t k = 0; k < 4; ++k) {
+    for (size_t c = 0; c < 4; ++c) EXPECT_EQ(compact_color[4 * k + c], color[4 * nodes[k] + c]) << k;
+    for (size_t c = 0; c < 3; ++c) EXPECT_EQ(compact_normal[3 * k + c], normal[3 * nodes[k] + c]) << k;
+  }
+  EXPECT_FLOAT_EQ(compact_color[4 * 2], 0.625f);  // node 0's red a quarter of the way from 0.5 to 1
+}
+
 TEST(GeomorphAttributes, RenormaliseZeroesWhatHasNoDirection) {
   std::vector<float> n = {0, 0, 0, 3, 0, 4, NAN, 0, 1};
   EXPECT_EQ(renormalise(n), 1u);
