@@ -98,8 +98,9 @@ bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
         ok = ok && c >= 0 && c <= 1;
       }
       if (!ok) {
-        std::snprintf(buf, sizeof buf, "vd object %u: vertex %u has a non-finite uv1 or a colour outside [0, 1]",
-                      o.object, v - o.first_vertex);
+        std::snprintf(buf, sizeof buf,
+                      "vd object %u: vertex %u has a non-finite uv1 or a colour outside [0, 1]", o.object,
+                      v - o.first_vertex);
         *why = buf;
         return false;
       }

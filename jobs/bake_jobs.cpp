@@ -116,9 +116,11 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   const MeshData mesh = level0_mesh(chain, model.file.string());
   if (!chain.hierarchy.empty()) {
     if (chain.hierarchy.seams_pinned)
-      log.line("bake " + model.name + ": vertex hierarchy built before it kept TEXCOORD_1, colours and normals, rebuilding");
+      log.line("bake " + model.name +
+               ": vertex hierarchy built before it kept TEXCOORD_1, colours and normals, rebuilding");
     else if (hierarchy_predates_seams(chain, mesh))
-      log.line("bake " + model.name + ": vertex hierarchy built before attribute seams were pinned, rebuilding");
+      log.line("bake " + model.name +
+               ": vertex hierarchy built before attribute seams were pinned, rebuilding");
     else
       return Status::success();
   }

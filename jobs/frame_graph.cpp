@@ -235,7 +235,7 @@ struct FrameGraph::Impl {
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
     std::vector<float> shown_uv;  // geomorphed uvs, 2 per node (trees with uvs)
-    std::vector<uint32_t> compact_nodes;  // several regions: the compact meshes' vertex order
+    std::vector<uint32_t> compact_nodes;       // several regions: the compact meshes' vertex order
     std::vector<uint32_t> sorted, slot_count;  // material grouping scratch
     std::vector<VdRunFrame> runs;              // this frame's runs (absolute first_index)
     FrontStats stats;          // summed over the regions
@@ -1012,9 +1012,11 @@ struct FrameGraph::Impl {
       MorphOutput extra[3];
       size_t extras = 0;
       if (e.has_uvs1)
-        extra[extras++] = {&o.morph.uv1, std::span(f.vd_uvs1.data() + 2 * size_t(e.first_vertex), 2 * size_t(e.vertex_count))};
+        extra[extras++] = {&o.morph.uv1, std::span(f.vd_uvs1.data() + 2 * size_t(e.first_vertex),
+                                                   2 * size_t(e.vertex_count))};
       if (e.has_colors)
-        extra[extras++] = {&o.morph.color, std::span(f.vd_colors.data() + 4 * size_t(e.first_vertex), 4 * size_t(e.vertex_count))};
+        extra[extras++] = {&o.morph.color, std::span(f.vd_colors.data() + 4 * size_t(e.first_vertex),
+                                                     4 * size_t(e.vertex_count))};
       if (e.has_authored_normals) extra[extras++] = {&o.morph.normal, normals};
       if (extras) {
         std::span<const uint32_t> order = o.fronts[0].vertices();

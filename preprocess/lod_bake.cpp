@@ -93,10 +93,13 @@ void note_import_warnings(const MeshData& mesh, std::vector<std::string>& notes)
 // Authored normals as level 0 keeps them: unit (OBJ's vn need not be), zero and non-finite ones zero.
 void unit_normals_in_place(std::vector<float>& n) {
   for (size_t v = 0; v + 2 < n.size(); v += 3) {
-    const double len = std::sqrt(double(n[v]) * n[v] + double(n[v + 1]) * n[v + 1] + double(n[v + 2]) * n[v + 2]);
+    const double len =
+        std::sqrt(double(n[v]) * n[v] + double(n[v + 1]) * n[v + 1] + double(n[v + 2]) * n[v + 2]);
     const bool unit = std::abs(len - 1) <= 0.5 * kTreeNormalTolerance;
     for (int k = 0; k < 3; ++k)
-      n[v + size_t(k)] = !std::isfinite(len) || len == 0 ? 0.f : unit ? n[v + size_t(k)] : float(n[v + size_t(k)] / len);
+      n[v + size_t(k)] = !std::isfinite(len) || len == 0 ? 0.f
+                         : unit                          ? n[v + size_t(k)]
+                                                         : float(n[v + size_t(k)] / len);
   }
 }
 
@@ -368,10 +371,11 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   // not kept, and said so. Coarser levels' normals always come from their faces.
   const bool authored_normals = !mesh.normals.empty() && report.cleaned.normal_conflicts == 0;
   if (!mesh.normals.empty() && !authored_normals)
-    report.notes.push_back("authored normals of " + mesh_file.string() + " not kept: " +
-                           std::to_string(report.cleaned.normal_conflicts) +
-                           " welded vertices differ in normal only (hard edges); every level's normals and the "
-                           "view-dependent mesh's are computed from their faces");
+    report.notes.push_back(
+        "authored normals of " + mesh_file.string() +
+        " not kept: " + std::to_string(report.cleaned.normal_conflicts) +
+        " welded vertices differ in normal only (hard edges); every level's normals and the "
+        "view-dependent mesh's are computed from their faces");
 
   std::vector<float> ratios;
   bool culled = false;

@@ -4,16 +4,16 @@
 // result depends only on the input.
 #include "preprocess/mesh_clean.h"
 
-#include "preprocess/first_of_equal.h"
-#include "preprocess/material_runs.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <compare>
+#include <cstring>
 #include <utility>
 #include <vector>
+
+#include "preprocess/first_of_equal.h"
+#include "preprocess/material_runs.h"
 
 namespace lod {
 namespace {

@@ -104,14 +104,17 @@ void unit_or_zero(float* n) {
 }
 
 // An optional per-vertex column of the mesh: `width` values per vertex, finite and not huge.
-Status check_attribute(const MeshData& mesh, const std::vector<float>& values, size_t width, const char* what) {
+Status check_attribute(const MeshData& mesh, const std::vector<float>& values, size_t width,
+                       const char* what) {
   if (values.empty()) return Status::success();
   if (values.size() != width * mesh.vertex_count())
     return Status::error(mesh.source + ": " + std::to_string(values.size()) + " " + what + " values for " +
-                         std::to_string(mesh.vertex_count()) + " vertices (" + std::to_string(width) + " each)");
+                         std::to_string(mesh.vertex_count()) + " vertices (" + std::to_string(width) +
+                         " each)");
   for (size_t i = 0; i < values.size(); ++i)
     if (!std::isfinite(values[i]) || std::abs(values[i]) > kMaxTreeMagnitude)
-      return Status::error(mesh.source + ": vertex " + std::to_string(i / width) + " has a non-finite or huge " + what);
+      return Status::error(mesh.source + ": vertex " + std::to_string(i / width) +
+                           " has a non-finite or huge " + what);
   return Status::success();
 }
 
@@ -138,7 +141,7 @@ class Builder {
   uint32_t leaf_count_ = 0;
   std::vector<double> pos_;  // per node
   std::vector<float> uv_;    // per node, 2 each, when the mesh has uvs
-  std::vector<float> uv1_;     // per node, 2 each, when the mesh has a second uv set
+  std::vector<float> uv1_;   // per node, 2 each, when the mesh has a second uv set
   std::vector<float> color_;   // per node, 4 each (linear RGBA), when the mesh has colours
   std::vector<float> normal_;  // per node, 3 each (unit or zero), when the mesh has normals
   std::vector<Quad> quad_;   // per node

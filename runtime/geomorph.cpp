@@ -148,9 +148,10 @@ void vertex_morph_column(std::span<float> out, const VertexMorph& m, const Morph
   }
 }
 
-void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorph& m, std::span<const uint32_t> nodes,
-                          double now) {
-  for (const MorphOutput& o : outputs) assert(!o.column->empty() && o.out.size() >= o.column->width * nodes.size());
+void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorph& m,
+                          std::span<const uint32_t> nodes, double now) {
+  for (const MorphOutput& o : outputs)
+    assert(!o.column->empty() && o.out.size() >= o.column->width * nodes.size());
   // Nodes are scattered over the tree's arrays: ask for a later node's lines ahead (the loop is
   // bound by those misses, not by its arithmetic).
   constexpr size_t kAhead = 16;
@@ -158,7 +159,8 @@ void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorp
     if (k + kAhead < nodes.size()) {
       const uint32_t w = nodes[k + kAhead];
       __builtin_prefetch(&m.start[w]);
-      for (const MorphOutput& o : outputs) __builtin_prefetch(&o.column->ends[2 * size_t(o.column->width) * w]);
+      for (const MorphOutput& o : outputs)
+        __builtin_prefetch(&o.column->ends[2 * size_t(o.column->width) * w]);
     }
     const uint32_t v = nodes[k];
     const float t = morph_factor(now, m.start[v], m.duration);

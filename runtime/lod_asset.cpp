@@ -60,8 +60,9 @@
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
 //       vertex; NRML flag bit 1 (since bake format 11): level 0's normals are the source's own
-//       (LodChain::authored_normals; each unit or zero), older readers ignore it. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
-//       unknown optional sections are skipped, so later versions can add data compatibly.
+//       (LodChain::authored_normals; each unit or zero), older readers ignore it. INDX: u32 per
+//       index. Flag bit 0 marks a section a reader must understand; unknown optional sections
+//       are skipped, so later versions can add data compatibly.
 // The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
 #include "runtime/lod_asset.h"
 
@@ -93,7 +94,8 @@ constexpr size_t kChecksumBytes = 8;
 constexpr size_t kMetaFixedBytes = 40;
 constexpr size_t kLevelBytes = 44;
 constexpr uint32_t kFlagRequired = 1;
-constexpr uint32_t kNrmlAuthored = 2;  // NRML only: level 0's normals are the source's (LodChain::authored_normals)
+// NRML only: level 0's normals are the source's (LodChain::authored_normals).
+constexpr uint32_t kNrmlAuthored = 2;
 constexpr uint32_t kMaxSections = 64;
 
 constexpr uint32_t fourcc(const char (&s)[5]) {
@@ -262,17 +264,22 @@ Status get_hierarchy_attributes(const uint8_t* p, uint64_t size, uint64_t nodes,
     return bad("layout " + std::to_string(layout) + " is newer than this build reads (" + std::to_string(kVhatLayout) +
                "); use a newer lodkit or re-bake it");
   if (layout == 0) return bad("layout 0 does not exist");
-  const uint32_t known = layout == 1 ? kVhatSeamsPinned : kVhatSeamsPinned | kVhatUvs1 | kVhatColors | kVhatNormals;
-  if (flags & ~known) return bad("unknown flags " + std::to_string(flags) + " for layout " + std::to_string(layout));
+  const uint32_t known =
+      layout == 1 ? kVhatSeamsPinned : kVhatSeamsPinned | kVhatUvs1 | kVhatColors | kVhatNormals;
+  if (flags & ~known)
+    return bad("unknown flags " + std::to_string(flags) + " for layout " + std::to_string(layout));
   if (count != 0 && count != nodes)
     return bad("uvs for " + std::to_string(count) + " nodes, the hierarchy has " + std::to_string(nodes));
   // Bytes per node of the layout-2 columns; nodes is bounded by VHIE's bytes, so no overflow.
-  const uint64_t per_node = (flags & kVhatUvs1 ? 8 : 0) + (flags & kVhatColors ? 16 : 0) + (flags & kVhatNormals ? 12 : 0);
+  const uint64_t per_node =
+      (flags & kVhatUvs1 ? 8 : 0) + (flags & kVhatColors ? 16 : 0) + (flags & kVhatNormals ? 12 : 0);
   if (count > (size - kVhatFixedBytes) / 8 || per_node * nodes > size - kVhatFixedBytes - 8 * count ||
       size != kVhatFixedBytes + 8 * count + per_node * nodes)
     return bad(std::to_string(size) + " bytes but " + std::to_string(count) + " uv nodes need " +
                std::to_string(kVhatFixedBytes) + " + 8 each" +
-               (per_node ? " and its flags " + std::to_string(per_node) + " per node of " + std::to_string(nodes) : "") +
+               (per_node
+                    ? " and its flags " + std::to_string(per_node) + " per node of " + std::to_string(nodes)
+                    : "") +
                " (truncated?)");
   const uint8_t* q = p + kVhatFixedBytes;
   get_words(q, 2 * count, t.uvs);
@@ -290,20 +297,22 @@ Status get_hierarchy_attributes(const uint8_t* p, uint64_t size, uint64_t nodes,
 }
 
 // Leaves are level 0's vertices: their uvs (either set) and colours must be its, bit for bit.
-Status check_leaf_column(const LodChain& chain, const std::vector<float>& tree_values, const std::vector<float>& level_values,
-                         size_t width, const char* what, const char* section, const std::string& where) {
+Status check_leaf_column(const LodChain& chain, const std::vector<float>& tree_values,
+                         const std::vector<float>& level_values, size_t width, const char* what,
+                         const char* section, const std::string& where) {
   const VertexTree& t = chain.hierarchy;
   if (tree_values.empty()) return Status::success();
   if (level_values.empty() || chain.levels.empty())
-    return refuse(where, std::string("VHAT section: the hierarchy has ") + what + "s but the levels have none (" +
-                             section + ")");
+    return refuse(where, std::string("VHAT section: the hierarchy has ") + what +
+                             "s but the levels have none (" + section + ")");
   const size_t first = width * size_t(chain.levels[0].first_vertex);
   const size_t bytes = 4 * width;
-  if (std::memcmp(tree_values.data(), level_values.data() + first, bytes * t.leaf_count) == 0) return Status::success();
+  if (std::memcmp(tree_values.data(), level_values.data() + first, bytes * t.leaf_count) == 0)
+    return Status::success();
   for (uint32_t v = 0; v < t.leaf_count; ++v)
     if (std::memcmp(&tree_values[width * v], &level_values[first + width * v], bytes) != 0)
-      return refuse(where, "VHAT section: leaf " + std::to_string(v) + " " + what + " differs from level 0 vertex " +
-                               std::to_string(v) + "'s");
+      return refuse(where, "VHAT section: leaf " + std::to_string(v) + " " + what +
+                               " differs from level 0 vertex " + std::to_string(v) + "'s");
   return Status::success();
 }
 
@@ -315,8 +324,8 @@ Status check_authored_normals(const LodChain& chain, const std::string& what) {
     const float* n = &chain.normals[3 * (size_t(l0.first_vertex) + v)];
     const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
     if (len != 0 && std::abs(len - 1) > kTreeNormalTolerance)
-      return refuse(what, "NRML section: level 0 vertex " + std::to_string(v) + " authored normal has length " +
-                              std::to_string(len) + ", not 1 or 0");
+      return refuse(what, "NRML section: level 0 vertex " + std::to_string(v) +
+                              " authored normal has length " + std::to_string(len) + ", not 1 or 0");
   }
   return Status::success();
 }
@@ -325,8 +334,10 @@ Status check_leaf_attributes(const LodChain& chain, const std::string& what) {
   const VertexTree& t = chain.hierarchy;
   if (!t.normals.empty()) {
     if (!chain.authored_normals)
-      return refuse(what, "VHAT section: the hierarchy has normals but level 0's are not authored (NRML flags)");
-    if (Status st = check_leaf_column(chain, t.normals, chain.normals, 3, "normal", "NRML", what); !st) return st;
+      return refuse(what,
+                    "VHAT section: the hierarchy has normals but level 0's are not authored (NRML flags)");
+    if (Status st = check_leaf_column(chain, t.normals, chain.normals, 3, "normal", "NRML", what); !st)
+      return st;
   }
   if (Status st = check_leaf_column(chain, t.uvs, chain.uvs, 2, "uv", "TEX0", what); !st) return st;
   if (Status st = check_leaf_column(chain, t.uvs1, chain.uvs1, 2, "uv1", "TEX1", what); !st) return st;
@@ -606,8 +617,9 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   Writer w;
   std::vector<uint32_t> tags = {kMeta, kLevl, kPosn, kNrml, kIndx};
   if (!chain.hierarchy.empty()) tags.push_back(kVhie);
-  if (!chain.hierarchy.empty() && (chain.hierarchy.seams_pinned || !chain.hierarchy.uvs.empty() || !chain.hierarchy.uvs1.empty() ||
-                                     !chain.hierarchy.colors.empty() || !chain.hierarchy.normals.empty()))
+  if (!chain.hierarchy.empty() &&
+      (chain.hierarchy.seams_pinned || !chain.hierarchy.uvs.empty() || !chain.hierarchy.uvs1.empty() ||
+       !chain.hierarchy.colors.empty() || !chain.hierarchy.normals.empty()))
     tags.push_back(kVhat);
   if (!chain.morph_targets.empty()) tags.push_back(kMrph);
   if (!chain.uvs.empty()) tags.push_back(kTex0);
@@ -623,10 +635,10 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
     w.u32(tags[s] == kVhie || tags[s] == kVhat || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kTex1 ||
-                   tags[s] == kCol0 || tags[s] == kMatl || tags[s] == kImgs
-               ? 0
-           : tags[s] == kNrml && chain.authored_normals ? kFlagRequired | kNrmlAuthored
-                                                        : kFlagRequired);
+                  tags[s] == kCol0 || tags[s] == kMatl || tags[s] == kImgs
+              ? 0
+          : tags[s] == kNrml && chain.authored_normals ? kFlagRequired | kNrmlAuthored
+                                                       : kFlagRequired);
     w.u64(0);  // offset, patched below
     w.u64(0);  // size
   }

@@ -136,8 +136,8 @@ bool check_node_column(const VertexTree& t, const std::vector<float>& values, si
                        bool boxed, std::string* message) {
   const size_t n = t.parent.size();
   if (values.size() != width * n)
-    return fail(message, std::string("hierarchy ") + what + "s hold " + num(values.size()) + " values, expected " +
-                             num(width * n));
+    return fail(message, std::string("hierarchy ") + what + "s hold " + num(values.size()) +
+                             " values, expected " + num(width * n));
   for (size_t i = 0; i < width * n; ++i)
     if (!std::isfinite(values[i]) || std::abs(values[i]) > kMaxTreeMagnitude)
       return fail(message, "node " + num(i / width) + " has a non-finite or huge " + what);
@@ -148,10 +148,11 @@ bool check_node_column(const VertexTree& t, const std::vector<float>& values, si
     if (a >= n || b >= n) return fail(message, "node " + num(t.leaf_count + i) + " has a child out of range");
     if (!boxed) continue;
     for (size_t k = 0; k < width; ++k) {
-      const float u = values[width * (t.leaf_count + i) + k], ua = values[width * a + k], ub = values[width * b + k];
+      const float u = values[width * (t.leaf_count + i) + k], ua = values[width * a + k],
+                  ub = values[width * b + k];
       if (u < std::min(ua, ub) || u > std::max(ua, ub))
-        return fail(message, "node " + num(t.leaf_count + i) + " " + what + " lies outside its children's (" + num(a) +
-                                 ", " + num(b) + ")");
+        return fail(message, "node " + num(t.leaf_count + i) + " " + what + " lies outside its children's (" +
+                                 num(a) + ", " + num(b) + ")");
     }
   }
   return true;

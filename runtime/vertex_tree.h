@@ -116,8 +116,9 @@ inline constexpr float kMaxTreeMagnitude = 1e18f;
 // kMaxTreeMagnitude, and replays the collapses in node order: split faces, wings, incident
 // faces and dependencies must be exactly what each collapse makes (what front_update and its
 // forced splits rely on). With uvs: two per node, finite, each parent's within the box of its
-// children's; the other attributes as validate_vertex_tree_attributes says. Linear in the arrays. On failure `message` names the element
-// ("node 812 child 90211 of 35947"); callers prefix the file.
+// children's; the other attributes as validate_vertex_tree_attributes says. Linear in the
+// arrays. On failure `message` names the element ("node 812 child 90211 of 35947"); callers
+// prefix the file.
 bool validate_vertex_tree(const VertexTree& tree, std::string* message);
 // The uv part of it alone, for a tree whose other arrays passed (asset readers name the two
 // sections apart).

@@ -46,14 +46,16 @@ TEST(LodRunVdAttributes, ColoursAndSecondUvsReachEveryFrameAndTheCachedHierarchy
   const fs::path dir = lod::test::temp_dir("run_vd_attributes");
   const fs::path ball = write_ball(dir);
   // lod bake: the smooth normals are kept (no note says they are not); nothing is dropped.
-  const lod::test::CliResult baked = lod::test::run_lod("bake " + ball.string() + " -o " + (dir / "out").string());
+  const lod::test::CliResult baked =
+      lod::test::run_lod("bake " + ball.string() + " -o " + (dir / "out").string());
   ASSERT_EQ(baked.code, 0) << baked.out;
   EXPECT_EQ(baked.out.find("authored normals of"), std::string::npos) << baked.out;
   EXPECT_EQ(baked.out.find("not kept"), std::string::npos) << baked.out;
 
   using namespace lod::test;
   const fs::path cfg = dir / "scene.toml";
-  write_text(cfg, run_block(30) + budget_block(30000) + orbit_camera_block({.radius = 60, .period_frames = 60}) +
+  write_text(cfg, run_block(30) + budget_block(30000) +
+                      orbit_camera_block({.radius = 60, .period_frames = 60}) +
                       model_block("ball", ball.string(), "[1.0, 0.5, 0.25]", "view_dependent = true\n") +
                       single_block("ball", "[0, 0, 0]", 20));
   const CliResult run = run_lod("run --config " + cfg.string() + " --cache " + (dir / "cache").string() +
@@ -80,7 +82,8 @@ TEST(LodRunVdAttributes, ColoursAndSecondUvsReachEveryFrameAndTheCachedHierarchy
   EXPECT_TRUE(a["hierarchy_colors"].get<bool>());
   EXPECT_TRUE(a["hierarchy_normals"].get<bool>());
   const CliResult text = run_lod("inspect " + asset.string());
-  EXPECT_NE(text.out.find("TEXCOORD_1 per node, colours per node, authored normals per node"), std::string::npos)
+  EXPECT_NE(text.out.find("TEXCOORD_1 per node, colours per node, authored normals per node"),
+            std::string::npos)
       << text.out;
 }
 

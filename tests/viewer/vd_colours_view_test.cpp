@@ -61,12 +61,14 @@ int red_pixels(const lod::test::Image& img) {
 }
 
 int shoot(const std::string& tag, const float (&rgba)[4]) {
-  const auto scene = lod::test::write_viewer_scene(tag, kRun, lod::test::front_camera(400, 300), kInstance, kModel);
+  const auto scene =
+      lod::test::write_viewer_scene(tag, kRun, lod::test::front_camera(400, 300), kInstance, kModel);
   EXPECT_TRUE(write_ball(scene.dir / "painted", rgba));
   const auto png = scene.dir / "shot.png";
   const auto stats = scene.dir / "shot.csv";
-  const auto r = lod::test::run_viewer(
-      scene, "--screenshot '" + png.string() + "' --frames 3 --width 400 --height 300 --stats '" + stats.string() + "'");
+  const auto r = lod::test::run_viewer(scene, "--screenshot '" + png.string() +
+                                                  "' --frames 3 --width 400 --height 300 --stats '" +
+                                                  stats.string() + "'");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   lod::test::CsvTable t;
   EXPECT_TRUE(lod::test::load_csv(stats, t));

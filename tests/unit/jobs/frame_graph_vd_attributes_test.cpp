@@ -115,7 +115,8 @@ TEST(FrameGraphVdAttributes, PublishesSecondUvsColoursAndAuthoredNormalsPerVerte
       ASSERT_TRUE(red || blue) << "frame " << n << " vertex " << v;
       // The lightmap set lies in (0.25 + u / 2, v / 2).
       const float* t = &f.vd_uvs1[2 * size_t(v)];
-      ASSERT_TRUE(t[0] >= 0.25f - 1e-6f && t[0] <= 0.75f + 1e-6f && t[1] >= 0 && t[1] <= 0.5f + 1e-6f) << "frame " << n;
+      ASSERT_TRUE(t[0] >= 0.25f - 1e-6f && t[0] <= 0.75f + 1e-6f && t[1] >= 0 && t[1] <= 0.5f + 1e-6f)
+          << "frame " << n;
       // Authored (radial) normals, unit, near the direction of the shown position.
       const float* q = &f.vd_normals[3 * size_t(v)];
       const float* p = &f.vd_positions[3 * size_t(v)];
@@ -144,8 +145,9 @@ TEST(FrameGraphVdAttributes, WithoutAuthoredNormalsTheShownFacesGiveThem) {
   // The sphere winds inward: computed normals point in, the authored ones would point out.
   double inward = 0;
   for (size_t v = 0; v < f.vd_positions.size() / 3; ++v)
-    inward += -(f.vd_normals[3 * v] * f.vd_positions[3 * v] + f.vd_normals[3 * v + 1] * f.vd_positions[3 * v + 1] +
-                f.vd_normals[3 * v + 2] * f.vd_positions[3 * v + 2]);
+    inward +=
+        -(f.vd_normals[3 * v] * f.vd_positions[3 * v] + f.vd_normals[3 * v + 1] * f.vd_positions[3 * v + 1] +
+          f.vd_normals[3 * v + 2] * f.vd_positions[3 * v + 2]);
   EXPECT_GT(inward, 0.0);
 }
 

@@ -65,7 +65,8 @@ TEST(LodBakeNormals, SmoothAuthoredNormalsAreLevelZerosAndRoundTrip) {
   // Cleaning keeps the vertex order (no welds here): level 0's normals are the file's.
   ASSERT_EQ(l0.vertex_count, m.vertex_count());
   for (uint32_t v = 0; v < l0.vertex_count; ++v)
-    for (int k = 0; k < 3; ++k) ASSERT_NEAR(chain.normals[3 * size_t(v) + k], m.normals[3 * size_t(v) + k], 1e-6f) << v;
+    for (int k = 0; k < 3; ++k)
+      ASSERT_NEAR(chain.normals[3 * size_t(v) + k], m.normals[3 * size_t(v) + k], 1e-6f) << v;
   LodChain back;
   const Status s = decode_lod_asset(encode_lod_asset(chain), "m.lod", back);
   ASSERT_TRUE(s.ok) << s.message;
@@ -77,7 +78,8 @@ TEST(LodBakeNormals, SmoothAuthoredNormalsAreLevelZerosAndRoundTrip) {
   LodChain out;
   const Status r = decode_lod_asset(encode_lod_asset(bad), "m.lod", out);
   EXPECT_FALSE(r.ok);
-  EXPECT_NE(r.message.find("NRML section: level 0 vertex 1 authored normal has length"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("NRML section: level 0 vertex 1 authored normal has length"), std::string::npos)
+      << r.message;
 }
 
 TEST(LodBakeNormals, HardEdgesWeldedByCleaningAreSaidAndNotKept) {

@@ -45,7 +45,8 @@ std::vector<uint32_t> leaf_order(const VertexTree& t) {
 }
 
 // Every node's value of a boxed column lies in the box of its leaves' values.
-void expect_inside_leaves_box(const VertexTree& t, const std::vector<float>& column, size_t width, const char* what) {
+void expect_inside_leaves_box(const VertexTree& t, const std::vector<float>& column, size_t width,
+                              const char* what) {
   const std::vector<uint32_t> order = leaf_order(t);
   for (uint32_t v = t.leaf_count; v < t.node_count(); ++v)
     for (size_t k = 0; k < width; ++k) {
@@ -75,7 +76,8 @@ TEST(VertexHierarchyAttributes, LeavesKeepTheInputsBitForBitAndTheFullFrontDraws
   std::vector<float> colors(4 * size_t(f.active_count));
   ASSERT_EQ(front_compact_column(colors, 4, f, t.colors), f.active_count);
   for (uint32_t k = 0; k < f.active_count; ++k)
-    for (int c = 0; c < 4; ++c) ASSERT_EQ(colors[4 * k + c], m.colors[4 * size_t(f.active[k]) + c]) << "vertex " << k;
+    for (int c = 0; c < 4; ++c)
+      ASSERT_EQ(colors[4 * k + c], m.colors[4 * size_t(f.active[k]) + c]) << "vertex " << k;
 }
 
 TEST(VertexHierarchyAttributes, ParentsStayInsideTheirLeavesRangeAndNormalsAreUnit) {
@@ -94,7 +96,8 @@ TEST(VertexHierarchyAttributes, ParentsStayInsideTheirLeavesRangeAndNormalsAreUn
   // No parent mixes the two colour halves: the equator's copies (a colour seam) never collapse.
   for (uint32_t v = t.leaf_count; v < t.node_count(); ++v) {
     const float* c = &t.colors[4 * size_t(v)];
-    const bool red = c[0] == 1 && c[2] == 0 && c[3] == 1, blue = c[0] == 0 && c[1] == 0 && c[2] == 1 && c[3] == 0.5f;
+    const bool red = c[0] == 1 && c[2] == 0 && c[3] == 1,
+               blue = c[0] == 0 && c[1] == 0 && c[2] == 1 && c[3] == 0.5f;
     ASSERT_TRUE(red || blue) << "node " << v << " mixes the halves' colours";
   }
 }
@@ -242,7 +245,9 @@ std::vector<uint8_t> forge_vhat(std::vector<uint8_t> bytes, size_t at, T value) 
   return bytes;
 }
 
-Status decode(const std::vector<uint8_t>& bytes, LodChain& out) { return decode_lod_asset(bytes, "ball.lod", out); }
+Status decode(const std::vector<uint8_t>& bytes, LodChain& out) {
+  return decode_lod_asset(bytes, "ball.lod", out);
+}
 
 TEST(VertexHierarchyAttributesAsset, RoundTripKeepsEveryColumnBitForBit) {
   const LodChain c = attributed_chain();
@@ -257,7 +262,8 @@ TEST(VertexHierarchyAttributesAsset, RoundTripKeepsEveryColumnBitForBit) {
   ASSERT_TRUE(s.ok) << s.message;
   const VertexTree& a = c.hierarchy;
   const VertexTree& b = back.hierarchy;
-  for (const auto& [x, y] : {std::pair{&a.uvs, &b.uvs}, {&a.uvs1, &b.uvs1}, {&a.colors, &b.colors}, {&a.normals, &b.normals}}) {
+  for (const auto& [x, y] :
+       {std::pair{&a.uvs, &b.uvs}, {&a.uvs1, &b.uvs1}, {&a.colors, &b.colors}, {&a.normals, &b.normals}}) {
     ASSERT_EQ(x->size(), y->size());
     EXPECT_EQ(std::memcmp(x->data(), y->data(), 4 * x->size()), 0);
   }
@@ -303,13 +309,17 @@ TEST(VertexHierarchyAttributesAsset, TruncatedOrForgedColumnsAreRefusedNamingThe
   refused(forge_vhat(good, 0, uint32_t(1)), "unknown flags 15 for layout 1");
   // Values: columns follow the 16-byte head and the uvs, in the order uv1, colour, normal.
   const size_t uv1_at = 16 + 8 * nodes, color_at = uv1_at + 8 * nodes, normal_at = color_at + 16 * nodes;
-  refused(forge_vhat(good, uv1_at + 8 * (nodes - 1), std::nanf("")), "VHAT section: node " + std::to_string(nodes - 1));
+  refused(forge_vhat(good, uv1_at + 8 * (nodes - 1), std::nanf("")),
+          "VHAT section: node " + std::to_string(nodes - 1));
   const uint32_t parent = t.leaf_count;
-  refused(forge_vhat(good, color_at + 16 * size_t(parent), 7.f), "node " + std::to_string(parent) + " colour lies outside");
-  refused(forge_vhat(good, normal_at + 12 * size_t(parent), 2.f), "node " + std::to_string(parent) + " normal has length");
+  refused(forge_vhat(good, color_at + 16 * size_t(parent), 7.f),
+          "node " + std::to_string(parent) + " colour lies outside");
+  refused(forge_vhat(good, normal_at + 12 * size_t(parent), 2.f),
+          "node " + std::to_string(parent) + " normal has length");
   uint32_t leaf = 0;
   while (t.parent[leaf] != kNoNode) ++leaf;  // a root leaf: no parent's range to break first
-  refused(forge_vhat(good, color_at + 16 * size_t(leaf), 0.25f), "leaf " + std::to_string(leaf) + " colour differs");
+  refused(forge_vhat(good, color_at + 16 * size_t(leaf), 0.25f),
+          "leaf " + std::to_string(leaf) + " colour differs");
   refused(forge_vhat(good, uv1_at + 8 * size_t(leaf), 0.3f), "leaf " + std::to_string(leaf) + " uv1 differs");
   refused(forge_vhat(good, normal_at + 12 * size_t(leaf) + 8, -t.normals[3 * size_t(leaf) + 2]),
           "leaf " + std::to_string(leaf) + " normal differs");
