@@ -171,6 +171,9 @@ int inspect_command(const InspectArgs& args) {
     j["morph_targets"] = chain.morph_targets.size();  // 0 = level changes cannot blend
     j["hierarchy_nodes"] = chain.hierarchy.node_count();
     j["hierarchy_uvs"] = !chain.hierarchy.uvs.empty();
+    j["hierarchy_uvs1"] = !chain.hierarchy.uvs1.empty();
+    j["hierarchy_colors"] = !chain.hierarchy.colors.empty();
+    j["hierarchy_normals"] = !chain.hierarchy.normals.empty();
     j["hierarchy_seams_pinned"] = chain.hierarchy.seams_pinned;
     j["texcoords"] = !chain.uvs.empty();
     j["texcoords1"] = !chain.uvs1.empty();
@@ -215,9 +218,13 @@ int inspect_command(const InspectArgs& args) {
     else if (chain.levels.size() > 1)
       std::printf("morph targets: none (level changes pop; re-bake to add them)\n");
     if (!chain.hierarchy.empty())
-      std::printf("vertex hierarchy: %zu nodes%s%s\n", size_t(chain.hierarchy.node_count()),
-                  chain.hierarchy.uvs.empty() ? "" : ", uvs per node",
-                  chain.hierarchy.seams_pinned ? ", attribute seams pinned" : " (built before seams were pinned)");
+      std::printf(
+          "vertex hierarchy: %zu nodes%s%s%s%s%s\n", size_t(chain.hierarchy.node_count()),
+          chain.hierarchy.uvs.empty() ? "" : ", uvs per node",
+          chain.hierarchy.uvs1.empty() ? "" : ", TEXCOORD_1 per node",
+          chain.hierarchy.colors.empty() ? "" : ", colours per node",
+          chain.hierarchy.normals.empty() ? "" : ", authored normals per node",
+          chain.hierarchy.seams_pinned ? ", attribute seams pinned" : " (built before seams were pinned)");
     if (!chain.uvs.empty()) {
       std::printf("texture coordinates: every level (uv seams kept); uv error per level:");
       for (float e : chain.uv_errors) std::printf(" %.4g", e);

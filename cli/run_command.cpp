@@ -82,6 +82,29 @@ bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
       *why = buf;
       return false;
     }
+    // Second uvs and colours likewise: one per vertex, finite; colours in [0, 1].
+    if ((o.has_uvs1 && f.vd_uvs1.size() != 2 * (f.vd_positions.size() / 3)) ||
+        (o.has_colors && f.vd_colors.size() != 4 * (f.vd_positions.size() / 3))) {
+      std::snprintf(buf, sizeof buf, "vd object %u: %zu uv1 and %zu colour values for %zu vertices", o.object,
+                    f.vd_uvs1.size(), f.vd_colors.size(), f.vd_positions.size() / 3);
+      *why = buf;
+      return false;
+    }
+    for (uint32_t v = o.first_vertex; v < o.first_vertex + o.vertex_count; ++v) {
+      bool ok = true;
+      for (int k = 0; o.has_uvs1 && k < 2; ++k) ok = ok && std::isfinite(f.vd_uvs1[2 * size_t(v) + k]);
+      for (int k = 0; o.has_colors && k < 4; ++k) {
+        const float c = f.vd_colors[4 * size_t(v) + k];
+        ok = ok && c >= 0 && c <= 1;
+      }
+      if (!ok) {
+        std::snprintf(buf, sizeof buf,
+                      "vd object %u: vertex %u has a non-finite uv1 or a colour outside [0, 1]", o.object,
+                      v - o.first_vertex);
+        *why = buf;
+        return false;
+      }
+    }
     if (!unit_or_zero_normals(f, o, &bad)) {
       *why = "vd object " + std::to_string(o.object) + ": " + bad;
       return false;

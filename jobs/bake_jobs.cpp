@@ -49,7 +49,9 @@ struct BakeTask {
   Status status;
 };
 
-// Level 0 as the hierarchy's input: positions, indices, uvs and material runs.
+// Level 0 as the hierarchy's input: positions, indices, uvs (both sets), colours, material runs
+// and its normals when they are authored (computed ones are left out: the front computes its
+// own from the shown faces, which follow the coarser shapes better).
 MeshData level0_mesh(const LodChain& chain, const std::string& source) {
   const LodLevel& l0 = chain.levels.at(0);
   MeshData mesh;
@@ -58,9 +60,15 @@ MeshData level0_mesh(const LodChain& chain, const std::string& source) {
                         chain.positions.begin() + 3 * size_t(l0.first_vertex + l0.vertex_count));
   mesh.indices.assign(chain.indices.begin() + l0.first_index,
                       chain.indices.begin() + l0.first_index + l0.index_count);
-  if (!chain.uvs.empty())
-    mesh.uvs.assign(chain.uvs.begin() + 2 * size_t(l0.first_vertex),
-                    chain.uvs.begin() + 2 * size_t(l0.first_vertex + l0.vertex_count));
+  auto level0 = [&](const std::vector<float>& column, size_t width, std::vector<float>& out) {
+    if (!column.empty())
+      out.assign(column.begin() + width * size_t(l0.first_vertex),
+                 column.begin() + width * size_t(l0.first_vertex + l0.vertex_count));
+  };
+  level0(chain.uvs, 2, mesh.uvs);
+  level0(chain.uvs1, 2, mesh.uvs1);
+  level0(chain.colors, 4, mesh.colors);
+  if (chain.authored_normals) level0(chain.normals, 3, mesh.normals);
   for (const LevelSubmesh& run : level_submeshes(chain, 0))
     mesh.submeshes.push_back({run.first_index / 3, run.index_count / 3, run.material});  // level-local
   return mesh;
@@ -78,6 +86,24 @@ bool hierarchy_predates_seams(const LodChain& chain, const MeshData& level0) {
   return false;
 }
 
+// A tree (seams pinned) from a build that kept only uvs, where level 0 has a second uv set,
+// colours or authored normals (format 10's named assets): rebuilt, so nothing is dropped from
+// the hierarchy.
+bool hierarchy_lacks_attributes(const LodChain& chain) {
+  const VertexTree& t = chain.hierarchy;
+  return (!chain.uvs1.empty() && t.uvs1.empty()) || (!chain.colors.empty() && t.colors.empty()) ||
+         (chain.authored_normals && t.normals.empty());
+}
+
+std::string hierarchy_attribute_names(const VertexTree& t) {
+  std::string s;
+  if (!t.uvs.empty()) s += ", uvs";
+  if (!t.uvs1.empty()) s += ", TEXCOORD_1";
+  if (!t.colors.empty()) s += ", colours";
+  if (!t.normals.empty()) s += ", normals";
+  return s.empty() ? s : ", with" + s.substr(1);
+}
+
 // View-dependent models need level 0's vertex hierarchy (built once, then kept in the cached
 // asset); other models drop one a shared cache file may carry.
 Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* rewrite, LogLines& log,
@@ -86,11 +112,17 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
     chain.hierarchy = VertexTree{};
     return Status::success();
   }
-  if (chain.hierarchy.seams_pinned) return Status::success();
+  if (chain.hierarchy.seams_pinned && !hierarchy_lacks_attributes(chain)) return Status::success();
   const MeshData mesh = level0_mesh(chain, model.file.string());
   if (!chain.hierarchy.empty()) {
-    if (!hierarchy_predates_seams(chain, mesh)) return Status::success();
-    log.line("bake " + model.name + ": vertex hierarchy built before attribute seams were pinned, rebuilding");
+    if (chain.hierarchy.seams_pinned)
+      log.line("bake " + model.name +
+               ": vertex hierarchy built before it kept TEXCOORD_1, colours and normals, rebuilding");
+    else if (hierarchy_predates_seams(chain, mesh))
+      log.line("bake " + model.name +
+               ": vertex hierarchy built before attribute seams were pinned, rebuilding");
+    else
+      return Status::success();
   }
   const auto t0 = std::chrono::steady_clock::now();
   HierarchyOptions options;
@@ -99,10 +131,7 @@ Status ensure_hierarchy(const ModelConfig& model, const std::filesystem::path* r
   char ms[32];
   std::snprintf(ms, sizeof ms, "%.0f", ms_since(t0));
   log.line("bake " + model.name + ": vertex hierarchy of " + std::to_string(chain.hierarchy.node_count()) +
-           " nodes in " + ms + " ms" + (chain.hierarchy.uvs.empty() ? "" : ", with uvs"));
-  if (!chain.uvs1.empty() || !chain.colors.empty())
-    log.line("bake " + model.name + ": the view-dependent mesh keeps uvs and materials; its colours and second " +
-             "texture coordinates are kept in the levels only");
+           " nodes in " + ms + " ms" + hierarchy_attribute_names(chain.hierarchy));
   return rewrite ? write_lod_asset(*rewrite, chain) : Status::success();
 }
 

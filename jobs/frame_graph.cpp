@@ -235,6 +235,7 @@ struct FrameGraph::Impl {
     VertexMorph morph;
     std::vector<float> shown;  // geomorphed positions, xyz per hierarchy node
     std::vector<float> shown_uv;  // geomorphed uvs, 2 per node (trees with uvs)
+    std::vector<uint32_t> compact_nodes;       // several regions: the compact meshes' vertex order
     std::vector<uint32_t> sorted, slot_count;  // material grouping scratch
     std::vector<VdRunFrame> runs;              // this frame's runs (absolute first_index)
     FrontStats stats;          // summed over the regions
@@ -940,7 +941,7 @@ struct FrameGraph::Impl {
     Frame& f = *out;
     f.vd_objects.resize(vd_visible.size());
     uint32_t vertices = 0, indices = 0;
-    bool any_uvs = false;
+    bool any_uvs = false, any_uvs1 = false, any_colors = false;
     f.vd_active_tris = f.vd_splits = f.vd_collapses = 0;
     for (size_t j = 0; j < vd_visible.size(); ++j) {
       const VdObject& o = *vd_visible[j];
@@ -960,8 +961,14 @@ struct FrameGraph::Impl {
       e.threshold = o.stats.threshold;
       e.closed = vm.edges == EdgeCheck::closed;
       e.oriented = vm.edges != EdgeCheck::corners;
-      e.has_uvs = !set->chains[o.model]->hierarchy.uvs.empty();
+      const VertexTree& tree = set->chains[o.model]->hierarchy;
+      e.has_uvs = !tree.uvs.empty();
+      e.has_uvs1 = !tree.uvs1.empty();
+      e.has_colors = !tree.colors.empty();
+      e.has_authored_normals = !tree.normals.empty();
       any_uvs |= e.has_uvs;
+      any_uvs1 |= e.has_uvs1;
+      any_colors |= e.has_colors;
       vertices += e.vertex_count;
       indices += e.index_count;
       f.vd_active_tris += tris;
@@ -971,6 +978,8 @@ struct FrameGraph::Impl {
     f.vd_positions.resize(3 * size_t(vertices));
     f.vd_indices.resize(indices);
     f.vd_uvs.assign(any_uvs ? 2 * size_t(vertices) : 0, 0.f);
+    f.vd_uvs1.assign(any_uvs1 ? 2 * size_t(vertices) : 0, 0.f);
+    f.vd_colors.assign(any_colors ? 4 * size_t(vertices) : 0, 1.f);
     f.vd_normals.resize(3 * size_t(vertices));
     for_items(Stage::vd_mesh, vd_visible.size(), [&](size_t j) {
       VdObject& o = *vd_visible[j];
@@ -997,8 +1006,31 @@ struct FrameGraph::Impl {
         assert(written == e.vertex_count);
         if (e.has_uvs) fronts_compact_uvs(uvs, std::span(fronts, o.fronts.size()), tree, o.shown_uv);
       }
-      area_weighted_normals(std::span(f.vd_normals.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count)),
-                            positions, tris);
+      // Second uvs, colours and authored normals geomorphed straight into the frame, in the
+      // compact meshes' vertex order (one pass, no per-node copy to compact afterwards).
+      const std::span normals(f.vd_normals.data() + 3 * size_t(e.first_vertex), 3 * size_t(e.vertex_count));
+      MorphOutput extra[3];
+      size_t extras = 0;
+      if (e.has_uvs1)
+        extra[extras++] = {&o.morph.uv1, std::span(f.vd_uvs1.data() + 2 * size_t(e.first_vertex),
+                                                   2 * size_t(e.vertex_count))};
+      if (e.has_colors)
+        extra[extras++] = {&o.morph.color, std::span(f.vd_colors.data() + 4 * size_t(e.first_vertex),
+                                                     4 * size_t(e.vertex_count))};
+      if (e.has_authored_normals) extra[extras++] = {&o.morph.normal, normals};
+      if (extras) {
+        std::span<const uint32_t> order = o.fronts[0].vertices();
+        if (o.fronts.size() > 1) {
+          o.compact_nodes.resize(e.vertex_count);
+          fronts_compact_nodes(o.compact_nodes, std::span(fronts, o.fronts.size()));
+          order = o.compact_nodes;
+        }
+        vertex_morph_compact(std::span(extra, extras), o.morph, order, time);
+      }
+      if (e.has_authored_normals)
+        renormalise(normals);
+      else
+        area_weighted_normals(normals, positions, tris);
       group_by_material(o, tris, std::span(fronts, o.fronts.size()), vd_models[o.model], e.first_index);
     });
     // Runs into the frame, object by object.

@@ -26,7 +26,7 @@ namespace {
 
 // Bump when anything that changes baked output changes (simplifier, measurement, layout):
 // it is part of every cache key.
-constexpr uint32_t kBakeFormatVersion = 10;  // 10: textures embedded in a GLB or data URI kept (IMGS); 9: vertex colours (COL0) and TEXCOORD_1 (TEX1) through the levels, texCoord per texture (MATL layout 2); 8: normal, occlusion, emissive and metallic-roughness textures (MATL layout 1); 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
+constexpr uint32_t kBakeFormatVersion = 11;  // 11: level 0 keeps authored normals (NRML flag), the vertex hierarchy TEXCOORD_1, colours and those normals (VHAT layout 2); 10: textures embedded in a GLB or data URI kept (IMGS); 9: vertex colours (COL0) and TEXCOORD_1 (TEX1) through the levels, texCoord per texture (MATL layout 2); 8: normal, occlusion, emissive and metallic-roughness textures (MATL layout 1); 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
                                              // 3: surface error samples in mesh order
 
 // Up to these sizes a model gets the reference's cow / bunny ratios (R0).
@@ -88,6 +88,19 @@ LodLevel culled_level(const LodChain& chain) {
 // What the reader skipped (each naming the element).
 void note_import_warnings(const MeshData& mesh, std::vector<std::string>& notes) {
   for (const std::string& w : mesh.warnings) notes.push_back("import: " + w);
+}
+
+// Authored normals as level 0 keeps them: unit (OBJ's vn need not be), zero and non-finite ones zero.
+void unit_normals_in_place(std::vector<float>& n) {
+  for (size_t v = 0; v + 2 < n.size(); v += 3) {
+    const double len =
+        std::sqrt(double(n[v]) * n[v] + double(n[v + 1]) * n[v + 1] + double(n[v + 2]) * n[v + 2]);
+    const bool unit = std::abs(len - 1) <= 0.5 * kTreeNormalTolerance;
+    for (int k = 0; k < 3; ++k)
+      n[v + size_t(k)] = !std::isfinite(len) || len == 0 ? 0.f
+                         : unit                          ? n[v + size_t(k)]
+                                                         : float(n[v + size_t(k)] / len);
+  }
 }
 
 const char* method_name(SimplifyMethod m) {
@@ -353,6 +366,16 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
   report.cleaned = clean_mesh(mesh);
   if (mesh.triangle_count() == 0)
     return Status::error(mesh_file.string() + ": no triangles left after cleaning (all degenerate)");
+  // Authored normals are level 0's (and so the vertex hierarchy's) unless cleaning welded copies
+  // that differ in normal only (hard edges: one side's normal would shade both); then they are
+  // not kept, and said so. Coarser levels' normals always come from their faces.
+  const bool authored_normals = !mesh.normals.empty() && report.cleaned.normal_conflicts == 0;
+  if (!mesh.normals.empty() && !authored_normals)
+    report.notes.push_back(
+        "authored normals of " + mesh_file.string() +
+        " not kept: " + std::to_string(report.cleaned.normal_conflicts) +
+        " welded vertices differ in normal only (hard edges); every level's normals and the "
+        "view-dependent mesh's are computed from their faces");
 
   std::vector<float> ratios;
   bool culled = false;
@@ -377,6 +400,11 @@ Status bake_model(const std::filesystem::path& mesh_file, const std::string& nam
     if (m >= int32_t(chain.materials.size())) m = -1;
   simplify_chain(mesh, vertex_material, ratios, method, settings.method == SimplifyMethod::automatic,
                  settings.uv_weight, settings.parallel_for, levels, sources, report.notes);
+  if (authored_normals) {
+    levels[0].normals = mesh.normals;
+    unit_normals_in_place(levels[0].normals);
+    chain.authored_normals = true;
+  }
 
   // A level no smaller than the one before it adds nothing: drop it.
   for (size_t i = 1; i < levels.size();) {

@@ -4,15 +4,16 @@
 // result depends only on the input.
 #include "preprocess/mesh_clean.h"
 
-#include "preprocess/first_of_equal.h"
-#include "preprocess/material_runs.h"
-
 #include <algorithm>
 #include <array>
-#include <cstring>
+#include <cmath>
 #include <compare>
+#include <cstring>
 #include <utility>
 #include <vector>
+
+#include "preprocess/first_of_equal.h"
+#include "preprocess/material_runs.h"
 
 namespace lod {
 namespace {
@@ -133,6 +134,19 @@ CleanReport clean_mesh(MeshData& mesh) {
     : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], 0); }, same_place)
             : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], 0); }, same_place);
   const std::vector<uint32_t>& face_weld = split ? same_place : weld;
+
+  // Normals are not part of the weld: say where that merged two that differ (a hard edge).
+  if (has_normals) {
+    const double min_cos = std::cos(kNormalWeldDegrees * 3.14159265358979323846 / 180);
+    for (size_t v = 0; v < nv; ++v) {
+      if (weld[v] == v) continue;
+      const float *a = &mesh.normals[3 * v], *b = &mesh.normals[3 * size_t(weld[v])];
+      const double d = double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2];
+      const double la = double(a[0]) * a[0] + double(a[1]) * a[1] + double(a[2]) * a[2];
+      const double lb = double(b[0]) * b[0] + double(b[1]) * b[1] + double(b[2]) * b[2];
+      if (!(d >= min_cos * std::sqrt(la * lb))) ++report.normal_conflicts;
+    }
+  }
 
   std::vector<uint32_t> kept;
   kept.reserve(mesh.indices.size());

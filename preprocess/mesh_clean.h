@@ -12,6 +12,9 @@ struct CleanReport {
   size_t unreferenced_vertices = 0;
   size_t duplicate_vertices = 0;    // bit-identical positions (and uvs, colours) of one material welded together
   size_t material_split_vertices = 0;  // copies made where two materials shared a vertex (kept apart)
+  // Welded vertices whose normal differed from the one kept by more than kNormalWeldDegrees
+  // (hard edges: copies that differ in normal only); 0 when the mesh has no normals.
+  size_t normal_conflicts = 0;
   bool changed() const {
     return degenerate_faces + duplicate_faces + unreferenced_vertices + duplicate_vertices > 0;
   }
@@ -23,5 +26,7 @@ struct CleanReport {
 // first split per material and vertices weld only within one, so material boundaries stay seams; a welded vertex keeps its first
 // normal (normal seams are not kept: level normals are recomputed from the geometry). Submeshes keep their surviving triangles.
 CleanReport clean_mesh(MeshData& mesh);
+
+inline constexpr double kNormalWeldDegrees = 1.0;
 
 }  // namespace lod

@@ -95,6 +95,29 @@ Cone merge_cones(const Cone& a, const Cone& b) {
   return {{axis.x / len, axis.y / len, axis.z / len}, half};
 }
 
+// A leaf normal as the tree keeps it: the input's when unit (within kTreeNormalTolerance) or
+// zero, else normalised (OBJ's vn need not be unit).
+void unit_or_zero(float* n) {
+  const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
+  if (len == 0 || std::abs(len - 1) <= 0.5 * kTreeNormalTolerance) return;
+  for (int k = 0; k < 3; ++k) n[k] = static_cast<float>(n[k] / len);
+}
+
+// An optional per-vertex column of the mesh: `width` values per vertex, finite and not huge.
+Status check_attribute(const MeshData& mesh, const std::vector<float>& values, size_t width,
+                       const char* what) {
+  if (values.empty()) return Status::success();
+  if (values.size() != width * mesh.vertex_count())
+    return Status::error(mesh.source + ": " + std::to_string(values.size()) + " " + what + " values for " +
+                         std::to_string(mesh.vertex_count()) + " vertices (" + std::to_string(width) +
+                         " each)");
+  for (size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]) || std::abs(values[i]) > kMaxTreeMagnitude)
+      return Status::error(mesh.source + ": vertex " + std::to_string(i / width) +
+                           " has a non-finite or huge " + what);
+  return Status::success();
+}
+
 class Builder {
  public:
   Builder(const HierarchyOptions& options) : opt_(options) {}
@@ -111,12 +134,16 @@ class Builder {
   void pin_part_seams();
   void pin_attribute_seams(const MeshData& mesh, const std::vector<int32_t>& face_material);
   void renumber_passes();
+  void push_parent_normal(uint32_t a, uint32_t b, float t, const Cone& cone);
   std::vector<uint32_t> pass_start_;  // first node id made by each pass
 
   HierarchyOptions opt_;
   uint32_t leaf_count_ = 0;
   std::vector<double> pos_;  // per node
   std::vector<float> uv_;    // per node, 2 each, when the mesh has uvs
+  std::vector<float> uv1_;   // per node, 2 each, when the mesh has a second uv set
+  std::vector<float> color_;   // per node, 4 each (linear RGBA), when the mesh has colours
+  std::vector<float> normal_;  // per node, 3 each (unit or zero), when the mesh has normals
   std::vector<Quad> quad_;   // per node
   std::vector<Cone> cone_;   // per node
   std::vector<float> radius_, error_;
@@ -366,18 +393,24 @@ bool Builder::try_collapse(uint32_t a, uint32_t b) {
   parent_.push_back(kNoNode);
   parent_[a] = parent_[b] = p;
   pos_.insert(pos_.end(), cand[best], cand[best] + 3);
-  if (!uv_.empty()) {
-    // Both endpoints lie in one chart (seam copies never collapse), so their uvs interpolate.
+  quad_.push_back(q);
+  cone_.push_back(merge_cones(cone_[a], cone_[b]));
+  if (!uv_.empty() || !uv1_.empty() || !color_.empty() || !normal_.empty()) {
+    // Both endpoints lie in one chart (seam copies never collapse), so their attributes interpolate.
     const float fa[3] = {float(pa.x), float(pa.y), float(pa.z)}, fb[3] = {float(pb.x), float(pb.y), float(pb.z)};
     const float fp[3] = {float(cand[best][0]), float(cand[best][1]), float(cand[best][2])};
     const float t = edge_parameter(fa, fb, fp);
-    for (int k = 0; k < 2; ++k) {
-      const float ua = uv_[2 * size_t(a) + k], ub = uv_[2 * size_t(b) + k];
-      uv_.push_back(std::clamp((1 - t) * ua + t * ub, std::min(ua, ub), std::max(ua, ub)));
-    }
+    auto interpolate = [&](std::vector<float>& column, size_t width) {
+      for (size_t k = 0; k < width; ++k) {
+        const float ua = column[width * a + k], ub = column[width * b + k];
+        column.push_back(std::clamp((1 - t) * ua + t * ub, std::min(ua, ub), std::max(ua, ub)));
+      }
+    };
+    if (!uv_.empty()) interpolate(uv_, 2);
+    if (!uv1_.empty()) interpolate(uv1_, 2);
+    if (!color_.empty()) interpolate(color_, 4);
+    if (!normal_.empty()) push_parent_normal(a, b, t, cone_.back());
   }
-  quad_.push_back(q);
-  cone_.push_back(merge_cones(cone_[a], cone_[b]));
   const Vec pp = pos(p);
   radius_.push_back(
       static_cast<float>(std::max(length(sub(pp, pa)) + radius_[a], length(sub(pp, pb)) + radius_[b])));
@@ -464,7 +497,7 @@ void Builder::renumber_passes() {
   auto map = [&](uint32_t v) { return v == kNoNode ? kNoNode : new_of[v]; };
 
   std::vector<double> pos(pos_.size());
-  std::vector<float> uv(uv_.size());
+  std::vector<float> uv(uv_.size()), uv1(uv1_.size()), color(color_.size()), normal(normal_.size());
   std::vector<Cone> cone(n);
   std::vector<float> radius(n), error(n);
   std::vector<uint32_t> parent(n);
@@ -477,6 +510,9 @@ void Builder::renumber_passes() {
     const uint32_t o = old_of[v];
     for (int k = 0; k < 3; ++k) pos[3 * v + k] = pos_[3 * o + k];
     if (!uv_.empty()) uv[2 * size_t(v)] = uv_[2 * size_t(o)], uv[2 * size_t(v) + 1] = uv_[2 * size_t(o) + 1];
+    if (!uv1_.empty()) std::copy_n(&uv1_[2 * size_t(o)], 2, &uv1[2 * size_t(v)]);
+    if (!color_.empty()) std::copy_n(&color_[4 * size_t(o)], 4, &color[4 * size_t(v)]);
+    if (!normal_.empty()) std::copy_n(&normal_[3 * size_t(o)], 3, &normal[3 * size_t(v)]);
     cone[v] = cone_[o];
     radius[v] = radius_[o];
     error[v] = error_[o];
@@ -496,6 +532,9 @@ void Builder::renumber_passes() {
   for (uint32_t& owner : face_owner_) owner = map(owner);
   pos_.swap(pos);
   uv_.swap(uv);
+  uv1_.swap(uv1);
+  color_.swap(color);
+  normal_.swap(normal);
   cone_.swap(cone);
   radius_.swap(radius);
   error_.swap(error);
@@ -589,6 +628,25 @@ void Builder::pin_part_seams() {
     }
 }
 
+// A parent's normal: its children's interpolated along the collapse and normalised; where they
+// cancel out (opposite normals), the parent's normal-cone axis, else a child's non-zero normal.
+void Builder::push_parent_normal(uint32_t a, uint32_t b, float t, const Cone& cone) {
+  const float* na = &normal_[3 * size_t(a)];
+  const float* nb = &normal_[3 * size_t(b)];
+  double n[3];
+  for (int k = 0; k < 3; ++k) n[k] = (1 - double(t)) * na[k] + double(t) * nb[k];
+  double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(len > 1e-6)) {
+    const bool has_cone = cone.half >= 0 && length(cone.axis) > 0.5;
+    const bool a_zero = na[0] == 0 && na[1] == 0 && na[2] == 0;
+    const float* child = a_zero ? nb : na;
+    n[0] = has_cone ? cone.axis.x : child[0], n[1] = has_cone ? cone.axis.y : child[1];
+    n[2] = has_cone ? cone.axis.z : child[2];
+    len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  }
+  for (int k = 0; k < 3; ++k) normal_.push_back(len > 0 ? static_cast<float>(n[k] / len) : 0.f);
+}
+
 // Attribute seams are pinned (the simplest rule that keeps a texture whole; the discrete QEM
 // instead moves a seam pair along its seam, which a vertex split cannot express for two
 // vertices at once): copies at one position (find_position_copies, the test QEM uses) and
@@ -619,6 +677,9 @@ void Builder::finish(VertexTree& out) {
   out.positions.resize(3 * size_t(n));
   for (size_t i = 0; i < 3 * size_t(n); ++i) out.positions[i] = static_cast<float>(pos_[i]);
   out.uvs = std::move(uv_);
+  out.uvs1 = std::move(uv1_);
+  out.colors = std::move(color_);
+  out.normals = std::move(normal_);
   out.seams_pinned = true;
   out.parent = parent_;
   out.radius = radius_;
@@ -682,6 +743,9 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
   for (size_t i = 0; i < mesh.uvs.size(); ++i)
     if (!std::isfinite(mesh.uvs[i]) || std::abs(mesh.uvs[i]) > kMaxTreeMagnitude)
       return Status::error(mesh.source + ": vertex " + std::to_string(i / 2) + " has a non-finite or huge uv");
+  if (Status st = check_attribute(mesh, mesh.uvs1, 2, "uv1"); !st) return st;
+  if (Status st = check_attribute(mesh, mesh.colors, 4, "colour"); !st) return st;
+  if (Status st = check_attribute(mesh, mesh.normals, 3, "normal"); !st) return st;
   // Per input triangle its material (-1 = default), from the submesh runs.
   std::vector<int32_t> input_material;
   if (!mesh.submeshes.empty()) {
@@ -715,6 +779,13 @@ Status Builder::run(VertexTree& out, const MeshData& mesh) {
   if (!mesh.uvs.empty()) {
     uv_.reserve(4 * vc);
     uv_.assign(mesh.uvs.begin(), mesh.uvs.end());
+  }
+  if (!mesh.uvs1.empty()) uv1_.reserve(4 * vc), uv1_.assign(mesh.uvs1.begin(), mesh.uvs1.end());
+  if (!mesh.colors.empty()) color_.reserve(8 * vc), color_.assign(mesh.colors.begin(), mesh.colors.end());
+  if (!mesh.normals.empty()) {
+    normal_.reserve(6 * vc);
+    normal_.assign(mesh.normals.begin(), mesh.normals.end());
+    for (size_t v = 0; v < vc; ++v) unit_or_zero(&normal_[3 * v]);
   }
   parent_.reserve(2 * vc);
   parent_.assign(vc, kNoNode);

@@ -38,14 +38,16 @@ struct HierarchyOptions {
   uint32_t parts = 1;
 };
 
-// Builds the hierarchy of `mesh` (positions, indices, and uvs and submeshes when it has them;
-// normals are not used). Faces with a repeated corner are dropped first; face ids in `out`
-// count the faces kept, in input order. Attribute seams are pinned (VertexTree::seams_pinned:
-// vertices sharing a position, vertices between two materials' faces), and each node carries a
-// uv when the mesh has them (leaves the input's, parents interpolated along the collapse).
-// Fails (out untouched) when an index is out of range, a position or uv is not finite, the
-// uvs are not two per vertex or a submesh runs past the triangles; the message names
-// mesh.source and the element.
+// Builds the hierarchy of `mesh` (positions, indices, submeshes, and the per-vertex attributes
+// it has: uvs, uvs1, colors, normals). Faces with a repeated corner are dropped first; face ids
+// in `out` count the faces kept, in input order. Attribute seams are pinned
+// (VertexTree::seams_pinned: vertices sharing a position, so every copy made by a uv, uv1,
+// colour or normal split; vertices between two materials' faces), and each node carries every
+// attribute the mesh has (VertexTree::uvs, uvs1, colors, normals): leaves the input's (normals
+// normalised where not unit), parents interpolated along the collapse (normals renormalised).
+// Fails (out untouched) when an index is out of range, a position or attribute is not finite,
+// an attribute has not its count per vertex (2, 2, 4, 3) or a submesh runs past the triangles;
+// the message names mesh.source and the element.
 Status build_vertex_hierarchy(VertexTree& out, const MeshData& mesh, const HierarchyOptions& options = {});
 
 }  // namespace lod

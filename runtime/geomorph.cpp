@@ -32,6 +32,18 @@ void vertex_morph_init(VertexMorph& m, const VertexTree& t, float duration) {
   m.to = t.positions;
   m.from_uv = t.uvs;
   m.to_uv = t.uvs;
+  auto init = [](MorphColumn& c, const std::vector<float>& values, uint32_t width) {
+    const size_t nodes = values.size() / width;
+    c.width = values.empty() ? 0 : width;
+    c.ends.resize(2 * values.size());
+    for (size_t v = 0; v < nodes; ++v) {
+      std::copy_n(&values[width * v], width, &c.ends[2 * width * v]);
+      std::copy_n(&values[width * v], width, &c.ends[2 * width * v + width]);
+    }
+  };
+  init(m.uv1, t.uvs1, 2);
+  init(m.color, t.colors, 4);
+  init(m.normal, t.normals, 3);
   m.start.assign(t.node_count(), -std::numeric_limits<double>::infinity());
   m.duration = duration;
 }
@@ -49,15 +61,35 @@ void vertex_morph_uv(const VertexMorph& m, uint32_t v, double now, float out[2])
   for (int k = 0; k < 2; ++k) out[k] = blend(m.from_uv[2 * size_t(v) + k], m.to_uv[2 * size_t(v) + k], t);
 }
 
+// Displayed value of one node's column at `now`.
+void vertex_morph_value(const MorphColumn& c, uint32_t v, float t, float* out) {
+  const size_t w = c.width;
+  const float* e = &c.ends[2 * w * v];
+  for (size_t k = 0; k < w; ++k) out[k] = blend(e[k], e[w + k], t);
+}
+
 }  // namespace
 
 void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const FrontEvent> events, double now) {
   const bool uvs = !m.to_uv.empty();
   // Node v moves from what `shown` (a node) displays now to `target`'s own position and uv.
+  MorphColumn* const extra[3] = {&m.uv1, &m.color, &m.normal};
+  const std::vector<float>* const extra_tree[3] = {&t.uvs1, &t.colors, &t.normals};
+  const bool extras = !m.uv1.empty() || !m.color.empty() || !m.normal.empty();
   auto retarget = [&](uint32_t v, uint32_t shown, uint32_t target) {
     float here[3], here_uv[2];
     vertex_morph_position(m, shown, now, here);
     if (uvs) vertex_morph_uv(m, shown, now, here_uv);
+    // Read before anything is written: `shown` may be v itself.
+    for (int c = 0; extras && c < 3; ++c) {
+      MorphColumn& col = *extra[c];
+      if (col.empty()) continue;
+      float value[4];
+      vertex_morph_value(col, shown, morph_factor(now, m.start[shown], m.duration), value);
+      const size_t w = col.width;
+      float* e = &col.ends[2 * w * v];
+      for (size_t k = 0; k < w; ++k) e[k] = value[k], e[w + k] = (*extra_tree[c])[w * target + k];
+    }
     for (int k = 0; k < 3; ++k) m.from[3 * size_t(v) + k] = here[k], m.to[3 * size_t(v) + k] = t.positions[3 * size_t(target) + k];
     if (uvs)
       for (int k = 0; k < 2; ++k) m.from_uv[2 * size_t(v) + k] = here_uv[k], m.to_uv[2 * size_t(v) + k] = t.uvs[2 * size_t(target) + k];
@@ -82,6 +114,12 @@ void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const Fro
         for (int k = 0; k < 3; ++k) m.from[3 * size_t(e.node) + k] = m.to[3 * size_t(e.node) + k] = t.positions[3 * size_t(e.node) + k];
         if (uvs)
           for (int k = 0; k < 2; ++k) m.from_uv[2 * size_t(e.node) + k] = m.to_uv[2 * size_t(e.node) + k] = t.uvs[2 * size_t(e.node) + k];
+        for (int c = 0; extras && c < 3; ++c) {
+          MorphColumn& col = *extra[c];
+          const size_t w = col.width;
+          float* ends = col.ends.data() + 2 * w * e.node;
+          for (size_t k = 0; k < w; ++k) ends[k] = ends[w + k] = (*extra_tree[c])[w * e.node + k];
+        }
         m.start[e.node] = -std::numeric_limits<double>::infinity();
         break;
     }
@@ -99,6 +137,35 @@ size_t vertex_morph_positions(std::span<float> out, const VertexMorph& m, std::s
       out[3 * size_t(v) + k] = blend(m.from[3 * size_t(v) + k], m.to[3 * size_t(v) + k], t);
   }
   return moving;
+}
+
+void vertex_morph_column(std::span<float> out, const VertexMorph& m, const MorphColumn& c,
+                         std::span<const uint32_t> nodes, double now) {
+  assert(!c.empty());
+  for (uint32_t v : nodes) {
+    assert(c.width * size_t(v) + c.width <= out.size());
+    vertex_morph_value(c, v, morph_factor(now, m.start[v], m.duration), &out[c.width * size_t(v)]);
+  }
+}
+
+void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorph& m,
+                          std::span<const uint32_t> nodes, double now) {
+  for (const MorphOutput& o : outputs)
+    assert(!o.column->empty() && o.out.size() >= o.column->width * nodes.size());
+  // Nodes are scattered over the tree's arrays: ask for a later node's lines ahead (the loop is
+  // bound by those misses, not by its arithmetic).
+  constexpr size_t kAhead = 16;
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    if (k + kAhead < nodes.size()) {
+      const uint32_t w = nodes[k + kAhead];
+      __builtin_prefetch(&m.start[w]);
+      for (const MorphOutput& o : outputs)
+        __builtin_prefetch(&o.column->ends[2 * size_t(o.column->width) * w]);
+    }
+    const uint32_t v = nodes[k];
+    const float t = morph_factor(now, m.start[v], m.duration);
+    for (const MorphOutput& o : outputs) vertex_morph_value(*o.column, v, t, &o.out[o.column->width * k]);
+  }
 }
 
 void vertex_morph_uvs(std::span<float> out, const VertexMorph& m, std::span<const uint32_t> nodes, double now) {

@@ -26,6 +26,15 @@ void geomorph_lerp(std::span<float> out, std::span<const float> from, std::span<
 // 1 when duration <= 0.
 float morph_factor(double now, double start, float duration);
 
+// One more per-node attribute travelling with the positions (empty when the tree has none of
+// it): per node its `width` start values, then its `width` end values, side by side so that a
+// node's morph is one cache line.
+struct MorphColumn {
+  std::vector<float> ends;
+  uint32_t width = 0;
+  bool empty() const { return ends.empty(); }
+};
+
 struct VertexMorph {
   std::vector<float> from;    // xyz per node
   std::vector<float> to;      // xyz per node
@@ -33,6 +42,9 @@ struct VertexMorph {
   // same factor, so a split child's texture coordinate starts at its parent's shown one.
   std::vector<float> from_uv;
   std::vector<float> to_uv;
+  // Likewise VertexTree::uvs1, colors and normals, when the tree has them (normals blend
+  // linearly here; whoever publishes them renormalises).
+  MorphColumn uv1, color, normal;
   std::vector<double> start;  // per node, seconds
   float duration = 0.25f;     // seconds
 };
@@ -56,6 +68,21 @@ size_t vertex_morph_positions(std::span<float> out, const VertexMorph& morph, st
 // Displayed uvs of `nodes` at `now` into out (uv per node id, sized for every node), by the
 // factor their positions use. The tree must have uvs. Sub-ranges give the same result.
 void vertex_morph_uvs(std::span<float> out, const VertexMorph& morph, std::span<const uint32_t> nodes, double now);
+// The same for one of morph's columns (uv1, color, normal; must not be empty): column.width
+// floats per node id.
+void vertex_morph_column(std::span<float> out, const VertexMorph& morph, const MorphColumn& column,
+                         std::span<const uint32_t> nodes, double now);
+
+// Displayed values of several columns for `nodes` at `now`, written compactly in the order of
+// `nodes` (out holds column->width floats per node): what a frame publishes, without a per-node
+// copy to compact afterwards. The factor is computed once per node. Sub-ranges give the same
+// result.
+struct MorphOutput {
+  const MorphColumn* column = nullptr;
+  std::span<float> out;
+};
+void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorph& morph,
+                          std::span<const uint32_t> nodes, double now);
 
 // ---- discrete levels --------------------------------------------------------------------------
 

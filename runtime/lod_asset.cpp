@@ -19,6 +19,13 @@
 //       level 0's TEX0 uvs bit for bit. A reader that predates it skips it (a tree without
 //       uvs, as before); a tree without it was built before seams were pinned, which
 //       jobs/bake_jobs rebuilds when level 0 has seams or uvs.
+//       Layout 2 (since bake format 11, written only when the tree has one of them): flags bit 1
+//       (VertexTree::uvs1), bit 2 (colors), bit 3 (normals); after the uvs, with each bit, one
+//       column per VHIE node in that order: 2 f32, 4 f32 (linear RGBA), 3 f32. Layout 1 (no
+//       such bits) is written otherwise and read as before; a reader of layout 1 only refuses
+//       layout 2 as newer ("re-bake"). Sizes are checked against the section's bytes first, the
+//       columns by validate_vertex_tree_attributes, the leaves' uv1s and colours against level
+//       0's TEX1 / COL0 bit for bit.
 // MRPH (optional, flag 0; written only when the chain has morph targets): u32 per vertex of
 //       every level but the last (LodChain::morph_targets), checked like the levels' indices.
 // TEX0 (optional, flag 0; written only when the chain has texture coordinates): u32 level
@@ -52,8 +59,10 @@
 //       exports those textures' materials without them, saying so.
 // META: u64 source_hash, u32 level count, u32 name bytes, u64 vertices, u64 normal vertices,
 //       u64 indices, name. LEVL: 44 bytes per level (see put_level). POSN/NRML: 3 f32 per
-//       vertex. INDX: u32 per index. Flag bit 0 marks a section a reader must understand;
-//       unknown optional sections are skipped, so later versions can add data compatibly.
+//       vertex; NRML flag bit 1 (since bake format 11): level 0's normals are the source's own
+//       (LodChain::authored_normals; each unit or zero), older readers ignore it. INDX: u32 per
+//       index. Flag bit 0 marks a section a reader must understand; unknown optional sections
+//       are skipped, so later versions can add data compatibly.
 // The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
 #include "runtime/lod_asset.h"
 
@@ -64,6 +73,7 @@
 #include <algorithm>
 #include <bit>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <new>
 #include <string_view>
@@ -84,6 +94,8 @@ constexpr size_t kChecksumBytes = 8;
 constexpr size_t kMetaFixedBytes = 40;
 constexpr size_t kLevelBytes = 44;
 constexpr uint32_t kFlagRequired = 1;
+// NRML only: level 0's normals are the source's (LodChain::authored_normals).
+constexpr uint32_t kNrmlAuthored = 2;
 constexpr uint32_t kMaxSections = 64;
 
 constexpr uint32_t fourcc(const char (&s)[5]) {
@@ -114,8 +126,9 @@ constexpr uint32_t kImgsLayout = 1;
 constexpr size_t kVhieFixedBytes = 32;
 constexpr uint32_t kVhat = fourcc("VHAT");
 constexpr size_t kVhatFixedBytes = 16;
-constexpr uint32_t kVhatLayout = 1;
+constexpr uint32_t kVhatLayout = 2;
 constexpr uint32_t kVhatSeamsPinned = 1;
+constexpr uint32_t kVhatUvs1 = 2, kVhatColors = 4, kVhatNormals = 8;  // layout 2 only
 constexpr uint32_t kKnownTags[] = {kMeta, kLevl, kPosn, kNrml, kIndx};
 
 std::string tag_name(uint32_t tag) {
@@ -218,11 +231,17 @@ void put_hierarchy(Writer& w, const VertexTree& t) {
   put_words(w, t.inc_faces);
 }
 
+// Layout 1 while the tree has nothing past uvs (so older readers still read it), else 2.
 void put_hierarchy_attributes(Writer& w, const VertexTree& t) {
-  w.u32(kVhatLayout);
-  w.u32(t.seams_pinned ? kVhatSeamsPinned : 0);
+  const uint32_t flags = (t.seams_pinned ? kVhatSeamsPinned : 0) | (t.uvs1.empty() ? 0 : kVhatUvs1) |
+                         (t.colors.empty() ? 0 : kVhatColors) | (t.normals.empty() ? 0 : kVhatNormals);
+  w.u32(flags & ~kVhatSeamsPinned ? 2 : 1);
+  w.u32(flags);
   w.u64(t.uvs.size() / 2);
   put_words(w, t.uvs);
+  put_words(w, t.uvs1);
+  put_words(w, t.colors);
+  put_words(w, t.normals);
 }
 
 struct SectionRef {
@@ -245,30 +264,84 @@ Status get_hierarchy_attributes(const uint8_t* p, uint64_t size, uint64_t nodes,
     return bad("layout " + std::to_string(layout) + " is newer than this build reads (" + std::to_string(kVhatLayout) +
                "); use a newer lodkit or re-bake it");
   if (layout == 0) return bad("layout 0 does not exist");
-  if (flags & ~kVhatSeamsPinned) return bad("unknown flags " + std::to_string(flags));
+  const uint32_t known =
+      layout == 1 ? kVhatSeamsPinned : kVhatSeamsPinned | kVhatUvs1 | kVhatColors | kVhatNormals;
+  if (flags & ~known)
+    return bad("unknown flags " + std::to_string(flags) + " for layout " + std::to_string(layout));
   if (count != 0 && count != nodes)
     return bad("uvs for " + std::to_string(count) + " nodes, the hierarchy has " + std::to_string(nodes));
-  if (count > (size - kVhatFixedBytes) / 8 || size != kVhatFixedBytes + 8 * count)
-    return bad(std::to_string(size) + " bytes but " + std::to_string(count) + " nodes need " +
-               std::to_string(kVhatFixedBytes) + " + 8 each (truncated?)");
-  get_words(p + kVhatFixedBytes, 2 * count, t.uvs);
+  // Bytes per node of the layout-2 columns; nodes is bounded by VHIE's bytes, so no overflow.
+  const uint64_t per_node =
+      (flags & kVhatUvs1 ? 8 : 0) + (flags & kVhatColors ? 16 : 0) + (flags & kVhatNormals ? 12 : 0);
+  if (count > (size - kVhatFixedBytes) / 8 || per_node * nodes > size - kVhatFixedBytes - 8 * count ||
+      size != kVhatFixedBytes + 8 * count + per_node * nodes)
+    return bad(std::to_string(size) + " bytes but " + std::to_string(count) + " uv nodes need " +
+               std::to_string(kVhatFixedBytes) + " + 8 each" +
+               (per_node
+                    ? " and its flags " + std::to_string(per_node) + " per node of " + std::to_string(nodes)
+                    : "") +
+               " (truncated?)");
+  const uint8_t* q = p + kVhatFixedBytes;
+  get_words(q, 2 * count, t.uvs);
+  q += 8 * count;
+  auto take = [&](uint32_t flag, uint64_t width, std::vector<float>& column) {
+    if (!(flags & flag)) return;
+    get_words(q, width * nodes, column);
+    q += 4 * width * nodes;
+  };
+  take(kVhatUvs1, 2, t.uvs1);
+  take(kVhatColors, 4, t.colors);
+  take(kVhatNormals, 3, t.normals);
   t.seams_pinned = (flags & kVhatSeamsPinned) != 0;
   return Status::success();
 }
 
-// Leaves are level 0's vertices: their uvs must be its uvs, bit for bit.
-Status check_leaf_uvs(const LodChain& chain, const std::string& what) {
+// Leaves are level 0's vertices: their uvs (either set) and colours must be its, bit for bit.
+Status check_leaf_column(const LodChain& chain, const std::vector<float>& tree_values,
+                         const std::vector<float>& level_values, size_t width, const char* what,
+                         const char* section, const std::string& where) {
   const VertexTree& t = chain.hierarchy;
-  if (t.uvs.empty()) return Status::success();
-  if (chain.uvs.empty() || chain.levels.empty())
-    return refuse(what, "VHAT section: the hierarchy has uvs but the levels have none (TEX0)");
-  const size_t first = 2 * size_t(chain.levels[0].first_vertex);
-  if (std::memcmp(t.uvs.data(), chain.uvs.data() + first, 8 * size_t(t.leaf_count)) == 0) return Status::success();
+  if (tree_values.empty()) return Status::success();
+  if (level_values.empty() || chain.levels.empty())
+    return refuse(where, std::string("VHAT section: the hierarchy has ") + what +
+                             "s but the levels have none (" + section + ")");
+  const size_t first = width * size_t(chain.levels[0].first_vertex);
+  const size_t bytes = 4 * width;
+  if (std::memcmp(tree_values.data(), level_values.data() + first, bytes * t.leaf_count) == 0)
+    return Status::success();
   for (uint32_t v = 0; v < t.leaf_count; ++v)
-    if (std::memcmp(&t.uvs[2 * size_t(v)], &chain.uvs[first + 2 * size_t(v)], 8) != 0)
-      return refuse(what, "VHAT section: leaf " + std::to_string(v) + " uv differs from level 0 vertex " +
-                              std::to_string(v) + "'s");
+    if (std::memcmp(&tree_values[width * v], &level_values[first + width * v], bytes) != 0)
+      return refuse(where, "VHAT section: leaf " + std::to_string(v) + " " + what +
+                               " differs from level 0 vertex " + std::to_string(v) + "'s");
   return Status::success();
+}
+
+// Authored normals at level 0 (what a tree's leaves carry): unit or zero, as the tree's are.
+Status check_authored_normals(const LodChain& chain, const std::string& what) {
+  if (chain.levels.empty()) return Status::success();
+  const LodLevel& l0 = chain.levels[0];
+  for (uint32_t v = 0; v < l0.vertex_count; ++v) {
+    const float* n = &chain.normals[3 * (size_t(l0.first_vertex) + v)];
+    const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
+    if (len != 0 && std::abs(len - 1) > kTreeNormalTolerance)
+      return refuse(what, "NRML section: level 0 vertex " + std::to_string(v) +
+                              " authored normal has length " + std::to_string(len) + ", not 1 or 0");
+  }
+  return Status::success();
+}
+
+Status check_leaf_attributes(const LodChain& chain, const std::string& what) {
+  const VertexTree& t = chain.hierarchy;
+  if (!t.normals.empty()) {
+    if (!chain.authored_normals)
+      return refuse(what,
+                    "VHAT section: the hierarchy has normals but level 0's are not authored (NRML flags)");
+    if (Status st = check_leaf_column(chain, t.normals, chain.normals, 3, "normal", "NRML", what); !st)
+      return st;
+  }
+  if (Status st = check_leaf_column(chain, t.uvs, chain.uvs, 2, "uv", "TEX0", what); !st) return st;
+  if (Status st = check_leaf_column(chain, t.uvs1, chain.uvs1, 2, "uv1", "TEX1", what); !st) return st;
+  return check_leaf_column(chain, t.colors, chain.colors, 4, "colour", "COL0", what);
 }
 
 Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, VertexTree& out,
@@ -315,11 +388,13 @@ Status get_hierarchy(const uint8_t* p, uint64_t size, const std::string& what, V
     if (Status st = get_hierarchy_attributes(file + attributes->offset, attributes->size, nodes, what, t); !st)
       return st;
   std::string message;
-  std::vector<float> uvs = std::move(t.uvs);
-  t.uvs.clear();
+  VertexTree columns;  // validated apart, so a bad one is named as VHAT's
+  columns.uvs.swap(t.uvs), columns.uvs1.swap(t.uvs1), columns.colors.swap(t.colors);
+  columns.normals.swap(t.normals);
   if (!validate_vertex_tree(t, &message)) return refuse(what, "VHIE section: " + message);
-  t.uvs = std::move(uvs);
-  if (!t.uvs.empty() && !validate_vertex_tree_uvs(t, &message)) return refuse(what, "VHAT section: " + message);
+  t.uvs.swap(columns.uvs), t.uvs1.swap(columns.uvs1), t.colors.swap(columns.colors);
+  t.normals.swap(columns.normals);
+  if (!validate_vertex_tree_attributes(t, &message)) return refuse(what, "VHAT section: " + message);
   pack_vertex_bounds(t);
   out = std::move(t);
   return Status::success();
@@ -542,7 +617,10 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   Writer w;
   std::vector<uint32_t> tags = {kMeta, kLevl, kPosn, kNrml, kIndx};
   if (!chain.hierarchy.empty()) tags.push_back(kVhie);
-  if (!chain.hierarchy.empty() && (chain.hierarchy.seams_pinned || !chain.hierarchy.uvs.empty())) tags.push_back(kVhat);
+  if (!chain.hierarchy.empty() &&
+      (chain.hierarchy.seams_pinned || !chain.hierarchy.uvs.empty() || !chain.hierarchy.uvs1.empty() ||
+       !chain.hierarchy.colors.empty() || !chain.hierarchy.normals.empty()))
+    tags.push_back(kVhat);
   if (!chain.morph_targets.empty()) tags.push_back(kMrph);
   if (!chain.uvs.empty()) tags.push_back(kTex0);
   if (!chain.uvs1.empty()) tags.push_back(kTex1);
@@ -557,9 +635,10 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   for (uint32_t s = 0; s < section_count; ++s) {
     w.u32(tags[s]);
     w.u32(tags[s] == kVhie || tags[s] == kVhat || tags[s] == kMrph || tags[s] == kTex0 || tags[s] == kTex1 ||
-                   tags[s] == kCol0 || tags[s] == kMatl || tags[s] == kImgs
-               ? 0
-               : kFlagRequired);
+                  tags[s] == kCol0 || tags[s] == kMatl || tags[s] == kImgs
+              ? 0
+          : tags[s] == kNrml && chain.authored_normals ? kFlagRequired | kNrmlAuthored
+                                                       : kFlagRequired);
     w.u64(0);  // offset, patched below
     w.u64(0);  // size
   }
@@ -661,6 +740,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
 
   SectionRef sec[5];
   SectionRef vhie, vhat, mrph, tex0, tex1, col0, matl, imgs;
+  uint32_t nrml_flags = 0;
   for (uint32_t s = 0; s < section_count; ++s) {
     const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
     const uint32_t tag = load_u32(e), flags = load_u32(e + 4);
@@ -710,6 +790,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
     }
     if (sec[known].present) return refuse(what, name + " appears twice");
     sec[known] = {off, sz, true};
+    if (tag == kNrml) nrml_flags = flags;
   }
   for (size_t k = 0; k < 5; ++k) {
     if (!sec[k].present) return refuse(what, "section '" + tag_name(kKnownTags[k]) + "' is missing");
@@ -780,6 +861,9 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
   std::string message;
   const char* section = "LEVL";
   if (!validate_chain(chain, &message, &section)) return refuse(what, std::string(section) + " section: " + message);
+  chain.authored_normals = (nrml_flags & kNrmlAuthored) != 0;
+  if (chain.authored_normals)
+    if (Status st = check_authored_normals(chain, what); !st) return st;
   if (vhat.present && !vhie.present) return refuse(what, "VHAT section without a hierarchy (VHIE)");
   if (vhie.present) {
     if (Status st = get_hierarchy(p + vhie.offset, vhie.size, what, chain.hierarchy, vhat.present ? &vhat : nullptr, p);
@@ -791,7 +875,7 @@ Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what,
       return refuse(what, "VHIE section: hierarchy has " + leaves + " leaves but level 0 has " +
                               std::to_string(chain.levels[0].vertex_count) + " vertices");
     }
-    if (Status st = check_leaf_uvs(chain, what); !st) return st;
+    if (Status st = check_leaf_attributes(chain, what); !st) return st;
   }
   out = std::move(chain);
   return Status::success();

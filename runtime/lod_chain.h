@@ -37,6 +37,9 @@ struct LodChain {
   std::vector<LodLevel> levels;    // 0 = full detail, then coarser
   std::vector<float> positions;    // xyz per vertex, all levels back to back
   std::vector<float> normals;      // xyz per vertex, same count as positions
+  // Level 0's normals are the source's own (unit or zero), not computed from its faces (coarser
+  // levels' always are); the vertex hierarchy then carries them. NRML's flag bit 1.
+  bool authored_normals = false;
   std::vector<uint32_t> indices;   // level-local vertex indices, all levels back to back
   // Optional texture coordinates (empty = none): uv per vertex (glTF's convention, origin top
   // left), laid out like positions; kept through every level by the simplifier (seams kept closed).

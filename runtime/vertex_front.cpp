@@ -1190,6 +1190,46 @@ uint32_t fronts_compact_uvs(std::span<float> uvs, std::span<const VertexFront* c
   return nv;
 }
 
+uint32_t front_compact_column(std::span<float> out, size_t width, const VertexFront& f,
+                              std::span<const float> per_node) {
+  assert(out.size() >= width * size_t(f.active_count));
+  for (uint32_t k = 0; k < f.active_count; ++k) {
+    assert(width * size_t(f.active[k]) + width <= per_node.size());
+    std::copy_n(per_node.data() + width * size_t(f.active[k]), width, out.data() + width * size_t(k));
+  }
+  return f.active_count;
+}
+
+uint32_t fronts_compact_nodes(std::span<uint32_t> nodes, std::span<const VertexFront* const> fronts) {
+  uint32_t nv = 0;
+  for (size_t r = 0; r < fronts.size(); ++r) {
+    const VertexFront& f = *fronts[r];
+    for (uint32_t k = 0; k < f.active_count; ++k) {
+      const uint32_t v = f.active[k];
+      if (r > 0 && f.numbering && f.numbering->region[v] == kSharedRegion) continue;
+      assert(nv < nodes.size());
+      nodes[nv++] = v;
+    }
+  }
+  return nv;
+}
+
+uint32_t fronts_compact_column(std::span<float> out, size_t width, std::span<const VertexFront* const> fronts,
+                               std::span<const float> per_node) {
+  uint32_t nv = 0;
+  // The vertex order of fronts_compact_mesh: fixed leaves once, from the first front.
+  for (size_t r = 0; r < fronts.size(); ++r) {
+    const VertexFront& f = *fronts[r];
+    for (uint32_t k = 0; k < f.active_count; ++k) {
+      const uint32_t v = f.active[k];
+      if (r > 0 && f.numbering && f.numbering->region[v] == kSharedRegion) continue;
+      assert(out.size() >= width * size_t(nv + 1) && width * size_t(v) + width <= per_node.size());
+      std::copy_n(per_node.data() + width * size_t(v), width, out.data() + width * size_t(nv++));
+    }
+  }
+  return nv;
+}
+
 bool check_triangles(std::span<const uint32_t> indices, uint32_t vertex_count, EdgeCheck edges,
                      std::string* message) {
   auto fail = [&](std::string text) {

@@ -250,6 +250,16 @@ uint32_t front_compact_uvs(std::span<float> uvs, const VertexFront& front, const
                            std::span<const float> shown_uvs);
 uint32_t fronts_compact_uvs(std::span<float> uvs, std::span<const VertexFront* const> fronts, const VertexTree& tree,
                             std::span<const float> shown_uvs);
+// The same for any per-node column of `width` floats (VertexTree::uvs1, colors, normals):
+// `per_node` holds width floats per node id, `out` width per written vertex. Return the
+// vertices written.
+uint32_t front_compact_column(std::span<float> out, size_t width, const VertexFront& front,
+                              std::span<const float> per_node);
+uint32_t fronts_compact_column(std::span<float> out, size_t width, std::span<const VertexFront* const> fronts,
+                               std::span<const float> per_node);
+// The node id of every vertex fronts_compact_mesh writes, in its order (`nodes` holds the summed
+// active vertices less the repeated fixed ones). Returns the count written.
+uint32_t fronts_compact_nodes(std::span<uint32_t> nodes, std::span<const VertexFront* const> fronts);
 
 // Checks a plain indexed triangle list: indices < vertex_count, no repeated corner; from
 // `oriented` on each directed edge at most once; with `closed` every edge also used the other

@@ -53,4 +53,20 @@ uint32_t area_weighted_normals(std::span<float> normals, std::span<const float> 
   return normalize_sums(normals);
 }
 
+uint32_t renormalise(std::span<float> normals) {
+  uint32_t unit = 0;
+  for (size_t v = 0; v + 2 < normals.size(); v += 3) {
+    float* n = &normals[v];
+    const float len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (len2 > 0 && std::isfinite(len2)) {
+      const float inv = 1.f / std::sqrt(len2);
+      n[0] *= inv, n[1] *= inv, n[2] *= inv;
+      ++unit;
+    } else {
+      n[0] = n[1] = n[2] = 0;
+    }
+  }
+  return unit;
+}
+
 }  // namespace lod

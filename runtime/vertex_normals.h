@@ -16,4 +16,9 @@ namespace lod {
 uint32_t area_weighted_normals(std::span<float> normals, std::span<const float> positions,
                                std::span<const uint32_t> indices);
 
+// Normalises every xyz triple of `normals` in place (geomorphed authored normals: a linear blend
+// of two unit normals is shorter); a zero or non-finite one becomes (0, 0, 0). Returns the
+// number made unit. Sub-ranges give the same result.
+uint32_t renormalise(std::span<float> normals);
+
 }  // namespace lod

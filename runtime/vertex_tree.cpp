@@ -128,26 +128,55 @@ bool check_collapse_order(const VertexTree& t, std::string* message) {
 
 }  // namespace
 
-// Uvs: one pair per node, finite, and a parent's inside its children's box (what interpolating
-// along the collapse gives): so no node's texture coordinate leaves the range of its leaves'.
-bool validate_vertex_tree_uvs(const VertexTree& t, std::string* message) {
+namespace {
+
+// One optional column of `width` values per node: finite, and (boxed) a parent's inside its
+// children's box, what interpolating along the collapse and clamping gives.
+bool check_node_column(const VertexTree& t, const std::vector<float>& values, size_t width, const char* what,
+                       bool boxed, std::string* message) {
   const size_t n = t.parent.size();
-  if (t.uvs.size() != 2 * n)
-    return fail(message, "hierarchy uvs hold " + num(t.uvs.size()) + " values, expected " + num(2 * n));
-  for (size_t i = 0; i < 2 * n; ++i)
-    if (!std::isfinite(t.uvs[i]) || std::abs(t.uvs[i]) > kMaxTreeMagnitude)
-      return fail(message, "node " + num(i / 2) + " has a non-finite or huge uv");
+  if (values.size() != width * n)
+    return fail(message, std::string("hierarchy ") + what + "s hold " + num(values.size()) +
+                             " values, expected " + num(width * n));
+  for (size_t i = 0; i < width * n; ++i)
+    if (!std::isfinite(values[i]) || std::abs(values[i]) > kMaxTreeMagnitude)
+      return fail(message, "node " + num(i / width) + " has a non-finite or huge " + what);
   if (n < t.leaf_count || t.children.size() != 2 * (n - t.leaf_count))
     return fail(message, "hierarchy children do not match its nodes");
   for (size_t i = 0; i < n - t.leaf_count; ++i) {
     const uint32_t a = t.children[2 * i], b = t.children[2 * i + 1];
     if (a >= n || b >= n) return fail(message, "node " + num(t.leaf_count + i) + " has a child out of range");
-    for (int k = 0; k < 2; ++k) {
-      const float u = t.uvs[2 * (t.leaf_count + i) + k], ua = t.uvs[2 * size_t(a) + k], ub = t.uvs[2 * size_t(b) + k];
+    if (!boxed) continue;
+    for (size_t k = 0; k < width; ++k) {
+      const float u = values[width * (t.leaf_count + i) + k], ua = values[width * a + k],
+                  ub = values[width * b + k];
       if (u < std::min(ua, ub) || u > std::max(ua, ub))
-        return fail(message, "node " + num(t.leaf_count + i) + " uv lies outside its children's (" + num(a) +
-                                 ", " + num(b) + ")");
+        return fail(message, "node " + num(t.leaf_count + i) + " " + what + " lies outside its children's (" +
+                                 num(a) + ", " + num(b) + ")");
     }
+  }
+  return true;
+}
+
+}  // namespace
+
+// Uvs: one pair per node, finite, and a parent's inside its children's box (what interpolating
+// along the collapse gives): so no node's texture coordinate leaves the range of its leaves'.
+bool validate_vertex_tree_uvs(const VertexTree& t, std::string* message) {
+  return check_node_column(t, t.uvs, 2, "uv", true, message);
+}
+
+bool validate_vertex_tree_attributes(const VertexTree& t, std::string* message) {
+  if (!t.uvs.empty() && !validate_vertex_tree_uvs(t, message)) return false;
+  if (!t.uvs1.empty() && !check_node_column(t, t.uvs1, 2, "uv1", true, message)) return false;
+  if (!t.colors.empty() && !check_node_column(t, t.colors, 4, "colour", true, message)) return false;
+  if (t.normals.empty()) return true;
+  if (!check_node_column(t, t.normals, 3, "normal", false, message)) return false;
+  for (size_t v = 0; v < t.parent.size(); ++v) {
+    const float* q = &t.normals[3 * v];
+    const double len = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2]);
+    if (len != 0 && std::abs(len - 1) > kTreeNormalTolerance)
+      return fail(message, "node " + num(v) + " normal has length " + std::to_string(len) + ", not 1 or 0");
   }
   return true;
 }
@@ -250,7 +279,7 @@ bool validate_vertex_tree(const VertexTree& t, std::string* message) {
         return fail(message, "face " + num(f) + " owner " + num(o) + " does not list it");
     }
   }
-  if (!t.uvs.empty() && !validate_vertex_tree_uvs(t, message)) return false;
+  if (!validate_vertex_tree_attributes(t, message)) return false;
   return check_collapse_order(t, message);
 }
 

@@ -55,6 +55,16 @@ struct VertexTree {
   // parent's interpolated along its collapse (edge_parameter) and so inside its children's
   // range. Stored in the asset's optional VHAT section.
   std::vector<float> uvs;
+  // Optional, likewise per node (empty = none): the second uv set (glTF TEXCOORD_1, 2 each) and
+  // vertex colours (glTF COLOR_0, linear RGBA, 4 each), leaves the input's bit for bit, a
+  // parent's interpolated along its collapse and clamped to its children's range as uvs are;
+  // and authored normals (3 each): leaves the input's (bit for bit when unit or zero; others
+  // normalised), a parent's the normalised interpolation of its children's (their cone axis,
+  // else a non-zero child's, when that cancels out); every one unit or zero. Stored in VHAT
+  // (layout 2).
+  std::vector<float> uvs1;
+  std::vector<float> colors;
+  std::vector<float> normals;
   // Built with attribute seams pinned: every vertex that shares its position with another (one
   // copy per side of a uv, normal or material seam) and every vertex between faces of two
   // materials is a root, never collapsed, so no collapse smears a texture across a seam or
@@ -106,12 +116,19 @@ inline constexpr float kMaxTreeMagnitude = 1e18f;
 // kMaxTreeMagnitude, and replays the collapses in node order: split faces, wings, incident
 // faces and dependencies must be exactly what each collapse makes (what front_update and its
 // forced splits rely on). With uvs: two per node, finite, each parent's within the box of its
-// children's. Linear in the arrays. On failure `message` names the element
-// ("node 812 child 90211 of 35947"); callers prefix the file.
+// children's; the other attributes as validate_vertex_tree_attributes says. Linear in the
+// arrays. On failure `message` names the element ("node 812 child 90211 of 35947"); callers
+// prefix the file.
 bool validate_vertex_tree(const VertexTree& tree, std::string* message);
 // The uv part of it alone, for a tree whose other arrays passed (asset readers name the two
 // sections apart).
 bool validate_vertex_tree_uvs(const VertexTree& tree, std::string* message);
+// Every optional per-node attribute the tree has (uvs, uvs1, colors, normals), for a tree whose
+// other arrays passed: uvs1 and colours like uvs (2 and 4 per node, finite, a parent's inside
+// its children's box), normals 3 per node, finite, each of length 1 (within
+// kTreeNormalTolerance) or exactly 0. validate_vertex_tree checks them too.
+bool validate_vertex_tree_attributes(const VertexTree& tree, std::string* message);
+inline constexpr float kTreeNormalTolerance = 1e-3f;
 
 // Fills tree.bounds from the per-node arrays. Builders and readers call it; fronts need it.
 void pack_vertex_bounds(VertexTree& tree);

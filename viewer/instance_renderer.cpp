@@ -27,7 +27,7 @@ layout(location = 5) in vec3 a_target_position;
 layout(location = 6) in vec3 a_target_normal;
 layout(location = 7) in vec2 a_uv;
 layout(location = 8) in vec2 a_target_uv;
-layout(location = 9) in vec4 a_color;  // COLOR_0 (HLOD nodes that have them), linear RGBA
+layout(location = 9) in vec4 a_colour;  // vertex colour (glTF COLOR_0), white when a mesh has none
 uniform mat4 u_view;
 uniform mat4 u_projection;
 uniform int u_blend;
@@ -35,7 +35,7 @@ out vec3 v_position_view;
 out vec3 v_normal_view;
 out float v_morph;
 out vec2 v_uv;
-out vec4 v_color;
+out vec4 v_colour;
 // q v q* for a unit quaternion, without building a matrix.
 vec3 rotate(vec4 q, vec3 v) {
   vec3 t = 2.0 * cross(q.xyz, v);
@@ -52,7 +52,7 @@ void main() {
   v_normal_view = mat3(u_view) * rotate(q, n);
   v_morph = i_morph_weight.x;
   v_uv = u_blend != 0 ? mix(a_uv, a_target_uv, w) : a_uv;
-  v_color = a_color;
+  v_colour = a_colour;
   gl_Position = u_projection * view_pos;
 }
 )";
@@ -62,12 +62,12 @@ in vec3 v_position_view;
 in vec3 v_normal_view;
 in float v_morph;
 in vec2 v_uv;
-in vec4 v_color;
+in vec4 v_colour;
 uniform vec3 u_colour;        // a material's base colour factor (rgb) or the mode's colour
 uniform float u_alpha;        // the factor's alpha
 uniform float u_alpha_cutoff; // alpha mode MASK: fragments below are dropped; < 0 otherwise
 uniform int u_textured;
-uniform int u_vertex_colours;  // glTF: base colour = factor x texture x COLOR_0
+uniform int u_vertex_colours;  // glTF: base colour = factor x texture x COLOR_0 (not in colour-by-level modes)
 uniform sampler2D u_texture;  // base colour (sRGB, read as linear), unit 0
 uniform int u_normal_mapped;
 uniform sampler2D u_normal_texture;  // tangent-space normals, unit 1
@@ -145,7 +145,7 @@ void main() {
   vec3 to_eye = normalize(-v_position_view);
   vec4 surface = vec4(u_colour, u_alpha);
   if (u_textured != 0) surface *= base_texel;
-  if (u_vertex_colours != 0) surface *= v_color;
+  if (u_vertex_colours != 0) surface *= v_colour;  // glTF: COLOR_0 multiplies the base colour
   if (surface.a < u_alpha_cutoff) discard;
   if (u_pbr != 0) {
     if (dot(n, to_eye) < 0.0) n = -n;  // two-sided: the side seen is lit (no culling, mixed windings)
@@ -371,6 +371,7 @@ void InstanceRenderer::bind_vd_meshes(const VdMeshBuffers& vd, const std::array<
   glBindVertexArray(vd.vao());
   glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);
   glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  glVertexAttrib4f(kAttribColor, 1.f, 1.f, 1.f, 1.f);
   set_plain_surface(colour);
 }
 
@@ -386,8 +387,11 @@ void InstanceRenderer::draw_vd_object(const DrawList& list, const VdDraw& d, con
     glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(size_t(first_index) * sizeof(uint32_t)), GLint(d.first_vertex));
   };
+  // The frame's colour stream is white for objects without COLOR_0; colour-by-level modes skip it.
+  glUniform1i(u_vertex_colours_, draws_materials(settings) ? 1 : 0);
   if (!draws_materials(settings) || d.run_count == 0) {
     if (pass == RunPass::opaque) draw(d.first_index, d.index_count);
+    glUniform1i(u_vertex_colours_, 0);
     return;
   }
   // Run by run with its material, as the levels are drawn (the frame grouped them).
@@ -402,6 +406,7 @@ void InstanceRenderer::draw_vd_object(const DrawList& list, const VdDraw& d, con
     }
     draw(run.first_index, run.index_count);
   }
+  glUniform1i(u_vertex_colours_, 0);
   set_plain_surface(colour);
 }
 
@@ -415,6 +420,7 @@ void InstanceRenderer::set_frame_uniforms(const glm::mat4& view, const glm::mat4
   glUniform1i(u_show_morph_, 0);
   glUniform1i(u_blend_, 0);
   glUniform1i(u_vertex_colours_, 0);
+  glVertexAttrib4f(kAttribColor, 1.f, 1.f, 1.f, 1.f);  // level meshes carry no colour stream: white
   const glm::vec3 sun = glm::normalize(glm::mat3(view) * glm::normalize(kSunDirection));
   const glm::vec3 up = glm::normalize(glm::mat3(view) * glm::vec3(0, 1, 0));
   glUniform3f(u_sun_view_, sun.x, sun.y, sun.z);
@@ -591,6 +597,7 @@ void InstanceRenderer::begin_mesh_draws(const glm::mat4& view, const glm::mat4& 
   set_frame_uniforms(view, projection, settings);
   glVertexAttrib3f(kAttribNormal, 0.f, 0.f, 0.f);  // meshes without normals: face normals
   glVertexAttrib2f(kAttribUv, 0.f, 0.f);
+  glVertexAttrib4f(kAttribColor, 1.f, 1.f, 1.f, 1.f);  // meshes without colours: white
   set_plain_surface(kModelColour);
   if (settings.count_primitives) glBeginQuery(GL_PRIMITIVES_GENERATED, query_);
 }

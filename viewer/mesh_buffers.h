@@ -22,7 +22,7 @@ inline constexpr GLuint kAttribTargetPosition = 5;         // morph target strea
 inline constexpr GLuint kAttribTargetNormal = 6;
 inline constexpr GLuint kAttribUv = 7;
 inline constexpr GLuint kAttribTargetUv = 8;            // morph target stream (MorphBuffers)
-inline constexpr GLuint kAttribColor = 9;               // COLOR_0 (HLOD nodes with vertex colours)
+inline constexpr GLuint kAttribColor = 9;  // linear RGBA COLOR_0 (HLOD nodes, vd meshes); constant white elsewhere
 
 // A static mesh in its own VAO: positions then normals (when `normals` is not empty) in one
 // VBO, indices in an IBO; the per-object attributes stay disabled, so the instance shader reads

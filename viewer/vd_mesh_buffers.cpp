@@ -20,6 +20,7 @@ VdMeshBuffers::~VdMeshBuffers() {
   if (ibo_) glDeleteBuffers(1, &ibo_);
   if (uv_vbo_) glDeleteBuffers(1, &uv_vbo_);
   if (normal_vbo_) glDeleteBuffers(1, &normal_vbo_);
+  if (color_vbo_) glDeleteBuffers(1, &color_vbo_);
   if (vbo_) glDeleteBuffers(1, &vbo_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
@@ -30,6 +31,7 @@ void VdMeshBuffers::init() {
   glGenBuffers(1, &ibo_);
   glGenBuffers(1, &uv_vbo_);
   glGenBuffers(1, &normal_vbo_);
+  glGenBuffers(1, &color_vbo_);
   glBindVertexArray(vao_);
   glBindBuffer(GL_ARRAY_BUFFER, vbo_);
   glEnableVertexAttribArray(kAttribPosition);
@@ -64,6 +66,15 @@ void VdMeshBuffers::upload(const Frame& frame) {
     glVertexAttribPointer(kAttribUv, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
   } else {
     glDisableVertexAttribArray(kAttribUv);
+  }
+  // Colours likewise (objects without them were given white by the frame).
+  if (!frame.vd_colors.empty() && 3 * frame.vd_colors.size() == 4 * frame.vd_positions.size()) {
+    glBindBuffer(GL_ARRAY_BUFFER, color_vbo_);
+    stream(GL_ARRAY_BUFFER, frame.vd_colors.size() * sizeof(float), frame.vd_colors.data(), color_capacity_);
+    glEnableVertexAttribArray(kAttribColor);
+    glVertexAttribPointer(kAttribColor, 4, GL_FLOAT, GL_FALSE, 4 * sizeof(float), nullptr);
+  } else {
+    glDisableVertexAttribArray(kAttribColor);
   }
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);

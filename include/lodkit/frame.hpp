@@ -23,9 +23,13 @@ inline constexpr std::size_t kHistogramLevels = 32;  // histogram bins by l = ro
 
 // One view-dependent object's active mesh in a Frame (runtime/vertex_front.h): what a renderer
 // draws instead of a discrete level. Positions are object space and already geomorphed.
-// Frame::vd_normals holds a smooth normal per vertex computed from the shown (geomorphed) faces,
-// so shading morphs with the shape and hard edges (split vertex copies) stay hard.
-// With uvs (has_uvs), Frame::vd_uvs holds one per vertex, geomorphed with the positions; with
+// Frame::vd_normals holds a unit (or zero) normal per vertex: with authored normals in the tree
+// (has_authored_normals), its geomorphed normals renormalised; else a smooth normal computed
+// from the shown (geomorphed) faces, so shading morphs with the shape and hard edges (split
+// vertex copies) stay hard.
+// With uvs (has_uvs), Frame::vd_uvs holds one per vertex, geomorphed with the positions; so do
+// Frame::vd_uvs1 (glTF TEXCOORD_1, has_uvs1) and Frame::vd_colors (glTF COLOR_0, linear RGBA,
+// has_colors; multiply it into the base colour, as glTF does); with
 // materials, the object's triangles come grouped by material, run_count runs from first_run of
 // Frame::vd_runs (in material order), which cover its indices in order.
 struct VdRunFrame {
@@ -47,6 +51,9 @@ struct VdObjectFrame {
   bool closed = false;        // the object's full mesh is closed (every edge in two faces)
   bool oriented = false;      // ... consistently oriented (each directed edge once)
   bool has_uvs = false;       // its vertices' uvs are in Frame::vd_uvs
+  bool has_uvs1 = false;      // ... second uvs in Frame::vd_uvs1
+  bool has_colors = false;    // ... colours in Frame::vd_colors
+  bool has_authored_normals = false;  // Frame::vd_normals are the tree's (authored), not computed
   uint32_t first_run = 0;     // into Frame::vd_runs; run_count == 0: no materials (one surface)
   uint32_t run_count = 0;
 };
@@ -134,8 +141,12 @@ struct Frame {
   std::vector<float> vd_positions;   // xyz per vertex, all vd objects back to back
   std::vector<uint32_t> vd_indices;  // all vd objects back to back
   std::vector<float> vd_uvs;         // uv per vertex like vd_positions when any vd object has uvs (else empty; 0 for those without)
-  std::vector<float> vd_normals;     // unit normal per vertex like vd_positions, from the shown faces
-                                     // (area weighted; (0, 0, 0) where every face is degenerate)
+  std::vector<float> vd_uvs1;        // TEXCOORD_1 per vertex, as vd_uvs (0 for objects without)
+  std::vector<float> vd_colors;      // linear RGBA per vertex when any vd object has colours (else
+                                     // empty; white (1, 1, 1, 1) for those without)
+  std::vector<float> vd_normals;     // unit normal per vertex like vd_positions: the tree's authored
+                                     // ones geomorphed and renormalised when it has them, else from
+                                     // the shown faces (area weighted); (0, 0, 0) where none is known
   std::vector<VdRunFrame> vd_runs;   // material runs of the vd objects with materials
   uint64_t vd_active_tris = 0;
   uint64_t vd_splits = 0;

@@ -18,6 +18,10 @@
 //   BM_CompactMesh         the vd_mesh stage's copy of a ~200k-triangle front into a frame (baseline)
 //   BM_CompactMeshNormals  the same plus the smooth normals the frame now carries
 //                          (runtime/vertex_normals.h); the ratio is the stage's cost of normals
+//   BM_CompactMeshAttributes  the same copy plus what a tree with TEXCOORD_1, colours and
+//                          authored normals adds: each geomorphed straight into the frame's
+//                          arrays, the normals renormalised (instead of computed from faces);
+//                          ratio to BM_CompactMeshNormals = the stage's cost of those columns
 #include <benchmark/benchmark.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
@@ -33,6 +37,7 @@
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
 #include "preprocess/vertex_hierarchy.h"
+#include "runtime/geomorph.h"
 #include "runtime/vertex_front.h"
 #include "runtime/vertex_normals.h"
 #include "test_support.h"
@@ -196,6 +201,42 @@ void BM_CompactMesh(benchmark::State& state) { compact_front(state, false); }
 void BM_CompactMeshNormals(benchmark::State& state) { compact_front(state, true); }
 BENCHMARK(BM_CompactMesh)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
 BENCHMARK(BM_CompactMeshNormals)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+
+// The frame graph's per-frame work for a tree with uvs1, colours and normals (values are
+// arbitrary: only the copies cost), on the same settled front.
+void BM_CompactMeshAttributes(benchmark::State& state) {
+  Fixture& fx = fixture();
+  VertexFront front;
+  front_init(front, fx.tree, 1.f);
+  FrontParams p;
+  p.target_triangles = kTarget;
+  p.max_triangles = kTarget + kTarget / 10;
+  for (int i = 0; i < 60; ++i) front_update(front, fx.tree, orbit_view(fx, 0, 0.6f * fx.size), p);
+  VertexTree columns;  // only what vertex_morph_init reads
+  columns.positions = fx.tree.positions;
+  columns.parent = fx.tree.parent;
+  const size_t nodes = fx.tree.node_count();
+  columns.uvs1.assign(2 * nodes, 0.5f);
+  columns.colors.assign(4 * nodes, 0.75f);
+  columns.normals.assign(3 * nodes, 0.f);
+  for (size_t v = 0; v < nodes; ++v) columns.normals[3 * v + 2] = 1;
+  VertexMorph morph;
+  vertex_morph_init(morph, columns, 0.25f);
+  const size_t nv = front.active_count;
+  std::vector<float> positions(3 * nv), uv1(2 * nv), color(4 * nv), n(3 * nv);
+  std::vector<uint32_t> tris(3 * size_t(front.tri_count));
+  const MorphOutput outputs[] = {{&morph.uv1, uv1}, {&morph.color, color}, {&morph.normal, n}};
+  for (auto _ : state) {
+    front_compact_mesh(positions, tris, front, fx.tree, {});
+    vertex_morph_compact(outputs, morph, front.vertices(), 1.0);
+    renormalise(n);
+    benchmark::DoNotOptimize(positions.data());
+    benchmark::DoNotOptimize(color.data());
+    benchmark::DoNotOptimize(n.data());
+  }
+  state.counters["active_tris"] = double(front.tri_count);
+}
+BENCHMARK(BM_CompactMeshAttributes)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
 
 // Cost follows the changes (camera speed), not the active size (target triangles).
 void BM_FrontScaling(benchmark::State& state) {

@@ -303,7 +303,7 @@ TEST(VertexHierarchyUvAsset, TruncatedOrForgedUvDataIsRefusedNamingTheSection) {
   // Huge and mismatched counts: refused before anything is allocated.
   refused(forge_vhat(good, 8, uint64_t(1) << 60), "VHAT section: uvs for");
   refused(forge_vhat(good, 8, nodes + 1), "VHAT section: uvs for");
-  refused(forge_vhat(good, 0, uint32_t(2)), "layout 2 is newer");
+  refused(forge_vhat(good, 0, uint32_t(3)), "layout 3 is newer");
   refused(forge_vhat(good, 4, uint32_t(6)), "unknown flags");
   // A non-finite uv, a parent's uv outside its children's, a leaf's unlike level 0's.
   refused(forge_vhat(good, 16 + 8 * (nodes - 1), std::nanf("")), "VHAT section: node");
