@@ -92,9 +92,9 @@ bool validate_vd_objects(const Frame& f, const Scene& scene, std::string* why) {
     }
     for (uint32_t v = o.first_vertex; v < o.first_vertex + o.vertex_count; ++v) {
       bool ok = true;
-      for (int k = 0; o.has_uvs1 && k < 2; ++k) ok = ok && std::isfinite(f.vd_uvs1[2 * size_t(v) + k]);
-      for (int k = 0; o.has_colors && k < 4; ++k) {
-        const float c = f.vd_colors[4 * size_t(v) + k];
+      for (int j = 0; o.has_uvs1 && j < 2; ++j) ok = ok && std::isfinite(f.vd_uvs1[2 * size_t(v) + j]);
+      for (int j = 0; o.has_colors && j < 4; ++j) {
+        const float c = f.vd_colors[4 * size_t(v) + j];
         ok = ok && c >= 0 && c <= 1;
       }
       if (!ok) {

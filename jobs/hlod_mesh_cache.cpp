@@ -136,10 +136,10 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   const uint8_t* p = b.data() + kFixedBytes;
   for (float& v : m.positions) v = detail::load_f32(p), p += 4;
   for (uint32_t& i : m.indices) i = detail::load_u32(p), p += 4;
-  auto column = [&](uint32_t flag, size_t per, std::vector<float>& out) {
+  auto column = [&](uint32_t flag, size_t per, std::vector<float>& into) {
     if (!(flags & flag)) return;
-    out.resize(size_t(per * vertices));
-    for (float& v : out) v = detail::load_f32(p), p += 4;
+    into.resize(size_t(per * vertices));
+    for (float& v : into) v = detail::load_f32(p), p += 4;
   };
   column(kFlagUvs, 2, m.uvs);
   column(kFlagUvs1, 2, m.uvs1);

@@ -114,11 +114,11 @@ void vertex_morph_apply(VertexMorph& m, const VertexTree& t, std::span<const Fro
         for (int k = 0; k < 3; ++k) m.from[3 * size_t(e.node) + k] = m.to[3 * size_t(e.node) + k] = t.positions[3 * size_t(e.node) + k];
         if (uvs)
           for (int k = 0; k < 2; ++k) m.from_uv[2 * size_t(e.node) + k] = m.to_uv[2 * size_t(e.node) + k] = t.uvs[2 * size_t(e.node) + k];
-        for (int c = 0; extras && c < 3; ++c) {
-          MorphColumn& col = *extra[c];
+        for (int x = 0; extras && x < 3; ++x) {
+          MorphColumn& col = *extra[x];
           const size_t w = col.width;
           float* ends = col.ends.data() + 2 * w * e.node;
-          for (size_t k = 0; k < w; ++k) ends[k] = ends[w + k] = (*extra_tree[c])[w * e.node + k];
+          for (size_t k = 0; k < w; ++k) ends[k] = ends[w + k] = (*extra_tree[x])[w * e.node + k];
         }
         m.start[e.node] = -std::numeric_limits<double>::infinity();
         break;
@@ -150,8 +150,9 @@ void vertex_morph_column(std::span<float> out, const VertexMorph& m, const Morph
 
 void vertex_morph_compact(std::span<const MorphOutput> outputs, const VertexMorph& m,
                           std::span<const uint32_t> nodes, double now) {
-  for (const MorphOutput& o : outputs)
-    assert(!o.column->empty() && o.out.size() >= o.column->width * nodes.size());
+#ifndef NDEBUG
+  for (const MorphOutput& o : outputs) assert(!o.column->empty() && o.out.size() >= o.column->width * nodes.size());
+#endif
   // Nodes are scattered over the tree's arrays: ask for a later node's lines ahead (the loop is
   // bound by those misses, not by its arithmetic).
   constexpr size_t kAhead = 16;
