@@ -44,24 +44,7 @@ LodChain globe_chain() {
   return c;
 }
 
-Scene globe_scene() {
-  SceneConfig c = test::synthetic_config(300, 200);
-  c.models.resize(1);
-  c.instances.resize(1);
-  c.instances[0].model = 0;
-  c.models.push_back(ModelConfig{"globe", {}, {}});
-  c.models.back().view_dependent = true;
-  InstanceConfig i;
-  i.model = 1;
-  i.count = 1;
-  i.grid = true;
-  i.box_min[0] = i.box_min[1] = i.box_min[2] = 0;
-  i.box_max[0] = i.box_max[1] = i.box_max[2] = 0;
-  i.scale_min = i.scale_max = 40;
-  c.instances.push_back(i);
-  std::vector<LodChain> chains = {test::synthetic_chains()[0], globe_chain()};
-  return make_scene(c, std::move(chains));
-}
+Scene globe_scene() { return test::one_vd_object_scene(globe_chain()); }
 
 TEST(FrameGraphVdUv, TexturedObjectPublishesUvsAndTrianglesGroupedByMaterial) {
   const Scene scene = globe_scene();

@@ -88,6 +88,27 @@ inline Scene synthetic_scene(uint32_t count, float extent, uint64_t seed = 1) {
   return make_scene(synthetic_config(count, extent, seed), synthetic_chains());
 }
 
+// One synthetic object (model 0) and one view-dependent `chain` (model 1) at the origin,
+// scaled 40: the view-dependent frame graph tests' scene.
+inline Scene one_vd_object_scene(LodChain chain) {
+  SceneConfig c = synthetic_config(300, 200);
+  c.models.resize(1);
+  c.instances.resize(1);
+  c.instances[0].model = 0;
+  c.models.push_back(ModelConfig{chain.name, {}, {}});
+  c.models.back().view_dependent = true;
+  InstanceConfig i;
+  i.model = 1;
+  i.count = 1;
+  i.grid = true;
+  i.box_min[0] = i.box_min[1] = i.box_min[2] = 0;
+  i.box_max[0] = i.box_max[1] = i.box_max[2] = 0;
+  i.scale_min = i.scale_max = 40;
+  c.instances.push_back(i);
+  std::vector<LodChain> chains = {synthetic_chains()[0], std::move(chain)};
+  return make_scene(c, std::move(chains));
+}
+
 // Field size that keeps object density the same at every count (about 10k objects per 1 km^2).
 inline float extent_for(uint32_t count) {
   return 500.f * std::sqrt(static_cast<float>(count) / 10000.f) + 50.f;
