@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "runtime/status.h"
@@ -20,7 +21,8 @@ Status write_file_atomic(const std::filesystem::path& path, const std::string& t
 // A file written in pieces, possibly by several processes at once (issue 16: every rank writes
 // its own subtrees' payloads into the .hlod): create_sized_temporary makes a temporary of its
 // own beside `path` at the full size; write_pieces opens it by name, writes each piece at its
-// offset and flushes its own ranges to the disk; commit_temporary flushes the whole file (its
+// offset (processes on one host taking turns, runtime/host_turn.h) and flushes its own ranges
+// to the disk; commit_temporary flushes the whole file (its
 // extents) and renames it over `path` once every writer
 // has succeeded (otherwise remove it).
 struct FilePiece {
@@ -28,8 +30,15 @@ struct FilePiece {
   std::span<const uint8_t> bytes;
 };
 Status create_sized_temporary(const std::filesystem::path& path, uint64_t size, std::filesystem::path& temp);
-Status write_pieces(const std::filesystem::path& file, std::span<const FilePiece> pieces, const std::string& what);
+Status write_pieces(const std::filesystem::path& file, std::span<const FilePiece> pieces,
+                    const std::string& what);
 Status commit_temporary(const std::filesystem::path& temp, const std::filesystem::path& path);
+
+namespace detail {
+// The byte ranges `pieces` cover, sorted, overlapping or touching ones joined: what a writer
+// flushes (a few large ranges for a rank's runs of neighbouring nodes).
+std::vector<std::pair<uint64_t, uint64_t>> covered_ranges(std::span<const FilePiece> pieces);
+}  // namespace detail
 
 // Writes all of `bytes` to an open descriptor, retrying short writes and EINTR. On failure
 // the message says how far it got and why ("the disk is full after 4096 of 9000 bytes").

@@ -1,3 +1,5 @@
+#include "runtime/file_write.h"
+
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -8,7 +10,6 @@
 #include <sstream>
 #include <vector>
 
-#include "runtime/file_write.h"
 #include "test_support.h"
 
 namespace {
@@ -96,4 +97,14 @@ TEST(FileWrite, PiecesFromSeveralWritersMakeTheFileOnlyWhenCommitted) {
   const lod::Status gone = lod::write_pieces(dir / "no-such.tmp", first, "out.bin");
   EXPECT_FALSE(gone);
   EXPECT_NE(gone.message.find("out.bin"), std::string::npos) << gone.message;
+}
+
+TEST(FileWrite, CoveredRangesAreSortedAndJoined) {
+  const std::vector<uint8_t> b(4, 0);
+  const std::span<const uint8_t> four(b), two(b.data(), 2), none;
+  const lod::FilePiece pieces[] = {{20, four}, {0, two}, {2, four}, {30, none}, {8, two}, {21, two}};
+  using R = std::pair<uint64_t, uint64_t>;
+  // [0,2) and [2,6) touch; [8,10) stands apart; [21,23) lies inside [20,24); the empty one is nothing.
+  EXPECT_EQ(lod::detail::covered_ranges(pieces), (std::vector<R>{{0, 6}, {8, 10}, {20, 24}}));
+  EXPECT_TRUE(lod::detail::covered_ranges({}).empty());
 }
