@@ -43,7 +43,8 @@ void expect_reference(const std::vector<Key3>& keys, auto hash) {
   size_t want_repeats = 0;
   const std::vector<uint32_t> want = reference(keys, want_repeats);
   std::vector<uint32_t> got;
-  const size_t repeats = first_of_equal(keys.size(), [&](size_t i) { return keys[i]; }, got, hash);
+  const size_t repeats = first_of_equal(
+      keys.size(), [&](size_t i) { return keys[i]; }, got, hash);
   EXPECT_EQ(repeats, want_repeats);
   EXPECT_EQ(got, want);
 }
@@ -70,12 +71,15 @@ TEST(FirstOfEqual, EmptyAndSingle) {
 
 TEST(RadixSortByHigh32, SortsByHighWordAndKeepsOrderOfEqualOnes) {
   std::mt19937_64 rng(11);
-  std::vector<uint64_t> items(100000);
-  for (size_t i = 0; i < items.size(); ++i) items[i] = (rng() & 0xFFFFFFFF00000000ull >> (i % 3 == 0 ? 20 : 0)) | i;
-  std::vector<uint64_t> want = items;
-  std::stable_sort(want.begin(), want.end(), [](uint64_t a, uint64_t b) { return (a >> 32) < (b >> 32); });
-  radix_sort_by_high32(items);
-  EXPECT_EQ(items, want);
+  for (size_t n : {size_t(100000), (size_t(1) << 20) + 5}) {  // three 11-bit passes, two 16-bit ones
+    std::vector<uint64_t> items(n);
+    for (size_t i = 0; i < items.size(); ++i)
+      items[i] = (rng() & 0xFFFFFFFF00000000ull >> (i % 3 == 0 ? 20 : 0)) | i;
+    std::vector<uint64_t> want = items;
+    std::stable_sort(want.begin(), want.end(), [](uint64_t a, uint64_t b) { return (a >> 32) < (b >> 32); });
+    radix_sort_by_high32(items);
+    EXPECT_EQ(items, want) << n << " items";
+  }
 }
 
 }  // namespace
