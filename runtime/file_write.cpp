@@ -180,10 +180,12 @@ Status write_pieces(const std::filesystem::path& file, std::span<const FilePiece
   std::vector<FilePiece> ordered(pieces.begin(), pieces.end());  // in file order: sequential writeback
   std::stable_sort(ordered.begin(), ordered.end(),
                    [](const FilePiece& a, const FilePiece& b) { return a.offset < b.offset; });
-  // The turn covers the flush too: the completions of one writer's flush run on whichever core
-  // takes the interrupt, and the next writer's copy would be charged for them.
-  const HostTurn turn(fd);
-  Status st = write_each(fd, ordered, what);
+  Status st;
+  {
+    // Released before the flush: one writer's writeback overlaps the next one's copy.
+    const HostTurn turn(fd);
+    st = write_each(fd, ordered, what);
+  }
   if (st) st = flush_ranges(fd, detail::covered_ranges(ordered), what);
   if (::close(fd) != 0 && st)
     st = Status::error(what + ": " + describe_write_errno(errno) + " while closing");
