@@ -37,7 +37,8 @@ bool locks_current_file(int fd, const std::filesystem::path& path) {
 HostTurn::HostTurn(int fd) : path_(lock_path_for(fd)) {
   if (path_.empty()) return;
   for (int attempt = 0; attempt < 64; ++attempt) {
-    const int lock = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    // Never through a link planted in the shared temporary folder.
+    const int lock = ::open(path_.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0600);
     if (lock < 0) return;
     int rc;
     while ((rc = ::flock(lock, LOCK_EX)) != 0 && errno == EINTR) {

@@ -2,11 +2,14 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -78,6 +81,32 @@ TEST(HostTurn, ManyRacingWritersHoldItOneAtATime) {
   for (std::thread& t : writers) t.join();
   EXPECT_EQ(turns.load(), 200);
   EXPECT_EQ(most.load(), 1);
+}
+
+// Another user could plant a link under the lock's name in the shared temporary folder: the turn
+// is then skipped (the write goes ahead unserialised), the link's target untouched.
+TEST(HostTurn, PlantedLinkIsNotFollowed) {
+  const auto dir = lod::test::temp_dir("host_turn_link");
+  const auto file = dir / "shared.bin", victim = dir / "victim.txt";
+  lod::test::write_text(victim, "keep me");
+  const int fd = open_file(file);
+  ASSERT_GE(fd, 0);
+  struct stat st {};
+  ASSERT_EQ(::fstat(fd, &st), 0);
+  const auto lock =
+      std::filesystem::temp_directory_path() / ("lodkit-write-" + std::to_string(uint64_t(st.st_dev)) + "-" +
+                                                std::to_string(uint64_t(st.st_ino)) + ".lock");
+  std::filesystem::remove(lock);
+  std::filesystem::create_symlink(victim, lock);
+  {
+    const lod::HostTurn turn(fd);
+    EXPECT_FALSE(turn.held());
+    EXPECT_EQ(turn.lock_file(), lock);
+  }
+  EXPECT_TRUE(std::filesystem::is_symlink(lock));
+  EXPECT_EQ(lod::test::read_bytes(victim), (std::vector<uint8_t>{'k', 'e', 'e', 'p', ' ', 'm', 'e'}));
+  std::filesystem::remove(lock);
+  ::close(fd);
 }
 
 TEST(HostTurn, OtherFilesDoNotWait) {
