@@ -14,13 +14,16 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <span>
 #include <vector>
 
 #include "runtime/byte_order.h"
+#include "runtime/bytes_hasher.h"
 #include "runtime/file_write.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/material_section.h"
@@ -43,8 +46,10 @@ bool read_whole(const std::filesystem::path& path, std::vector<uint8_t>& out) {
   for (size_t done = 0; ok && done < out.size();) {
     const ssize_t n = ::pread(fd, out.data() + done, out.size() - done, off_t(done));
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) ok = false;
-    else done += size_t(n);
+    if (n <= 0)
+      ok = false;
+    else
+      done += size_t(n);
   }
   ::close(fd);
   return ok;
@@ -58,49 +63,83 @@ std::filesystem::path hlod_mesh_entry_path(const std::filesystem::path& dir, uin
   return dir / name;
 }
 
+namespace {
+
+struct Columns {
+  bool uvs, uvs1, colors;
+};
+
+std::vector<uint8_t> entry_head(uint64_t source_hash, uint64_t input_triangles, const MeshData& mesh,
+                                Columns has, size_t material_bytes, size_t image_bytes) {
+  detail::ByteWriter head;
+  for (char c : kMagic) head.u8(uint8_t(c));
+  head.u32(kHlodMeshEntryVersion);
+  head.u32((has.uvs ? kFlagUvs : 0) | (has.colors ? kFlagColors : 0) | (has.uvs1 ? kFlagUvs1 : 0));
+  for (uint64_t v :
+       {source_hash, input_triangles, uint64_t(mesh.vertex_count()), uint64_t(mesh.indices.size()),
+        uint64_t(mesh.submeshes.size()), uint64_t(material_bytes), uint64_t(image_bytes)})
+    head.u64(v);
+  return std::move(head.bytes);
+}
+
+std::vector<uint8_t> submesh_rows(const MeshData& mesh) {
+  detail::ByteWriter rows;
+  for (const Submesh& sm : mesh.submeshes) {
+    rows.u32(sm.first_triangle);
+    rows.u32(sm.triangle_count);
+    rows.u32(uint32_t(sm.material));
+  }
+  return std::move(rows.bytes);
+}
+
+// A 32-bit array's bytes in the file's order: where it lies on a little-endian host (a
+// 14M-triangle mesh is 250 MB, written without a copy), a swapped copy kept in `copies` else.
+template <class T>
+std::span<const uint8_t> le_words(const std::vector<T>& v, std::vector<std::vector<uint8_t>>& copies) {
+  if constexpr (std::endian::native == std::endian::little) {
+    return {reinterpret_cast<const uint8_t*>(v.data()), 4 * v.size()};
+  } else {
+    detail::ByteWriter w;
+    w.words(v.data(), v.size());
+    return copies.emplace_back(std::move(w.bytes));  // a moved vector keeps its buffer
+  }
+}
+
+}  // namespace
+
 Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const MeshData& mesh,
                        uint64_t input_triangles, const HlodSurfaces& surfaces) {
-  const bool uvs = !mesh.uvs.empty() && mesh.uvs.size() == 2 * mesh.vertex_count();
-  const bool uvs1 = !mesh.uvs1.empty() && mesh.uvs1.size() == 2 * mesh.vertex_count();
-  const bool colors = !mesh.colors.empty() && mesh.colors.size() == 4 * mesh.vertex_count();
+  const size_t nv = mesh.vertex_count();
+  const Columns has{mesh.uvs.size() == 2 * nv && nv > 0, mesh.uvs1.size() == 2 * nv && nv > 0,
+                    mesh.colors.size() == 4 * nv && nv > 0};
   LodChain chain;
   chain.materials = surfaces.materials;
   chain.texture_base = surfaces.texture_base;
-  const std::vector<uint8_t> materials = surfaces.materials.empty() ? std::vector<uint8_t>() : encode_material_section(chain);
-  const std::vector<uint8_t> images = surfaces.images.empty() ? std::vector<uint8_t>() : encode_image_section(surfaces.images);
-  detail::ByteWriter w;
-  w.bytes.reserve(kFixedBytes + 4 * (mesh.positions.size() + mesh.indices.size() + mesh.uvs.size() + mesh.uvs1.size() +
-                                     mesh.colors.size()) + 8);
-  for (char c : kMagic) w.u8(uint8_t(c));
-  w.u32(kHlodMeshEntryVersion);
-  w.u32((uvs ? kFlagUvs : 0) | (colors ? kFlagColors : 0) | (uvs1 ? kFlagUvs1 : 0));
-  w.u64(source_hash);
-  w.u64(input_triangles);
-  w.u64(mesh.vertex_count());
-  w.u64(mesh.indices.size());
-  w.u64(mesh.submeshes.size());
-  w.u64(materials.size());
-  w.u64(images.size());
-  w.words(mesh.positions.data(), mesh.positions.size());
-  w.words(mesh.indices.data(), mesh.indices.size());
-  if (uvs) w.words(mesh.uvs.data(), mesh.uvs.size());
-  if (uvs1) w.words(mesh.uvs1.data(), mesh.uvs1.size());
-  if (colors) w.words(mesh.colors.data(), mesh.colors.size());
-  for (const Submesh& sm : mesh.submeshes) {
-    w.u32(sm.first_triangle);
-    w.u32(sm.triangle_count);
-    w.u32(uint32_t(sm.material));
-  }
-  w.raw(materials.data(), materials.size());
-  w.raw(images.data(), images.size());
-  w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
-  const std::filesystem::path path = hlod_mesh_entry_path(dir, source_hash);
-  if (Status s = write_file_atomic(path, w.bytes); !s) return s;
-  return Status::success();
+  const std::vector<uint8_t> materials =
+      surfaces.materials.empty() ? std::vector<uint8_t>() : encode_material_section(chain);
+  const std::vector<uint8_t> images =
+      surfaces.images.empty() ? std::vector<uint8_t>() : encode_image_section(surfaces.images);
+  const std::vector<uint8_t> head =
+      entry_head(source_hash, input_triangles, mesh, has, materials.size(), images.size());
+  const std::vector<uint8_t> rows = submesh_rows(mesh);
+  std::vector<std::vector<uint8_t>> copies;
+  std::vector<std::span<const uint8_t>> parts{head, le_words(mesh.positions, copies),
+                                              le_words(mesh.indices, copies)};
+  if (has.uvs) parts.push_back(le_words(mesh.uvs, copies));
+  if (has.uvs1) parts.push_back(le_words(mesh.uvs1, copies));
+  if (has.colors) parts.push_back(le_words(mesh.colors, copies));
+  parts.insert(parts.end(), {rows, materials, images});
+  BytesHasher hash;
+  for (std::span<const uint8_t> part : parts) hash.add(part.data(), part.size());
+  detail::ByteWriter checksum;
+  checksum.u64(hash.finish());
+  parts.push_back(checksum.bytes);
+  return write_file_atomic(hlod_mesh_entry_path(dir, source_hash), parts);
 }
 
-CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const std::string& source_name,
-                           MeshData& out, uint64_t& input_triangles, std::string* why, HlodSurfaces* surfaces) {
+CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash,
+                           const std::string& source_name, MeshData& out, uint64_t& input_triangles,
+                           std::string* why, HlodSurfaces* surfaces) {
   const std::filesystem::path path = hlod_mesh_entry_path(dir, source_hash);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return CacheLookup::missing;
@@ -112,23 +151,31 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   if (!read_whole(path, b)) return refuse("cannot be read (not a regular file?)");
   if (b.size() < kFixedBytes + 8) return refuse("too short for a cleaned mesh entry (truncated?)");
   if (std::memcmp(b.data(), kMagic, 8) != 0) return refuse("not a cleaned mesh entry (bad magic bytes)");
-  if (detail::load_u32(b.data() + 8) != kHlodMeshEntryVersion) return refuse("entry version is not supported");
+  if (detail::load_u32(b.data() + 8) != kHlodMeshEntryVersion)
+    return refuse("entry version is not supported");
   const uint32_t flags = detail::load_u32(b.data() + 12);
   const uint64_t vertices = detail::load_u64(b.data() + 32), indices = detail::load_u64(b.data() + 40);
-  const uint64_t submeshes = detail::load_u64(b.data() + 48), material_bytes = detail::load_u64(b.data() + 56);
+  const uint64_t submeshes = detail::load_u64(b.data() + 48),
+                 material_bytes = detail::load_u64(b.data() + 56);
   const uint64_t image_bytes = detail::load_u64(b.data() + 64);
-  if ((flags & ~(kFlagUvs | kFlagColors | kFlagUvs1)) != 0) return refuse("unknown flags " + std::to_string(flags));
-  const uint64_t per_vertex = 12 + ((flags & kFlagUvs) ? 8 : 0) + ((flags & kFlagUvs1) ? 8 : 0) + ((flags & kFlagColors) ? 16 : 0);
+  if ((flags & ~(kFlagUvs | kFlagColors | kFlagUvs1)) != 0)
+    return refuse("unknown flags " + std::to_string(flags));
+  const uint64_t per_vertex =
+      12 + ((flags & kFlagUvs) ? 8 : 0) + ((flags & kFlagUvs1) ? 8 : 0) + ((flags & kFlagColors) ? 16 : 0);
   // Counts against the size before anything is allocated (each bounded first, so the sum cannot overflow).
   if (vertices >= UINT32_MAX || indices % 3 != 0 || indices > b.size() / 4 || submeshes > b.size() / 12 ||
       material_bytes > b.size() || image_bytes > b.size() ||
-      b.size() != kFixedBytes + per_vertex * vertices + 4 * indices + 12 * submeshes + material_bytes + image_bytes + 8)
-    return refuse("its counts (" + std::to_string(vertices) + " vertices, " + std::to_string(indices) + " indices, " +
-                  std::to_string(submeshes) + " submeshes, " + std::to_string(material_bytes) +
-                  " bytes of materials, " + std::to_string(image_bytes) + " of images) do not match its " + std::to_string(b.size()) + " bytes (truncated?)");
+      b.size() != kFixedBytes + per_vertex * vertices + 4 * indices + 12 * submeshes + material_bytes +
+                      image_bytes + 8)
+    return refuse("its counts (" + std::to_string(vertices) + " vertices, " + std::to_string(indices) +
+                  " indices, " + std::to_string(submeshes) + " submeshes, " + std::to_string(material_bytes) +
+                  " bytes of materials, " + std::to_string(image_bytes) + " of images) do not match its " +
+                  std::to_string(b.size()) + " bytes (truncated?)");
   const size_t body = b.size() - 8;
-  if (detail::load_u64(b.data() + body) != hash_bytes(b.data(), body)) return refuse("checksum mismatch (corrupted)");
-  if (detail::load_u64(b.data() + 16) != source_hash) return refuse("written for another source (a misplaced entry)");
+  if (detail::load_u64(b.data() + body) != hash_bytes(b.data(), body))
+    return refuse("checksum mismatch (corrupted)");
+  if (detail::load_u64(b.data() + 16) != source_hash)
+    return refuse("written for another source (a misplaced entry)");
   MeshData m;
   m.source = source_name;
   m.positions.resize(size_t(3 * vertices));
@@ -154,15 +201,19 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   LodChain chain;  // images first: the materials' embedded:<k> are checked against them
   if (image_bytes > 0 && material_bytes == 0) return refuse("it has images but no materials");
   if (image_bytes > 0)
-    if (Status s = decode_image_section({p + material_bytes, size_t(image_bytes)}, "images", chain.images); !s)
+    if (Status s = decode_image_section({p + material_bytes, size_t(image_bytes)}, "images", chain.images);
+        !s)
       return refuse(s.message);
   if (material_bytes > 0)
-    if (Status s = decode_material_section({p, size_t(material_bytes)}, "materials", chain); !s) return refuse(s.message);
+    if (Status s = decode_material_section({p, size_t(material_bytes)}, "materials", chain); !s)
+      return refuse(s.message);
   // The writer stores the section only with materials: one without (its texture base and
   // images lost on the next store) is not one it wrote.
-  if (material_bytes > 0 && chain.materials.empty()) return refuse("its materials section holds no materials");
+  if (material_bytes > 0 && chain.materials.empty())
+    return refuse("its materials section holds no materials");
   for (uint32_t i : m.indices)
-    if (i >= vertices) return refuse("an index names vertex " + std::to_string(i) + " of " + std::to_string(vertices));
+    if (i >= vertices)
+      return refuse("an index names vertex " + std::to_string(i) + " of " + std::to_string(vertices));
   for (float v : m.positions)
     if (!std::isfinite(v)) return refuse("a position is not finite");
   for (float v : m.uvs)
@@ -174,11 +225,15 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   // Submeshes in order inside the triangles, each naming a stored material (or the default).
   uint64_t covered = 0;
   for (const Submesh& sm : m.submeshes) {
-    if (sm.first_triangle < covered || sm.first_triangle > indices / 3 || sm.triangle_count > indices / 3 - sm.first_triangle ||
-        sm.material < -1 || (sm.material >= 0 && size_t(sm.material) >= chain.materials.size()))
-      return refuse("submesh at triangle " + std::to_string(sm.first_triangle) + " (" + std::to_string(sm.triangle_count) +
-                    " triangles, material " + std::to_string(sm.material) + ") does not continue the runs before it or "
-                    "names a material of the " + std::to_string(chain.materials.size()));
+    if (sm.first_triangle < covered || sm.first_triangle > indices / 3 ||
+        sm.triangle_count > indices / 3 - sm.first_triangle || sm.material < -1 ||
+        (sm.material >= 0 && size_t(sm.material) >= chain.materials.size()))
+      return refuse("submesh at triangle " + std::to_string(sm.first_triangle) + " (" +
+                    std::to_string(sm.triangle_count) + " triangles, material " +
+                    std::to_string(sm.material) +
+                    ") does not continue the runs before it or "
+                    "names a material of the " +
+                    std::to_string(chain.materials.size()));
     covered = uint64_t(sm.first_triangle) + sm.triangle_count;
   }
   if (surfaces) {

@@ -426,7 +426,8 @@ namespace {
 // usemtl / newmtl names: no blanks (OBJ splits on them), unique by the index in front.
 std::string obj_material_name(const std::vector<ObjMaterialView>& materials, int32_t m) {
   if (m < 0) return "lodkit_default";
-  std::string s = "m" + std::to_string(m);
+  std::string s = "m";  // appended piecewise: GCC 12 warns (-Wrestrict) on "m" + to_string
+  s += std::to_string(m);
   if (!materials[size_t(m)].name.empty()) s += '_';
   for (unsigned char c : materials[size_t(m)].name) s += std::isalnum(c) || c == '-' || c == '.' ? char(c) : '_';
   return s.substr(0, 128);

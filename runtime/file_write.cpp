@@ -65,12 +65,13 @@ std::filesystem::path temporary_beside(const std::filesystem::path& path) {
   return tmp;
 }
 
-Status write_and_sync(const std::filesystem::path& tmp, std::span<const uint8_t> bytes,
+Status write_and_sync(const std::filesystem::path& tmp, std::span<const std::span<const uint8_t>> parts,
                       const std::string& what) {
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0)
     return Status::error(what + ": cannot create " + tmp.string() + ": " + describe_write_errno(errno));
-  Status st = write_all(fd, bytes, what);
+  Status st;
+  for (size_t i = 0; st && i < parts.size(); ++i) st = write_all(fd, parts[i], what);
   // Delayed allocation can report a full disk only here.
   if (st && ::fsync(fd) != 0)
     st = Status::error(what + ": " + describe_write_errno(errno) + " while flushing to disk");
@@ -81,10 +82,10 @@ Status write_and_sync(const std::filesystem::path& tmp, std::span<const uint8_t>
 
 }  // namespace
 
-Status write_file_atomic(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+Status write_file_atomic(const std::filesystem::path& path, std::span<const std::span<const uint8_t>> parts) {
   const std::string what = path.string();
   const std::filesystem::path tmp = temporary_beside(path);
-  Status st = write_and_sync(tmp, bytes, what);
+  Status st = write_and_sync(tmp, parts, what);
   std::error_code ec;
   if (st) {
     std::filesystem::rename(tmp, path, ec);
@@ -92,6 +93,11 @@ Status write_file_atomic(const std::filesystem::path& path, std::span<const uint
   }
   if (!st) std::filesystem::remove(tmp, ec);
   return st;
+}
+
+Status write_file_atomic(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+  const std::span<const uint8_t> parts[] = {bytes};
+  return write_file_atomic(path, parts);
 }
 
 Status write_file_atomic(const std::filesystem::path& path, const std::string& text) {

@@ -17,6 +17,8 @@ namespace lod {
 // `path` is the file to replace; messages start with it.
 Status write_file_atomic(const std::filesystem::path& path, std::span<const uint8_t> bytes);
 Status write_file_atomic(const std::filesystem::path& path, const std::string& text);
+// The file is the parts one after another (written where they lie: no concatenated copy).
+Status write_file_atomic(const std::filesystem::path& path, std::span<const std::span<const uint8_t>> parts);
 
 // A file written in pieces, possibly by several processes at once (issue 16: every rank writes
 // its own subtrees' payloads into the .hlod): create_sized_temporary makes a temporary of its
