@@ -7,6 +7,9 @@
 //   BM_Clean/indexed      clean_mesh of the indexed sphere (nothing to weld)
 //   BM_Clean/soup         clean_mesh of the same triangles, three vertices each (all to weld)
 //   BM_SurfaceBuild / BM_SurfaceQuery   the closest-point BVH over it: build, and queries
+//   BM_EntryChecksumConcatenated / BM_EntryChecksumPieces   the cleaned-mesh cache entry's
+//                         checksum: its arrays copied into one buffer and hashed (the former
+//                         store), against hashed where they lie (BytesHasher, what it does now)
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -22,6 +25,8 @@
 #include "preprocess/mesh_io.h"
 #include "preprocess/mesh_readers.h"
 #include "preprocess/surface_error.h"
+#include "runtime/bytes_hasher.h"
+#include "runtime/lod_asset.h"
 #include "vd_meshes.h"
 
 namespace {
@@ -38,7 +43,8 @@ const MeshData& sphere() {
   static const MeshData m = [] {
     MeshData d;
     if (!bench_mesh()) return test::vd_sphere(1000, 2000);  // 4.0M triangles, 2.0M vertices
-    if (Status s = load_mesh(bench_mesh(), d); !s) std::fprintf(stderr, "%s\n", s.message.c_str()), std::exit(1);
+    if (Status s = load_mesh(bench_mesh(), d); !s)
+      std::fprintf(stderr, "%s\n", s.message.c_str()), std::exit(1);
     return d;
   }();
   return m;
@@ -47,7 +53,8 @@ const MeshData& sphere() {
 MeshData soup_of(const MeshData& in) {
   MeshData m;
   m.source = "soup";
-  for (uint32_t v : in.indices) m.positions.insert(m.positions.end(), &in.positions[3 * v], &in.positions[3 * v] + 3);
+  for (uint32_t v : in.indices)
+    m.positions.insert(m.positions.end(), &in.positions[3 * v], &in.positions[3 * v] + 3);
   for (size_t i = 0; i < in.indices.size(); ++i) m.indices.push_back(uint32_t(i));
   return m;
 }
@@ -111,8 +118,8 @@ void BM_FaceGroupsSorted(benchmark::State& state) {
   for (size_t i = 0; i < all.size(); ++i) all[i] = i;
   for (auto _ : state) {
     std::vector<uint32_t> first(keys.size());
-    benchmark::DoNotOptimize(
-        detail::first_in_group_sorted(all.data(), all.size(), [&](size_t i) { return keys[i]; }, first));
+    benchmark::DoNotOptimize(detail::first_in_group_sorted(
+        all.data(), all.size(), [&](size_t i) { return keys[i]; }, first));
   }
 }
 
@@ -120,7 +127,8 @@ void BM_FaceGroupsHashed(benchmark::State& state) {
   const std::vector<FaceKey> keys = face_keys();
   for (auto _ : state) {
     std::vector<uint32_t> first;
-    benchmark::DoNotOptimize(detail::first_of_equal(keys.size(), [&](size_t i) { return keys[i]; }, first));
+    benchmark::DoNotOptimize(detail::first_of_equal(
+        keys.size(), [&](size_t i) { return keys[i]; }, first));
   }
 }
 
@@ -134,6 +142,33 @@ void BM_Clean(benchmark::State& state) {
     welded = clean_mesh(m).duplicate_vertices;
   }
   state.counters["welded"] = double(welded);
+}
+
+void BM_EntryChecksumConcatenated(benchmark::State& state) {
+  const MeshData& m = sphere();
+  for (auto _ : state) {
+    std::vector<uint8_t> bytes;
+    bytes.reserve(4 * (m.positions.size() + m.indices.size()));
+    auto put = [&bytes](const auto& v) {
+      const auto* p = reinterpret_cast<const uint8_t*>(v.data());
+      bytes.insert(bytes.end(), p, p + 4 * v.size());
+    };
+    put(m.positions);
+    put(m.indices);
+    benchmark::DoNotOptimize(hash_bytes(bytes.data(), bytes.size()));
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(4 * (m.positions.size() + m.indices.size())));
+}
+
+void BM_EntryChecksumPieces(benchmark::State& state) {
+  const MeshData& m = sphere();
+  for (auto _ : state) {
+    BytesHasher h;
+    h.add(m.positions.data(), 4 * m.positions.size());
+    h.add(m.indices.data(), 4 * m.indices.size());
+    benchmark::DoNotOptimize(h.finish());
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(4 * (m.positions.size() + m.indices.size())));
 }
 
 // The closest-point BVH every HLOD bake builds over the original (and each rank over its part).
@@ -159,7 +194,8 @@ void BM_SurfaceQuery(benchmark::State& state) {
   const std::vector<float> known(points.size() / 3, 0.01f);
   for (auto _ : state) {
     SurfaceError e;
-    if (!d.from_points(points.data(), points.size() / 3, known.data(), e)) state.SkipWithError("query failed");
+    if (!d.from_points(points.data(), points.size() / 3, known.data(), e))
+      state.SkipWithError("query failed");
     benchmark::DoNotOptimize(e.max);
   }
   state.counters["queries"] = double(points.size() / 3);
@@ -170,6 +206,8 @@ BENCHMARK(BM_LoadPly)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_FaceGroupsSorted)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_FaceGroupsHashed)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_Clean)->ArgName("soup")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_EntryChecksumConcatenated)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_EntryChecksumPieces)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_SurfaceBuild)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_SurfaceQuery)->Unit(benchmark::kMillisecond)->Iterations(2);
 
