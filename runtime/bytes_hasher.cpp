@@ -35,6 +35,7 @@ void BytesHasher::block(const uint8_t* p) {
 }
 
 void BytesHasher::add(const void* data, size_t size) {
+  if (size == 0) return;  // an empty piece may come as a null pointer, which memcpy must not see
   const auto* p = static_cast<const uint8_t*>(data);
   total_ += size;
   if (pending_size_ > 0) {
