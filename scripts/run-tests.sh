@@ -24,12 +24,12 @@ for label in unit integration stress viewer package; do
 done
 ./scripts/ctest-all.sh build -j "$JOBS" --timeout 900
 
-echo "== ThreadSanitizer: frame pool, service (simulation + consumers), frame graph, stream pager, bake loops, distributed bakes (ranks as threads) =="
+echo "== ThreadSanitizer: frame pool, service (simulation + consumers), frame graph, stream pager, bake loops, distributed bakes (ranks as threads), writers taking turns =="
 ./scripts/configure.sh build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=thread \
       -DLOD_BUILD_BENCH=OFF -DLOD_BUILD_VIEWER=OFF
-cmake --build build-tsan -j "$JOBS" --target test_jobs test_stress
+cmake --build build-tsan -j "$JOBS" --target test_jobs test_stress test_runtime
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" LOD_SOAK_SECONDS=${LOD_TSAN_SOAK_SECONDS:-15} \
-  ./scripts/ctest-all.sh build-tsan -j "$JOBS" --timeout 900 -R '^(FramePool|Service|ServiceObjects|ServiceThreads|FrameGraph|FrameGraphVd|FrameGraphTerrain|FrameGeomorph|StreamPager|HlodStream|Soak|TsanProbe|BakeJobs|BakeJobsCulledLevel|FrameGraphHlod|HlodDistributedBake|HlodModelsDistributedBake)\.'
+  ./scripts/ctest-all.sh build-tsan -j "$JOBS" --timeout 900 -R '^(FramePool|Service|ServiceObjects|ServiceThreads|FrameGraph|FrameGraphVd|FrameGraphTerrain|FrameGeomorph|StreamPager|HlodStream|Soak|TsanProbe|BakeJobs|BakeJobsCulledLevel|FrameGraphHlod|HlodDistributedBake|HlodModelsDistributedBake|HostTurn)\.'
 
 echo "== AddressSanitizer + UBSan: runtime, preprocess, jobs, integration =="
 ./scripts/configure.sh build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=address \
