@@ -15,6 +15,8 @@
 #include <limits>
 #include <vector>
 
+#include "runtime/bytes_hasher.h"
+
 namespace lod {
 namespace {
 
@@ -143,14 +145,7 @@ size_t count_spanning(const Id* ids, const Prepared& p) {
   return n;
 }
 
-inline uint64_t mix(uint64_t h) {
-  h ^= h >> 33;
-  h *= 0xff51afd7ed558ccdull;
-  h ^= h >> 33;
-  h *= 0xc4ceb9fe1a85ec53ull;
-  h ^= h >> 33;
-  return h;
-}
+inline uint64_t mix(uint64_t h) { return detail::fmix64(h); }
 
 // Open-addressing table from 64-bit cell id to dense cluster number; grows as it fills, so
 // it can start at the size the search expects rather than one slot pair per vertex.

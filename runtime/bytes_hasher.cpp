@@ -1,5 +1,4 @@
-// The lanes, steps and finish of hash_bytes (runtime/lod_asset.cpp), fed in pieces: whole
-// 32-byte blocks step the lanes as they come, up to 31 bytes wait for the next piece.
+// Whole 32-byte blocks step the lanes as they come; up to 31 bytes wait for the next piece.
 #include "runtime/bytes_hasher.h"
 
 #include <bit>
@@ -14,15 +13,6 @@ constexpr uint64_t k1 = 0x87c37b91114253d5ull, k2 = 0x4cf5ad432745937full;
 constexpr uint64_t basis = 0xcbf29ce484222325ull, golden = 0x9e3779b97f4a7c15ull;
 
 uint64_t step(uint64_t h, uint64_t w) { return std::rotl(h ^ (w * k1), 29) * k2; }
-
-uint64_t fmix(uint64_t k) {
-  k ^= k >> 33;
-  k *= 0xff51afd7ed558ccdull;
-  k ^= k >> 33;
-  k *= 0xc4ceb9fe1a85ec53ull;
-  k ^= k >> 33;
-  return k;
-}
 
 }  // namespace
 
@@ -62,8 +52,8 @@ uint64_t BytesHasher::finish() const {
     lane[l] = step(lane[l], tail);
   }
   uint64_t h = seed_ ^ golden;
-  for (int j = 0; j < 4; ++j) h = (h ^ fmix(lane[j])) * k2;
-  return fmix(h ^ total_);
+  for (int j = 0; j < 4; ++j) h = (h ^ detail::fmix64(lane[j])) * k2;
+  return detail::fmix64(h ^ total_);
 }
 
 }  // namespace lod

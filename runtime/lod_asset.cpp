@@ -66,6 +66,8 @@
 // The \x1a\n in the magic catches text-mode transfers that rewrite line endings.
 #include "runtime/lod_asset.h"
 
+#include "runtime/bytes_hasher.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -577,40 +579,9 @@ Status get_images(const uint8_t* p, uint64_t size, const std::string& what, std:
 }  // namespace
 
 uint64_t hash_bytes(const void* data, size_t size, uint64_t seed) {
-  // Four independent lanes of h = rotl(h ^ w * k1, 29) * k2 over 8-byte words, combined and
-  // finished with murmur's fmix64. Every step is a bijection of the word and of the lane, so
-  // changing any single word (in particular any single byte) always changes the hash.
-  constexpr uint64_t k1 = 0x87c37b91114253d5ull, k2 = 0x4cf5ad432745937full;
-  constexpr uint64_t basis = 0xcbf29ce484222325ull, golden = 0x9e3779b97f4a7c15ull;
-  auto step = [](uint64_t h, uint64_t w) { return std::rotl(h ^ (w * k1), 29) * k2; };
-  auto fmix = [](uint64_t k) {
-    k ^= k >> 33;
-    k *= 0xff51afd7ed558ccdull;
-    k ^= k >> 33;
-    k *= 0xc4ceb9fe1a85ec53ull;
-    k ^= k >> 33;
-    return k;
-  };
-  const auto* p = static_cast<const uint8_t*>(data);
-  uint64_t lane[4];
-  for (int i = 0; i < 4; ++i) lane[i] = (basis ^ seed) + golden * static_cast<uint64_t>(i + 1);
-  size_t i = 0;
-  for (; i + 32 <= size; i += 32) {
-    lane[0] = step(lane[0], load_u64(p + i));
-    lane[1] = step(lane[1], load_u64(p + i + 8));
-    lane[2] = step(lane[2], load_u64(p + i + 16));
-    lane[3] = step(lane[3], load_u64(p + i + 24));
-  }
-  int l = 0;
-  for (; i + 8 <= size; i += 8) lane[l] = step(lane[l], load_u64(p + i)), ++l;
-  if (i < size) {
-    uint64_t tail = 0;
-    for (size_t b = 0; i + b < size; ++b) tail |= uint64_t{p[i + b]} << (8 * b);
-    lane[l] = step(lane[l], tail);
-  }
-  uint64_t h = seed ^ golden;
-  for (int j = 0; j < 4; ++j) h = (h ^ fmix(lane[j])) * k2;
-  return fmix(h ^ static_cast<uint64_t>(size));
+  BytesHasher h(seed);  // one implementation for whole buffers and pieces (runtime/bytes_hasher.h)
+  h.add(data, size);
+  return h.finish();
 }
 
 std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {

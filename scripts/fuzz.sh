@@ -39,12 +39,12 @@ FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -f
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
               preprocess/obj_reader.cpp preprocess/mtl_reader.cpp preprocess/texture_uri.cpp preprocess/gltf_io.cpp
               runtime/file_write.cpp runtime/host_turn.cpp runtime/embedded_image.cpp)  # gltf_io compiles tinygltf in
-LOD_SOURCES=(runtime/lod_asset.cpp runtime/lod_chain.cpp runtime/embedded_image.cpp runtime/vertex_tree.cpp
+LOD_SOURCES=(runtime/lod_asset.cpp runtime/bytes_hasher.cpp runtime/lod_chain.cpp runtime/embedded_image.cpp runtime/vertex_tree.cpp
              runtime/vertex_front.cpp runtime/file_write.cpp runtime/host_turn.cpp runtime/model_table.cpp runtime/view.cpp)
-HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp
+HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp runtime/bytes_hasher.cpp
               runtime/lod_chain.cpp runtime/embedded_image.cpp runtime/vertex_tree.cpp runtime/file_write.cpp runtime/host_turn.cpp
               runtime/model_table.cpp runtime/view.cpp runtime/world_bounds.cpp)
-HMESH_SOURCES=(jobs/hlod_mesh_cache.cpp runtime/bytes_hasher.cpp "${LOD_SOURCES[@]}")
+HMESH_SOURCES=(jobs/hlod_mesh_cache.cpp "${LOD_SOURCES[@]}")
 HEIGHTMAP_SOURCES=(preprocess/height_field_io.cpp preprocess/height_field_png.cpp preprocess/height_field_raster.cpp
                    runtime/height_field.cpp)  # GDAL itself is Debian's, uninstrumented
 SCENE_SOURCES=(jobs/scene_config.cpp runtime/roam.cpp runtime/height_field.cpp runtime/view.cpp)  # [[terrain]] checks grid sizes
