@@ -71,12 +71,35 @@ Status check_png_chunks(std::span<const uint8_t> b, const std::string& name) {
   return Status::error(name + ": truncated PNG (no IEND chunk)");
 }
 
+// stb copies IDAT data into a buffer it allocates at the first non-empty chunk; an empty IDAT
+// before that hands memcpy a null pointer (undefined behaviour). Empty IDATs carry nothing, so
+// they are dropped. Returns no bytes when there is none to drop. Chunks are checked already.
+std::vector<uint8_t> without_empty_idat(std::span<const uint8_t> b) {
+  std::vector<uint8_t> kept;
+  size_t at = 8, copied = 0;
+  while (at + 12 <= b.size()) {
+    const uint32_t length = big_endian32(&b[at]);
+    const bool empty_idat = length == 0 && std::equal(&b[at + 4], &b[at + 8], "IDAT");
+    if (empty_idat) {
+      if (kept.empty()) kept.reserve(b.size());
+      kept.insert(kept.end(), b.begin() + ptrdiff_t(copied), b.begin() + ptrdiff_t(at));
+      copied = at + 12;
+    }
+    at += size_t(length) + 12;
+  }
+  if (copied == 0) return {};
+  kept.insert(kept.end(), b.begin() + ptrdiff_t(copied), b.end());
+  return kept;
+}
+
 }  // namespace detail
 
 Status parse_height_field_png(std::span<const uint8_t> bytes, const std::string& name, HeightField& out,
                               const HeightFieldOptions& o) {
   if (bytes.size() > size_t(INT_MAX)) return Status::error(name + ": PNG over 2 GiB");
   if (Status st = detail::check_png_chunks(bytes, name); !st) return st;
+  const std::vector<uint8_t> trimmed = detail::without_empty_idat(bytes);
+  if (!trimmed.empty()) bytes = trimmed;
   const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
   const int len = int(bytes.size());
   int w = 0, h = 0, comp = 0;

@@ -159,5 +159,39 @@ TEST(HeightFieldPng, HugeDeclaredSizeTruncationAndGarbageAreRefused) {
   EXPECT_TRUE(has(read_height_field(dir / "absent.png", f), "absent.png: cannot open"));
 }
 
+// Fuzzer finding: an empty IDAT before the first one with data made stb call memcpy with a null
+// destination (UBSan). Empty IDATs anywhere decode to the same heights as without them.
+TEST(HeightFieldPng, EmptyImageDataChunksAreHarmless) {
+  const int w = 9, h = 5;
+  std::vector<uint8_t> px(w * h);
+  for (size_t i = 0; i < px.size(); ++i) px[i] = uint8_t(i * 11 + 3);
+  const std::vector<uint8_t> whole = png8(w, h, 1, px);
+  const size_t idat = 8 + 25;
+  ASSERT_EQ(std::string(whole.begin() + idat + 4, whole.begin() + idat + 8), "IDAT");
+  const size_t after_idat = idat + 12 + (size_t(whole[idat + 2]) << 8 | whole[idat + 3]);
+  std::vector<uint8_t> empty;
+  put32(empty, 0);
+  empty.insert(empty.end(), {'I', 'D', 'A', 'T'});
+  put32(empty, 0x35af061e);  // the CRC of an empty IDAT
+  std::vector<uint8_t> padded(whole.begin(), whole.begin() + idat);
+  padded.insert(padded.end(), empty.begin(), empty.end());
+  padded.insert(padded.end(), empty.begin(), empty.end());
+  padded.insert(padded.end(), whole.begin() + idat, whole.begin() + after_idat);
+  padded.insert(padded.end(), empty.begin(), empty.end());
+  padded.insert(padded.end(), whole.begin() + after_idat, whole.end());
+  HeightField plain, with_empty;
+  ASSERT_TRUE(parse_height_field_png(whole, "plain.png", plain).ok);
+  const Status st = parse_height_field_png(padded, "padded.png", with_empty);
+  ASSERT_TRUE(st.ok) << st.message;
+  ASSERT_EQ(with_empty.width, 9u);
+  EXPECT_EQ(with_empty.heights, plain.heights);
+  std::vector<uint8_t> only_empty(whole.begin(), whole.begin() + idat);
+  only_empty.insert(only_empty.end(), empty.begin(), empty.end());
+  only_empty.insert(only_empty.end(), whole.begin() + after_idat, whole.end());
+  const Status none = parse_height_field_png(only_empty, "nodata.png", with_empty);
+  ASSERT_FALSE(none.ok);
+  EXPECT_TRUE(has(none, "nodata.png: PNG decoding failed")) << none.message;
+}
+
 }  // namespace
 }  // namespace lod
