@@ -11,9 +11,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <fstream>
 #include <mutex>
 #include <utility>
 #include <vector>
+
+#include "preprocess/ascii_grid_header.h"
 
 namespace lod {
 namespace detail {
@@ -144,11 +147,18 @@ Status read_height_field_raster(const std::filesystem::path& path, HeightField& 
   const std::string name = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return Status::error(name + ": cannot open (no such file)");
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  std::vector<uint8_t> head(std::min<uint64_t>(ec ? 0 : size, kAsciiGridHeadBytes));
+  std::ifstream in(path, std::ios::binary);
+  if (ec || !in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size())))
+    return Status::error(name + ": cannot read");
+  if (Status st = check_ascii_grid_header(head, size, name, o, detail::kBytesPerSample); !st) return st;
   return detail::open_and_read(name, name, out, o);
 }
 
 Status parse_height_field_raster(std::span<const uint8_t> bytes, const std::string& name, HeightField& out,
                                  const HeightFieldOptions& o) {
+  if (Status st = check_ascii_grid_header(bytes, bytes.size(), name, o, detail::kBytesPerSample); !st) return st;
   detail::gdal_register_once();
   static std::atomic<uint64_t> serial{0};
   // A folder per call keeps the file's own name, which some drivers read (.hgt: its tile).

@@ -45,7 +45,7 @@ HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_sel
               runtime/lod_chain.cpp runtime/embedded_image.cpp runtime/vertex_tree.cpp runtime/file_write.cpp runtime/host_turn.cpp
               runtime/model_table.cpp runtime/view.cpp runtime/world_bounds.cpp)
 HMESH_SOURCES=(jobs/hlod_mesh_cache.cpp "${LOD_SOURCES[@]}")
-HEIGHTMAP_SOURCES=(preprocess/height_field_io.cpp preprocess/height_field_png.cpp preprocess/height_field_raster.cpp
+HEIGHTMAP_SOURCES=(preprocess/height_field_io.cpp preprocess/height_field_png.cpp preprocess/height_field_raster.cpp preprocess/ascii_grid_header.cpp
                    runtime/height_field.cpp)  # GDAL itself is Debian's, uninstrumented
 SCENE_SOURCES=(jobs/scene_config.cpp runtime/roam.cpp runtime/height_field.cpp runtime/view.cpp)  # [[terrain]] checks grid sizes
 # The scene reader links Debian's toml++ library as lodkit does (its header-only mode has debug

@@ -268,6 +268,36 @@ TEST(HeightFieldRaster, HugeDeclaredSizeIsRefusedBeforeAllocating) {
   EXPECT_EQ(f.width, 0u);
 }
 
+// Fuzzer finding: a 190-byte ESRI grid declaring 8,888,888 rows made GDAL allocate 71 MB while
+// opening it (8 bytes per row). Text grids are sized against their file before GDAL sees them.
+TEST(HeightFieldRaster, TextGridDeclaringMoreSamplesThanItsBytesIsRefusedBeforeGdal) {
+  HeightFieldOptions unlimited;
+  unlimited.max_samples = SIZE_MAX;
+  auto parse = [&](const std::string& text, const std::string& name) {
+    HeightField f;
+    const Status st = parse_height_field_raster({reinterpret_cast<const uint8_t*>(text.data()), text.size()}, name, f,
+                                                unlimited);
+    EXPECT_EQ(f.width, st.ok ? f.width : 0u);
+    return st;
+  };
+  const std::string esri = "ncols 2\nNROWS 8888888\xce" "88tRNS\nxllcorner 0\nyllcorner 0\ncellsize 25\n1 2\n3 4\n";
+  const Status e = parse(esri, "rows.asc");
+  ASSERT_FALSE(e.ok);
+  EXPECT_TRUE(has(e, "rows.asc: text grid declares 2 x 8888888 samples, but the file has only")) << e.message;
+  const std::string grass = "north: 3\nsouth: 0\neast: 3\nwest: 0\nrows: 900000\ncols: 3\n1 2 3\n4 5 6\n";
+  const Status g = parse(grass, "grass.asc");
+  ASSERT_FALSE(g.ok);
+  EXPECT_TRUE(has(g, "grass.asc: text grid declares 3 x 900000 samples")) << g.message;
+  const auto dir = test::temp_dir("raster_rows");
+  test::write_text(dir / "rows.asc", esri);
+  HeightField f;
+  const Status from_file = read_height_field_raster(dir / "rows.asc", f, unlimited);
+  ASSERT_FALSE(from_file.ok);
+  EXPECT_TRUE(has(from_file, "rows.asc: text grid declares 2 x 8888888 samples")) << from_file.message;
+  // Exactly as many samples as the text holds passes on to GDAL and reads.
+  EXPECT_TRUE(parse("ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4", "fits.asc").ok);
+}
+
 TEST(HeightFieldRaster, TruncatedAndGarbageFilesAreRefusedNamingThem) {
   const auto dir = test::temp_dir("raster_cut");
   TiffSpec s;
