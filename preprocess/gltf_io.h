@@ -6,8 +6,9 @@
 // mirroring transform flips the winding back). TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN,
 // indexed (u8/u16/u32) or not; POSITION, NORMAL, TEXCOORD_0 and TEXCOORD_1 as float, normalized
 // (u)int8/(u)int16 or, as KHR_mesh_quantization allows, plain (u)int8/(u)int16; byte strides
-// honoured; the base colour texture's KHR_texture_transform is applied to TEXCOORD_0 (so
-// gltfpack's quantized UVs come out in texture space); COLOR_0 (VEC3 or VEC4, float or
+// honoured; each uv set takes the KHR_texture_transform of the first texture reading it (base
+// colour first; so gltfpack's quantized UVs come out in texture space), another texture on that
+// set with another transform is said in the warnings; COLOR_0 (VEC3 or VEC4, float or
 // normalized u8/u16) as linear RGBA, clamped to [0, 1]; a primitive lacking TEXCOORD_1 or COLOR_0
 // in a file where another has it gets (0, 0) / white, said in the warnings. Materials (metallic-roughness factors, texture URIs, alpha mode,
 // double-sided) become MeshData::materials, each primitive a Submesh. Images held in the file
