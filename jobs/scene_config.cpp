@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -567,6 +568,25 @@ void read_terrain_shares(const Reader& r, const toml::table& t, const std::strin
   c.min_share = float(v[0]), c.initial_share = float(v[1]), c.max_share = float(v[2]);
 }
 
+// Driver short names as GDAL spells them ("GTiff", "SRTMHGT"); whether this GDAL has each is
+// checked when the file is read (the config reader does not link GDAL).
+void read_gdal_drivers(const Reader& r, const toml::table& t, const std::string& key, TerrainConfig& c) {
+  const toml::array* a = r.array(t, "gdal_drivers", key + ".gdal_drivers");
+  if (!a) return;
+  if (a->empty()) r.fail(key + ".gdal_drivers", "is empty; leave it out to allow every driver");
+  if (a->size() > 64) r.fail(key + ".gdal_drivers", "lists " + std::to_string(a->size()) + " drivers, at most 64");
+  for (size_t i = 0; i < a->size(); ++i) {
+    const std::string at = indexed(key + ".gdal_drivers", i);
+    const toml::value<std::string>* v = a->get(i)->as_string();
+    if (!v) r.fail(at, "expected a driver name (a string such as \"GTiff\")");
+    const std::string& name = v->get();
+    const bool plain = !name.empty() && name.size() <= 32 &&
+                       std::all_of(name.begin(), name.end(), [](char ch) { return std::isalnum(uint8_t(ch)) || ch == '_' || ch == '-'; });
+    if (!plain) r.fail(at, "\"" + name.substr(0, 40) + "\" is not a GDAL driver name (letters, digits, _ and -, at most 32)");
+    c.gdal_drivers.push_back(name);
+  }
+}
+
 void read_terrain_grid(const Reader& r, const toml::table& t, const std::string& key, TerrainConfig& c) {
   if (auto v = r.string(t, "coordinates", key + ".coordinates")) {
     if (*v == "metres") c.coordinates = GridCoordinates::metres;
@@ -594,6 +614,7 @@ void read_terrain_grid(const Reader& r, const toml::table& t, const std::string&
     else if (*v != "center") r.fail(key + ".placement", "must be \"center\" or \"corner\", got \"" + *v + "\"");
   }
   r.vec3(t, "position", key + ".position", c.position);
+  read_gdal_drivers(r, t, key, c);
   r.integer_in(t, "samples", key + ".samples", 3, 4097, c.samples);
   if (c.samples && !roam_size_valid(c.samples, c.samples))
     r.fail(key + ".samples", "must be 2^n + 1 (3, 5, 9, ..., 4097), got " + std::to_string(c.samples));
@@ -608,7 +629,7 @@ void read_terrain(const Reader& r, const toml::table& root, const std::filesyste
   const std::string key = "terrain[0]";
   r.only_keys(t, key,
               {"file", "coordinates", "cell_size", "vertical_scale", "no_data", "placement", "position", "samples",
-               "pixel_error", "target", "max_ms", "max_triangles", "share"});
+               "pixel_error", "target", "max_ms", "max_triangles", "share", "gdal_drivers"});
   TerrainConfig tc;
   auto file = r.string(t, "file", key + ".file");
   if (!file || file->empty()) r.fail(key + ".file", "missing");

@@ -72,6 +72,7 @@ struct TerrainConfig {
   float max_ms = 0;             // max_ms: ROAM's time limit per frame, any target (needed by "time"); 0 = none
   uint32_t max_triangles = 1u << 18;  // max_triangles: cap in any mode (the share of levels budgets)
   float initial_share = 0.5f, min_share = 0.05f, max_share = 0.9f;  // share = [min, initial, max] of M
+  std::vector<std::string> gdal_drivers;  // gdal_drivers = ["GTiff", ...]: GDAL drivers allowed to open file; [] = all
 };
 
 struct SceneConfig {

@@ -37,6 +37,7 @@ Status load_terrain_model(const TerrainConfig& config, float pixel_error, Terrai
   options.coordinates = config.coordinates;
   options.vertical_scale = config.vertical_scale;
   options.no_data_value = config.no_data;
+  options.gdal_drivers = config.gdal_drivers;
   HeightField field;
   if (auto st = read_height_field(config.file, field, options); !st) return st;
   if (config.cell_size[0] > 0) field.cell_size_x = config.cell_size[0];

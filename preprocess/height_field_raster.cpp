@@ -133,7 +133,11 @@ Status open_and_read(const std::string& path, const std::string& name, HeightFie
   QuietGdal quiet;
   Dataset ds;
   std::vector<const char*> drivers;
-  for (const std::string& d : o.gdal_drivers) drivers.push_back(d.c_str());
+  for (const std::string& d : o.gdal_drivers) {
+    if (!GDALGetDriverByName(d.c_str()))
+      return Status::error(name + ": the allowed GDAL drivers name '" + d + "', which this GDAL does not have");
+    drivers.push_back(d.c_str());
+  }
   drivers.push_back(nullptr);
   ds.handle = GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, o.gdal_drivers.empty() ? nullptr : drivers.data(),
                          nullptr, nullptr);

@@ -58,6 +58,7 @@ pixel_error = 0.75
 target = "triangles"
 max_triangles = 5000
 share = [0.1, 0.3, 0.6]
+gdal_drivers = ["GTiff", "AAIGrid"]
 )", c);
   ASSERT_TRUE(s.ok) << s.message;
   ASSERT_TRUE(c.terrain.has_value());
@@ -76,6 +77,7 @@ share = [0.1, 0.3, 0.6]
   EXPECT_EQ(t.min_share, 0.1f);
   EXPECT_EQ(t.initial_share, 0.3f);
   EXPECT_EQ(t.max_share, 0.6f);
+  EXPECT_EQ(t.gdal_drivers, (std::vector<std::string>{"GTiff", "AAIGrid"}));
 }
 
 TEST(TerrainConfig, AbsentMeansNoTerrain) {
@@ -112,6 +114,15 @@ TEST(TerrainConfig, RefusesSharesOutOfOrder) {
   expect_refused("file = \"hills.txt\"\nshare = [0.5, 0.2, 0.9]\n", "terrain[0].share", "min <= initial <= max");
 }
 TEST(TerrainConfig, RefusesUnknownTarget) { expect_refused("file = \"hills.txt\"\ntarget = \"speed\"\n", "terrain[0].target"); }
+TEST(TerrainConfig, RefusesMalformedDriverLists) {
+  expect_refused("file = \"hills.txt\"\ngdal_drivers = \"GTiff\"\n", "terrain[0].gdal_drivers", "expected an array");
+  expect_refused("file = \"hills.txt\"\ngdal_drivers = []\n", "terrain[0].gdal_drivers", "is empty");
+  expect_refused("file = \"hills.txt\"\ngdal_drivers = [\"GTiff\", 3]\n", "terrain[0].gdal_drivers[1]",
+                 "expected a driver name");
+  expect_refused("file = \"hills.txt\"\ngdal_drivers = [\"../GTiff\"]\n", "terrain[0].gdal_drivers[0]",
+                 "is not a GDAL driver name");
+}
+
 TEST(TerrainConfig, TimeTargetTakesItsLimit) {
   TerrainDir d;
   SceneConfig c;
@@ -226,6 +237,29 @@ TEST(TerrainModelLoad, ReadsAnEsriAsciiGridThroughGdal) {
     EXPECT_FLOAT_EQ(a.roam.positions[i].y, b.roam.positions[i].y) << i;
     EXPECT_FLOAT_EQ(a.roam.positions[i].z, b.roam.positions[i].z);
   }
+}
+
+// gdal_drivers reaches the reader: a list without the file's driver refuses it, naming the
+// file; a name this GDAL lacks is said as such.
+TEST(TerrainModelLoad, GdalDriverListDecidesWhoMayOpenTheRaster) {
+  TerrainDir d;
+  test::write_text(d.dir / "hills.asc", "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 10\n1 2 3\n4 5 6\n");
+  auto load = [&](const std::string& drivers) {
+    SceneConfig c;
+    const Status parsed = d.load("file = \"hills.asc\"\ngdal_drivers = " + drivers + "\n", c);
+    EXPECT_TRUE(parsed.ok) << parsed.message;
+    TerrainModel m;
+    return parsed.ok ? load_terrain_model(*c.terrain, 1, m) : parsed;
+  };
+  EXPECT_TRUE(load("[\"GTiff\", \"AAIGrid\"]").ok);
+  const Status other = load("[\"GTiff\"]");
+  ASSERT_FALSE(other.ok);
+  EXPECT_NE(other.message.find("hills.asc: not a raster GDAL can read"), std::string::npos) << other.message;
+  const Status unknown = load("[\"AAIGrid\", \"NoSuchDriver\"]");
+  ASSERT_FALSE(unknown.ok);
+  EXPECT_NE(unknown.message.find("hills.asc: the allowed GDAL drivers name 'NoSuchDriver', which this GDAL does not have"),
+            std::string::npos)
+      << unknown.message;
 }
 
 }  // namespace
