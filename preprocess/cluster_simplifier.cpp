@@ -145,8 +145,6 @@ size_t count_spanning(const Id* ids, const Prepared& p) {
   return n;
 }
 
-inline uint64_t mix(uint64_t h) { return detail::fmix64(h); }
-
 // Open-addressing table from 64-bit cell id to dense cluster number; grows as it fills, so
 // it can start at the size the search expects rather than one slot pair per vertex.
 struct CellTable {
@@ -165,7 +163,7 @@ struct CellTable {
   }
   uint32_t insert(uint64_t key, uint32_t next) {
     if (2 * (count + 1) > entries.size()) grow();
-    size_t slot = mix(key) & mask;
+    size_t slot = detail::fmix64(key) & mask;
     while (entries[slot].key != ~0ull && entries[slot].key != key) slot = (slot + 1) & mask;
     if (entries[slot].key == ~0ull) entries[slot] = Entry{key, next, 0}, count++;
     return entries[slot].value;
@@ -176,7 +174,7 @@ struct CellTable {
     mask = entries.size() - 1;
     for (const Entry& e : old) {
       if (e.key == ~0ull) continue;
-      size_t slot = mix(e.key) & mask;
+      size_t slot = detail::fmix64(e.key) & mask;
       while (entries[slot].key != ~0ull) slot = (slot + 1) & mask;
       entries[slot] = e;
     }
@@ -213,7 +211,7 @@ size_t unique_faces(std::vector<uint32_t>& faces, std::vector<uint64_t>& table, 
   auto key_of = [&](size_t f) {
     const uint32_t* x = &faces[3 * f];
     const uint64_t xl = std::min(x[1], x[2]), xh = std::max(x[1], x[2]);
-    return packed ? uint64_t(x[0]) << 42 | xl << 21 | xh : mix(uint64_t(x[0]) * 0x9e3779b97f4a7c15ull ^ (xl << 32 | xh));
+    return packed ? uint64_t(x[0]) << 42 | xl << 21 | xh : detail::fmix64(uint64_t(x[0]) * 0x9e3779b97f4a7c15ull ^ (xl << 32 | xh));
   };
   auto same = [&](size_t f, uint64_t stored, uint64_t key) {
     if (packed) return stored == key;
@@ -227,11 +225,11 @@ size_t unique_faces(std::vector<uint32_t>& faces, std::vector<uint64_t>& table, 
     const size_t m = std::min(kBatch, n - f0);
     for (size_t j = 0; j < m; ++j) {
       keys[j] = key_of(f0 + j);
-      __builtin_prefetch(&table[(packed ? mix(keys[j]) : keys[j]) & mask]);
+      __builtin_prefetch(&table[(packed ? detail::fmix64(keys[j]) : keys[j]) & mask]);
     }
     for (size_t j = 0; j < m; ++j) {
       const size_t f = f0 + j;
-      size_t slot = (packed ? mix(keys[j]) : keys[j]) & mask;
+      size_t slot = (packed ? detail::fmix64(keys[j]) : keys[j]) & mask;
       bool duplicate = false;
       while (table[slot] != ~0ull) {
         if (same(f, table[slot], keys[j])) {
