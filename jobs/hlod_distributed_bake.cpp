@@ -163,7 +163,10 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
   j.r.load_seconds = seconds_since(t0);
   t0 = Clock::now();
   j.options.min_verts = j.settings.min_verts;
-  j.options.subtrees = j.settings.subtrees ? j.settings.subtrees : 16 * uint32_t(j.ranks());
+  // Few subtrees keep the top small (rank 0's serial part and everyone's measuring grow with
+  // it); the cuts between the ranks' shares are refined instead, so that they still split evenly.
+  j.options.subtrees = j.settings.subtrees ? j.settings.subtrees : default_subtrees(j.ranks());
+  j.options.balance_parts = uint32_t(j.ranks());
   j.options.parallel_for = tbb_parallel_for();
   j.builder = std::make_unique<HlodBuilder>(j.mesh, j.options);
   Status planned;

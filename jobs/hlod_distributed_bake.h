@@ -19,6 +19,7 @@
 // The communication is two collectives (HlodRankComm), so that lodkit's libraries never link
 // MPI: lod-bake-mpi gives MPI_Bcast and MPI_Gatherv; tests may give threads or nothing.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -53,10 +54,14 @@ std::vector<int> assign_subtrees(const std::vector<uint64_t>& costs, int ranks);
 std::vector<int> assign_subtrees_spatially(const std::vector<uint64_t>& costs, const std::vector<size_t>& order,
                                            int ranks);
 
+// The frontier's default target: 8 per rank, at least 16 (the local bake's). A split refined
+// at the ranks' cuts (HlodBuildOptions::balance_parts) needs no more for an even split.
+inline uint32_t default_subtrees(int ranks) { return std::max(16u, 8u * uint32_t(std::max(1, ranks))); }
+
 struct HlodDistributedSettings {
   uint32_t min_verts = 1000;
   uint32_t threads = 0;    // per rank; 0 = all its cores
-  uint32_t subtrees = 0;   // the frontier's target (HlodBuildOptions::subtrees); 0 = 16 per rank
+  uint32_t subtrees = 0;   // the frontier's target (HlodBuildOptions::subtrees); 0 = default_subtrees
   std::filesystem::path cache_dir;
   // Called before each of this rank's entries is stored (count: entries this rank stored so
   // far), from the thread that finished it. Tests inject a crash here.

@@ -75,6 +75,10 @@ struct HlodBuildOptions {
   // About how many subtrees the top is split into (see the frontier rule). The output is the
   // same for any value; it only decides the units a distributed build hands out.
   uint32_t subtrees = 16;
+  // A distributed build's rank count: where the frontier's depth-first order is cut into this
+  // many equal shares, the subtree a cut falls in is split further (see refine_at_cuts), so
+  // that a few subtrees per rank split evenly. Like `subtrees`, it never changes the output.
+  uint32_t balance_parts = 1;
   // The materials the mesh's submeshes name, copied into the tree. A submesh id at or past their
   // count is drawn with the default material. None: one surface, no runs.
   HlodSurfaces surfaces;

@@ -183,7 +183,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   app.add_option("--cache", cache_dir, "subtree cache directory on shared storage")->required();
   app.add_option("--min-verts", min_verts, "a cell with more vertices splits (default 1000)")->check(CLI::Range(3, 100000000));
   app.add_option("--threads", threads, "threads per rank, 0 = all cores")->check(CLI::Range(0, 1024));
-  app.add_option("--subtrees", subtrees, "subtrees to split into (default 16 per rank)")->check(CLI::Range(0, 1 << 20));
+  app.add_option("--subtrees", subtrees, "subtrees to split into (default 8 per rank, at least 16)")->check(CLI::Range(0, 1 << 20));
   app.add_flag("--json", json, "rank 0 prints a JSON summary");
   app.add_flag("--quiet", quiet, "print nothing but errors");
   try {

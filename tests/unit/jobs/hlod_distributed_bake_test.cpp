@@ -76,6 +76,36 @@ TEST(HlodAssign, SpatialRunsAreContiguousAndBalanced) {
   EXPECT_EQ(assign_subtrees_spatially({1, 1, 1, 1}, {3, 2, 1, 0}, 2), (std::vector<int>{1, 1, 0, 0}));
 }
 
+// The slowest rank's share of the estimated cost over the mean, for a frontier planned with
+// `subtrees` and refined (or not) at the cuts between `ranks` spatial runs.
+double spatial_imbalance(const MeshData& m, uint32_t subtrees, int ranks, bool refine) {
+  HlodBuildOptions o;
+  o.min_verts = 100;
+  o.subtrees = subtrees;
+  o.balance_parts = refine ? uint32_t(ranks) : 1;
+  HlodBuilder b(m, o);
+  EXPECT_TRUE(b.plan());
+  std::vector<uint64_t> costs;
+  std::vector<size_t> order(b.subtrees().size());
+  for (const HlodSubtreeSpec& s : b.subtrees()) costs.push_back(s.triangles);
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t c) { return b.subtrees()[a].spatial < b.subtrees()[c].spatial; });
+  const std::vector<int> owner = assign_subtrees_spatially(costs, order, ranks);
+  std::vector<double> load(size_t(ranks), 0);
+  for (size_t i = 0; i < costs.size(); ++i) load[size_t(owner[i])] += double(costs[i]);
+  const double mean = std::accumulate(load.begin(), load.end(), 0.0) / ranks;
+  return *std::max_element(load.begin(), load.end()) / mean;
+}
+
+// Few subtrees (a small top) split evenly once the cuts between the ranks' runs are refined;
+// without it the same frontier leaves a rank a subtree-sized share more.
+TEST(HlodAssign, FrontierRefinedAtTheCutsSplitsFewSubtreesEvenly) {
+  const MeshData m = test::vd_concat(test::vd_sphere(120, 160, 0.4f, 0.5f, 0.3f, 0.5f), test::vd_grid(120, 120));
+  for (int ranks : {2, 3, 4}) EXPECT_LT(spatial_imbalance(m, uint32_t(ranks), ranks, true), 1.01) << ranks << " ranks";
+  // Where the coarse frontier's runs are uneven (this mesh is symmetric enough at 2 ranks).
+  for (int ranks : {3, 4}) EXPECT_GT(spatial_imbalance(m, uint32_t(ranks), ranks, false), 1.05) << ranks << " ranks";
+}
+
 // The mixed test mesh as an OFF file.
 std::filesystem::path write_mesh(const std::filesystem::path& dir) {
   const MeshData m = test::vd_concat(test::vd_sphere(40, 50, 0.4f, 0.5f, 0.3f, 0.5f), test::vd_grid(40, 40));

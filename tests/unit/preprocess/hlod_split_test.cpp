@@ -36,6 +36,18 @@ TEST(HlodSplit, SameBytesWhereverTheFrontierIs) {
   for (uint32_t subtrees : {2u, 5u, 16u, 64u, 100000u}) EXPECT_EQ(local_build(m, subtrees), one) << subtrees << " subtrees";
 }
 
+TEST(HlodSplit, SameBytesWithTheFrontierRefinedAtRankCuts) {
+  const MeshData m = mesh();
+  const std::vector<uint8_t> one = local_build(m, 1);
+  for (uint32_t parts : {2u, 3u, 7u, 64u}) {
+    HlodBuildOptions o = options_with(4);
+    o.balance_parts = parts;
+    HlodModel model;
+    ASSERT_TRUE(build_hlod(model, m, o));
+    EXPECT_EQ(bytes_of(model), one) << parts << " parts";
+  }
+}
+
 TEST(HlodSplit, FrontierHoldsNoSplittableSubtreeAboveTheLimit) {
   const MeshData m = mesh();
   const HlodBuildOptions o = options_with(16);
