@@ -114,9 +114,10 @@ std::string device_error_text(RTCDevice device) {
   }
 }
 
-Status commit_query_mesh(RTCDevice device, const std::string& what, QueryMesh& out);
+Status commit_query_mesh(RTCDevice device, const std::string& what, BvhBuilder builder, QueryMesh& out);
 
-Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const std::string& what, QueryMesh& out) {
+Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const std::string& what, QueryMesh& out,
+                        BvhBuilder builder = BvhBuilder::sah) {
   out.release();
   if (view.index_count % 3 != 0 || view.index_count == 0)
     return Status::error(what + ": no triangles to measure against");
@@ -124,32 +125,35 @@ Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const st
     if (view.indices[i] >= view.vertex_count)
       return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
                            std::to_string(view.indices[i]) + " of " + std::to_string(view.vertex_count));
+  out.positions.reserve(3 * view.vertex_count + 1);
   out.positions.assign(view.positions, view.positions + 3 * view.vertex_count);
   out.indices.assign(view.indices, view.indices + view.index_count);
   out.slack = rounding_slack(view.positions, 3 * view.vertex_count);
-  return commit_query_mesh(device, what, out);
+  return commit_query_mesh(device, what, builder, out);
 }
 
-// out's arrays into an Embree scene.
-Status commit_query_mesh(RTCDevice device, const std::string& what, QueryMesh& out) {
+// out's arrays into an Embree scene, shared rather than copied (out keeps them while the scene
+// lives): a vertex buffer is read 16 bytes at a time, so one float of padding follows the last.
+Status commit_query_mesh(RTCDevice device, const std::string& what, BvhBuilder builder, QueryMesh& out) {
   const size_t vertex_count = out.positions.size() / 3, index_count = out.indices.size();
+  out.positions.resize(3 * vertex_count + 1, 0.0f);
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   if (!geom) return Status::error(what + ": Embree could not create a geometry (" + device_error_text(device) + ")");
-  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                         3 * sizeof(float), vertex_count));
-  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                            3 * sizeof(uint32_t), index_count / 3));
-  if (!vb || !ib) {
-    rtcReleaseGeometry(geom);
-    return Status::error(what + ": Embree could not allocate buffers (" + device_error_text(device) + ")");
-  }
-  std::memcpy(vb, out.positions.data(), out.positions.size() * sizeof(float));
-  std::memcpy(ib, out.indices.data(), out.indices.size() * sizeof(uint32_t));
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, out.positions.data(), 0,
+                             3 * sizeof(float), vertex_count);
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, out.indices.data(), 0,
+                             3 * sizeof(uint32_t), index_count / 3);
+  // Morton: Embree picks its Morton-code builder only for a low-quality geometry in a dynamic,
+  // low-quality scene.
+  const bool morton = builder == BvhBuilder::morton;
+  if (morton) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_LOW);
   rtcCommitGeometry(geom);
   out.scene = rtcNewScene(device);
   // Compact: half the BVH's memory, and on a 14M-triangle original a quarter less build time
   // (memory-bound) at the same query speed (bench_mesh_input); the answers never depend on it.
-  rtcSetSceneFlags(out.scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT));
+  rtcSetSceneFlags(out.scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT |
+                                            (morton ? RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_NONE)));
+  if (morton) rtcSetSceneBuildQuality(out.scene, RTC_BUILD_QUALITY_LOW);
   rtcAttachGeometry(out.scene, geom);
   rtcReleaseGeometry(geom);
   rtcCommitScene(out.scene);
@@ -346,11 +350,32 @@ CellRange cells_of_box(const SurfaceGrid& g, const float* lo, const float* hi) {
 
 // A triangle spanning more cells than this stays in every part (bounds the cost of huge ones).
 constexpr size_t kPartSpanCells = 4096;
+// Cells per axis a part's grid may have: a cell coordinate fits 16 bits (and the flags memory).
+constexpr uint32_t kMaxGridCells = 65535;
+
+// Each vertex's cell per axis. The cell is monotonic in the coordinate, so a triangle's box's
+// cells are its vertices' least and greatest: once per vertex instead of once per use.
+std::vector<uint16_t> vertex_cells(const TriangleMeshView& mesh, const SurfaceGrid& g) {
+  std::vector<uint16_t> cells(3 * mesh.vertex_count);
+  for (size_t v = 0; v < mesh.vertex_count; ++v)
+    for (int k = 0; k < 3; ++k) cells[3 * v + k] = uint16_t(g.cell(mesh.positions[3 * v + k], k));
+  return cells;
+}
+
+CellRange cells_of_triangle(const uint16_t* cells, const uint32_t* f) {
+  const uint16_t* a = cells + 3 * size_t(f[0]);
+  const uint16_t* b = cells + 3 * size_t(f[1]);
+  const uint16_t* c = cells + 3 * size_t(f[2]);
+  CellRange r;
+  for (int k = 0; k < 3; ++k) r.lo[k] = std::min({a[k], b[k], c[k]}), r.hi[k] = std::max({a[k], b[k], c[k]});
+  return r;
+}
 
 }  // namespace
 
 struct SurfaceDistance::Impl {
   RTCDevice device = nullptr;
+  BvhBuilder builder = BvhBuilder::morton;
   QueryMesh surface;
   std::string what;
   bool ready = false;
@@ -373,7 +398,7 @@ struct SurfaceDistance::Impl {
   }
 };
 
-SurfaceDistance::SurfaceDistance() : impl_(std::make_unique<Impl>()) {}
+SurfaceDistance::SurfaceDistance(BvhBuilder builder) : impl_(std::make_unique<Impl>()) { impl_->builder = builder; }
 SurfaceDistance::~SurfaceDistance() = default;
 
 Status SurfaceDistance::set_surface(const TriangleMeshView& surface, const std::string& what) {
@@ -384,7 +409,7 @@ Status SurfaceDistance::set_surface(const TriangleMeshView& surface, const std::
     m.device = rtcNewDevice(nullptr);
     if (!m.device) return Status::error(what + ": Embree device could not be created");
   }
-  if (Status s = build_query_mesh(m.device, surface, what, m.surface); !s) return s;
+  if (Status s = build_query_mesh(m.device, surface, what, m.surface, m.builder); !s) return s;
   m.part = false;
   m.triangles = surface.index_count / 3;
   m.ready = true;
@@ -397,7 +422,7 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
   m.ready = false;
   m.what = what;
   m.surface.release();
-  if (whole.index_count % 3 != 0 || grid.n == 0 || wanted.size() != grid.cells())
+  if (whole.index_count % 3 != 0 || grid.n == 0 || grid.n > kMaxGridCells || wanted.size() != grid.cells())
     return Status::error(what + ": a surface part needs whole triangles and one flag per grid cell");
   for (size_t i = 0; i < whole.index_count; ++i)
     if (whole.indices[i] >= whole.vertex_count)
@@ -411,19 +436,17 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
   // reaches into is incomplete.
   m.grid = grid;
   m.complete.assign(grid.cells(), 1);
+  const std::vector<uint16_t> cells = vertex_cells(whole, grid);
   std::vector<uint32_t> remap(whole.vertex_count, UINT32_MAX);
   QueryMesh& part = m.surface;
   part.positions.clear();
   part.indices.clear();
+  // Address space only: the pages a smaller part never touches are never committed.
+  part.positions.reserve(3 * whole.vertex_count + 1);
+  part.indices.reserve(whole.index_count);
   for (size_t t = 0; t < whole.index_count / 3; ++t) {
     const uint32_t* f = whole.indices + 3 * t;
-    float lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) {
-      const float a = whole.positions[3 * size_t(f[0]) + k], b = whole.positions[3 * size_t(f[1]) + k],
-                  c = whole.positions[3 * size_t(f[2]) + k];
-      lo[k] = std::min({a, b, c}), hi[k] = std::max({a, b, c});
-    }
-    const CellRange range = cells_of_box(grid, lo, hi);
+    const CellRange range = cells_of_triangle(cells.data(), f);
     const bool keep = range.count() > kPartSpanCells || !range.all(grid, [&](size_t c) { return wanted[c] == 0; });
     if (!keep) {
       range.all(grid, [&](size_t c) { return m.complete[c] = 0, true; });
@@ -443,7 +466,7 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
   m.part = true;
   m.triangles = part.indices.size() / 3;
   if (m.triangles > 0)
-    if (Status s = commit_query_mesh(m.device, what, part); !s) return s;
+    if (Status s = commit_query_mesh(m.device, what, m.builder, part); !s) return s;
   m.ready = true;
   return Status::success();
 }

@@ -6,7 +6,8 @@
 //   BM_FaceGroupsHashed   the same answer by hash groups (first_of_equal, what clean uses)
 //   BM_Clean/indexed      clean_mesh of the indexed sphere (nothing to weld)
 //   BM_Clean/soup         clean_mesh of the same triangles, three vertices each (all to weld)
-//   BM_SurfaceBuild / BM_SurfaceQuery   the closest-point BVH over it: build, and queries
+//   BM_SurfaceBuild / BM_SurfaceQuery   the closest-point BVH over it: build, and queries;
+//                         /sah (the former builder) is the baseline for /morton (the default)
 //   BM_EntryChecksumConcatenated / BM_EntryChecksumPieces   the cleaned-mesh cache entry's
 //                         checksum: its arrays copied into one buffer and hashed (the former
 //                         store), against hashed where they lie (BytesHasher, what it does now)
@@ -172,10 +173,14 @@ void BM_EntryChecksumPieces(benchmark::State& state) {
 }
 
 // The closest-point BVH every HLOD bake builds over the original (and each rank over its part).
+BvhBuilder builder_of(const benchmark::State& state) {
+  return state.range(0) == 0 ? BvhBuilder::morton : BvhBuilder::sah;
+}
+
 void BM_SurfaceBuild(benchmark::State& state) {
   const MeshData& m = sphere();
   for (auto _ : state) {
-    SurfaceDistance d;
+    SurfaceDistance d(builder_of(state));
     if (!d.set_surface({m.positions.data(), m.vertex_count(), m.indices.data(), m.indices.size()}, "bench"))
       state.SkipWithError("the BVH was not built");
   }
@@ -185,7 +190,7 @@ void BM_SurfaceBuild(benchmark::State& state) {
 // Every 7th vertex pushed off the surface by 0.1 %, each query started from a 1 % radius.
 void BM_SurfaceQuery(benchmark::State& state) {
   const MeshData& m = sphere();
-  SurfaceDistance d;
+  SurfaceDistance d(builder_of(state));
   if (!d.set_surface({m.positions.data(), m.vertex_count(), m.indices.data(), m.indices.size()}, "bench"))
     state.SkipWithError("the BVH was not built");
   std::vector<float> points;
@@ -208,8 +213,8 @@ BENCHMARK(BM_FaceGroupsHashed)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_Clean)->ArgName("soup")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_EntryChecksumConcatenated)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_EntryChecksumPieces)->Unit(benchmark::kMillisecond)->Iterations(5);
-BENCHMARK(BM_SurfaceBuild)->Unit(benchmark::kMillisecond)->Iterations(2);
-BENCHMARK(BM_SurfaceQuery)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_SurfaceBuild)->ArgName("sah")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_SurfaceQuery)->ArgName("sah")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
 

@@ -1,7 +1,9 @@
 // SurfaceDistance: one surface queried from many threads, with and without known bounds.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <random>
 #include <thread>
 #include <vector>
 
@@ -63,6 +65,30 @@ TEST(SurfaceDistance, MeasuresToAnotherMeshAndFromManyThreads) {
   EXPECT_NEAR(got[0].max, 0.75f, 1e-4f);
   EXPECT_EQ(got[0].max, got[2].max);
   EXPECT_EQ(got[1].rms, got[3].rms);
+}
+
+// The answers never depend on the BVH (every triangle within rounding of the nearest is visited),
+// so the fast-built Morton tree and the SAH tree agree to the bit, point by point and in sum.
+TEST(SurfaceDistance, MortonAndSahTreesAnswerToTheBit) {
+  const MeshData sphere = test::vd_sphere(60, 80);
+  SurfaceDistance morton(BvhBuilder::morton), sah(BvhBuilder::sah);
+  ASSERT_TRUE(morton.set_surface(view_of(sphere), "sphere"));
+  ASSERT_TRUE(sah.set_surface(view_of(sphere), "sphere"));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> box(-1.6f, 1.6f);
+  std::vector<float> points;
+  for (int i = 0; i < 3000; ++i) points.insert(points.end(), {box(rng), box(rng), box(rng)});
+  for (size_t i = 0; i < points.size(); i += 3) {
+    SurfaceError a, b;
+    ASSERT_TRUE(morton.from_points(&points[i], 1, nullptr, a));
+    ASSERT_TRUE(sah.from_points(&points[i], 1, nullptr, b));
+    ASSERT_EQ(std::bit_cast<uint32_t>(a.max), std::bit_cast<uint32_t>(b.max)) << "point " << i / 3;
+  }
+  SurfaceError a, b;
+  ASSERT_TRUE(morton.from_points(points.data(), points.size() / 3, nullptr, a));
+  ASSERT_TRUE(sah.from_points(points.data(), points.size() / 3, nullptr, b));
+  EXPECT_EQ(std::bit_cast<uint32_t>(a.rms), std::bit_cast<uint32_t>(b.rms));
+  EXPECT_GT(a.max, 0.5f);  // the box's corners are far from the unit sphere
 }
 
 TEST(SurfaceDistance, RefusesQueriesBeforeASurface) {
