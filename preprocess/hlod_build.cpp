@@ -28,8 +28,8 @@
 #include "preprocess/decimater_chain.h"  // compute_vertex_normals
 #include "preprocess/material_runs.h"
 #include "preprocess/surface_error.h"
+#include "runtime/bytes_hasher.h"
 #include "runtime/hlod_asset.h"  // hlod_resident_bytes
-#include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/lod_chain.h"
 
 namespace lod {
@@ -121,29 +121,39 @@ int octant(const Context& c, const BuildNode& n, uint32_t v) {
   return (p[0] >= n.center[0] ? 1 : 0) | (p[1] >= n.center[1] ? 2 : 0) | (p[2] >= n.center[2] ? 4 : 0);
 }
 
-size_t count_vertices(Context& c, const std::vector<uint32_t>& triangles) {
+// Distinct vertices of `triangles`, counted only up to one above `enough` (all a split needs:
+// the root of a 14M-triangle scan would otherwise count 42M corners at every level of the top).
+size_t count_vertices(Context& c, const std::vector<uint32_t>& triangles, size_t enough) {
   const uint32_t s = c.new_stamp();
   size_t count = 0;
-  for (uint32_t t : triangles)
+  for (uint32_t t : triangles) {
     for (int k = 0; k < 3; ++k) {
       const uint32_t v = c.indices[3 * size_t(t) + k];
       if (c.stamp[v] != s) c.stamp[v] = s, ++count;
     }
+    if (count > enough) break;
+  }
   return count;
 }
 
 // Triangles within one octant go to that child, the others to the patch. false (nothing
 // changed) when every triangle crosses octants: the node stays a leaf.
 bool split_node(Context& c, BuildNode& n) {
-  std::vector<uint32_t> part[8];
-  std::vector<uint32_t> patch;
-  for (uint32_t t : n.triangles) {
-    const uint32_t* f = c.indices + 3 * size_t(t);
+  // Each triangle's octant (kPatch: it crosses octants) first, so each part is allocated once.
+  constexpr uint8_t kPatch = 8;
+  std::vector<uint8_t> where(n.triangles.size());
+  size_t count[9] = {};
+  for (size_t i = 0; i < n.triangles.size(); ++i) {
+    const uint32_t* f = c.indices + 3 * size_t(n.triangles[i]);
     const int o = octant(c, n, f[0]);
-    if (octant(c, n, f[1]) == o && octant(c, n, f[2]) == o) part[o].push_back(t);
-    else patch.push_back(t);
+    where[i] = octant(c, n, f[1]) == o && octant(c, n, f[2]) == o ? uint8_t(o) : kPatch;
+    ++count[where[i]];
   }
-  if (patch.size() == n.triangles.size()) return false;
+  if (count[kPatch] == n.triangles.size()) return false;
+  std::vector<uint32_t> part[9];
+  for (int o = 0; o < 9; ++o) part[o].reserve(count[o]);
+  for (size_t i = 0; i < n.triangles.size(); ++i) part[where[i]].push_back(n.triangles[i]);
+  std::vector<uint32_t>& patch = part[kPatch];
   for (int o = 0; o < 8; ++o) {
     if (part[o].empty()) continue;
     auto child = std::make_unique<BuildNode>();
@@ -461,7 +471,7 @@ Sphere node_bounds(const BuildNode& n) {
 // The octree's rule: a cell with more than min_verts vertices splits, unless it is at the
 // depth limit or every one of its triangles crosses its octants.
 bool split_if_large(Context& c, BuildNode& n, size_t& vertices) {
-  vertices = count_vertices(c, n.triangles);
+  vertices = count_vertices(c, n.triangles, c.options.min_verts);
   return vertices > c.options.min_verts && n.depth < kHlodMaxDepth && split_node(c, n);
 }
 
@@ -914,20 +924,30 @@ HlodSubtreeSpec describe_subtree(const Context& c, const BuildNode& n) {
   for (int k = 0; k < 3; ++k) spec.center[k] = n.center[k];
   spec.half = n.half;
   spec.triangles = n.triangles.size();
-  std::vector<uint32_t> words{n.depth, std::bit_cast<uint32_t>(n.center[0]), std::bit_cast<uint32_t>(n.center[1]),
-                              std::bit_cast<uint32_t>(n.center[2]), std::bit_cast<uint32_t>(n.half)};
-  words.reserve(words.size() + 5 * n.triangles.size());
-  for (uint32_t t : n.triangles) {
-    uint32_t locks = 0;
-    words.push_back(t);
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t v = c.indices[3 * size_t(t) + k];
-      words.push_back(v);
-      locks |= uint32_t(c.patch_depth[v] < n.depth) << k;
+  // Hashed in pieces (the same value as over all the words at once): a 14M-triangle frontier
+  // would otherwise stage 280 MB of words.
+  BytesHasher h(0x4c4f4448'53554254ull);
+  const uint32_t head[5] = {n.depth, std::bit_cast<uint32_t>(n.center[0]), std::bit_cast<uint32_t>(n.center[1]),
+                            std::bit_cast<uint32_t>(n.center[2]), std::bit_cast<uint32_t>(n.half)};
+  h.add(head, sizeof head);
+  constexpr size_t kChunk = 1024;
+  uint32_t words[5 * kChunk];
+  for (size_t first = 0; first < n.triangles.size(); first += kChunk) {
+    const size_t count = std::min(kChunk, n.triangles.size() - first);
+    for (size_t i = 0; i < count; ++i) {
+      const uint32_t t = n.triangles[first + i];
+      uint32_t* w = words + 5 * i;
+      w[0] = t;
+      w[4] = 0;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = c.indices[3 * size_t(t) + k];
+        w[1 + k] = v;
+        w[4] |= uint32_t(c.patch_depth[v] < n.depth) << k;
+      }
     }
-    words.push_back(locks);
+    h.add(words, 4 * 5 * count);
   }
-  spec.fingerprint = hash_bytes(words.data(), 4 * words.size(), 0x4c4f4448'53554254ull);
+  spec.fingerprint = h.finish();
   return spec;
 }
 
