@@ -17,6 +17,7 @@
 #include "preprocess/material_runs.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
+#include "preprocess/mesh_readers.h"  // read_regular_file
 #include "runtime/embedded_image.h"
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
@@ -46,15 +47,13 @@ std::vector<EmbeddedImage> kept_embedded_images(std::vector<ChainMaterial>& mate
 }  // namespace
 
 // Content hash of the mesh file's bytes, mixed with what else decides the output.
-Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out) {
-  std::ifstream f(file, std::ios::binary | std::ios::ate);
-  if (!f) return Status::error(file.string() + ": cannot be opened for reading");
-  const std::streamoff size = f.tellg();
-  std::vector<char> bytes(size > 0 ? size_t(size) : 0);
-  f.seekg(0);
-  if (size < 0 || !f.read(bytes.data(), std::streamsize(bytes.size())))
-    return Status::error(file.string() + ": read error");
+Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out,
+                        std::vector<uint8_t>* content_out) {
+  // The mesh readers' own read: a directory, FIFO or device is refused by name, not read.
+  std::vector<uint8_t> bytes;
+  if (Status s = detail::read_regular_file(file, bytes); !s) return s;
   uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  if (content_out) *content_out = std::move(bytes);
   // The materials and uvs are in the tree since build version 2: what an OBJ's .mtl or a glTF's
   // buffers and images hold is part of the source. Version 3 keeps embedded images, so a tree
   // cached before (its embedded textures left out) is not taken for current; version 4 keeps

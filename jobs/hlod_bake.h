@@ -39,7 +39,9 @@ ParallelFor tbb_parallel_for();
 // The content hash of a mesh file's bytes (and of the files it names: an OBJ's .mtl files and
 // images, a glTF's buffers and images) mixed with min_verts and the build's version: the
 // source_hash of what bake_hlod_file writes, so a cached .hlod with it is current.
-Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out);
+// `content` (optional): the mesh file's bytes as read, for load_mesh to parse without reading again.
+Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out,
+                        std::vector<uint8_t>* content = nullptr);
 
 // The mesh as an HLOD build takes it: loaded and cleaned (uv seams and material boundaries stay
 // copies at one position), its materials converted for the tree (add_chain_materials) with the

@@ -134,7 +134,11 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
   };
   // The cleaned mesh from the cache when a run before stored it; otherwise loaded, cleaned and
   // (rank 0) stored for the reruns.
-  if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, j.source_hash); !s) return s;
+  std::vector<uint8_t> content;  // read once: hashed, then parsed if the cache lacks the mesh
+  if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, j.source_hash, &content); !s) return s;
+  std::error_code gone;
+  if (std::filesystem::exists(hlod_mesh_entry_path(j.settings.cache_dir, j.source_hash), gone))
+    std::vector<uint8_t>().swap(content);  // not held beside the cached mesh (a refused one reads the file again)
   uint64_t input_triangles = 0;
   std::string why;
   const CacheLookup cached =
@@ -150,7 +154,8 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
     j.r.mesh_cached = true;
     lap(j.work.load_cpu_seconds);
   } else {
-    if (Status s = load_mesh(mesh_file, j.mesh); !s) return s;
+    if (Status s = content.empty() ? load_mesh(mesh_file, j.mesh) : load_mesh(mesh_file, std::move(content), j.mesh); !s)
+      return s;
     j.r.input_triangles = j.mesh.triangle_count();
     lap(j.work.load_cpu_seconds);
     std::vector<std::string> notes;
@@ -777,7 +782,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   double serial_cpu = 0;  // rank 0's own, while the others wait
   if (comm.rank == 0) {
     st = take_reports(j, reports, true);
-    if (!st) st.message += " (the cache keeps every finished subtree: run again to resume)";
+    if (!st && go) st.message += " (the cache keeps every finished subtree: run again to resume)";
     const double cpu0 = process_cpu_seconds();
     if (st) st = collect_roots(j);
     const double cpu1 = process_cpu_seconds();

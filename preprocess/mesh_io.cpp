@@ -347,8 +347,19 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   std::vector<uint8_t> bytes;
   Status r = read_regular_file(path, bytes);
   if (!r) return r;
+  return load_mesh(path, std::move(bytes), out);
+}
+
+Status load_mesh(const std::filesystem::path& path, std::vector<uint8_t>&& bytes, MeshData& out) {
+  using namespace detail;
+  const std::string ext = lower(path.extension().string());
+  if (ext == ".gltf" || ext == ".glb" || ext == ".gz" || ext == ".zip" || ext == ".bz2" || ext == ".xz") {
+    std::vector<uint8_t>().swap(bytes);
+    return load_mesh(path, out);
+  }
+  std::vector<uint8_t> owned = std::move(bytes);
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  return parse_and_finish(what, path.extension().string(), bytes.data(), bytes.size(), out, &bytes, dir);
+  return parse_and_finish(path.string(), path.extension().string(), owned.data(), owned.size(), out, &owned, dir);
 }
 
 namespace {

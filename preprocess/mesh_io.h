@@ -19,6 +19,9 @@ namespace lod {
 // vertex named as the file numbers it). A UTF-8 byte-order mark before an OBJ or ASCII STL
 // is skipped. Polygons are fan-triangulated; points-only files are refused.
 Status load_mesh(const std::filesystem::path& path, MeshData& out);
+// The same over `bytes`, the file's content already read (freed once parsed): a caller that
+// hashed the file first reads it once. A glTF is read from `path` (its buffers may be files).
+Status load_mesh(const std::filesystem::path& path, std::vector<uint8_t>&& bytes, MeshData& out);
 
 // The same readers over bytes already in memory; `extension` picks the format (".ply",
 // ".off", ".stl", ".obj", ".gltf", ".glb"; any case), `name` is used in messages. Never reads

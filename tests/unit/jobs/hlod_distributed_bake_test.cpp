@@ -2,6 +2,7 @@
 // (store, verify, refuse), and whole bakes with one rank and with ranks as threads, whose files
 // must be the local bake's bytes; reruns bake only what the cache lacks.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -523,6 +524,30 @@ TEST(HlodDistributedBake, FailingStoreNamesTheSubtreeAndKeepsTheOthers) {
   size_t kept = 0;
   for (const auto& e : std::filesystem::directory_iterator(s.cache_dir)) kept += e.path().extension() == ".hsub";
   EXPECT_EQ(kept, 5u);
+}
+
+// The input is hashed before anything else: a directory or a FIFO is refused by name, never
+// read (a directory once reached an allocation of its "size"; a FIFO would block).
+TEST(HlodDistributedBake, InputThatIsNotARegularFileIsRefusedByName) {
+  const auto dir = test::temp_dir("hlod_dist_notfile");
+  HlodDistributedSettings s;
+  s.cache_dir = dir / "cache";
+  std::filesystem::create_directories(dir / "folder.ply");
+  const std::filesystem::path fifo = dir / "pipe.ply";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::pair<std::filesystem::path, const char*> inputs[] = {
+      {dir / "folder.ply", "is a directory"}, {fifo, "FIFO"}, {dir / "absent.ply", "no such file"}};
+  for (const auto& [input, says] : inputs) {
+    HlodDistributedResult r;
+    const Status st = bake_hlod_distributed(input, "x", dir / "out", s, single_rank_comm(), {}, &r);
+    ASSERT_FALSE(st) << input;
+    EXPECT_NE(st.message.find(input.string()), std::string::npos) << st.message;
+    EXPECT_NE(st.message.find(says), std::string::npos) << st.message;
+    EXPECT_EQ(st.message.find("run again"), std::string::npos) << "nothing was baked: " << st.message;
+    uint64_t hash = 0;
+    EXPECT_FALSE(hlod_source_hash(input, 150, hash)) << input;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "x.hlod"));
 }
 
 }  // namespace
