@@ -84,20 +84,12 @@ Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64
   temp += path.filename();
   temp += suffix;
   std::vector<uint8_t> bytes = encode_hlod_subtree(subtree, key);
-  if (Status s = write_file_atomic(temp, bytes); !s) return s;
-  // Verified against what was encoded: the bytes on the disk must be those (a reader decodes
-  // and checks an entry in full whenever it takes one up).
   (void)mesh_vertices;
-  bool opened = false;
-  const std::vector<uint8_t> back = read_all(temp, opened);
-  Status verified = !opened        ? Status::error(temp.string() + ": cannot be read back")
-                    : back != bytes ? Status::error(temp.string() + ": reads back other bytes than were written")
-                                    : Status::success();
+  // Read back from the disk and compared before it is trusted (a reader still decodes and
+  // checks an entry in full whenever it takes one up).
+  if (Status s = write_new_file_checked(temp, bytes, path.string()); !s)
+    return Status::error(s.message + " (the entry was not stored)");
   std::error_code ec;
-  if (!verified) {
-    std::filesystem::remove(temp, ec);
-    return Status::error(path.string() + ": written entry does not verify: " + verified.message);
-  }
   std::filesystem::rename(temp, path, ec);
   if (ec) {
     std::error_code ignored;

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <memory>
 
 #include "runtime/host_turn.h"
 
@@ -195,6 +196,106 @@ Status write_pieces(const std::filesystem::path& file, std::span<const FilePiece
   if (st) st = flush_ranges(fd, detail::covered_ranges(ordered), what);
   if (::close(fd) != 0 && st)
     st = Status::error(what + ": " + describe_write_errno(errno) + " while closing");
+  return st;
+}
+
+namespace {
+
+constexpr size_t kDirectAlign = 4096;           // O_DIRECT's alignment on every common device
+constexpr size_t kDirectChunk = size_t(4) << 20;
+
+size_t round_up(size_t n) { return (n + kDirectAlign - 1) & ~(kDirectAlign - 1); }
+
+// The bounce buffer O_DIRECT needs (address, length and offset all aligned).
+struct AlignedBuffer {
+  explicit AlignedBuffer(size_t n) : raw(new uint8_t[n + kDirectAlign]), size(n) {
+    data = raw.get() + ((kDirectAlign - reinterpret_cast<uintptr_t>(raw.get()) % kDirectAlign) % kDirectAlign);
+  }
+  std::unique_ptr<uint8_t[]> raw;
+  uint8_t* data = nullptr;
+  size_t size = 0;
+};
+
+Status pwrite_all(int fd, const uint8_t* p, size_t n, uint64_t at, const std::string& what) {
+  size_t done = 0;
+  while (done < n) {
+    const ssize_t k = ::pwrite(fd, p + done, n - done, off_t(at + done));
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0)
+      return Status::error(what + ": " + describe_write_errno(k < 0 ? errno : EIO) + " after writing " +
+                           std::to_string(at + done) + " bytes");
+    done += size_t(k);
+  }
+  return Status::success();
+}
+
+// Whole aligned chunks, the last one zero-padded; the padding is cut off afterwards.
+Status write_direct(int fd, std::span<const uint8_t> bytes, AlignedBuffer& buf, const std::string& what) {
+  for (uint64_t at = 0; at < bytes.size(); at += buf.size) {
+    const size_t n = size_t(std::min<uint64_t>(buf.size, bytes.size() - at));
+    std::memcpy(buf.data, bytes.data() + at, n);
+    std::memset(buf.data + n, 0, round_up(n) - n);
+    if (Status s = pwrite_all(fd, buf.data, round_up(n), at, what); !s) return s;
+  }
+  if (::ftruncate(fd, off_t(bytes.size())) != 0)
+    return Status::error(what + ": " + describe_write_errno(errno) + " while sizing the file");
+  return Status::success();
+}
+
+// Reads the file back chunk by chunk and compares; says where it first differs.
+Status compare_file(int fd, std::span<const uint8_t> bytes, AlignedBuffer& buf, const std::string& what) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || uint64_t(st.st_size) != bytes.size())
+    return Status::error(what + ": reads back " + std::to_string(st.st_size) + " bytes, " +
+                         std::to_string(bytes.size()) + " were written");
+  for (uint64_t at = 0; at < bytes.size(); at += buf.size) {
+    const size_t n = size_t(std::min<uint64_t>(buf.size, bytes.size() - at));
+    size_t got = 0;
+    while (got < n) {
+      const ssize_t k = ::pread(fd, buf.data + got, round_up(n) - got, off_t(at + got));
+      if (k < 0 && errno == EINTR) continue;
+      if (k <= 0)
+        return Status::error(what + ": " + (k < 0 ? std::string(std::strerror(errno)) : "early end of file") +
+                             " reading back at " + std::to_string(at + got));
+      got += size_t(k);
+    }
+    if (std::memcmp(buf.data, bytes.data() + at, n) != 0)
+      return Status::error(what + ": reads back other bytes than were written (in the " + std::to_string(n) +
+                           " bytes from " + std::to_string(at) + ")");
+  }
+  return Status::success();
+}
+
+Status write_new_and_sync(const std::filesystem::path& file, std::span<const uint8_t> bytes, AlignedBuffer& buf,
+                          const std::string& what, bool& direct, bool& created) {
+  int fd = direct ? ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_DIRECT, 0644) : -1;
+  if (fd < 0 && direct && errno == EINVAL) direct = false;  // a file system without O_DIRECT
+  else if (fd < 0 && direct)
+    return Status::error(what + ": cannot create " + file.string() + ": " + describe_write_errno(errno));
+  if (!direct) fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return Status::error(what + ": cannot create " + file.string() + ": " + describe_write_errno(errno));
+  created = true;
+  Status st = direct ? write_direct(fd, bytes, buf, what) : write_all(fd, bytes, what);
+  if (st && ::fdatasync(fd) != 0)
+    st = Status::error(what + ": " + describe_write_errno(errno) + " while flushing to disk");
+  if (st && !direct) ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);  // read back from the disk
+  if (::close(fd) != 0 && st) st = Status::error(what + ": " + describe_write_errno(errno) + " while closing");
+  return st;
+}
+
+}  // namespace
+
+Status write_new_file_checked(const std::filesystem::path& file, std::span<const uint8_t> bytes,
+                              const std::string& what, bool direct) {
+  AlignedBuffer buf(std::min(kDirectChunk, std::max(kDirectAlign, round_up(bytes.size()))));
+  bool created = false;
+  Status st = write_new_and_sync(file, bytes, buf, what, direct, created);
+  const int fd = st ? ::open(file.c_str(), O_RDONLY | O_CLOEXEC | (direct ? O_DIRECT : 0)) : -1;
+  if (st && fd < 0) st = Status::error(what + ": cannot read " + file.string() + " back: " + std::strerror(errno));
+  if (st) st = compare_file(fd, bytes, buf, what);
+  if (fd >= 0) ::close(fd);
+  std::error_code ec;
+  if (!st && created) std::filesystem::remove(file, ec);
   return st;
 }
 

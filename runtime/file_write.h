@@ -20,6 +20,17 @@ Status write_file_atomic(const std::filesystem::path& path, const std::string& t
 // The file is the parts one after another (written where they lie: no concatenated copy).
 Status write_file_atomic(const std::filesystem::path& path, std::span<const std::span<const uint8_t>> parts);
 
+// A new file (created, never replaced: `file` must not exist) holding `bytes`, checked against the
+// device before the caller trusts it: written past the page cache where the file system allows
+// (O_DIRECT through an aligned bounce buffer; otherwise written and dropped from the cache),
+// flushed, then read back the same way and compared. A cache entry is renamed into place only
+// after this succeeds, and reading back from the disk, not the page cache, checks what a rerun
+// will read. Large entries (0.9 GB of them for a 14M-triangle bake) also stay out of the page
+// cache, which the bake's ranks would otherwise fill and evict. `direct` false takes the buffered
+// path (the one used where O_DIRECT is refused). On failure the file is removed (if this made it).
+Status write_new_file_checked(const std::filesystem::path& file, std::span<const uint8_t> bytes,
+                              const std::string& what, bool direct = true);
+
 // A file written in pieces, possibly by several processes at once (issue 16: every rank writes
 // its own subtrees' payloads into the .hlod): create_sized_temporary makes a temporary of its
 // own beside `path` at the full size; write_pieces opens it by name, writes each piece at its

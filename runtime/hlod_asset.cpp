@@ -42,6 +42,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 
 #include "runtime/byte_order.h"
 #include "runtime/file_write.h"
@@ -420,8 +421,22 @@ std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint
   return std::move(w.bytes);
 }
 
-std::vector<uint8_t> encode_hlod_payload(const HlodPayload& p) {
-  Writer w;
+namespace {
+
+uint64_t range_bytes(const HlodPayload& p, const LodLevel& r) {
+  const uint64_t per_vertex = 24 + (p.uvs.empty() ? 0 : 8) + (p.uvs1.empty() ? 0 : 8) + (p.colors.empty() ? 0 : 16);
+  return per_vertex * r.vertex_count + 4ull * r.index_count;
+}
+
+// What put_payload appends: the buffer is sized once from these before anything is written.
+uint64_t encoded_payload_bytes(const HlodPayload& p) {
+  uint64_t b = range_bytes(p, p.boundary) + 16ull * p.runs.size() + kChecksumBytes;
+  for (const LodLevel& r : p.layers) b += range_bytes(p, r);
+  return b;
+}
+
+void put_payload(Writer& w, const HlodPayload& p) {
+  const size_t start = w.bytes.size();
   auto put_range = [&](const LodLevel& r) {
     w.words(p.positions.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
     w.words(p.normals.data() + 3 * size_t(r.first_vertex), 3 * size_t(r.vertex_count));
@@ -438,20 +453,36 @@ std::vector<uint8_t> encode_hlod_payload(const HlodPayload& p) {
     w.u32(r.index_count);
     w.u32(uint32_t(r.material));
   }
-  w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
+  w.u64(hash_bytes(w.bytes.data() + start, w.bytes.size() - start));
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_hlod_payload(const HlodPayload& p) {
+  Writer w;
+  w.bytes.reserve(encoded_payload_bytes(p));
+  put_payload(w, p);
   return std::move(w.bytes);
 }
 
-std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads) {
+uint64_t append_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads, std::vector<uint8_t>& out) {
   const size_t count = tree.nodes.size();
-  std::vector<std::vector<uint8_t>> encoded(count);
   std::vector<uint64_t> sizes(count);
-  for (size_t i = 0; i < count; ++i) encoded[i] = encode_hlod_payload(payloads[i]), sizes[i] = encoded[i].size();
-  std::vector<uint8_t> bytes = encode_hlod_head(tree, sizes);
-  size_t total = bytes.size();
-  for (uint64_t s : sizes) total += s;
-  bytes.reserve(total);
-  for (const std::vector<uint8_t>& e : encoded) bytes.insert(bytes.end(), e.begin(), e.end());
+  for (size_t i = 0; i < count; ++i) sizes[i] = encoded_payload_bytes(payloads[i]);
+  const std::vector<uint8_t> head = encode_hlod_head(tree, sizes);
+  Writer w;
+  w.bytes.swap(out);
+  const size_t start = w.bytes.size();
+  w.bytes.reserve(start + std::accumulate(sizes.begin(), sizes.end(), uint64_t(head.size())));
+  w.raw(head.data(), head.size());
+  for (size_t i = 0; i < count; ++i) put_payload(w, payloads[i]);
+  w.bytes.swap(out);
+  return out.size() - start;
+}
+
+std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads) {
+  std::vector<uint8_t> bytes;
+  append_hlod_asset(tree, payloads, bytes);
   return bytes;
 }
 

@@ -26,6 +26,9 @@ inline constexpr uint32_t kHlodAssetVersion = 3;
 // The whole file. Offsets and sizes in the written file are computed here (tree's own
 // payload_offset / payload_size are ignored); payloads[i] is node i's geometry.
 std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads);
+// The same bytes appended to `out`, which grows once to hold them (an asset of hundreds of MB is
+// not built in pieces and copied together); returns how many were appended.
+uint64_t append_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads, std::vector<uint8_t>& out);
 
 // The same in pieces, for a writer that places each payload itself (issue 16: every rank
 // writes its own subtrees' payloads): the head, whose offset table lays the payloads out back to

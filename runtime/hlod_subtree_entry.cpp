@@ -111,7 +111,6 @@ Status take_header(const uint8_t* p, uint64_t mesh_vertices, const std::string& 
 }  // namespace
 
 std::vector<uint8_t> encode_hlod_subtree(const HlodSubtree& s, uint64_t key) {
-  const std::vector<uint8_t> asset = encode_hlod_asset(relative_tree(s, key), s.payloads);
   detail::ByteWriter w;
   for (char c : kMagic) w.u8(uint8_t(c));
   w.u32(kHlodSubtreeEntryVersion);
@@ -121,11 +120,14 @@ std::vector<uint8_t> encode_hlod_subtree(const HlodSubtree& s, uint64_t key) {
   w.u64(s.oversized_leaves);
   w.u32(uint32_t(s.root_source.size()));
   w.u32(uint32_t(s.root_reference.size()));
-  w.u64(asset.size());
+  const size_t asset_size_at = w.bytes.size();
+  w.u64(0);  // the asset's size and the header's checksum, once the asset is appended after them
   w.words(s.root_source.data(), s.root_source.size());
   w.words(s.root_reference.data(), s.root_reference.size());
-  w.u64(hash_bytes(w.bytes.data(), w.bytes.size()));
-  w.raw(asset.data(), asset.size());
+  const size_t checksum_at = w.bytes.size();
+  w.u64(0);
+  w.patch_u64(asset_size_at, append_hlod_asset(relative_tree(s, key), s.payloads, w.bytes));
+  w.patch_u64(checksum_at, hash_bytes(w.bytes.data(), checksum_at));
   return std::move(w.bytes);
 }
 

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -107,4 +108,36 @@ TEST(FileWrite, CoveredRangesAreSortedAndJoined) {
   // [0,2) and [2,6) touch; [8,10) stands apart; [21,23) lies inside [20,24); the empty one is nothing.
   EXPECT_EQ(lod::detail::covered_ranges(pieces), (std::vector<R>{{0, 6}, {8, 10}, {20, 24}}));
   EXPECT_TRUE(lod::detail::covered_ranges({}).empty());
+}
+
+TEST(FileWrite, CheckedNewFilesHoldEveryByteAtEverySizeDirectOrNot) {
+  const auto dir = lod::test::temp_dir("file_write_checked");
+  // Around the 4 KB blocks O_DIRECT writes and the 4 MB chunks it copies through.
+  for (const size_t size : {size_t(0), size_t(1), size_t(4095), size_t(4096), size_t(4097), (size_t(4) << 20) + 4099})
+    for (const bool direct : {true, false}) {
+      std::vector<uint8_t> bytes(size);
+      for (size_t i = 0; i < size; ++i) bytes[i] = uint8_t((i * 2654435761u) >> 13);
+      std::string name = std::to_string(size);  // not "f" + to_string: GCC 12 warns (-Wrestrict)
+      name += direct ? ".direct" : ".buffered";
+      const auto file = dir / name;
+      const lod::Status st = lod::write_new_file_checked(file, bytes, "entry", direct);
+      ASSERT_TRUE(st.ok) << size << ": " << st.message;
+      const std::string back = read_text(file);
+      ASSERT_EQ(back.size(), size);
+      EXPECT_EQ(std::memcmp(back.data(), bytes.data(), size), 0) << size;
+    }
+}
+
+TEST(FileWrite, CheckedNewFileNeverReplacesOneAndSaysWhy) {
+  const auto dir = lod::test::temp_dir("file_write_checked_exists");
+  const auto file = dir / "entry.hsub";
+  ASSERT_TRUE(lod::write_file_atomic(file, std::string("someone else's")).ok);
+  const std::vector<uint8_t> bytes(10000, 3);
+  const lod::Status st = lod::write_new_file_checked(file, bytes, "cache/entry.hsub");
+  ASSERT_FALSE(st.ok);
+  EXPECT_NE(st.message.find("cache/entry.hsub: cannot create"), std::string::npos) << st.message;
+  EXPECT_EQ(read_text(file), "someone else's");  // left as it was
+  const lod::Status missing = lod::write_new_file_checked(dir / "no" / "such", bytes, "cache/x.hsub");
+  ASSERT_FALSE(missing.ok);
+  EXPECT_NE(missing.message.find("cache/x.hsub: cannot create"), std::string::npos) << missing.message;
 }
