@@ -141,3 +141,32 @@ TEST(FileWrite, CheckedNewFileNeverReplacesOneAndSaysWhy) {
   ASSERT_FALSE(missing.ok);
   EXPECT_NE(missing.message.find("cache/x.hsub: cannot create"), std::string::npos) << missing.message;
 }
+
+TEST(FileWrite, InterleavedWritersOwningPartsOfTheSameBlocksMakeTheExactFile) {
+  // Two writers own alternating runs of odd-sized pieces (most blocks of 4 KB hold bytes of
+  // both, some runs span several 4 MB chunks): whole blocks go past the page cache, the partial
+  // ones at each run's ends through it, and every byte must land where it belongs.
+  const auto dir = lod::test::temp_dir("file_write_interleaved");
+  std::vector<uint8_t> whole;
+  std::vector<std::vector<lod::FilePiece>> writer(2);
+  std::vector<std::vector<uint8_t>> storage;
+  storage.reserve(64);
+  uint64_t at = 0;
+  for (size_t k = 0; k < 60; ++k) {
+    const size_t size = k % 13 == 3 ? (size_t(5) << 20) + 123 : 1 + (k * 7919) % 20000;
+    storage.emplace_back(size);
+    for (size_t i = 0; i < size; ++i) storage.back()[i] = uint8_t((at + i) * 40503u >> 7);
+    whole.insert(whole.end(), storage.back().begin(), storage.back().end());
+    writer[(k / 3) % 2].push_back({at, storage.back()});  // runs of three pieces each
+    at += size;
+  }
+  const auto path = dir / "out.bin";
+  std::filesystem::path temp;
+  ASSERT_TRUE(lod::create_sized_temporary(path, at, temp));
+  ASSERT_TRUE(lod::write_pieces(temp, writer[1], "out.bin"));
+  ASSERT_TRUE(lod::write_pieces(temp, writer[0], "out.bin"));
+  ASSERT_TRUE(lod::commit_temporary(temp, path));
+  const std::vector<uint8_t> back = lod::test::read_bytes(path);
+  ASSERT_EQ(back.size(), whole.size());
+  EXPECT_TRUE(back == whole);
+}
