@@ -148,8 +148,9 @@ CleanReport clean_mesh(MeshData& mesh) {
     }
   }
 
-  std::vector<uint32_t> kept;
-  kept.reserve(mesh.indices.size());
+  // Kept faces are compacted into mesh.indices itself and kept vertices into their own arrays
+  // (each writes at or before where it reads): a scan's cleaning allocates no second copy.
+  size_t kept = 0;
   // Kept triangles before triangle t, to re-range submeshes (only when there are some).
   const bool has_submeshes = !mesh.submeshes.empty();
   std::vector<uint32_t> kept_before(has_submeshes ? mesh.triangle_count() + 1 : 0, 0);
@@ -157,9 +158,7 @@ CleanReport clean_mesh(MeshData& mesh) {
     // Non-degenerate faces by their sorted corners; a face is kept when it is the first of them.
     const size_t nt = mesh.triangle_count();
     std::vector<uint32_t> live;
-    std::vector<FaceKey> keys;
     live.reserve(nt);
-    keys.reserve(nt);
     for (size_t t = 0; t < nt; ++t) {
       const uint32_t a = weld[mesh.indices[3 * t]], b = weld[mesh.indices[3 * t + 1]], c = weld[mesh.indices[3 * t + 2]];
       if (a == b || b == c || a == c ||
@@ -167,35 +166,38 @@ CleanReport clean_mesh(MeshData& mesh) {
         ++report.degenerate_faces;
         continue;
       }
+      live.push_back(uint32_t(t));
+    }
+    auto face_key = [&](size_t i) {  // computed when asked: no array of 12-byte keys per face
+      const size_t t = live[i];
       FaceKey key{{face_weld[mesh.indices[3 * t]], face_weld[mesh.indices[3 * t + 1]], face_weld[mesh.indices[3 * t + 2]]}};
       std::sort(key.v.begin(), key.v.end());
-      live.push_back(uint32_t(t));
-      keys.push_back(key);
-    }
+      return key;
+    };
     std::vector<uint32_t> first(live.size());
-    report.duplicate_faces = detail::first_of_equal(live.size(), [&](size_t i) { return keys[i]; }, first);
+    report.duplicate_faces = detail::first_of_equal(live.size(), face_key, first);
     size_t next = 0;
     for (size_t t = 0; t < nt; ++t) {
-      if (has_submeshes) kept_before[t] = uint32_t(kept.size() / 3);
+      if (has_submeshes) kept_before[t] = uint32_t(kept);
       if (next == live.size() || live[next] != t) continue;  // degenerate
       const size_t i = next++;
       if (first[i] != i) continue;  // same corners as an earlier face
-      kept.insert(kept.end(), {weld[mesh.indices[3 * t]], weld[mesh.indices[3 * t + 1]], weld[mesh.indices[3 * t + 2]]});
+      for (int k = 0; k < 3; ++k) mesh.indices[3 * kept + k] = weld[mesh.indices[3 * t + k]];
+      ++kept;
     }
-    if (has_submeshes) kept_before[mesh.triangle_count()] = uint32_t(kept.size() / 3);
+    if (has_submeshes) kept_before[mesh.triangle_count()] = uint32_t(kept);
+    mesh.indices.resize(3 * kept);
   }
 
   // Pass 3: compact to the referenced vertices, in their original order. Vertices welded
   // away in pass 1 are never referenced and were already counted there.
   std::vector<uint8_t> used(nv, 0);
-  for (uint32_t v : kept) used[v] = 1;
+  for (uint32_t v : mesh.indices) used[v] = 1;
   std::vector<uint32_t> remap(nv, UINT32_MAX);
-  std::vector<float> positions, normals, uvs, uvs1, colors;
-  positions.reserve(mesh.positions.size());
-  if (has_normals) normals.reserve(mesh.normals.size());
-  if (has_uvs) uvs.reserve(mesh.uvs.size());
-  if (has_uvs1) uvs1.reserve(mesh.uvs1.size());
-  if (has_colors) colors.reserve(mesh.colors.size());
+  auto move_down = [](std::vector<float>& values, size_t per, size_t from, size_t to) {
+    if (from != to)
+      std::copy_n(values.begin() + std::ptrdiff_t(per * from), per, values.begin() + std::ptrdiff_t(per * to));
+  };
   uint32_t next = 0;
   for (size_t v = 0; v < nv; ++v) {
     if (weld[v] != v) continue;
@@ -203,21 +205,21 @@ CleanReport clean_mesh(MeshData& mesh) {
       ++report.unreferenced_vertices;
       continue;
     }
-    remap[v] = next++;
-    positions.insert(positions.end(), &mesh.positions[3 * v], &mesh.positions[3 * v] + 3);
-    if (has_normals) normals.insert(normals.end(), &mesh.normals[3 * v], &mesh.normals[3 * v] + 3);
-    if (has_uvs) uvs.insert(uvs.end(), &mesh.uvs[2 * v], &mesh.uvs[2 * v] + 2);
-    if (has_uvs1) uvs1.insert(uvs1.end(), &mesh.uvs1[2 * v], &mesh.uvs1[2 * v] + 2);
-    if (has_colors) colors.insert(colors.end(), &mesh.colors[4 * v], &mesh.colors[4 * v] + 4);
+    remap[v] = next;
+    move_down(mesh.positions, 3, v, next);
+    if (has_normals) move_down(mesh.normals, 3, v, next);
+    if (has_uvs) move_down(mesh.uvs, 2, v, next);
+    if (has_uvs1) move_down(mesh.uvs1, 2, v, next);
+    if (has_colors) move_down(mesh.colors, 4, v, next);
+    ++next;
   }
-  for (uint32_t& v : kept) v = remap[v];
+  for (uint32_t& v : mesh.indices) v = remap[v];
 
-  mesh.positions = std::move(positions);
-  mesh.normals = has_normals ? std::move(normals) : std::vector<float>{};
-  mesh.uvs = has_uvs ? std::move(uvs) : std::vector<float>{};
-  mesh.uvs1 = has_uvs1 ? std::move(uvs1) : std::vector<float>{};
-  mesh.colors = has_colors ? std::move(colors) : std::vector<float>{};
-  mesh.indices = std::move(kept);
+  mesh.positions.resize(3 * size_t(next));
+  mesh.normals.resize(has_normals ? 3 * size_t(next) : 0);
+  mesh.uvs.resize(has_uvs ? 2 * size_t(next) : 0);
+  mesh.uvs1.resize(has_uvs1 ? 2 * size_t(next) : 0);
+  mesh.colors.resize(has_colors ? 4 * size_t(next) : 0);
   if (has_submeshes) resubmesh(mesh.submeshes, kept_before);
   return report;
 }

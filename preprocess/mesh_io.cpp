@@ -134,7 +134,31 @@ Status take_vertex_attributes(const std::string& what, RawPolygons& raw, MeshDat
 
 }  // namespace
 
+namespace {
+
+// Faces read as 32-bit triangles (RawPolygons::triangles): checked, then taken as they are.
+Status finish_triangles(const std::string& what, RawPolygons& raw, MeshData& out) {
+  const size_t nv = raw.vertex_count();
+  for (size_t k = 0; k < raw.triangles.size(); ++k) {
+    if (raw.triangles[k] < nv) continue;
+    const uint32_t v = raw.triangles[k];
+    const std::string number = raw.triangles_signed ? std::to_string(int32_t(v)) : std::to_string(v);
+    return Status::error(what + ": face " + std::to_string(k / 3) + " references vertex " + number + " of " +
+                         std::to_string(nv));
+  }
+  MeshData mesh;
+  mesh.source = what;
+  if (Status s = take_vertex_attributes(what, raw, mesh); !s) return s;
+  mesh.indices = std::move(raw.triangles);
+  mesh.positions = std::move(raw.positions);
+  out = std::move(mesh);
+  return Status::success();
+}
+
+}  // namespace
+
 Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out, bool obj_numbering) {
+  if (!raw.triangles.empty()) return finish_triangles(what, raw, out);
   const size_t nv = raw.vertex_count();
   const size_t nf = raw.polygon_count();
   if (nf == 0) return Status::error(what + ": has no faces (points only: " + std::to_string(nv) + " vertices)");

@@ -29,8 +29,13 @@ struct RawPolygons {
   std::vector<std::string> warnings;     // what the reader skipped
   std::vector<int64_t> corners;          // vertex numbers as written in the file
   std::vector<uint32_t> offsets{0};      // polygon p is corners[offsets[p], offsets[p+1])
+  // Instead of corners and offsets, when every polygon is a triangle of 32-bit numbers (binary
+  // PLY's usual faces): three per triangle, as stored (int32 ones when `triangles_signed`), so
+  // that a scan's indices are read once into the size they keep, not widened and copied.
+  std::vector<uint32_t> triangles;
+  bool triangles_signed = false;
   size_t vertex_count() const { return positions.size() / 3; }
-  size_t polygon_count() const { return offsets.size() - 1; }
+  size_t polygon_count() const { return triangles.empty() ? offsets.size() - 1 : triangles.size() / 3; }
 };
 
 // What an OBJ adds beside its polygons (all empty when it has no vt, vn, usemtl or mtllib).

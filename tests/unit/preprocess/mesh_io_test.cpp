@@ -162,6 +162,30 @@ TEST(MeshIo, RefusesOffAndPlyIndexOutOfRange) {
   expect_refused(dir / "x.ply", "face 1 references vertex 90211 of 4");
 }
 
+TEST(MeshIo, BinaryPlyTrianglesThenAPolygonKeepEveryFaceInOrder) {
+  // Triangles are read straight into 32-bit corners until a face is not one; from there the
+  // general reader goes on with what was read so far.
+  const fs::path dir = test::temp_dir("io-ply-spill");
+  std::vector<uint8_t> bytes = binary_ply(5, 4, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 2, 0, 0}, {0, 1, 2, 0, 2, 3});
+  auto face = [&bytes](std::initializer_list<uint32_t> corners) {
+    bytes.push_back(uint8_t(corners.size()));
+    for (uint32_t v : corners)
+      bytes.insert(bytes.end(), reinterpret_cast<const uint8_t*>(&v), reinterpret_cast<const uint8_t*>(&v) + 4);
+  };
+  face({1, 4, 2, 0});  // a quad, then one more triangle
+  face({3, 2, 4});
+  test::write_bytes(dir / "mixed.ply", bytes);
+  MeshData m;
+  ASSERT_TRUE(load_mesh(dir / "mixed.ply", m).ok);
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 1, 4, 2, 1, 2, 0, 3, 2, 4}));
+}
+
+TEST(MeshIo, BinaryPlyNegativeIndexIsQuotedAsWritten) {
+  const fs::path dir = test::temp_dir("io-ply-negative");
+  test::write_bytes(dir / "neg.ply", binary_ply(4, 2, kQuadXyz, {0, 1, 2, 0, 2, uint32_t(-1)}));
+  expect_refused(dir / "neg.ply", "face 1 references vertex -1 of 4");
+}
+
 TEST(MeshIo, RefusesNonFiniteCoordinates) {
   const fs::path dir = test::temp_dir("io-nan");
   test::write_text(dir / "x.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
