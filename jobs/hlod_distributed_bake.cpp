@@ -154,7 +154,7 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
     j.r.mesh_cached = true;
     lap(j.work.load_cpu_seconds);
   } else {
-    if (Status s = content.empty() ? load_mesh(mesh_file, j.mesh) : load_mesh(mesh_file, std::move(content), j.mesh); !s)
+    if (Status s = load_mesh(mesh_file, std::move(content), j.mesh); !s)
       return s;
     j.r.input_triangles = j.mesh.triangle_count();
     lap(j.work.load_cpu_seconds);

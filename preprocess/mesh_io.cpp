@@ -357,6 +357,14 @@ Status load_mesh_from_memory(const std::string& name, const std::string& extensi
   return detail::parse_and_finish(name, extension, data, size, out, nullptr);
 }
 
+namespace {
+
+// The formats parsed from one file's bytes (glTF's buffers may be files of their own; compressed
+// files are refused by name).
+bool parses_from_bytes(const std::string& ext) { return ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl"; }
+
+}  // namespace
+
 Status load_mesh(const std::filesystem::path& path, MeshData& out) {
   using namespace detail;
   const std::string what = path.string();
@@ -377,7 +385,7 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
 Status load_mesh(const std::filesystem::path& path, std::vector<uint8_t>&& bytes, MeshData& out) {
   using namespace detail;
   const std::string ext = lower(path.extension().string());
-  if (ext == ".gltf" || ext == ".glb" || ext == ".gz" || ext == ".zip" || ext == ".bz2" || ext == ".xz") {
+  if (bytes.empty() || !parses_from_bytes(ext)) {  // read (or refused) by path
     std::vector<uint8_t>().swap(bytes);
     return load_mesh(path, out);
   }

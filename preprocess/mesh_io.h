@@ -20,7 +20,8 @@ namespace lod {
 // is skipped. Polygons are fan-triangulated; points-only files are refused.
 Status load_mesh(const std::filesystem::path& path, MeshData& out);
 // The same over `bytes`, the file's content already read (freed once parsed): a caller that
-// hashed the file first reads it once. A glTF is read from `path` (its buffers may be files).
+// hashed the file first reads it once. A glTF is read from `path` (its buffers may be files),
+// and so is any file when `bytes` is empty (a caller that had no need to read it).
 Status load_mesh(const std::filesystem::path& path, std::vector<uint8_t>&& bytes, MeshData& out);
 
 // The same readers over bytes already in memory; `extension` picks the format (".ply",

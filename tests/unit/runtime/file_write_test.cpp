@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -124,7 +125,8 @@ TEST(FileWrite, CheckedNewFilesHoldEveryByteAtEverySizeDirectOrNot) {
       ASSERT_TRUE(st.ok) << size << ": " << st.message;
       const std::string back = read_text(file);
       ASSERT_EQ(back.size(), size);
-      EXPECT_EQ(std::memcmp(back.data(), bytes.data(), size), 0) << size;
+      EXPECT_TRUE(std::equal(back.begin(), back.end(), bytes.begin(), [](char a, uint8_t b) { return uint8_t(a) == b; }))
+          << size;
     }
 }
 
