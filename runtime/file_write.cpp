@@ -146,20 +146,22 @@ std::vector<std::pair<uint64_t, uint64_t>> covered_ranges(std::span<const FilePi
 
 namespace {
 
-Status write_each(int fd, std::span<const FilePiece> pieces, const std::string& what) {
-  for (const FilePiece& piece : pieces) {
-    size_t done = 0;
-    while (done < piece.bytes.size()) {
-      const ssize_t n =
-          ::pwrite(fd, piece.bytes.data() + done, piece.bytes.size() - done, off_t(piece.offset + done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0)
-        return Status::error(what + ": " + describe_write_errno(n < 0 ? errno : EIO) + " writing " +
-                             std::to_string(piece.bytes.size()) + " bytes at " +
-                             std::to_string(piece.offset));
-      done += size_t(n);
-    }
+Status pwrite_all(int fd, const uint8_t* p, size_t n, uint64_t at, const std::string& what) {
+  size_t done = 0;
+  while (done < n) {
+    const ssize_t k = ::pwrite(fd, p + done, n - done, off_t(at + done));
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0)
+      return Status::error(what + ": " + describe_write_errno(k < 0 ? errno : EIO) + " writing " +
+                           std::to_string(n) + " bytes at " + std::to_string(at));
+    done += size_t(k);
   }
+  return Status::success();
+}
+
+Status write_each(int fd, std::span<const FilePiece> pieces, const std::string& what) {
+  for (const FilePiece& piece : pieces)
+    if (Status s = pwrite_all(fd, piece.bytes.data(), piece.bytes.size(), piece.offset, what); !s) return s;
   return Status::success();
 }
 
@@ -177,7 +179,6 @@ Status flush_ranges(int fd, const std::vector<std::pair<uint64_t, uint64_t>>& ra
   return Status::success();
 }
 
-
 constexpr size_t kDirectAlign = 4096;           // O_DIRECT's alignment on every common device
 constexpr size_t kDirectChunk = size_t(4) << 20;
 
@@ -192,19 +193,6 @@ struct AlignedBuffer {
   uint8_t* data = nullptr;
   size_t size = 0;
 };
-
-Status pwrite_all(int fd, const uint8_t* p, size_t n, uint64_t at, const std::string& what) {
-  size_t done = 0;
-  while (done < n) {
-    const ssize_t k = ::pwrite(fd, p + done, n - done, off_t(at + done));
-    if (k < 0 && errno == EINTR) continue;
-    if (k <= 0)
-      return Status::error(what + ": " + describe_write_errno(k < 0 ? errno : EIO) + " after writing " +
-                           std::to_string(at + done) + " bytes");
-    done += size_t(k);
-  }
-  return Status::success();
-}
 
 // Whole aligned chunks, the last one zero-padded; the padding is cut off afterwards.
 Status write_direct(int fd, std::span<const uint8_t> bytes, AlignedBuffer& buf, const std::string& what) {
@@ -290,7 +278,9 @@ Status write_run(int fd, int direct_fd, std::span<const FilePiece> run, uint64_t
   for (uint64_t at = inner_begin; at < inner_end; at += buf.size) {
     const size_t n = size_t(std::min<uint64_t>(buf.size, inner_end - at));
     gather(run, at, at + n, buf.data);
-    if (Status s = pwrite_all(direct_fd, buf.data, n, at, what); !s) return s;
+    // A file system that opens O_DIRECT but refuses its writes: the whole run again, buffered
+    // (a real failure, a full disk, repeats there and is reported).
+    if (!pwrite_all(direct_fd, buf.data, n, at, what)) return write_each(fd, run, what);
   }
   return Status::success();
 }
@@ -320,11 +310,16 @@ Status write_new_file_checked(const std::filesystem::path& file, std::span<const
   AlignedBuffer buf(std::min(kDirectChunk, std::max(kDirectAlign, round_up(bytes.size()))));
   bool created = false;
   Status st = write_new_and_sync(file, bytes, buf, what, direct, created);
+  std::error_code ec;
+  if (!st && created && direct) {  // O_DIRECT opened but refused: once more, buffered
+    std::filesystem::remove(file, ec);
+    created = direct = false;
+    st = write_new_and_sync(file, bytes, buf, what, direct, created);
+  }
   const int fd = st ? ::open(file.c_str(), O_RDONLY | O_CLOEXEC | (direct ? O_DIRECT : 0)) : -1;
   if (st && fd < 0) st = Status::error(what + ": cannot read " + file.string() + " back: " + std::strerror(errno));
   if (st) st = compare_file(fd, bytes, buf, what);
   if (fd >= 0) ::close(fd);
-  std::error_code ec;
   if (!st && created) std::filesystem::remove(file, ec);
   return st;
 }
