@@ -2,8 +2,10 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
+#include "cli/huge_page_malloc.h"
 
 int main(int argc, char** argv) {
+  lod::cli::restart_with_huge_page_malloc(argv);
   CLI::App app{"lodkit: multithreaded level-of-detail runtime"};
   app.require_subcommand(1);
 

@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cli/huge_page_malloc.h"
 #include "jobs/hlod_distributed_bake.h"
 #include "jobs/hlod_models_distributed.h"
 
@@ -94,6 +95,7 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
           // 0's serial part, the slowest rank's write (each rank runs one thread; the machine
           // these figures come from is shared).
           {"critical_cpu_s", r.critical_cpu_seconds},
+          {"malloc_huge_pages", cli::malloc_uses_huge_pages()},  // rank 0's (cli/huge_page_malloc.h)
           {"balance_cpu", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
 }
 
@@ -130,6 +132,7 @@ nlohmann::json to_json(const HlodModelsResult& r, int ranks) {
           {"total_s", r.total_seconds},
           // The job on idle cores: the slowest rank's check and whole models + every split model's critical CPU.
           {"critical_cpu_s", r.critical_cpu_seconds},
+          {"malloc_huge_pages", cli::malloc_uses_huge_pages()},
           // The slowest rank's bake CPU / the mean: whole and split models; whole ones only.
           {"balance_cpu", r.balance_cpu}, {"balance_whole_cpu", r.balance_whole_cpu},
           {"models", models}, {"per_rank", per_rank}};
@@ -239,6 +242,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  lod::cli::restart_with_huge_page_malloc(argv);  // before MPI_Init: the rank starts again as itself
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);  // MPI from the main thread only
   const int code = run(argc, argv, mpi_comm());

@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "bake_cache_files.h"
 #include "run_cli.h"
@@ -168,6 +170,33 @@ TEST(LodBakeMpi, FailingRankNamesTheSubtreeAndTheJobFailsKeepingTheCache) {
   EXPECT_NE(r.out.find("run again"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "ball.hlod"));
   EXPECT_EQ(entries(dir / "cache"), files.size() - 1);
+}
+
+// Each rank starts itself again with glibc.malloc.hugetlb=1 where the kernel gives huge pages by
+// madvise (cli/huge_page_malloc.h), unless told not to; the bytes never change.
+TEST(LodBakeMpi, RanksAskForHugePagesUnlessToldNotTo) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's allocator ignores glibc's malloc tunables";
+#endif
+  std::ifstream thp("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string modes;
+  std::getline(thp, modes);
+  if (modes.find("[madvise]") == std::string::npos)
+    GTEST_SKIP() << "transparent huge pages are not in madvise mode here: '" << modes << "'";
+  const auto dir = test::temp_dir("lod_bake_mpi_huge_pages");
+  const std::pair<std::string, bool> cases[] = {{"", true},
+                                                {"LOD_HUGE_PAGES=0", false},
+                                                {"GLIBC_TUNABLES=glibc.malloc.hugetlb=0", false}};
+  int k = 0;
+  for (const auto& [env, huge] : cases) {
+    const auto run = dir / std::to_string(k++);
+    const test::CliResult r = run_mpi(2, bake_args(run / "out", run / "cache") + " --json", env);
+    ASSERT_EQ(r.code, 0) << env << "\n" << r.out;
+    const nlohmann::json j = test::printed_json(r);
+    ASSERT_TRUE(j.is_object()) << r.out;
+    EXPECT_EQ(j["malloc_huge_pages"], huge) << env;
+    EXPECT_EQ(test::read_bytes(run / "out" / "ball.hlod"), fixture().local) << env;
+  }
 }
 
 #else
