@@ -6,6 +6,8 @@
 #   - 2 ranks killed at <= 50 % (each dies once it has stored a quarter of the subtrees; the first
 #     to die ends the job), then the rerun: its time against the full 2-rank build
 #   - per rank, CPU seconds per phase; critical_cpu_s (the job on idle cores) for the ratios
+#   - PAIRS=K (default 0): K more 1-rank / 2-rank runs, alternating, each from an empty cache, and
+#     the median of their ratios: on a shared VM one pair's ratio moves by +-10 %
 # Output: one JSON summary per run in $OUT (default /tmp/hlod-mpi-figures), a table on stdout.
 set -euo pipefail
 export NPS=${NPS:-1 2 4}
@@ -70,3 +72,30 @@ r, rw = load("rerun")
 print(f"resume: rerun {rw:.2f} s wall = {rw / w2:.0%} of the full 2-rank build; critical-path CPU "
       f"{r['critical_cpu_s']:.2f} s = {r['critical_cpu_s'] / c[2]:.0%} ({r['cached']} of {r['subtrees']} cached)")
 PY
+
+pairs=${PAIRS:-0}
+for k in $(seq 1 "$pairs"); do
+  for np in 1 2; do
+    rm -rf "$out/pair"
+    t0=$(now)
+    "${mpi[@]}" -np $np "$build/lod-bake-mpi" "$mesh" -o "$out/pair/out" --cache "$out/pair/cache" --threads 1 --json \
+      > "$out/pair$k-np$np.json" 2> "$out/pair$k-np$np.err"
+    t1=$(now)
+    echo "{\"wall_s\": $(echo "$t1 - $t0" | bc)}" > "$out/pair$k-np$np.wall"
+  done
+  rm -rf "$out/pair"
+done
+[ "$pairs" -gt 0 ] && python3 - "$out" "$pairs" <<'PY'
+import json, statistics, sys
+out, pairs = sys.argv[1], int(sys.argv[2])
+wall, cpu = [], []
+for k in range(1, pairs + 1):
+    j = {np: json.load(open(f"{out}/pair{k}-np{np}.json")) for np in (1, 2)}
+    w = {np: json.load(open(f"{out}/pair{k}-np{np}.wall"))["wall_s"] for np in (1, 2)}
+    wall.append(w[1] / w[2]), cpu.append(j[1]["critical_cpu_s"] / j[2]["critical_cpu_s"])
+    print(f"pair {k}: 1 rank {w[1]:.2f} s wall / {j[1]['critical_cpu_s']:.2f} s CPU, 2 ranks {w[2]:.2f} / "
+          f"{j[2]['critical_cpu_s']:.2f}: {wall[-1]:.2f}x wall, {cpu[-1]:.2f}x critical CPU")
+print(f"pairs: median {statistics.median(wall):.2f}x wall ({min(wall):.2f}-{max(wall):.2f}), "
+      f"{statistics.median(cpu):.2f}x critical CPU ({min(cpu):.2f}-{max(cpu):.2f})")
+PY
+true
