@@ -55,7 +55,7 @@ void each_number(Work& w, F&& f) {
   f(w.subtrees), f(w.triangles), f(w.checked), f(w.bytes_checked), f(w.bake_seconds), f(w.bake_cpu_seconds),
       f(w.total_seconds), f(w.cpu_seconds), f(w.load_cpu_seconds), f(w.clean_cpu_seconds), f(w.plan_cpu_seconds),
       f(w.check_cpu_seconds), f(w.surface_cpu_seconds), f(w.measure_cpu_seconds), f(w.write_cpu_seconds),
-      f(w.bytes_written), f(w.bytes_placed), f(w.region_triangles), f(w.whole_surface);
+      f(w.bytes_written), f(w.bytes_placed), f(w.bytes_read_back), f(w.region_triangles), f(w.whole_surface);
 }
 
 std::vector<uint8_t> encode_report(const RankReport& r) {
@@ -105,9 +105,10 @@ struct Job {
   std::vector<uint8_t> have;           // rank 0: per subtree, roots[i] holds it
   std::vector<uint8_t> missing;        // per subtree: not in the cache when the job began
   std::vector<int32_t> writer;         // per subtree: the rank writing its payloads into the .hlod
-  std::vector<std::vector<uint8_t>> entries;  // per subtree: its entry's bytes, where this rank writes it
+  std::vector<std::vector<uint8_t>> entries;  // per subtree: its entry's bytes, where this rank writes it and holds them
   std::unique_ptr<tbb::task_arena> arena;
   bool store_mesh = false;  // the mesh was cleaned here, not read from the cache: one rank stores it
+  std::atomic<uint64_t> held{0};  // the entries' bytes held, at most settings.held_entry_bytes
 
   void say(const std::string& line) const {
     if (log) log(line);
@@ -122,6 +123,15 @@ HlodSubtree root_only(HlodSubtree&& s) {
   s.payloads.resize(std::min<size_t>(s.payloads.size(), 1));
   s.payloads.shrink_to_fit();
   return std::move(s);
+}
+
+// Keeps an entry's bytes for the write while the rank's budget allows; otherwise they go and
+// the write reads the entry back.
+void hold_entry(Job& j, std::vector<uint8_t>& entry) {
+  const uint64_t size = entry.size();
+  if (j.held.fetch_add(size) + size <= j.settings.held_entry_bytes) return;
+  j.held.fetch_sub(size);
+  std::vector<uint8_t>().swap(entry);
 }
 
 Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
@@ -224,6 +234,8 @@ std::vector<uint8_t> check_share(Job& j) {
       const size_t i = mine[k];
       found[k] = load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), decoded[k], &why[k], &bytes[k],
                                    &j.entries[i]);
+      if (found[k] == CacheLookup::found) hold_entry(j, j.entries[i]);
+      else std::vector<uint8_t>().swap(j.entries[i]);
       if (j.comm.rank == 0 && found[k] == CacheLookup::found) j.roots[i] = root_only(std::move(decoded[k]));
       decoded[k] = {};
     });
@@ -310,6 +322,7 @@ std::vector<size_t> my_share(const Job& j) {
 Status keep_baked(Job& j, size_t i, HlodSubtree&& s, std::mutex& mutex, uint64_t* bytes) {
   std::vector<uint8_t> entry;
   if (Status st = store_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), s, bytes, &entry); !st) return st;
+  hold_entry(j, entry);
   std::lock_guard lock(mutex);
   j.entries[i] = std::move(entry);
   if (j.comm.rank == 0) j.roots[i] = root_only(std::move(s)), j.have[i] = 1;
@@ -640,32 +653,59 @@ Status finish_and_lay_out(Job& j, const std::vector<float>& errors, const std::s
   return Status::success();
 }
 
-// Every rank: the payloads of the subtrees it writes, from their entries' bytes, at the places
-// rank 0 gave (each piece's size checked against the entry's own record of it).
+// An entry this rank writes but did not hold: read back and checked in full, as a cached one
+// is (the cache is shared storage: it may have changed since).
+Status read_back_entry(Job& j, size_t i, const std::string& entry, std::vector<uint8_t>& bytes) {
+  HlodSubtree decoded;
+  std::string why;
+  uint64_t size = 0;
+  if (load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), decoded, &why, &size, &bytes) != CacheLookup::found)
+    return Status::error(entry + ": this rank stored or checked it, but reading it back to write its payloads failed: " +
+                         (why.empty() ? "entry missing" : why) + " (run again: it is baked anew)");
+  j.work.bytes_read_back += size;
+  return Status::success();
+}
+
+// Subtree i's payloads in `entry` and where they go (each piece's size checked against the
+// entry's own record of it).
+Status place_entry(Job& j, const Layout& layout, size_t i, const std::vector<uint8_t>& bytes, const std::string& entry,
+                   std::vector<FilePiece>& pieces) {
+  std::vector<std::span<const uint8_t>> payloads;
+  if (Status s = hlod_subtree_entry_payloads(bytes, entry, payloads); !s) return s;
+  if (payloads.size() != layout.pieces[i].size())
+    return Status::error(entry + ": " + std::to_string(payloads.size()) + " nodes, the assembled tree has " +
+                         std::to_string(layout.pieces[i].size()));
+  for (size_t k = 0; k < payloads.size(); ++k) {
+    if (payloads[k].size() != layout.pieces[i][k].second)
+      return Status::error(entry + ": node " + std::to_string(k) + "'s payload is " + std::to_string(payloads[k].size()) +
+                           " bytes, its record says " + std::to_string(layout.pieces[i][k].second));
+    pieces.push_back({layout.pieces[i][k].first, payloads[k]});
+    j.work.bytes_placed += payloads[k].size();
+  }
+  return Status::success();
+}
+
+// Every rank: the payloads of the subtrees it writes, at the places rank 0 gave: those of the
+// entries it holds in one pass at the end, each entry read back written on its own and let go.
 RankReport write_share(Job& j, const Layout& layout, const std::string& what) {
   RankReport rep;
   const auto t0 = Clock::now();
   const double cpu0 = process_cpu_seconds();
-  std::vector<FilePiece> pieces;
+  std::vector<FilePiece> held;
   for (size_t i = 0; i < layout.writer.size() && rep.status; ++i) {
     if (layout.writer[i] != j.comm.rank) continue;
     const std::string entry = hlod_subtree_entry_path(j.settings.cache_dir, j.keys[i]).string();
-    std::vector<std::span<const uint8_t>> payloads;
-    if (j.entries[i].empty()) rep.status = Status::error(entry + ": this rank was to write it but holds no entry");
-    else rep.status = hlod_subtree_entry_payloads(j.entries[i], entry, payloads);
-    if (rep.status && payloads.size() != layout.pieces[i].size())
-      rep.status = Status::error(entry + ": " + std::to_string(payloads.size()) + " nodes, the assembled tree has " +
-                                 std::to_string(layout.pieces[i].size()));
-    for (size_t k = 0; rep.status && k < payloads.size(); ++k) {
-      if (payloads[k].size() != layout.pieces[i][k].second)
-        rep.status = Status::error(entry + ": node " + std::to_string(k) + "'s payload is " +
-                                   std::to_string(payloads[k].size()) + " bytes, its record says " +
-                                   std::to_string(layout.pieces[i][k].second));
-      pieces.push_back({layout.pieces[i][k].first, payloads[k]});
-      j.work.bytes_placed += payloads[k].size();
+    if (!j.entries[i].empty()) {
+      rep.status = place_entry(j, layout, i, j.entries[i], entry, held);
+      continue;
     }
+    std::vector<uint8_t> bytes;
+    std::vector<FilePiece> pieces;
+    rep.status = read_back_entry(j, i, entry, bytes);
+    if (rep.status) rep.status = place_entry(j, layout, i, bytes, entry, pieces);
+    if (rep.status) rep.status = write_pieces(layout.temp, pieces, what);
   }
-  if (rep.status) rep.status = write_pieces(layout.temp, pieces, what);
+  if (rep.status) rep.status = write_pieces(layout.temp, held, what);
   if (!rep.status) rep.status.message = "rank " + std::to_string(j.comm.rank) + ": " + rep.status.message;
   j.entries.clear();
   j.work.write_cpu_seconds = process_cpu_seconds() - cpu0;
@@ -684,6 +724,7 @@ Status take_reports(Job& j, const std::vector<std::vector<uint8_t>>& reports, bo
       j.r.ranks[r].write_cpu_seconds = other.work.write_cpu_seconds;
       j.r.ranks[r].measure_cpu_seconds = other.work.measure_cpu_seconds;
       j.r.ranks[r].bytes_placed = other.work.bytes_placed;
+      j.r.ranks[r].bytes_read_back = other.work.bytes_read_back;
     }
     if (!other.status && failed) failed = other.status;
     if (!other.status && r != 0) j.say(other.status.message);

@@ -13,7 +13,8 @@
 //                share of them) -> gather -> rank 0 measures any sample no region answered
 //   rank 0       finish the levels above, write the head and their payloads into a temporary
 //                file at its full size -> broadcast where every subtree node's payload goes
-//   every rank   write the payloads of the subtrees it baked or checked, at those offsets
+//   every rank   write the payloads of the subtrees it baked or checked, at those offsets (from
+//                the entries' bytes it held, or read back: HlodDistributedSettings::held_entry_bytes)
 //   gather       per rank: its write's status -> rank 0 renames the file into place
 //
 // The communication is two collectives (HlodRankComm), so that lodkit's libraries never link
@@ -63,6 +64,10 @@ struct HlodDistributedSettings {
   uint32_t threads = 0;    // per rank; 0 = all its cores
   uint32_t subtrees = 0;   // the frontier's target (HlodBuildOptions::subtrees); 0 = default_subtrees
   std::filesystem::path cache_dir;
+  // The entries' bytes a rank holds in memory between storing (or checking) them and writing
+  // their payloads into the .hlod; an entry beyond it is read back from the cache, checked in
+  // full, when its payloads are written: a rank's memory stays bounded however large its share.
+  uint64_t held_entry_bytes = uint64_t(1) << 30;
   // Called before each of this rank's entries is stored (count: entries this rank stored so
   // far), from the thread that finished it. Tests inject a crash here.
   std::function<void(size_t subtree, size_t stored)> before_store;
@@ -84,6 +89,7 @@ struct HlodRankWork {
   double write_cpu_seconds = 0;    // placing its payloads into the .hlod (after rank 0's assembly)
   uint64_t bytes_written = 0;      // cache entries
   uint64_t bytes_placed = 0;       // payload bytes it wrote into the .hlod
+  uint64_t bytes_read_back = 0;    // of entries it did not hold (held_entry_bytes), read back to write them
   uint64_t region_triangles = 0;   // in its region's BVH (the original's triangles near its cells)
   uint32_t whole_surface = 0;      // 1: it needed the whole original's BVH too
 };

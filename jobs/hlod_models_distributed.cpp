@@ -316,6 +316,7 @@ void bake_split(Job& j, size_t i) {
   ds.threads = j.settings.threads;
   ds.subtrees = j.settings.subtrees;
   ds.cache_dir = j.settings.cache_dir;
+  ds.held_entry_bytes = j.settings.held_entry_bytes;
   ds.before_store = [&j, name = m.name](size_t subtree, size_t) {
     j.before_store("model " + name + " subtree " + std::to_string(subtree));
     j.stored.fetch_add(1);

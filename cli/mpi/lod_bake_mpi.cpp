@@ -1,6 +1,7 @@
 // lod-bake-mpi: the HLOD bake of one mesh, or of a scene of many, spread over MPI ranks (issue 16).
 //
 //   mpirun -np 4 lod-bake-mpi MESH... -o DIR --cache DIR [--min-verts N] [--threads N] [--subtrees N]
+//                             [--entry-memory-mb N]
 //
 // One mesh: every rank reads MESH itself (a path all ranks see) and bakes its share of the
 // subtrees into the cache folder (shared storage); rank 0 prints progress, assembles and writes
@@ -76,6 +77,7 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
                                    {"bvh", w.surface_cpu_seconds}, {"bake", w.bake_cpu_seconds},
                                    {"measure_top", w.measure_cpu_seconds}, {"write", w.write_cpu_seconds}}},
                         {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed},
+                        {"bytes_read_back", w.bytes_read_back},
                         {"region_triangles", w.region_triangles}, {"whole_bvh", w.whole_surface != 0}});
     slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
   }
@@ -180,6 +182,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   std::vector<std::string> meshes;
   std::string out_dir, cache_dir;
   int min_verts = 1000, threads = 0, subtrees = 0;
+  uint64_t entry_memory_mb = 1024;
   bool json = false, quiet = false;
   app.add_option("mesh", meshes, "mesh files, on paths every rank sees (one .hlod each)")->required();
   app.add_option("-o,--out", out_dir, "output directory (rank 0 writes <name>.hlod there)")->required();
@@ -187,6 +190,9 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   app.add_option("--min-verts", min_verts, "a cell with more vertices splits (default 1000)")->check(CLI::Range(3, 100000000));
   app.add_option("--threads", threads, "threads per rank, 0 = all cores")->check(CLI::Range(0, 1024));
   app.add_option("--subtrees", subtrees, "subtrees to split into (default 8 per rank, at least 16)")->check(CLI::Range(0, 1 << 20));
+  app.add_option("--entry-memory-mb", entry_memory_mb,
+                 "cache entries a rank holds for its write (default 1024); beyond, they are read back")
+      ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
   app.add_flag("--json", json, "rank 0 prints a JSON summary");
   app.add_flag("--quiet", quiet, "print nothing but errors");
   try {
@@ -199,12 +205,14 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   settings.threads = uint32_t(threads);
   settings.subtrees = uint32_t(subtrees);
   settings.cache_dir = cache_dir;
+  settings.held_entry_bytes = entry_memory_mb << 20;
   if (meshes.size() > 1) {
     HlodModelsSettings models;
     models.min_verts = settings.min_verts;
     models.threads = settings.threads;
     models.subtrees = settings.subtrees;
     models.cache_dir = settings.cache_dir;
+    models.held_entry_bytes = settings.held_entry_bytes;
     return run_models(meshes, out_dir, models, json, quiet, comm);
   }
   const std::string& mesh = meshes.front();

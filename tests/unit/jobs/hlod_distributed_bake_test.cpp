@@ -192,7 +192,7 @@ struct RankRun {
 };
 
 std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, const std::filesystem::path& out,
-                           const std::filesystem::path& cache) {
+                               const std::filesystem::path& cache, uint64_t held_entry_bytes = uint64_t(1) << 30) {
   ThreadRanks tr(ranks);
   std::vector<RankRun> runs(static_cast<size_t>(ranks));
   std::vector<std::thread> threads;
@@ -202,6 +202,7 @@ std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, con
       s.min_verts = 150;
       s.threads = 1;
       s.cache_dir = cache;
+      s.held_entry_bytes = held_entry_bytes;
       runs[size_t(r)].status = bake_hlod_distributed(mesh, "mixed", out, s, tr.comm(r), {}, &runs[size_t(r)].result);
     });
   for (auto& t : threads) t.join();
@@ -239,6 +240,75 @@ TEST(HlodDistributedBake, ThreeRanksWriteTheLocalBakesBytesAndARerunBakesNothing
   ASSERT_TRUE(runs[0].status) << runs[0].status.message;
   EXPECT_EQ(runs[0].result.cached, subtrees);
   for (const HlodRankWork& w : runs[0].result.ranks) EXPECT_EQ(w.subtrees, 0u);
+  EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+}
+
+// A rank holds its entries' bytes for the write up to held_entry_bytes; the others are read
+// back from the cache when written. Nothing held, half held, all held: the same bytes.
+TEST(HlodDistributedBake, EntriesBeyondTheMemoryBudgetAreReadBackIntoTheSameBytes) {
+  const auto dir = test::temp_dir("hlod_dist_held");
+  const auto mesh = write_mesh(dir);
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  auto sums = [](const std::vector<RankRun>& runs, uint64_t HlodRankWork::*field) {
+    uint64_t sum = 0;
+    for (const HlodRankWork& w : runs[0].result.ranks) sum += w.*field;
+    return sum;
+  };
+  std::vector<RankRun> runs = run_ranks(2, mesh, dir / "none" / "out", dir / "none" / "cache", 0);
+  for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+  EXPECT_EQ(test::read_bytes(dir / "none" / "out" / "mixed.hlod"), local);
+  const uint64_t written = sums(runs, &HlodRankWork::bytes_written);
+  EXPECT_GT(written, 0u);
+  EXPECT_EQ(sums(runs, &HlodRankWork::bytes_read_back), written) << "every entry read back";
+
+  // From the cache (checked, not baked), half of each rank's share held.
+  std::filesystem::remove(dir / "none" / "out" / "mixed.hlod");
+  runs = run_ranks(2, mesh, dir / "none" / "out", dir / "none" / "cache", written / 4);
+  for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+  EXPECT_EQ(test::read_bytes(dir / "none" / "out" / "mixed.hlod"), local);
+  const uint64_t back = sums(runs, &HlodRankWork::bytes_read_back);
+  EXPECT_GT(back, 0u);
+  EXPECT_LT(back, written);
+  EXPECT_EQ(sums(runs, &HlodRankWork::bytes_checked), written);
+
+  runs = run_ranks(2, mesh, dir / "all" / "out", dir / "all" / "cache");
+  for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+  EXPECT_EQ(test::read_bytes(dir / "all" / "out" / "mixed.hlod"), local);
+  EXPECT_EQ(sums(runs, &HlodRankWork::bytes_read_back), 0u);
+}
+
+// An entry that changed on the shared storage between its store and its write is refused when
+// read back: the job fails naming it and writes no file; the rerun bakes it again.
+TEST(HlodDistributedBake, AnEntryChangedBeforeItIsReadBackFailsTheJobNamingIt) {
+  const auto dir = test::temp_dir("hlod_dist_changed");
+  const auto mesh = write_mesh(dir);
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  HlodDistributedSettings s;
+  s.min_verts = 150;
+  s.threads = 1;
+  s.cache_dir = dir / "cache";
+  s.held_entry_bytes = 0;
+  std::filesystem::path changed;
+  s.before_store = [&](size_t, size_t stored) {
+    if (stored != 3) return;
+    for (const auto& e : std::filesystem::directory_iterator(s.cache_dir))
+      if (e.path().extension() == ".hsub") changed = e.path();
+    std::vector<uint8_t> bytes = test::read_bytes(changed);
+    bytes[bytes.size() / 2] ^= 0x10;
+    test::write_bytes(changed, bytes);
+  };
+  HlodDistributedResult r;
+  const Status st = bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r);
+  ASSERT_FALSE(st);
+  ASSERT_FALSE(changed.empty());
+  EXPECT_NE(st.message.find(changed.filename().string()), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("reading it back"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("run again"), std::string::npos) << st.message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
+
+  s.before_store = {};
+  ASSERT_TRUE(bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r));
+  EXPECT_EQ(r.ranks.at(0).subtrees, 1u) << "only the changed entry is baked again";
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
 }
 
