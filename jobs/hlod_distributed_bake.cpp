@@ -29,6 +29,7 @@
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/hlod_subtree_entry.h"
+#include "runtime/lod_asset.h"  // hash_bytes
 
 namespace lod {
 namespace {
@@ -109,6 +110,8 @@ struct Job {
   std::unique_ptr<tbb::task_arena> arena;
   bool store_mesh = false;  // the mesh was cleaned here, not read from the cache: one rank stores it
   std::atomic<uint64_t> held{0};  // the entries' bytes held, at most settings.held_entry_bytes
+  // Per subtree whose entry this rank let go: its size and hash, what reading it back must find.
+  std::vector<std::pair<uint64_t, uint64_t>> let_go;
 
   void say(const std::string& line) const {
     if (log) log(line);
@@ -125,12 +128,14 @@ HlodSubtree root_only(HlodSubtree&& s) {
   return std::move(s);
 }
 
-// Keeps an entry's bytes for the write while the rank's budget allows; otherwise they go and
-// the write reads the entry back.
-void hold_entry(Job& j, std::vector<uint8_t>& entry) {
+// Keeps subtree i's entry bytes (checked: stored and read back from the disk, or decoded in
+// full) for the write while the rank's budget allows; otherwise they go, their size and hash
+// kept, and the write reads the entry back.
+void hold_entry(Job& j, size_t i, std::vector<uint8_t>& entry) {
   const uint64_t size = entry.size();
   if (j.held.fetch_add(size) + size <= j.settings.held_entry_bytes) return;
   j.held.fetch_sub(size);
+  j.let_go[i] = {size, hash_bytes(entry.data(), entry.size())};
   std::vector<uint8_t>().swap(entry);
 }
 
@@ -195,6 +200,7 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
   j.missing.assign(n, 1);
   j.writer.assign(n, -1);
   j.entries.resize(n);
+  j.let_go.assign(n, {0, 0});
   lap(j.work.plan_cpu_seconds);
   j.r.plan_seconds = seconds_since(t0);
   return Status::success();
@@ -234,7 +240,7 @@ std::vector<uint8_t> check_share(Job& j) {
       const size_t i = mine[k];
       found[k] = load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), decoded[k], &why[k], &bytes[k],
                                    &j.entries[i]);
-      if (found[k] == CacheLookup::found) hold_entry(j, j.entries[i]);
+      if (found[k] == CacheLookup::found) hold_entry(j, i, j.entries[i]);
       else std::vector<uint8_t>().swap(j.entries[i]);
       if (j.comm.rank == 0 && found[k] == CacheLookup::found) j.roots[i] = root_only(std::move(decoded[k]));
       decoded[k] = {};
@@ -322,7 +328,7 @@ std::vector<size_t> my_share(const Job& j) {
 Status keep_baked(Job& j, size_t i, HlodSubtree&& s, std::mutex& mutex, uint64_t* bytes) {
   std::vector<uint8_t> entry;
   if (Status st = store_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), s, bytes, &entry); !st) return st;
-  hold_entry(j, entry);
+  hold_entry(j, i, entry);
   std::lock_guard lock(mutex);
   j.entries[i] = std::move(entry);
   if (j.comm.rank == 0) j.roots[i] = root_only(std::move(s)), j.have[i] = 1;
@@ -653,17 +659,20 @@ Status finish_and_lay_out(Job& j, const std::vector<float>& errors, const std::s
   return Status::success();
 }
 
-// An entry this rank writes but did not hold: read back and checked in full, as a cached one
-// is (the cache is shared storage: it may have changed since).
+// An entry this rank writes but let go: read back, its size checked before the read and its
+// bytes against the hash of those it checked. The cache is shared storage: an entry changed
+// since is removed (the rerun bakes it anew) and fails the write.
 Status read_back_entry(Job& j, size_t i, const std::string& entry, std::vector<uint8_t>& bytes) {
-  HlodSubtree decoded;
-  std::string why;
-  uint64_t size = 0;
-  if (load_hlod_subtree(j.settings.cache_dir, j.keys[i], j.vertices(), decoded, &why, &size, &bytes) != CacheLookup::found)
-    return Status::error(entry + ": this rank stored or checked it, but reading it back to write its payloads failed: " +
-                         (why.empty() ? "entry missing" : why) + " (run again: it is baked anew)");
+  const auto [size, hash] = j.let_go[i];
+  const std::string again = " (run again: it is baked anew)";
+  if (Status s = read_hlod_subtree_entry(j.settings.cache_dir, j.keys[i], size, bytes); !s)
+    return Status::error(s.message + ": reading back an entry this rank stored or checked" + again);
   j.work.bytes_read_back += size;
-  return Status::success();
+  if (hash_bytes(bytes.data(), bytes.size()) == hash) return Status::success();
+  std::error_code ec;
+  std::filesystem::remove(hlod_subtree_entry_path(j.settings.cache_dir, j.keys[i]), ec);
+  return Status::error(entry + ": changed on the storage since this rank stored or checked it, found reading it back" +
+                       again);
 }
 
 // Subtree i's payloads in `entry` and where they go (each piece's size checked against the
@@ -692,6 +701,11 @@ RankReport write_share(Job& j, const Layout& layout, const std::string& what) {
   const auto t0 = Clock::now();
   const double cpu0 = process_cpu_seconds();
   std::vector<FilePiece> held;
+  std::vector<uint8_t> bytes;  // each entry read back, in one buffer (no fresh memory per entry)
+  uint64_t largest = 0;
+  for (size_t i = 0; i < layout.writer.size(); ++i)
+    if (layout.writer[i] == j.comm.rank && j.entries[i].empty()) largest = std::max(largest, j.let_go[i].first);
+  bytes.reserve(size_t(largest));
   for (size_t i = 0; i < layout.writer.size() && rep.status; ++i) {
     if (layout.writer[i] != j.comm.rank) continue;
     const std::string entry = hlod_subtree_entry_path(j.settings.cache_dir, j.keys[i]).string();
@@ -699,7 +713,6 @@ RankReport write_share(Job& j, const Layout& layout, const std::string& what) {
       rep.status = place_entry(j, layout, i, j.entries[i], entry, held);
       continue;
     }
-    std::vector<uint8_t> bytes;
     std::vector<FilePiece> pieces;
     rep.status = read_back_entry(j, i, entry, bytes);
     if (rep.status) rep.status = place_entry(j, layout, i, bytes, entry, pieces);

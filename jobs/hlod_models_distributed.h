@@ -49,7 +49,7 @@ struct HlodModelsSettings {
   uint32_t threads = 0;   // per rank; 0 = all its cores
   uint32_t subtrees = 0;  // for split models: HlodDistributedSettings::subtrees
   std::filesystem::path cache_dir;
-  uint64_t held_entry_bytes = uint64_t(1) << 30;  // for split models: HlodDistributedSettings::held_entry_bytes
+  uint64_t held_entry_bytes = 0;  // for split models: HlodDistributedSettings::held_entry_bytes
   // Called before each of this rank's cache entries (a model, or a split model's subtree) is
   // stored; `stored`: entries this rank stored so far in the job. Tests inject a crash here.
   std::function<void(const std::string& what, size_t stored)> before_store;

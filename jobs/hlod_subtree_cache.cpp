@@ -12,6 +12,8 @@
 #include <atomic>
 #include <bit>
 #include <cstdio>
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include "jobs/hlod_bake.h"  // kHlodBuildVersion
@@ -119,6 +121,29 @@ CacheLookup load_hlod_subtree(const std::filesystem::path& dir, uint64_t key, ui
   }
   if (entry) *entry = std::move(bytes);
   return CacheLookup::found;
+}
+
+Status read_hlod_subtree_entry(const std::filesystem::path& dir, uint64_t key, uint64_t size,
+                               std::vector<uint8_t>& bytes) {
+  const std::filesystem::path path = hlod_subtree_entry_path(dir, key);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return Status::error(path.string() + ": cannot be opened: " + std::strerror(errno));
+  struct stat st {};
+  std::string wrong;
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) wrong = "is not a regular file";
+  else if (uint64_t(st.st_size) != size)
+    wrong = "is " + std::to_string(st.st_size) + " bytes, not the " + std::to_string(size) + " this rank had";
+  if (wrong.empty()) {
+    bytes.clear();  // a buffer reused: nothing copied when it grows
+    bytes.resize(size_t(size));
+    if (!read_at(fd, 0, bytes)) wrong = "cannot be read";
+    // Read once: its page-cache pages go back at once, for the next read to reuse.
+    ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+  }
+  ::close(fd);
+  if (wrong.empty()) return Status::success();
+  std::vector<uint8_t>().swap(bytes);
+  return Status::error(path.string() + ": " + wrong);
 }
 
 CacheLookup load_hlod_subtree_root(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,

@@ -37,6 +37,11 @@ enum class CacheLookup : uint8_t { found, missing, refused };
 CacheLookup load_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,
                               HlodSubtree& out, std::string* why = nullptr, uint64_t* bytes_read = nullptr,
                               std::vector<uint8_t>* entry = nullptr);
+// An entry's bytes, when it is a regular file of exactly `size` bytes (checked before anything
+// is allocated): how a rank reads back an entry it stored or checked earlier in the job.
+Status read_hlod_subtree_entry(const std::filesystem::path& dir, uint64_t key, uint64_t size,
+                               std::vector<uint8_t>& bytes);
+
 // The subtree's nodes and root only (decode_hlod_subtree_root), read from the entry's first
 // bytes: what the levels above need. `bytes_read`: how many were read.
 CacheLookup load_hlod_subtree_root(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,

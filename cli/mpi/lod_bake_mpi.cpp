@@ -182,7 +182,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   std::vector<std::string> meshes;
   std::string out_dir, cache_dir;
   int min_verts = 1000, threads = 0, subtrees = 0;
-  uint64_t entry_memory_mb = 1024;
+  uint64_t entry_memory_mb = 0;
   bool json = false, quiet = false;
   app.add_option("mesh", meshes, "mesh files, on paths every rank sees (one .hlod each)")->required();
   app.add_option("-o,--out", out_dir, "output directory (rank 0 writes <name>.hlod there)")->required();
@@ -191,7 +191,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   app.add_option("--threads", threads, "threads per rank, 0 = all cores")->check(CLI::Range(0, 1024));
   app.add_option("--subtrees", subtrees, "subtrees to split into (default 8 per rank, at least 16)")->check(CLI::Range(0, 1 << 20));
   app.add_option("--entry-memory-mb", entry_memory_mb,
-                 "cache entries a rank holds for its write (default 1024); beyond, they are read back")
+                 "MB of cache entries a rank holds for its write (default 0: each is read back when written)")
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
   app.add_flag("--json", json, "rank 0 prints a JSON summary");
   app.add_flag("--quiet", quiet, "print nothing but errors");

@@ -277,39 +277,47 @@ TEST(HlodDistributedBake, EntriesBeyondTheMemoryBudgetAreReadBackIntoTheSameByte
   EXPECT_EQ(sums(runs, &HlodRankWork::bytes_read_back), 0u);
 }
 
-// An entry that changed on the shared storage between its store and its write is refused when
-// read back: the job fails naming it and writes no file; the rerun bakes it again.
+// An entry that changed on the shared storage between its store and its write (a byte flipped,
+// cut short, removed) is found out when read back: the job fails naming it and writes no file;
+// the rerun bakes that one again and gives the local bytes.
 TEST(HlodDistributedBake, AnEntryChangedBeforeItIsReadBackFailsTheJobNamingIt) {
   const auto dir = test::temp_dir("hlod_dist_changed");
   const auto mesh = write_mesh(dir);
   const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
-  HlodDistributedSettings s;
-  s.min_verts = 150;
-  s.threads = 1;
-  s.cache_dir = dir / "cache";
-  s.held_entry_bytes = 0;
-  std::filesystem::path changed;
-  s.before_store = [&](size_t, size_t stored) {
-    if (stored != 3) return;
-    for (const auto& e : std::filesystem::directory_iterator(s.cache_dir))
-      if (e.path().extension() == ".hsub") changed = e.path();
-    std::vector<uint8_t> bytes = test::read_bytes(changed);
-    bytes[bytes.size() / 2] ^= 0x10;
-    test::write_bytes(changed, bytes);
-  };
-  HlodDistributedResult r;
-  const Status st = bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r);
-  ASSERT_FALSE(st);
-  ASSERT_FALSE(changed.empty());
-  EXPECT_NE(st.message.find(changed.filename().string()), std::string::npos) << st.message;
-  EXPECT_NE(st.message.find("reading it back"), std::string::npos) << st.message;
-  EXPECT_NE(st.message.find("run again"), std::string::npos) << st.message;
-  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
+  enum Change { flip, cut, remove };
+  for (Change change : {flip, cut, remove}) {
+    SCOPED_TRACE(change == flip ? "flipped" : change == cut ? "cut short" : "removed");
+    HlodDistributedSettings s;
+    s.min_verts = 150;
+    s.threads = 1;
+    s.cache_dir = dir / ("cache" + std::to_string(int(change)));
+    s.held_entry_bytes = 0;
+    std::filesystem::path changed;
+    s.before_store = [&](size_t, size_t stored) {
+      if (stored != 3) return;
+      for (const auto& e : std::filesystem::directory_iterator(s.cache_dir))
+        if (e.path().extension() == ".hsub") changed = e.path();
+      std::vector<uint8_t> bytes = test::read_bytes(changed);
+      if (change == flip) bytes[bytes.size() / 2] ^= 0x10;
+      if (change == cut) bytes.resize(bytes.size() - 1);
+      if (change == remove) std::filesystem::remove(changed);
+      else test::write_bytes(changed, bytes);
+    };
+    HlodDistributedResult r;
+    const Status st = bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r);
+    ASSERT_FALSE(st);
+    ASSERT_FALSE(changed.empty());
+    EXPECT_NE(st.message.find(changed.filename().string()), std::string::npos) << st.message;
+    EXPECT_NE(st.message.find("reading"), std::string::npos) << st.message;
+    EXPECT_NE(st.message.find("run again"), std::string::npos) << st.message;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
 
-  s.before_store = {};
-  ASSERT_TRUE(bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r));
-  EXPECT_EQ(r.ranks.at(0).subtrees, 1u) << "only the changed entry is baked again";
-  EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+    s.before_store = {};
+    ASSERT_TRUE(bake_hlod_distributed(mesh, "mixed", dir / "out", s, single_rank_comm(), {}, &r)) << st.message;
+    EXPECT_EQ(r.ranks.at(0).subtrees, 1u) << "only the changed entry is baked again";
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+    std::filesystem::remove(dir / "out" / "mixed.hlod");
+  }
 }
 
 TEST(HlodDistributedBake, OneRankRebakesOnlyTheCorruptedAndMissingEntries) {
