@@ -349,7 +349,7 @@ bool get_runs(const uint8_t* p, const HlodNode& node, uint32_t materials, HlodPa
 }  // namespace
 
 uint64_t hlod_resident_bytes(const HlodNode& n) {
-  const uint64_t per_vertex = 24 + (n.uvs ? 8 : 0) + (n.uvs1 ? 8 : 0) + (n.colors ? 16 : 0);
+  const uint64_t per_vertex = detail::hlod_vertex_bytes(n.uvs, n.uvs1, n.colors);
   uint64_t b = 0;
   for (uint32_t k = 0; k < n.layer_count && k < kHlodMaxLayers; ++k)
     b += per_vertex * n.layers[k].vertices + 12ull * n.layers[k].triangles;
@@ -424,13 +424,13 @@ std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint
 namespace {
 
 uint64_t range_bytes(const HlodPayload& p, const LodLevel& r) {
-  const uint64_t per_vertex = 24 + (p.uvs.empty() ? 0 : 8) + (p.uvs1.empty() ? 0 : 8) + (p.colors.empty() ? 0 : 16);
+  const uint64_t per_vertex = detail::hlod_vertex_bytes(!p.uvs.empty(), !p.uvs1.empty(), !p.colors.empty());
   return per_vertex * r.vertex_count + 4ull * r.index_count;
 }
 
 // What put_payload appends: the buffer is sized once from these before anything is written.
 uint64_t encoded_payload_bytes(const HlodPayload& p) {
-  uint64_t b = range_bytes(p, p.boundary) + 16ull * p.runs.size() + kChecksumBytes;
+  uint64_t b = range_bytes(p, p.boundary) + kRunBytes * p.runs.size() + kChecksumBytes;
   for (const LodLevel& r : p.layers) b += range_bytes(p, r);
   return b;
 }

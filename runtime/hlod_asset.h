@@ -87,4 +87,12 @@ Status read_hlod_node(const std::filesystem::path& path, const HlodNode& node, H
 // as HlodNode::resident_bytes counts them.
 uint64_t hlod_resident_bytes(const HlodNode& node);
 
+namespace detail {
+// One vertex in a payload: position and normal (24), each uv set (8), RGBA (16). What the
+// resident bytes count and what the encoder sizes its buffer by.
+constexpr uint64_t hlod_vertex_bytes(bool uvs, bool uvs1, bool colors) {
+  return 24 + (uvs ? 8 : 0) + (uvs1 ? 8 : 0) + (colors ? 16 : 0);
+}
+}  // namespace detail
+
 }  // namespace lod
