@@ -66,13 +66,15 @@ std::filesystem::path temporary_beside(const std::filesystem::path& path) {
   return tmp;
 }
 
+Status write_parts(const std::filesystem::path& file, int fd, std::span<const std::span<const uint8_t>> parts,
+                   const std::string& what);
+
 Status write_and_sync(const std::filesystem::path& tmp, std::span<const std::span<const uint8_t>> parts,
                       const std::string& what) {
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0)
     return Status::error(what + ": cannot create " + tmp.string() + ": " + describe_write_errno(errno));
-  Status st;
-  for (size_t i = 0; st && i < parts.size(); ++i) st = write_all(fd, parts[i], what);
+  Status st = write_parts(tmp, fd, parts, what);
   // Delayed allocation can report a full disk only here.
   if (st && ::fsync(fd) != 0)
     st = Status::error(what + ": " + describe_write_errno(errno) + " while flushing to disk");
@@ -289,7 +291,9 @@ Status write_run(int fd, int direct_fd, std::span<const FilePiece> run, uint64_t
 Status write_runs(const std::filesystem::path& file, int fd, std::span<const FilePiece> ordered,
                   const std::vector<std::pair<uint64_t, uint64_t>>& ranges, const std::string& what) {
   const int direct_fd = ::open(file.c_str(), O_WRONLY | O_CLOEXEC | O_DIRECT);  // none: all buffered
-  AlignedBuffer buf(direct_fd >= 0 ? kDirectChunk : kDirectAlign);
+  const uint64_t span = ranges.empty() ? 0 : ranges.back().second - ranges.front().first;
+  AlignedBuffer buf(direct_fd >= 0 ? std::min(kDirectChunk, std::max(kDirectAlign, round_up(size_t(span))))
+                                   : kDirectAlign);
   Status st;
   size_t first = 0;
   for (const auto& [begin, end] : ranges) {
@@ -301,6 +305,20 @@ Status write_runs(const std::filesystem::path& file, int fd, std::span<const Fil
   }
   if (direct_fd >= 0) ::close(direct_fd);
   return st;
+}
+
+// A new file's parts one after another: one run, its whole blocks past the page cache where
+// the file system allows (a cleaned 14M-triangle mesh is 250 MB, a local bake's .hlod 0.9 GB).
+Status write_parts(const std::filesystem::path& file, int fd, std::span<const std::span<const uint8_t>> parts,
+                   const std::string& what) {
+  std::vector<FilePiece> pieces;
+  uint64_t at = 0;
+  for (std::span<const uint8_t> part : parts) {
+    if (!part.empty()) pieces.push_back({at, part});
+    at += part.size();
+  }
+  if (at < 2 * kDirectAlign) return write_each(fd, pieces, what);  // nothing worth a bounce buffer
+  return write_runs(file, fd, pieces, {{0, at}}, what);
 }
 
 }  // namespace

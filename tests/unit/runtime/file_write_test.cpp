@@ -9,7 +9,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "test_support.h"
@@ -128,6 +130,33 @@ TEST(FileWrite, CheckedNewFilesHoldEveryByteAtEverySizeDirectOrNot) {
       EXPECT_TRUE(std::equal(back.begin(), back.end(), bytes.begin(), [](char a, uint8_t b) { return uint8_t(a) == b; }))
           << size;
     }
+}
+
+// A file in parts (the cleaned mesh's columns, an .hlod): its whole blocks go past the page
+// cache, the last partial one buffered; parts of odd sizes, empty ones among them, across the
+// 4 KB blocks and the 4 MB chunks, make the exact concatenation, and it replaces a longer file.
+TEST(FileWrite, PartsAcrossBlocksAndChunksMakeTheExactFile) {
+  const auto dir = lod::test::temp_dir("file_write_parts");
+  const auto file = dir / "parts.bin";
+  ASSERT_TRUE(lod::write_file_atomic(file, std::string(size_t(9) << 20, 'x')).ok);
+  for (const std::vector<size_t>& sizes : {std::vector<size_t>{1, 4095, 0, 4097, (size_t(4) << 20) + 3, 8191, 5},
+                                           std::vector<size_t>{8192}, std::vector<size_t>{3, 8190},
+                                           std::vector<size_t>{100}}) {
+    std::vector<std::vector<uint8_t>> parts;
+    std::vector<std::span<const uint8_t>> spans;
+    std::string expected;
+    size_t seed = 0;
+    for (size_t n : sizes) {
+      std::vector<uint8_t>& part = parts.emplace_back(n);
+      for (uint8_t& b : part) b = uint8_t((seed++ * 2654435761u) >> 13);
+      expected.append(part.begin(), part.end());
+    }
+    for (const std::vector<uint8_t>& part : parts) spans.emplace_back(part);
+    const lod::Status st = lod::write_file_atomic(file, spans);
+    ASSERT_TRUE(st.ok) << st.message;
+    EXPECT_EQ(read_text(file), expected) << sizes.size() << " parts";
+  }
+  EXPECT_EQ(leftover_temporaries(dir), 0u);
 }
 
 TEST(FileWrite, CheckedNewFileNeverReplacesOneAndSaysWhy) {
