@@ -8,7 +8,8 @@
 #   - per rank, CPU seconds per phase; critical_cpu_s (the job on idle cores) for the ratios
 #   - PAIRS=K (default 0): K more 1-rank / 2-rank runs, alternating, each from an empty cache, and
 #     the median of their ratios: on a shared VM one pair's ratio moves by +-10 %
-# Output: one JSON summary per run in $OUT (default /tmp/hlod-mpi-figures), a table on stdout.
+# Output: one JSON summary per run in $OUT (default /tmp/hlod-mpi-figures), a table on stdout;
+# the runs' files and caches (GBs on a 14M-triangle mesh) are removed at the end unless KEEP=1.
 set -euo pipefail
 export NPS=${NPS:-1 2 4}
 mesh=$1
@@ -19,15 +20,16 @@ mpi=(mpirun --oversubscribe --mca btl self,vader,tcp --mca btl_tcp_if_include lo
 name=$(basename "${mesh%.*}")
 rm -rf "$out" && mkdir -p "$out"
 now() { date +%s.%N; }
+since() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", b - a }'; }  # JSON needs the 0 of 0.5
 
 t0=$(now); "$build/lod" bake "$mesh" -o "$out/local" --hlod --threads 1 --quiet; t1=$(now)
-echo "local  1 thread : $(echo "$t1 - $t0" | bc) s"
+echo "local  1 thread : $(since "$t0" "$t1") s"
 for np in ${NPS:-1 2 4}; do
   t0=$(now)
   "${mpi[@]}" -np $np "$build/lod-bake-mpi" "$mesh" -o "$out/np$np" --cache "$out/cache$np" --threads 1 --json \
     > "$out/np$np.json" 2> "$out/np$np.err"
   t1=$(now)
-  echo "{\"wall_s\": $(echo "$t1 - $t0" | bc)}" > "$out/np$np.wall"
+  echo "{\"wall_s\": $(since "$t0" "$t1")}" > "$out/np$np.wall"
   cmp -s "$out/local/$name.hlod" "$out/np$np/$name.hlod" && same=identical || same=DIFFERENT
   echo "mpi np=$np x 1 thread: $(cat "$out/np$np.wall") bytes $same"
 done
@@ -39,12 +41,12 @@ LOD_MPI_FAIL_AFTER=$quarter LOD_MPI_FAIL_RANK=-1 "${mpi[@]}" -np 2 "$build/lod-b
   --cache "$out/cache-resume" --threads 1 --quiet > /dev/null 2> "$out/killed.err" || true
 t1=$(now)
 kept=$(ls "$out/cache-resume" | grep -c '\.hsub$' || true)
-echo "killed run: $(echo "$t1 - $t0" | bc) s, $kept of $total subtrees kept"
+echo "killed run: $(since "$t0" "$t1") s, $kept of $total subtrees kept"
 t0=$(now)
 "${mpi[@]}" -np 2 "$build/lod-bake-mpi" "$mesh" -o "$out/resume" --cache "$out/cache-resume" --threads 1 --json \
   > "$out/rerun.json" 2> "$out/rerun.err"
 t1=$(now)
-echo "{\"wall_s\": $(echo "$t1 - $t0" | bc)}" > "$out/rerun.wall"
+echo "{\"wall_s\": $(since "$t0" "$t1")}" > "$out/rerun.wall"
 cmp -s "$out/local/$name.hlod" "$out/resume/$name.hlod" && same=identical || same=DIFFERENT
 echo "rerun: $(cat "$out/rerun.wall") bytes $same"
 
@@ -81,7 +83,7 @@ for k in $(seq 1 "$pairs"); do
     "${mpi[@]}" -np $np "$build/lod-bake-mpi" "$mesh" -o "$out/pair/out" --cache "$out/pair/cache" --threads 1 --json \
       > "$out/pair$k-np$np.json" 2> "$out/pair$k-np$np.err"
     t1=$(now)
-    echo "{\"wall_s\": $(echo "$t1 - $t0" | bc)}" > "$out/pair$k-np$np.wall"
+    echo "{\"wall_s\": $(since "$t0" "$t1")}" > "$out/pair$k-np$np.wall"
   done
   rm -rf "$out/pair"
 done
@@ -98,4 +100,5 @@ for k in range(1, pairs + 1):
 print(f"pairs: median {statistics.median(wall):.2f}x wall ({min(wall):.2f}-{max(wall):.2f}), "
       f"{statistics.median(cpu):.2f}x critical CPU ({min(cpu):.2f}-{max(cpu):.2f})")
 PY
+[ "${KEEP:-0}" = 1 ] || find "$out" -mindepth 1 -maxdepth 1 -type d -exec rm -rf {} +
 true
