@@ -6,6 +6,7 @@
 
 
 #include <oneapi/tbb/task_arena.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <atomic>
@@ -44,6 +45,14 @@ double process_cpu_seconds() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
+// Kernel CPU time and peak memory of this process so far.
+void take_usage(HlodRankWork& w) {
+  rusage u{};
+  if (getrusage(RUSAGE_SELF, &u) != 0) return;
+  w.kernel_cpu_seconds = double(u.ru_stime.tv_sec) + 1e-6 * double(u.ru_stime.tv_usec);
+  w.peak_rss_bytes = uint64_t(u.ru_maxrss) * 1024;  // Linux: kilobytes
+}
+
 // What a rank tells rank 0 at the end: its status and its work.
 struct RankReport {
   Status status;
@@ -56,7 +65,8 @@ void each_number(Work& w, F&& f) {
   f(w.subtrees), f(w.triangles), f(w.checked), f(w.bytes_checked), f(w.bake_seconds), f(w.bake_cpu_seconds),
       f(w.total_seconds), f(w.cpu_seconds), f(w.load_cpu_seconds), f(w.clean_cpu_seconds), f(w.plan_cpu_seconds),
       f(w.check_cpu_seconds), f(w.surface_cpu_seconds), f(w.measure_cpu_seconds), f(w.write_cpu_seconds),
-      f(w.bytes_written), f(w.bytes_placed), f(w.bytes_read_back), f(w.region_triangles), f(w.whole_surface);
+      f(w.bytes_written), f(w.bytes_placed), f(w.bytes_read_back), f(w.region_triangles), f(w.whole_surface),
+      f(w.kernel_cpu_seconds), f(w.peak_rss_bytes);
 }
 
 std::vector<uint8_t> encode_report(const RankReport& r) {
@@ -723,6 +733,7 @@ RankReport write_share(Job& j, const Layout& layout, const std::string& what) {
   j.entries.clear();
   j.work.write_cpu_seconds = process_cpu_seconds() - cpu0;
   if (j.comm.rank == 0) j.r.write_seconds += seconds_since(t0);
+  take_usage(j.work);
   rep.work = j.work;
   return rep;
 }
@@ -738,6 +749,8 @@ Status take_reports(Job& j, const std::vector<std::vector<uint8_t>>& reports, bo
       j.r.ranks[r].measure_cpu_seconds = other.work.measure_cpu_seconds;
       j.r.ranks[r].bytes_placed = other.work.bytes_placed;
       j.r.ranks[r].bytes_read_back = other.work.bytes_read_back;
+      j.r.ranks[r].kernel_cpu_seconds = other.work.kernel_cpu_seconds;
+      j.r.ranks[r].peak_rss_bytes = other.work.peak_rss_bytes;
     }
     if (!other.status && failed) failed = other.status;
     if (!other.status && r != 0) j.say(other.status.message);
@@ -790,7 +803,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
                              const HlodRankComm& comm, const HlodBakeLog& log, HlodDistributedResult* result) {
   const auto t_start = Clock::now();
   const double cpu_start = process_cpu_seconds();
-  Job j{settings, comm, log, {}, {}, {}, {}, {}, 0, {}, {}, {}, {}, {}, {}, {}, false};
+  Job j{settings, comm, log, {}, {}, {}, {}, {}, 0, {}, {}, {}, {}, {}, {}, {}, false, {}, {}};
   j.arena = std::make_unique<tbb::task_arena>(settings.threads == 0 ? tbb::task_arena::automatic : int(settings.threads));
   std::error_code ec;
   std::filesystem::create_directories(settings.cache_dir, ec);
@@ -823,6 +836,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   }
   j.work.total_seconds = seconds_since(t_start);
   j.work.cpu_seconds = process_cpu_seconds() - cpu_start;
+  take_usage(j.work);
   rep.work = j.work;
   const std::vector<std::vector<uint8_t>> reports = comm.gather(encode_report(rep));
   watch.reset();

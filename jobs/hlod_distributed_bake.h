@@ -95,6 +95,11 @@ struct HlodRankWork {
   uint64_t bytes_read_back = 0;    // of entries it did not hold (held_entry_bytes), read back to write them
   uint64_t region_triangles = 0;   // in its region's BVH (the original's triangles near its cells)
   uint32_t whole_surface = 0;      // 1: it needed the whole original's BVH too
+  // The process over its whole run so far (getrusage, at its last report): CPU time in the kernel
+  // (mostly first touches of fresh memory: on a VM whose host takes free pages back, each is a
+  // host fault too) and the peak resident memory.
+  double kernel_cpu_seconds = 0;
+  uint64_t peak_rss_bytes = 0;
 };
 
 struct HlodDistributedResult {

@@ -5,7 +5,8 @@
 #     bake CPU seconds (balance = slowest / mean), bytes identical to the local bake
 #   - 2 ranks killed at <= 50 % (each dies once it has stored a quarter of the subtrees; the first
 #     to die ends the job), then the rerun: its time against the full 2-rank build
-#   - per rank, CPU seconds per phase; critical_cpu_s (the job on idle cores) for the ratios
+#   - per rank, CPU seconds per phase, the process's kernel CPU and peak RSS; critical_cpu_s (the
+#     job on idle cores) for the ratios
 #   - PAIRS=K (default 0): K more 1-rank / 2-rank runs, alternating, each from an empty cache, and
 #     the median of their ratios: on a shared VM one pair's ratio moves by +-10 %
 # Output: one JSON summary per run in $OUT (default /tmp/hlod-mpi-figures), a table on stdout;
@@ -63,7 +64,8 @@ for np, (j, wall) in runs.items():
           f"bake cpu per rank {[round(c, 2) for c in cpu]}, balance {max(cpu) / (sum(cpu) / len(cpu)):.3f}, "
           f"entries read {j['entry_bytes_read'] / 1e6:.1f} MB, file {j['bytes'] / 1e6:.1f} MB")
     for r, w in enumerate(j["per_rank"]):  # CPU seconds per phase (bvh is part of bake)
-        print(f"  rank {r} CPU s: " + ", ".join(f"{k} {v:.2f}" for k, v in w["cpu_s"].items()))
+        print(f"  rank {r} CPU s: " + ", ".join(f"{k} {v:.2f}" for k, v in w["cpu_s"].items()) +
+              f"; process: kernel {w['kernel_cpu_s']:.2f} s, peak RSS {w['peak_rss_mb']:.0f} MB")
     print("  rank 0 serial CPU s: " + ", ".join(f"{k} {v:.2f}" for k, v in j["rank0_cpu_s"].items()))
 w1, w2 = runs[1][1], runs[2][1]
 c = {np: runs[np][0]["critical_cpu_s"] for np in runs}
@@ -95,8 +97,10 @@ for k in range(1, pairs + 1):
     j = {np: json.load(open(f"{out}/pair{k}-np{np}.json")) for np in (1, 2)}
     w = {np: json.load(open(f"{out}/pair{k}-np{np}.wall"))["wall_s"] for np in (1, 2)}
     wall.append(w[1] / w[2]), cpu.append(j[1]["critical_cpu_s"] / j[2]["critical_cpu_s"])
+    kernel = {np: max(w["kernel_cpu_s"] for w in j[np]["per_rank"]) for np in (1, 2)}
     print(f"pair {k}: 1 rank {w[1]:.2f} s wall / {j[1]['critical_cpu_s']:.2f} s CPU, 2 ranks {w[2]:.2f} / "
-          f"{j[2]['critical_cpu_s']:.2f}: {wall[-1]:.2f}x wall, {cpu[-1]:.2f}x critical CPU")
+          f"{j[2]['critical_cpu_s']:.2f}: {wall[-1]:.2f}x wall, {cpu[-1]:.2f}x critical CPU; kernel CPU "
+          f"{kernel[1]:.2f} s at 1 rank, {kernel[2]:.2f} s on the busiest of 2")
 print(f"pairs: median {statistics.median(wall):.2f}x wall ({min(wall):.2f}-{max(wall):.2f}), "
       f"{statistics.median(cpu):.2f}x critical CPU ({min(cpu):.2f}-{max(cpu):.2f})")
 PY

@@ -78,7 +78,9 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
                                    {"measure_top", w.measure_cpu_seconds}, {"write", w.write_cpu_seconds}}},
                         {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed},
                         {"bytes_read_back", w.bytes_read_back},
-                        {"region_triangles", w.region_triangles}, {"whole_bvh", w.whole_surface != 0}});
+                        {"region_triangles", w.region_triangles}, {"whole_bvh", w.whole_surface != 0},
+                        // The process's whole run: CPU time in the kernel, peak resident memory.
+                        {"kernel_cpu_s", w.kernel_cpu_seconds}, {"peak_rss_mb", double(w.peak_rss_bytes) / 1e6}});
     slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
   }
   return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},

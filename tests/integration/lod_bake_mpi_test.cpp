@@ -64,7 +64,12 @@ TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
     EXPECT_EQ(j["ranks"], ranks);
     EXPECT_GE(j["subtrees"].get<int>(), std::max(16, 8 * ranks));  // lod::default_subtrees
     EXPECT_EQ(j["per_rank"].size(), size_t(ranks));
-    for (const auto& w : j["per_rank"]) EXPECT_GT(w["subtrees"].get<int>(), 0) << "a rank without work";
+    for (const auto& w : j["per_rank"]) {
+      EXPECT_GT(w["subtrees"].get<int>(), 0) << "a rank without work";
+      // Every rank's own process figures, taken at its last report (an MPI process holds MBs).
+      EXPECT_GT(w["kernel_cpu_s"].get<double>(), 0.0) << w;
+      EXPECT_GT(w["peak_rss_mb"].get<double>(), 1.0) << w;
+    }
   }
 }
 
