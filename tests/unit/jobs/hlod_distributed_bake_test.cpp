@@ -68,7 +68,9 @@ TEST(HlodAssign, SpatialRunsAreContiguousAndBalanced) {
     for (size_t k = 0; k < order.size(); ++k) {
       ASSERT_GE(owner[order[k]], 0);
       ASSERT_LT(owner[order[k]], ranks);
-      if (k) ASSERT_GE(owner[order[k]], owner[order[k - 1]]) << "runs follow the order";
+      if (k) {
+        ASSERT_GE(owner[order[k]], owner[order[k - 1]]) << "runs follow the order";
+      }
       load[size_t(owner[order[k]])] += costs[order[k]];
     }
     const double mean = double(std::accumulate(costs.begin(), costs.end(), uint64_t(0))) / ranks;
