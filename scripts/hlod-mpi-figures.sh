@@ -7,8 +7,9 @@
 #     to die ends the job), then the rerun: its time against the full 2-rank build
 #   - per rank, CPU seconds per phase, the process's kernel CPU and peak RSS; critical_cpu_s (the
 #     job on idle cores) for the ratios
-#   - PAIRS=K (default 0): K more 1-rank / 2-rank runs, alternating, each from an empty cache, and
-#     the median of their ratios: on a shared VM one pair's ratio moves by +-10 %
+#   - PAIRS=K (default 0): K more 1-rank / 2-rank runs, alternating (1 2, 2 1, 1 2, ...), each
+#     from an empty cache, and the median of their ratios: on a shared VM one pair's ratio moves
+#     by +-10 %, and a run right after another one finds the memory that one freed
 # Output: one JSON summary per run in $OUT (default /tmp/hlod-mpi-figures), a table on stdout;
 # the runs' files and caches (GBs on a 14M-triangle mesh) are removed at the end unless KEEP=1.
 set -euo pipefail
@@ -79,7 +80,9 @@ PY
 
 pairs=${PAIRS:-0}
 for k in $(seq 1 "$pairs"); do
-  for np in 1 2; do
+  order="1 2"
+  [ $((k % 2)) = 0 ] && order="2 1"  # ABBA: neither always runs right after the other (freed memory)
+  for np in $order; do
     rm -rf "$out/pair"
     t0=$(now)
     "${mpi[@]}" -np $np "$build/lod-bake-mpi" "$mesh" -o "$out/pair/out" --cache "$out/pair/cache" --threads 1 --json \
