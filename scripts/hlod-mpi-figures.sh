@@ -23,15 +23,20 @@ name=$(basename "${mesh%.*}")
 rm -rf "$out" && mkdir -p "$out"
 now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", b - a }'; }  # JSON needs the 0 of 0.5
+# bake NP RUN OUT CACHE: one lod-bake-mpi job at NP ranks x 1 thread; $out/RUN.{json,err,wall}
+bake() {
+  local t0 t1
+  t0=$(now)
+  "${mpi[@]}" -np "$1" "$build/lod-bake-mpi" "$mesh" -o "$3" --cache "$4" --threads 1 --json \
+    > "$out/$2.json" 2> "$out/$2.err"
+  t1=$(now)
+  echo "{\"wall_s\": $(since "$t0" "$t1")}" > "$out/$2.wall"
+}
 
 t0=$(now); "$build/lod" bake "$mesh" -o "$out/local" --hlod --threads 1 --quiet; t1=$(now)
 echo "local  1 thread : $(since "$t0" "$t1") s"
 for np in ${NPS:-1 2 4}; do
-  t0=$(now)
-  "${mpi[@]}" -np $np "$build/lod-bake-mpi" "$mesh" -o "$out/np$np" --cache "$out/cache$np" --threads 1 --json \
-    > "$out/np$np.json" 2> "$out/np$np.err"
-  t1=$(now)
-  echo "{\"wall_s\": $(since "$t0" "$t1")}" > "$out/np$np.wall"
+  bake $np np$np "$out/np$np" "$out/cache$np"
   cmp -s "$out/local/$name.hlod" "$out/np$np/$name.hlod" && same=identical || same=DIFFERENT
   echo "mpi np=$np x 1 thread: $(cat "$out/np$np.wall") bytes $same"
 done
@@ -44,11 +49,7 @@ LOD_MPI_FAIL_AFTER=$quarter LOD_MPI_FAIL_RANK=-1 "${mpi[@]}" -np 2 "$build/lod-b
 t1=$(now)
 kept=$(ls "$out/cache-resume" | grep -c '\.hsub$' || true)
 echo "killed run: $(since "$t0" "$t1") s, $kept of $total subtrees kept"
-t0=$(now)
-"${mpi[@]}" -np 2 "$build/lod-bake-mpi" "$mesh" -o "$out/resume" --cache "$out/cache-resume" --threads 1 --json \
-  > "$out/rerun.json" 2> "$out/rerun.err"
-t1=$(now)
-echo "{\"wall_s\": $(since "$t0" "$t1")}" > "$out/rerun.wall"
+bake 2 rerun "$out/resume" "$out/cache-resume"
 cmp -s "$out/local/$name.hlod" "$out/resume/$name.hlod" && same=identical || same=DIFFERENT
 echo "rerun: $(cat "$out/rerun.wall") bytes $same"
 
@@ -84,11 +85,7 @@ for k in $(seq 1 "$pairs"); do
   [ $((k % 2)) = 0 ] && order="2 1"  # ABBA: neither always runs right after the other (freed memory)
   for np in $order; do
     rm -rf "$out/pair"
-    t0=$(now)
-    "${mpi[@]}" -np $np "$build/lod-bake-mpi" "$mesh" -o "$out/pair/out" --cache "$out/pair/cache" --threads 1 --json \
-      > "$out/pair$k-np$np.json" 2> "$out/pair$k-np$np.err"
-    t1=$(now)
-    echo "{\"wall_s\": $(since "$t0" "$t1")}" > "$out/pair$k-np$np.wall"
+    bake $np pair$k-np$np "$out/pair/out" "$out/pair/cache"
   done
   rm -rf "$out/pair"
 done
