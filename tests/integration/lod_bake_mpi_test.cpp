@@ -73,6 +73,29 @@ TEST(LodBakeMpi, SameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
   }
 }
 
+// "At any rank and thread count": several TBB threads per rank (subtrees finished in any
+// order, the BVH beside them) and an odd rank count (uneven shares, cuts refined for 3) give
+// the local bake's bytes too; the test above runs 1 thread per rank.
+TEST(LodBakeMpi, SameBytesWithSeveralThreadsPerRankAndThreeRanks) {
+  ASSERT_FALSE(fixture().local.empty());
+  const std::pair<int, int> runs[] = {{1, 3}, {2, 2}, {3, 1}, {3, 2}};
+  for (const auto& [ranks, threads] : runs) {
+    const std::string what = std::to_string(ranks) + " ranks x " + std::to_string(threads) + " threads";
+    const auto dir = test::temp_dir("lod_bake_mpi_np" + std::to_string(ranks) + "t" + std::to_string(threads));
+    std::string args = bake_args(dir / "out", dir / "cache");
+    args.replace(args.rfind("--threads 1"), std::string("--threads 1").size(), "--threads " + std::to_string(threads));
+    const test::CliResult r = run_mpi(ranks, args + " --json");
+    ASSERT_EQ(r.code, 0) << what << "\n" << r.out;
+    EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local) << what;
+    const nlohmann::json j = test::printed_json(r);
+    ASSERT_TRUE(j.is_object()) << r.out;
+    EXPECT_EQ(j["ranks"], ranks) << what;
+    int baked = 0;
+    for (const auto& w : j["per_rank"]) baked += w["subtrees"].get<int>();
+    EXPECT_EQ(baked, j["subtrees"].get<int>()) << what << ": every subtree baked once, from an empty cache";
+  }
+}
+
 // A textured, two-material model (issue 12): uvs, runs and materials, the same bytes at 1, 2
 // and 4 ranks as lod bake --hlod.
 TEST(LodBakeMpi, TexturedModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
