@@ -10,6 +10,11 @@
 namespace lod::cli {
 
 int bake_command(const BakeArgs& args) {
+  if (args.distributed) return bake_distributed_command(args);
+  if (!args.cache_dir.empty() || args.subtrees || args.entry_memory_mb) {
+    std::fprintf(stderr, "lod bake: --cache, --subtrees and --entry-memory-mb are options of --distributed\n");
+    return 1;
+  }
   if (args.hlod) return bake_hlod_command(args);
   // The config's rules for ratios: 1 first, each in (0, 1], strictly decreasing, at most 16
   // (a repeated ratio used to drop a level silently).

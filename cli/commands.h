@@ -44,9 +44,16 @@ struct BakeArgs {
   bool quiet = false;  // nothing but errors (no progress, no table)
   bool hlod = false;   // write DIR/<name>.hlod (R1's model HLOD) instead of .lod chains
   int64_t min_verts = 1000;
+  // --hlod --distributed: the bake over MPI ranks (lod-bake-mpi); the options only it takes.
+  bool distributed = false;
+  std::string cache_dir;         // empty = <out_dir>/hlod-cache
+  int64_t subtrees = 0;          // 0 = lod-bake-mpi's default
+  uint64_t entry_memory_mb = 0;
 };
 int bake_command(const BakeArgs& args);
-int bake_hlod_command(const BakeArgs& args);  // cli/bake_hlod.cpp
+int bake_hlod_command(const BakeArgs& args);         // cli/bake_hlod.cpp
+int bake_distributed_command(const BakeArgs& args);  // cli/bake_distributed.cpp: execs lod-bake-mpi
+std::string distributed_cache_dir(const BakeArgs& args);
 
 struct ExportArgs {
   std::string file;       // the .hlod file

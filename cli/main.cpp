@@ -53,6 +53,15 @@ int main(int argc, char** argv) {
   bake_cmd->add_flag("--hlod", bake.hlod, "write an .hlod octree (R1 model HLOD) per mesh instead of a .lod chain");
   bake_cmd->add_option("--min-verts", bake.min_verts, "--hlod: a cell with more vertices splits (default 1000)")
       ->check(CLI::Range(int64_t{3}, int64_t{100000000}));
+  bake_cmd->add_flag("--distributed", bake.distributed,
+                     "--hlod over MPI ranks: run under mpirun -np N (lod-bake-mpi does the bake; same bytes)");
+  bake_cmd->add_option("--cache", bake.cache_dir,
+                       "--distributed: subtree cache on storage every rank sees (default OUT/hlod-cache)");
+  bake_cmd->add_option("--subtrees", bake.subtrees, "--distributed: subtrees to split into (default 8 per rank, at least 16)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 20));
+  bake_cmd->add_option("--entry-memory-mb", bake.entry_memory_mb,
+                       "--distributed: MB of cache entries a rank holds for its write (default 0)")
+      ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
 
   lod::cli::ExportArgs exp;
   auto* export_cmd = app.add_subcommand("export", "write an .hlod file as an OGC 3D Tiles 1.1 tileset");

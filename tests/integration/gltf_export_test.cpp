@@ -622,7 +622,9 @@ TEST(GltfExport, AnHlodBakeOfAGlbWithAnEmbeddedTextureKeepsItThroughTheTiles) {
       }
     }
     EXPECT_GT(textured, 0u) << "some tile draws the textured cap";
-    if (shared) EXPECT_EQ(lod::test::read_bytes(out / "textures" / "image0.png"), png);
+    if (shared) {
+      EXPECT_EQ(lod::test::read_bytes(out / "textures" / "image0.png"), png);
+    }
     expect_valid(glbs);
   }
 }

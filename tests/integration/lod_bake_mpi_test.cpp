@@ -162,6 +162,47 @@ TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes)
   EXPECT_TRUE(j["mesh_cached"].get<bool>()) << "the rerun reads the cleaned mesh the killed run stored";
 }
 
+// Issue 16's own spelling, `mpirun -np N lod bake ... --hlod --distributed`: each rank becomes
+// the lod-bake-mpi beside lod; without --cache the cache is OUT/hlod-cache, so the same command
+// run again resumes from it (here: finds every subtree).
+TEST(LodBakeMpi, LodBakeDistributedIsTheSameBakeAndResumesFromItsDefaultCache) {
+  const auto dir = test::temp_dir("lod_bake_distributed");
+  const std::string args = "bake " + fixture().mesh.string() + " -o " + (dir / "out").string() +
+                           " --hlod --distributed --min-verts 300 --threads 1 --json";
+  const test::CliResult first = test::run_mpi_program(2, LOD_CLI_PATH, args);
+  ASSERT_EQ(first.code, 0) << first.out;
+  EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local);
+  const nlohmann::json j = test::printed_json(first);
+  ASSERT_TRUE(j.is_object()) << first.out;
+  EXPECT_EQ(j["ranks"], 2);
+  EXPECT_EQ(j["cached"].get<size_t>(), 0u);
+  const size_t total = j["subtrees"].get<size_t>();
+  EXPECT_EQ(entries(dir / "out" / "hlod-cache"), total);
+
+  const test::CliResult again = test::run_mpi_program(2, LOD_CLI_PATH, args);
+  ASSERT_EQ(again.code, 0) << again.out;
+  const nlohmann::json k = test::printed_json(again);
+  ASSERT_TRUE(k.is_object()) << again.out;
+  EXPECT_EQ(k["cached"].get<size_t>(), total) << "the rerun found the default cache";
+  EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local);
+}
+
+TEST(LodBakeMpi, LodBakeDistributedRefusesWhatItCannotDo) {
+  const std::string mesh = fixture().mesh.string(), out = (test::temp_dir("lod_bake_distributed_bad") / "o").string();
+  const std::pair<std::string, std::string> cases[] = {
+      {"bake " + mesh + " -o " + out + " --distributed", "add --hlod"},
+      {"bake " + mesh + " -o " + out + " --hlod --distributed --ratios 1 0.5", "--ratios and --method"},
+      {"bake " + mesh + " -o " + out + " --hlod --cache " + out, "options of --distributed"},
+      {"bake " + mesh + " -o " + out + " --subtrees 4", "options of --distributed"},
+  };
+  for (const auto& [args, says] : cases) {
+    const test::CliResult r = test::run_lod(args);
+    EXPECT_EQ(r.code, 1) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out)) << "nothing written";
+}
+
 TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
   const auto dir = test::temp_dir("lod_bake_mpi_corrupt");
   ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);

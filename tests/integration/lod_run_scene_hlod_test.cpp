@@ -73,8 +73,8 @@ TEST(LodRunSceneHlod, FarAwayProxiesCutDrawsAndTrianglesAtTheSamePixelError) {
 
 TEST(LodRunSceneHlod, BadSettingsAreRefusedNamingTheKey) {
   const auto dir = lod::test::temp_dir("lodrun-scene-hlod-bad");
-  for (const std::string& bad : {"[scene_hlod]\nenabled = 1\n", "[scene_hlod]\nreduction = 1.5\n",
-                                 "[scene_hlod]\nmin_objects = 1\n", "[scene_hlod]\nsplit = true\n"}) {
+  for (const char* bad : {"[scene_hlod]\nenabled = 1\n", "[scene_hlod]\nreduction = 1.5\n",
+                          "[scene_hlod]\nmin_objects = 1\n", "[scene_hlod]\nsplit = true\n"}) {
     const auto cfg = write_field(dir, bad);
     const auto r = run_lod("run --config " + cfg.string() + " --frames 1 --quiet --cache " + (dir / "cache").string());
     EXPECT_NE(r.code, 0) << bad;

@@ -45,7 +45,9 @@ void expect_terrain_frames(const fs::path& json, size_t frames, bool merging = t
     merges += fr["terrain_merges"].get<uint64_t>();
   }
   EXPECT_GT(splits, 0u);
-  if (merging) EXPECT_GT(merges, 0u) << "the flying camera leaves detail behind";
+  if (merging) {
+    EXPECT_GT(merges, 0u) << "the flying camera leaves detail behind";
+  }
   EXPECT_EQ(j["summary"]["terrain_failures"].get<uint64_t>(), 0u);
   EXPECT_GT(j["summary"]["mean_terrain_tris"].get<double>(), 0.0);
 }

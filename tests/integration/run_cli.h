@@ -40,11 +40,15 @@ inline CliResult run_lod(const std::string& args) { return run_shell(std::string
 // lod-bake-mpi on `ranks` ranks. Root may run mpirun here (containers, CI); loopback only; more
 // ranks than cores is fine. Under AddressSanitizer, OpenMPI's own allocations at exit are not
 // reported as leaks.
-inline CliResult run_mpi(int ranks, const std::string& args, const std::string& env = "") {
+inline CliResult run_mpi_program(int ranks, const std::string& program, const std::string& args,
+                                 const std::string& env = "") {
   return run_shell("env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
                    "ASAN_OPTIONS=\"${ASAN_OPTIONS:-}:detect_leaks=0\" " +
                    env + " " LOD_MPIEXEC " --oversubscribe --mca btl self,vader,tcp --mca btl_tcp_if_include lo" +
-                   " --mca oob_tcp_if_include lo -np " + std::to_string(ranks) + " " LOD_BAKE_MPI_PATH " " + args);
+                   " --mca oob_tcp_if_include lo -np " + std::to_string(ranks) + " " + program + " " + args);
+}
+inline CliResult run_mpi(int ranks, const std::string& args, const std::string& env = "") {
+  return run_mpi_program(ranks, LOD_BAKE_MPI_PATH, args, env);
 }
 #endif
 
