@@ -275,15 +275,36 @@ std::vector<uint8_t> check_share(Job& j) {
   return bits;
 }
 
+// What a rank tells rank 0 after its check: one byte per subtree (check_share), the content
+// hash of the input it read, whether it planned.
+std::vector<uint8_t> encode_check(const Job& j, std::vector<uint8_t> bits, bool ready) {
+  detail::ByteWriter w;
+  w.bytes = std::move(bits);
+  w.u64(j.source_hash);
+  w.u8(ready ? 1 : 0);
+  return std::move(w.bytes);
+}
+
 // Rank 0: every rank's check merged into the missing mask (a subtree is cached when its
-// checker found it; a rank that could not plan found nothing).
-std::vector<uint8_t> merge_checks(const Job& j, const std::vector<std::vector<uint8_t>>& checks) {
-  std::vector<uint8_t> missing(j.keys.size(), 1);
-  for (const std::vector<uint8_t>& bits : checks)
-    if (bits.size() == missing.size() + 1 && bits.back() == 1)
-      for (size_t i = 0; i < missing.size(); ++i)
-        if (bits[i] == 1) missing[i] = 0;
-  return missing;
+// checker found it; a rank that could not plan found nothing). Ranks that read other bytes
+// than rank 0 (the "shared" storage is not, or MESH changed as the job started) would bake
+// subtrees of another mesh: the job stops, naming them.
+Status merge_checks(const Job& j, const std::vector<std::vector<uint8_t>>& checks, std::vector<uint8_t>& missing) {
+  missing.assign(j.keys.size(), 1);
+  std::string differ;
+  for (size_t r = 0; r < checks.size(); ++r) {
+    const std::vector<uint8_t>& c = checks[r];
+    if (c.size() < 9 || c.back() != 1) continue;  // could not plan: it says why itself
+    if (detail::load_u64(c.data() + c.size() - 9) != j.source_hash || c.size() != missing.size() + 9) {
+      differ += (differ.empty() ? "rank " : ", ") + std::to_string(r);
+      continue;
+    }
+    for (size_t i = 0; i < missing.size(); ++i)
+      if (c[i] == 1) missing[i] = 0;
+  }
+  if (differ.empty()) return Status::success();
+  return Status::error(differ + " read another input than rank 0 (other bytes, or another number of subtrees): the mesh "
+                       "must be the same file on every rank's storage, and unchanged while the job runs");
 }
 
 std::unique_ptr<CacheProgress> watch_progress(const Job& j) {
@@ -811,16 +832,20 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   Status ready = ec ? Status::error(settings.cache_dir.string() + ": cannot create the cache directory: " + ec.message())
                     : load_and_plan(j, mesh_file);
   if (!ready) ready.message = "rank " + std::to_string(comm.rank) + ": " + ready.message;
-  std::vector<uint8_t> check = ready ? check_share(j) : std::vector<uint8_t>{};
-  check.push_back(ready ? 1 : 0);
-  const std::vector<std::vector<uint8_t>> checks = comm.gather(check);
+  const std::vector<std::vector<uint8_t>> checks =
+      comm.gather(encode_check(j, ready ? check_share(j) : std::vector<uint8_t>{}, bool(ready)));
+  // The missing mask and 1; or why nobody bakes and 0 (nothing when rank 0 could not plan).
   std::vector<uint8_t> mask;
-  if (comm.rank == 0 && ready) mask = merge_checks(j, checks);
-  mask.push_back(ready ? 1 : 0);  // rank 0 could not plan: nobody bakes
+  Status agreed = ready;
+  if (comm.rank == 0 && ready) agreed = merge_checks(j, checks, mask);
+  if (!agreed && ready) mask.assign(agreed.message.begin(), agreed.message.end());
+  mask.push_back(agreed ? 1 : 0);
   comm.broadcast(mask);
   const bool go = !mask.empty() && mask.back() == 1 && ready && mask.size() == j.keys.size() + 1;
   RankReport rep;
   rep.status = ready;
+  if (ready && !mask.empty() && mask.back() == 0 && mask.size() > 1)
+    rep.status = Status::error("rank " + std::to_string(comm.rank) + ": " + std::string(mask.begin(), mask.end() - 1));
   std::unique_ptr<CacheProgress> watch;  // rank 0, until every rank has reported
   if (go) {
     mask.pop_back();
@@ -831,7 +856,7 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
     if (comm.rank == 0) watch = watch_progress(j);
     rep = bake_share(j, my_share(j));
     j.r.bake_seconds = j.work.bake_seconds;  // a failure: the caller prints it, rank 0 gathers it
-  } else if (ready) {
+  } else if (ready && rep.status) {
     rep.status = Status::error("rank " + std::to_string(comm.rank) + ": rank 0 could not plan the build");
   }
   j.work.total_seconds = seconds_since(t_start);

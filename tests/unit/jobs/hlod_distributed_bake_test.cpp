@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <numeric>
 #include <random>
 #include <thread>
@@ -193,8 +194,9 @@ struct RankRun {
   HlodDistributedResult result;
 };
 
-std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, const std::filesystem::path& out,
-                               const std::filesystem::path& cache, uint64_t held_entry_bytes = uint64_t(1) << 30) {
+std::vector<RankRun> run_ranks(int ranks, const std::function<std::filesystem::path(int)>& mesh_of,
+                               const std::filesystem::path& out, const std::filesystem::path& cache,
+                               uint64_t held_entry_bytes = uint64_t(1) << 30) {
   ThreadRanks tr(ranks);
   std::vector<RankRun> runs(static_cast<size_t>(ranks));
   std::vector<std::thread> threads;
@@ -205,10 +207,16 @@ std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, con
       s.threads = 1;
       s.cache_dir = cache;
       s.held_entry_bytes = held_entry_bytes;
-      runs[size_t(r)].status = bake_hlod_distributed(mesh, "mixed", out, s, tr.comm(r), {}, &runs[size_t(r)].result);
+      runs[size_t(r)].status =
+          bake_hlod_distributed(mesh_of(r), "mixed", out, s, tr.comm(r), {}, &runs[size_t(r)].result);
     });
   for (auto& t : threads) t.join();
   return runs;
+}
+
+std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, const std::filesystem::path& out,
+                               const std::filesystem::path& cache, uint64_t held_entry_bytes = uint64_t(1) << 30) {
+  return run_ranks(ranks, [&](int) { return mesh; }, out, cache, held_entry_bytes);
 }
 
 std::vector<uint8_t> local_bake(const std::filesystem::path& mesh, const std::filesystem::path& out) {
@@ -217,6 +225,26 @@ std::vector<uint8_t> local_bake(const std::filesystem::path& mesh, const std::fi
   HlodBakeResult r;
   EXPECT_TRUE(bake_hlod_file(mesh, "mixed", out, s, {}, &r));
   return test::read_bytes(r.file);
+}
+
+// Shared storage that is not: one rank reads another version of MESH (one vertex moved a
+// little, so the same counts, plan shape and payload sizes). The ranks would bake subtrees of
+// two meshes into one file; the job refuses instead, naming the rank, and writes nothing.
+TEST(HlodDistributedBake, ARankThatReadsAnotherInputFailsTheJobNamingIt) {
+  const auto dir = test::temp_dir("hlod_dist_other_input");
+  const auto mesh = write_mesh(dir);
+  MeshData other = test::vd_concat(test::vd_sphere(40, 50, 0.4f, 0.5f, 0.3f, 0.5f), test::vd_grid(40, 40));
+  other.positions[3 * 7 + 1] += 1e-4f;
+  std::filesystem::create_directories(dir / "elsewhere");
+  const auto moved = dir / "elsewhere" / "mixed.ply";
+  ASSERT_TRUE(save_ply(moved, other.positions.data(), other.vertex_count(), other.indices.data(), other.indices.size()));
+  const std::vector<RankRun> runs = run_ranks(3, [&](int r) { return r == 1 ? moved : mesh; }, dir / "out", dir / "cache");
+  for (size_t r = 0; r < runs.size(); ++r) {
+    EXPECT_FALSE(runs[r].status) << "rank " << r;
+    EXPECT_NE(runs[r].status.message.find("rank 1"), std::string::npos) << r << ": " << runs[r].status.message;
+  }
+  EXPECT_NE(runs[0].status.message.find("another input"), std::string::npos) << runs[0].status.message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
 }
 
 TEST(HlodDistributedBake, ThreeRanksWriteTheLocalBakesBytesAndARerunBakesNothing) {
