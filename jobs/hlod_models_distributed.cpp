@@ -258,7 +258,7 @@ std::vector<uint8_t> merge_checks(const Job& j, const std::vector<std::vector<ui
 // A folder of this process's (and rank's) own inside the cache, for one bake's output.
 std::filesystem::path stage_dir(const Job& j, size_t i, bool shared) {
   std::string name = ".stage-" + hex(j.models[i].key);
-  if (!shared) name += "-" + std::to_string(::getpid()) + "-" + std::to_string(j.comm.rank);
+  if (!shared) name += unique_temporary_suffix();  // unique across processes and hosts
   return j.settings.cache_dir / name;
 }
 

@@ -78,13 +78,10 @@ std::filesystem::path hlod_subtree_entry_path(const std::filesystem::path& dir, 
 
 Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64_t mesh_vertices,
                           const HlodSubtree& subtree, uint64_t* bytes_written, std::vector<uint8_t>* entry) {
-  static std::atomic<uint64_t> serial{0};
   const std::filesystem::path path = hlod_subtree_entry_path(dir, key);
-  char suffix[64];  // a temporary of this process's own, beside the entry
-  std::snprintf(suffix, sizeof suffix, ".%d.%llu.tmp", int(::getpid()), static_cast<unsigned long long>(serial++));
-  std::filesystem::path temp = dir / ".";
+  std::filesystem::path temp = dir / ".";  // a temporary of this writer's own, beside the entry
   temp += path.filename();
-  temp += suffix;
+  temp += unique_temporary_suffix();
   std::vector<uint8_t> bytes = encode_hlod_subtree(subtree, key);
   (void)mesh_vertices;
   // Read back from the disk and compared before it is trusted (a reader still decodes and

@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <random>
 #include <memory>
 
 #include "runtime/host_turn.h"
@@ -55,14 +57,8 @@ namespace {
 // A name of its own per process and call: runs sharing a folder may write the same file at
 // once, and each rename then replaces it whole (last one wins).
 std::filesystem::path temporary_beside(const std::filesystem::path& path) {
-  static std::atomic<uint64_t> serial{0};
   std::filesystem::path tmp = path;
-  std::string suffix = ".";  // appended piecewise: GCC 12 warns (-Wrestrict) on "." + to_string
-  suffix += std::to_string(::getpid());
-  suffix += '-';
-  suffix += std::to_string(serial++);
-  suffix += ".tmp";
-  tmp += suffix;
+  tmp += unique_temporary_suffix();
   return tmp;
 }
 
@@ -105,6 +101,20 @@ Status write_file_atomic(const std::filesystem::path& path, std::span<const uint
 
 Status write_file_atomic(const std::filesystem::path& path, const std::string& text) {
   return write_file_atomic(path, std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+}
+
+std::string unique_temporary_suffix() {
+  // Drawn once; the pid mixed in at every call, since a forked child keeps the parent's draw.
+  static const uint64_t drawn = [] {
+    std::random_device rd;
+    return uint64_t(rd()) << 32 | rd();
+  }();
+  const uint64_t token = drawn ^ (uint64_t(::getpid()) * 0x9E3779B97F4A7C15ull);
+  static std::atomic<uint64_t> serial{0};
+  char suffix[48];
+  std::snprintf(suffix, sizeof suffix, ".%016llx-%llu.tmp", static_cast<unsigned long long>(token),
+                static_cast<unsigned long long>(serial++));
+  return suffix;
 }
 
 Status create_sized_temporary(const std::filesystem::path& path, uint64_t size, std::filesystem::path& temp) {

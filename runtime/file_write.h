@@ -57,6 +57,11 @@ std::vector<std::pair<uint64_t, uint64_t>> covered_ranges(std::span<const FilePi
 // the message says how far it got and why ("the disk is full after 4096 of 9000 bytes").
 Status write_all(int fd, std::span<const uint8_t> bytes, const std::string& what);
 
+// ".<token>-<n>.tmp": a temporary's suffix no other writer uses, in this process (n counts) or
+// in any other, on this host or another sharing the folder (token: random per process; a pid
+// alone repeats across the nodes of an MPI job writing to shared storage).
+std::string unique_temporary_suffix();
+
 // errno in plain words for file writes: ENOSPC "the disk is full", EDQUOT "the disk quota is
 // exceeded", EROFS "the file system is read-only", EACCES/EPERM "permission denied", EFBIG
 // "the file is too large", EIO "an I/O error"; otherwise strerror.

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -200,4 +201,38 @@ TEST(FileWrite, InterleavedWritersOwningPartsOfTheSameBlocksMakeTheExactFile) {
   const std::vector<uint8_t> back = lod::test::read_bytes(path);
   ASSERT_EQ(back.size(), whole.size());
   EXPECT_TRUE(back == whole);
+}
+
+// Temporaries beside a cache entry on shared storage: ranks on two nodes can have one pid, and
+// a forked child keeps its parent's statics; neither may draw the other's name.
+TEST(FileWrite, TemporarySuffixesDifferWithinAProcessAndInAForkedChild) {
+  std::vector<std::string> seen;
+  for (int i = 0; i < 1000; ++i) seen.push_back(lod::unique_temporary_suffix());
+  for (const std::string& s : seen) {
+    EXPECT_EQ(s.front(), '.');
+    EXPECT_EQ(s.substr(s.size() - 4), ".tmp");
+  }
+  std::sort(seen.begin(), seen.end());
+  EXPECT_EQ(std::unique(seen.begin(), seen.end()), seen.end()) << "a suffix repeated";
+  const std::string parent = lod::unique_temporary_suffix();
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const std::string mine = lod::unique_temporary_suffix();
+    const ssize_t n = write(fds[1], mine.data(), mine.size());
+    _exit(n == ssize_t(mine.size()) ? 0 : 1);
+  }
+  close(fds[1]);
+  char buf[64] = {};
+  const ssize_t n = read(fds[0], buf, sizeof buf - 1);
+  close(fds[0]);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  ASSERT_GT(n, 0);
+  const std::string theirs(buf, size_t(n));
+  // The token (before the '-') differs, not only the count after it.
+  EXPECT_NE(theirs.substr(0, theirs.find('-')), parent.substr(0, parent.find('-'))) << theirs << " vs " << parent;
 }
