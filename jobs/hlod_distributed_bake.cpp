@@ -781,6 +781,28 @@ Status take_reports(Job& j, const std::vector<std::vector<uint8_t>>& reports, bo
 
 }  // namespace
 
+Status check_shared_folders(const std::vector<SharedFolder>& folders, const HlodRankComm& comm) {
+  std::string name;
+  Status placed;
+  if (comm.rank == 0) placed = place_probes(folders, name);
+  std::vector<uint8_t> sent(name.begin(), name.end());
+  if (!placed) sent.clear();
+  comm.broadcast(sent);  // empty: rank 0 could not place them (it says why)
+  const std::string seen_name(sent.begin(), sent.end());
+  const std::vector<std::vector<uint8_t>> answers =
+      comm.gather(sent.empty() ? std::vector<uint8_t>{} : sees_probes(folders, seen_name));
+  std::vector<uint8_t> verdict;  // why the job cannot go on; empty: every rank saw every probe
+  if (comm.rank == 0) {
+    const std::string unseen = placed ? unseen_message(folders, answers) : placed.message;
+    verdict.assign(unseen.begin(), unseen.end());
+    if (!name.empty()) remove_probes(folders, name);  // also those placed before a failure
+  }
+  comm.broadcast(verdict);
+  if (!verdict.empty()) return Status::error(std::string(verdict.begin(), verdict.end()));
+  if (sent.empty()) return Status::error("rank 0 sent no folder probe");
+  return Status::success();
+}
+
 HlodRankComm single_rank_comm() {
   HlodRankComm c;
   c.broadcast = [](std::vector<uint8_t>&) {};
@@ -830,7 +852,12 @@ Status bake_hlod_distributed(const std::filesystem::path& mesh_file, const std::
   std::filesystem::create_directories(settings.cache_dir, ec);
   // A rank that cannot load or plan still takes part in the collectives (others wait there).
   Status ready = ec ? Status::error(settings.cache_dir.string() + ": cannot create the cache directory: " + ec.message())
-                    : load_and_plan(j, mesh_file);
+                    : Status::success();
+  // Before any work: every rank must see rank 0's cache and output folders.
+  if (Status shared = check_shared_folders({{"cache folder", settings.cache_dir}, {"output folder", out_dir}}, comm);
+      !shared && ready)
+    ready = shared;
+  if (ready) ready = load_and_plan(j, mesh_file);
   if (!ready) ready.message = "rank " + std::to_string(comm.rank) + ": " + ready.message;
   const std::vector<std::vector<uint8_t>> checks =
       comm.gather(encode_check(j, ready ? check_share(j) : std::vector<uint8_t>{}, bool(ready)));

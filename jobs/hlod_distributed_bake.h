@@ -1,5 +1,7 @@
 // The HLOD bake spread over ranks (issue 16), one call per rank (an MPI process, say):
 //
+//   every rank   sees the probe files rank 0 made in the cache and output folders, or the job
+//                stops before any work (check_shared_folders)
 //   every rank   load the mesh from the shared path, plan the split (the same on every rank),
 //                check its share of the cache's entries in full
 //   gather       which entries were found -> rank 0 broadcasts which are missing
@@ -28,6 +30,7 @@
 #include <vector>
 
 #include "jobs/hlod_bake.h"
+#include "jobs/shared_folder_probe.h"
 
 namespace lod {
 
@@ -42,6 +45,11 @@ struct HlodRankComm {
 
 // One rank, no communication: the distributed bake run in one process.
 HlodRankComm single_rank_comm();
+
+// Every rank calls it with its own folders, the same kinds in the same order (three
+// collectives): fails on every rank, naming the ranks and folders, unless each rank finds in
+// its folders the files rank 0 made in its own (jobs/shared_folder_probe.h).
+Status check_shared_folders(const std::vector<SharedFolder>& folders, const HlodRankComm& comm);
 
 // Longest processing time first: subtrees by cost, largest first (ties: lower index), each to
 // the rank with the least cost so far (ties: lower rank). The slowest rank then carries at

@@ -523,6 +523,10 @@ Status bake_hlod_models_distributed(const std::vector<std::filesystem::path>& me
                     : Status::success();
   std::filesystem::create_directories(out_dir, ec);
   if (ready && ec) ready = Status::error(out_dir.string() + ": cannot create the output directory: " + ec.message());
+  // Before any work: every rank must see rank 0's cache and output folders.
+  if (Status shared = check_shared_folders({{"cache folder", settings.cache_dir}, {"output folder", out_dir}}, comm);
+      ready && !shared)
+    ready = shared;
   if (Status s = share_estimates(j); ready && !s) ready = s;
   if (!ready) ready.message = "rank " + std::to_string(comm.rank) + ": " + ready.message;
   std::vector<uint8_t> check = ready ? check_share(j, arena) : std::vector<uint8_t>{};

@@ -203,6 +203,22 @@ TEST(LodBakeMpi, LodBakeDistributedRefusesWhatItCannotDo) {
   EXPECT_FALSE(std::filesystem::exists(out)) << "nothing written";
 }
 
+// A cache folder of each node's own (here: a path per rank, as a job script giving node-local
+// scratch would): the job stops before any bake, exit code 1, naming the rank and the folder.
+TEST(LodBakeMpi, NodeLocalCacheFolderStopsTheJobBeforeAnyBake) {
+  const auto dir = test::temp_dir("lod_bake_mpi_node_local");
+  const std::string per_rank = std::string("sh -c '") + LOD_BAKE_MPI_PATH + " " + fixture().mesh.string() + " -o " +
+                               (dir / "out").string() + " --cache " + (dir / "cache-").string() +
+                               "$OMPI_COMM_WORLD_RANK --min-verts 300 --threads 1'";
+  const test::CliResult r = test::run_mpi_program(2, per_rank, "");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("rank 1 does not see, in its cache folder, the file rank 0 made in " + (dir / "cache-0").string()),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "ball.hlod"));
+  EXPECT_EQ(entries(dir / "cache-0") + entries(dir / "cache-1"), 0u) << "nothing baked";
+}
+
 TEST(LodBakeMpi, CorruptedAndTruncatedEntriesAreRebaked) {
   const auto dir = test::temp_dir("lod_bake_mpi_corrupt");
   ASSERT_EQ(run_mpi(2, bake_args(dir / "out", dir / "cache") + " --quiet").code, 0);

@@ -194,21 +194,26 @@ struct RankRun {
   HlodDistributedResult result;
 };
 
-std::vector<RankRun> run_ranks(int ranks, const std::function<std::filesystem::path(int)>& mesh_of,
-                               const std::filesystem::path& out, const std::filesystem::path& cache,
+// What one rank is given: its mesh path, output and cache folders (the same on every rank
+// unless a test says otherwise, as a node with its own storage would have).
+struct RankPaths {
+  std::filesystem::path mesh, out, cache;
+};
+
+std::vector<RankRun> run_ranks(int ranks, const std::function<RankPaths(int)>& paths_of,
                                uint64_t held_entry_bytes = uint64_t(1) << 30) {
   ThreadRanks tr(ranks);
   std::vector<RankRun> runs(static_cast<size_t>(ranks));
   std::vector<std::thread> threads;
   for (int r = 0; r < ranks; ++r)
     threads.emplace_back([&, r] {
+      const RankPaths p = paths_of(r);
       HlodDistributedSettings s;
       s.min_verts = 150;
       s.threads = 1;
-      s.cache_dir = cache;
+      s.cache_dir = p.cache;
       s.held_entry_bytes = held_entry_bytes;
-      runs[size_t(r)].status =
-          bake_hlod_distributed(mesh_of(r), "mixed", out, s, tr.comm(r), {}, &runs[size_t(r)].result);
+      runs[size_t(r)].status = bake_hlod_distributed(p.mesh, "mixed", p.out, s, tr.comm(r), {}, &runs[size_t(r)].result);
     });
   for (auto& t : threads) t.join();
   return runs;
@@ -216,7 +221,7 @@ std::vector<RankRun> run_ranks(int ranks, const std::function<std::filesystem::p
 
 std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, const std::filesystem::path& out,
                                const std::filesystem::path& cache, uint64_t held_entry_bytes = uint64_t(1) << 30) {
-  return run_ranks(ranks, [&](int) { return mesh; }, out, cache, held_entry_bytes);
+  return run_ranks(ranks, [&](int) { return RankPaths{mesh, out, cache}; }, held_entry_bytes);
 }
 
 std::vector<uint8_t> local_bake(const std::filesystem::path& mesh, const std::filesystem::path& out) {
@@ -238,13 +243,47 @@ TEST(HlodDistributedBake, ARankThatReadsAnotherInputFailsTheJobNamingIt) {
   std::filesystem::create_directories(dir / "elsewhere");
   const auto moved = dir / "elsewhere" / "mixed.ply";
   ASSERT_TRUE(save_ply(moved, other.positions.data(), other.vertex_count(), other.indices.data(), other.indices.size()));
-  const std::vector<RankRun> runs = run_ranks(3, [&](int r) { return r == 1 ? moved : mesh; }, dir / "out", dir / "cache");
+  const std::vector<RankRun> runs =
+      run_ranks(3, [&](int r) { return RankPaths{r == 1 ? moved : mesh, dir / "out", dir / "cache"}; });
   for (size_t r = 0; r < runs.size(); ++r) {
     EXPECT_FALSE(runs[r].status) << "rank " << r;
     EXPECT_NE(runs[r].status.message.find("rank 1"), std::string::npos) << r << ": " << runs[r].status.message;
   }
   EXPECT_NE(runs[0].status.message.find("another input"), std::string::npos) << runs[0].status.message;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
+}
+
+// Folders that are not shared: a rank whose cache (or output) folder is its node's own would
+// bake into a cache rank 0 never reads, or write its part where nobody looks. The job stops
+// before any load or bake, naming the rank and the folder, and leaves no probe file behind.
+TEST(HlodDistributedBake, ARankThatDoesNotSeeTheSharedFoldersStopsTheJobBeforeAnyWork) {
+  const auto dir = test::temp_dir("hlod_dist_not_shared");
+  const auto mesh = write_mesh(dir);
+  struct Case {
+    int odd_rank;
+    bool cache;  // else the output folder is the odd one
+  };
+  for (const Case c : {Case{1, true}, Case{2, false}}) {
+    const auto base = dir / (c.cache ? "cache-case" : "out-case");
+    const std::vector<RankRun> runs = run_ranks(3, [&](int r) {
+      const bool odd = r == c.odd_rank;
+      return RankPaths{mesh, base / (odd && !c.cache ? "node-out" : "out"), base / (odd && c.cache ? "node-cache" : "cache")};
+    });
+    const std::string folder = c.cache ? "cache folder" : "output folder";
+    for (size_t r = 0; r < runs.size(); ++r) {
+      EXPECT_FALSE(runs[r].status) << r;
+      EXPECT_NE(runs[r].status.message.find("rank " + std::to_string(c.odd_rank) + " does not see, in its " + folder),
+                std::string::npos)
+          << r << ": " << runs[r].status.message;
+    }
+    EXPECT_FALSE(std::filesystem::exists(base / "out" / "mixed.hlod"));
+    for (const char* sub : {"out", "cache", "node-out", "node-cache"}) {
+      std::error_code ec;
+      if (!std::filesystem::exists(base / sub)) continue;
+      for (const auto& e : std::filesystem::directory_iterator(base / sub, ec))
+        ADD_FAILURE() << "left behind (nothing is loaded, baked or probed any more): " << e.path();
+    }
+  }
 }
 
 TEST(HlodDistributedBake, ThreeRanksWriteTheLocalBakesBytesAndARerunBakesNothing) {

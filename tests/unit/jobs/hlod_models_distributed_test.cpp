@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <numeric>
 #include <random>
 #include <thread>
@@ -162,7 +163,8 @@ struct RankRun {
   HlodModelsResult result;
 };
 
-std::vector<RankRun> run_ranks(int ranks, const Scene& scene, const std::filesystem::path& out,
+// out_of(r): rank r's output folder (the same for all unless a test says otherwise).
+std::vector<RankRun> run_ranks(int ranks, const Scene& scene, const std::function<std::filesystem::path(int)>& out_of,
                                const std::filesystem::path& cache) {
   ThreadRanks tr(ranks);
   std::vector<RankRun> runs(static_cast<size_t>(ranks));
@@ -173,10 +175,16 @@ std::vector<RankRun> run_ranks(int ranks, const Scene& scene, const std::filesys
       s.min_verts = 150;
       s.threads = 1;
       s.cache_dir = cache;
-      runs[size_t(r)].status = bake_hlod_models_distributed(scene.meshes, out, s, tr.comm(r), {}, &runs[size_t(r)].result);
+      runs[size_t(r)].status =
+          bake_hlod_models_distributed(scene.meshes, out_of(r), s, tr.comm(r), {}, &runs[size_t(r)].result);
     });
   for (auto& t : threads) t.join();
   return runs;
+}
+
+std::vector<RankRun> run_ranks(int ranks, const Scene& scene, const std::filesystem::path& out,
+                               const std::filesystem::path& cache) {
+  return run_ranks(ranks, scene, [&](int) { return out; }, cache);
 }
 
 void expect_local_bytes(const Scene& scene, const std::filesystem::path& out) {
@@ -266,6 +274,24 @@ TEST(HlodModelsDistributedBake, UnreadableModelIsNamedAndTheOthersAreStillBaked)
   EXPECT_EQ(runs[0].result.models[1].route, HlodModelRoute::failed);
   scene.meshes.erase(scene.meshes.begin() + 1);
   expect_local_bytes(scene, dir / "out");
+}
+
+// A rank whose output folder is its node's own would write its models where nobody looks (and
+// say it had): the job stops before any bake, naming the rank and the folder.
+TEST(HlodModelsDistributedBake, ARankWithItsOwnOutputFolderStopsTheJobBeforeAnyBake) {
+  const auto dir = test::temp_dir("hlod_models_not_shared");
+  const Scene scene = write_scene(dir);
+  const std::vector<RankRun> runs =
+      run_ranks(3, scene, [&](int r) { return r == 2 ? dir / "node-out" : dir / "out"; }, dir / "cache");
+  for (size_t r = 0; r < runs.size(); ++r) {
+    EXPECT_FALSE(runs[r].status) << r;
+    EXPECT_NE(runs[r].status.message.find("rank 2 does not see, in its output folder"), std::string::npos)
+        << r << ": " << runs[r].status.message;
+  }
+  for (const char* sub : {"out", "node-out", "cache"}) {
+    if (!std::filesystem::exists(dir / sub)) continue;
+    EXPECT_TRUE(std::filesystem::is_empty(dir / sub)) << sub << ": nothing baked, no probe left";
+  }
 }
 
 TEST(HlodModelsDistributedBake, TwoModelsWithOneNameAreRefusedBeforeAnything) {
