@@ -50,10 +50,18 @@ std::vector<EmbeddedImage> kept_embedded_images(std::vector<ChainMaterial>& mate
 Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out,
                         std::vector<uint8_t>* content_out) {
   // The mesh readers' own read: a directory, FIFO or device is refused by name, not read.
-  std::vector<uint8_t> bytes;
-  if (Status s = detail::read_regular_file(file, bytes); !s) return s;
-  uint64_t content = hash_bytes(bytes.data(), bytes.size());
-  if (content_out) *content_out = std::move(bytes);
+  uint64_t content = 0;
+  if (content_out) {
+    if (Status s = detail::read_regular_file(file, *content_out); !s) return s;
+    content = hash_bytes(content_out->data(), content_out->size());
+  } else if (Status s = detail::hash_regular_file(file, content); !s) {
+    return s;
+  }
+  out = hlod_source_hash_of(file, content, min_verts);
+  return Status::success();
+}
+
+uint64_t hlod_source_hash_of(const std::filesystem::path& file, uint64_t content, uint32_t min_verts) {
   // The materials and uvs are in the tree since build version 2: what an OBJ's .mtl or a glTF's
   // buffers and images hold is part of the source. Version 3 keeps embedded images, so a tree
   // cached before (its embedded textures left out) is not taken for current; version 4 keeps
@@ -67,14 +75,15 @@ Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, u
       content = hash_bytes(more.data(), more.size(), content);
     }
   const uint64_t settings[2] = {kHlodBuildVersion, min_verts};
-  out = hash_bytes(settings, sizeof settings, content);
-  return Status::success();
+  return hash_bytes(settings, sizeof settings, content);
 }
 
 Status load_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
-                       std::vector<std::string>& notes, size_t* input_triangles) {
+                       std::vector<std::string>& notes, size_t* input_triangles, uint64_t* content_hash) {
   MeshData m;
-  if (Status s = load_mesh(mesh_file, m); !s) return s;
+  uint64_t hash = 0;
+  if (Status s = load_mesh_hashed(mesh_file, m, hash); !s) return s;
+  if (content_hash) *content_hash = hash;
   if (input_triangles) *input_triangles = m.triangle_count();
   prepare_hlod_input(mesh_file, m, surfaces, notes);
   mesh = std::move(m);
@@ -118,11 +127,12 @@ Status bake_hlod_file(const std::filesystem::path& mesh_file, const std::string&
   MeshData mesh;
   HlodBuildOptions options;
   std::vector<std::string> notes;
-  if (Status s = load_hlod_input(mesh_file, mesh, options.surfaces, notes, &r.input_triangles); !s) return s;
+  uint64_t content = 0;  // of the bytes parsed: the file is read once
+  if (Status s = load_hlod_input(mesh_file, mesh, options.surfaces, notes, &r.input_triangles, &content); !s) return s;
   if (log)
     for (const std::string& note : notes) log("hlod " + name + ": note: " + note);
   HlodModel model;
-  if (Status s = hlod_source_hash(mesh_file, settings.min_verts, model.tree.source_hash); !s) return s;
+  model.tree.source_hash = hlod_source_hash_of(mesh_file, content, settings.min_verts);
   const uint64_t hash = model.tree.source_hash;
   r.load_seconds = seconds_since(t0);
 

@@ -42,14 +42,18 @@ ParallelFor tbb_parallel_for();
 // `content` (optional): the mesh file's bytes as read, for load_mesh to parse without reading again.
 Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out,
                         std::vector<uint8_t>* content = nullptr);
+// The same from the hash of the mesh file's bytes already taken (load_mesh_hashed's).
+uint64_t hlod_source_hash_of(const std::filesystem::path& mesh_file, uint64_t content_hash, uint32_t min_verts);
 
 // The mesh as an HLOD build takes it: loaded and cleaned (uv seams and material boundaries stay
 // copies at one position), its materials converted for the tree (add_chain_materials) with the
 // images they embed (only those a kept slot names, renumbered). The uvs (both sets) and colours
 // stay; what the tree does not keep (a texture reading a uv set the mesh lacks) is said in
 // `notes`, each naming the file.
+// `content_hash` (optional): hash_bytes of the file's bytes as parsed (the file is read once).
 Status load_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
-                       std::vector<std::string>& notes, size_t* input_triangles = nullptr);
+                       std::vector<std::string>& notes, size_t* input_triangles = nullptr,
+                       uint64_t* content_hash = nullptr);
 // The same for a mesh already loaded from `mesh_file` (cleaned in place).
 void prepare_hlod_input(const std::filesystem::path& mesh_file, MeshData& mesh, HlodSurfaces& surfaces,
                         std::vector<std::string>& notes);

@@ -158,12 +158,9 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
     cpu = now;
   };
   // The cleaned mesh from the cache when a run before stored it; otherwise loaded, cleaned and
-  // (rank 0) stored for the reruns.
-  std::vector<uint8_t> content;  // read once: hashed, then parsed if the cache lacks the mesh
-  if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, j.source_hash, &content); !s) return s;
-  std::error_code gone;
-  if (std::filesystem::exists(hlod_mesh_entry_path(j.settings.cache_dir, j.source_hash), gone))
-    std::vector<uint8_t>().swap(content);  // not held beside the cached mesh (a refused one reads the file again)
+  // (rank 0) stored for the reruns. The key is hashed in 1 MB pieces (no copy of the file in
+  // memory); a load hashes what it parses too, and the two must agree.
+  if (Status s = hlod_source_hash(mesh_file, j.settings.min_verts, j.source_hash); !s) return s;
   uint64_t input_triangles = 0;
   std::string why;
   const CacheLookup cached =
@@ -179,8 +176,10 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
     j.r.mesh_cached = true;
     lap(j.work.load_cpu_seconds);
   } else {
-    if (Status s = load_mesh(mesh_file, std::move(content), j.mesh); !s)
-      return s;
+    uint64_t parsed = 0;
+    if (Status s = load_mesh_hashed(mesh_file, j.mesh, parsed); !s) return s;
+    if (hlod_source_hash_of(mesh_file, parsed, j.settings.min_verts) != j.source_hash)
+      return Status::error(mesh_file.string() + ": changed while this rank read it (hashed, then loaded other bytes)");
     j.r.input_triangles = j.mesh.triangle_count();
     lap(j.work.load_cpu_seconds);
     std::vector<std::string> notes;

@@ -9,6 +9,7 @@
 #include "preprocess/gltf_io.h"
 #include "preprocess/mesh_readers.h"
 #include "preprocess/texture_uri.h"
+#include "runtime/bytes_hasher.h"
 #include "runtime/file_write.h"
 
 #include <fcntl.h>
@@ -212,10 +213,10 @@ std::string lower(std::string s) {
 
 }  // namespace
 
-// Reads a regular file whole. stat first (a directory, FIFO, socket or device is refused by
-// name without opening it), then open with O_NONBLOCK (a FIFO swapped in meanwhile does not
-// block the open) and fstat the descriptor (refused unless still a regular file).
-Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
+// Opens a regular file for reading. stat first (a directory, FIFO, socket or device is
+// refused by name without opening it), then open with O_NONBLOCK (a FIFO swapped in meanwhile
+// does not block the open) and fstat the descriptor (refused unless still a regular file).
+Status open_regular_file(const fs::path& path, RegularFile& out) {
   const std::string what = path.string();
   auto kind = [](mode_t m) -> const char* {
     if (S_ISDIR(m)) return "is a directory, not a mesh file";
@@ -233,18 +234,45 @@ Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
     return Status::error(what + ": cannot be read (" + std::strerror(e) + ")");
   }
   if (const char* k = kind(st.st_mode)) return Status::error(what + ": " + k);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) {
+  RegularFile f;
+  f.fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (f.fd < 0) {
     const int e = errno;
     return Status::error(what + ": cannot be opened for reading (" + std::strerror(e) + ")");
   }
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  if (::fstat(fd, &st) != 0) return Status::error(what + ": cannot be read (" + std::strerror(errno) + ")");
+  if (::fstat(f.fd, &st) != 0) return Status::error(what + ": cannot be read (" + std::strerror(errno) + ")");
   if (const char* k = kind(st.st_mode)) return Status::error(what + ": " + k);
   if (st.st_size == 0) return Status::error(what + ": file is empty");
+  f.size = uint64_t(st.st_size);
+  out = std::move(f);
+  return Status::success();
+}
+
+RegularFile::~RegularFile() {
+  if (fd >= 0) ::close(fd);
+}
+
+size_t RegularFile::read_some(uint8_t* into, size_t n, Status& st, const std::string& what) {
+  size_t got = 0;
+  while (got < n) {
+    const ssize_t r = ::read(fd, into + got, n - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) {
+      st = Status::error(what + ": read error (" + std::strerror(errno) + ")");
+      return got;
+    }
+    if (r == 0) break;  // shrank while reading
+    got += size_t(r);
+  }
+  return got;
+}
+
+Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
+  const std::string what = path.string();
+  RegularFile f;
+  if (Status s = open_regular_file(path, f); !s) return s;
+  struct stat st {};
+  st.st_size = off_t(f.size);
   if (uint64_t(st.st_size) > std::numeric_limits<size_t>::max() / 2)
     return Status::error(what + ": is too large (" + std::to_string(st.st_size) + " bytes)");
   try {
@@ -252,16 +280,30 @@ Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
   } catch (const std::bad_alloc&) {
     return Status::error(what + ": not enough memory to read its " + std::to_string(st.st_size) + " bytes");
   }
-  size_t got = 0;
-  while (got < bytes.size()) {
-    const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
-    if (r < 0 && errno == EINTR) continue;
-    if (r < 0) return Status::error(what + ": read error (" + std::strerror(errno) + ")");
-    if (r == 0) break;  // shrank while reading
-    got += size_t(r);
-  }
-  bytes.resize(got);
+  Status read;
+  bytes.resize(f.read_some(bytes.data(), bytes.size(), read, what));
+  if (!read) return read;
   if (bytes.empty()) return Status::error(what + ": file is empty");
+  return Status::success();
+}
+
+Status hash_regular_file(const fs::path& path, uint64_t& hash) {
+  const std::string what = path.string();
+  RegularFile f;
+  if (Status s = open_regular_file(path, f); !s) return s;
+  std::vector<uint8_t> chunk(size_t(1) << 20);  // one small buffer, not the file's size in fresh memory
+  BytesHasher h;
+  uint64_t total = 0;
+  for (;;) {
+    Status read;
+    const size_t got = f.read_some(chunk.data(), chunk.size(), read, what);
+    if (!read) return read;
+    h.add(chunk.data(), got);
+    total += got;
+    if (got < chunk.size()) break;
+  }
+  if (total == 0) return Status::error(what + ": file is empty");
+  hash = h.finish();
   return Status::success();
 }
 
@@ -392,6 +434,35 @@ Status load_mesh(const std::filesystem::path& path, std::vector<uint8_t>&& bytes
   std::vector<uint8_t> owned = std::move(bytes);
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   return parse_and_finish(path.string(), path.extension().string(), owned.data(), owned.size(), out, &owned, dir);
+}
+
+Status load_mesh_hashed(const std::filesystem::path& path, MeshData& out, uint64_t& content_hash) {
+  using namespace detail;
+  if (lower(path.extension().string()) == ".ply") {
+    RawPolygons raw;
+    bool handled = false;
+    uint64_t hash = 0;
+    if (Status s = read_plain_ply_file(path, raw, hash, handled); !s) return s;
+    if (handled) {
+      MeshData m;
+      try {
+        if (Status s = finish_polygons(path.string(), raw, m, /*obj_numbering=*/false); !s) return s;
+      } catch (const std::bad_alloc&) {
+        return Status::error(path.string() + ": not enough memory to load it");
+      }
+      out = std::move(m);
+      content_hash = hash;
+      return Status::success();
+    }
+  }
+  std::vector<uint8_t> bytes;
+  if (Status s = read_regular_file(path, bytes); !s) return s;
+  BytesHasher hasher;  // hash_bytes, without linking the asset code into the readers
+  hasher.add(bytes.data(), bytes.size());
+  const uint64_t hash = hasher.finish();
+  if (Status s = load_mesh(path, std::move(bytes), out); !s) return s;
+  content_hash = hash;
+  return Status::success();
 }
 
 namespace {

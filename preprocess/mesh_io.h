@@ -23,6 +23,10 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out);
 // hashed the file first reads it once. A glTF is read from `path` (its buffers may be files),
 // and so is any file when `bytes` is empty (a caller that had no need to read it).
 Status load_mesh(const std::filesystem::path& path, std::vector<uint8_t>&& bytes, MeshData& out);
+// load_mesh, and the content hash (hash_bytes) of exactly the bytes it parsed: a binary PLY
+// in the scanners' layout is read straight into the mesh's arrays (no copy of the file in
+// memory), any other file whole, then parsed.
+Status load_mesh_hashed(const std::filesystem::path& path, MeshData& out, uint64_t& content_hash);
 
 // The same readers over bytes already in memory; `extension` picks the format (".ply",
 // ".off", ".stl", ".obj", ".gltf", ".glb"; any case), `name` is used in messages. Never reads

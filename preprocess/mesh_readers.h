@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "preprocess/mesh.h"
@@ -88,6 +89,35 @@ Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out,
 // Reads a regular file whole (a directory, FIFO, socket or device is refused by name and
 // never blocks); the message names the file.
 Status read_regular_file(const std::filesystem::path& path, std::vector<uint8_t>& bytes);
+
+// A regular file open for reading (open_regular_file's checks), closed when it goes.
+struct RegularFile {
+  int fd = -1;
+  uint64_t size = 0;  // at open
+  RegularFile() = default;
+  RegularFile(RegularFile&& o) noexcept : fd(std::exchange(o.fd, -1)), size(o.size) {}
+  RegularFile& operator=(RegularFile&& o) noexcept {
+    std::swap(fd, o.fd);
+    size = o.size;
+    return *this;
+  }
+  ~RegularFile();
+  // Up to n bytes from the current offset (fewer at the end of the file); a read error sets st.
+  size_t read_some(uint8_t* into, size_t n, Status& st, const std::string& what);
+};
+Status open_regular_file(const std::filesystem::path& path, RegularFile& out);
+
+// The content hash (hash_bytes) of a regular file's bytes, read in 1 MB pieces.
+Status hash_regular_file(const std::filesystem::path& path, uint64_t& hash);
+
+// The layout scanners write, binary little-endian PLY with a vertex element of float x, y, z
+// alone and a face element of one uchar-counted list of 32-bit indices, every face a triangle:
+// read from the file straight into raw.positions and raw.triangles (no copy of the file in
+// memory: a 14M-triangle scan's 265 MB) and hashed on the way (content_hash = hash_bytes of
+// the whole file). `handled` false, raw and the hash untouched: another layout, or something
+// read_ply names (a short file, a non-finite coordinate, another face size); read the file
+// whole then. A status only when the file cannot be opened or memory runs out.
+Status read_plain_ply_file(const std::filesystem::path& path, RawPolygons& raw, uint64_t& content_hash, bool& handled);
 
 // ---- helpers shared by the text readers ------------------------------------------------
 

@@ -2,6 +2,8 @@
 // cleaning it (issue 16: each rank of a distributed bake repeats both, so their time bounds
 // the speed-up); LOD_BENCH_MESH=FILE.ply takes a real mesh instead. Baselines in the same run:
 //   BM_ReadBytes          the file's bytes into memory (the floor for BM_LoadPly)
+//   BM_ReadHashParse      read whole, hashed, parsed: the baseline for BM_LoadPlyHashedStreamed
+//                         (load_mesh_hashed: the same mesh and hash, streamed into the arrays)
 //   BM_FaceGroupsSorted   repeated faces found by sorting (key, index) pairs (the former clean)
 //   BM_FaceGroupsHashed   the same answer by hash groups (first_of_equal, what clean uses)
 //   BM_Clean/indexed      clean_mesh of the indexed sphere (nothing to weld)
@@ -96,6 +98,30 @@ void BM_LoadPly(benchmark::State& state) {
     benchmark::DoNotOptimize(m.indices.data());
   }
   state.counters["triangles"] = double(sphere().triangle_count());
+}
+
+// What a bake did before the streamed read: the file whole, hashed, parsed (the baseline).
+void BM_ReadHashParse(benchmark::State& state) {
+  for (auto _ : state) {
+    std::vector<uint8_t> bytes;
+    if (!detail::read_regular_file(ply_file(), bytes)) state.SkipWithError("cannot read the bench file");
+    const uint64_t hash = hash_bytes(bytes.data(), bytes.size());
+    MeshData m;
+    if (Status s = load_mesh(ply_file(), std::move(bytes), m); !s) state.SkipWithError(s.message.c_str());
+    benchmark::DoNotOptimize(hash);
+    benchmark::DoNotOptimize(m.indices.data());
+  }
+}
+
+// The same mesh and hash by load_mesh_hashed: the scanners' layout streamed into the arrays.
+void BM_LoadPlyHashedStreamed(benchmark::State& state) {
+  for (auto _ : state) {
+    MeshData m;
+    uint64_t hash = 0;
+    if (Status s = load_mesh_hashed(ply_file(), m, hash); !s) state.SkipWithError(s.message.c_str());
+    benchmark::DoNotOptimize(hash);
+    benchmark::DoNotOptimize(m.indices.data());
+  }
 }
 
 struct FaceKey {
@@ -208,6 +234,8 @@ void BM_SurfaceQuery(benchmark::State& state) {
 
 BENCHMARK(BM_ReadBytes)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_LoadPly)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_ReadHashParse)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_LoadPlyHashedStreamed)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_FaceGroupsSorted)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_FaceGroupsHashed)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_Clean)->ArgName("soup")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);

@@ -3,21 +3,57 @@
 // -DLOD_FUZZ_EXT='".ply"' (".off", ".stl", ".obj", ".glb") by scripts/fuzz.sh.
 //
 // Checks beyond the sanitizers: a load either fails with a message naming the input, or
-// gives a mesh whose indices are in range and whose coordinates are finite.
+// gives a mesh whose indices are in range and whose coordinates are finite; for PLY, reading
+// the same bytes from a file (load_mesh_hashed) agrees.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 
+#include <unistd.h>
+
+#include <string>
+
 #include "preprocess/mesh_io.h"
+#include "runtime/bytes_hasher.h"
 
 #ifndef LOD_FUZZ_EXT
 #error "build with -DLOD_FUZZ_EXT='\".ply\"' (or .off, .stl, .obj, .glb)"
 #endif
 
+// PLY only: the same bytes as a file through load_mesh_hashed, whose scanners'-layout path reads
+// the file itself (preprocess/plain_ply_file.cpp). It must agree with the reader above: loaded
+// or refused alike, the same mesh, and the hash of the bytes.
+void check_file_read(const uint8_t* data, size_t size, const lod::Status& from_memory, const lod::MeshData& expected) {
+  if (std::string(LOD_FUZZ_EXT) != ".ply" || size == 0) return;
+  static const std::string path = "/tmp/lod-fuzz-" + std::to_string(::getpid()) + ".ply";
+  static const struct Gone {
+    ~Gone() { std::remove(path.c_str()); }  // at exit
+  } gone;
+  FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f || std::fwrite(data, 1, size, f) != size) std::abort();
+  std::fclose(f);
+  lod::MeshData mesh;
+  uint64_t hash = 0;
+  const lod::Status s = lod::load_mesh_hashed(path, mesh, hash);
+  if (s.ok != from_memory.ok) {
+    std::fprintf(stderr, "file read %s, memory read %s: %s | %s\n", s.ok ? "loads" : "refuses",
+                 from_memory.ok ? "loads" : "refuses", s.message.c_str(), from_memory.message.c_str());
+    std::abort();
+  }
+  if (!s.ok) {
+    if (s.message.find(path) == std::string::npos) std::abort();
+    return;
+  }
+  lod::BytesHasher h;
+  h.add(data, size);
+  if (hash != h.finish() || mesh.positions != expected.positions || mesh.indices != expected.indices) std::abort();
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   lod::MeshData mesh;
   const lod::Status s = lod::load_mesh_from_memory("fuzz-input", LOD_FUZZ_EXT, data, size, mesh);
+  check_file_read(data, size, s, mesh);
   if (!s.ok) {
     if (s.message.find("fuzz-input") == std::string::npos) {
       std::fprintf(stderr, "refusal does not name the input: %s\n", s.message.c_str());

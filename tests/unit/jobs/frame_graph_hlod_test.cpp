@@ -69,8 +69,12 @@ void run_flight(uint64_t budget, bool expect_fit) {
     EXPECT_LE(f.resident_bytes, f.stream_budget);
     EXPECT_EQ(f.stream_budget, 64ull << 20);
     const uint64_t left = budget > discrete ? budget - discrete : 0;
-    if (!f.over_budget) EXPECT_LE(f.hlod_tris, left) << "frame " << n << ": the HLOD cut gets what M leaves";
-    if (expect_fit) EXPECT_FALSE(f.over_budget) << "frame " << n;
+    if (!f.over_budget) {
+      EXPECT_LE(f.hlod_tris, left) << "frame " << n << ": the HLOD cut gets what M leaves";
+    }
+    if (expect_fit) {
+      EXPECT_FALSE(f.over_budget) << "frame " << n;
+    }
     for (const HlodDrawFrame& d : f.hlod_drawn) {
       EXPECT_EQ(d.model, 0u);
       EXPECT_LT(d.layer, o.hlod->trees[0].nodes[d.node].layer_count);
@@ -79,7 +83,9 @@ void run_flight(uint64_t budget, bool expect_fit) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));  // a frame's time: the loaders read
   }
   EXPECT_GT(f.stream_loads, 1u);
-  if (expect_fit) EXPECT_GT(most_nodes, 1u) << "the cut refined as the camera came close";
+  if (expect_fit) {
+    EXPECT_GT(most_nodes, 1u) << "the cut refined as the camera came close";
+  }
 }
 
 TEST(FrameGraphHlod, DrawsTheCutWithinWhatTheDiscreteSelectionLeaves) { run_flight(20000000, true); }
