@@ -17,6 +17,7 @@
 #include "jobs/hlod_distributed_bake.h"
 #include "jobs/hlod_mesh_cache.h"
 #include "jobs/hlod_subtree_cache.h"
+#include "preprocess/gltf_io.h"  // gltf_external_files
 #include "preprocess/mesh_io.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/lod_asset.h"  // hash_bytes
@@ -421,6 +422,38 @@ TEST(HlodDistributedBake, OneRankRebakesOnlyTheCorruptedAndMissingEntries) {
   EXPECT_EQ(r.ranks[0].subtrees, 2u);
   EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("baking it again") != std::string::npos; }));
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+}
+
+// The source hash covers a glTF's other files (images, buffers), hashed piece by piece now: the
+// same value as over each file whole, a file of several pieces included, and a missing one
+// adds nothing (the load says it is missing).
+TEST(HlodDistributedBake, SourceHashCoversTheFilesAGltfNamesPieceByPiece) {
+  const auto dir = test::temp_dir("hlod_source_hash_gltf");
+  const auto mesh = test::write_two_material_gltf(dir, "mixed", 8, 16);
+  const std::vector<std::filesystem::path> named = gltf_external_files(mesh);
+  ASSERT_FALSE(named.empty()) << "the fixture's images and buffer are files of their own";
+  const std::filesystem::path victim = named.back();
+  std::vector<uint8_t> big(size_t(2) << 20 | 12345);
+  std::iota(big.begin(), big.end(), uint8_t(7));
+  test::write_bytes(victim, big);  // bytes only: nothing decodes them here
+  auto expected = [&] {
+    const std::vector<uint8_t> own = test::read_bytes(mesh);
+    uint64_t content = hash_bytes(own.data(), own.size());
+    for (const auto& other : gltf_external_files(mesh)) {
+      const std::vector<uint8_t> more = std::filesystem::exists(other) ? test::read_bytes(other) : std::vector<uint8_t>{};
+      content = hash_bytes(more.data(), more.size(), content);
+    }
+    const uint64_t settings[2] = {kHlodBuildVersion, 150};
+    return hash_bytes(settings, sizeof settings, content);
+  };
+  uint64_t got = 0;
+  ASSERT_TRUE(hlod_source_hash(mesh, 150, got));
+  EXPECT_EQ(got, expected());
+  std::filesystem::remove(victim);
+  const uint64_t before = got;
+  ASSERT_TRUE(hlod_source_hash(mesh, 150, got));
+  EXPECT_EQ(got, expected());
+  EXPECT_NE(got, before) << victim << " is part of the source";
 }
 
 // A textured, two-material sphere (issue 12): the distributed bake writes the local bake's
