@@ -7,8 +7,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <fstream>
-#include <iterator>
 #include <mutex>
 #include <vector>
 
@@ -18,7 +16,6 @@
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
 #include "preprocess/mesh_readers.h"  // read_regular_file
-#include "runtime/bytes_hasher.h"
 #include "runtime/embedded_image.h"
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
@@ -48,16 +45,10 @@ std::vector<EmbeddedImage> kept_embedded_images(std::vector<ChainMaterial>& mate
 }  // namespace
 
 // Content hash of the mesh file's bytes, mixed with what else decides the output.
-Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out,
-                        std::vector<uint8_t>* content_out) {
+Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out) {
   // The mesh readers' own read: a directory, FIFO or device is refused by name, not read.
   uint64_t content = 0;
-  if (content_out) {
-    if (Status s = detail::read_regular_file(file, *content_out); !s) return s;
-    content = hash_bytes(content_out->data(), content_out->size());
-  } else if (Status s = detail::hash_regular_file(file, content); !s) {
-    return s;
-  }
+  if (Status s = detail::hash_regular_file(file, content); !s) return s;
   out = hlod_source_hash_of(file, content, min_verts);
   return Status::success();
 }
@@ -71,14 +62,10 @@ uint64_t hlod_source_hash_of(const std::filesystem::path& file, uint64_t content
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
     for (const auto& named : ext == ".obj" ? obj_external_files(file) : gltf_external_files(file)) {
-      // In 1 MB pieces (a glTF's .bin is the geometry, hundreds of MB on a scan): the same value
-      // as hash_bytes over the whole file; a missing or unreadable one adds nothing.
-      std::ifstream g(named, std::ios::binary);
-      BytesHasher h(content);
-      std::vector<char> piece(size_t(1) << 20);
-      while (g.read(piece.data(), std::streamsize(piece.size())) || g.gcount() > 0)
-        h.add(piece.data(), size_t(g.gcount()));
-      content = h.finish();
+      // In 1 MB pieces (a glTF's .bin is the geometry, hundreds of MB on a scan); a missing,
+      // empty or unreadable one adds nothing (the load says what is wrong with it).
+      if (uint64_t more = 0; detail::hash_regular_file(named, more, content)) content = more;
+      else content = hash_bytes(nullptr, 0, content);
     }
   const uint64_t settings[2] = {kHlodBuildVersion, min_verts};
   return hash_bytes(settings, sizeof settings, content);

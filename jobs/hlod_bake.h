@@ -39,9 +39,8 @@ ParallelFor tbb_parallel_for();
 // The content hash of a mesh file's bytes (and of the files it names: an OBJ's .mtl files and
 // images, a glTF's buffers and images) mixed with min_verts and the build's version: the
 // source_hash of what bake_hlod_file writes, so a cached .hlod with it is current.
-// `content` (optional): the mesh file's bytes as read, for load_mesh to parse without reading again.
-Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out,
-                        std::vector<uint8_t>* content = nullptr);
+// The file is hashed in 1 MB pieces (no copy of it in memory).
+Status hlod_source_hash(const std::filesystem::path& mesh_file, uint32_t min_verts, uint64_t& out);
 // The same from the hash of the mesh file's bytes already taken (load_mesh_hashed's).
 uint64_t hlod_source_hash_of(const std::filesystem::path& mesh_file, uint64_t content_hash, uint32_t min_verts);
 

@@ -252,10 +252,10 @@ RegularFile::~RegularFile() {
   if (fd >= 0) ::close(fd);
 }
 
-size_t RegularFile::read_some(uint8_t* into, size_t n, Status& st, const std::string& what) {
+size_t RegularFile::read_at(uint8_t* into, size_t n, uint64_t offset, Status& st, const std::string& what) const {
   size_t got = 0;
   while (got < n) {
-    const ssize_t r = ::read(fd, into + got, n - got);
+    const ssize_t r = ::pread(fd, into + got, n - got, off_t(offset + got));
     if (r < 0 && errno == EINTR) continue;
     if (r < 0) {
       st = Status::error(what + ": read error (" + std::strerror(errno) + ")");
@@ -271,32 +271,30 @@ Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
   const std::string what = path.string();
   RegularFile f;
   if (Status s = open_regular_file(path, f); !s) return s;
-  struct stat st {};
-  st.st_size = off_t(f.size);
-  if (uint64_t(st.st_size) > std::numeric_limits<size_t>::max() / 2)
-    return Status::error(what + ": is too large (" + std::to_string(st.st_size) + " bytes)");
+  if (f.size > std::numeric_limits<size_t>::max() / 2)
+    return Status::error(what + ": is too large (" + std::to_string(f.size) + " bytes)");
   try {
-    bytes.resize(size_t(st.st_size));
+    bytes.resize(size_t(f.size));
   } catch (const std::bad_alloc&) {
-    return Status::error(what + ": not enough memory to read its " + std::to_string(st.st_size) + " bytes");
+    return Status::error(what + ": not enough memory to read its " + std::to_string(f.size) + " bytes");
   }
   Status read;
-  bytes.resize(f.read_some(bytes.data(), bytes.size(), read, what));
+  bytes.resize(f.read_at(bytes.data(), bytes.size(), 0, read, what));
   if (!read) return read;
   if (bytes.empty()) return Status::error(what + ": file is empty");
   return Status::success();
 }
 
-Status hash_regular_file(const fs::path& path, uint64_t& hash) {
+Status hash_regular_file(const fs::path& path, uint64_t& hash, uint64_t seed) {
   const std::string what = path.string();
   RegularFile f;
   if (Status s = open_regular_file(path, f); !s) return s;
   std::vector<uint8_t> chunk(size_t(1) << 20);  // one small buffer, not the file's size in fresh memory
-  BytesHasher h;
+  BytesHasher h(seed);
   uint64_t total = 0;
   for (;;) {
     Status read;
-    const size_t got = f.read_some(chunk.data(), chunk.size(), read, what);
+    const size_t got = f.read_at(chunk.data(), chunk.size(), total, read, what);
     if (!read) return read;
     h.add(chunk.data(), got);
     total += got;

@@ -102,13 +102,14 @@ struct RegularFile {
     return *this;
   }
   ~RegularFile();
-  // Up to n bytes from the current offset (fewer at the end of the file); a read error sets st.
-  size_t read_some(uint8_t* into, size_t n, Status& st, const std::string& what);
+  // Up to n bytes from `offset` (fewer at the end of the file, or when it shrank); a read error
+  // sets st.
+  size_t read_at(uint8_t* into, size_t n, uint64_t offset, Status& st, const std::string& what) const;
 };
 Status open_regular_file(const std::filesystem::path& path, RegularFile& out);
 
-// The content hash (hash_bytes) of a regular file's bytes, read in 1 MB pieces.
-Status hash_regular_file(const std::filesystem::path& path, uint64_t& hash);
+// The content hash (hash_bytes with `seed`) of a regular file's bytes, read in 1 MB pieces.
+Status hash_regular_file(const std::filesystem::path& path, uint64_t& hash, uint64_t seed = 0);
 
 // The layout scanners write, binary little-endian PLY with a vertex element of float x, y, z
 // alone and a face element of one uchar-counted list of 32-bit indices, every face a triangle:

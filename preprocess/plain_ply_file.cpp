@@ -3,9 +3,6 @@
 // reader must name (a short file, a non-finite coordinate, a face that is not a triangle),
 // falls back to reading the file whole: this path only ever accepts what read_ply accepts, the
 // same way.
-#include <unistd.h>
-
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -22,15 +19,10 @@ struct PlainLayout {
   bool signed_indices = false;
 };
 
-bool read_at(int fd, uint8_t* into, size_t n, uint64_t offset) {
-  size_t got = 0;
-  while (got < n) {
-    const ssize_t r = ::pread(fd, into + got, n - got, off_t(offset + got));
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) return false;
-    got += size_t(r);
-  }
-  return true;
+// The whole of n bytes at `offset`, or false (a short file: the general reader names it).
+bool read_at(const RegularFile& f, uint8_t* into, size_t n, uint64_t offset) {
+  Status st;
+  return f.read_at(into, n, offset, st, "") == n && st;
 }
 
 bool count_of(std::string_view word, uint64_t& out) {
@@ -77,7 +69,7 @@ bool fits(const PlainLayout& l, uint64_t size) {
   return l.vertices <= left / 12 && l.faces <= (left - 12 * l.vertices) / 13;
 }
 
-bool read_positions(int fd, const PlainLayout& l, RawPolygons& raw, BytesHasher& h) {
+bool read_positions(const RegularFile& fd, const PlainLayout& l, RawPolygons& raw, BytesHasher& h) {
   raw.positions.resize(size_t(3 * l.vertices));
   uint8_t* bytes = reinterpret_cast<uint8_t*>(raw.positions.data());
   if (!read_at(fd, bytes, size_t(12 * l.vertices), l.header)) return false;
@@ -87,7 +79,7 @@ bool read_positions(int fd, const PlainLayout& l, RawPolygons& raw, BytesHasher&
   return true;
 }
 
-bool read_triangles(int fd, const PlainLayout& l, RawPolygons& raw, BytesHasher& h) {
+bool read_triangles(const RegularFile& fd, const PlainLayout& l, RawPolygons& raw, BytesHasher& h) {
   raw.triangles.resize(size_t(3 * l.faces));
   constexpr size_t kRows = 80000;  // ~1 MB of rows at a time
   std::vector<uint8_t> chunk(13 * kRows);
@@ -108,15 +100,15 @@ bool read_triangles(int fd, const PlainLayout& l, RawPolygons& raw, BytesHasher&
 }
 
 // What follows the faces (other elements, or nothing) is part of the content too.
-bool hash_tail(int fd, uint64_t from, BytesHasher& h) {
+bool hash_tail(const RegularFile& f, uint64_t from, BytesHasher& h) {
   std::vector<uint8_t> chunk(size_t(1) << 20);
   for (;;) {
-    ssize_t r = ::pread(fd, chunk.data(), chunk.size(), off_t(from));
-    if (r < 0 && errno == EINTR) continue;
-    if (r < 0) return false;
-    if (r == 0) return true;
-    h.add(chunk.data(), size_t(r));
-    from += uint64_t(r);
+    Status st;
+    const size_t got = f.read_at(chunk.data(), chunk.size(), from, st, "");
+    if (!st) return false;
+    h.add(chunk.data(), got);
+    from += got;
+    if (got < chunk.size()) return true;
   }
 }
 
@@ -128,15 +120,15 @@ Status read_plain_ply_file(const std::filesystem::path& path, RawPolygons& raw, 
   if (Status s = open_regular_file(path, f); !s) return s;
   std::vector<uint8_t> head(size_t(std::min<uint64_t>(f.size, 65536)));
   PlainLayout l;
-  if (!read_at(f.fd, head.data(), head.size(), 0) ||
+  if (!read_at(f, head.data(), head.size(), 0) ||
       !plain_header(std::string_view(reinterpret_cast<const char*>(head.data()), head.size()), l) || !fits(l, f.size))
     return Status::success();
   BytesHasher h;
   h.add(head.data(), size_t(l.header));
   RawPolygons mine;
   try {
-    if (!read_positions(f.fd, l, mine, h) || !read_triangles(f.fd, l, mine, h) ||
-        !hash_tail(f.fd, l.header + 12 * l.vertices + 13 * l.faces, h))
+    if (!read_positions(f, l, mine, h) || !read_triangles(f, l, mine, h) ||
+        !hash_tail(f, l.header + 12 * l.vertices + 13 * l.faces, h))
       return Status::success();
   } catch (const std::bad_alloc&) {
     return Status::error(path.string() + ": not enough memory to load it (" + std::to_string(f.size) + " bytes)");

@@ -95,12 +95,13 @@ TEST(PlainPlyFile, TheScannersLayoutIsStreamedIntoTheSameMeshAndHash) {
   const std::pair<const char*, PlyParts> cases[] = {{"big.ply", big}, {"tail.ply", unsigned_tail}};
   for (const auto& [name, parts] : cases) {
     test::write_bytes(dir / name, ply_bytes(parts));
-    if (std::string(name) == "big.ply") EXPECT_TRUE(streamed(dir / name)) << name;
+    if (std::string(name) == "big.ply") {
+      EXPECT_TRUE(streamed(dir / name)) << name;
+    }
     expect_same_as_load_mesh(dir / name);
   }
   // A trailing element is not the scanners' layout: read whole, the same either way.
   EXPECT_FALSE(streamed(dir / "tail.ply"));
-  test::write_bytes(dir / "save.ply", {});
   const PlyParts g = grid(5);
   std::vector<uint32_t> idx;
   for (const auto& f : g.faces) idx.insert(idx.end(), f.begin(), f.end());
