@@ -2,8 +2,9 @@
 //
 //   every rank   sees the probe files rank 0 made in the cache and output folders, or the job
 //                stops before any work (check_shared_folders)
-//   every rank   load the mesh from the shared path, plan the split (the same on every rank),
-//                check its share of the cache's entries in full
+//   every rank   load the mesh from the shared path (where the ranks of a node share memory,
+//                the node's first loads it once for all: HlodRankComm::node_buffer), plan the
+//                split (the same on every rank), check its share of the cache's entries in full
 //   gather       which entries were found -> rank 0 broadcasts which are missing
 //   every rank   bake its share of the missing ones (spatially contiguous runs balanced by
 //                cost), each result stored in the cache as it is finished; queries against
@@ -20,12 +21,14 @@
 //   gather       per rank: its write's status -> rank 0 renames the file into place
 //
 // The communication is two collectives (HlodRankComm), so that lodkit's libraries never link
-// MPI: lod-bake-mpi gives MPI_Bcast and MPI_Gatherv; tests may give threads or nothing.
+// MPI: lod-bake-mpi gives MPI_Bcast and MPI_Gatherv (and a node's shared memory); tests may
+// give threads or nothing.
 #pragma once
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,6 +44,19 @@ struct HlodRankComm {
   std::function<void(std::vector<uint8_t>& bytes)> broadcast;
   // Every rank calls it; rank 0 gets every rank's bytes (by rank), the others nothing.
   std::function<std::vector<std::vector<uint8_t>>(const std::vector<uint8_t>& mine)> gather;
+  // Optional (null: every rank loads its own copy of the mesh). The ranks on this one's node,
+  // which share memory: how many, and whether this is their first (it loads for all of them).
+  int node_size = 1;
+  bool node_first = true;
+  // Every rank of the node calls it, as often: waits until all have, without spinning (a
+  // waiting rank's core is another's).
+  std::function<void()> node_barrier;
+  // Every rank of the node calls it, as often: the first passes the bytes it needs, the
+  // others 0; each gets the first's buffer (for the first to write, then the node to read),
+  // kept until node_release.
+  std::function<std::span<uint8_t>(uint64_t bytes)> node_buffer;
+  // Every rank of the node calls it, as often: frees the buffers node_buffer gave.
+  std::function<void()> node_release;
 };
 
 // One rank, no communication: the distributed bake run in one process.
@@ -103,6 +119,7 @@ struct HlodRankWork {
   uint64_t bytes_read_back = 0;    // of entries it did not hold (held_entry_bytes), read back to write them
   uint64_t region_triangles = 0;   // in its region's BVH (the original's triangles near its cells)
   uint32_t whole_surface = 0;      // 1: it needed the whole original's BVH too
+  uint32_t mesh_loaded = 0;        // 1: it loaded the mesh (its own copy, or its node's for all)
   // The process over its whole run so far (getrusage, at its last report): CPU time in the kernel
   // (mostly first touches of fresh memory: on a VM whose host takes free pages back, each is a
   // host fault too) and the peak resident memory.
@@ -115,6 +132,7 @@ struct HlodDistributedResult {
   uint64_t bytes = 0;
   size_t input_triangles = 0;
   bool mesh_cached = false;    // the cleaned mesh came from the cache (a run before stored it)
+  bool mesh_shared = false;    // one copy on rank 0's node, which its first rank loaded for all
   size_t subtrees = 0, cached = 0, rebaked = 0;  // rebaked: refused at assembly, baked again on rank 0
   std::vector<HlodRankWork> ranks;                // rank 0: every rank's work
   uint64_t entry_bytes_read = 0;                  // rank 0: of the entries, to take up their roots

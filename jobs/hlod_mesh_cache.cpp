@@ -107,35 +107,161 @@ std::span<const uint8_t> le_words(const std::vector<T>& v, std::vector<std::vect
 
 }  // namespace
 
-Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const MeshData& mesh,
-                       uint64_t input_triangles, const HlodSurfaces& surfaces) {
+HlodMeshEntry hlod_mesh_entry(uint64_t source_hash, const MeshData& mesh, uint64_t input_triangles,
+                              const HlodSurfaces& surfaces) {
   const size_t nv = mesh.vertex_count();
   const Columns has{mesh.uvs.size() == 2 * nv && nv > 0, mesh.uvs1.size() == 2 * nv && nv > 0,
                     mesh.colors.size() == 4 * nv && nv > 0};
   LodChain chain;
   chain.materials = surfaces.materials;
   chain.texture_base = surfaces.texture_base;
-  const std::vector<uint8_t> materials =
-      surfaces.materials.empty() ? std::vector<uint8_t>() : encode_material_section(chain);
-  const std::vector<uint8_t> images =
-      surfaces.images.empty() ? std::vector<uint8_t>() : encode_image_section(surfaces.images);
-  const std::vector<uint8_t> head =
-      entry_head(source_hash, input_triangles, mesh, has, materials.size(), images.size());
-  const std::vector<uint8_t> rows = submesh_rows(mesh);
-  std::vector<std::vector<uint8_t>> copies;
-  std::vector<std::span<const uint8_t>> parts{head, le_words(mesh.positions, copies),
-                                              le_words(mesh.indices, copies)};
-  if (has.uvs) parts.push_back(le_words(mesh.uvs, copies));
-  if (has.uvs1) parts.push_back(le_words(mesh.uvs1, copies));
-  if (has.colors) parts.push_back(le_words(mesh.colors, copies));
-  parts.insert(parts.end(), {rows, materials, images});
+  HlodMeshEntry e;
+  std::vector<std::vector<uint8_t>>& own = e.owned;
+  own.reserve(12);  // the parts point into them: never reallocated (at most 10)
+  const std::vector<uint8_t>& materials =
+      own.emplace_back(surfaces.materials.empty() ? std::vector<uint8_t>() : encode_material_section(chain));
+  const std::vector<uint8_t>& images =
+      own.emplace_back(surfaces.images.empty() ? std::vector<uint8_t>() : encode_image_section(surfaces.images));
+  const std::vector<uint8_t>& head =
+      own.emplace_back(entry_head(source_hash, input_triangles, mesh, has, materials.size(), images.size()));
+  const std::vector<uint8_t>& rows = own.emplace_back(submesh_rows(mesh));
+  e.parts = {head, le_words(mesh.positions, own), le_words(mesh.indices, own)};
+  if (has.uvs) e.parts.push_back(le_words(mesh.uvs, own));
+  if (has.uvs1) e.parts.push_back(le_words(mesh.uvs1, own));
+  if (has.colors) e.parts.push_back(le_words(mesh.colors, own));
+  e.parts.insert(e.parts.end(), {rows, materials, images});
   BytesHasher hash;
-  for (std::span<const uint8_t> part : parts) hash.add(part.data(), part.size());
+  for (std::span<const uint8_t> part : e.parts) hash.add(part.data(), part.size());
   detail::ByteWriter checksum;
   checksum.u64(hash.finish());
-  parts.push_back(checksum.bytes);
-  return write_file_atomic(hlod_mesh_entry_path(dir, source_hash), parts);
+  e.parts.push_back(own.emplace_back(std::move(checksum.bytes)));
+  return e;
 }
+
+uint64_t HlodMeshEntry::size() const {
+  uint64_t n = 0;
+  for (std::span<const uint8_t> part : parts) n += part.size();
+  return n;
+}
+
+void HlodMeshEntry::copy_to(uint8_t* out) const {
+  for (std::span<const uint8_t> part : parts) out = std::copy(part.begin(), part.end(), out);
+}
+
+Status store_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash, const MeshData& mesh,
+                       uint64_t input_triangles, const HlodSurfaces& surfaces) {
+  const HlodMeshEntry e = hlod_mesh_entry(source_hash, mesh, input_triangles, surfaces);
+  return write_file_atomic(hlod_mesh_entry_path(dir, source_hash), e.parts);
+}
+
+Status store_hlod_mesh_bytes(const std::filesystem::path& dir, uint64_t source_hash, std::span<const uint8_t> entry) {
+  return write_file_atomic(hlod_mesh_entry_path(dir, source_hash), entry);
+}
+
+namespace {
+
+// Where an entry's columns lie, from its head; counts checked against its size.
+struct EntryLayout {
+  uint32_t flags = 0;
+  uint64_t vertices = 0, indices = 0, submeshes = 0, material_bytes = 0, image_bytes = 0, input_triangles = 0;
+  size_t positions = 0, index_words = 0, uvs = 0, uvs1 = 0, colors = 0, rows = 0, materials = 0, images = 0;
+};
+
+std::string read_layout(std::span<const uint8_t> b, uint64_t source_hash, bool check, EntryLayout& l) {
+  if (b.size() < kFixedBytes + 8) return "too short for a cleaned mesh entry (truncated?)";
+  if (std::memcmp(b.data(), kMagic, 8) != 0) return "not a cleaned mesh entry (bad magic bytes)";
+  if (detail::load_u32(b.data() + 8) != kHlodMeshEntryVersion) return "entry version is not supported";
+  l.flags = detail::load_u32(b.data() + 12);
+  l.input_triangles = detail::load_u64(b.data() + 24);
+  l.vertices = detail::load_u64(b.data() + 32), l.indices = detail::load_u64(b.data() + 40);
+  l.submeshes = detail::load_u64(b.data() + 48), l.material_bytes = detail::load_u64(b.data() + 56);
+  l.image_bytes = detail::load_u64(b.data() + 64);
+  if ((l.flags & ~(kFlagUvs | kFlagColors | kFlagUvs1)) != 0) return "unknown flags " + std::to_string(l.flags);
+  const uint64_t per_vertex =
+      12 + ((l.flags & kFlagUvs) ? 8 : 0) + ((l.flags & kFlagUvs1) ? 8 : 0) + ((l.flags & kFlagColors) ? 16 : 0);
+  // Counts against the size before anything is allocated (each bounded first, so the sum cannot overflow).
+  if (l.vertices >= UINT32_MAX || l.indices % 3 != 0 || l.indices > b.size() / 4 || l.submeshes > b.size() / 12 ||
+      l.material_bytes > b.size() || l.image_bytes > b.size() ||
+      b.size() != kFixedBytes + per_vertex * l.vertices + 4 * l.indices + 12 * l.submeshes + l.material_bytes +
+                      l.image_bytes + 8)
+    return "its counts (" + std::to_string(l.vertices) + " vertices, " + std::to_string(l.indices) + " indices, " +
+           std::to_string(l.submeshes) + " submeshes, " + std::to_string(l.material_bytes) + " bytes of materials, " +
+           std::to_string(l.image_bytes) + " of images) do not match its " + std::to_string(b.size()) +
+           " bytes (truncated?)";
+  const size_t body = b.size() - 8;
+  if (check && detail::load_u64(b.data() + body) != hash_bytes(b.data(), body)) return "checksum mismatch (corrupted)";
+  if (detail::load_u64(b.data() + 16) != source_hash) return "written for another source (a misplaced entry)";
+  size_t at = kFixedBytes;
+  auto column = [&](size_t& where, uint64_t bytes) { where = at, at += size_t(bytes); };
+  column(l.positions, 12 * l.vertices);
+  column(l.index_words, 4 * l.indices);
+  column(l.uvs, (l.flags & kFlagUvs) ? 8 * l.vertices : 0);
+  column(l.uvs1, (l.flags & kFlagUvs1) ? 8 * l.vertices : 0);
+  column(l.colors, (l.flags & kFlagColors) ? 16 * l.vertices : 0);
+  column(l.rows, 12 * l.submeshes);
+  column(l.materials, l.material_bytes);
+  column(l.images, l.image_bytes);
+  return {};
+}
+
+// The small parts: submesh runs (in order inside the triangles, each naming a stored material
+// or the default), the materials and the images they embed.
+std::string read_surfaces(std::span<const uint8_t> b, const EntryLayout& l, std::vector<Submesh>& submeshes,
+                          HlodSurfaces* surfaces) {
+  submeshes.resize(size_t(l.submeshes));
+  const uint8_t* p = b.data() + l.rows;
+  for (Submesh& sm : submeshes) {
+    sm.first_triangle = detail::load_u32(p);
+    sm.triangle_count = detail::load_u32(p + 4);
+    sm.material = int32_t(detail::load_u32(p + 8));
+    p += 12;
+  }
+  LodChain chain;  // images first: the materials' embedded:<k> are checked against them
+  if (l.image_bytes > 0 && l.material_bytes == 0) return "it has images but no materials";
+  if (l.image_bytes > 0)
+    if (Status s = decode_image_section({b.data() + l.images, size_t(l.image_bytes)}, "images", chain.images); !s)
+      return s.message;
+  if (l.material_bytes > 0)
+    if (Status s = decode_material_section({b.data() + l.materials, size_t(l.material_bytes)}, "materials", chain); !s)
+      return s.message;
+  // The writer stores the section only with materials: one without (its texture base and
+  // images lost on the next store) is not one it wrote.
+  if (l.material_bytes > 0 && chain.materials.empty()) return "its materials section holds no materials";
+  uint64_t covered = 0;
+  const uint64_t triangles = l.indices / 3;
+  for (const Submesh& sm : submeshes) {
+    if (sm.first_triangle < covered || sm.first_triangle > triangles || sm.triangle_count > triangles - sm.first_triangle ||
+        sm.material < -1 || (sm.material >= 0 && size_t(sm.material) >= chain.materials.size()))
+      return "submesh at triangle " + std::to_string(sm.first_triangle) + " (" + std::to_string(sm.triangle_count) +
+             " triangles, material " + std::to_string(sm.material) +
+             ") does not continue the runs before it or names a material of the " +
+             std::to_string(chain.materials.size());
+    covered = uint64_t(sm.first_triangle) + sm.triangle_count;
+  }
+  if (surfaces) {
+    surfaces->materials = std::move(chain.materials);
+    surfaces->texture_base = std::move(chain.texture_base);
+    surfaces->images = std::move(chain.images);
+  }
+  return {};
+}
+
+std::string check_values(const MeshView& m) {
+  const size_t vertices = m.vertex_count();
+  for (uint32_t i : m.indices)
+    if (i >= vertices) return "an index names vertex " + std::to_string(i) + " of " + std::to_string(vertices);
+  for (float v : m.positions)
+    if (!std::isfinite(v)) return "a position is not finite";
+  for (float v : m.uvs)
+    if (!std::isfinite(v)) return "a texture coordinate is not finite";
+  for (float v : m.uvs1)
+    if (!std::isfinite(v)) return "a TEXCOORD_1 value is not finite";
+  for (float v : m.colors)
+    if (!std::isfinite(v)) return "a colour is not finite";
+  return {};
+}
+
+}  // namespace
 
 CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_hash,
                            const std::string& source_name, MeshData& out, uint64_t& input_triangles,
@@ -149,101 +275,59 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
   };
   std::vector<uint8_t> b;
   if (!read_whole(path, b)) return refuse("cannot be read (not a regular file?)");
-  if (b.size() < kFixedBytes + 8) return refuse("too short for a cleaned mesh entry (truncated?)");
-  if (std::memcmp(b.data(), kMagic, 8) != 0) return refuse("not a cleaned mesh entry (bad magic bytes)");
-  if (detail::load_u32(b.data() + 8) != kHlodMeshEntryVersion)
-    return refuse("entry version is not supported");
-  const uint32_t flags = detail::load_u32(b.data() + 12);
-  const uint64_t vertices = detail::load_u64(b.data() + 32), indices = detail::load_u64(b.data() + 40);
-  const uint64_t submeshes = detail::load_u64(b.data() + 48),
-                 material_bytes = detail::load_u64(b.data() + 56);
-  const uint64_t image_bytes = detail::load_u64(b.data() + 64);
-  if ((flags & ~(kFlagUvs | kFlagColors | kFlagUvs1)) != 0)
-    return refuse("unknown flags " + std::to_string(flags));
-  const uint64_t per_vertex =
-      12 + ((flags & kFlagUvs) ? 8 : 0) + ((flags & kFlagUvs1) ? 8 : 0) + ((flags & kFlagColors) ? 16 : 0);
-  // Counts against the size before anything is allocated (each bounded first, so the sum cannot overflow).
-  if (vertices >= UINT32_MAX || indices % 3 != 0 || indices > b.size() / 4 || submeshes > b.size() / 12 ||
-      material_bytes > b.size() || image_bytes > b.size() ||
-      b.size() != kFixedBytes + per_vertex * vertices + 4 * indices + 12 * submeshes + material_bytes +
-                      image_bytes + 8)
-    return refuse("its counts (" + std::to_string(vertices) + " vertices, " + std::to_string(indices) +
-                  " indices, " + std::to_string(submeshes) + " submeshes, " + std::to_string(material_bytes) +
-                  " bytes of materials, " + std::to_string(image_bytes) + " of images) do not match its " +
-                  std::to_string(b.size()) + " bytes (truncated?)");
-  const size_t body = b.size() - 8;
-  if (detail::load_u64(b.data() + body) != hash_bytes(b.data(), body))
-    return refuse("checksum mismatch (corrupted)");
-  if (detail::load_u64(b.data() + 16) != source_hash)
-    return refuse("written for another source (a misplaced entry)");
+  EntryLayout l;
+  if (std::string bad = read_layout(b, source_hash, true, l); !bad.empty()) return refuse(bad);
   MeshData m;
   m.source = source_name;
-  m.positions.resize(size_t(3 * vertices));
-  m.indices.resize(size_t(indices));
-  const uint8_t* p = b.data() + kFixedBytes;
-  for (float& v : m.positions) v = detail::load_f32(p), p += 4;
-  for (uint32_t& i : m.indices) i = detail::load_u32(p), p += 4;
-  auto column = [&](uint32_t flag, size_t per, std::vector<float>& into) {
-    if (!(flags & flag)) return;
-    into.resize(size_t(per * vertices));
+  auto column = [&](size_t at, uint64_t count, std::vector<float>& into) {
+    into.resize(size_t(count));
+    const uint8_t* p = b.data() + at;
     for (float& v : into) v = detail::load_f32(p), p += 4;
   };
-  column(kFlagUvs, 2, m.uvs);
-  column(kFlagUvs1, 2, m.uvs1);
-  column(kFlagColors, 4, m.colors);
-  m.submeshes.resize(size_t(submeshes));
-  for (Submesh& sm : m.submeshes) {
-    sm.first_triangle = detail::load_u32(p);
-    sm.triangle_count = detail::load_u32(p + 4);
-    sm.material = int32_t(detail::load_u32(p + 8));
-    p += 12;
-  }
-  LodChain chain;  // images first: the materials' embedded:<k> are checked against them
-  if (image_bytes > 0 && material_bytes == 0) return refuse("it has images but no materials");
-  if (image_bytes > 0)
-    if (Status s = decode_image_section({p + material_bytes, size_t(image_bytes)}, "images", chain.images);
-        !s)
-      return refuse(s.message);
-  if (material_bytes > 0)
-    if (Status s = decode_material_section({p, size_t(material_bytes)}, "materials", chain); !s)
-      return refuse(s.message);
-  // The writer stores the section only with materials: one without (its texture base and
-  // images lost on the next store) is not one it wrote.
-  if (material_bytes > 0 && chain.materials.empty())
-    return refuse("its materials section holds no materials");
-  for (uint32_t i : m.indices)
-    if (i >= vertices)
-      return refuse("an index names vertex " + std::to_string(i) + " of " + std::to_string(vertices));
-  for (float v : m.positions)
-    if (!std::isfinite(v)) return refuse("a position is not finite");
-  for (float v : m.uvs)
-    if (!std::isfinite(v)) return refuse("a texture coordinate is not finite");
-  for (float v : m.uvs1)
-    if (!std::isfinite(v)) return refuse("a TEXCOORD_1 value is not finite");
-  for (float v : m.colors)
-    if (!std::isfinite(v)) return refuse("a colour is not finite");
-  // Submeshes in order inside the triangles, each naming a stored material (or the default).
-  uint64_t covered = 0;
-  for (const Submesh& sm : m.submeshes) {
-    if (sm.first_triangle < covered || sm.first_triangle > indices / 3 ||
-        sm.triangle_count > indices / 3 - sm.first_triangle || sm.material < -1 ||
-        (sm.material >= 0 && size_t(sm.material) >= chain.materials.size()))
-      return refuse("submesh at triangle " + std::to_string(sm.first_triangle) + " (" +
-                    std::to_string(sm.triangle_count) + " triangles, material " +
-                    std::to_string(sm.material) +
-                    ") does not continue the runs before it or "
-                    "names a material of the " +
-                    std::to_string(chain.materials.size()));
-    covered = uint64_t(sm.first_triangle) + sm.triangle_count;
-  }
-  if (surfaces) {
-    surfaces->materials = std::move(chain.materials);
-    surfaces->texture_base = std::move(chain.texture_base);
-    surfaces->images = std::move(chain.images);
-  }
-  input_triangles = detail::load_u64(b.data() + 24);
+  column(l.positions, 3 * l.vertices, m.positions);
+  m.indices.resize(size_t(l.indices));
+  const uint8_t* p = b.data() + l.index_words;
+  for (uint32_t& i : m.indices) i = detail::load_u32(p), p += 4;
+  if (l.flags & kFlagUvs) column(l.uvs, 2 * l.vertices, m.uvs);
+  if (l.flags & kFlagUvs1) column(l.uvs1, 2 * l.vertices, m.uvs1);
+  if (l.flags & kFlagColors) column(l.colors, 4 * l.vertices, m.colors);
+  HlodSurfaces read;
+  if (std::string bad = read_surfaces(b, l, m.submeshes, &read); !bad.empty()) return refuse(bad);
+  if (std::string bad = check_values(m); !bad.empty()) return refuse(bad);
+  if (surfaces) *surfaces = std::move(read);
+  input_triangles = l.input_triangles;
   out = std::move(m);
   return CacheLookup::found;
+}
+
+Status view_hlod_mesh(std::span<const uint8_t> entry, uint64_t source_hash, std::string_view source_name, bool check,
+                      HlodMeshInPlace& out) {
+  if constexpr (std::endian::native != std::endian::little)
+    return Status::error(std::string(source_name) + ": a cleaned mesh is viewed in place on little-endian hosts only");
+  auto refuse = [&](const std::string& reason) {
+    return Status::error(std::string(source_name) + ": the cleaned mesh " + reason);
+  };
+  if (reinterpret_cast<uintptr_t>(entry.data()) % alignof(float) != 0) return refuse("is not aligned for its arrays");
+  EntryLayout l;
+  if (std::string bad = read_layout(entry, source_hash, check, l); !bad.empty()) return refuse(bad);
+  HlodMeshInPlace v;
+  auto floats = [&](size_t at, uint64_t count) {
+    return std::span<const float>(reinterpret_cast<const float*>(entry.data() + at), size_t(count));
+  };
+  v.mesh.source = source_name;
+  v.mesh.positions = floats(l.positions, 3 * l.vertices);
+  v.mesh.indices = {reinterpret_cast<const uint32_t*>(entry.data() + l.index_words), size_t(l.indices)};
+  if (l.flags & kFlagUvs) v.mesh.uvs = floats(l.uvs, 2 * l.vertices);
+  if (l.flags & kFlagUvs1) v.mesh.uvs1 = floats(l.uvs1, 2 * l.vertices);
+  if (l.flags & kFlagColors) v.mesh.colors = floats(l.colors, 4 * l.vertices);
+  if (std::string bad = read_surfaces(entry, l, v.submeshes, &v.surfaces); !bad.empty()) return refuse(bad);
+  v.mesh.submeshes = v.submeshes;
+  if (check)
+    if (std::string bad = check_values(v.mesh); !bad.empty()) return refuse(bad);
+  v.input_triangles = l.input_triangles;
+  out = std::move(v);
+  out.mesh.submeshes = out.submeshes;  // the moved vector keeps its buffer; pointed to again for clarity
+  return Status::success();
 }
 
 }  // namespace lod

@@ -85,7 +85,7 @@ struct Attributes {
   bool has(size_t at) const { return at != kNone; }
 };
 
-Attributes attribute_layout(const MeshData& mesh) {
+Attributes attribute_layout(const MeshView& mesh) {
   Attributes a;
   if (!mesh.uvs.empty()) a.uv = a.count, a.count += 2;
   if (!mesh.uvs1.empty()) a.uv1 = a.count, a.count += 2;
@@ -781,8 +781,8 @@ void splice(Context& c, BuildNode& root, const std::vector<HlodSubtree>& baked, 
 }
 
 
-Status check_input(const MeshData& mesh) {
-  const std::string what = mesh.source.empty() ? std::string("mesh") : mesh.source;
+Status check_input(const MeshView& mesh) {
+  const std::string what = mesh.source.empty() ? std::string("mesh") : std::string(mesh.source);
   if (mesh.vertex_count() >= UINT32_MAX) return Status::error(what + ": more than 2^32 - 1 vertices");
   if (mesh.indices.size() % 3 != 0) return Status::error(what + ": index count is not a multiple of 3");
   for (size_t i = 0; i < mesh.positions.size(); ++i)
@@ -814,7 +814,7 @@ Status check_input(const MeshData& mesh) {
 }
 
 // The root cell: the cube around the used vertices' box.
-void root_cell(const MeshData& mesh, const std::vector<uint32_t>& triangles, BuildNode& root) {
+void root_cell(const MeshView& mesh, const std::vector<uint32_t>& triangles, BuildNode& root) {
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (uint32_t t : triangles)
     for (int k = 0; k < 3; ++k) {
@@ -982,7 +982,7 @@ void want_box(const SurfaceGrid& g, const float* lo, const float* hi, std::vecto
 }  // namespace
 
 struct HlodBuilder::Impl {
-  const MeshData& mesh;
+  const MeshView mesh;
   std::string what;
   HlodBuildOptions options;  // a copy: Context keeps a reference, callers pass temporaries
   Context c;
@@ -1002,8 +1002,8 @@ struct HlodBuilder::Impl {
   Status region_status;
   Tally top_tally;
 
-  Impl(const MeshData& m, const HlodBuildOptions& o)
-      : mesh(m), what(m.source.empty() ? std::string("mesh") : m.source), options(o), c(options) {}
+  Impl(const MeshView& m, const HlodBuildOptions& o)
+      : mesh(m), what(m.source.empty() ? std::string("mesh") : std::string(m.source)), options(o), c(options) {}
 
   TriangleMeshView original() const {
     return {mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size()};
@@ -1034,7 +1034,7 @@ struct HlodBuilder::Impl {
   void build_top(BuildNode& n);
 };
 
-HlodBuilder::HlodBuilder(const MeshData& mesh, const HlodBuildOptions& options)
+HlodBuilder::HlodBuilder(const MeshView& mesh, const HlodBuildOptions& options)
     : impl_(std::make_unique<Impl>(mesh, options)) {}
 HlodBuilder::~HlodBuilder() = default;
 
@@ -1079,7 +1079,7 @@ void HlodBuilder::Impl::ensure_region() {
 
 Status HlodBuilder::plan() {
   Impl& m = *impl_;
-  const MeshData& mesh = m.mesh;
+  const MeshView& mesh = m.mesh;
   if (m.planned) return Status::error(m.what + ": HLOD build planned twice");
   if (Status s = check_input(mesh); !s) return s;
   if (m.options.surfaces.materials.size() > kMaxMaterials)
@@ -1106,7 +1106,7 @@ Status HlodBuilder::plan() {
     c.attributes = mesh.uvs.data();  // uvs alone: no copy
   } else if (c.layout.count) {
     c.interleaved.resize(c.layout.count * mesh.vertex_count());
-    auto put = [&](size_t at, const std::vector<float>& column, size_t per) {
+    auto put = [&](size_t at, std::span<const float> column, size_t per) {
       if (!c.layout.has(at)) return;
       for (size_t v = 0; v < mesh.vertex_count(); ++v)
         std::copy_n(&column[per * v], per, &c.interleaved[c.layout.count * v + at]);

@@ -148,12 +148,12 @@ struct HlodSubtreeSpec {
   uint32_t spatial = 0;
 };
 
-// The three steps of build_hlod, for a caller that spreads (b) over processes. `mesh` must
-// outlive the builder (the options are copied). Not thread-safe itself; bake_subtrees runs its subtrees
-// through options.parallel_for.
+// The three steps of build_hlod, for a caller that spreads (b) over processes. `mesh`'s arrays
+// (a MeshData's, or memory a node's ranks share) must outlive the builder; the options are
+// copied. Not thread-safe itself; bake_subtrees runs its subtrees through options.parallel_for.
 class HlodBuilder {
  public:
-  HlodBuilder(const MeshData& mesh, const HlodBuildOptions& options);
+  HlodBuilder(const MeshView& mesh, const HlodBuildOptions& options);
   ~HlodBuilder();
   HlodBuilder(const HlodBuilder&) = delete;
   HlodBuilder& operator=(const HlodBuilder&) = delete;

@@ -11,7 +11,7 @@
 
 namespace lod {
 
-std::vector<int32_t> triangle_materials(const MeshData& mesh) {
+std::vector<int32_t> triangle_materials(const MeshView& mesh) {
   std::vector<int32_t> out(mesh.triangle_count(), -1);
   for (const Submesh& s : mesh.submeshes) {
     const size_t end = std::min<size_t>(size_t(s.first_triangle) + s.triangle_count, out.size());
@@ -55,7 +55,7 @@ size_t split_vertices_by_material(MeshData& mesh) {
   return copies.size();
 }
 
-std::vector<int32_t> vertex_materials(const MeshData& mesh) {
+std::vector<int32_t> vertex_materials(const MeshView& mesh) {
   std::vector<int32_t> out(mesh.vertex_count(), -1);
   const std::vector<int32_t> tri = triangle_materials(mesh);
   for (size_t t = 0; t < tri.size(); ++t)

@@ -20,7 +20,7 @@
 namespace lod {
 
 // Material per triangle from mesh.submeshes (-1 where no submesh covers a triangle).
-std::vector<int32_t> triangle_materials(const MeshData& mesh);
+std::vector<int32_t> triangle_materials(const MeshView& mesh);
 
 // Gives every vertex used by triangles of several materials one copy per further material
 // (same position, normal and uv), so afterwards each vertex belongs to one material. Returns
@@ -29,7 +29,7 @@ size_t split_vertices_by_material(MeshData& mesh);
 
 // Material per vertex (-1 for vertices of the default material or unused ones), for a mesh
 // whose vertices each belong to one material (after split_vertices_by_material).
-std::vector<int32_t> vertex_materials(const MeshData& mesh);
+std::vector<int32_t> vertex_materials(const MeshView& mesh);
 
 // Number of distinct materials (-1 included) among the used vertices.
 size_t distinct_materials(const std::vector<int32_t>& vertex_material);

@@ -4,7 +4,9 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -82,6 +84,23 @@ struct MeshData {
   std::vector<EmbeddedImage> images;    // PNG / JPEG bytes the file held itself, named "embedded:<k>" by materials
   std::vector<std::string> warnings;    // what the reader skipped, each naming the element
 
+  size_t vertex_count() const { return positions.size() / 3; }
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// A mesh's arrays held elsewhere (a MeshData, or memory the ranks of a node share): what the
+// builders that only read a mesh take. It does not own them; they must outlive it.
+struct MeshView {
+  std::string_view source;
+  std::span<const float> positions, normals;
+  std::span<const uint32_t> indices;
+  std::span<const float> uvs, uvs1, colors;
+  std::span<const Submesh> submeshes;
+
+  MeshView() = default;
+  MeshView(const MeshData& m)  // NOLINT(google-explicit-constructor): every MeshData is one
+      : source(m.source), positions(m.positions), normals(m.normals), indices(m.indices), uvs(m.uvs),
+        uvs1(m.uvs1), colors(m.colors), submeshes(m.submeshes) {}
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return indices.size() / 3; }
 };

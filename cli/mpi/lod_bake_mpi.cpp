@@ -16,11 +16,17 @@
 #include <mpi.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <memory>
+#include <span>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "cli/huge_page_malloc.h"
 #include "jobs/hlod_distributed_bake.h"
@@ -29,6 +35,58 @@
 namespace {
 
 using namespace lod;
+
+// A node's ranks (MPI_COMM_TYPE_SHARED) and the shared windows made on it, freed (a collective
+// of the node) by node_release, or when the last copy of the comm goes, before MPI_Finalize.
+struct NodeMemory {
+  MPI_Comm node = MPI_COMM_NULL;
+  std::vector<MPI_Win> windows;
+  ~NodeMemory() {
+    for (MPI_Win& w : windows) MPI_Win_free(&w);
+    if (node != MPI_COMM_NULL) MPI_Comm_free(&node);
+  }
+};
+
+// Waits in a nonblocking barrier, sleeping between tests: the waiting rank's core goes to
+// the rank loading for the node, and its CPU time is not a spin.
+void sleeping_barrier(MPI_Comm comm) {
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+  MPI_Request req;
+  MPI_Ibarrier(comm, &req);
+  for (int done = 0;;) {
+    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+    if (done) break;
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+}
+
+void add_node_memory(HlodRankComm& c) {
+  auto m = std::make_shared<NodeMemory>();
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, c.rank, MPI_INFO_NULL, &m->node);
+  int node_rank = 0;
+  MPI_Comm_rank(m->node, &node_rank);
+  MPI_Comm_size(m->node, &c.node_size);
+  c.node_first = node_rank == 0;
+  c.node_barrier = [m] { sleeping_barrier(m->node); };
+  c.node_buffer = [m](uint64_t bytes) -> std::span<uint8_t> {
+    MPI_Win win;
+    void* mine = nullptr;
+    MPI_Win_allocate_shared(MPI_Aint(bytes), 1, MPI_INFO_NULL, m->node, &mine, &win);
+    m->windows.push_back(win);
+    MPI_Aint size = 0;
+    int unit = 0;
+    void* first = nullptr;
+    MPI_Win_shared_query(win, 0, &size, &unit, &first);
+    if (size <= 0 || first == nullptr) return {};
+    return {static_cast<uint8_t*>(first), size_t(size)};
+  };
+  c.node_release = [m] {
+    sleeping_barrier(m->node);  // MPI_Win_free would spin there
+    for (MPI_Win& w : m->windows) MPI_Win_free(&w);
+    m->windows.clear();
+  };
+}
 
 HlodRankComm mpi_comm() {
   HlodRankComm c;
@@ -55,6 +113,7 @@ HlodRankComm mpi_comm() {
       out.emplace_back(all.begin() + offsets[size_t(r)], all.begin() + offsets[size_t(r)] + counts[size_t(r)]);
     return out;
   };
+  add_node_memory(c);
   return c;
 }
 
@@ -79,12 +138,13 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
                         {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed},
                         {"bytes_read_back", w.bytes_read_back},
                         {"region_triangles", w.region_triangles}, {"whole_bvh", w.whole_surface != 0},
+                        {"mesh_loaded", w.mesh_loaded != 0},
                         // The process's whole run: CPU time in the kernel, peak resident memory.
                         {"kernel_cpu_s", w.kernel_cpu_seconds}, {"peak_rss_mb", double(w.peak_rss_bytes) / 1e6}});
     slowest = std::max(slowest, w.bake_cpu_seconds), sum += w.bake_cpu_seconds;
   }
   return {{"file", r.file.string()}, {"bytes", r.bytes}, {"ranks", ranks}, {"input_triangles", r.input_triangles},
-          {"mesh_cached", r.mesh_cached},
+          {"mesh_cached", r.mesh_cached}, {"mesh_shared", r.mesh_shared},
           {"subtrees", r.subtrees}, {"cached", r.cached}, {"rebaked", r.rebaked}, {"nodes", r.report.nodes},
           {"entry_bytes_read", r.entry_bytes_read}, {"load_s", r.load_seconds}, {"plan_s", r.plan_seconds},
           {"lookup_s", r.lookup_seconds}, {"bake_s", r.bake_seconds}, {"assemble_s", r.assemble_seconds},
@@ -179,13 +239,13 @@ int run_models(const std::vector<std::string>& meshes, const std::string& out_di
   return 0;
 }
 
-int run(int argc, char** argv, const HlodRankComm& comm) {
+int run(int argc, char** argv, HlodRankComm comm) {
   CLI::App app{"HLOD bake of one mesh or many over MPI ranks (byte-identical to lod bake --hlod)"};
   std::vector<std::string> meshes;
   std::string out_dir, cache_dir;
   int min_verts = 1000, threads = 0, subtrees = 0;
   uint64_t entry_memory_mb = 0;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, mesh_per_rank = false;
   app.add_option("mesh", meshes, "mesh files, on paths every rank sees (one .hlod each)")->required();
   app.add_option("-o,--out", out_dir, "output directory (rank 0 writes <name>.hlod there)")->required();
   app.add_option("--cache", cache_dir, "subtree cache directory on shared storage")->required();
@@ -195,6 +255,8 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   app.add_option("--entry-memory-mb", entry_memory_mb,
                  "MB of cache entries a rank holds for its write (default 0: each is read back when written)")
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
+  app.add_flag("--mesh-per-rank", mesh_per_rank,
+               "every rank loads its own copy of the mesh (default: one per node, in memory its ranks share)");
   app.add_flag("--json", json, "rank 0 prints a JSON summary");
   app.add_flag("--quiet", quiet, "print nothing but errors");
   try {
@@ -202,6 +264,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
   } catch (const CLI::ParseError& e) {
     return comm.rank == 0 ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 1);
   }
+  if (mesh_per_rank) comm.node_barrier = nullptr, comm.node_buffer = nullptr, comm.node_release = nullptr;
   HlodDistributedSettings settings;
   settings.min_verts = uint32_t(min_verts);
   settings.threads = uint32_t(threads);

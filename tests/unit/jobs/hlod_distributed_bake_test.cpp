@@ -202,8 +202,8 @@ struct RankPaths {
 };
 
 std::vector<RankRun> run_ranks(int ranks, const std::function<RankPaths(int)>& paths_of,
-                               uint64_t held_entry_bytes = uint64_t(1) << 30) {
-  ThreadRanks tr(ranks);
+                               uint64_t held_entry_bytes = uint64_t(1) << 30, int per_node = 1) {
+  ThreadRanks tr(ranks, per_node);
   std::vector<RankRun> runs(static_cast<size_t>(ranks));
   std::vector<std::thread> threads;
   for (int r = 0; r < ranks; ++r)
@@ -221,8 +221,9 @@ std::vector<RankRun> run_ranks(int ranks, const std::function<RankPaths(int)>& p
 }
 
 std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, const std::filesystem::path& out,
-                               const std::filesystem::path& cache, uint64_t held_entry_bytes = uint64_t(1) << 30) {
-  return run_ranks(ranks, [&](int) { return RankPaths{mesh, out, cache}; }, held_entry_bytes);
+                               const std::filesystem::path& cache, uint64_t held_entry_bytes = uint64_t(1) << 30,
+                               int per_node = 1) {
+  return run_ranks(ranks, [&](int) { return RankPaths{mesh, out, cache}; }, held_entry_bytes, per_node);
 }
 
 std::vector<uint8_t> local_bake(const std::filesystem::path& mesh, const std::filesystem::path& out) {
@@ -311,6 +312,61 @@ TEST(HlodDistributedBake, ThreeRanksWriteTheLocalBakesBytesAndARerunBakesNothing
   EXPECT_EQ(runs[0].result.cached, subtrees);
   for (const HlodRankWork& w : runs[0].result.ranks) EXPECT_EQ(w.subtrees, 0u);
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+}
+
+// Ranks on one node share one copy of the cleaned mesh, which the node's first rank loads
+// (HlodRankComm::node_buffer): 4 ranks as 2 nodes of 2 write the local bake's bytes, each
+// node's first rank alone loading; a rerun views the cached mesh the same way.
+TEST(HlodDistributedBake, RanksOfANodeShareOneCopyOfTheMeshAndWriteTheSameBytes) {
+  const auto dir = test::temp_dir("hlod_dist_node");
+  const auto mesh = write_mesh(dir);
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  for (bool rerun : {false, true}) {
+    std::filesystem::remove(dir / "out" / "mixed.hlod");
+    const std::vector<RankRun> runs = run_ranks(4, mesh, dir / "out", dir / "cache", uint64_t(1) << 30, 2);
+    for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << (rerun ? "rerun" : "first run");
+    const HlodDistributedResult& res = runs[0].result;
+    EXPECT_TRUE(res.mesh_shared);
+    EXPECT_EQ(res.mesh_cached, rerun);
+    ASSERT_EQ(res.ranks.size(), 4u);
+    for (size_t r = 0; r < 4; ++r) EXPECT_EQ(res.ranks[r].mesh_loaded, r % 2 == 0 ? 1u : 0u) << "rank " << r;
+  }
+  uint64_t source_hash = 0;
+  ASSERT_TRUE(hlod_source_hash(mesh, 150, source_hash));
+  EXPECT_TRUE(std::filesystem::exists(hlod_mesh_entry_path(dir / "cache", source_hash))) << "stored from the node's copy";
+}
+
+// A textured model's uvs, runs and materials go through the node's copy unchanged.
+TEST(HlodDistributedBake, TexturedModelThroughANodesCopyGivesTheLocalBytes) {
+  const auto dir = test::temp_dir("hlod_dist_node_textured");
+  const auto mesh = test::write_two_material_gltf(dir, "mixed", 48, 96);
+  ASSERT_FALSE(mesh.empty());
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  for (bool rerun : {false, true}) {
+    std::filesystem::remove(dir / "out" / "mixed.hlod");
+    const std::vector<RankRun> runs = run_ranks(3, mesh, dir / "out", dir / "cache", uint64_t(1) << 30, 3);
+    for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+    EXPECT_TRUE(runs[0].result.mesh_shared);
+    EXPECT_EQ(runs[0].result.mesh_cached, rerun);
+    EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local) << (rerun ? "rerun" : "first run");
+  }
+}
+
+// The node's first rank cannot load: it names the file, its node's other rank says its
+// loader failed, rank 0 fails the job naming them, and nothing is written.
+TEST(HlodDistributedBake, ANodesFirstRankThatCannotLoadFailsItsNodeByName) {
+  const auto dir = test::temp_dir("hlod_dist_node_fail");
+  const auto mesh = write_mesh(dir);
+  const auto gone = dir / "gone" / "mixed.ply";
+  const std::vector<RankRun> runs = run_ranks(
+      4, [&](int r) { return RankPaths{r == 2 ? gone : mesh, dir / "out", dir / "cache"}; }, uint64_t(1) << 30, 2);
+  for (size_t r : {0, 2, 3}) EXPECT_FALSE(runs[r].status) << "rank " << r;
+  EXPECT_NE(runs[0].status.message.find("rank 2"), std::string::npos) << runs[0].status.message;
+  EXPECT_NE(runs[2].status.message.find(gone.string()), std::string::npos) << runs[2].status.message;
+  EXPECT_NE(runs[3].status.message.find("this node's first rank could not load it"), std::string::npos)
+      << runs[3].status.message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
 }
 
 // A rank holds its entries' bytes for the write up to held_entry_bytes; the others are read
