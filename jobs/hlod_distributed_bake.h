@@ -57,6 +57,9 @@ struct HlodRankComm {
   std::function<std::span<uint8_t>(uint64_t bytes)> node_buffer;
   // Every rank of the node calls it, as often: frees the buffers node_buffer gave.
   std::function<void()> node_release;
+  // Per rank of the job: 1 where it is its node's first (it loads for its node). The same on
+  // every rank; empty without node_buffer.
+  std::vector<uint8_t> loads_for_node;
 };
 
 // One rank, no communication: the distributed bake run in one process.
@@ -78,6 +81,15 @@ std::vector<int> assign_subtrees(const std::vector<uint64_t>& costs, int ranks);
 // mean plus one subtree, and each rank's cells form a few compact regions (its BVH's region).
 std::vector<int> assign_subtrees_spatially(const std::vector<uint64_t>& costs, const std::vector<size_t>& order,
                                            int ranks);
+// The same with unequal shares: rank r's run ends at cuts[r] of the total cost (fractions,
+// ascending; ranks - 1 of them).
+std::vector<int> assign_subtrees_at_cuts(const std::vector<uint64_t>& costs, const std::vector<size_t>& order,
+                                         const std::vector<double>& cuts);
+
+// The ranks' cuts when some load the mesh for their node (loads[r] = 1; HlodRankComm::loads_for_node):
+// each such rank's share of the bake is smaller by that load's estimated cost, so that every
+// rank's CPU time comes out even. Empty when every rank loads (equal shares).
+std::vector<double> node_loader_cuts(const std::vector<uint8_t>& loads);
 
 // The frontier's default target: 8 per rank, at least 16 (the local bake's). A split refined
 // at the ranks' cuts (HlodBuildOptions::balance_parts) needs no more for an even split.

@@ -864,19 +864,19 @@ void frontier_depth_first(BuildNode& n, std::vector<BuildNode*>& out) {
     if (child) frontier_depth_first(*child, out);
 }
 
-// The frontier nodes inside which a cut between `parts` equal shares of the cost falls (in
-// depth-first order), those holding more than `fine` triangles and not kept whole.
-std::vector<BuildNode*> nodes_at_cuts(const std::vector<BuildNode*>& frontier, uint32_t parts, uint64_t fine,
-                                      const std::vector<const BuildNode*>& kept) {
+// The frontier nodes inside which a cut between the shares falls (in depth-first order; at
+// `cuts`, fractions of the cost), those holding more than `fine` triangles and not kept whole.
+std::vector<BuildNode*> nodes_at_cuts(const std::vector<BuildNode*>& frontier, const std::vector<double>& cuts,
+                                      uint64_t fine, const std::vector<const BuildNode*>& kept) {
   uint64_t total = 0;
   for (const BuildNode* n : frontier) total += n->triangles.size();
   std::vector<BuildNode*> cut;
   uint64_t before = 0;
   for (BuildNode* n : frontier) {
     const uint64_t cost = n->triangles.size();
-    // Is a cut k * total / parts (0 < k < parts) strictly inside (before, before + cost)?
-    const unsigned __int128 k = (unsigned __int128)before * parts / std::max<uint64_t>(1, total) + 1;
-    if (k < parts && k * total < (unsigned __int128)(before + cost) * parts && cost > fine &&
+    // Is a cut strictly inside (before, before + cost)?
+    const auto next = std::upper_bound(cuts.begin(), cuts.end(), double(before) / double(std::max<uint64_t>(1, total)));
+    if (next != cuts.end() && *next * double(total) < double(before + cost) && cost > fine &&
         std::find(kept.begin(), kept.end(), n) == kept.end())
       cut.push_back(n);
     before += cost;
@@ -884,18 +884,26 @@ std::vector<BuildNode*> nodes_at_cuts(const std::vector<BuildNode*>& frontier, u
   return cut;
 }
 
-// Where the frontier's depth-first order is cut into `parts` equal shares (a distributed build's
+// Equal shares' cuts: k / parts.
+std::vector<double> equal_cuts(uint32_t parts) {
+  std::vector<double> cuts;
+  for (uint32_t k = 1; k < parts; ++k) cuts.push_back(double(k) / double(parts));
+  return cuts;
+}
+
+// Where the frontier's depth-first order is cut into `parts` shares (a distributed build's
 // ranks, each a contiguous run: jobs/hlod_distributed_bake.h), the subtree a cut falls in splits
 // by the octree's rule until it holds under a 64th of a share: a few subtrees per part then
 // still split evenly, and the top stays small (it grows with the subtree count).
-void refine_at_cuts(Context& c, BuildNode& root, uint32_t parts) {
+void refine_at_cuts(Context& c, BuildNode& root, uint32_t parts, const std::vector<double>& unequal) {
   if (parts < 2) return;
   const uint64_t fine = c.total_triangles / (64 * uint64_t(parts));
+  const std::vector<double> cuts = unequal.size() + 1 == parts ? unequal : equal_cuts(parts);
   std::vector<const BuildNode*> kept;  // leaves by the octree's rule
   for (;;) {
     std::vector<BuildNode*> frontier;
     frontier_depth_first(root, frontier);
-    const std::vector<BuildNode*> cut = nodes_at_cuts(frontier, parts, fine, kept);
+    const std::vector<BuildNode*> cut = nodes_at_cuts(frontier, cuts, fine, kept);
     if (cut.empty()) return;
     for (BuildNode* n : cut)
       if (size_t vertices = 0; !split_if_large(c, *n, vertices)) kept.push_back(n);
@@ -1125,7 +1133,7 @@ Status HlodBuilder::plan() {
   compute_vertex_normals(mesh.positions.data(), mesh.vertex_count(), mesh.indices.data(), mesh.indices.size(),
                          c.normals.data());
   split_top(c, *m.root, c.options.subtrees);
-  refine_at_cuts(c, *m.root, c.options.balance_parts);
+  refine_at_cuts(c, *m.root, c.options.balance_parts, c.options.balance_cuts);
   m.frontier = number_frontier(*m.root);
   for (const BuildNode* n : m.frontier) m.specs.push_back(describe_subtree(c, *n));
   uint32_t next = 0;

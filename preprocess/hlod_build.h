@@ -79,6 +79,9 @@ struct HlodBuildOptions {
   // many equal shares, the subtree a cut falls in is split further (see refine_at_cuts), so
   // that a few subtrees per rank split evenly. Like `subtrees`, it never changes the output.
   uint32_t balance_parts = 1;
+  // Unequal shares instead (a rank that loads the mesh for its node bakes less): the cuts as
+  // fractions of the cost, ascending in (0, 1), balance_parts - 1 of them. Empty: equal shares.
+  std::vector<double> balance_cuts;
   // The materials the mesh's submeshes name, copied into the tree. A submesh id at or past their
   // count is drawn with the default material. None: one surface, no runs.
   HlodSurfaces surfaces;

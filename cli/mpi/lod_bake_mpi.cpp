@@ -68,6 +68,9 @@ void add_node_memory(HlodRankComm& c) {
   MPI_Comm_rank(m->node, &node_rank);
   MPI_Comm_size(m->node, &c.node_size);
   c.node_first = node_rank == 0;
+  c.loads_for_node.assign(size_t(c.size), 0);
+  const uint8_t loads = c.node_first ? 1 : 0;
+  MPI_Allgather(&loads, 1, MPI_BYTE, c.loads_for_node.data(), 1, MPI_BYTE, MPI_COMM_WORLD);
   c.node_barrier = [m] { sleeping_barrier(m->node); };
   c.node_buffer = [m](uint64_t bytes) -> std::span<uint8_t> {
     MPI_Win win;
@@ -264,7 +267,10 @@ int run(int argc, char** argv, HlodRankComm comm) {
   } catch (const CLI::ParseError& e) {
     return comm.rank == 0 ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 1);
   }
-  if (mesh_per_rank) comm.node_barrier = nullptr, comm.node_buffer = nullptr, comm.node_release = nullptr;
+  if (mesh_per_rank) {
+    comm.node_barrier = nullptr, comm.node_buffer = nullptr, comm.node_release = nullptr;
+    comm.loads_for_node.clear();
+  }
   HlodDistributedSettings settings;
   settings.min_verts = uint32_t(min_verts);
   settings.threads = uint32_t(threads);

@@ -102,6 +102,43 @@ double spatial_imbalance(const MeshData& m, uint32_t subtrees, int ranks, bool r
   return *std::max_element(load.begin(), load.end()) / mean;
 }
 
+// Ranks that load the mesh for their node bake less, by the load's estimated cost; the cuts
+// are ascending and leave every rank a share. Without loaders, or all loaders: equal shares.
+TEST(HlodAssign, NodeLoadersGetSmallerSharesAndTheRunsFollowTheCuts) {
+  EXPECT_TRUE(node_loader_cuts({0, 0}).empty());
+  EXPECT_TRUE(node_loader_cuts({1, 1, 1}).empty());
+  EXPECT_TRUE(node_loader_cuts({1}).empty());
+  const std::vector<double> two = node_loader_cuts({1, 0});
+  ASSERT_EQ(two.size(), 1u);
+  EXPECT_LT(two[0], 0.5);
+  EXPECT_GT(two[0], 0.45);
+  const std::vector<double> four = node_loader_cuts({1, 0, 1, 0});
+  ASSERT_EQ(four.size(), 3u);
+  const double shares[4] = {four[0], four[1] - four[0], four[2] - four[1], 1 - four[2]};
+  EXPECT_NEAR(shares[0], shares[2], 1e-12);
+  EXPECT_NEAR(shares[1], shares[3], 1e-12);
+  EXPECT_LT(shares[0], shares[1]);
+  for (const std::vector<double>& cuts : {node_loader_cuts(std::vector<uint8_t>(64, 0)), node_loader_cuts([] {
+         std::vector<uint8_t> one_node(64, 0);
+         one_node[0] = 1;
+         return one_node;
+       }())})
+    for (size_t k = 1; k < cuts.size(); ++k) EXPECT_GT(cuts[k], cuts[k - 1]);
+  // Runs at equal cuts are the equal split's; at a quarter, rank 0 gets about a quarter.
+  std::mt19937 rng(5);
+  std::vector<uint64_t> costs(300);
+  for (uint64_t& c : costs) c = 1 + rng() % 1000;
+  std::vector<size_t> order(costs.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::shuffle(order.begin(), order.end(), rng);
+  EXPECT_EQ(assign_subtrees_at_cuts(costs, order, {0.5}), assign_subtrees_spatially(costs, order, 2));
+  EXPECT_EQ(assign_subtrees_at_cuts(costs, order, {1.0 / 3, 2.0 / 3}), assign_subtrees_spatially(costs, order, 3));
+  const std::vector<int> owner = assign_subtrees_at_cuts(costs, order, {0.25});
+  double first = 0, total = 0;
+  for (size_t i = 0; i < costs.size(); ++i) first += owner[i] == 0 ? double(costs[i]) : 0, total += double(costs[i]);
+  EXPECT_NEAR(first / total, 0.25, 1000 / total);
+}
+
 // Few subtrees (a small top) split evenly once the cuts between the ranks' runs are refined;
 // without it the same frontier leaves a rank a subtree-sized share more.
 TEST(HlodAssign, FrontierRefinedAtTheCutsSplitsFewSubtreesEvenly) {
@@ -331,6 +368,9 @@ TEST(HlodDistributedBake, RanksOfANodeShareOneCopyOfTheMeshAndWriteTheSameBytes)
     EXPECT_EQ(res.mesh_cached, rerun);
     ASSERT_EQ(res.ranks.size(), 4u);
     for (size_t r = 0; r < 4; ++r) EXPECT_EQ(res.ranks[r].mesh_loaded, r % 2 == 0 ? 1u : 0u) << "rank " << r;
+    if (!rerun) {  // a loader's share is smaller by its load
+      for (size_t r : {0, 2}) EXPECT_LT(res.ranks[r].triangles, res.ranks[r + 1].triangles) << "rank " << r;
+    }
   }
   uint64_t source_hash = 0;
   ASSERT_TRUE(hlod_source_hash(mesh, 150, source_hash));
