@@ -104,6 +104,11 @@ RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   return r;
 }
 
+// Measured on the 13.9M-triangle scan, one thread: the node's load (parse, clean, the copy
+// into shared memory) took 0.78 s of its first rank's CPU against 28.5 s for the whole bake:
+// per triangle, 2.7 % of a bake's cost.
+constexpr double kNodeLoadShare = 0.027;
+
 struct Job {
   Job(const HlodDistributedSettings& s, const HlodRankComm& c, const HlodBakeLog& l) : settings(s), comm(c), log(l) {}
   const HlodDistributedSettings& settings;
@@ -424,13 +429,16 @@ void assign_writers(Job& j) {
 }
 
 // The cleaned mesh goes into the cache before any subtree is baked (a rerun after a kill skips
-// the clean), by the rank with the least to bake: it is a second of one rank's CPU on 14M
-// triangles, on the critical path when that rank is rank 0 with as much as the others.
+// the clean), by the rank with the least to do (its bake, and its node's load): it is a second
+// of one rank's CPU on 14M triangles, on the critical path when that rank has as much as the others.
 void store_cleaned_mesh(Job& j) {
   if (!j.store_mesh) return;
   std::vector<uint64_t> load(size_t(j.ranks()), 0);
   for (size_t i = 0; i < j.missing.size(); ++i)
     if (j.missing[i] && j.writer[i] >= 0 && j.writer[i] < j.ranks()) load[size_t(j.writer[i])] += j.specs()[i].triangles;
+  if (shares_node(j) && j.comm.loads_for_node.size() == load.size())
+    for (size_t r = 0; r < load.size(); ++r)
+      if (j.comm.loads_for_node[r]) load[r] += uint64_t(kNodeLoadShare * double(j.r.input_triangles));
   const int storer = int(std::min_element(load.begin(), load.end()) - load.begin());
   if (j.comm.rank != storer) return;
   const double cpu0 = process_cpu_seconds();
@@ -917,11 +925,6 @@ std::vector<int> assign_subtrees_at_cuts(const std::vector<uint64_t>& costs, con
   }
   return owner;
 }
-
-// Measured on the 13.9M-triangle scan, one thread: the node's load (parse, clean, the copy
-// into shared memory) took 0.78 s of its first rank's CPU against 28.5 s for the whole bake:
-// per triangle, 2.7 % of a bake's cost.
-constexpr double kNodeLoadShare = 0.027;
 
 std::vector<double> node_loader_cuts(const std::vector<uint8_t>& loads) {
   const size_t ranks = loads.size();
