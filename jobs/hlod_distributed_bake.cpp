@@ -104,10 +104,10 @@ RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   return r;
 }
 
-// Measured on the 13.9M-triangle scan, one thread: the node's load (parse, clean, the copy
-// into shared memory) took 0.78 s of its first rank's CPU against 28.5 s for the whole bake:
-// per triangle, 2.7 % of a bake's cost.
-constexpr double kNodeLoadShare = 0.027;
+// Measured on the 13.9M-triangle scan, one thread, 2 ranks: the node's load (parse, clean,
+// the copy into shared memory) cost its first rank 0.55-0.65 s more CPU than the other rank's
+// view of it, against 33 s for the whole bake: per triangle, 1.8 % of a bake's cost.
+constexpr double kNodeLoadShare = 0.018;
 
 struct Job {
   Job(const HlodDistributedSettings& s, const HlodRankComm& c, const HlodBakeLog& l) : settings(s), comm(c), log(l) {}
@@ -229,7 +229,8 @@ Status load_shared(Job& j, const std::filesystem::path& mesh_file, const std::fu
     if (mine) entry = hlod_mesh_entry(j.source_hash, j.mesh, j.r.input_triangles, j.options.surfaces);
   }
   j.comm.node_barrier();
-  const std::span<uint8_t> node = j.comm.node_buffer(mine && j.comm.node_first ? kNodeHead + entry.size() : 0);
+  const uint64_t entry_bytes = entry.size();
+  const std::span<uint8_t> node = j.comm.node_buffer(mine && j.comm.node_first ? kNodeHead + entry_bytes : 0);
   if (j.comm.node_first && mine && node.size() == kNodeHead + entry.size()) {
     populate(node, true);
     const uint64_t head[2] = {j.source_hash, j.r.mesh_cached ? 1u : 0u};  // host order: one host reads it
@@ -241,8 +242,11 @@ Status load_shared(Job& j, const std::filesystem::path& mesh_file, const std::fu
   j.view = {};
   j.comm.node_barrier();
   if (!mine) return mine;
+  if (node.size() < kNodeHead && j.comm.node_first)
+    return Status::error(mesh_file.string() + ": could not get " + std::to_string((kNodeHead + entry_bytes) >> 20) +
+                         " MB of memory this node's ranks share (/dev/shm full?): run with --mesh-per-rank");
   if (node.size() < kNodeHead)
-    return Status::error(mesh_file.string() + ": this node's first rank could not load it (its own message says why)");
+    return Status::error(mesh_file.string() + ": this node's first rank could not load it or share it (its own message says why)");
   uint64_t head[2];
   std::memcpy(head, node.data(), kNodeHead);
   j.source_hash = head[0];

@@ -67,6 +67,7 @@ void add_node_memory(HlodRankComm& c) {
   int node_rank = 0;
   MPI_Comm_rank(m->node, &node_rank);
   MPI_Comm_size(m->node, &c.node_size);
+  MPI_Comm_set_errhandler(m->node, MPI_ERRORS_RETURN);
   c.node_first = node_rank == 0;
   c.loads_for_node.assign(size_t(c.size), 0);
   const uint8_t loads = c.node_first ? 1 : 0;
@@ -75,7 +76,8 @@ void add_node_memory(HlodRankComm& c) {
   c.node_buffer = [m](uint64_t bytes) -> std::span<uint8_t> {
     MPI_Win win;
     void* mine = nullptr;
-    MPI_Win_allocate_shared(MPI_Aint(bytes), 1, MPI_INFO_NULL, m->node, &mine, &win);
+    // /dev/shm full, say: an error the job reports, not an abort (errors return on `node`).
+    if (MPI_Win_allocate_shared(MPI_Aint(bytes), 1, MPI_INFO_NULL, m->node, &mine, &win) != MPI_SUCCESS) return {};
     m->windows.push_back(win);
     MPI_Aint size = 0;
     int unit = 0;

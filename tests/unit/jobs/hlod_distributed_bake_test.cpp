@@ -409,6 +409,34 @@ TEST(HlodDistributedBake, ANodesFirstRankThatCannotLoadFailsItsNodeByName) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
 }
 
+// Memory the node cannot share (/dev/shm full): the loader says so and how to go on, the
+// node's other rank that its loader failed; nothing is written.
+TEST(HlodDistributedBake, ANodeThatCannotShareItsMemorySaysSoAndHowToGoOn) {
+  const auto dir = test::temp_dir("hlod_dist_node_full");
+  const auto mesh = write_mesh(dir);
+  ThreadRanks tr(2, 2);
+  tr.nodes[0]->memory = 1024;
+  std::vector<RankRun> runs(2);
+  std::vector<std::thread> threads;
+  for (int r = 0; r < 2; ++r)
+    threads.emplace_back([&, r] {
+      HlodDistributedSettings s;
+      s.min_verts = 150;
+      s.threads = 1;
+      s.cache_dir = dir / "cache";
+      runs[size_t(r)].status = bake_hlod_distributed(mesh, "mixed", dir / "out", s, tr.comm(r), {}, &runs[size_t(r)].result);
+    });
+  for (auto& t : threads) t.join();
+  ASSERT_FALSE(runs[0].status);
+  EXPECT_NE(runs[0].status.message.find("memory this node's ranks share (/dev/shm full?): run with --mesh-per-rank"),
+            std::string::npos)
+      << runs[0].status.message;
+  ASSERT_FALSE(runs[1].status);
+  EXPECT_NE(runs[1].status.message.find("this node's first rank could not load it"), std::string::npos)
+      << runs[1].status.message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
+}
+
 // A rank holds its entries' bytes for the write up to held_entry_bytes; the others are read
 // back from the cache when written. Nothing held, half held, all held: the same bytes.
 TEST(HlodDistributedBake, EntriesBeyondTheMemoryBudgetAreReadBackIntoTheSameBytes) {

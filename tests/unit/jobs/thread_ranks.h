@@ -51,6 +51,7 @@ struct ThreadRanks {
     std::barrier<> sync;
     std::deque<std::vector<uint64_t>> buffers;  // 8-byte words: aligned for any array in them
     std::deque<size_t> sizes;
+    uint64_t memory = UINT64_MAX;  // what a node buffer may hold
   };
   static void add_node(HlodRankComm& c, Node& node, bool first) {
     c.node_size = node.ranks;
@@ -58,6 +59,7 @@ struct ThreadRanks {
     c.node_barrier = [&node] { node.sync.arrive_and_wait(); };
     c.node_buffer = [&node, first](uint64_t bytes) {
       if (first) {
+        if (bytes > node.memory) bytes = 0;  // as MPI when /dev/shm cannot hold it
         node.buffers.emplace_back(size_t((bytes + 7) / 8));
         node.sizes.push_back(size_t(bytes));
       }
