@@ -11,9 +11,9 @@ namespace lod::cli {
 
 int bake_command(const BakeArgs& args) {
   if (args.distributed) return bake_distributed_command(args);
-  if (!args.cache_dir.empty() || args.subtrees || args.entry_memory_mb || args.mesh_per_rank) {
+  if (!args.cache_dir.empty() || args.subtrees || args.entry_memory_mb || !args.mesh_copies.empty()) {
     std::fprintf(stderr,
-                 "lod bake: --cache, --subtrees, --entry-memory-mb and --mesh-per-rank are options of --distributed\n");
+                 "lod bake: --cache, --subtrees, --entry-memory-mb and --mesh-copies are options of --distributed\n");
     return 1;
   }
   if (args.hlod) return bake_hlod_command(args);

@@ -43,7 +43,7 @@ std::vector<std::string> bake_mpi_arguments(const fs::path& tool, const BakeArgs
                      std::to_string(args.min_verts), "--threads", std::to_string(args.threads)});
   if (args.subtrees) v.insert(v.end(), {"--subtrees", std::to_string(args.subtrees)});
   if (args.entry_memory_mb) v.insert(v.end(), {"--entry-memory-mb", std::to_string(args.entry_memory_mb)});
-  if (args.mesh_per_rank) v.push_back("--mesh-per-rank");
+  if (!args.mesh_copies.empty()) v.insert(v.end(), {"--mesh-copies", args.mesh_copies});
   if (args.json) v.push_back("--json");
   if (args.quiet) v.push_back("--quiet");
   return v;

@@ -49,7 +49,7 @@ struct BakeArgs {
   std::string cache_dir;         // empty = <out_dir>/hlod-cache
   int64_t subtrees = 0;          // 0 = lod-bake-mpi's default
   uint64_t entry_memory_mb = 0;
-  bool mesh_per_rank = false;
+  std::string mesh_copies;  // --distributed: auto, node or rank (empty: lod-bake-mpi's default)
 };
 int bake_command(const BakeArgs& args);
 int bake_hlod_command(const BakeArgs& args);         // cli/bake_hlod.cpp

@@ -62,8 +62,10 @@ int main(int argc, char** argv) {
   bake_cmd->add_option("--entry-memory-mb", bake.entry_memory_mb,
                        "--distributed: MB of cache entries a rank holds for its write (default 0)")
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
-  bake_cmd->add_flag("--mesh-per-rank", bake.mesh_per_rank,
-                     "--distributed: every rank loads its own copy of the mesh (default: one per node, shared)");
+  bake_cmd->add_option("--mesh-copies", bake.mesh_copies,
+                       "--distributed: the mesh once per node (shared by its ranks) or per rank (default auto: per "
+                       "node where a node runs 4 ranks or more)")
+      ->check(CLI::IsMember({"auto", "node", "rank"}));
 
   lod::cli::ExportArgs exp;
   auto* export_cmd = app.add_subcommand("export", "write an .hlod file as an OGC 3D Tiles 1.1 tileset");

@@ -244,7 +244,7 @@ Status load_shared(Job& j, const std::filesystem::path& mesh_file, const std::fu
   if (!mine) return mine;
   if (node.size() < kNodeHead && j.comm.node_first)
     return Status::error(mesh_file.string() + ": could not get " + std::to_string((kNodeHead + entry_bytes) >> 20) +
-                         " MB of memory this node's ranks share (/dev/shm full?): run with --mesh-per-rank");
+                         " MB of memory this node's ranks share (/dev/shm full?): run with --mesh-copies rank");
   if (node.size() < kNodeHead)
     return Status::error(mesh_file.string() + ": this node's first rank could not load it or share it (its own message says why)");
   uint64_t head[2];
@@ -271,9 +271,23 @@ void sit_out_node_load(Job& j) {
   j.comm.node_barrier();
 }
 
-bool shares_node(const Job& j) {
-  return std::endian::native == std::endian::little && j.comm.node_size > 1 && j.comm.node_barrier &&
+// Nodes may share (the comm gives node memory; settings allow it), and a node of `ranks` does.
+bool can_share(const Job& j) {
+  return std::endian::native == std::endian::little && j.settings.share_mesh_from > 0 && j.comm.node_barrier &&
          j.comm.node_buffer && j.comm.node_release;
+}
+bool node_shares(const Job& j, int64_t ranks) { return ranks >= int64_t(std::max(2u, j.settings.share_mesh_from)); }
+bool shares_node(const Job& j) { return can_share(j) && node_shares(j, j.comm.node_size); }
+
+// Per rank: 1 where it loads a copy of the mesh (its node's first where the node shares one,
+// every rank where it does not); empty when no node shares.
+std::vector<uint8_t> mesh_loaders(const Job& j) {
+  const std::vector<int32_t>& node_of = j.comm.node_of;
+  if (!can_share(j) || node_of.size() != size_t(j.ranks())) return {};  // the same answer on every rank
+  std::vector<uint8_t> loads(node_of.size(), 1);
+  for (size_t r = 0; r < node_of.size(); ++r)
+    if (node_shares(j, std::count(node_of.begin(), node_of.end(), node_of[r]))) loads[r] = node_of[r] == int32_t(r);
+  return loads;
 }
 
 Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
@@ -293,8 +307,7 @@ Status load_and_plan(Job& j, const std::filesystem::path& mesh_file) {
   // it); the cuts between the ranks' shares are refined instead, so that they still split evenly.
   j.options.subtrees = j.settings.subtrees ? j.settings.subtrees : default_subtrees(j.ranks());
   j.options.balance_parts = uint32_t(j.ranks());
-  if (shares_node(j) && j.comm.loads_for_node.size() == size_t(j.ranks()))
-    j.options.balance_cuts = node_loader_cuts(j.comm.loads_for_node);
+  j.options.balance_cuts = node_loader_cuts(mesh_loaders(j));
   j.options.parallel_for = tbb_parallel_for();
   j.builder = std::make_unique<HlodBuilder>(j.view, j.options);
   Status planned;
@@ -440,9 +453,9 @@ void store_cleaned_mesh(Job& j) {
   std::vector<uint64_t> load(size_t(j.ranks()), 0);
   for (size_t i = 0; i < j.missing.size(); ++i)
     if (j.missing[i] && j.writer[i] >= 0 && j.writer[i] < j.ranks()) load[size_t(j.writer[i])] += j.specs()[i].triangles;
-  if (shares_node(j) && j.comm.loads_for_node.size() == load.size())
-    for (size_t r = 0; r < load.size(); ++r)
-      if (j.comm.loads_for_node[r]) load[r] += uint64_t(kNodeLoadShare * double(j.r.input_triangles));
+  const std::vector<uint8_t> loaders = mesh_loaders(j);
+  for (size_t r = 0; r < loaders.size() && r < load.size(); ++r)
+    if (loaders[r]) load[r] += uint64_t(kNodeLoadShare * double(j.r.input_triangles));
   const int storer = int(std::min_element(load.begin(), load.end()) - load.begin());
   if (j.comm.rank != storer) return;
   const double cpu0 = process_cpu_seconds();

@@ -69,9 +69,10 @@ void add_node_memory(HlodRankComm& c) {
   MPI_Comm_size(m->node, &c.node_size);
   MPI_Comm_set_errhandler(m->node, MPI_ERRORS_RETURN);
   c.node_first = node_rank == 0;
-  c.loads_for_node.assign(size_t(c.size), 0);
-  const uint8_t loads = c.node_first ? 1 : 0;
-  MPI_Allgather(&loads, 1, MPI_BYTE, c.loads_for_node.data(), 1, MPI_BYTE, MPI_COMM_WORLD);
+  int first = c.rank;  // the node's first rank, as every rank of the job knows it
+  MPI_Bcast(&first, 1, MPI_INT, 0, m->node);
+  c.node_of.assign(size_t(c.size), 0);
+  MPI_Allgather(&first, 1, MPI_INT, c.node_of.data(), 1, MPI_INT, MPI_COMM_WORLD);
   c.node_barrier = [m] { sleeping_barrier(m->node); };
   c.node_buffer = [m](uint64_t bytes) -> std::span<uint8_t> {
     MPI_Win win;
@@ -81,10 +82,10 @@ void add_node_memory(HlodRankComm& c) {
     m->windows.push_back(win);
     MPI_Aint size = 0;
     int unit = 0;
-    void* first = nullptr;
-    MPI_Win_shared_query(win, 0, &size, &unit, &first);
-    if (size <= 0 || first == nullptr) return {};
-    return {static_cast<uint8_t*>(first), size_t(size)};
+    void* base = nullptr;
+    MPI_Win_shared_query(win, 0, &size, &unit, &base);
+    if (size <= 0 || base == nullptr) return {};
+    return {static_cast<uint8_t*>(base), size_t(size)};
   };
   c.node_release = [m] {
     sleeping_barrier(m->node);  // MPI_Win_free would spin there
@@ -244,13 +245,14 @@ int run_models(const std::vector<std::string>& meshes, const std::string& out_di
   return 0;
 }
 
-int run(int argc, char** argv, HlodRankComm comm) {
+int run(int argc, char** argv, const HlodRankComm& comm) {
   CLI::App app{"HLOD bake of one mesh or many over MPI ranks (byte-identical to lod bake --hlod)"};
   std::vector<std::string> meshes;
   std::string out_dir, cache_dir;
   int min_verts = 1000, threads = 0, subtrees = 0;
   uint64_t entry_memory_mb = 0;
-  bool json = false, quiet = false, mesh_per_rank = false;
+  bool json = false, quiet = false;
+  std::string mesh_copies = "auto";
   app.add_option("mesh", meshes, "mesh files, on paths every rank sees (one .hlod each)")->required();
   app.add_option("-o,--out", out_dir, "output directory (rank 0 writes <name>.hlod there)")->required();
   app.add_option("--cache", cache_dir, "subtree cache directory on shared storage")->required();
@@ -260,8 +262,10 @@ int run(int argc, char** argv, HlodRankComm comm) {
   app.add_option("--entry-memory-mb", entry_memory_mb,
                  "MB of cache entries a rank holds for its write (default 0: each is read back when written)")
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
-  app.add_flag("--mesh-per-rank", mesh_per_rank,
-               "every rank loads its own copy of the mesh (default: one per node, in memory its ranks share)");
+  app.add_option("--mesh-copies", mesh_copies,
+                 "one copy of the mesh per node, in memory its ranks share, or per rank (auto: per node where a "
+                 "node runs 4 ranks or more)")
+      ->check(CLI::IsMember({"auto", "node", "rank"}));
   app.add_flag("--json", json, "rank 0 prints a JSON summary");
   app.add_flag("--quiet", quiet, "print nothing but errors");
   try {
@@ -269,11 +273,8 @@ int run(int argc, char** argv, HlodRankComm comm) {
   } catch (const CLI::ParseError& e) {
     return comm.rank == 0 ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 1);
   }
-  if (mesh_per_rank) {
-    comm.node_barrier = nullptr, comm.node_buffer = nullptr, comm.node_release = nullptr;
-    comm.loads_for_node.clear();
-  }
   HlodDistributedSettings settings;
+  settings.share_mesh_from = mesh_copies == "node" ? 2 : mesh_copies == "rank" ? 0 : settings.share_mesh_from;
   settings.min_verts = uint32_t(min_verts);
   settings.threads = uint32_t(threads);
   settings.subtrees = uint32_t(subtrees);

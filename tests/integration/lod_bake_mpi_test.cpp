@@ -185,14 +185,14 @@ TEST(LodBakeMpi, LodBakeDistributedIsTheSameBakeAndResumesFromItsDefaultCache) {
   ASSERT_TRUE(k.is_object()) << again.out;
   EXPECT_EQ(k["cached"].get<size_t>(), total) << "the rerun found the default cache";
   EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local);
-  EXPECT_TRUE(j["mesh_shared"].get<bool>());
+  EXPECT_FALSE(j["mesh_shared"].get<bool>()) << "2 ranks on a node keep a copy each by default";
 
-  const test::CliResult own = test::run_mpi_program(
-      2, LOD_CLI_PATH, args + " --mesh-per-rank --cache " + (dir / "own-cache").string());
-  ASSERT_EQ(own.code, 0) << own.out;
-  const nlohmann::json o = test::printed_json(own);
-  ASSERT_TRUE(o.is_object()) << own.out;
-  EXPECT_FALSE(o["mesh_shared"].get<bool>()) << "--mesh-per-rank reaches lod-bake-mpi";
+  const test::CliResult shared = test::run_mpi_program(
+      2, LOD_CLI_PATH, args + " --mesh-copies node --cache " + (dir / "node-cache").string());
+  ASSERT_EQ(shared.code, 0) << shared.out;
+  const nlohmann::json o = test::printed_json(shared);
+  ASSERT_TRUE(o.is_object()) << shared.out;
+  EXPECT_TRUE(o["mesh_shared"].get<bool>()) << "--mesh-copies reaches lod-bake-mpi";
   EXPECT_EQ(test::read_bytes(dir / "out" / "ball.hlod"), fixture().local);
 }
 
@@ -203,7 +203,7 @@ TEST(LodBakeMpi, LodBakeDistributedRefusesWhatItCannotDo) {
       {"bake " + mesh + " -o " + out + " --hlod --distributed --ratios 1 0.5", "--ratios and --method"},
       {"bake " + mesh + " -o " + out + " --hlod --cache " + out, "options of --distributed"},
       {"bake " + mesh + " -o " + out + " --subtrees 4", "options of --distributed"},
-      {"bake " + mesh + " -o " + out + " --hlod --mesh-per-rank", "options of --distributed"},
+      {"bake " + mesh + " -o " + out + " --hlod --mesh-copies rank", "options of --distributed"},
   };
   for (const auto& [args, says] : cases) {
     const test::CliResult r = test::run_lod(args);
@@ -294,22 +294,29 @@ TEST(LodBakeMpi, RanksAskForHugePagesUnlessToldNotTo) {
   }
 }
 
-// One node here: its first rank loads the mesh into the memory the ranks share and the others
-// read it in place; --mesh-per-rank gives every rank its own copy. The same bytes either way.
-TEST(LodBakeMpi, RanksOfANodeShareOneCopyOfTheMeshUnlessToldNotTo) {
+// One node here: with --mesh-copies node its first rank loads the mesh into the memory the
+// ranks share and the others read it in place; with rank every rank has its own copy; auto
+// shares from 4 ranks on a node. The same bytes every way.
+TEST(LodBakeMpi, RanksOfANodeShareOneCopyOfTheMeshWhenAskedOrFromFourRanks) {
   const auto dir = test::temp_dir("lod_bake_mpi_node_share");
-  for (const bool per_rank : {false, true}) {
-    const auto run = dir / (per_rank ? "per-rank" : "shared");
+  struct Case {
+    const char* copies;
+    int ranks;
+    bool shared;
+  };
+  for (const Case c : {Case{"node", 3, true}, Case{"rank", 3, false}, Case{"auto", 3, false}, Case{"auto", 4, true}}) {
+    const std::string what = std::string(c.copies) + " at " + std::to_string(c.ranks);
+    const auto run = dir / (std::string(c.copies) + std::to_string(c.ranks));
     const test::CliResult r =
-        run_mpi(3, bake_args(run / "out", run / "cache") + " --json" + (per_rank ? " --mesh-per-rank" : ""), "");
+        run_mpi(c.ranks, bake_args(run / "out", run / "cache") + " --json --mesh-copies " + c.copies, "");
     ASSERT_EQ(r.code, 0) << r.out;
     const nlohmann::json j = test::printed_json(r);
     ASSERT_TRUE(j.is_object()) << r.out;
-    EXPECT_EQ(j["mesh_shared"], !per_rank);
-    ASSERT_EQ(j["per_rank"].size(), 3u);
-    for (size_t rank = 0; rank < 3; ++rank)
-      EXPECT_EQ(j["per_rank"][rank]["mesh_loaded"], per_rank || rank == 0) << (per_rank ? "per rank, " : "shared, ") << rank;
-    EXPECT_EQ(test::read_bytes(run / "out" / "ball.hlod"), fixture().local) << (per_rank ? "per rank" : "shared");
+    EXPECT_EQ(j["mesh_shared"], c.shared) << what;
+    ASSERT_EQ(j["per_rank"].size(), size_t(c.ranks));
+    for (int rank = 0; rank < c.ranks; ++rank)
+      EXPECT_EQ(j["per_rank"][size_t(rank)]["mesh_loaded"], !c.shared || rank == 0) << what << ", rank " << rank;
+    EXPECT_EQ(test::read_bytes(run / "out" / "ball.hlod"), fixture().local) << what;
   }
 }
 

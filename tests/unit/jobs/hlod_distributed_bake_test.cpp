@@ -239,7 +239,7 @@ struct RankPaths {
 };
 
 std::vector<RankRun> run_ranks(int ranks, const std::function<RankPaths(int)>& paths_of,
-                               uint64_t held_entry_bytes = uint64_t(1) << 30, int per_node = 1) {
+                               uint64_t held_entry_bytes = uint64_t(1) << 30, int per_node = 1, uint32_t share_from = 2) {
   ThreadRanks tr(ranks, per_node);
   std::vector<RankRun> runs(static_cast<size_t>(ranks));
   std::vector<std::thread> threads;
@@ -251,6 +251,7 @@ std::vector<RankRun> run_ranks(int ranks, const std::function<RankPaths(int)>& p
       s.threads = 1;
       s.cache_dir = p.cache;
       s.held_entry_bytes = held_entry_bytes;
+      s.share_mesh_from = share_from;
       runs[size_t(r)].status = bake_hlod_distributed(p.mesh, "mixed", p.out, s, tr.comm(r), {}, &runs[size_t(r)].result);
     });
   for (auto& t : threads) t.join();
@@ -259,8 +260,8 @@ std::vector<RankRun> run_ranks(int ranks, const std::function<RankPaths(int)>& p
 
 std::vector<RankRun> run_ranks(int ranks, const std::filesystem::path& mesh, const std::filesystem::path& out,
                                const std::filesystem::path& cache, uint64_t held_entry_bytes = uint64_t(1) << 30,
-                               int per_node = 1) {
-  return run_ranks(ranks, [&](int) { return RankPaths{mesh, out, cache}; }, held_entry_bytes, per_node);
+                               int per_node = 1, uint32_t share_from = 2) {
+  return run_ranks(ranks, [&](int) { return RankPaths{mesh, out, cache}; }, held_entry_bytes, per_node, share_from);
 }
 
 std::vector<uint8_t> local_bake(const std::filesystem::path& mesh, const std::filesystem::path& out) {
@@ -377,6 +378,25 @@ TEST(HlodDistributedBake, RanksOfANodeShareOneCopyOfTheMeshAndWriteTheSameBytes)
   EXPECT_TRUE(std::filesystem::exists(hlod_mesh_entry_path(dir / "cache", source_hash))) << "stored from the node's copy";
 }
 
+// By default a node shares from 4 ranks on: here a node of 4 shares (its first loads), a node
+// of 2 keeps a copy per rank (both load), every rank agrees on the plan, and the bytes are the
+// local bake's.
+TEST(HlodDistributedBake, NodesShareFromFourRanksAndMixedNodesAgreeOnThePlan) {
+  const auto dir = test::temp_dir("hlod_dist_node_mixed");
+  const auto mesh = write_mesh(dir);
+  const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
+  const uint32_t from = HlodDistributedSettings{}.share_mesh_from;
+  ASSERT_EQ(from, 4u);
+  const std::vector<RankRun> runs = run_ranks(6, mesh, dir / "out", dir / "cache", uint64_t(1) << 30, 4, from);
+  for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
+  EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
+  const std::vector<uint32_t> loaded{1, 0, 0, 0, 1, 1};
+  ASSERT_EQ(runs[0].result.ranks.size(), 6u);
+  for (size_t r = 0; r < 6; ++r) EXPECT_EQ(runs[0].result.ranks[r].mesh_loaded, loaded[r]) << "rank " << r;
+  EXPECT_TRUE(runs[0].result.mesh_shared);
+  EXPECT_FALSE(runs[4].result.mesh_shared);
+}
+
 // A textured model's uvs, runs and materials go through the node's copy unchanged.
 TEST(HlodDistributedBake, TexturedModelThroughANodesCopyGivesTheLocalBytes) {
   const auto dir = test::temp_dir("hlod_dist_node_textured");
@@ -424,11 +444,12 @@ TEST(HlodDistributedBake, ANodeThatCannotShareItsMemorySaysSoAndHowToGoOn) {
       s.min_verts = 150;
       s.threads = 1;
       s.cache_dir = dir / "cache";
+      s.share_mesh_from = 2;
       runs[size_t(r)].status = bake_hlod_distributed(mesh, "mixed", dir / "out", s, tr.comm(r), {}, &runs[size_t(r)].result);
     });
   for (auto& t : threads) t.join();
   ASSERT_FALSE(runs[0].status);
-  EXPECT_NE(runs[0].status.message.find("memory this node's ranks share (/dev/shm full?): run with --mesh-per-rank"),
+  EXPECT_NE(runs[0].status.message.find("memory this node's ranks share (/dev/shm full?): run with --mesh-copies rank"),
             std::string::npos)
       << runs[0].status.message;
   ASSERT_FALSE(runs[1].status);

@@ -40,7 +40,7 @@ struct ThreadRanks {
     };
     if (per_node > 1) {
       add_node(c, *nodes[size_t(rank / per_node)], rank % per_node == 0);
-      for (int r = 0; r < size; ++r) c.loads_for_node.push_back(r % per_node == 0 ? 1 : 0);
+      for (int r = 0; r < size; ++r) c.node_of.push_back(r / per_node * per_node);
     }
     return c;
   }
