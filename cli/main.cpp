@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
   bake_cmd->add_option("--mesh-copies", bake.mesh_copies,
                        "--distributed: the mesh once per node (shared by its ranks) or per rank (default auto: per "
-                       "node where a node runs 4 ranks or more)")
+                       "node where a node runs 8 ranks or more)")
       ->check(CLI::IsMember({"auto", "node", "rank"}));
 
   lod::cli::ExportArgs exp;

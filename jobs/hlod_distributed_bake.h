@@ -108,10 +108,11 @@ struct HlodDistributedSettings {
   // cache is on slow shared storage, holding some saves reading it.
   uint64_t held_entry_bytes = 0;
   // The ranks on one node share one copy of the mesh (HlodRankComm::node_buffer) when the node
-  // runs at least this many; 0 = never. Measured on the 13.9M scan (2-core VM, 2 ranks): the
-  // shared copy's fresh pages cost its loader ~0.8 s more CPU than its own load, and each other
-  // rank saves ~0.35 s, so sharing pays from 4 ranks on (and saves a mesh's memory per rank).
-  uint32_t share_mesh_from = 4;
+  // runs at least this many; 0 = never. Measured on the 13.9M scan (2-core VM): the shared
+  // copy's fresh pages cost its loader 0.6-2 s more CPU than its own load (spikes to 8 s) while
+  // each other rank saves 0.3-1.7 s: a loss at 2 ranks, even at 4, a clear gain at 8 (and a
+  // mesh's memory saved per rank).
+  uint32_t share_mesh_from = 8;
   // Called before each of this rank's entries is stored (count: entries this rank stored so
   // far), from the thread that finished it. Tests inject a crash here.
   std::function<void(size_t subtree, size_t stored)> before_store;

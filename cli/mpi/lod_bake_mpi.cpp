@@ -264,7 +264,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
   app.add_option("--mesh-copies", mesh_copies,
                  "one copy of the mesh per node, in memory its ranks share, or per rank (auto: per node where a "
-                 "node runs 4 ranks or more)")
+                 "node runs 8 ranks or more)")
       ->check(CLI::IsMember({"auto", "node", "rank"}));
   app.add_flag("--json", json, "rank 0 prints a JSON summary");
   app.add_flag("--quiet", quiet, "print nothing but errors");

@@ -378,16 +378,15 @@ TEST(HlodDistributedBake, RanksOfANodeShareOneCopyOfTheMeshAndWriteTheSameBytes)
   EXPECT_TRUE(std::filesystem::exists(hlod_mesh_entry_path(dir / "cache", source_hash))) << "stored from the node's copy";
 }
 
-// By default a node shares from 4 ranks on: here a node of 4 shares (its first loads), a node
-// of 2 keeps a copy per rank (both load), every rank agrees on the plan, and the bytes are the
-// local bake's.
-TEST(HlodDistributedBake, NodesShareFromFourRanksAndMixedNodesAgreeOnThePlan) {
+// Nodes share from share_mesh_from ranks on (8 by default): with 4, a node of 4 shares (its
+// first loads), a node of 2 keeps a copy per rank (both load), every rank agrees on the plan,
+// and the bytes are the local bake's.
+TEST(HlodDistributedBake, NodesShareFromTheirThresholdAndMixedNodesAgreeOnThePlan) {
   const auto dir = test::temp_dir("hlod_dist_node_mixed");
   const auto mesh = write_mesh(dir);
   const std::vector<uint8_t> local = local_bake(mesh, dir / "local");
-  const uint32_t from = HlodDistributedSettings{}.share_mesh_from;
-  ASSERT_EQ(from, 4u);
-  const std::vector<RankRun> runs = run_ranks(6, mesh, dir / "out", dir / "cache", uint64_t(1) << 30, 4, from);
+  EXPECT_EQ(HlodDistributedSettings{}.share_mesh_from, 8u);
+  const std::vector<RankRun> runs = run_ranks(6, mesh, dir / "out", dir / "cache", uint64_t(1) << 30, 4, 4);
   for (const RankRun& r : runs) ASSERT_TRUE(r.status) << r.status.message;
   EXPECT_EQ(test::read_bytes(dir / "out" / "mixed.hlod"), local);
   const std::vector<uint32_t> loaded{1, 0, 0, 0, 1, 1};
