@@ -238,9 +238,13 @@ struct RankPaths {
   std::filesystem::path mesh, out, cache;
 };
 
+// Ranks as threads; `per_node` consecutive ones form a node, which shares the mesh from
+// `share_from` ranks on in at most `node_memory` bytes.
 std::vector<RankRun> run_ranks(int ranks, const std::function<RankPaths(int)>& paths_of,
-                               uint64_t held_entry_bytes = uint64_t(1) << 30, int per_node = 1, uint32_t share_from = 2) {
+                               uint64_t held_entry_bytes = uint64_t(1) << 30, int per_node = 1, uint32_t share_from = 2,
+                               uint64_t node_memory = UINT64_MAX) {
   ThreadRanks tr(ranks, per_node);
+  for (auto& node : tr.nodes) node->memory = node_memory;
   std::vector<RankRun> runs(static_cast<size_t>(ranks));
   std::vector<std::thread> threads;
   for (int r = 0; r < ranks; ++r)
@@ -433,20 +437,8 @@ TEST(HlodDistributedBake, ANodesFirstRankThatCannotLoadFailsItsNodeByName) {
 TEST(HlodDistributedBake, ANodeThatCannotShareItsMemorySaysSoAndHowToGoOn) {
   const auto dir = test::temp_dir("hlod_dist_node_full");
   const auto mesh = write_mesh(dir);
-  ThreadRanks tr(2, 2);
-  tr.nodes[0]->memory = 1024;
-  std::vector<RankRun> runs(2);
-  std::vector<std::thread> threads;
-  for (int r = 0; r < 2; ++r)
-    threads.emplace_back([&, r] {
-      HlodDistributedSettings s;
-      s.min_verts = 150;
-      s.threads = 1;
-      s.cache_dir = dir / "cache";
-      s.share_mesh_from = 2;
-      runs[size_t(r)].status = bake_hlod_distributed(mesh, "mixed", dir / "out", s, tr.comm(r), {}, &runs[size_t(r)].result);
-    });
-  for (auto& t : threads) t.join();
+  const std::vector<RankRun> runs =
+      run_ranks(2, [&](int) { return RankPaths{mesh, dir / "out", dir / "cache"}; }, uint64_t(1) << 30, 2, 2, 1024);
   ASSERT_FALSE(runs[0].status);
   EXPECT_NE(runs[0].status.message.find("memory this node's ranks share (/dev/shm full?): run with --mesh-copies rank"),
             std::string::npos)
