@@ -17,16 +17,20 @@
 // untouched; an accepted entry holds what the bake relies on (indices below the vertex count,
 // finite positions and uvs, uvs for every vertex or none, submeshes in order inside the
 // triangles naming a stored material, every "embedded:<k>" naming a stored image of its
-// type), and stored again by the writer it reads back the same.
+// type), and stored again by the writer it reads back the same. The in-place reader a node's
+// ranks share (view_hlod_mesh) must agree: checked, it accepts exactly what load_hlod_mesh
+// accepts, with the same arrays bit for bit; unchecked, an accepted entry views the same.
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -274,6 +278,34 @@ void check_accepted(const lod::MeshData& m, const lod::HlodSurfaces& s, uint64_t
     if (s.images[i].type != surfaces.images[i].type || s.images[i].bytes != surfaces.images[i].bytes) differs("images");
 }
 
+// view_hlod_mesh over the same bytes (aligned, as a node's shared memory is) against load_hlod_mesh.
+void agrees_in_place(const uint8_t* data, size_t size, uint64_t hash, bool accepted, const lod::MeshData& loaded) {
+  std::vector<uint64_t> words((size + 7) / 8);
+  if (size) std::memcpy(words.data(), data, size);
+  const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(words.data()), size);
+  lod::HlodMeshInPlace in;
+  const lod::Status checked = lod::view_hlod_mesh(bytes, hash, "fuzz-source", true, in);
+  if (bool(checked) != accepted)
+    fail(std::string("view_hlod_mesh ") + (accepted ? "refused an entry load_hlod_mesh accepts: " + checked.message
+                                                     : "accepted an entry load_hlod_mesh refuses"));
+  if (!accepted) {
+    if (checked.message.rfind("fuzz-source: the cleaned mesh ", 0) != 0) fail("in-place refusal does not say why: " + checked.message);
+    return;
+  }
+  const auto same = [](std::span<const float> a, const std::vector<float>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), 4 * a.size()) == 0);
+  };
+  for (bool check : {true, false}) {
+    lod::HlodMeshInPlace v;
+    if (lod::Status st = lod::view_hlod_mesh(bytes, hash, "fuzz-source", check, v); !st) fail("in place: " + st.message);
+    if (!same(v.mesh.positions, loaded.positions) || !same(v.mesh.uvs, loaded.uvs) || !same(v.mesh.uvs1, loaded.uvs1) ||
+        !same(v.mesh.colors, loaded.colors) ||
+        !std::equal(v.mesh.indices.begin(), v.mesh.indices.end(), loaded.indices.begin(), loaded.indices.end()) ||
+        v.mesh.submeshes.size() != loaded.submeshes.size() || v.mesh.source != loaded.source)
+      fail("the in-place view differs from the loaded mesh");
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
@@ -327,6 +359,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string why;
   const lod::CacheLookup got = lod::load_hlod_mesh(g_dir, hash, "fuzz-source", mesh, input, &why, &surfaces);
   std::filesystem::remove(path);
+  if (got != lod::CacheLookup::missing) agrees_in_place(data, size, hash, got == lod::CacheLookup::found, mesh);
   if (got == lod::CacheLookup::missing) fail("an entry that was there is missing");
   if (got == lod::CacheLookup::refused) {
     if (why.rfind(path.string() + ": ", 0) != 0 || why.size() <= path.string().size() + 2)

@@ -416,6 +416,11 @@ TEST(HlodDistributedBake, TexturedModelThroughANodesCopyGivesTheLocalBytes) {
   }
 }
 
+void expect_failure_saying(const Status& s, const std::string& words) {
+  EXPECT_FALSE(s) << "expected a failure saying: " << words;
+  EXPECT_NE(s.message.find(words), std::string::npos) << s.message;
+}
+
 // The node's first rank cannot load: it names the file, its node's other rank says its
 // loader failed, rank 0 fails the job naming them, and nothing is written.
 TEST(HlodDistributedBake, ANodesFirstRankThatCannotLoadFailsItsNodeByName) {
@@ -424,11 +429,9 @@ TEST(HlodDistributedBake, ANodesFirstRankThatCannotLoadFailsItsNodeByName) {
   const auto gone = dir / "gone" / "mixed.ply";
   const std::vector<RankRun> runs = run_ranks(
       4, [&](int r) { return RankPaths{r == 2 ? gone : mesh, dir / "out", dir / "cache"}; }, uint64_t(1) << 30, 2);
-  for (size_t r : {0, 2, 3}) EXPECT_FALSE(runs[r].status) << "rank " << r;
-  EXPECT_NE(runs[0].status.message.find("rank 2"), std::string::npos) << runs[0].status.message;
-  EXPECT_NE(runs[2].status.message.find(gone.string()), std::string::npos) << runs[2].status.message;
-  EXPECT_NE(runs[3].status.message.find("this node's first rank could not load it"), std::string::npos)
-      << runs[3].status.message;
+  expect_failure_saying(runs[0].status, "rank 2");
+  expect_failure_saying(runs[2].status, gone.string());
+  expect_failure_saying(runs[3].status, "this node's first rank could not load it");
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
 }
 
@@ -439,13 +442,8 @@ TEST(HlodDistributedBake, ANodeThatCannotShareItsMemorySaysSoAndHowToGoOn) {
   const auto mesh = write_mesh(dir);
   const std::vector<RankRun> runs =
       run_ranks(2, [&](int) { return RankPaths{mesh, dir / "out", dir / "cache"}; }, uint64_t(1) << 30, 2, 2, 1024);
-  ASSERT_FALSE(runs[0].status);
-  EXPECT_NE(runs[0].status.message.find("memory this node's ranks share (/dev/shm full?): run with --mesh-copies rank"),
-            std::string::npos)
-      << runs[0].status.message;
-  ASSERT_FALSE(runs[1].status);
-  EXPECT_NE(runs[1].status.message.find("this node's first rank could not load it"), std::string::npos)
-      << runs[1].status.message;
+  expect_failure_saying(runs[0].status, "memory this node's ranks share (/dev/shm full?): run with --mesh-copies rank");
+  expect_failure_saying(runs[1].status, "this node's first rank could not load it");
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "mixed.hlod"));
 }
 
