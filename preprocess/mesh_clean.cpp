@@ -155,33 +155,33 @@ CleanReport clean_mesh(MeshData& mesh) {
   const bool has_submeshes = !mesh.submeshes.empty();
   std::vector<uint32_t> kept_before(has_submeshes ? mesh.triangle_count() + 1 : 0, 0);
   {
-    // Non-degenerate faces by their sorted corners; a face is kept when it is the first of them.
+    // Per face: live, degenerate, or repeating an earlier face's corners.
+    enum : uint8_t { kLive, kDegenerate, kRepeat };
     const size_t nt = mesh.triangle_count();
-    std::vector<uint32_t> live;
-    live.reserve(nt);
+    std::vector<uint8_t> fate(nt, kLive);
     for (size_t t = 0; t < nt; ++t) {
       const uint32_t a = weld[mesh.indices[3 * t]], b = weld[mesh.indices[3 * t + 1]], c = weld[mesh.indices[3 * t + 2]];
-      if (a == b || b == c || a == c ||
-          zero_area(&mesh.positions[3 * a], &mesh.positions[3 * b], &mesh.positions[3 * c])) {
+      if (a == b || b == c || a == c || zero_area(&mesh.positions[3 * a], &mesh.positions[3 * b], &mesh.positions[3 * c])) {
+        fate[t] = kDegenerate;
         ++report.degenerate_faces;
-        continue;
       }
-      live.push_back(uint32_t(t));
     }
-    auto face_key = [&](size_t i) {  // computed when asked: no array of 12-byte keys per face
-      const size_t t = live[i];
+    // Repeats share their least corner: faces are grouped by it (no hash, no 8-byte items).
+    auto face_key = [&](size_t t) {  // computed when asked: no array of 12-byte keys per face
       FaceKey key{{face_weld[mesh.indices[3 * t]], face_weld[mesh.indices[3 * t + 1]], face_weld[mesh.indices[3 * t + 2]]}};
       std::sort(key.v.begin(), key.v.end());
       return key;
     };
-    std::vector<uint32_t> first(live.size());
-    report.duplicate_faces = detail::first_of_equal(live.size(), face_key, first);
-    size_t next = 0;
+    auto least_corner = [&](size_t t) {
+      if (fate[t] == kDegenerate) return detail::kNoGroup;
+      const uint32_t* f = &mesh.indices[3 * t];
+      return std::min({face_weld[f[0]], face_weld[f[1]], face_weld[f[2]]});
+    };
+    report.duplicate_faces = detail::first_of_equal_grouped(nt, nv, least_corner, face_key,
+                                                            [&fate](uint32_t t, uint32_t) { fate[t] = kRepeat; });
     for (size_t t = 0; t < nt; ++t) {
       if (has_submeshes) kept_before[t] = uint32_t(kept);
-      if (next == live.size() || live[next] != t) continue;  // degenerate
-      const size_t i = next++;
-      if (first[i] != i) continue;  // same corners as an earlier face
+      if (fate[t] != kLive) continue;
       for (int k = 0; k < 3; ++k) mesh.indices[3 * kept + k] = weld[mesh.indices[3 * t + k]];
       ++kept;
     }
@@ -193,19 +193,17 @@ CleanReport clean_mesh(MeshData& mesh) {
   // away in pass 1 are never referenced and were already counted there.
   std::vector<uint8_t> used(nv, 0);
   for (uint32_t v : mesh.indices) used[v] = 1;
-  std::vector<uint32_t> remap(nv, UINT32_MAX);
+  std::vector<uint32_t>& remap = weld;  // weld[v] is read only at v, before it is rewritten
   auto move_down = [](std::vector<float>& values, size_t per, size_t from, size_t to) {
     if (from != to)
       std::copy_n(values.begin() + std::ptrdiff_t(per * from), per, values.begin() + std::ptrdiff_t(per * to));
   };
   uint32_t next = 0;
   for (size_t v = 0; v < nv; ++v) {
-    if (weld[v] != v) continue;
-    if (!used[v]) {
-      ++report.unreferenced_vertices;
-      continue;
-    }
-    remap[v] = next;
+    const bool kept_vertex = weld[v] == v && used[v];
+    if (weld[v] == v && !used[v]) ++report.unreferenced_vertices;
+    remap[v] = kept_vertex ? next : UINT32_MAX;
+    if (!kept_vertex) continue;
     move_down(mesh.positions, 3, v, next);
     if (has_normals) move_down(mesh.normals, 3, v, next);
     if (has_uvs) move_down(mesh.uvs, 2, v, next);

@@ -39,7 +39,10 @@ FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -f
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
               preprocess/obj_reader.cpp preprocess/mtl_reader.cpp preprocess/texture_uri.cpp preprocess/gltf_io.cpp
               runtime/file_write.cpp runtime/host_turn.cpp runtime/embedded_image.cpp
-              preprocess/plain_ply_file.cpp runtime/bytes_hasher.cpp)  # gltf_io compiles tinygltf in
+              preprocess/plain_ply_file.cpp runtime/bytes_hasher.cpp preprocess/mesh_clean.cpp preprocess/material_runs.cpp
+              preprocess/first_of_equal.cpp preprocess/cluster_simplifier.cpp
+              preprocess/qem_simplifier.cpp preprocess/position_copies.cpp)  # gltf_io compiles tinygltf in;
+# mesh_clean for the clean's checks, material_runs for it, and the simplifiers material_runs calls
 LOD_SOURCES=(runtime/lod_asset.cpp runtime/bytes_hasher.cpp runtime/lod_chain.cpp runtime/embedded_image.cpp runtime/vertex_tree.cpp
              runtime/vertex_front.cpp runtime/file_write.cpp runtime/host_turn.cpp runtime/model_table.cpp runtime/view.cpp)
 HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp runtime/bytes_hasher.cpp

@@ -4,7 +4,9 @@
 //
 // Checks beyond the sanitizers: a load either fails with a message naming the input, or
 // gives a mesh whose indices are in range and whose coordinates are finite; for PLY, reading
-// the same bytes from a file (load_mesh_hashed) agrees.
+// the same bytes from a file (load_mesh_hashed) agrees; cleaning the mesh leaves faces in
+// range, none degenerate by index, no two on one corner set, the counts adding up, and a
+// second clean with nothing to do.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +16,11 @@
 
 #include <string>
 
+#include <algorithm>
+#include <array>
+#include <set>
+
+#include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
 #include "runtime/bytes_hasher.h"
 
@@ -50,6 +57,21 @@ void check_file_read(const uint8_t* data, size_t size, const lod::Status& from_m
   if (hash != h.finish() || mesh.positions != expected.positions || mesh.indices != expected.indices) std::abort();
 }
 
+void check_clean(lod::MeshData mesh) {
+  const size_t triangles = mesh.triangle_count();
+  const lod::CleanReport report = lod::clean_mesh(mesh);
+  if (mesh.indices.size() % 3 != 0 || triangles - report.degenerate_faces - report.duplicate_faces != mesh.triangle_count())
+    std::abort();
+  std::set<std::array<uint32_t, 3>> corners;
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    std::array<uint32_t, 3> f = {mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]};
+    std::sort(f.begin(), f.end());
+    if (f[2] >= mesh.vertex_count() || f[0] == f[1] || f[1] == f[2] || !corners.insert(f).second) std::abort();
+  }
+  const lod::MeshData once = mesh;
+  if (lod::clean_mesh(mesh).changed() || mesh.indices != once.indices || mesh.positions != once.positions) std::abort();
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   lod::MeshData mesh;
   const lod::Status s = lod::load_mesh_from_memory("fuzz-input", LOD_FUZZ_EXT, data, size, mesh);
@@ -66,5 +88,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (i >= mesh.vertex_count()) std::abort();
   for (float c : mesh.positions)
     if (!std::isfinite(c)) std::abort();
+  check_clean(mesh);
   return 0;
 }

@@ -69,6 +69,39 @@ TEST(FirstOfEqual, EmptyAndSingle) {
   expect_reference({Key3{{1, 2, 3}}}, [](const Key3& k) { return hash_key(k); });
 }
 
+// first_of_equal_grouped against the map, over the items not left out: group_of = a word of
+// the key mod `groups` (equal keys share a group), `skip` every skip-th item left out.
+void expect_grouped_reference(const std::vector<Key3>& keys, uint32_t groups, size_t skip) {
+  auto left_out = [skip](size_t i) { return skip && i % skip == 0; };
+  std::vector<Key3> taking;
+  std::vector<size_t> index;
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (!left_out(i)) taking.push_back(keys[i]), index.push_back(i);
+  size_t want_repeats = 0;
+  const std::vector<uint32_t> first = reference(taking, want_repeats);
+  std::vector<uint32_t> want(keys.size()), got(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) want[i] = got[i] = uint32_t(i);
+  for (size_t k = 0; k < taking.size(); ++k) want[index[k]] = uint32_t(index[first[k]]);
+  const size_t repeats = first_of_equal_grouped(
+      keys.size(), groups, [&](size_t i) { return left_out(i) ? kNoGroup : keys[i].w[1] % groups; },
+      [&](size_t i) { return keys[i]; }, [&](uint32_t i, uint32_t j) { got[i] = j; });
+  EXPECT_EQ(repeats, want_repeats) << groups << " groups";
+  EXPECT_EQ(got, want) << groups << " groups";
+}
+
+TEST(FirstOfEqualGrouped, MatchesFirstOccurrencesInGroupsSmallAndLarge) {
+  // One group holds everything (sorted past 16 keys); many groups of a few keys each.
+  for (uint32_t groups : {1u, 7u, 5000u})
+    for (uint32_t distinct : {1u, 12u, 300u, 20000u}) expect_grouped_reference(random_keys(20000, distinct, distinct + groups), groups, 0);
+}
+
+TEST(FirstOfEqualGrouped, ItemsLeftOutNeitherRepeatNorAreRepeated) {
+  // Every third item is out: an item equal only to left-out ones is a first occurrence.
+  expect_grouped_reference(random_keys(9000, 40, 5), 3, 3);
+  expect_grouped_reference(random_keys(9000, 40, 5), 1000, 2);
+  expect_grouped_reference({}, 4, 0);
+}
+
 TEST(RadixSortByHigh32, SortsByHighWordAndKeepsOrderOfEqualOnes) {
   std::mt19937_64 rng(11);
   for (size_t n : {size_t(100000), (size_t(1) << 20) + 5}) {  // three 11-bit passes, two 16-bit ones
