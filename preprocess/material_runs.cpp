@@ -57,6 +57,7 @@ size_t split_vertices_by_material(MeshData& mesh) {
 
 std::vector<int32_t> vertex_materials(const MeshView& mesh) {
   std::vector<int32_t> out(mesh.vertex_count(), -1);
+  if (mesh.submeshes.empty()) return out;  // no per-triangle array of -1s to go through
   const std::vector<int32_t> tri = triangle_materials(mesh);
   for (size_t t = 0; t < tri.size(); ++t)
     for (int c = 0; c < 3; ++c)

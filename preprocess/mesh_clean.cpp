@@ -106,7 +106,9 @@ CleanReport clean_mesh(MeshData& mesh) {
   CleanReport report;
   // Pass 0: a vertex shared by two materials becomes one per material.
   report.material_split_vertices = split_vertices_by_material(mesh);
-  const std::vector<int32_t> material = vertex_materials(mesh);
+  // Without submeshes every vertex is of no material (-1): no per-vertex array for it.
+  const std::vector<int32_t> materials = mesh.submeshes.empty() ? std::vector<int32_t>{} : vertex_materials(mesh);
+  auto material = [&materials](size_t v) { return materials.empty() ? -1 : materials[v]; };
   const size_t nv = mesh.vertex_count();
   const bool has_normals = mesh.normals.size() == mesh.positions.size();
   const bool has_uvs = mesh.uvs.size() == 2 * nv;
@@ -121,9 +123,9 @@ CleanReport clean_mesh(MeshData& mesh) {
   // occurrence.
   std::vector<uint32_t> weld(nv);
   report.duplicate_vertices =
-      wide      ? detail::first_of_equal(nv, [&](size_t v) { return wide_key(v, material[v]); }, weld)
-      : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], material[v]); }, weld)
-              : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], material[v]); }, weld);
+      wide      ? detail::first_of_equal(nv, [&](size_t v) { return wide_key(v, material(v)); }, weld)
+      : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], material(v)); }, weld)
+              : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], material(v)); }, weld);
 
   // Faces repeat each other by their corners' positions (and uvs) whatever their materials:
   // the same face twice in two materials would fight for the same pixels.
