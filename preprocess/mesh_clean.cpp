@@ -135,7 +135,11 @@ CleanReport clean_mesh(MeshData& mesh) {
     wide      ? detail::first_of_equal(nv, [&](size_t v) { return wide_key(v, 0); }, same_place)
     : has_uvs ? detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], &mesh.uvs[2 * v], 0); }, same_place)
             : detail::first_of_equal(nv, [&](size_t v) { return key_of(&mesh.positions[3 * v], 0); }, same_place);
-  const std::vector<uint32_t>& face_weld = split ? same_place : weld;
+  // Weld the corners in place (what every kept face keeps); a corner's place, by which faces
+  // repeat each other, is then its vertex, or with materials split its first same-place vertex
+  // (a vertex welds only onto one of the same place).
+  for (uint32_t& v : mesh.indices) v = weld[v];
+  auto place = [&](uint32_t v) { return split ? same_place[v] : v; };
 
   // Normals are not part of the weld: say where that merged two that differ (a hard edge).
   if (has_normals) {
@@ -162,7 +166,7 @@ CleanReport clean_mesh(MeshData& mesh) {
     const size_t nt = mesh.triangle_count();
     std::vector<uint8_t> fate(nt, kLive);
     for (size_t t = 0; t < nt; ++t) {
-      const uint32_t a = weld[mesh.indices[3 * t]], b = weld[mesh.indices[3 * t + 1]], c = weld[mesh.indices[3 * t + 2]];
+      const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1], c = mesh.indices[3 * t + 2];
       if (a == b || b == c || a == c || zero_area(&mesh.positions[3 * a], &mesh.positions[3 * b], &mesh.positions[3 * c])) {
         fate[t] = kDegenerate;
         ++report.degenerate_faces;
@@ -170,21 +174,22 @@ CleanReport clean_mesh(MeshData& mesh) {
     }
     // Repeats share their least corner: faces are grouped by it (no hash, no 8-byte items).
     auto face_key = [&](size_t t) {  // computed when asked: no array of 12-byte keys per face
-      FaceKey key{{face_weld[mesh.indices[3 * t]], face_weld[mesh.indices[3 * t + 1]], face_weld[mesh.indices[3 * t + 2]]}};
+      FaceKey key{{place(mesh.indices[3 * t]), place(mesh.indices[3 * t + 1]), place(mesh.indices[3 * t + 2])}};
       std::sort(key.v.begin(), key.v.end());
       return key;
     };
     auto least_corner = [&](size_t t) {
       if (fate[t] == kDegenerate) return detail::kNoGroup;
       const uint32_t* f = &mesh.indices[3 * t];
-      return std::min({face_weld[f[0]], face_weld[f[1]], face_weld[f[2]]});
+      return std::min({place(f[0]), place(f[1]), place(f[2])});
     };
     report.duplicate_faces = detail::first_of_equal_grouped(nt, nv, least_corner, face_key,
-                                                            [&fate](uint32_t t, uint32_t) { fate[t] = kRepeat; });
+                                                            [&fate](uint32_t t, uint32_t) { fate[t] = kRepeat; },
+                                                            [&](uint32_t t) { __builtin_prefetch(&mesh.indices[3 * size_t(t)]); });
     for (size_t t = 0; t < nt; ++t) {
       if (has_submeshes) kept_before[t] = uint32_t(kept);
       if (fate[t] != kLive) continue;
-      for (int k = 0; k < 3; ++k) mesh.indices[3 * kept + k] = weld[mesh.indices[3 * t + k]];
+      for (int k = 0; k < 3; ++k) mesh.indices[3 * kept + k] = mesh.indices[3 * t + k];
       ++kept;
     }
     if (has_submeshes) kept_before[mesh.triangle_count()] = uint32_t(kept);
