@@ -355,19 +355,23 @@ constexpr uint32_t kMaxGridCells = 65535;
 
 // Each vertex's cell per axis. The cell is monotonic in the coordinate, so a triangle's box's
 // cells are its vertices' least and greatest: once per vertex instead of once per use.
-std::vector<uint16_t> vertex_cells(const TriangleMeshView& mesh, const SurfaceGrid& g) {
-  std::vector<uint16_t> cells(3 * mesh.vertex_count);
-  for (size_t v = 0; v < mesh.vertex_count; ++v)
-    for (int k = 0; k < 3; ++k) cells[3 * v + k] = uint16_t(g.cell(mesh.positions[3 * v + k], k));
+// Per vertex, the index of its cell (x fastest): a triangle whose three agree lies in one cell.
+std::vector<uint32_t> vertex_cells(const TriangleMeshView& mesh, const SurfaceGrid& g) {
+  std::vector<uint32_t> cells(mesh.vertex_count);
+  for (size_t v = 0; v < mesh.vertex_count; ++v) {
+    const float* p = mesh.positions + 3 * v;
+    cells[v] = (g.cell(p[2], 2) * g.n + g.cell(p[1], 1)) * g.n + g.cell(p[0], 0);
+  }
   return cells;
 }
 
-CellRange cells_of_triangle(const uint16_t* cells, const uint32_t* f) {
-  const uint16_t* a = cells + 3 * size_t(f[0]);
-  const uint16_t* b = cells + 3 * size_t(f[1]);
-  const uint16_t* c = cells + 3 * size_t(f[2]);
+CellRange cells_of_triangle(const TriangleMeshView& mesh, const SurfaceGrid& g, const uint32_t* f) {
   CellRange r;
-  for (int k = 0; k < 3; ++k) r.lo[k] = std::min({a[k], b[k], c[k]}), r.hi[k] = std::max({a[k], b[k], c[k]});
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t a = g.cell(mesh.positions[3 * size_t(f[0]) + k], k), b = g.cell(mesh.positions[3 * size_t(f[1]) + k], k),
+                   c = g.cell(mesh.positions[3 * size_t(f[2]) + k], k);
+    r.lo[k] = std::min({a, b, c}), r.hi[k] = std::max({a, b, c});
+  }
   return r;
 }
 
@@ -422,8 +426,9 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
   m.ready = false;
   m.what = what;
   m.surface.release();
-  if (whole.index_count % 3 != 0 || grid.n == 0 || grid.n > kMaxGridCells || wanted.size() != grid.cells())
-    return Status::error(what + ": a surface part needs whole triangles and one flag per grid cell");
+  if (whole.index_count % 3 != 0 || grid.n == 0 || grid.n > kMaxGridCells || wanted.size() != grid.cells() ||
+      grid.cells() > UINT32_MAX)
+    return Status::error(what + ": a surface part needs whole triangles and one flag per grid cell (at most 2^32)");
   for (size_t i = 0; i < whole.index_count; ++i)
     if (whole.indices[i] >= whole.vertex_count)
       return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
@@ -436,7 +441,7 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
   // reaches into is incomplete.
   m.grid = grid;
   m.complete.assign(grid.cells(), 1);
-  const std::vector<uint16_t> cells = vertex_cells(whole, grid);
+  const std::vector<uint32_t> cells = vertex_cells(whole, grid);
   std::vector<uint32_t> remap(whole.vertex_count, UINT32_MAX);
   QueryMesh& part = m.surface;
   part.positions.clear();
@@ -446,9 +451,14 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
   part.indices.reserve(whole.index_count);
   for (size_t t = 0; t < whole.index_count / 3; ++t) {
     const uint32_t* f = whole.indices + 3 * t;
-    const CellRange range = cells_of_triangle(cells.data(), f);
-    const bool keep = range.count() > kPartSpanCells || !range.all(grid, [&](size_t c) { return wanted[c] == 0; });
-    if (!keep) {
+    const uint32_t cell = cells[f[0]];
+    if (cell == cells[f[1]] && cell == cells[f[2]]) {  // most triangles: one cell, one flag
+      if (!wanted[cell]) {
+        m.complete[cell] = 0;
+        continue;
+      }
+    } else if (const CellRange range = cells_of_triangle(whole, grid, f);
+               range.count() <= kPartSpanCells && range.all(grid, [&](size_t c) { return wanted[c] == 0; })) {
       range.all(grid, [&](size_t c) { return m.complete[c] = 0, true; });
       continue;
     }
