@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace lod {
 namespace {
 
@@ -118,6 +120,31 @@ TEST(MeshClean, DropsDuplicateFacesWhateverTheirOrientation) {
   const CleanReport r = clean_mesh(m);
   EXPECT_EQ(r.duplicate_faces, 2u);
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
+}
+
+// Repeated faces are found among the faces of one least corner: a fan of 40 faces around
+// vertex 0 (past the 16 distinct keys a group compares directly), each repeated later in
+// another winding, some through a welded copy of its rim vertex; the first of each is kept.
+TEST(MeshClean, DropsRepeatsInAWideFanKeepingTheFirstOfEach) {
+  constexpr uint32_t kRim = 41;  // rim vertices 1..41, then copies of them at 42..82
+  std::vector<float> p = {0, 0, 0};
+  for (uint32_t k = 0; k < kRim; ++k) p.insert(p.end(), {std::cos(0.07f * float(k)), std::sin(0.07f * float(k)), 0});
+  for (uint32_t k = 0; k < kRim; ++k) p.insert(p.end(), p.begin() + 3 * (1 + k), p.begin() + 3 * (2 + k));
+  std::vector<uint32_t> fan, repeats;
+  for (uint32_t k = 1; k < kRim; ++k) {
+    fan.insert(fan.end(), {0, k, k + 1});
+    const uint32_t a = k % 2 ? k + kRim : k;  // every other repeat names the copy
+    repeats.insert(repeats.end(), {k + 1, 0, a});
+  }
+  std::vector<uint32_t> all = fan;
+  all.insert(all.end(), repeats.begin(), repeats.end());
+  MeshData m = make(p, all);
+  const CleanReport r = clean_mesh(m);
+  EXPECT_EQ(r.duplicate_faces, kRim - 1);
+  EXPECT_EQ(r.duplicate_vertices, kRim);
+  EXPECT_EQ(r.degenerate_faces, 0u);
+  EXPECT_EQ(m.indices, fan);
+  EXPECT_EQ(m.vertex_count(), size_t(kRim) + 1);
 }
 
 TEST(MeshClean, WeldsBitIdenticalVerticesOntoTheFirst) {
