@@ -353,9 +353,9 @@ constexpr size_t kPartSpanCells = 4096;
 // Cells per axis a part's grid may have: a cell coordinate fits 16 bits (and the flags memory).
 constexpr uint32_t kMaxGridCells = 65535;
 
-// Each vertex's cell per axis. The cell is monotonic in the coordinate, so a triangle's box's
-// cells are its vertices' least and greatest: once per vertex instead of once per use.
-// Per vertex, the index of its cell (x fastest): a triangle whose three agree lies in one cell.
+// Per vertex, the index of its cell (x fastest), once per vertex instead of once per use: a
+// triangle whose three agree lies in that cell. The cell is monotonic in the coordinate, so a
+// triangle's box's cells are its vertices' least and greatest on each axis (cells_of_triangle).
 std::vector<uint32_t> vertex_cells(const TriangleMeshView& mesh, const SurfaceGrid& g) {
   std::vector<uint32_t> cells(mesh.vertex_count);
   for (size_t v = 0; v < mesh.vertex_count; ++v) {
