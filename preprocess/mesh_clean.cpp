@@ -79,6 +79,8 @@ AttributeKey key_of(const float* p, const float* uv, const float* uv1, const flo
 struct FaceKey {
   std::array<uint32_t, 3> v;  // sorted
   auto operator<=>(const FaceKey&) const = default;
+  // Word by word: the array's own == is a memcmp call per comparison, a tenth of the clean.
+  bool operator==(const FaceKey& o) const { return v[0] == o.v[0] && v[1] == o.v[1] && v[2] == o.v[2]; }
 };
 
 bool zero_area(const float* a, const float* b, const float* c) {
