@@ -204,8 +204,7 @@ CleanReport clean_mesh(MeshData& mesh) {
   for (uint32_t v : mesh.indices) used[v] = 1;
   std::vector<uint32_t>& remap = weld;  // weld[v] is read only at v, before it is rewritten
   auto move_down = [](std::vector<float>& values, size_t per, size_t from, size_t to) {
-    if (from != to)
-      std::copy_n(values.begin() + std::ptrdiff_t(per * from), per, values.begin() + std::ptrdiff_t(per * to));
+    for (size_t k = 0; k < per && from != to; ++k) values[per * to + k] = values[per * from + k];  // no memmove call per vertex
   };
   uint32_t next = 0;
   for (size_t v = 0; v < nv; ++v) {
