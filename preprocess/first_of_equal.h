@@ -122,8 +122,8 @@ size_t first_of_equal_grouped(size_t n, size_t groups, const GroupOf& group_of, 
   size_t repeats = 0, touched = 0;
   for (size_t g = 0, begin = 0; g < groups; begin = start[g++]) {
     if (start[g] - begin < 2) continue;
-    for (const size_t ahead = std::min<size_t>(start[g] + kAhead, order.size()); touched < ahead; ++touched)
-      if (touched >= begin) touch(order[touched]);
+    for (touched = std::max(touched, begin); touched < std::min<size_t>(start[g] + kAhead, order.size()); ++touched)
+      touch(order[touched]);
     repeats += first_in_group(order.data() + begin, start[g] - begin, key_of, repeat);
   }
   return repeats;

@@ -168,7 +168,7 @@ void BM_FaceGroupsByLeastCorner(benchmark::State& state) {
     std::vector<uint8_t> repeats(keys.size(), 0);
     benchmark::DoNotOptimize(detail::first_of_equal_grouped(
         keys.size(), vertices, [&](size_t i) { return keys[i].v[0]; }, [&](size_t i) { return keys[i]; },
-        [&repeats](uint32_t i, uint32_t) { repeats[i] = 1; }));
+        [&repeats](uint32_t i, uint32_t) { repeats[i] = 1; }, [&keys](uint32_t i) { __builtin_prefetch(&keys[i]); }));
   }
 }
 
