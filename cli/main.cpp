@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
+#include "cli/freed_memory.h"
 #include "cli/huge_page_malloc.h"
 
 int main(int argc, char** argv) {
@@ -79,7 +80,10 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (run_cmd->parsed()) return lod::cli::run_command(run);
   if (inspect_cmd->parsed()) return lod::cli::inspect_command(inspect);
-  if (bake_cmd->parsed()) return lod::cli::bake_command(bake);
+  if (bake_cmd->parsed()) {
+    lod::cli::keep_freed_memory();  // a batch job: what one phase frees, the next reuses
+    return lod::cli::bake_command(bake);
+  }
   if (export_cmd->parsed()) return lod::cli::export_command(exp);
   return 2;
 }

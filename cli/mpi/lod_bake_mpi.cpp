@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "cli/freed_memory.h"
 #include "cli/huge_page_malloc.h"
 #include "jobs/hlod_distributed_bake.h"
 #include "jobs/hlod_models_distributed.h"
@@ -166,6 +167,7 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
           // these figures come from is shared).
           {"critical_cpu_s", r.critical_cpu_seconds},
           {"malloc_huge_pages", cli::malloc_uses_huge_pages()},  // rank 0's (cli/huge_page_malloc.h)
+          {"malloc_keeps_freed_memory", cli::malloc_keeps_freed_memory()},  // (cli/freed_memory.h)
           {"balance_cpu", sum > 0 ? slowest / (sum / double(r.ranks.size())) : 1.0}, {"per_rank", per_rank}};
 }
 
@@ -203,6 +205,7 @@ nlohmann::json to_json(const HlodModelsResult& r, int ranks) {
           // The job on idle cores: the slowest rank's check and whole models + every split model's critical CPU.
           {"critical_cpu_s", r.critical_cpu_seconds},
           {"malloc_huge_pages", cli::malloc_uses_huge_pages()},
+          {"malloc_keeps_freed_memory", cli::malloc_keeps_freed_memory()},
           // The slowest rank's bake CPU / the mean: whole and split models; whole ones only.
           {"balance_cpu", r.balance_cpu}, {"balance_whole_cpu", r.balance_whole_cpu},
           {"models", models}, {"per_rank", per_rank}};
@@ -325,6 +328,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
 
 int main(int argc, char** argv) {
   lod::cli::restart_with_huge_page_malloc(argv);  // before MPI_Init: the rank starts again as itself
+  lod::cli::keep_freed_memory();
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);  // MPI from the main thread only
   const int code = run(argc, argv, mpi_comm());
