@@ -294,6 +294,26 @@ TEST(LodBakeMpi, RanksAskForHugePagesUnlessToldNotTo) {
   }
 }
 
+// Each rank keeps what it frees for its next phase (cli/freed_memory.h) unless told not to; the
+// bytes never change.
+TEST(LodBakeMpi, RanksKeepFreedMemoryUnlessToldNotTo) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's allocator refuses glibc's mallopt";
+#endif
+  const auto dir = test::temp_dir("lod_bake_mpi_freed_memory");
+  const std::pair<std::string, bool> cases[] = {{"", true}, {"LOD_KEEP_FREED_MEMORY=0", false}};
+  int k = 0;
+  for (const auto& [env, keeps] : cases) {
+    const auto run = dir / std::to_string(k++);
+    const test::CliResult r = run_mpi(2, bake_args(run / "out", run / "cache") + " --json", env);
+    ASSERT_EQ(r.code, 0) << env << "\n" << r.out;
+    const nlohmann::json j = test::printed_json(r);
+    ASSERT_TRUE(j.is_object()) << r.out;
+    EXPECT_EQ(j["malloc_keeps_freed_memory"], keeps) << env;
+    EXPECT_EQ(test::read_bytes(run / "out" / "ball.hlod"), fixture().local) << env;
+  }
+}
+
 // One node here: with --mesh-copies node its first rank loads the mesh into the memory the
 // ranks share and the others read it in place; with rank every rank has its own copy; auto
 // shares from 8 ranks on a node. The same bytes every way.
