@@ -1,5 +1,5 @@
-// On the 13.9M-triangle HLOD bake at 2 ranks x 1 thread, each rank's critical CPU fell from
-// 17.5-18.0 s to 16.7-16.9 s, its kernel time from 1.9-2.6 s to 1.7-1.8 s, peak RSS unchanged
+// On the 13.9M-triangle HLOD bake (1 thread per rank) the busiest rank's kernel CPU fell from
+// 1.5-2.9 s to 0.65-1.8 s at 2 ranks, and from 2.2-2.9 s to 0.55-1.3 s at 1, peak RSS no higher
 // (docs/distributed-bake-measurements.md, "Stop 35").
 #include "cli/freed_memory.h"
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -267,6 +268,21 @@ TEST(LodBakeMpi, FailingRankNamesTheSubtreeAndTheJobFailsKeepingTheCache) {
   EXPECT_EQ(entries(dir / "cache"), files.size() - 1);
 }
 
+// A 2-rank bake per environment: `key` in --json as expected, the bytes those of the local bake.
+void expect_malloc_flag(const char* dir_name, const char* key, std::initializer_list<std::pair<std::string, bool>> cases) {
+  const auto dir = test::temp_dir(dir_name);
+  int k = 0;
+  for (const auto& [env, expected] : cases) {
+    const auto run = dir / std::to_string(k++);
+    const test::CliResult r = run_mpi(2, bake_args(run / "out", run / "cache") + " --json", env);
+    ASSERT_EQ(r.code, 0) << env << "\n" << r.out;
+    const nlohmann::json j = test::printed_json(r);
+    ASSERT_TRUE(j.is_object()) << r.out;
+    EXPECT_EQ(j[key], expected) << env;
+    EXPECT_EQ(test::read_bytes(run / "out" / "ball.hlod"), fixture().local) << env;
+  }
+}
+
 // Each rank starts itself again with glibc.malloc.hugetlb=1 where the kernel gives huge pages by
 // madvise (cli/huge_page_malloc.h), unless told not to; the bytes never change.
 TEST(LodBakeMpi, RanksAskForHugePagesUnlessToldNotTo) {
@@ -278,20 +294,8 @@ TEST(LodBakeMpi, RanksAskForHugePagesUnlessToldNotTo) {
   std::getline(thp, modes);
   if (modes.find("[madvise]") == std::string::npos)
     GTEST_SKIP() << "transparent huge pages are not in madvise mode here: '" << modes << "'";
-  const auto dir = test::temp_dir("lod_bake_mpi_huge_pages");
-  const std::pair<std::string, bool> cases[] = {{"", true},
-                                                {"LOD_HUGE_PAGES=0", false},
-                                                {"GLIBC_TUNABLES=glibc.malloc.hugetlb=0", false}};
-  int k = 0;
-  for (const auto& [env, huge] : cases) {
-    const auto run = dir / std::to_string(k++);
-    const test::CliResult r = run_mpi(2, bake_args(run / "out", run / "cache") + " --json", env);
-    ASSERT_EQ(r.code, 0) << env << "\n" << r.out;
-    const nlohmann::json j = test::printed_json(r);
-    ASSERT_TRUE(j.is_object()) << r.out;
-    EXPECT_EQ(j["malloc_huge_pages"], huge) << env;
-    EXPECT_EQ(test::read_bytes(run / "out" / "ball.hlod"), fixture().local) << env;
-  }
+  expect_malloc_flag("lod_bake_mpi_huge_pages", "malloc_huge_pages",
+                     {{"", true}, {"LOD_HUGE_PAGES=0", false}, {"GLIBC_TUNABLES=glibc.malloc.hugetlb=0", false}});
 }
 
 // Each rank keeps what it frees for its next phase (cli/freed_memory.h) unless told not to; the
@@ -300,18 +304,8 @@ TEST(LodBakeMpi, RanksKeepFreedMemoryUnlessToldNotTo) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "a sanitizer's allocator refuses glibc's mallopt";
 #endif
-  const auto dir = test::temp_dir("lod_bake_mpi_freed_memory");
-  const std::pair<std::string, bool> cases[] = {{"", true}, {"LOD_KEEP_FREED_MEMORY=0", false}};
-  int k = 0;
-  for (const auto& [env, keeps] : cases) {
-    const auto run = dir / std::to_string(k++);
-    const test::CliResult r = run_mpi(2, bake_args(run / "out", run / "cache") + " --json", env);
-    ASSERT_EQ(r.code, 0) << env << "\n" << r.out;
-    const nlohmann::json j = test::printed_json(r);
-    ASSERT_TRUE(j.is_object()) << r.out;
-    EXPECT_EQ(j["malloc_keeps_freed_memory"], keeps) << env;
-    EXPECT_EQ(test::read_bytes(run / "out" / "ball.hlod"), fixture().local) << env;
-  }
+  expect_malloc_flag("lod_bake_mpi_freed_memory", "malloc_keeps_freed_memory",
+                     {{"", true}, {"LOD_KEEP_FREED_MEMORY=0", false}});
 }
 
 // One node here: with --mesh-copies node its first rank loads the mesh into the memory the
