@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "cli/huge_page_malloc.h"
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -18,10 +20,9 @@ bool kept = false;
 
 void keep_freed_memory() {
   const char* off = std::getenv("LOD_KEEP_FREED_MEMORY");
-  if (off && std::string(off) == "0") return;
+  if ((off && std::string(off) == "0") || sanitizer_allocator()) return;
 #if defined(__GLIBC__)
-  // Both or neither: without the trim threshold the heap's free top still goes back (and a
-  // sanitizer's allocator refuses both, returning 0).
+  // Both or neither: without the trim threshold the heap's free top still goes back.
   if (mallopt(M_TRIM_THRESHOLD, INT_MAX) != 1) return;
   if (mallopt(M_MMAP_MAX, 0) != 1) {
     mallopt(M_TRIM_THRESHOLD, 128 * 1024);  // glibc's default

@@ -37,6 +37,16 @@ bool glibc_reads_the_tunable() {
 #endif
 }
 
+// The value given to glibc.malloc.hugetlb ('\0' when none): 1 is THP by madvise, 2 hugetlbfs.
+char hugetlb_value() {
+  const char* t = std::getenv("GLIBC_TUNABLES");
+  const std::string key = "glibc.malloc.hugetlb=", all = t ? t : "";
+  const size_t at = all.find(key);
+  return at == std::string::npos || at + key.size() >= all.size() ? '\0' : all[at + key.size()];
+}
+
+}  // namespace
+
 bool sanitizer_allocator() {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   return true;
@@ -47,16 +57,6 @@ bool sanitizer_allocator() {
 #endif
   return false;
 }
-
-// The value given to glibc.malloc.hugetlb ('\0' when none): 1 is THP by madvise, 2 hugetlbfs.
-char hugetlb_value() {
-  const char* t = std::getenv("GLIBC_TUNABLES");
-  const std::string key = "glibc.malloc.hugetlb=", all = t ? t : "";
-  const size_t at = all.find(key);
-  return at == std::string::npos || at + key.size() >= all.size() ? '\0' : all[at + key.size()];
-}
-
-}  // namespace
 
 void restart_with_huge_page_malloc(char** argv) {
   const char* off = std::getenv("LOD_HUGE_PAGES");

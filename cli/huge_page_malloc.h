@@ -11,6 +11,9 @@ namespace lod::cli {
 // process goes on as it is (including when the exec fails). Call first thing in main.
 void restart_with_huge_page_malloc(char** argv);
 
+// Whether malloc is a sanitizer's (ASan, TSan, MSan): glibc's tunables and mallopt do not reach it.
+bool sanitizer_allocator();
+
 // Whether this process's malloc gets transparent huge pages (the tunable above, or THP "always").
 bool malloc_uses_huge_pages();
 
