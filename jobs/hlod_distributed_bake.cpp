@@ -68,7 +68,7 @@ void each_number(Work& w, F&& f) {
   f(w.subtrees), f(w.triangles), f(w.checked), f(w.bytes_checked), f(w.bake_seconds), f(w.bake_cpu_seconds),
       f(w.total_seconds), f(w.cpu_seconds), f(w.load_cpu_seconds), f(w.clean_cpu_seconds), f(w.plan_cpu_seconds),
       f(w.check_cpu_seconds), f(w.surface_cpu_seconds), f(w.measure_cpu_seconds), f(w.write_cpu_seconds),
-      f(w.bytes_written), f(w.bytes_placed), f(w.bytes_read_back), f(w.region_triangles), f(w.whole_surface),
+      f(w.bytes_written), f(w.bytes_placed), f(w.bytes_read_back), f(w.part_triangles), f(w.whole_surface),
       f(w.mesh_loaded), f(w.kernel_cpu_seconds), f(w.peak_rss_bytes);
 }
 
@@ -431,7 +431,7 @@ std::unique_ptr<CacheProgress> watch_progress(const Job& j) {
 }
 
 // Who writes each subtree's payloads: the rank that checked a cached entry, or bakes a missing
-// one (the missing ones in contiguous runs of their own). A rank's region is what it writes.
+// one (the missing ones in contiguous runs of their own).
 void assign_writers(Job& j) {
   const std::vector<int> checker = spatial_share(j, nullptr);
   std::vector<size_t> todo;
@@ -440,10 +440,6 @@ void assign_writers(Job& j) {
     else j.writer[i] = checker[i];
   const std::vector<int> owner = spatial_share(j, &todo);
   for (size_t k = 0; k < todo.size(); ++k) j.writer[todo[k]] = owner[k];
-  std::vector<size_t> region;
-  for (size_t i = 0; i < j.writer.size(); ++i)
-    if (j.writer[i] == j.comm.rank) region.push_back(i);
-  j.builder->set_region(region);
 }
 
 // The cleaned mesh goes into the cache before any subtree is baked (a rerun after a kill skips
@@ -514,7 +510,7 @@ RankReport bake_share(Job& j, const std::vector<size_t>& mine) {
   j.work.bake_seconds = seconds_since(t0);
   j.work.bake_cpu_seconds = process_cpu_seconds() - cpu0;
   j.work.surface_cpu_seconds = j.builder->surface_cpu_seconds();
-  j.work.region_triangles = j.builder->region_triangles();
+  j.work.part_triangles = j.builder->part_triangles();
   j.work.whole_surface = j.builder->whole_surface_built() ? 1 : 0;
   if (!rep.status) rep.status.message = "rank " + std::to_string(j.comm.rank) + ": " + rep.status.message;
   return rep;
@@ -661,7 +657,7 @@ std::vector<int> probe_owners(const std::vector<HlodLayerProbe>& probes, int ran
   return assign_subtrees(costs, ranks);
 }
 
-// Every rank: the top's layers measured by sample, each rank the samples its region answers
+// Every rank: the top's layers measured by sample, each rank those in the cells it baked
 // (the original's side of its share of the layers as well). The reply: a status, then per
 // layer the largest distance found, the other side's errors of its share, and per layer which
 // samples it answered (bits).

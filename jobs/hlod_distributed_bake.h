@@ -8,12 +8,13 @@
 //   gather       which entries were found -> rank 0 broadcasts which are missing
 //   every rank   bake its share of the missing ones (spatially contiguous runs balanced by
 //                cost), each result stored in the cache as it is finished; queries against
-//                the original go to a BVH over the rank's region (HlodBuilder::set_region)
+//                the original go to a BVH of the part of it near the subtree being measured
 //   gather       per rank: its status (a failure names the subtree), work and bytes
 //   rank 0       read the subtrees' roots from the entries (a refused one is baked again here),
 //                build the layers of the levels above -> broadcast them
-//   every rank   measure those layers' samples its region answers (and the other side of a
-//                share of them) -> gather -> rank 0 measures any sample no region answered
+//   every rank   measure those layers' samples in the cells it baked (against the parts of the
+//                original it kept) and the other side of a share of the layers -> gather ->
+//                rank 0 measures any sample no rank answered, against the original near them
 //   rank 0       finish the levels above, write the head and their payloads into a temporary
 //                file at its full size -> broadcast where every subtree node's payload goes
 //   every rank   write the payloads of the subtrees it baked or checked, at those offsets (from
@@ -77,7 +78,7 @@ std::vector<int> assign_subtrees(const std::vector<uint64_t>& costs, int ranks);
 // Spatially contiguous runs: subtrees taken in `order` (a permutation of their indices; the
 // top's depth-first order keeps neighbours together), each to the rank whose 1/ranks of the
 // total cost holds the middle of the subtree's cost. The slowest rank then carries at most the
-// mean plus one subtree, and each rank's cells form a few compact regions (its BVH's region).
+// mean plus one subtree, and each rank's cells form a few compact regions.
 std::vector<int> assign_subtrees_spatially(const std::vector<uint64_t>& costs, const std::vector<size_t>& order,
                                            int ranks);
 // The same with unequal shares: rank r's run ends at cuts[r] of the total cost (fractions,
@@ -135,7 +136,7 @@ struct HlodRankWork {
   uint64_t bytes_written = 0;      // cache entries
   uint64_t bytes_placed = 0;       // payload bytes it wrote into the .hlod
   uint64_t bytes_read_back = 0;    // of entries it did not hold (held_entry_bytes), read back to write them
-  uint64_t region_triangles = 0;   // in its region's BVH (the original's triangles near its cells)
+  uint64_t part_triangles = 0;     // in the BVHs of the original's parts it built (near each subtree)
   uint32_t whole_surface = 0;      // 1: it needed the whole original's BVH too
   uint32_t mesh_loaded = 0;        // 1: it loaded the mesh (its own copy, or its node's for all)
   // The process over its whole run so far (getrusage, at its last report): CPU time in the kernel
@@ -156,7 +157,7 @@ struct HlodDistributedResult {
   uint64_t entry_bytes_read = 0;                  // rank 0: of the entries, to take up their roots
   double cpu_after_gather_seconds = 0;            // rank 0: CPU time reading roots, assembling, writing
   double collect_cpu_seconds = 0, assemble_cpu_seconds = 0, head_cpu_seconds = 0;  // rank 0, after the gather
-  // Rank 0: the top's samples no rank's region answered (measured by rank 0 near them), and
+  // Rank 0: the top's samples no rank answered (measured by rank 0 near them), and
   // whether rank 0 needed the whole original's BVH at all (a refused entry rebaked, or those).
   size_t top_samples_left = 0;
   bool top_whole_surface = false;

@@ -93,6 +93,13 @@ Attributes attribute_layout(const MeshView& mesh) {
   return a;
 }
 
+// What a node's layers are measured against: a part of the original near the node, and the
+// whole original for a query the part cannot answer as it would (built on first need).
+struct Queries {
+  const SurfaceDistance* part = nullptr;
+  std::function<const SurfaceDistance*()> whole;
+};
+
 struct Context {
   const HlodBuildOptions& options;
   const float* positions = nullptr;
@@ -106,9 +113,7 @@ struct Context {
   std::vector<uint32_t> stamp;         // per vertex: which node last visited it
   std::vector<uint32_t> local;         // per vertex: its index in that node's arrays
   std::atomic<uint32_t> next_stamp{1};
-  SurfaceDistance original;                        // the whole original, when built
-  const SurfaceDistance* region = nullptr;         // a part of it (set_region): queries go there first
-  std::function<const SurfaceDistance*()> whole;  // with a region: the whole original, built on first call
+  SurfaceDistance original;  // the whole original, when a query needs it (rarely: see Queries)
   uint64_t total_triangles = 0;
   std::atomic<uint64_t> done_triangles{0};
 
@@ -361,12 +366,18 @@ void reference_samples(const Context& c, const std::vector<uint32_t>& reference,
 // Each comes with a distance the original surface is known to be within (to the original
 // vertex it, or its triangle's nearest corner, descends from), so that its closest-point
 // query starts small.
+size_t layer_centroids(const Context& c, const Layer& layer) {
+  const size_t tris = layer.triangles();
+  return std::min(tris, size_t(std::ceil(double(c.options.layer_samples_per_triangle) * double(tris))));
+}
+size_t layer_sample_count(const Context& c, const Layer& layer) { return layer.vertices() + layer_centroids(c, layer); }
+
 void layer_samples(const Context& c, const Layer& layer, std::vector<float>& points, std::vector<float>& known) {
   points = layer.positions;
   known.resize(layer.vertices());
   for (size_t i = 0; i < layer.vertices(); ++i) known[i] = distance_to_original(c, &layer.positions[3 * i], layer.source[i]);
   const size_t tris = layer.triangles();
-  const auto centroids = std::min(tris, size_t(std::ceil(double(c.options.layer_samples_per_triangle) * double(tris))));
+  const size_t centroids = layer_centroids(c, layer);
   for (size_t k = 0; k < centroids; ++k) {
     const uint32_t* f = &layer.indices[3 * (k * tris / centroids)];
     float p[3];
@@ -379,14 +390,12 @@ void layer_samples(const Context& c, const Layer& layer, std::vector<float>& poi
   }
 }
 
-// The layer's samples to the whole original surface (through the region when there is one:
-// the same distances).
-Status layer_to_original(const Context& c, const Layer& layer, float& max) {
+// The layer's samples to the whole original surface (through the part: the same distances).
+Status layer_to_original(const Context& c, const Queries& q, const Layer& layer, float& max) {
   std::vector<float> samples, known;
   layer_samples(c, layer, samples, known);
   SurfaceError e;
-  const Status s = c.region ? c.region->from_points_part(samples.data(), samples.size() / 3, known.data(), c.whole, e, nullptr)
-                            : c.original.from_points(samples.data(), samples.size() / 3, known.data(), e);
+  const Status s = q.part->from_points_part(samples.data(), samples.size() / 3, known.data(), q.whole, e, nullptr);
   max = e.max;
   return s;
 }
@@ -405,10 +414,11 @@ Status original_to_layer(const Context& c, const SurfaceDistance& device, const 
 
 // Symmetric distance between a layer and the original: the layer's samples to the whole
 // original surface, the node's original samples to the layer.
-Status measure_layer(const Context& c, const std::vector<uint32_t>& reference, const Layer& layer, float& error) {
+Status measure_layer(const Context& c, const Queries& q, const std::vector<uint32_t>& reference, const Layer& layer,
+                     float& error) {
   float to = 0, from = 0;
-  if (Status s = layer_to_original(c, layer, to); !s) return s;
-  if (Status s = original_to_layer(c, c.region ? *c.region : c.original, reference, layer, from); !s) return s;
+  if (Status s = layer_to_original(c, q, layer, to); !s) return s;
+  if (Status s = original_to_layer(c, *q.part, reference, layer, from); !s) return s;
   error = std::max(to, from);
   return Status::success();
 }
@@ -422,9 +432,9 @@ void report_done(Context& c, const BuildNode& n) {
 
 // Pass 2, any node in any order: each layer's own distance to the original (a leaf's layer 0
 // is the original itself).
-Status measure_layers(Context& c, BuildNode& n) {
+Status measure_layers(Context& c, const Queries& q, BuildNode& n) {
   for (size_t k = n.leaf() ? 1 : 0; k < n.layers.size(); ++k)
-    if (Status s = measure_layer(c, n.reference, n.layers[k], n.layers[k].error); !s) return s;
+    if (Status s = measure_layer(c, q, n.reference, n.layers[k], n.layers[k].error); !s) return s;
   report_done(c, n);
   return Status::success();
 }
@@ -523,9 +533,9 @@ std::vector<BuildNode*> breadth_first(BuildNode& root, Below below) {
 }
 
 // Pass 2 over `nodes` at once, then pass 3 (children before parents).
-Status measure_and_order_errors(Context& c, const std::vector<BuildNode*>& nodes) {
+Status measure_and_order_errors(Context& c, const Queries& q, const std::vector<BuildNode*>& nodes) {
   std::vector<Status> measured(nodes.size());
-  run_all(c.options.parallel_for, nodes.size(), [&](size_t i) { measured[i] = measure_layers(c, *nodes[i]); });
+  run_all(c.options.parallel_for, nodes.size(), [&](size_t i) { measured[i] = measure_layers(c, q, *nodes[i]); });
   for (const Status& s : measured)
     if (!s) return s;
   make_errors_monotonic(nodes);
@@ -969,12 +979,15 @@ void number_spatially(const BuildNode& n, std::vector<HlodSubtreeSpec>& specs, u
     if (child) number_spatially(*child, specs, next);
 }
 
-// The grid a region is chosen on: 256^3 cells over the root cube (16 MB of flags).
-SurfaceGrid region_grid(const BuildNode& root) {
+// The grids parts of the original are chosen on, over the root cube: 256^3 cells where a part
+// is chosen by flags (16 MB of them); 1024^3 for the subtrees' parts, chosen by box, so that a
+// deep subtree's margin is not rounded up to a whole coarse cell (the parts' triangles then
+// sum to ~1.15 times the mesh's, not ~1.3).
+SurfaceGrid part_grid(const BuildNode& root, uint32_t n = 256) {
   SurfaceGrid g;
   for (int k = 0; k < 3; ++k) g.lo[k] = root.center[k] - root.half;
   g.edge = 2 * root.half;
-  g.n = 256;
+  g.n = n;
   return g;
 }
 
@@ -985,6 +998,60 @@ void want_box(const SurfaceGrid& g, const float* lo, const float* hi, std::vecto
   for (uint32_t z = a[2]; z <= b[2]; ++z)
     for (uint32_t y = a[1]; y <= b[1]; ++y)
       for (uint32_t x = a[0]; x <= b[0]; ++x) wanted[(size_t(z) * g.n + y) * g.n + x] = 1;
+}
+
+// A subtree's cell grown by a sixteenth of its half-edge: a layer's vertices are vertices of its
+// cell's triangles, so its samples lie within a triangle of the cell, and their nearest points
+// within the layer's error of them (~1 % of the cell). A query the part cannot answer exactly
+// still goes to the whole.
+SurfaceBox grown_cell(const HlodSubtreeSpec& spec, float grow) {
+  SurfaceBox b;
+  for (int k = 0; k < 3; ++k) b.lo[k] = spec.center[k] - grow * spec.half, b.hi[k] = spec.center[k] + grow * spec.half;
+  return b;
+}
+
+// A part of the original and its vertex scratch, reused by one task after another: a build
+// holds one part per task at a time, never a BVH of the whole original.
+struct PartSlot {
+  SurfaceDistance part;
+  std::vector<uint32_t> remap;
+};
+
+class PartPool {
+ public:
+  std::unique_ptr<PartSlot> take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (free_.empty()) return std::make_unique<PartSlot>();
+    std::unique_ptr<PartSlot> slot = std::move(free_.back());
+    free_.pop_back();
+    return slot;
+  }
+  void give(std::unique_ptr<PartSlot> slot) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(slot));
+  }
+  // A part built before (ready, so its Embree device can build a layer's BVH), if any.
+  const SurfaceDistance* any() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& slot : free_)
+      if (slot->part.ready()) return &slot->part;
+    return nullptr;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<PartSlot>> free_;
+};
+
+// The frontier node whose cell holds p (-1: none, p in an empty octant of the top).
+int subtree_at(const BuildNode& root, const float* p) {
+  const BuildNode* n = &root;
+  while (n->subtree < 0) {
+    const int o = (p[0] >= n->center[0] ? 1 : 0) | (p[1] >= n->center[1] ? 2 : 0) | (p[2] >= n->center[2] ? 4 : 0);
+    if (!n->children[size_t(o)]) return -1;
+    n = n->children[size_t(o)].get();
+  }
+  return n->subtree;
 }
 
 }  // namespace
@@ -1003,11 +1070,13 @@ struct HlodBuilder::Impl {
   std::once_flag whole_once;
   std::atomic<bool> whole_built{false};
   Status surface;  // the whole original's BVH, once built
-  double whole_cpu = 0, region_cpu = 0;
-  std::vector<size_t> region_subtrees;
-  bool region_wanted = false, region_built = false;
-  SurfaceDistance region;
-  Status region_status;
+  double whole_cpu = 0;
+  std::atomic<uint64_t> part_ns{0}, part_triangles{0};
+  // Per subtree baked here, where its part's triangles are listed (plan, box): built again to
+  // measure the top's samples in its cell (the top's finest layers cover the whole surface).
+  std::vector<std::unique_ptr<SurfacePartPlan>> plans;
+  std::vector<std::pair<int32_t, uint32_t>> part_of;
+  PartPool pool;
   Tally top_tally;
 
   Impl(const MeshView& m, const HlodBuildOptions& o)
@@ -1026,19 +1095,41 @@ struct HlodBuilder::Impl {
     });
     return surface ? &c.original : nullptr;
   }
-  void ensure_region();
-  // What queries start from: the region when one is set, else the whole original.
-  void ensure_queries() {
-    if (region_wanted) ensure_region();
-    else whole_surface();
+  std::function<const SurfaceDistance*()> whole() {
+    return [this] { return whole_surface(); };
   }
-  bool queries_built() const { return region_wanted ? region_built : whole_built.load(); }
-  const Status& queries_status() const { return region_wanted ? region_status : surface; }
+  void count_part(double cpu0, size_t triangles) {
+    part_ns.fetch_add(uint64_t((thread_cpu_seconds() - cpu0) * 1e9), std::memory_order_relaxed);
+    part_triangles.fetch_add(triangles, std::memory_order_relaxed);
+  }
+  Status plan_parts(const std::vector<size_t>& which, SurfacePartPlan& plan) {
+    const double cpu0 = thread_cpu_seconds();
+    std::vector<SurfaceBox> boxes;
+    for (size_t i : which) boxes.push_back(grown_cell(specs[i], 1.0625f));
+    const Status s = plan_surface_parts(original(), part_grid(*root, 1024), std::move(boxes), plan, what + " (subtrees' parts)");
+    count_part(cpu0, 0);
+    return s;
+  }
   std::string name(size_t i) const {
     return what + ": subtree " + std::to_string(i) + " (depth " + std::to_string(specs[i].depth) + ", " +
            std::to_string(specs[i].triangles) + " triangles)";
   }
   Status finish(size_t i, Tally& tally, const SubtreeDone& done);
+  Status build_part(size_t subtree, PartSlot& slot) {
+    const auto [plan, box] = part_of[subtree];
+    const double cpu0 = thread_cpu_seconds();
+    const Status s = slot.part.set_surface_planned(original(), *plans[size_t(plan)], box, slot.remap,
+                                                   name(subtree) + " (the original near it)");
+    count_part(cpu0, slot.part.triangles());
+    return s;
+  }
+  Status measure_in_parts(const std::vector<HlodLayerProbe>& probes, const std::vector<uint8_t>& listed,
+                          std::vector<float>& to_max, std::vector<std::vector<uint8_t>>& answered);
+  Status measure_near(const std::vector<HlodLayerProbe>& probes, const std::function<bool(size_t, size_t, const float*)>& take,
+                      bool whole_answers, std::vector<float>& to_max, std::vector<std::vector<uint8_t>>* answered,
+                      const std::vector<size_t>& reference, std::vector<float>& from_max);
+  Status measure_from_side(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& reference,
+                           const SurfaceDistance& device, std::vector<float>& from_max);
   void build_top(BuildNode& n);
 };
 
@@ -1047,43 +1138,10 @@ HlodBuilder::HlodBuilder(const MeshView& mesh, const HlodBuildOptions& options)
 HlodBuilder::~HlodBuilder() = default;
 
 const std::vector<HlodSubtreeSpec>& HlodBuilder::subtrees() const { return impl_->specs; }
-double HlodBuilder::surface_cpu_seconds() const { return impl_->whole_cpu + impl_->region_cpu; }
-size_t HlodBuilder::region_triangles() const { return impl_->region_built ? impl_->region.triangles() : 0; }
+double HlodBuilder::surface_cpu_seconds() const { return impl_->whole_cpu + double(impl_->part_ns.load()) * 1e-9; }
+size_t HlodBuilder::part_triangles() const { return impl_->part_triangles.load(); }
 bool HlodBuilder::whole_surface_built() const { return impl_->whole_built.load(); }
 
-void HlodBuilder::set_region(const std::vector<size_t>& subtrees) {
-  impl_->region_subtrees = subtrees;
-  // Every subtree (one rank): the whole original is the region, without the part's pass.
-  std::vector<uint8_t> seen(impl_->specs.size(), 0);
-  size_t distinct = 0;
-  for (size_t i : subtrees)
-    if (i < seen.size() && !seen[i]) seen[i] = 1, ++distinct;
-  impl_->region_wanted = distinct < impl_->specs.size();
-}
-
-// The region's BVH: the triangles reaching into its subtrees' cells grown by a sixteenth of
-// their half-edge: a layer's vertices are vertices of its cell's triangles, so its samples lie
-// within a triangle of the cell, and their nearest points within the layer's error of them
-// (~1 % of the cell). A query the region cannot answer exactly still goes to the whole.
-void HlodBuilder::Impl::ensure_region() {
-  if (region_built) return;
-  const double cpu0 = thread_cpu_seconds();
-  const SurfaceGrid grid = region_grid(*root);
-  std::vector<uint8_t> wanted(grid.cells(), 0);
-  for (size_t i : region_subtrees) {
-    if (i >= specs.size()) continue;
-    const HlodSubtreeSpec& spec = specs[i];
-    const float grow = 1.0625f * spec.half;
-    float lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) lo[k] = spec.center[k] - grow, hi[k] = spec.center[k] + grow;
-    want_box(grid, lo, hi, wanted);
-  }
-  region_status = region.set_surface_part(original(), grid, wanted, what + " (region)");
-  c.region = &region;
-  c.whole = [this] { return whole_surface(); };
-  region_cpu = thread_cpu_seconds() - cpu0;
-  region_built = true;
-}
 
 Status HlodBuilder::plan() {
   Impl& m = *impl_;
@@ -1139,15 +1197,21 @@ Status HlodBuilder::plan() {
   uint32_t next = 0;
   number_spatially(*m.root, m.specs, next);
   m.baked.assign(m.frontier.size(), 0);
+  m.part_of.assign(m.frontier.size(), {-1, 0});
   m.planned = true;
   return Status::success();
 }
 
-// Passes 2 and 3 of a grown subtree, its result handed on, its build nodes freed.
+// Passes 2 and 3 of a grown subtree, against the part of the original near its cell, its
+// result handed on, its build nodes freed.
 Status HlodBuilder::Impl::finish(size_t i, Tally& tally, const SubtreeDone& done) {
   BuildNode& n = *frontier[i];
   const std::vector<BuildNode*> order = breadth_first(n, Below::everything);
-  if (Status s = measure_and_order_errors(c, order); !s) return Status::error(name(i) + ": " + s.message);
+  std::unique_ptr<PartSlot> slot = pool.take();
+  Status measured = build_part(i, *slot);
+  if (measured) measured = measure_and_order_errors(c, Queries{&slot->part, whole()}, order);
+  pool.give(std::move(slot));
+  if (!measured) return Status::error(name(i) + ": " + measured.message);
   HlodSubtree result = flatten_subtree(c, order);
   result.short_layers = tally.short_layers.load();
   result.oversized_leaves = tally.oversized_leaves.load();
@@ -1158,8 +1222,10 @@ Status HlodBuilder::Impl::finish(size_t i, Tally& tally, const SubtreeDone& done
   return Status::success();
 }
 
-// The original's BVH (passes 2 need it) with subtrees growing beside it, then per subtree
-// passes 1 (if not grown yet), 2 and 3, each result handed on as it is finished.
+// The parts of the original near the subtrees planned (passes 2 need them) with subtrees growing
+// beside, then per subtree passes 1 (if not grown yet), 2 and 3, each result handed on as it is
+// finished. Only the parts being measured are held: never a BVH of the whole original, unless a
+// query no part can answer exactly needs it.
 Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const SubtreeDone& done) {
   Impl& m = *impl_;
   if (!m.planned) return Status::error(m.what + ": HLOD subtrees baked before the build was planned");
@@ -1168,25 +1234,27 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
       return Status::error(m.what + ": subtree " + std::to_string(i) + " does not exist or was baked already");
     m.baked[i] = 1;
   }
-  if (which.empty()) return Status::success();  // no BVH for nothing (a rank with no share)
+  if (which.empty()) return Status::success();
   const ParallelFor& parallel_for = m.c.options.parallel_for;
   std::vector<Tally> tallies(which.size());
   std::vector<uint8_t> grown(which.size(), 0);
-  if (!m.queries_built()) {  // subtrees grow beside the BVH for as long as it takes (none serially)
-    std::atomic<bool> surface_done{false};
-    run_all(parallel_for, 2, [&](size_t part) {
-      if (part == 0) {
-        m.ensure_queries();
-        surface_done.store(true);
-        return;
-      }
-      for (size_t k = 0; k < which.size() && !surface_done.load(); ++k) {
-        grow(m.c, tallies[k], *m.frontier[which[k]]);
-        grown[k] = 1;
-      }
-    });
-  }
-  if (!m.queries_status()) return m.queries_status();
+  auto plan = std::make_unique<SurfacePartPlan>();
+  Status planned;
+  std::atomic<bool> plan_done{false};
+  run_all(parallel_for, 2, [&](size_t part) {  // subtrees grow beside the plan (none serially)
+    if (part == 0) {
+      planned = m.plan_parts(which, *plan);
+      plan_done.store(true);
+      return;
+    }
+    for (size_t k = 0; k < which.size() && !plan_done.load(); ++k) {
+      grow(m.c, tallies[k], *m.frontier[which[k]]);
+      grown[k] = 1;
+    }
+  });
+  if (!planned) return planned;
+  for (size_t k = 0; k < which.size(); ++k) m.part_of[which[k]] = {int32_t(m.plans.size()), uint32_t(k)};
+  m.plans.push_back(std::move(plan));
   // The rest grow and finish one by one, so that results are handed on from the start.
   std::vector<Status> finished(which.size());
   std::atomic<bool> failed{false};
@@ -1277,21 +1345,143 @@ std::vector<size_t> every(size_t n) {
 
 }  // namespace
 
+// The top's layers measured against a part of the original built near their samples (the
+// top's nodes span the whole mesh, their samples do not): the samples of `layers` that `take`
+// picks, each with the cells within its known bound of it (and a cell's width more). A sample
+// the part cannot answer exactly goes to the whole original when `whole_answers`, else is left
+// unanswered (answered flags, one per sample of every probe). For the probes in `reference`, the
+// other side (the node's original samples to the layer; from_max by position in `reference`).
+Status HlodBuilder::Impl::measure_near(const std::vector<HlodLayerProbe>& probes,
+                                       const std::function<bool(size_t, size_t, const float*)>& take, bool whole_answers,
+                                       std::vector<float>& to_max, std::vector<std::vector<uint8_t>>* answered,
+                                       const std::vector<size_t>& reference, std::vector<float>& from_max) {
+  const size_t n = probes.size();
+  std::vector<std::vector<float>> points(n), known(n);
+  std::vector<std::vector<uint32_t>> taken(n);
+  const SurfaceGrid grid = part_grid(*root);
+  std::vector<uint8_t> wanted(grid.cells(), 0);
+  if (answered) answered->assign(n, {});
+  for (size_t k = 0; k < n; ++k) {
+    std::vector<float> pts, kn;
+    layer_samples(c, probe_layer(probes[k]), pts, kn);
+    if (answered) (*answered)[k].assign(kn.size(), 0);
+    for (size_t i = 0; i < kn.size(); ++i) {
+      if (!take(k, i, &pts[3 * i])) continue;
+      taken[k].push_back(uint32_t(i));
+      points[k].insert(points[k].end(), &pts[3 * i], &pts[3 * i] + 3);
+      known[k].push_back(kn[i]);
+      const float reach = std::isfinite(kn[i]) ? kn[i] * 1.01f + grid.edge / float(grid.n) : grid.edge;
+      float lo[3], hi[3];
+      for (int j = 0; j < 3; ++j) lo[j] = pts[3 * i + j] - reach, hi[j] = pts[3 * i + j] + reach;
+      want_box(grid, lo, hi, wanted);
+    }
+  }
+  from_max.assign(reference.size(), 0.0f);
+  size_t left = 0;
+  for (const auto& t : taken) left += t.size();
+  const SurfaceDistance* device = pool.any();  // the other side needs only an Embree device
+  if (left == 0 && reference.empty()) return Status::success();
+  if (left == 0 && device) return measure_from_side(probes, reference, *device, from_max);
+  SurfaceDistance near;
+  const double cpu0 = thread_cpu_seconds();
+  if (Status s = near.set_surface_part(original(), grid, wanted, what + " (near the top's samples)"); !s) return s;
+  count_part(cpu0, near.triangles());
+  const std::function<const SurfaceDistance*()> fallback = whole_answers ? whole() : nullptr;
+  std::vector<Status> measured(n);
+  run_all(c.options.parallel_for, n, [&](size_t k) {
+    if (taken[k].empty()) return;
+    std::vector<uint8_t> got;
+    SurfaceError e;
+    measured[k] = near.from_points_part(points[k].data(), taken[k].size(), known[k].data(), fallback, e,
+                                        answered ? &got : nullptr);
+    to_max[k] = std::max(to_max[k], e.max);
+    for (size_t i = 0; i < got.size(); ++i) (*answered)[k][taken[k][i]] = got[i];
+  });
+  for (const Status& s : measured)
+    if (!s) return s;
+  return measure_from_side(probes, reference, device ? *device : near, from_max);
+}
+
+// The original's side of the probes in `reference` (the node's original samples to the layer,
+// its BVH built on `device`'s Embree device): from_max by position in `reference`.
+Status HlodBuilder::Impl::measure_from_side(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& reference,
+                                            const SurfaceDistance& device, std::vector<float>& from_max) {
+  from_max.assign(reference.size(), 0.0f);
+  std::vector<Status> measured(reference.size());
+  run_all(c.options.parallel_for, reference.size(), [&](size_t k) {
+    const HlodLayerProbe& p = probes[reference[k]];
+    measured[k] = original_to_layer(c, device, p.reference, probe_layer(p), from_max[k]);
+  });
+  for (const Status& s : measured)
+    if (!s) return s;
+  return Status::success();
+}
+
+// The samples of the listed probes in the cells of subtrees baked here, each subtree's against
+// its part built again (one part per task at a time): to_max raised, answered flagged (one flag
+// per sample of every probe).
+Status HlodBuilder::Impl::measure_in_parts(const std::vector<HlodLayerProbe>& probes, const std::vector<uint8_t>& listed,
+                                           std::vector<float>& to_max, std::vector<std::vector<uint8_t>>& answered) {
+  const size_t n = probes.size();
+  std::vector<std::vector<float>> points(n), known(n);
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> in(specs.size());  // per subtree: (probe, sample)
+  answered.assign(n, {});
+  for (size_t k = 0; k < n; ++k) {
+    const Layer layer = probe_layer(probes[k]);
+    answered[k].assign(layer_sample_count(c, layer), 0);
+    if (!listed[k]) continue;
+    layer_samples(c, layer, points[k], known[k]);
+    for (size_t i = 0; i < known[k].size(); ++i)
+      if (const int t = subtree_at(*root, &points[k][3 * i]); t >= 0 && part_of[size_t(t)].first >= 0)
+        in[size_t(t)].push_back({uint32_t(k), uint32_t(i)});
+  }
+  std::vector<size_t> todo;
+  for (size_t t = 0; t < in.size(); ++t)
+    if (!in[t].empty()) todo.push_back(t);
+  std::vector<std::vector<float>> maxes(todo.size());
+  std::vector<Status> measured(todo.size());
+  run_all(c.options.parallel_for, todo.size(), [&](size_t x) {
+    const auto& samples = in[todo[x]];
+    std::unique_ptr<PartSlot> slot = pool.take();
+    measured[x] = build_part(todo[x], *slot);
+    maxes[x].assign(n, 0.0f);
+    for (size_t a = 0, b = 0; measured[x] && a < samples.size(); a = b) {  // one run per probe
+      const uint32_t k = samples[a].first;
+      std::vector<float> pts, kn;
+      for (b = a; b < samples.size() && samples[b].first == k; ++b) {
+        const uint32_t i = samples[b].second;
+        pts.insert(pts.end(), &points[k][3 * size_t(i)], &points[k][3 * size_t(i)] + 3);
+        kn.push_back(known[k][i]);
+      }
+      std::vector<uint8_t> got;
+      SurfaceError e;
+      measured[x] = slot->part.from_points_part(pts.data(), kn.size(), kn.data(), {}, e, &got);
+      maxes[x][k] = e.max;
+      for (size_t i = 0; i < got.size(); ++i) answered[k][samples[a + i].second] = got[i];
+    }
+    pool.give(std::move(slot));
+  });
+  for (size_t x = 0; x < todo.size(); ++x) {
+    if (!measured[x]) return measured[x];
+    for (size_t k = 0; k < n; ++k) to_max[k] = std::max(to_max[k], maxes[x][k]);
+  }
+  return Status::success();
+}
+
 Status HlodBuilder::measure_probes(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& which,
                                    std::vector<float>& errors) {
   Impl& m = *impl_;
   if (!m.planned) return Status::error(m.what + ": HLOD layers measured before the build was planned");
   if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, which); !s) return s;
-  m.ensure_queries();
-  if (!m.queries_status()) return m.queries_status();
-  errors.assign(which.size(), 0.0f);
-  std::vector<Status> measured(which.size());
-  run_all(m.c.options.parallel_for, which.size(), [&](size_t k) {
-    const HlodLayerProbe& p = probes[which[k]];
-    measured[k] = measure_layer(m.c, p.reference, probe_layer(p), errors[k]);
-  });
-  for (const Status& s : measured)
-    if (!s) return s;
+  std::vector<uint8_t> listed(probes.size(), 0);
+  for (size_t k : which) listed[k] = 1;
+  std::vector<float> to_max(probes.size(), 0.0f), from_max;
+  std::vector<std::vector<uint8_t>> answered;
+  if (Status s = m.measure_in_parts(probes, listed, to_max, answered); !s) return s;
+  const auto left = [&](size_t k, size_t i, const float*) { return listed[k] && !answered[k][i]; };
+  if (Status s = m.measure_near(probes, left, true, to_max, nullptr, which, from_max); !s) return s;
+  errors.resize(which.size());
+  for (size_t k = 0; k < which.size(); ++k) errors[k] = std::max(to_max[which[k]], from_max[k]);
   return Status::success();
 }
 
@@ -1303,40 +1493,14 @@ Status HlodBuilder::measure_probes_part(const std::vector<HlodLayerProbe>& probe
   if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, every(probes.size())); !s) return s;
   for (size_t i : reference)
     if (i >= probes.size()) return Status::error(m.what + ": top layer " + std::to_string(i) + " does not exist");
-  m.ensure_queries();
-  if (!m.queries_status()) return m.queries_status();
-  const SurfaceDistance& queries = m.region_wanted ? m.region : m.c.original;
   to_max.assign(probes.size(), 0.0f);
-  answered.assign(probes.size(), {});
-  from_max.assign(reference.size(), 0.0f);
-  std::vector<Status> measured(probes.size() + reference.size());
-  run_all(m.c.options.parallel_for, measured.size(), [&](size_t k) {
-    if (k >= probes.size()) {  // the original's side of a listed probe
-      const HlodLayerProbe& p = probes[reference[k - probes.size()]];
-      measured[k] = original_to_layer(m.c, queries, p.reference, probe_layer(p), from_max[k - probes.size()]);
-      return;
-    }
-    // The layer's side: only the samples in cells the region holds whole are asked about.
-    std::vector<float> points, known, mine_points, mine_known;
-    layer_samples(m.c, probe_layer(probes[k]), points, known);
-    const size_t n = known.size();
-    std::vector<uint32_t> mine;
-    for (size_t i = 0; i < n; ++i)
-      if (queries.holds(&points[3 * i])) {
-        mine.push_back(uint32_t(i));
-        mine_points.insert(mine_points.end(), &points[3 * i], &points[3 * i] + 3);
-        mine_known.push_back(known[i]);
-      }
-    std::vector<uint8_t> got;
-    SurfaceError e;
-    measured[k] = queries.from_points_part(mine_points.data(), mine.size(), mine_known.data(), {}, e, &got);
-    to_max[k] = e.max;
-    answered[k].assign(n, 0);
-    for (size_t i = 0; i < mine.size() && i < got.size(); ++i) answered[k][mine[i]] = got[i];
-  });
-  for (const Status& s : measured)
-    if (!s) return s;
-  return Status::success();
+  if (Status s = m.measure_in_parts(probes, std::vector<uint8_t>(probes.size(), 1), to_max, answered); !s) return s;
+  from_max.clear();
+  if (reference.empty()) return Status::success();
+  if (const SurfaceDistance* device = m.pool.any()) return m.measure_from_side(probes, reference, *device, from_max);
+  const auto nothing = [](size_t, size_t, const float*) { return false; };  // near nothing: a device
+  std::vector<float> unused(probes.size(), 0.0f);
+  return m.measure_near(probes, nothing, false, unused, nullptr, reference, from_max);
 }
 
 Status HlodBuilder::measure_probes_rest(const std::vector<HlodLayerProbe>& probes,
@@ -1347,40 +1511,12 @@ Status HlodBuilder::measure_probes_rest(const std::vector<HlodLayerProbe>& probe
     return Status::error(m.what + ": " + std::to_string(answered.size()) + " answered lists for " +
                          std::to_string(probes.size()) + " top layers");
   if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, every(probes.size())); !s) return s;
-  // Each probe's unanswered samples, and the cells within their known bounds (a cell's width more).
-  std::vector<std::vector<float>> points(probes.size()), known(probes.size());
-  const SurfaceGrid grid = region_grid(*m.root);
-  std::vector<uint8_t> wanted(grid.cells(), 0);
-  size_t left = 0;
-  for (size_t k = 0; k < probes.size(); ++k) {
-    std::vector<float> pts, kn;
-    layer_samples(m.c, probe_layer(probes[k]), pts, kn);
-    if (answered[k].size() != kn.size()) return Status::error(m.what + ": top layer " + std::to_string(k) + ": answered flags do not match its samples");
-    for (size_t i = 0; i < kn.size(); ++i) {
-      if (answered[k][i]) continue;
-      ++left;
-      points[k].insert(points[k].end(), &pts[3 * i], &pts[3 * i] + 3);
-      known[k].push_back(kn[i]);
-      const float reach = std::isfinite(kn[i]) ? kn[i] * 1.01f + grid.edge / float(grid.n) : grid.edge;
-      float lo[3], hi[3];
-      for (int j = 0; j < 3; ++j) lo[j] = pts[3 * i + j] - reach, hi[j] = pts[3 * i + j] + reach;
-      want_box(grid, lo, hi, wanted);
-    }
-  }
-  if (left == 0) return Status::success();
-  SurfaceDistance near;
-  if (Status s = near.set_surface_part(m.original(), grid, wanted, m.what + " (near the top's samples)"); !s) return s;
-  const std::function<const SurfaceDistance*()> whole = [&m] { return m.whole_surface(); };
-  std::vector<Status> measured(probes.size());
-  run_all(m.c.options.parallel_for, probes.size(), [&](size_t k) {
-    if (known[k].empty()) return;
-    SurfaceError e;
-    measured[k] = near.from_points_part(points[k].data(), known[k].size(), known[k].data(), whole, e, nullptr);
-    to_max[k] = std::max(to_max[k], e.max);
-  });
-  for (const Status& s : measured)
-    if (!s) return s;
-  return Status::success();
+  for (size_t k = 0; k < probes.size(); ++k)
+    if (answered[k].size() != layer_sample_count(m.c, probe_layer(probes[k])))
+      return Status::error(m.what + ": top layer " + std::to_string(k) + ": answered flags do not match its samples");
+  const auto take = [&](size_t k, size_t i, const float*) { return answered[k][i] == 0; };
+  std::vector<float> from_max;
+  return m.measure_near(probes, take, true, to_max, nullptr, {}, from_max);
 }
 
 Status HlodBuilder::finish_top(const std::vector<HlodSubtree>& baked, const std::vector<float>& errors,

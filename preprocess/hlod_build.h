@@ -188,30 +188,29 @@ class HlodBuilder {
                         std::vector<float>& errors);
   Status finish_top(const std::vector<HlodSubtree>& baked, const std::vector<float>& errors, HlodAssembly& out,
                     HlodBuildReport* report = nullptr);
-  // A distributed build's region (issue 16): the subtrees this builder bakes, or whose cells'
-  // share of the top's samples it measures (measure_probes_part). Its queries against the
-  // original then go to a BVH over the triangles near their cells (a margin of a quarter of a
-  // cell's half-edge) and, where that cannot answer exactly as the whole original would (the
-  // nearest found is not provably the nearest), to the whole original's BVH, built on first
-  // need only. The bytes are the same either way. Before bake_subtrees and measure_probes_part.
-  // Every subtree listed (one rank): the whole original, as without a region.
-  void set_region(const std::vector<size_t>& subtrees);
-  // The top's errors split by sample rather than by layer, for builders with a region: per
-  // probe, the largest distance to the original among its layer samples the region answers
-  // (to_max) and which samples those are (answered, one flag per sample); for the probes listed
+  // How the original is queried (issue 16): each subtree's layers against a BVH of the part of
+  // the original near its cell (bake_subtrees), kept for the top's samples in that cell; the
+  // top's other samples against a part built near them; and a query a part cannot answer
+  // exactly as the whole original would (the nearest found is not provably the nearest)
+  // against the whole original's BVH, built on first need only. The bytes are the same either way.
+  //
+  // The top's errors split by sample rather than by layer, for a builder that baked some of the
+  // subtrees: per probe, the largest distance to the original among its layer samples the parts
+  // it kept answer (to_max) and which samples those are (answered, one flag per sample); for the probes listed
   // in `reference`, the other side (the node's original samples to the layer; from_max, by
   // position in `reference`). A layer's error is max(to_max over every sample, from_max).
   Status measure_probes_part(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& reference,
                              std::vector<float>& to_max, std::vector<std::vector<uint8_t>>& answered,
                              std::vector<float>& from_max);
-  // The samples no region answered (answered: every region's flags merged), measured against
+  // The samples no builder answered (answered: every builder's flags merged), measured against
   // the original near them (the whole original only where that cannot answer); raises to_max.
   Status measure_probes_rest(const std::vector<HlodLayerProbe>& probes,
                              const std::vector<std::vector<uint8_t>>& answered, std::vector<float>& to_max);
-  // Process CPU seconds the original's BVHs took to build (region and whole; 0 until built).
+  // Thread CPU seconds the original's BVHs took to plan and build (its parts and the whole).
   double surface_cpu_seconds() const;
-  // Triangles in the region's BVH (0 without one), and whether the whole original's was built.
-  size_t region_triangles() const;
+  // Triangles in the parts of the original built so far (a triangle near several subtrees
+  // counts once per part), and whether the whole original's BVH was built.
+  size_t part_triangles() const;
   bool whole_surface_built() const;
 
  private:

@@ -387,13 +387,21 @@ struct SurfaceDistance::Impl {
   size_t triangles = 0;
   SurfaceGrid grid;
   std::vector<uint8_t> complete;  // a part's: per cell, no triangle outside the part reaches in
+  bool planned = false;           // a planned part: the cells of `box` are complete, no others
+  CellRange box{};
 
+  bool holds_cells(const CellRange& r) const {
+    if (planned)
+      return r.lo[0] >= box.lo[0] && r.lo[1] >= box.lo[1] && r.lo[2] >= box.lo[2] && r.hi[0] <= box.hi[0] &&
+             r.hi[1] <= box.hi[1] && r.hi[2] <= box.hi[2];
+    return r.all(grid, [&](size_t c) { return complete[c] != 0; });
+  }
   // Whether every triangle of the whole surface within `radius` of p is in the part: each one
   // reaches into a cell the ball's box reaches into (cells are monotonic in the coordinate).
   bool holds_ball(Vec3 p, double radius) const {
     const float r = float(radius);
     const float lo[3] = {p.x - r, p.y - r, p.z - r}, hi[3] = {p.x + r, p.y + r, p.z + r};
-    return cells_of_box(grid, lo, hi).all(grid, [&](size_t c) { return complete[c] != 0; });
+    return holds_cells(cells_of_box(grid, lo, hi));
   }
 
   ~Impl() {
@@ -440,6 +448,7 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
   // A triangle is kept when its box reaches into a wanted cell; otherwise every cell its box
   // reaches into is incomplete.
   m.grid = grid;
+  m.planned = false;
   m.complete.assign(grid.cells(), 1);
   const std::vector<uint32_t> cells = vertex_cells(whole, grid);
   std::vector<uint32_t> remap(whole.vertex_count, UINT32_MAX);
@@ -482,12 +491,13 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
 }
 
 size_t SurfaceDistance::triangles() const { return impl_->triangles; }
+bool SurfaceDistance::ready() const { return impl_->ready; }
 
 bool SurfaceDistance::holds(const float* p) const {
   const Impl& m = *impl_;
   if (!m.part) return m.ready;
   const float q[3] = {p[0], p[1], p[2]};
-  return cells_of_box(m.grid, q, q).all(m.grid, [&](size_t c) { return m.complete[c] != 0; });
+  return m.holds_cells(cells_of_box(m.grid, q, q));
 }
 
 namespace {
@@ -499,6 +509,127 @@ SurfaceError distance_summary(double max_d, double sum_sq, size_t n) {
   return e;
 }
 }  // namespace
+
+namespace {
+
+bool meet(const CellRange& a, const CellRange& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+  return true;
+}
+
+// Boxes by blocks of cells (about 32 per axis), so that a triangle is tested against the few
+// boxes near it rather than every one: per block, the boxes meeting it (offsets, ids).
+struct BoxBlocks {
+  uint32_t size = 1, per_axis = 1;
+  std::vector<uint32_t> offsets, ids;
+
+  BoxBlocks(const SurfaceGrid& g, const std::vector<CellRange>& boxes)
+      : size((g.n + 31) / 32), per_axis((g.n + size - 1) / size) {
+    const size_t blocks = size_t(per_axis) * per_axis * per_axis;
+    offsets.assign(blocks + 1, 0);
+    for_blocks(boxes, [&](size_t b, uint32_t) { ++offsets[b + 1]; });
+    for (size_t b = 0; b < blocks; ++b) offsets[b + 1] += offsets[b];
+    ids.resize(offsets[blocks]);
+    std::vector<uint32_t> at(offsets.begin(), offsets.end() - 1);
+    for_blocks(boxes, [&](size_t b, uint32_t i) { ids[at[b]++] = i; });
+  }
+  CellRange blocks_of(const CellRange& r) const {
+    CellRange b;
+    for (int k = 0; k < 3; ++k) b.lo[k] = r.lo[k] / size, b.hi[k] = r.hi[k] / size;
+    return b;
+  }
+  template <class F>
+  void for_blocks(const std::vector<CellRange>& boxes, F&& f) const {
+    const SurfaceGrid blocks = block_grid();
+    for (uint32_t i = 0; i < boxes.size(); ++i) blocks_of(boxes[i]).all(blocks, [&](size_t b) { return f(b, i), true; });
+  }
+  SurfaceGrid block_grid() const {
+    SurfaceGrid g;
+    g.n = per_axis;
+    return g;
+  }
+};
+
+}  // namespace
+
+Status plan_surface_parts(const TriangleMeshView& whole, const SurfaceGrid& grid, std::vector<SurfaceBox> boxes,
+                          SurfacePartPlan& out, const std::string& what) {
+  if (whole.index_count % 3 != 0 || grid.n == 0 || grid.n > kMaxGridCells || boxes.size() > UINT32_MAX)
+    return Status::error(what + ": surface parts need whole triangles and a grid of at most " +
+                         std::to_string(kMaxGridCells) + " cells per axis");
+  for (size_t i = 0; i < whole.index_count; ++i)
+    if (whole.indices[i] >= whole.vertex_count)
+      return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
+                           std::to_string(whole.indices[i]) + " of " + std::to_string(whole.vertex_count));
+  std::vector<CellRange> ranges;
+  for (const SurfaceBox& b : boxes) ranges.push_back(cells_of_box(grid, b.lo, b.hi));
+  const BoxBlocks blocks(grid, ranges);
+  const SurfaceGrid block_grid = blocks.block_grid();
+  std::vector<std::vector<uint32_t>> lists(boxes.size());
+  for (uint32_t t = 0; t < whole.index_count / 3; ++t) {
+    const CellRange r = cells_of_triangle(whole, grid, whole.indices + 3 * size_t(t));
+    blocks.blocks_of(r).all(block_grid, [&](size_t b) {
+      for (uint32_t k = blocks.offsets[b]; k < blocks.offsets[b + 1]; ++k) {
+        std::vector<uint32_t>& list = lists[blocks.ids[k]];
+        if (meet(r, ranges[blocks.ids[k]]) && (list.empty() || list.back() != t)) list.push_back(t);
+      }
+      return true;
+    });
+  }
+  out.grid = grid;
+  out.slack = rounding_slack(whole.positions, 3 * whole.vertex_count);
+  out.vertex_count = whole.vertex_count;
+  out.triangle_count = whole.index_count / 3;
+  out.boxes = std::move(boxes);
+  out.triangles = std::move(lists);
+  return Status::success();
+}
+
+Status SurfaceDistance::set_surface_planned(const TriangleMeshView& whole, const SurfacePartPlan& plan, size_t box,
+                                            std::vector<uint32_t>& remap, const std::string& what) {
+  Impl& m = *impl_;
+  m.ready = false;
+  m.what = what;
+  m.surface.release();
+  if (box >= plan.boxes.size() || plan.vertex_count != whole.vertex_count || plan.triangle_count != whole.index_count / 3)
+    return Status::error(what + ": no such part in a plan made over this surface");
+  if (remap.empty()) remap.assign(whole.vertex_count, UINT32_MAX);
+  if (remap.size() != whole.vertex_count) return Status::error(what + ": vertex scratch of another surface");
+  if (!m.device) {
+    m.device = rtcNewDevice(nullptr);
+    if (!m.device) return Status::error(what + ": Embree device could not be created");
+  }
+  QueryMesh& part = m.surface;
+  part.positions.clear();
+  part.indices.clear();
+  const std::vector<uint32_t>& list = plan.triangles[box];
+  for (uint32_t t : list)
+    if (t >= plan.triangle_count) return Status::error(what + ": the plan lists a triangle the surface lacks");
+  part.indices.reserve(3 * list.size());
+  for (uint32_t t : list) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = whole.indices[3 * size_t(t) + k];  // checked when planned
+      if (remap[v] == UINT32_MAX) {
+        remap[v] = uint32_t(part.positions.size() / 3);
+        part.positions.insert(part.positions.end(), whole.positions + 3 * size_t(v), whole.positions + 3 * size_t(v) + 3);
+      }
+      part.indices.push_back(remap[v]);
+    }
+  }
+  for (uint32_t t : list)
+    for (int k = 0; k < 3; ++k) remap[whole.indices[3 * size_t(t) + k]] = UINT32_MAX;
+  part.slack = plan.slack;
+  m.grid = plan.grid;
+  m.part = m.planned = true;
+  m.box = cells_of_box(plan.grid, plan.boxes[box].lo, plan.boxes[box].hi);
+  m.complete.clear();
+  m.triangles = list.size();
+  if (m.triangles > 0)
+    if (Status s = commit_query_mesh(m.device, what, m.builder, part); !s) return s;
+  m.ready = true;
+  return Status::success();
+}
 
 Status SurfaceDistance::from_points(const float* points, size_t count, const float* known, SurfaceError& out) const {
   const Impl& m = *impl_;

@@ -63,6 +63,26 @@ struct SurfaceGrid {
   uint32_t cell(float x, int axis) const;
 };
 
+// A box on a SurfaceGrid: the cells [lo, hi] reaches into.
+struct SurfaceBox {
+  float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+};
+
+// Parts of one surface chosen in one pass over it: per box, every triangle whose box reaches
+// into one of the box's cells, so that the part built from that list holds each of those cells
+// completely (SurfaceDistance::set_surface_planned). Many small parts instead of one large one:
+// an HLOD build holds only the parts of the subtrees it is measuring, not a BVH of the whole.
+struct SurfacePartPlan {
+  SurfaceGrid grid;
+  float slack = 0;                               // the whole surface's rounding slack
+  size_t vertex_count = 0, triangle_count = 0;  // of the whole surface
+  std::vector<SurfaceBox> boxes;
+  std::vector<std::vector<uint32_t>> triangles;  // per box, ascending
+};
+// The plan for `boxes` over `whole` (its indices checked here). `what` names it in messages.
+Status plan_surface_parts(const TriangleMeshView& whole, const SurfaceGrid& grid, std::vector<SurfaceBox> boxes,
+                          SurfacePartPlan& out, const std::string& what);
+
 // How a held surface's BVH is built. The answers never depend on it (every query visits all
 // triangles within rounding of the nearest, on any BVH); only the build's and queries' time do.
 enum class BvhBuilder : uint8_t {
@@ -90,6 +110,13 @@ class SurfaceDistance {
   // a triangle spanning very many cells is always kept). No triangle: every query unanswered.
   Status set_surface_part(const TriangleMeshView& whole, const SurfaceGrid& grid, const std::vector<uint8_t>& wanted,
                           const std::string& what);
+  // The part `plan` (made over `whole`) lists for its box `box`: the box's cells held completely.
+  // `remap`: whole.vertex_count entries of scratch, all UINT32_MAX (filled so when empty), and
+  // left so. Reuses this object's Embree device and arrays from part to part.
+  Status set_surface_planned(const TriangleMeshView& whole, const SurfacePartPlan& plan, size_t box,
+                             std::vector<uint32_t>& remap, const std::string& what);
+  // Whether a surface (or part) was set: queries and from_points_to may be made.
+  bool ready() const;
   // Triangles held (a part's; the whole surface's otherwise).
   size_t triangles() const;
   // A part: whether the cell holding p is held completely (a caller choosing points to ask about).

@@ -144,7 +144,7 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
                                    {"measure_top", w.measure_cpu_seconds}, {"write", w.write_cpu_seconds}}},
                         {"bytes_written", w.bytes_written}, {"bytes_placed", w.bytes_placed},
                         {"bytes_read_back", w.bytes_read_back},
-                        {"region_triangles", w.region_triangles}, {"whole_bvh", w.whole_surface != 0},
+                        {"part_triangles", w.part_triangles}, {"whole_bvh", w.whole_surface != 0},
                         {"mesh_loaded", w.mesh_loaded != 0},
                         // The process's whole run: CPU time in the kernel, peak resident memory.
                         {"kernel_cpu_s", w.kernel_cpu_seconds}, {"peak_rss_mb", double(w.peak_rss_bytes) / 1e6}});
@@ -160,7 +160,7 @@ nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
           // Rank 0's serial CPU seconds between the gather and the layout's broadcast.
           {"rank0_cpu_s", {{"roots", r.collect_cpu_seconds}, {"assemble", r.assemble_cpu_seconds},
                            {"head", r.head_cpu_seconds}, {"top_rest", r.top_rest_cpu_seconds}}},
-          // The top's samples no rank's region answered; whether rank 0 built the whole BVH.
+          // The top's samples no rank answered; whether rank 0 built the whole BVH.
           {"top_samples_left", r.top_samples_left}, {"rank0_whole_bvh", r.top_whole_surface},
           // The job's length on idle cores: the slowest rank's CPU time up to the gather, rank
           // 0's serial part, the slowest rank's write (each rank runs one thread; the machine

@@ -94,9 +94,8 @@ TEST(HlodSplit, SubtreesBakedByOtherBuildersSpliceIntoTheSameFile) {
   EXPECT_EQ(bytes_of(model), local_build(m, 16));
 }
 
-// Two builders with regions (the two spatial halves of the frontier) bake and measure the top by
-// sample as a distributed build does, a third assembles: the local bytes, from BVHs over less
-// than the whole mesh.
+// Two builders (the two spatial halves of the frontier) bake and measure the top by sample as a
+// distributed build does, a third assembles: the local bytes, from BVHs of parts of the mesh.
 TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
   const MeshData m = mesh();
   const HlodBuildOptions o = options_with(16);
@@ -105,8 +104,6 @@ TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
   const size_t n = root.subtrees().size();
   std::vector<size_t> low, high;
   for (size_t i = 0; i < n; ++i) (root.subtrees()[i].spatial < n / 2 ? low : high).push_back(i);
-  a.set_region(low);
-  b.set_region(high);
   std::vector<HlodSubtree> baked(n);
   auto keep = [&](size_t i, HlodSubtree&& s) {
     baked[i] = std::move(s);
@@ -115,8 +112,8 @@ TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
   ASSERT_TRUE(a.bake_subtrees(low, keep));
   ASSERT_TRUE(b.bake_subtrees(high, keep));
   for (const HlodBuilder* x : {&a, &b}) {
-    EXPECT_GT(x->region_triangles(), 0u);
-    EXPECT_LT(x->region_triangles(), m.triangle_count());
+    EXPECT_GT(x->part_triangles(), 0u);
+    EXPECT_LT(x->part_triangles(), m.triangle_count());
   }
   std::vector<HlodLayerProbe> probes;
   ASSERT_TRUE(root.build_top(baked, probes));
@@ -128,16 +125,16 @@ TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
   ASSERT_TRUE(b.measure_probes_part(probes, second, to_b, ans_b, from_b));
   std::vector<float> to(probes.size()), errors(probes.size());
   std::vector<std::vector<uint8_t>> answered(probes.size());
-  size_t samples = 0, by_regions = 0;
+  size_t samples = 0, by_parts = 0;
   for (size_t i = 0; i < probes.size(); ++i) {
     to[i] = std::max(to_a[i], to_b[i]);
     ASSERT_EQ(ans_a[i].size(), ans_b[i].size());
     answered[i].resize(ans_a[i].size());
     for (size_t k = 0; k < answered[i].size(); ++k) answered[i][k] = ans_a[i][k] | ans_b[i][k];
     samples += answered[i].size();
-    by_regions += size_t(std::count(answered[i].begin(), answered[i].end(), 1));
+    by_parts += size_t(std::count(answered[i].begin(), answered[i].end(), 1));
   }
-  EXPECT_GT(by_regions, samples / 2) << "most of the top's samples are answered by a region";
+  EXPECT_GT(by_parts, samples / 2) << "most of the top's samples are answered by the parts the builders kept";
   ASSERT_TRUE(root.measure_probes_rest(probes, answered, to));
   for (size_t i = 0; i < probes.size(); ++i) errors[i] = std::max(to[i], (i % 2 ? from_b[i / 2] : from_a[i / 2]));
   HlodAssembly assembly;
