@@ -431,7 +431,8 @@ std::unique_ptr<CacheProgress> watch_progress(const Job& j) {
 }
 
 // Who writes each subtree's payloads: the rank that checked a cached entry, or bakes a missing
-// one (the missing ones in contiguous runs of their own).
+// one (the missing ones in contiguous runs of their own). A rank measures the top's samples in
+// the cells of what it writes.
 void assign_writers(Job& j) {
   const std::vector<int> checker = spatial_share(j, nullptr);
   std::vector<size_t> todo;
@@ -440,6 +441,10 @@ void assign_writers(Job& j) {
     else j.writer[i] = checker[i];
   const std::vector<int> owner = spatial_share(j, &todo);
   for (size_t k = 0; k < todo.size(); ++k) j.writer[todo[k]] = owner[k];
+  std::vector<size_t> region;
+  for (size_t i = 0; i < j.writer.size(); ++i)
+    if (j.writer[i] == j.comm.rank) region.push_back(i);
+  j.builder->set_region(region);
 }
 
 // The cleaned mesh goes into the cache before any subtree is baked (a rerun after a kill skips
@@ -657,7 +662,7 @@ std::vector<int> probe_owners(const std::vector<HlodLayerProbe>& probes, int ran
   return assign_subtrees(costs, ranks);
 }
 
-// Every rank: the top's layers measured by sample, each rank those in the cells it baked
+// Every rank: the top's layers measured by sample, each rank those in the cells it writes
 // (the original's side of its share of the layers as well). The reply: a status, then per
 // layer the largest distance found, the other side's errors of its share, and per layer which
 // samples it answered (bits).

@@ -12,8 +12,8 @@
 //   gather       per rank: its status (a failure names the subtree), work and bytes
 //   rank 0       read the subtrees' roots from the entries (a refused one is baked again here),
 //                build the layers of the levels above -> broadcast them
-//   every rank   measure those layers' samples in the cells it baked (against the parts of the
-//                original it kept) and the other side of a share of the layers -> gather ->
+//   every rank   measure those layers' samples in the cells it writes (against the parts of
+//                the original near them) and the other side of a share of the layers -> gather ->
 //                rank 0 measures any sample no rank answered, against the original near them
 //   rank 0       finish the levels above, write the head and their payloads into a temporary
 //                file at its full size -> broadcast where every subtree node's payload goes

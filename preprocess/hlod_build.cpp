@@ -1030,7 +1030,8 @@ class PartPool {
     std::lock_guard<std::mutex> lock(mutex_);
     free_.push_back(std::move(slot));
   }
-  // A part built before (ready, so its Embree device can build a layer's BVH), if any.
+  // A part built before (ready, so its Embree device can build a layer's BVH), if any: valid
+  // while no task takes parts from the pool.
   const SurfaceDistance* any() {
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& slot : free_)
@@ -1076,6 +1077,7 @@ struct HlodBuilder::Impl {
   // measure the top's samples in its cell (the top's finest layers cover the whole surface).
   std::vector<std::unique_ptr<SurfacePartPlan>> plans;
   std::vector<std::pair<int32_t, uint32_t>> part_of;
+  std::vector<size_t> region;  // set_region: the subtrees whose cells' top samples it answers
   PartPool pool;
   Tally top_tally;
 
@@ -1102,13 +1104,24 @@ struct HlodBuilder::Impl {
     part_ns.fetch_add(uint64_t((thread_cpu_seconds() - cpu0) * 1e9), std::memory_order_relaxed);
     part_triangles.fetch_add(triangles, std::memory_order_relaxed);
   }
-  Status plan_parts(const std::vector<size_t>& which, SurfacePartPlan& plan) {
+  // The parts of `subtrees` (those not planned yet) listed in one pass over the original.
+  Status plan_parts(const std::vector<size_t>& subtrees) {
     const double cpu0 = thread_cpu_seconds();
+    std::vector<size_t> todo;
     std::vector<SurfaceBox> boxes;
-    for (size_t i : which) boxes.push_back(grown_cell(specs[i], 1.0625f));
-    const Status s = plan_surface_parts(original(), part_grid(*root, 1024), std::move(boxes), plan, what + " (subtrees' parts)");
+    for (size_t i : subtrees)
+      if (i < specs.size() && part_of[i].first < 0 && std::find(todo.begin(), todo.end(), i) == todo.end()) {
+        todo.push_back(i);
+        boxes.push_back(grown_cell(specs[i], 1.0625f));
+      }
+    if (todo.empty()) return Status::success();
+    auto plan = std::make_unique<SurfacePartPlan>();
+    const Status s = plan_surface_parts(original(), part_grid(*root, 1024), std::move(boxes), *plan, what + " (subtrees' parts)");
     count_part(cpu0, 0);
-    return s;
+    if (!s) return s;
+    for (size_t k = 0; k < todo.size(); ++k) part_of[todo[k]] = {int32_t(plans.size()), uint32_t(k)};
+    plans.push_back(std::move(plan));
+    return Status::success();
   }
   std::string name(size_t i) const {
     return what + ": subtree " + std::to_string(i) + " (depth " + std::to_string(specs[i].depth) + ", " +
@@ -1141,6 +1154,7 @@ const std::vector<HlodSubtreeSpec>& HlodBuilder::subtrees() const { return impl_
 double HlodBuilder::surface_cpu_seconds() const { return impl_->whole_cpu + double(impl_->part_ns.load()) * 1e-9; }
 size_t HlodBuilder::part_triangles() const { return impl_->part_triangles.load(); }
 bool HlodBuilder::whole_surface_built() const { return impl_->whole_built.load(); }
+void HlodBuilder::set_region(const std::vector<size_t>& subtrees) { impl_->region = subtrees; }
 
 
 Status HlodBuilder::plan() {
@@ -1238,12 +1252,13 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
   const ParallelFor& parallel_for = m.c.options.parallel_for;
   std::vector<Tally> tallies(which.size());
   std::vector<uint8_t> grown(which.size(), 0);
-  auto plan = std::make_unique<SurfacePartPlan>();
+  std::vector<size_t> planned_here = which;  // with the region's, in the same pass
+  planned_here.insert(planned_here.end(), m.region.begin(), m.region.end());
   Status planned;
   std::atomic<bool> plan_done{false};
   run_all(parallel_for, 2, [&](size_t part) {  // subtrees grow beside the plan (none serially)
     if (part == 0) {
-      planned = m.plan_parts(which, *plan);
+      planned = m.plan_parts(planned_here);
       plan_done.store(true);
       return;
     }
@@ -1253,8 +1268,6 @@ Status HlodBuilder::bake_subtrees(const std::vector<size_t>& which, const Subtre
     }
   });
   if (!planned) return planned;
-  for (size_t k = 0; k < which.size(); ++k) m.part_of[which[k]] = {int32_t(m.plans.size()), uint32_t(k)};
-  m.plans.push_back(std::move(plan));
   // The rest grow and finish one by one, so that results are handed on from the start.
   std::vector<Status> finished(which.size());
   std::atomic<bool> failed{false};
@@ -1345,9 +1358,10 @@ std::vector<size_t> every(size_t n) {
 
 }  // namespace
 
-// The top's layers measured against a part of the original built near their samples (the
-// top's nodes span the whole mesh, their samples do not): the samples of `layers` that `take`
-// picks, each with the cells within its known bound of it (and a cell's width more). A sample
+// The top's layers measured against a part of the original built near their samples: the
+// samples `take` picks (probe, sample, point), each with the cells within its known bound of it
+// (and a cell's width more). One pass over the whole mesh: for the few samples no subtree's
+// part answered, or for a builder that baked no subtree. A sample
 // the part cannot answer exactly goes to the whole original when `whole_answers`, else is left
 // unanswered (answered flags, one per sample of every probe). For the probes in `reference`, the
 // other side (the node's original samples to the layer; from_max by position in `reference`).
@@ -1493,6 +1507,7 @@ Status HlodBuilder::measure_probes_part(const std::vector<HlodLayerProbe>& probe
   if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, every(probes.size())); !s) return s;
   for (size_t i : reference)
     if (i >= probes.size()) return Status::error(m.what + ": top layer " + std::to_string(i) + " does not exist");
+  if (Status s = m.plan_parts(m.region); !s) return s;  // a rank that baked none of its region
   to_max.assign(probes.size(), 0.0f);
   if (Status s = m.measure_in_parts(probes, std::vector<uint8_t>(probes.size(), 1), to_max, answered); !s) return s;
   from_max.clear();

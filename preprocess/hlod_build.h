@@ -194,9 +194,14 @@ class HlodBuilder {
   // exactly as the whole original would (the nearest found is not provably the nearest)
   // against the whole original's BVH, built on first need only. The bytes are the same either way.
   //
-  // The top's errors split by sample rather than by layer, for a builder that baked some of the
-  // subtrees: per probe, the largest distance to the original among its layer samples the parts
-  // it kept answer (to_max) and which samples those are (answered, one flag per sample); for the probes listed
+  // A distributed build's region: the subtrees whose cells' top samples this builder measures
+  // (measure_probes_part): those it writes, baked or found in the cache. Their parts are listed
+  // in the same pass over the original as its bake's. Before bake_subtrees.
+  void set_region(const std::vector<size_t>& subtrees);
+  // The top's errors split by sample rather than by layer: per probe, the largest distance to
+  // the original among its layer samples in the cells of the subtrees this builder baked or has
+  // in its region, each answered by that subtree's part (to_max), and which samples those are
+  // (answered, one flag per sample); for the probes listed
   // in `reference`, the other side (the node's original samples to the layer; from_max, by
   // position in `reference`). A layer's error is max(to_max over every sample, from_max).
   Status measure_probes_part(const std::vector<HlodLayerProbe>& probes, const std::vector<size_t>& reference,

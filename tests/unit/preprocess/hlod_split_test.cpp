@@ -65,9 +65,34 @@ TEST(HlodSplit, FrontierHoldsNoSplittableSubtreeAboveTheLimit) {
   const uint64_t limit = m.triangle_count() / 16;
   for (size_t i = 0; i < specs.size(); ++i) {
     EXPECT_EQ(baked[i].nodes[0].depth, specs[i].depth);
-    if (specs[i].triangles > limit) EXPECT_EQ(baked[i].nodes.size(), 1u) << "subtree " << i << " could have split";
+    if (specs[i].triangles > limit) {
+      EXPECT_EQ(baked[i].nodes.size(), 1u) << "subtree " << i << " could have split";
+    }
   }
   for (size_t i = 1; i < specs.size(); ++i) EXPECT_NE(specs[i].fingerprint, specs[0].fingerprint);
+}
+
+// Every layer is measured against a BVH of the part of the original near its subtree's cell (the
+// top's samples against their subtree's part again), never against a BVH of the whole: the
+// parts hold each triangle about once (a margin's more), and the bytes are the local build's.
+TEST(HlodSplit, ABuildMeasuresAgainstPartsOfTheOriginalNeverItsWholeBvh) {
+  const MeshData m = mesh();
+  HlodBuilder b(m, options_with(16));
+  ASSERT_TRUE(b.plan());
+  std::vector<HlodSubtree> baked(b.subtrees().size());
+  std::vector<size_t> all(baked.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  ASSERT_TRUE(b.bake_subtrees(all, [&](size_t i, HlodSubtree&& s) {
+    baked[i] = std::move(s);
+    return Status::success();
+  }));
+  EXPECT_GE(b.part_triangles(), m.triangle_count());
+  EXPECT_LT(b.part_triangles(), m.triangle_count() * 3 / 2);
+  HlodModel model;
+  ASSERT_TRUE(b.assemble(baked, model));
+  EXPECT_FALSE(b.whole_surface_built()) << "a query no part could answer built the whole original's BVH";
+  EXPECT_GT(b.surface_cpu_seconds(), 0.0);
+  EXPECT_EQ(bytes_of(model), local_build(m, 1)) << "the bytes of one subtree, whose part is the whole mesh";
 }
 
 // Three builders as three processes: two bake half the subtrees each, the third only assembles.
@@ -94,24 +119,28 @@ TEST(HlodSplit, SubtreesBakedByOtherBuildersSpliceIntoTheSameFile) {
   EXPECT_EQ(bytes_of(model), local_build(m, 16));
 }
 
-// Two builders (the two spatial halves of the frontier) bake and measure the top by sample as a
+// Two builders (the two spatial halves of the frontier) measure the top by sample as a
 // distributed build does, a third assembles: the local bytes, from BVHs of parts of the mesh.
-TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
+// One baked its half; the other's half came from elsewhere (a rerun's cache), so it lists the
+// parts of its region itself.
+TEST(HlodSplit, TwoBuildersMeasuringTheTopBySampleGiveTheLocalBytes) {
   const MeshData m = mesh();
   const HlodBuildOptions o = options_with(16);
-  HlodBuilder a(m, o), b(m, o), root(m, o);
-  for (HlodBuilder* builder : {&a, &b, &root}) ASSERT_TRUE(builder->plan());
+  HlodBuilder a(m, o), b(m, o), elsewhere(m, o), root(m, o);
+  for (HlodBuilder* builder : {&a, &b, &elsewhere, &root}) ASSERT_TRUE(builder->plan());
   const size_t n = root.subtrees().size();
   std::vector<size_t> low, high;
   for (size_t i = 0; i < n; ++i) (root.subtrees()[i].spatial < n / 2 ? low : high).push_back(i);
+  a.set_region(low);
+  b.set_region(high);
   std::vector<HlodSubtree> baked(n);
   auto keep = [&](size_t i, HlodSubtree&& s) {
     baked[i] = std::move(s);
     return Status::success();
   };
   ASSERT_TRUE(a.bake_subtrees(low, keep));
-  ASSERT_TRUE(b.bake_subtrees(high, keep));
-  for (const HlodBuilder* x : {&a, &b}) {
+  ASSERT_TRUE(elsewhere.bake_subtrees(high, keep));
+  for (const HlodBuilder* x : {&a, &elsewhere}) {
     EXPECT_GT(x->part_triangles(), 0u);
     EXPECT_LT(x->part_triangles(), m.triangle_count());
   }
@@ -125,8 +154,9 @@ TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
   ASSERT_TRUE(b.measure_probes_part(probes, second, to_b, ans_b, from_b));
   std::vector<float> to(probes.size()), errors(probes.size());
   std::vector<std::vector<uint8_t>> answered(probes.size());
-  size_t samples = 0, by_parts = 0;
+  size_t samples = 0, by_parts = 0, by_b = 0;
   for (size_t i = 0; i < probes.size(); ++i) {
+    by_b += size_t(std::count(ans_b[i].begin(), ans_b[i].end(), 1));
     to[i] = std::max(to_a[i], to_b[i]);
     ASSERT_EQ(ans_a[i].size(), ans_b[i].size());
     answered[i].resize(ans_a[i].size());
@@ -134,7 +164,8 @@ TEST(HlodSplit, RegionalBuildersGiveTheLocalBytes) {
     samples += answered[i].size();
     by_parts += size_t(std::count(answered[i].begin(), answered[i].end(), 1));
   }
-  EXPECT_GT(by_parts, samples / 2) << "most of the top's samples are answered by the parts the builders kept";
+  EXPECT_GT(by_parts, samples * 9 / 10) << "the top's samples are answered by their cells' parts";
+  EXPECT_GT(by_b, samples / 4) << "the builder that baked none of its region answers its cells' samples";
   ASSERT_TRUE(root.measure_probes_rest(probes, answered, to));
   for (size_t i = 0; i < probes.size(); ++i) errors[i] = std::max(to[i], (i % 2 ? from_b[i / 2] : from_a[i / 2]));
   HlodAssembly assembly;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <functional>
@@ -164,6 +165,123 @@ TEST(SurfaceDistance, PartAnswersExactlyAsTheWhole) {
   }
   EXPECT_GT(mine, 300u);
   EXPECT_GT(theirs, 300u);
+}
+
+// The wavy 60 x 60 sheet over [0, 1]^2 the part tests query.
+void wavy_sheet(std::vector<float>& p, std::vector<uint32_t>& t) {
+  const uint32_t n = 60;
+  for (uint32_t y = 0; y <= n; ++y)
+    for (uint32_t x = 0; x <= n; ++x) {
+      const float u = float(x) / n, v = float(y) / n;
+      p.insert(p.end(), {u, v, 0.05f * std::sin(9 * u) * std::cos(7 * v) + 0.5f});
+    }
+  for (uint32_t y = 0; y < n; ++y)
+    for (uint32_t x = 0; x < n; ++x) {
+      const uint32_t a = y * (n + 1) + x;
+      t.insert(t.end(), {a, a + 1, a + n + 2, a, a + n + 2, a + n + 1});
+    }
+}
+
+SurfaceBox box(float x0, float y0, float x1, float y1) {
+  SurfaceBox b;
+  b.lo[0] = x0, b.lo[1] = y0, b.lo[2] = 0, b.hi[0] = x1, b.hi[1] = y1, b.hi[2] = 1;
+  return b;
+}
+
+// Each planned part lists exactly the triangles whose box reaches into its box's cells (as a
+// brute force over every triangle and box finds them), and answers a query only as the whole
+// surface would, to the bit; one SurfaceDistance and one scratch serve every part in turn.
+TEST(SurfaceDistance, PlannedPartsListWhatReachesTheirBoxesAndAnswerExactlyAsTheWhole) {
+  std::vector<float> p;
+  std::vector<uint32_t> t;
+  wavy_sheet(p, t);
+  SurfaceGrid grid;
+  grid.n = 64;
+  const std::vector<SurfaceBox> boxes = {box(0, 0, 0.53f, 0.53f), box(0.47f, 0, 1, 0.53f), box(0, 0.47f, 0.53f, 1),
+                                         box(0.47f, 0.47f, 1, 1), box(0.3f, 0.3f, 0.31f, 0.7f)};
+  SurfacePartPlan plan;
+  ASSERT_TRUE(plan_surface_parts(view(p, t), grid, boxes, plan, "sheet"));
+  ASSERT_EQ(plan.triangles.size(), boxes.size());
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    std::vector<uint32_t> expected;
+    for (uint32_t f = 0; f < t.size() / 3; ++f) {
+      bool meets = true;
+      for (int k = 0; k < 3; ++k) {
+        uint32_t lo = grid.n, hi = 0;
+        for (int c = 0; c < 3; ++c) {
+          const uint32_t cell = grid.cell(p[3 * size_t(t[3 * f + c]) + k], k);
+          lo = std::min(lo, cell), hi = std::max(hi, cell);
+        }
+        meets = meets && hi >= grid.cell(boxes[b].lo[k], k) && lo <= grid.cell(boxes[b].hi[k], k);
+      }
+      if (meets) expected.push_back(f);
+    }
+    EXPECT_EQ(plan.triangles[b], expected) << "box " << b;
+  }
+  SurfaceDistance whole, part;
+  ASSERT_TRUE(whole.set_surface(view(p, t), "sheet"));
+  std::vector<uint32_t> remap;
+  const std::function<const SurfaceDistance*()> ask_whole = [&] { return &whole; };
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0, 1), h(0.3f, 0.7f);
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    ASSERT_TRUE(part.set_surface_planned(view(p, t), plan, b, remap, "sheet part"));
+    EXPECT_EQ(part.triangles(), plan.triangles[b].size());
+    ASSERT_EQ(remap.size(), p.size() / 3);
+    EXPECT_EQ(std::count(remap.begin(), remap.end(), UINT32_MAX), ptrdiff_t(remap.size())) << "scratch left dirty";
+    const float centre[3] = {(boxes[b].lo[0] + boxes[b].hi[0]) / 2, (boxes[b].lo[1] + boxes[b].hi[1]) / 2, 0.5f};
+    const float far[3] = {boxes[b].hi[0] + 0.2f > 1 ? boxes[b].lo[0] - 0.2f : boxes[b].hi[0] + 0.2f, centre[1], 0.5f};
+    EXPECT_TRUE(part.holds(centre));
+    EXPECT_FALSE(part.holds(far));
+    size_t mine = 0;
+    for (int k = 0; k < 500; ++k) {
+      const float q[3] = {u(rng), u(rng), h(rng)};
+      SurfaceError w, a, c;
+      std::vector<uint8_t> answered;
+      ASSERT_TRUE(whole.from_points(q, 1, nullptr, w));
+      ASSERT_TRUE(part.from_points_part(q, 1, nullptr, ask_whole, a, nullptr));
+      EXPECT_EQ(std::bit_cast<uint32_t>(a.max), std::bit_cast<uint32_t>(w.max)) << "box " << b;
+      ASSERT_TRUE(part.from_points_part(q, 1, nullptr, {}, c, &answered));
+      if (!answered[0]) continue;
+      ++mine;
+      EXPECT_EQ(std::bit_cast<uint32_t>(c.max), std::bit_cast<uint32_t>(w.max)) << "box " << b;
+    }
+    if (b < 4) {
+      EXPECT_GT(mine, 30u) << "box " << b << " answers nothing itself";
+    }
+  }
+}
+
+TEST(SurfaceDistance, PlannedPartsRefuseWhatDoesNotFit) {
+  std::vector<float> p;
+  std::vector<uint32_t> t;
+  wavy_sheet(p, t);
+  SurfaceGrid grid;
+  grid.n = 16;
+  SurfacePartPlan plan;
+  std::vector<uint32_t> broken = t;
+  broken[3 * 7 + 1] = uint32_t(p.size());  // triangle 7 names a vertex the sheet lacks
+  Status s = plan_surface_parts(view(p, broken), grid, {box(0, 0, 1, 1)}, plan, "broken sheet");
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("broken sheet: triangle 7"), std::string::npos) << s.message;
+  SurfaceGrid huge = grid;
+  huge.n = 70000;
+  EXPECT_FALSE(plan_surface_parts(view(p, t), huge, {box(0, 0, 1, 1)}, plan, "sheet").ok);
+  ASSERT_TRUE(plan_surface_parts(view(p, t), grid, {box(0, 0, 1, 1)}, plan, "sheet"));
+  SurfaceDistance part;
+  std::vector<uint32_t> remap;
+  s = part.set_surface_planned(view(p, t), plan, 1, remap, "sheet part");
+  EXPECT_FALSE(s.ok) << "a box the plan lacks";
+  EXPECT_NE(s.message.find("sheet part"), std::string::npos);
+  EXPECT_FALSE(part.ready());
+  const std::vector<float> fewer(p.begin(), p.end() - 3);
+  EXPECT_FALSE(part.set_surface_planned(view(fewer, {0, 1, 2}), plan, 0, remap, "another").ok) << "another surface";
+  remap.assign(5, UINT32_MAX);
+  EXPECT_FALSE(part.set_surface_planned(view(p, t), plan, 0, remap, "sheet part").ok) << "scratch of another size";
+  remap.clear();
+  EXPECT_TRUE(part.set_surface_planned(view(p, t), plan, 0, remap, "sheet part"));
+  EXPECT_TRUE(part.ready());
+  EXPECT_EQ(part.triangles(), t.size() / 3);
 }
 
 TEST(SurfaceError, RefusesBadInput) {
