@@ -12,6 +12,9 @@
 //   BM_Clean/soup         clean_mesh of the same triangles, three vertices each (all to weld)
 //   BM_SurfaceBuild / BM_SurfaceQuery   the closest-point BVH over it: build, and queries;
 //                         /sah (the former builder) is the baseline for /morton (the default)
+//   BM_SurfaceParts       what an HLOD bake builds instead of BM_SurfaceBuild/morton (its
+//                         baseline): 4^3 parts, each a cell grown by a sixteenth of its half-edge,
+//                         listed in one pass and built one after another in the same memory
 //   BM_EntryChecksumConcatenated / BM_EntryChecksumPieces   the cleaned-mesh cache entry's
 //                         checksum: its arrays copied into one buffer and hashed (the former
 //                         store), against hashed where they lie (BytesHasher, what it does now)
@@ -19,6 +22,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <compare>
 #include <cstdio>
 #include <cstdlib>
@@ -226,6 +230,42 @@ void BM_SurfaceBuild(benchmark::State& state) {
   state.counters["triangles"] = double(m.triangle_count());
 }
 
+void BM_SurfaceParts(benchmark::State& state) {
+  const MeshData& m = sphere();
+  const TriangleMeshView whole{m.positions.data(), m.vertex_count(), m.indices.data(), m.indices.size()};
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.positions[3 * v + k]), hi[k] = std::max(hi[k], m.positions[3 * v + k]);
+  SurfaceGrid grid;
+  grid.edge = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}) * 1.001f;
+  std::copy_n(lo, 3, grid.lo);
+  grid.n = 1024;
+  const float half = grid.edge / 8, grow = half / 16;
+  std::vector<SurfaceBox> boxes;
+  for (int z = 0; z < 4; ++z)
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) {
+        SurfaceBox b;
+        const int at[3] = {x, y, z};
+        for (int k = 0; k < 3; ++k) b.lo[k] = lo[k] + float(at[k]) * 2 * half - grow, b.hi[k] = b.lo[k] + 2 * (half + grow);
+        boxes.push_back(b);
+      }
+  size_t held = 0;
+  for (auto _ : state) {
+    SurfacePartPlan plan;
+    if (!plan_surface_parts(whole, grid, boxes, plan, "bench")) state.SkipWithError("not planned");
+    SurfaceDistance part;
+    std::vector<uint32_t> remap;
+    held = 0;
+    for (size_t b = 0; b < boxes.size(); ++b) {
+      if (!part.set_surface_planned(whole, plan, b, remap, "bench part")) state.SkipWithError("a part was not built");
+      held += part.triangles();
+    }
+  }
+  state.counters["triangles"] = double(m.triangle_count());
+  state.counters["held"] = double(held);  // the parts' triangles together
+}
+
 // Every 7th vertex pushed off the surface by 0.1 %, each query started from a 1 % radius.
 void BM_SurfaceQuery(benchmark::State& state) {
   const MeshData& m = sphere();
@@ -256,6 +296,7 @@ BENCHMARK(BM_Clean)->ArgName("soup")->Arg(0)->Arg(1)->Unit(benchmark::kMilliseco
 BENCHMARK(BM_EntryChecksumConcatenated)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_EntryChecksumPieces)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_SurfaceBuild)->ArgName("sah")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_SurfaceParts)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_SurfaceQuery)->ArgName("sah")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
