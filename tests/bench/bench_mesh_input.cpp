@@ -15,6 +15,8 @@
 //   BM_SurfaceParts       what an HLOD bake builds instead of BM_SurfaceBuild/morton (its
 //                         baseline): 4^3 parts, each a cell grown by a sixteenth of its half-edge,
 //                         listed in one pass and built one after another in the same memory
+//                         (13.9M, one core: 0.98x of the one BVH's time, 1.18x its triangles;
+//                         the bake's gain is the memory it does not take)
 //   BM_EntryChecksumConcatenated / BM_EntryChecksumPieces   the cleaned-mesh cache entry's
 //                         checksum: its arrays copied into one buffer and hashed (the former
 //                         store), against hashed where they lie (BytesHasher, what it does now)

@@ -30,6 +30,17 @@ std::vector<uint8_t> local_build(const MeshData& m, uint32_t subtrees) {
   return bytes_of(model);
 }
 
+// Every subtree of a planned builder, baked in order into `baked`.
+Status bake_all(HlodBuilder& b, std::vector<HlodSubtree>& baked) {
+  baked.assign(b.subtrees().size(), {});
+  std::vector<size_t> all(baked.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return b.bake_subtrees(all, [&](size_t i, HlodSubtree&& s) {
+    baked[i] = std::move(s);
+    return Status::success();
+  });
+}
+
 TEST(HlodSplit, SameBytesWhereverTheFrontierIs) {
   const MeshData m = mesh();
   const std::vector<uint8_t> one = local_build(m, 1);
@@ -55,13 +66,8 @@ TEST(HlodSplit, FrontierHoldsNoSplittableSubtreeAboveTheLimit) {
   ASSERT_TRUE(b.plan());
   const auto& specs = b.subtrees();
   ASSERT_GE(specs.size(), 16u);
-  std::vector<HlodSubtree> baked(specs.size());
-  std::vector<size_t> all(specs.size());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
-  ASSERT_TRUE(b.bake_subtrees(all, [&](size_t i, HlodSubtree&& s) {
-    baked[i] = std::move(s);
-    return Status::success();
-  }));
+  std::vector<HlodSubtree> baked;
+  ASSERT_TRUE(bake_all(b, baked));
   const uint64_t limit = m.triangle_count() / 16;
   for (size_t i = 0; i < specs.size(); ++i) {
     EXPECT_EQ(baked[i].nodes[0].depth, specs[i].depth);
@@ -79,13 +85,8 @@ TEST(HlodSplit, ABuildMeasuresAgainstPartsOfTheOriginalNeverItsWholeBvh) {
   const MeshData m = mesh();
   HlodBuilder b(m, options_with(16));
   ASSERT_TRUE(b.plan());
-  std::vector<HlodSubtree> baked(b.subtrees().size());
-  std::vector<size_t> all(baked.size());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
-  ASSERT_TRUE(b.bake_subtrees(all, [&](size_t i, HlodSubtree&& s) {
-    baked[i] = std::move(s);
-    return Status::success();
-  }));
+  std::vector<HlodSubtree> baked;
+  ASSERT_TRUE(bake_all(b, baked));
   EXPECT_GE(b.part_triangles(), m.triangle_count());
   EXPECT_LT(b.part_triangles(), m.triangle_count() * 3 / 2);
   HlodModel model;
@@ -182,13 +183,8 @@ TEST(HlodSplit, AssemblyRefusesASubtreeInTheWrongPlace) {
   HlodBuilder b(m, o), root(m, o);
   ASSERT_TRUE(b.plan());
   ASSERT_TRUE(root.plan());
-  std::vector<HlodSubtree> baked(b.subtrees().size());
-  std::vector<size_t> all(baked.size());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
-  ASSERT_TRUE(b.bake_subtrees(all, [&](size_t i, HlodSubtree&& s) {
-    baked[i] = std::move(s);
-    return Status::success();
-  }));
+  std::vector<HlodSubtree> baked;
+  ASSERT_TRUE(bake_all(b, baked));
   std::swap(baked[0], baked[1]);
   HlodModel model;
   const Status st = root.assemble(baked, model);

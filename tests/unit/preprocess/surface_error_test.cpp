@@ -109,12 +109,8 @@ TEST(SurfaceError, MeterReusesItsReference) {
   EXPECT_NEAR(shifted.max, 0.5f, 1e-6f);
 }
 
-// A surface part answers a point only when it is provably the whole surface's answer, to the
-// bit; the others go to the whole (or are left unanswered); cells outside reach none of it.
-TEST(SurfaceDistance, PartAnswersExactlyAsTheWhole) {
-  // A wavy 60 x 60 sheet over [0, 1]^2.
-  std::vector<float> p;
-  std::vector<uint32_t> t;
+// The wavy 60 x 60 sheet over [0, 1]^2 the part tests query.
+void wavy_sheet(std::vector<float>& p, std::vector<uint32_t>& t) {
   const uint32_t n = 60;
   for (uint32_t y = 0; y <= n; ++y)
     for (uint32_t x = 0; x <= n; ++x) {
@@ -126,6 +122,14 @@ TEST(SurfaceDistance, PartAnswersExactlyAsTheWhole) {
       const uint32_t a = y * (n + 1) + x;
       t.insert(t.end(), {a, a + 1, a + n + 2, a, a + n + 2, a + n + 1});
     }
+}
+
+// A surface part answers a point only when it is provably the whole surface's answer, to the
+// bit; the others go to the whole (or are left unanswered); cells outside reach none of it.
+TEST(SurfaceDistance, PartAnswersExactlyAsTheWhole) {
+  std::vector<float> p;
+  std::vector<uint32_t> t;
+  wavy_sheet(p, t);
   SurfaceDistance whole, part;
   ASSERT_TRUE(whole.set_surface(view(p, t), "sheet"));
   SurfaceGrid grid;
@@ -165,21 +169,6 @@ TEST(SurfaceDistance, PartAnswersExactlyAsTheWhole) {
   }
   EXPECT_GT(mine, 300u);
   EXPECT_GT(theirs, 300u);
-}
-
-// The wavy 60 x 60 sheet over [0, 1]^2 the part tests query.
-void wavy_sheet(std::vector<float>& p, std::vector<uint32_t>& t) {
-  const uint32_t n = 60;
-  for (uint32_t y = 0; y <= n; ++y)
-    for (uint32_t x = 0; x <= n; ++x) {
-      const float u = float(x) / n, v = float(y) / n;
-      p.insert(p.end(), {u, v, 0.05f * std::sin(9 * u) * std::cos(7 * v) + 0.5f});
-    }
-  for (uint32_t y = 0; y < n; ++y)
-    for (uint32_t x = 0; x < n; ++x) {
-      const uint32_t a = y * (n + 1) + x;
-      t.insert(t.end(), {a, a + 1, a + n + 2, a, a + n + 2, a + n + 1});
-    }
 }
 
 SurfaceBox box(float x0, float y0, float x1, float y1) {
