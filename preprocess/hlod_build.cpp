@@ -366,18 +366,16 @@ void reference_samples(const Context& c, const std::vector<uint32_t>& reference,
 // Each comes with a distance the original surface is known to be within (to the original
 // vertex it, or its triangle's nearest corner, descends from), so that its closest-point
 // query starts small.
-size_t layer_centroids(const Context& c, const Layer& layer) {
-  const size_t tris = layer.triangles();
+size_t layer_centroids(const Context& c, size_t tris) {
   return std::min(tris, size_t(std::ceil(double(c.options.layer_samples_per_triangle) * double(tris))));
 }
-size_t layer_sample_count(const Context& c, const Layer& layer) { return layer.vertices() + layer_centroids(c, layer); }
 
 void layer_samples(const Context& c, const Layer& layer, std::vector<float>& points, std::vector<float>& known) {
   points = layer.positions;
   known.resize(layer.vertices());
   for (size_t i = 0; i < layer.vertices(); ++i) known[i] = distance_to_original(c, &layer.positions[3 * i], layer.source[i]);
   const size_t tris = layer.triangles();
-  const size_t centroids = layer_centroids(c, layer);
+  const size_t centroids = layer_centroids(c, tris);
   for (size_t k = 0; k < centroids; ++k) {
     const uint32_t* f = &layer.indices[3 * (k * tris / centroids)];
     float p[3];
@@ -1109,8 +1107,10 @@ struct HlodBuilder::Impl {
     const double cpu0 = thread_cpu_seconds();
     std::vector<size_t> todo;
     std::vector<SurfaceBox> boxes;
+    std::vector<uint8_t> listed(specs.size(), 0);
     for (size_t i : subtrees)
-      if (i < specs.size() && part_of[i].first < 0 && std::find(todo.begin(), todo.end(), i) == todo.end()) {
+      if (i < specs.size() && part_of[i].first < 0 && !listed[i]) {
+        listed[i] = 1;
         todo.push_back(i);
         boxes.push_back(grown_cell(specs[i], 1.0625f));
       }
@@ -1342,6 +1342,11 @@ Status check_probes(const std::string& what, uint64_t vertices, const std::vecto
   return Status::success();
 }
 
+// How many samples layer_samples takes of a probe's layer (without copying it).
+size_t probe_sample_count(const Context& c, const HlodLayerProbe& p) {
+  return p.positions.size() / 3 + layer_centroids(c, p.indices.size() / 3);
+}
+
 Layer probe_layer(const HlodLayerProbe& p) {
   Layer layer;
   layer.positions = p.positions;
@@ -1441,10 +1446,9 @@ Status HlodBuilder::Impl::measure_in_parts(const std::vector<HlodLayerProbe>& pr
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> in(specs.size());  // per subtree: (probe, sample)
   answered.assign(n, {});
   for (size_t k = 0; k < n; ++k) {
-    const Layer layer = probe_layer(probes[k]);
-    answered[k].assign(layer_sample_count(c, layer), 0);
+    answered[k].assign(probe_sample_count(c, probes[k]), 0);
     if (!listed[k]) continue;
-    layer_samples(c, layer, points[k], known[k]);
+    layer_samples(c, probe_layer(probes[k]), points[k], known[k]);
     for (size_t i = 0; i < known[k].size(); ++i)
       if (const int t = subtree_at(*root, &points[k][3 * i]); t >= 0 && part_of[size_t(t)].first >= 0)
         in[size_t(t)].push_back({uint32_t(k), uint32_t(i)});
@@ -1527,7 +1531,7 @@ Status HlodBuilder::measure_probes_rest(const std::vector<HlodLayerProbe>& probe
                          std::to_string(probes.size()) + " top layers");
   if (Status s = check_probes(m.what, m.mesh.vertex_count(), probes, every(probes.size())); !s) return s;
   for (size_t k = 0; k < probes.size(); ++k)
-    if (answered[k].size() != layer_sample_count(m.c, probe_layer(probes[k])))
+    if (answered[k].size() != probe_sample_count(m.c, probes[k]))
       return Status::error(m.what + ": top layer " + std::to_string(k) + ": answered flags do not match its samples");
   const auto take = [&](size_t k, size_t i, const float*) { return answered[k][i] == 0; };
   std::vector<float> from_max;

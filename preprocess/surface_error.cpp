@@ -116,6 +116,19 @@ std::string device_error_text(RTCDevice device) {
 
 Status commit_query_mesh(RTCDevice device, const std::string& what, BvhBuilder builder, QueryMesh& out);
 
+// Triangle f of `whole` into a part, its vertices renumbered in the order the part meets them
+// (remap: whole's vertex -> the part's, UINT32_MAX where not yet taken).
+void take_triangle(const TriangleMeshView& whole, const uint32_t* f, std::vector<uint32_t>& remap, QueryMesh& part) {
+  for (int k = 0; k < 3; ++k) {
+    uint32_t& v = remap[f[k]];
+    if (v == UINT32_MAX) {
+      v = uint32_t(part.positions.size() / 3);
+      part.positions.insert(part.positions.end(), whole.positions + 3 * size_t(f[k]), whole.positions + 3 * size_t(f[k]) + 3);
+    }
+    part.indices.push_back(v);
+  }
+}
+
 Status build_query_mesh(RTCDevice device, const TriangleMeshView& view, const std::string& what, QueryMesh& out,
                         BvhBuilder builder = BvhBuilder::sah) {
   out.release();
@@ -404,6 +417,11 @@ struct SurfaceDistance::Impl {
     return holds_cells(cells_of_box(grid, lo, hi));
   }
 
+  Status ensure_device() {  // `what` set already
+    if (!device) device = rtcNewDevice(nullptr);
+    return device ? Status::success() : Status::error(what + ": Embree device could not be created");
+  }
+
   ~Impl() {
     surface.release();
     if (device) rtcReleaseDevice(device);
@@ -417,10 +435,7 @@ Status SurfaceDistance::set_surface(const TriangleMeshView& surface, const std::
   Impl& m = *impl_;
   m.ready = false;
   m.what = what;
-  if (!m.device) {
-    m.device = rtcNewDevice(nullptr);
-    if (!m.device) return Status::error(what + ": Embree device could not be created");
-  }
+  if (Status s = m.ensure_device(); !s) return s;
   if (Status s = build_query_mesh(m.device, surface, what, m.surface, m.builder); !s) return s;
   m.part = false;
   m.triangles = surface.index_count / 3;
@@ -441,10 +456,7 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
     if (whole.indices[i] >= whole.vertex_count)
       return Status::error(what + ": triangle " + std::to_string(i / 3) + " references vertex " +
                            std::to_string(whole.indices[i]) + " of " + std::to_string(whole.vertex_count));
-  if (!m.device) {
-    m.device = rtcNewDevice(nullptr);
-    if (!m.device) return Status::error(what + ": Embree device could not be created");
-  }
+  if (Status s = m.ensure_device(); !s) return s;
   // A triangle is kept when its box reaches into a wanted cell; otherwise every cell its box
   // reaches into is incomplete.
   m.grid = grid;
@@ -471,14 +483,7 @@ Status SurfaceDistance::set_surface_part(const TriangleMeshView& whole, const Su
       range.all(grid, [&](size_t c) { return m.complete[c] = 0, true; });
       continue;
     }
-    for (int k = 0; k < 3; ++k) {
-      uint32_t& v = remap[f[k]];
-      if (v == UINT32_MAX) {
-        v = uint32_t(part.positions.size() / 3);
-        part.positions.insert(part.positions.end(), whole.positions + 3 * size_t(f[k]), whole.positions + 3 * size_t(f[k]) + 3);
-      }
-      part.indices.push_back(v);
-    }
+    take_triangle(whole, f, remap, part);
   }
   // The whole surface's slack, so that start radii and sphere updates are the whole's.
   part.slack = rounding_slack(whole.positions, 3 * whole.vertex_count);
@@ -596,10 +601,7 @@ Status SurfaceDistance::set_surface_planned(const TriangleMeshView& whole, const
     return Status::error(what + ": no such part in a plan made over this surface");
   if (remap.empty()) remap.assign(whole.vertex_count, UINT32_MAX);
   if (remap.size() != whole.vertex_count) return Status::error(what + ": vertex scratch of another surface");
-  if (!m.device) {
-    m.device = rtcNewDevice(nullptr);
-    if (!m.device) return Status::error(what + ": Embree device could not be created");
-  }
+  if (Status s = m.ensure_device(); !s) return s;
   QueryMesh& part = m.surface;
   part.positions.clear();
   part.indices.clear();
@@ -607,16 +609,7 @@ Status SurfaceDistance::set_surface_planned(const TriangleMeshView& whole, const
   for (uint32_t t : list)
     if (t >= plan.triangle_count) return Status::error(what + ": the plan lists a triangle the surface lacks");
   part.indices.reserve(3 * list.size());
-  for (uint32_t t : list) {
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t v = whole.indices[3 * size_t(t) + k];  // checked when planned
-      if (remap[v] == UINT32_MAX) {
-        remap[v] = uint32_t(part.positions.size() / 3);
-        part.positions.insert(part.positions.end(), whole.positions + 3 * size_t(v), whole.positions + 3 * size_t(v) + 3);
-      }
-      part.indices.push_back(remap[v]);
-    }
-  }
+  for (uint32_t t : list) take_triangle(whole, whole.indices + 3 * size_t(t), remap, part);  // checked when planned
   for (uint32_t t : list)
     for (int k = 0; k < 3; ++k) remap[whole.indices[3 * size_t(t) + k]] = UINT32_MAX;
   part.slack = plan.slack;
