@@ -779,6 +779,9 @@ struct FrameGraph::Impl {
     const size_t v = visible_total;
     std::fill(selection_total.begin(), selection_total.end(), 0u);
     for (size_t c = 0; c < chunks; ++c) {
+      // A chunk with nothing visible this frame was not compacted: its counts are an earlier
+      // frame's and must not be summed.
+      if (chunk_visible[c] == 0) continue;
       const uint32_t* counts = selection_counts.data() + c * level_total;
       for (size_t k = 0; k < level_total; ++k) selection_total[k] += counts[k];
     }

@@ -170,8 +170,9 @@ struct Lowered {
 
 // Pass 3: lower the top until the budget holds (greedy: one level per pop; greedy_multi: while
 // its next key, divided by the slack, still ranks above the runner-up). The coarsest levels fit,
-// so the heap cannot run dry first (and placeholders, ranked below every real entry, are never
-// reached).
+// so with counts that describe the heap's objects it cannot run dry first (and placeholders,
+// ranked below every real entry, are never reached); the loop stops there all the same, so
+// that counts out of step with the objects give a wrong cost, never a read past the heap.
 Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std::span<const float> weight,
                         std::span<const uint32_t> model, const ModelTable& models, const LowerParams& p,
                         uint64_t& cost, uint64_t& tri_sum, uint64_t& lev_sum) {
@@ -184,8 +185,7 @@ Lowered lower_from_heap(HeapEntry* h, size_t size, std::span<uint8_t> level, std
   // Below `relaxed_until` only the steps greedy itself would take next are taken in a row.
   const uint64_t relaxed_until = p.budget + uint64_t(double(cost - p.budget) * p.exact_tail);
   Lowered done;
-  while (cost > p.budget) {
-    assert(size > 0 && h[0].object != kPlaceholder);
+  while (cost > p.budget && size > 0 && h[0].object != kPlaceholder) {
     const uint32_t obj = h[0].object;
     const uint32_t m = model[obj];
     const uint64_t runner_up = multi ? runner_up_rank(h, size) : 0;
@@ -346,9 +346,11 @@ SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uin
   const size_t n = visible.size();
   assert(level.size() == n && weight.size() == n && model.size() == n && heap.size() == n);
   assert(level_counts.size() == models.triangles.size());
+  if (n == 0) return {};  // nothing visible: nothing to select
   const uint32_t* tris = models.triangles.data();
   const int32_t* ls = models.level_l.data();
   uint64_t tri_sum = 0, lev_sum = 0, tri_coarse = 0, lev_coarse = 0;
+  [[maybe_unused]] uint64_t counted = 0;
   for (size_t m = 0; m < models.model_count(); ++m) {
     const uint32_t begin = models.first_level[m], last = begin + models.level_count[m] - 1u;
     uint64_t count = 0;
@@ -359,7 +361,10 @@ SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uin
     }
     tri_coarse += count * tris[last];
     lev_coarse += count * pow2(ls[last]);
+    counted += count;
   }
+  assert(counted == size_t(std::count_if(visible.begin(), visible.end(), [](uint8_t v) { return v != 0; })) &&
+         "level_counts must count exactly the visible objects");
   const bool by_triangles = params.count == BudgetCount::triangles;
   SelectionResult r;
   r.coarsest_cost = by_triangles ? tri_coarse : lev_coarse;

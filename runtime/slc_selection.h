@@ -103,6 +103,9 @@ void gather_selection(std::span<HeapEntry> heap, std::span<uint32_t> level_count
                       const SelectionTables& tables);
 
 // `heap` holds one entry per object (from gather_selection); it is reordered in place.
+// `level_counts` must count exactly the visible objects of `visible` (summed over every range
+// gather_selection ran on, and over nothing else). Total: no objects, none visible, one, or a
+// budget below their coarsest levels each give a result, whatever an earlier call was given.
 // `benefit_weight` (per object, benefit_weight() in runtime/benefit_cost_selection.h) is read
 // only by Selector::benefit_cost, which needs it; the heap selectors ignore it.
 SelectionResult lower_under_budget(std::span<uint8_t> level, std::span<const uint8_t> visible,

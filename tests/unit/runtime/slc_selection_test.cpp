@@ -327,3 +327,50 @@ TEST(Selection, LowersFarSmallObjectsBeforeNearLargeOnes) {
 
 }  // namespace
 }  // namespace lod
+
+namespace lod {
+namespace {
+
+// Every selector on the smallest inputs: no objects, none visible, one, at budgets 0, 1 and
+// unbounded, the gathered (chunked) path against the one-call path.
+TEST(Selection, EverySelectorIsTotalOnEmptyAndSingleInputs) {
+  const ModelTable t = paper_table();
+  const SelectionTables tables = build_selection_tables(t);
+  std::mt19937 rng(5);
+  for (Selector selector : {Selector::greedy, Selector::greedy_multi, Selector::benefit_cost})
+    for (BudgetCount unit : {BudgetCount::triangles, BudgetCount::levels})
+      for (size_t n : {size_t(0), size_t(1), size_t(3)})
+        for (int visibility = 0; visibility < 2; ++visibility)
+          for (uint64_t budget : {uint64_t(0), uint64_t(1), UINT64_MAX}) {
+            SCOPED_TRACE("selector " + std::to_string(int(selector)) + " n " + std::to_string(n) + " visible " +
+                         std::to_string(visibility) + " budget " + std::to_string(budget));
+            Scene one = random_scene(t, n, rng);
+            for (uint8_t& v : one.visible) v = uint8_t(visibility);
+            Scene two = one;
+            SelectionParams p;
+            p.selector = selector;
+            p.count = unit;
+            p.budget = budget;
+            const std::vector<float> benefit(n, 1.0f);
+            const SelectionResult a =
+                select_under_budget(one.level, one.visible, one.weight, one.model, t, p, one.heap, benefit);
+            std::vector<uint32_t> counts(t.triangles.size(), 0);
+            gather_selection(two.heap, counts, two.level, two.visible, two.weight, two.model, 0, t, tables);
+            const SelectionResult b =
+                lower_under_budget(two.level, two.visible, two.weight, two.model, t, p, counts, two.heap, benefit);
+            EXPECT_EQ(a.cost, b.cost);
+            EXPECT_EQ(a.over_budget, b.over_budget);
+            EXPECT_EQ(one.level, two.level);
+            EXPECT_EQ(a.over_budget, a.coarsest_cost > budget);
+            if (!a.over_budget) {
+              EXPECT_LE(a.cost, budget);
+            }
+            if (n == 0 || visibility == 0) {
+              EXPECT_EQ(a.cost, 0u);
+              EXPECT_FALSE(a.over_budget);
+            }
+          }
+}
+
+}  // namespace
+}  // namespace lod
