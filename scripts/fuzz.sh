@@ -6,7 +6,9 @@
 # cleaned-mesh cache entry (`hmesh`: positions, indices, uvs, submeshes, materials, images; its
 # mutator keeps the checksum valid and resizes one section at a time), the scene config
 # reader (`scene`) and the height-field readers (`heightmap`: PNG through stb, ESRI ASCII grid
-# through GDAL, "x y z" text; the first input byte picks one), built with Debian's clang
+# through GDAL, "x y z" text; the first input byte picks one), and the service itself (`service`:
+# byte-derived sessions through the C API only, checking every frame's invariants; built by CMake
+# with LOD_SANITIZE=fuzzer in $OUT/service-build, since it links the whole library), built with Debian's clang
 # (-fsanitize=fuzzer,address,undefined; UB aborts), each
 # run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with
 # tests/fuzz/<target>.dict. A target without a corpus folder there (hmesh) writes its own seeds
@@ -26,7 +28,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-600}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod hsub hmesh scene heightmap)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(ply off stl obj glb lod hlod hsub hmesh scene heightmap service)
 OUT=${LOD_FUZZ_BUILD:-build-fuzz}
 JOBS=${LOD_FUZZ_JOBS:-$(nproc)}
 CXX=${LOD_FUZZ_CXX:-clang++}
@@ -81,17 +83,28 @@ sources_of() {
     hmesh) echo "${HMESH_SOURCES[@]}" ;;
     scene) echo "${SCENE_SOURCES[@]}" ;;
     heightmap) echo "${HEIGHTMAP_SOURCES[@]}" ;;
+    service) ;;  # built by CMake below
     *) echo "${MESH_SOURCES[@]}" ;;
   esac
 }
 for t in "${TARGETS[@]}"; do
-  case $t in ply|off|stl|obj|glb|lod|hlod|hsub|hmesh|scene|heightmap) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod hsub hmesh scene heightmap)" >&2; exit 2 ;; esac
+  case $t in ply|off|stl|obj|glb|lod|hlod|hsub|hmesh|scene|heightmap|service) ;; *) echo "[fuzz] unknown target '$t' (ply off stl obj glb lod hlod hsub hmesh scene heightmap service)" >&2; exit 2 ;; esac
   # shellcheck disable=SC2046
   compile $(sources_of "$t")
 done
 for p in "${pids[@]}"; do wait "$p"; done
 for t in "${TARGETS[@]}"; do
   bin="$OUT/fuzz_$t"
+  if [ "$t" = service ]; then  # the whole library instrumented: CMake builds it, ccache keeps rebuilds short
+    CC_BIN=${LOD_FUZZ_CC:-clang}
+    ./scripts/configure.sh "$OUT/service-build" -DCMAKE_CXX_COMPILER="$CXX" -DCMAKE_C_COMPILER="$CC_BIN" \
+      -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLOD_SANITIZE=fuzzer -DLOD_BUILD_BENCH=OFF -DLOD_BUILD_VIEWER=OFF \
+      -DLOD_BUILD_CLI=OFF -DLOD_BUILD_EXAMPLES=OFF -DLOD_INSTALL=OFF >"$OUT/service-build.log" 2>&1 &&
+      cmake --build "$OUT/service-build" -j "$(nproc)" --target fuzz_service >>"$OUT/service-build.log" 2>&1 ||
+      { echo "[fuzz] service: build failed; see $OUT/service-build.log" >&2; tail -20 "$OUT/service-build.log" >&2; exit 1; }
+    cp "$OUT/service-build/tests/fuzz_service" "$bin"
+    continue
+  fi
   objs=()
   for src in $(sources_of "$t"); do objs+=("$(object_of "$src")"); done
   case $t in
