@@ -65,5 +65,4 @@ struct ExportArgs {
 };
 int export_command(const ExportArgs& args);  // cli/export_command.cpp
 
-
 }  // namespace lod::cli
