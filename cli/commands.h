@@ -9,7 +9,7 @@ namespace lod::cli {
 struct RunArgs {
   std::string config;
   std::string data_dir;      // empty = default_data_dir()
-  std::string cache_dir;     // empty = $LOD_CACHE_DIR or <data_dir>/../cache
+  std::string cache_dir;     // empty = cache_dir_for's default (jobs/cache_folder.h)
   std::string json_file;
   std::string report_dir;
   int64_t frames = -1;       // -1 = config
@@ -64,8 +64,5 @@ struct ExportArgs {
   bool json = false;
 };
 int export_command(const ExportArgs& args);  // cli/export_command.cpp
-
-// Where baked assets are cached: $LOD_CACHE_DIR, else next to the data directory.
-std::string default_cache_dir(const std::string& data_dir);
 
 }  // namespace lod::cli

@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--threads", run.threads, "worker threads, 0 = all cores (default: config)")
       ->check(CLI::Range(int64_t{0}, int64_t{1024}));
   run_cmd->add_option("--data", run.data_dir, "mesh directory searched after the config's folder");
-  run_cmd->add_option("--cache", run.cache_dir, "baked asset cache (default: $LOD_CACHE_DIR or <data>/../cache)");
+  run_cmd->add_option("--cache", run.cache_dir, "baked asset cache (default: the config's [cache] dir, else $LOD_CACHE_DIR, else "
+                 "$XDG_CACHE_HOME/lodkit or ~/.cache/lodkit)");
   run_cmd->add_option("--json", run.json_file, "write per-frame figures and a summary as JSON");
   run_cmd->add_option("--report", run.report_dir, "write frames.csv, summary.json, graph.dot and SVG plots here");
   run_cmd->add_flag("--validate", run.validate, "check every frame's invariants; fail on the first bad one");

@@ -15,6 +15,7 @@
 #include "cli/scene_hlod_check.h"
 #include "cli/terrain_check.h"
 #include "jobs/bake_jobs.h"
+#include "jobs/cache_folder.h"
 #include "jobs/hlod_scene.h"
 #include "jobs/scene.h"
 #include "jobs/scene_config.h"
@@ -182,11 +183,6 @@ bool validate_frame(const Frame& f, const Scene& scene, uint64_t expected_index,
 
 }  // namespace
 
-std::string default_cache_dir(const std::string& data_dir) {
-  if (const char* env = std::getenv("LOD_CACHE_DIR"); env && *env) return env;
-  return (std::filesystem::path(data_dir).parent_path() / "cache").string();
-}
-
 int run_command(const RunArgs& args) {
   const auto wall_start = std::chrono::steady_clock::now();
   const std::string data_dir = args.data_dir.empty() ? default_data_dir().string() : args.data_dir;
@@ -210,7 +206,7 @@ int run_command(const RunArgs& args) {
     config.threads = uint32_t(args.threads);
   }
 
-  const std::string cache_dir = args.cache_dir.empty() ? default_cache_dir(data_dir) : args.cache_dir;
+  const std::string cache_dir = cache_dir_for(args.cache_dir, config.cache_dir).string();
   auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   // hlod = true models stream through the hlod node; the rest are discrete objects.
   auto hlod = std::make_shared<HlodModels>();

@@ -36,6 +36,13 @@ static_assert(offsetof(lod_view, width) == offsetof(lod::Camera, width));
 static_assert(offsetof(lod_view, height) == offsetof(lod::Camera, height));
 static_assert(offsetof(lod_view, near_z) == offsetof(lod::Camera, near_z));
 static_assert(offsetof(lod_view, far_z) == offsetof(lod::Camera, far_z));
+// lodkit.h's ranges are the service's.
+static_assert(LOD_MIN_BUDGET == lod::kMinBudget);
+static_assert(LOD_MAX_PIXEL_ERROR == lod::kMaxPixelError);
+static_assert(LOD_MAX_HYSTERESIS == lod::kMaxHysteresis);
+static_assert(LOD_MAX_BLEND_SECONDS == lod::kMaxBlendSeconds);
+static_assert(LOD_MIN_FOV_Y_DEG == lod::kMinFovYDeg);
+static_assert(LOD_MAX_FOV_Y_DEG == lod::kMaxFovYDeg);
 
 // A frame handed to C: the FrameRef keeps the frame unchanged until lod_frame_release.
 struct lod_frame {
@@ -260,9 +267,9 @@ int lod_object_set_options(lod_service* s, lod_object object, const lod_object_o
   });
 }
 
-void lod_commit(lod_service* s, uint64_t tick) {
-  if (!usable(s)) return (void)fail("lod_commit: service is NULL");
-  guarded_void([&] { s->service->commit(tick); });
+int lod_commit(lod_service* s, uint64_t tick) {
+  if (!usable(s)) return fail("lod_commit: service is NULL");
+  return guarded(1, nullptr, 0, [&] { return s->service->commit(tick) ? 0 : fail_from(s, "lod_commit: refused"); });
 }
 
 int lod_set_view(lod_service* s, uint32_t view_index, const lod_view* view) {
@@ -284,24 +291,32 @@ int lod_set_view_count(lod_service* s, uint32_t count) {
   });
 }
 
-void lod_set_budget(lod_service* s, uint64_t triangles) {
-  if (!usable(s)) return (void)fail("lod_set_budget: service is NULL");
-  guarded_void([&] { s->service->set_budget(triangles); });
+int lod_set_budget(lod_service* s, uint64_t triangles) {
+  if (!usable(s)) return fail("lod_set_budget: service is NULL");
+  return guarded(1, nullptr, 0, [&] {
+    return s->service->set_budget(triangles) ? 0 : fail_from(s, "lod_set_budget: refused");
+  });
 }
 
-void lod_set_pixel_error(lod_service* s, float pixels) {
-  if (!usable(s)) return (void)fail("lod_set_pixel_error: service is NULL");
-  guarded_void([&] { s->service->set_pixel_error(pixels); });
+int lod_set_pixel_error(lod_service* s, float pixels) {
+  if (!usable(s)) return fail("lod_set_pixel_error: service is NULL");
+  return guarded(1, nullptr, 0, [&] {
+    return s->service->set_pixel_error(pixels) ? 0 : fail_from(s, "lod_set_pixel_error: refused");
+  });
 }
 
-void lod_set_hysteresis(lod_service* s, float band) {
-  if (!usable(s)) return (void)fail("lod_set_hysteresis: service is NULL");
-  guarded_void([&] { s->service->set_hysteresis(band); });
+int lod_set_hysteresis(lod_service* s, float band) {
+  if (!usable(s)) return fail("lod_set_hysteresis: service is NULL");
+  return guarded(1, nullptr, 0, [&] {
+    return s->service->set_hysteresis(band) ? 0 : fail_from(s, "lod_set_hysteresis: refused");
+  });
 }
 
-void lod_set_blend_seconds(lod_service* s, float seconds) {
-  if (!usable(s)) return (void)fail("lod_set_blend_seconds: service is NULL");
-  guarded_void([&] { s->service->set_blend_seconds(seconds); });
+int lod_set_blend_seconds(lod_service* s, float seconds) {
+  if (!usable(s)) return fail("lod_set_blend_seconds: service is NULL");
+  return guarded(1, nullptr, 0, [&] {
+    return s->service->set_blend_seconds(seconds) ? 0 : fail_from(s, "lod_set_blend_seconds: refused");
+  });
 }
 
 int lod_start(lod_service* s) {

@@ -103,10 +103,15 @@ uint64_t CommitQueue::commits() const {
   return commits_;
 }
 
-void CommitQueue::commit(uint64_t tick) {
+bool CommitQueue::commit(uint64_t tick, uint64_t* last) {
   std::lock_guard stage(stage_mutex_);
+  if (commits_ > 0 && tick < last_tick_) {
+    if (last) *last = last_tick_;
+    return false;
+  }
   std::lock_guard pending(pending_mutex_);
   ++commits_;
+  last_tick_ = tick;
   Batch& b = pending_.emplace_back();
   b.tick = tick;
   b.commands.swap(staged_);
@@ -116,6 +121,7 @@ void CommitQueue::commit(uint64_t tick) {
   } else {
     buffers_.fetch_add(1, std::memory_order_relaxed);  // the new staging buffer grows from empty
   }
+  return true;
 }
 
 void CommitQueue::take(std::vector<Batch>& out) {

@@ -37,7 +37,9 @@ class CommitQueue {
   // Staging buffers made so far (each grows to the largest batch it carried): 1 + the most
   // batches ever pending or in use at once, when commits outpace frames.
   uint64_t buffers() const { return buffers_.load(std::memory_order_relaxed); }
-  void commit(uint64_t tick);
+  // Closes the staged batch under `tick`. Ticks never decrease: a tick below the last
+  // accepted one returns false, leaves the staged commands staged and sets *last to it.
+  bool commit(uint64_t tick, uint64_t* last = nullptr);
 
   // LOD side (one thread): every batch committed so far, oldest first, swapped into `out`
   // (which must be empty); then hand them back with recycle().
@@ -48,7 +50,8 @@ class CommitQueue {
   mutable SpinLock stage_mutex_;  // staged_, handles_, commits_
   std::vector<ObjectCommand> staged_;
   HandleTable handles_;
-  uint64_t commits_ = 0;
+  uint64_t commits_ = 0;  // accepted
+  uint64_t last_tick_ = 0;  // of the last accepted commit (none yet: any tick is accepted)
   std::atomic<uint64_t> buffers_{1};
 
   std::mutex pending_mutex_;  // pending_, spare_

@@ -382,6 +382,19 @@ void read_stream(const Reader& r, const toml::table& root, SceneConfig& c) {
   r.integer_in(*t, "loader_threads", "stream.loader_threads", 1, 64, c.stream.loader_threads);
 }
 
+// [cache] dir: where baked models are cached; relative to the config's folder.
+void read_cache(const Reader& r, const toml::table& root, const std::filesystem::path& config_dir, SceneConfig& c) {
+  const toml::table* t = r.table(root, "cache", "cache");
+  if (!t) return;
+  r.only_keys(*t, "cache", {"dir"});
+  if (auto dir = r.string(*t, "dir", "cache.dir")) {
+    if (dir->empty()) r.fail("cache.dir", "must not be empty (leave the key out for the default folder)");
+    if (dir->find('\0') != std::string::npos) r.fail("cache.dir", "must not contain a NUL character");
+    const std::filesystem::path p(*dir);
+    c.cache_dir = p.is_absolute() ? p : (config_dir / p).lexically_normal();
+  }
+}
+
 // [scene_hlod]: proxies over the static instances.
 void read_scene_hlod(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "scene_hlod", "scene_hlod");
@@ -691,7 +704,8 @@ Status parse_scene_config(std::string_view text, const std::filesystem::path& fi
   c.file = file;
   const Reader r(name);
   try {
-    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "stream", "scene_hlod", "model", "instances", "terrain"});
+    r.only_keys(root, "", {"run", "budget", "lod", "visibility", "camera", "stream", "scene_hlod", "cache", "model",
+                           "instances", "terrain"});
     read_run(r, root, c);
     read_budget(r, root, c);
     read_lod(r, root, c);
@@ -701,6 +715,7 @@ Status parse_scene_config(std::string_view text, const std::filesystem::path& fi
     read_scene_hlod(r, root, c);
     const std::filesystem::path dir =
         file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+    read_cache(r, root, dir, c);
     read_models(r, root, dir, data_dir, !objects_optional, c);
     read_instances(r, root, !objects_optional, c);
     read_terrain(r, root, dir, data_dir, c);

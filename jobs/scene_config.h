@@ -93,6 +93,9 @@ struct SceneConfig {
   std::vector<ModelConfig> models;
   std::vector<InstanceConfig> instances;
   std::optional<TerrainConfig> terrain;
+  // [cache] dir: where baked models are cached (relative: to the config's folder); empty =
+  // the default folder (cache_dir_for, jobs/cache_folder.h).
+  std::filesystem::path cache_dir;
 };
 
 // Refuses unknown paths, wrong types, absurd values (negative counts, zero size windows,

@@ -3,6 +3,8 @@
 #include "jobs/service.h"
 
 #include <cmath>
+#include <cstdio>
+#include <string_view>
 
 #include "jobs/service_impl.h"
 #include "runtime/lod_asset.h"
@@ -17,6 +19,13 @@ thread_local std::string t_last_error;
 bool fail(std::string message) {
   t_last_error = std::move(message);
   return false;
+}
+
+// A value as a message shows it: six significant digits, "nan" and "inf" spelled out.
+std::string value_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 }  // namespace
 
@@ -136,12 +145,20 @@ size_t Service::set_transforms(std::span<const ObjectHandle> objects, std::span<
 
 bool Service::alive(ObjectHandle object) const { return impl_->queue.live(object); }
 
-void Service::commit(uint64_t tick) { impl_->queue.commit(tick); }
+bool Service::commit(uint64_t tick) {
+  uint64_t last = 0;
+  if (impl_->queue.commit(tick, &last)) return true;
+  return fail("commit: tick " + std::to_string(tick) + " is below the last committed tick " + std::to_string(last) +
+              " (ticks never decrease); the staged changes stay staged");
+}
 
 bool Service::set_view(uint32_t index, const Camera& camera) {
   if (index >= kMaxViews) return fail("set_view: view index " + std::to_string(index) + " is not below 8");
-  if (const char* why = nullptr; !camera_valid(camera, &why))
-    return fail("set_view: view " + std::to_string(index) + ": " + why);
+  if (const char* why = nullptr; !camera_valid(camera, &why)) {
+    std::string message = "set_view: view " + std::to_string(index) + ": " + why;
+    if (std::string_view(why).starts_with("fov_y_deg")) message += ", got " + value_text(camera.fov_y_deg);
+    return fail(message);
+  }
   std::lock_guard lock(impl_->view_mutex);
   impl_->views[index] = view_of(camera);
   impl_->view_count = std::max(impl_->view_count, index + 1);
@@ -155,15 +172,32 @@ bool Service::set_view_count(uint32_t count) {
   return true;
 }
 
-void Service::set_budget(uint64_t triangles) { impl_->budget.store(std::max<uint64_t>(triangles, 1)); }
-void Service::set_pixel_error(float pixels) {
-  if (std::isfinite(pixels) && pixels > 0) impl_->pixel_error.store(pixels);
+bool Service::set_budget(uint64_t triangles) {
+  if (triangles < kMinBudget) return fail("set_budget: " + std::to_string(triangles) + " is below 1");
+  impl_->budget.store(triangles);
+  return true;
 }
-void Service::set_hysteresis(float band) {
-  if (std::isfinite(band) && band >= 0) impl_->hysteresis.store(band);
+
+bool Service::set_pixel_error(float pixels) {
+  if (!(pixels > 0 && pixels <= kMaxPixelError))
+    return fail("set_pixel_error: " + value_text(pixels) + " is not in (0, " + value_text(kMaxPixelError) + "] pixels");
+  impl_->pixel_error.store(pixels);
+  return true;
 }
-void Service::set_blend_seconds(float seconds) {
-  if (std::isfinite(seconds) && seconds >= 0) impl_->blend_seconds.store(seconds);
+
+bool Service::set_hysteresis(float band) {
+  if (!(band >= 0 && band <= kMaxHysteresis))
+    return fail("set_hysteresis: " + value_text(band) + " is not in [0, " + value_text(kMaxHysteresis) + "]");
+  impl_->hysteresis.store(band);
+  return true;
+}
+
+bool Service::set_blend_seconds(float seconds) {
+  if (!(seconds >= 0 && seconds <= kMaxBlendSeconds))
+    return fail("set_blend_seconds: " + value_text(seconds) + " is not in [0, " + value_text(kMaxBlendSeconds) +
+                "] seconds");
+  impl_->blend_seconds.store(seconds);
+  return true;
 }
 
 bool Service::start() {

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "jobs/bake_jobs.h"
+#include "jobs/cache_folder.h"
 #include "jobs/hlod_scene.h"
 #include "jobs/scene_hlod_bake.h"
 #include "jobs/scene.h"
@@ -16,15 +17,6 @@
 #include "runtime/view.h"
 
 namespace lod {
-
-namespace {
-
-std::filesystem::path cache_dir_for(const std::filesystem::path& asked, const std::filesystem::path& data_dir) {
-  if (!asked.empty()) return asked;
-  return data_dir.parent_path() / "cache";
-}
-
-}  // namespace
 
 FrameGraphOptions frame_graph_options(const SceneConfig& config) {
   FrameGraphOptions g;
@@ -78,7 +70,7 @@ std::unique_ptr<Service> Service::from_config(const std::filesystem::path& confi
   const std::filesystem::path data = data_dir.empty() ? default_data_dir() : data_dir;
   SceneConfig sc;
   if (auto st = load_scene_config(config, data, sc, /*objects_optional=*/true); !st) return failed(st.message);
-  const std::filesystem::path cache = cache_dir_for(cache_dir, data);
+  const std::filesystem::path cache = cache_dir_for(cache_dir, sc.cache_dir);
   auto hlod = std::make_shared<HlodModels>();
   if (auto st = bake_hlod_models(sc, cache, nullptr, *hlod); !st) return failed(st.message);
   sc = discrete_part(sc);  // hlod models are drawn by the hlod node, not as objects

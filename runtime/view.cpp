@@ -40,22 +40,32 @@ glm::mat4 projection_matrix(const View& v) {
 }
 
 Frustum frustum_of(const View& v) {
-  // Gribb-Hartmann: each plane is a sum or difference of rows of the clip matrix.
-  const glm::mat4 m = projection_matrix(v) * view_matrix(v);
-  const glm::vec4 row0(m[0][0], m[1][0], m[2][0], m[3][0]);
-  const glm::vec4 row1(m[0][1], m[1][1], m[2][1], m[3][1]);
-  const glm::vec4 row2(m[0][2], m[1][2], m[2][2], m[3][2]);
-  const glm::vec4 row3(m[0][3], m[1][3], m[2][3], m[3][3]);
+  // The planes straight from the camera's basis and half-angles, in double: Gribb-Hartmann
+  // over a float clip matrix loses the near plane when far / near is large (its rows nearly
+  // cancel) and the side planes when the field is tiny (1 / tan(fov / 2) swamps the view
+  // row), which let objects far outside the view through. Same planes and order as the
+  // clip-matrix rows: left, right, bottom, top, near, far.
+  using V = glm::dvec3;
+  const V eye(v.eye);
+  V fwd = V(v.target) - eye;
+  fwd = glm::length(fwd) > 0 ? glm::normalize(fwd) : V(0, 0, -1);
+  V right = glm::cross(fwd, V(v.up));  // view_matrix's basis and fallbacks
+  if (!(glm::length(right) >= 1e-12))
+    right = glm::cross(fwd, std::abs(fwd.y) < 0.9 ? V(0, 1, 0) : V(1, 0, 0));
+  right = glm::normalize(right);
+  const V up = glm::cross(right, fwd);
+  const double ty = std::tan(0.5 * glm::radians(double(v.fov_y_deg)));
+  const double aspect = double(v.width) / double(v.height > 0 ? v.height : 1);
+  const double hy = std::atan(ty), hx = std::atan(aspect * ty);
+  // Unit normals pointing inwards; each side plane passes through the eye.
+  const V normals[6] = {std::cos(hx) * right + std::sin(hx) * fwd, -std::cos(hx) * right + std::sin(hx) * fwd,
+                        std::cos(hy) * up + std::sin(hy) * fwd,    -std::cos(hy) * up + std::sin(hy) * fwd,
+                        fwd,                                       -fwd};
+  const double offsets[6] = {0, 0, 0, 0, -double(v.near_plane), double(v.far_plane)};
   Frustum f;
-  f.planes[0] = row3 + row0;  // left
-  f.planes[1] = row3 - row0;  // right
-  f.planes[2] = row3 + row1;  // bottom
-  f.planes[3] = row3 - row1;  // top
-  f.planes[4] = row3 + row2;  // near (clip z in [-w, w])
-  f.planes[5] = row3 - row2;  // far
-  for (glm::vec4& p : f.planes) {
-    // Normalized so dot(n, c) + w is a signed distance a sphere radius compares against.
-    p /= glm::length(glm::vec3(p));
+  for (int k = 0; k < 6; ++k) {
+    // dot(n, p) + w >= 0 inside: w = -dot(n, eye) + the plane's distance from the eye.
+    f.planes[k] = glm::vec4(glm::vec3(normals[k]), static_cast<float>(offsets[k] - glm::dot(normals[k], eye)));
   }
   return f;
 }
@@ -101,7 +111,7 @@ bool camera_valid(const Camera& c, const char** why) {
   if (glm::length(f) < 1e-12) return fail("forward must not be zero");
   if (glm::length(u) < 1e-12) return fail("up must not be zero");
   if (glm::length(glm::cross(glm::normalize(f), glm::normalize(u))) < 1e-6) return fail("up must not be parallel to forward");
-  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180)) return fail("fov_y_deg must be in (0, 180)");
+  if (!(c.fov_y_deg >= kMinFovYDeg && c.fov_y_deg <= kMaxFovYDeg)) return fail("fov_y_deg must be in [0.001, 179] degrees");
   if (c.width == 0 || c.height == 0 || c.width > 65536 || c.height > 65536) return fail("width and height must be 1..65536");
   if (!(c.near_z > 0 && std::isfinite(c.far_z) && c.far_z > c.near_z)) return fail("need 0 < near_z < far_z, finite");
   return true;

@@ -25,7 +25,7 @@ struct Frustum {
 View view_of(const Camera& c);
 Camera camera_of(const View& v);
 // True when a camera gives a usable view: finite, forward and up not zero nor parallel,
-// 0 < fov < 180, width and height > 0, 0 < near < far. Otherwise `why` names the value.
+// fov in [kMinFovYDeg, kMaxFovYDeg], width and height > 0, 0 < near < far. Otherwise `why` names the value.
 bool camera_valid(const Camera& c, const char** why);
 
 glm::mat4 view_matrix(const View& v);

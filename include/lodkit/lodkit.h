@@ -25,6 +25,19 @@ typedef struct lod_transform {
   float scale;
 } lod_transform;
 
+/* The ranges the setters accept, both ends included unless stated. A value outside (NaN and
+ * infinities included) is refused: nonzero return, lod_last_error() naming the value, the
+ * setting unchanged. */
+#define LOD_MIN_BUDGET 1u                 /* lod_set_budget: >= 1 */
+#define LOD_MAX_PIXEL_ERROR 10000.0f      /* lod_set_pixel_error: (0, 10000] pixels, 0 excluded */
+#define LOD_MAX_HYSTERESIS 10.0f          /* lod_set_hysteresis: [0, 10] */
+#define LOD_MAX_BLEND_SECONDS 60.0f       /* lod_set_blend_seconds: [0, 60] seconds */
+#define LOD_MIN_FOV_Y_DEG 0.001f          /* lod_view.fov_y_deg: [0.001, 179] degrees */
+#define LOD_MAX_FOV_Y_DEG 179.0f
+
+/* A view is refused unless eye, forward and up are finite, up is not parallel to forward,
+ * fov_y_deg is in [LOD_MIN_FOV_Y_DEG, LOD_MAX_FOV_Y_DEG], width and height are 1..65536 and
+ * 0 < near_z < far_z with far_z finite. Culling is exact over that whole range. */
 typedef struct lod_view {
   float eye[3], forward[3], up[3];
   float fov_y_deg;
@@ -56,7 +69,9 @@ typedef struct lod_object_options {
   int never_cull;       /* nonzero: visible to every view */
 } lod_object_options;
 
-/* A scene TOML; [[model]]/[[instances]] optional. NULL on error, with the message. */
+/* A scene TOML; [[model]]/[[instances]] optional. NULL on error, with the message. Baked
+ * models are cached in the config's [cache] dir, else $LOD_CACHE_DIR, else
+ * $XDG_CACHE_HOME/lodkit, else $HOME/.cache/lodkit, else a folder in the temp directory. */
 lod_service* lod_service_create(const char* config_path, char* error, size_t error_size);
 void lod_service_destroy(lod_service*);
 
@@ -70,14 +85,18 @@ int lod_object_destroy(lod_service*, lod_object);                            /* 
 int lod_object_set_transform(lod_service*, lod_object, const lod_transform*); /* nonzero: stale or unknown */
 void lod_object_options_default(lod_object_options* out);
 int lod_object_set_options(lod_service*, lod_object, const lod_object_options*); /* nonzero: stale, unknown, bad */
-void lod_commit(lod_service*, uint64_t tick);
+/* Publishes what was staged under `tick`; 0 = ok. Ticks never decrease: a tick below the last
+ * committed one (a config's instances are committed at 0) is refused, nonzero with the message
+ * in lod_last_error(), and the staged changes stay staged for the next commit. */
+int lod_commit(lod_service*, uint64_t tick);
 
 int lod_set_view(lod_service*, uint32_t view_index, const lod_view*); /* nonzero: index >= 8 or a bad view */
 int lod_set_view_count(lod_service*, uint32_t count);                 /* 1..8 */
-void lod_set_budget(lod_service*, uint64_t triangles);
-void lod_set_pixel_error(lod_service*, float pixels);
-void lod_set_hysteresis(lod_service*, float band);
-void lod_set_blend_seconds(lod_service*, float seconds);
+/* 0 = ok; nonzero (lod_last_error() says why) for a value outside the ranges above. */
+int lod_set_budget(lod_service*, uint64_t triangles);  /* >= LOD_MIN_BUDGET */
+int lod_set_pixel_error(lod_service*, float pixels);   /* (0, LOD_MAX_PIXEL_ERROR] */
+int lod_set_hysteresis(lod_service*, float band);      /* [0, LOD_MAX_HYSTERESIS] */
+int lod_set_blend_seconds(lod_service*, float seconds); /* [0, LOD_MAX_BLEND_SECONDS] */
 
 int lod_start(lod_service*); /* free-running LOD thread at [run] rate_hz; 0 = ok */
 void lod_stop(lod_service*);

@@ -5,9 +5,11 @@
 //   thread; the service serialises them with a short lock that is never held across a frame.
 //   They are staged: nothing a frame sees changes until commit(tick) publishes everything
 //   staged since the last commit. The next frame computed after a commit uses exactly that
-//   state and carries its tick (Frame::tick).
+//   state and carries its tick (Frame::tick). Ticks never decrease: a commit whose tick is
+//   below the last committed one is refused and what was staged stays staged.
 // - Runtime settings (budget, pixel error, hysteresis, blend time, views) may be set from any
-//   thread and apply from the next frame on.
+//   thread and apply from the next frame on. A value outside its documented range (NaN and
+//   infinities included) is refused and the setting keeps its previous value.
 // - Frames: acquire_frame() from any thread, by any number of consumers; a FrameRef keeps its
 //   frame unchanged until it is released (destroyed). The LOD thread never waits for a
 //   consumer: when every frame is held it writes a new one.
@@ -97,7 +99,7 @@ struct ServiceStats {
   uint64_t errors = 0;        // frames lost to an exception in a node (last good frame kept)
   double last_ms = 0;
   double mean_ms = 0;
-  uint64_t commits = 0;       // commit() calls
+  uint64_t commits = 0;       // commits accepted (a refused tick is not counted)
   uint64_t live_objects = 0;  // objects created and not destroyed (as staged)
   uint64_t handle_slots = 0;  // slots the handle table holds: its peak of live objects
   // Frames the pool holds: one more than the most ever held at once by consumers, plus the
@@ -107,6 +109,12 @@ struct ServiceStats {
   uint64_t commit_buffers = 0;
 };
 
+// The ranges the runtime setters accept, both ends included unless stated.
+inline constexpr uint64_t kMinBudget = 1;          // set_budget: >= 1 (triangles or levels, as budget_unit)
+inline constexpr float kMaxPixelError = 10000.0f;  // set_pixel_error: (0, 10000] pixels (0 excluded)
+inline constexpr float kMaxHysteresis = 10.0f;     // set_hysteresis: [0, 10], a fraction of the error
+inline constexpr float kMaxBlendSeconds = 60.0f;   // set_blend_seconds: [0, 60] seconds (0 = switch at once)
+
 class Service {
  public:
   explicit Service(const ServiceOptions& options = {});
@@ -114,8 +122,10 @@ class Service {
   Service(const Service&) = delete;
   Service& operator=(const Service&) = delete;
 
-  // A scene config (TOML): its [run]/[budget]/[lod] settings, its [[model]]s baked (cached in
-  // cache_dir, or the config's cache) and its [[instances]] created and committed at tick 0.
+  // A scene config (TOML): its [run]/[budget]/[lod] settings, its [[model]]s baked and its
+  // [[instances]] created and committed at tick 0. Baked models are cached in the first of:
+  // `cache_dir`, the config's [cache] dir, $LOD_CACHE_DIR, $XDG_CACHE_HOME/lodkit,
+  // $HOME/.cache/lodkit, a lodkit-cache folder in the temp directory.
   // nullptr on error, with the message (naming the file and key) in *error.
   static std::unique_ptr<Service> from_config(const std::filesystem::path& config, std::string* error,
                                               const std::filesystem::path& data_dir = {},
@@ -137,17 +147,27 @@ class Service {
   // Many transforms under one lock; returns how many were accepted (stale handles skipped).
   size_t set_transforms(std::span<const ObjectHandle> objects, std::span<const Transform> transforms);
   bool alive(ObjectHandle object) const;  // as staged
-  void commit(uint64_t tick);
+  // Publishes everything staged since the last commit under `tick`. Ticks never decrease:
+  // a tick below the last committed one (from_config's services commit their instances at 0)
+  // returns false, last_error() names both ticks, and the staged changes stay staged for the
+  // next commit. An equal tick is accepted.
+  bool commit(uint64_t tick);
 
   // Views: up to kMaxViews; an object's level is the finest any view needs and it counts once
   // against M. set_view_count(n) uses views 0..n-1 (set_view(i) raises the count to i + 1).
+  // A camera is refused (false, last_error() naming the value) unless its vectors are finite,
+  // up is not parallel to forward, fov_y_deg is in [kMinFovYDeg, kMaxFovYDeg], width and height
+  // are 1..65536 and 0 < near_z < far_z, far_z finite.
   bool set_view(uint32_t index, const Camera& camera);
   bool set_view_count(uint32_t count);
 
-  void set_budget(uint64_t triangles);
-  void set_pixel_error(float pixels);
-  void set_hysteresis(float band);
-  void set_blend_seconds(float seconds);
+  // Runtime settings: false (the setting unchanged, last_error() naming the value) unless
+  // budget >= kMinBudget, pixel error in (0, kMaxPixelError], hysteresis in [0, kMaxHysteresis],
+  // blend time in [0, kMaxBlendSeconds]; NaN and infinities are always refused.
+  bool set_budget(uint64_t triangles);
+  bool set_pixel_error(float pixels);
+  bool set_hysteresis(float band);
+  bool set_blend_seconds(float seconds);
 
   bool start();  // free-running at rate_hz; false when already running
   void stop();

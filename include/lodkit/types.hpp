@@ -13,6 +13,11 @@ using ModelId = uint32_t;
 
 inline constexpr uint32_t kMaxViews = 8;
 
+// The vertical field of view a Camera may have, degrees, both ends included. Culling is
+// exact over the whole range (and for far_z up to float's limit); a view outside it is refused.
+inline constexpr float kMinFovYDeg = 0.001f;
+inline constexpr float kMaxFovYDeg = 179.0f;
+
 // World placement of an object: p_world = position + scale * rotate(rotation, p_model).
 struct Transform {
   float position[3] = {0, 0, 0};
@@ -35,10 +40,10 @@ struct Camera {
   float eye[3] = {0, 0, 0};
   float forward[3] = {0, 0, -1};
   float up[3] = {0, 1, 0};
-  float fov_y_deg = 60;       // (0, 180)
+  float fov_y_deg = 60;       // [kMinFovYDeg, kMaxFovYDeg] = [0.001, 179]
   uint32_t width = 1280;      // pixels; projected areas and screen-space errors use them
   uint32_t height = 720;
-  float near_z = 0.5f;        // 0 < near_z < far_z
+  float near_z = 0.5f;        // 0 < near_z < far_z, far_z finite
   float far_z = 5000.f;
 };
 
