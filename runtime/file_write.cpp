@@ -1,6 +1,7 @@
 // write_file_atomic: temporary + fsync + rename, as the header says.
 #include "runtime/file_write.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -174,16 +175,19 @@ size_t remove_dead_temporaries(const std::filesystem::path& dir, const std::stri
   const uint64_t scope = writer_scope();
   const pid_t self = ::getpid();
   size_t removed = 0;
-  std::error_code ec;
-  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string file = it->path().filename().string();
+  // readdir, not directory_iterator: a cache folder holds thousands of entries, and only names
+  // starting with `name` are looked at further.
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return 0;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string_view file(e->d_name);
     if (file.size() <= name.size() || file.compare(0, name.size(), name) != 0) continue;
-    const pid_t pid = pid_of_suffix(std::string_view(file).substr(name.size()), scope);
+    const pid_t pid = pid_of_suffix(file.substr(name.size()), scope);
     if (pid <= 0 || pid == self) continue;
     if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to ask (EPERM: alive)
-    std::error_code ignored;
-    if (std::filesystem::remove(it->path(), ignored)) ++removed;
+    if (::unlinkat(::dirfd(d), e->d_name, 0) == 0) ++removed;
   }
+  ::closedir(d);
   return removed;
 }
 
