@@ -348,8 +348,9 @@ int run_command(const RunArgs& args) {
     }
     for (; told_failures < frame.stream_failed.size(); ++told_failures) {  // each by file, node and why
       summary.stream_failed.push_back(frame.stream_failed[told_failures].message);
-      std::fprintf(stderr, "lod run: frame %u: hlod read failed: %s (its parent stays drawn)\n", n,
-                   summary.stream_failed.back().c_str());
+      std::fprintf(stderr, "lod run: frame %u: hlod read failed: %s (%s)\n", n, summary.stream_failed.back().c_str(),
+                   frame.stream_failed[told_failures].node == 0 ? "the root: the model is not drawn"
+                                                                : "its parent stays drawn");
     }
     records.push_back(record_of(frame));
     if (!args.quiet && (n % every == 0 || n + 1 == config.frames))
