@@ -26,6 +26,10 @@ struct InspectArgs {
   bool json = false;
   std::string export_dir;
   std::string format = "ply";  // of --export: ply | obj | glb | gltf
+  // An .hlod file: read every node's payload and check it (its checksum, its counts); exit 2
+  // naming each bad node when any is damaged, 0 when all are sound. (A .lod is checked in full
+  // whenever it is read.)
+  bool verify = false;
 };
 int inspect_command(const InspectArgs& args);
 // The .hlod side of `lod inspect` (cli/inspect_hlod.cpp): true when `file` starts with the

@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
   auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels or an .hlod file's tree");
   inspect_cmd->add_option("file", inspect.file, ".lod or .hlod file")->required();
   inspect_cmd->add_flag("--json", inspect.json, "print JSON");
+  inspect_cmd->add_flag("--verify", inspect.verify,
+                        "an .hlod file: check every node payload; exit 2 naming each damaged node, 0 when sound");
   inspect_cmd->add_option("--export", inspect.export_dir, "write every level into this directory (as --format)");
   inspect_cmd->add_option("--format", inspect.format, "format of --export: ply (default) | obj | glb | gltf")
       ->check(CLI::IsMember({"ply", "obj", "glb", "gltf"}));

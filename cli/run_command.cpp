@@ -219,7 +219,7 @@ int run_command(const RunArgs& args) {
     const auto delay = std::chrono::duration<double, std::milli>(args.stream_read_delay_ms);
     hlod->load = [files = hlod->files, trees = hlod->trees, delay](uint32_t model, uint32_t node, HlodPayload& out) {
       std::this_thread::sleep_for(delay);
-      return read_hlod_node(files[model], trees[model].nodes[node], out);
+      return read_hlod_node(files[model], node, trees[model].nodes[node], out);
     };
   }
   HlodCheck hlod_check;
@@ -342,10 +342,11 @@ int run_command(const RunArgs& args) {
         std::fprintf(stderr, "lod run: frame %u: %s\n", n,
                      shortfall_text(budget_shortfall(frame, scene.models, config.selection.count), model_names).c_str());
     }
-    if (frame.stream_failures > told_failures) {
-      std::fprintf(stderr, "lod run: frame %u: %llu hlod node reads failed so far (their parents stay drawn)\n", n,
-                   (unsigned long long)frame.stream_failures);
-      told_failures = frame.stream_failures;
+    for (; told_failures < frame.stream_failed.size(); ++told_failures) {  // each by file, node and why
+      summary.stream_failed.push_back(frame.stream_failed[told_failures].message);
+      std::fprintf(stderr, "lod run: frame %u: hlod read failed: %s (%s)\n", n, summary.stream_failed.back().c_str(),
+                   frame.stream_failed[told_failures].node == 0 ? "the root: the model is not drawn"
+                                                                : "its parent stays drawn");
     }
     records.push_back(record_of(frame));
     if (!args.quiet && (n % every == 0 || n + 1 == config.frames))

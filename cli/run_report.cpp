@@ -117,6 +117,7 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"stream_loads", s.stream_loads},
           {"stream_evictions", s.stream_evictions},
           {"stream_failures", s.stream_failures},
+          {"stream_failed", s.stream_failed},
           {"mean_hlod_nodes_drawn", s.mean_hlod_nodes_drawn},
           {"scene_hlod_nodes", s.scene_hlod_nodes},
           {"mean_scene_proxies", s.mean_scene_proxies},
@@ -331,6 +332,10 @@ std::string summary_text(const RunSummary& s) {
                   (unsigned long long)s.stream_evictions, (unsigned long long)s.stream_failures,
                   (unsigned long long)s.total_holes);
     o << buf;
+    // Which, by file, node and reason (the first few; the JSON summary lists them all).
+    constexpr size_t kNamed = 10;
+    for (size_t k = 0; k < std::min(kNamed, s.stream_failed.size()); ++k) o << "    failed: " << s.stream_failed[k] << "\n";
+    if (s.stream_failed.size() > kNamed) o << "    ... and " << s.stream_failed.size() - kNamed << " more failed reads\n";
   }
   if (s.scene_hlod_nodes > 0) {
     std::snprintf(buf, sizeof buf,

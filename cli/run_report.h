@@ -79,6 +79,7 @@ struct RunSummary {
   size_t hlod_models = 0;
   uint64_t stream_budget = 0, max_resident_bytes = 0, total_holes = 0, stream_loads = 0, stream_evictions = 0,
            stream_failures = 0;
+  std::vector<std::string> stream_failed;  // each failed node read: file, node and why
   double mean_hlod_nodes_drawn = 0;
   double mean_scene_proxies = 0, mean_proxy_objects = 0, mean_draws = 0;
   size_t scene_hlod_nodes = 0;  // proxies in the scene HLOD (0: off)

@@ -29,6 +29,7 @@
 #include <span>
 
 #include "jobs/tsan_annotations.h"
+#include "jobs/hlod_read_failures.h"
 #include "jobs/hlod_stream.h"
 #include "runtime/geomorph.h"
 #include "runtime/hlod_asset.h"
@@ -263,6 +264,7 @@ struct FrameGraph::Impl {
   std::vector<HlodModelInput> hlod_inputs;
   bool hlod_over_budget = false;
   uint64_t hlod_wanted_last = 0;  // last frame's cuts before their budget: the HLOD demand
+  std::vector<HlodFailedFrame> hlod_failed;  // every failed node so far, messages made once
 
   // The terrain (options.terrain): ROAM state and share across frames, last frame's feedback.
   TerrainLod terrain;
@@ -286,12 +288,9 @@ struct FrameGraph::Impl {
   }
 
   // Reads run on the pager's threads, several at once: read_hlod_node opens the file per read.
+  // A cache entry that fails a read is marked bad for the next bake.
   void make_hlod_stream(std::shared_ptr<const HlodModels> h) {
-    ModelNodeLoader load = h->load;
-    if (!load)
-      load = [h](uint32_t model, uint32_t node, HlodPayload& payload) {
-        return read_hlod_node(h->files[model], h->trees[model].nodes[node], payload);
-      };
+    const ModelNodeLoader load = marking_bad_entries(h, h->load);
     hlod_stream = std::make_unique<HlodStream>(h->trees, h->stream, load);
     hlod_inputs.resize(h->trees.size());
     for (size_t m = 0; m < hlod_inputs.size(); ++m) hlod_inputs[m].transform = h->transforms[m];
@@ -1091,6 +1090,7 @@ struct FrameGraph::Impl {
     f.hlod_nodes_drawn = 0;
     f.hlod_tris = f.resident_bytes = f.stream_requests = f.stream_loads = f.stream_evictions = f.stream_failures = f.stream_budget = 0;
     f.holes = 0;
+    f.stream_failed.clear();
     if (!hlod_stream) return;
     const uint64_t share = hlod_share();
     for (HlodModelInput& in : hlod_inputs) {
@@ -1117,6 +1117,11 @@ struct FrameGraph::Impl {
     f.stream_loads = fig.stream_loads;
     f.stream_evictions = fig.stream_evictions;
     f.stream_failures = fig.stream_failures;
+    const std::span<const HlodStreamFailure> failed = hlod_stream->failures();
+    for (size_t k = hlod_failed.size(); k < failed.size(); ++k)
+      hlod_failed.push_back({failed[k].model, failed[k].node,
+                             hlod_failure_message(*options.hlod, failed[k].model, failed[k].node, failed[k].why)});
+    f.stream_failed = hlod_failed;
     f.holes = fig.holes;
   }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "jobs/hlod_read_failures.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 
@@ -74,6 +75,7 @@ Status store_hlod_model(const std::filesystem::path& dir, uint64_t key, const st
     std::filesystem::remove(baked, ignored);
     return Status::error(path.string() + ": cannot rename the verified entry into place: " + ec.message());
   }
+  clear_bad_mark(path);
   return Status::success();
 }
 
@@ -84,6 +86,8 @@ CacheLookup load_hlod_model(const std::filesystem::path& dir, uint64_t key, cons
   std::vector<uint8_t> read;
   Status st = read_file(path, read, opened);
   if (!opened) return CacheLookup::missing;
+  // A reader that streamed it found a node damaged since (the check below would too).
+  if (std::string bad; st && entry_marked_bad(path, &bad)) st = Status::error(path.string() + ": marked bad: " + bad);
   if (st) st = check_hlod_model(read, name, source_hash, path.string(), tree);
   if (!st) {
     if (why) *why = st.message;

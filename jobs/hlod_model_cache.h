@@ -3,7 +3,8 @@
 // the model's .hlod exactly as `lod bake --hlod` writes it. An entry appears under its name only
 // complete and verified (the bake's finished file read back and decoded in full, then renamed),
 // so a rank killed mid-way leaves at worst a folder of its own; an entry that is nevertheless
-// wrong (flipped bits, truncated, another model's) is refused when read and baked again.
+// wrong (flipped bits, truncated, another model's) is refused when read and baked again, as is
+// one marked bad (jobs/hlod_read_failures.h); storing an entry removes its mark.
 #pragma once
 #include <cstdint>
 #include <filesystem>

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "jobs/hlod_bake.h"
+#include "jobs/hlod_read_failures.h"
 #include "jobs/scene.h"
 #include "runtime/hlod_asset.h"
 
@@ -32,7 +33,11 @@ Status cached_or_baked(const ModelConfig& m, const std::filesystem::path& cache_
   const std::string stem = m.name + "-" + hex64(key);
   path = cache_dir / (stem + ".hlod");
   std::error_code ec;
-  if (std::filesystem::exists(path, ec)) {
+  std::string bad;
+  if (entry_marked_bad(path, &bad)) {
+    // The head checks out, a payload behind it did not (found while streaming it).
+    if (log) log("bake " + m.name + ": cache file " + path.string() + " was marked bad (" + bad + "), rebaking");
+  } else if (std::filesystem::exists(path, ec)) {
     const Status read = read_hlod_tree(path, tree);
     if (read && tree.source_hash == key) {
       from_cache = true;
@@ -48,6 +53,7 @@ Status cached_or_baked(const ModelConfig& m, const std::filesystem::path& cache_
   if (Status s = bake_hlod_file(m.file, stem, cache_dir, settings, log, &result); !s)
     return Status::error("model " + m.name + ": " + s.message);
   from_cache = false;
+  clear_bad_mark(path);  // the fresh entry has replaced the bad one
   if (Status s = read_hlod_tree(path, tree); !s) return Status::error("model " + m.name + ": " + s.message);
   if (log) log("bake " + m.name + ": hlod of " + std::to_string(tree.nodes.size()) + " nodes -> " + path.string());
   return Status::success();
@@ -99,6 +105,7 @@ Status bake_hlod_models(const SceneConfig& config, const std::filesystem::path& 
     h.names.push_back(m.name);
     h.trees.push_back(std::move(tree));
     h.files.push_back(path);
+    h.cache_entry.push_back(m.file.extension() == ".hlod" ? 0 : 1);
     h.transforms.push_back(transform_of(placed[0]));
   }
   out = std::move(h);

@@ -18,8 +18,9 @@ SceneConfig discrete_part(const SceneConfig& config);
 
 // Loads `cache_dir/<name>-<key>.hlod` when its tree is valid and its source_hash is the key
 // (hlod_source_hash of the mesh and min_verts), otherwise bakes it with bake_hlod_file. Every
-// hlod model must have exactly one instance. `log` gets progress lines; `baked` / `cached`
-// count the models each way.
+// hlod model must have exactly one instance. An entry marked bad (a node of it failed to read
+// while streaming: jobs/hlod_read_failures.h) is rebaked, and the mark removed. `log` gets
+// progress lines; `baked` / `cached` count the models each way.
 Status bake_hlod_models(const SceneConfig& config, const std::filesystem::path& cache_dir,
                         const std::function<void(const std::string&)>& log, HlodModels& out, size_t* baked = nullptr,
                         size_t* cached = nullptr);

@@ -79,6 +79,14 @@ void HlodStream::frame(uint64_t frame, const HlodView& view, std::span<const Hlo
   // One priority order across models (each cut's requests are already in it).
   if (models_.size() > 1) std::sort(wanted_.begin(), wanted_.end(), request_before);
   update_ = &pager_.update(frame + frame_offset_, wanted_, in_use_);
+  keep_failures(*update_);
+}
+
+void HlodStream::keep_failures(const StreamUpdate& update) {
+  for (const StreamFailure& f : update.failures) {
+    const uint32_t m = model_of_[f.node];
+    failures_.push_back({m, f.node - models_[m].first, f.why});
+  }
 }
 
 bool HlodStream::load_roots(double timeout_s) {
@@ -91,6 +99,7 @@ bool HlodStream::load_roots(double timeout_s) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     const StreamUpdate& u = pager_.update(++frame_offset_, roots, keep);
+    keep_failures(u);
     if (!u.failures.empty()) return false;
     const bool all = std::all_of(keep.begin(), keep.end(), [&](uint32_t n) { return pager_.residency()[n] != 0; });
     if (all) return true;

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "jobs/stream_pager.h"
@@ -44,6 +45,13 @@ struct HlodStreamFigures {
   uint32_t wanted = 0;  // this frame's requests
 };
 
+// A node of a model that failed for good (its parent stays drawn).
+struct HlodStreamFailure {
+  uint32_t model = 0;
+  uint32_t node = 0;  // in the model's tree
+  std::string why;    // the loader's message (or the pager's reason)
+};
+
 class HlodStream {
  public:
   HlodStream(std::vector<HlodTree> trees, const StreamPagerConfig& config, ModelNodeLoader load);
@@ -70,6 +78,8 @@ class HlodStream {
   }
   const StreamPager& pager() const { return pager_; }
   const StreamUpdate& last_update() const { return *update_; }  // pager-wide node ids
+  // Every node that failed so far, load_roots' included, in the order they failed.
+  std::span<const HlodStreamFailure> failures() const { return failures_; }
   HlodStreamFigures figures() const;
 
  private:
@@ -82,6 +92,7 @@ class HlodStream {
   static std::vector<Model> models_of(std::vector<HlodTree> trees);
   static std::vector<uint64_t> bytes_of(const std::vector<Model>& models);
   Status load_node(uint32_t node, HlodPayload& out) const;
+  void keep_failures(const StreamUpdate& update);
 
   // Declared before pager_: its loader threads read them (never written after construction).
   std::vector<Model> models_;
@@ -93,6 +104,7 @@ class HlodStream {
   StreamUpdate none_;
   const StreamUpdate* update_ = &none_;
   uint64_t frame_offset_ = 0;  // pager frames load_roots used
+  std::vector<HlodStreamFailure> failures_;
 };
 
 }  // namespace lod

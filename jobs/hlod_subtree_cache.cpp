@@ -81,6 +81,7 @@ Status store_hlod_subtree(const std::filesystem::path& dir, uint64_t key, uint64
   const std::filesystem::path path = hlod_subtree_entry_path(dir, key);
   std::filesystem::path temp = dir / ".";  // a temporary of this writer's own, beside the entry
   temp += path.filename();
+  remove_dead_temporaries(dir, temp.filename().string());  // what killed writers of it left
   temp += unique_temporary_suffix();
   std::vector<uint8_t> bytes = encode_hlod_subtree(subtree, key);
   (void)mesh_vertices;

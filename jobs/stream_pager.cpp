@@ -130,7 +130,7 @@ void StreamPager::take_completions(uint64_t frame) {
     } else {
       // Failed for good: reported here once, never issued again; its parent stays drawn.
       stream_failed(state_, c.node);
-      update_.failures.push_back({c.node, node_message(c.node, c.status.message)});
+      update_.failures.push_back({c.node, node_message(c.node, c.status.message), c.status.message});
     }
   }
   sh.taken.clear();
@@ -162,9 +162,9 @@ void StreamPager::requeue(uint64_t frame, std::span<const HlodRequest> wanted) {
   for (size_t i = 0; i < update_.issued.size(); ++i) sh.wake.notify_one();
   for (uint32_t n : update_.evicted) payloads_[n].reset();
   for (uint32_t n : too_large_) {
-    update_.failures.push_back(
-        {n, node_message(n, "needs " + std::to_string(state_.bytes[n]) +
-                                " bytes, more than the stream budget of " + std::to_string(state_.budget))});
+    std::string why = "needs " + std::to_string(state_.bytes[n]) + " bytes, more than the stream budget of " +
+                      std::to_string(state_.budget);
+    update_.failures.push_back({n, node_message(n, why), why});
   }
 }
 

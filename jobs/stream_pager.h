@@ -46,6 +46,7 @@ using NodeLoader = std::function<Status(uint32_t node, HlodPayload& out)>;
 struct StreamFailure {
   uint32_t node;
   std::string message;  // "node 17: truncated at byte 812"
+  std::string why;      // the loader's message alone ("truncated at byte 812"), or the pager's reason
 };
 
 // What one update changed; valid until the next update.

@@ -1,7 +1,9 @@
 // write_file_atomic: temporary + fsync + rename, as the header says.
 #include "runtime/file_write.h"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,8 +12,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <random>
 #include <memory>
+#include <random>
+#include <string_view>
 
 #include "runtime/host_turn.h"
 
@@ -55,11 +58,67 @@ Status write_all(int fd, std::span<const uint8_t> bytes, const std::string& what
 namespace {
 
 // A name of its own per process and call: runs sharing a folder may write the same file at
-// once, and each rename then replaces it whole (last one wins).
+// once, and each rename then replaces it whole (last one wins). What killed writers of the same
+// file left there goes first.
 std::filesystem::path temporary_beside(const std::filesystem::path& path) {
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  remove_dead_temporaries(dir, path.filename().string());
   std::filesystem::path tmp = path;
   tmp += unique_temporary_suffix();
   return tmp;
+}
+
+uint64_t fnv1a(uint64_t h, const std::string& text) {
+  for (const unsigned char c : text) h = (h ^ c) * 0x100000001b3ull;
+  return h;
+}
+
+std::string first_line_of(const char* file) {
+  const int fd = ::open(file, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return {};
+  char buf[128];
+  const ssize_t n = ::read(fd, buf, sizeof buf);
+  ::close(fd);
+  return n > 0 ? std::string(buf, size_t(n)) : std::string();
+}
+
+// Where a pid means something: the host's name, its boot and this process's pid namespace.
+// Without the namespace to go by, a random draw: no other process shares the scope, so no
+// temporary is ever taken for a dead writer's that might be a live one's.
+uint64_t writer_scope() {
+  static const uint64_t scope = [] {
+    uint64_t h = 0xcbf29ce484222325ull;
+    char host[256] = {};
+    if (::gethostname(host, sizeof host - 1) == 0) h = fnv1a(h, host);
+    h = fnv1a(h, first_line_of("/proc/sys/kernel/random/boot_id"));
+    struct stat ns {};
+    if (::stat("/proc/self/ns/pid", &ns) == 0) {
+      h = fnv1a(h, std::to_string(ns.st_dev) + ":" + std::to_string(ns.st_ino));
+    } else {
+      std::random_device rd;
+      h = fnv1a(h, std::to_string(rd()) + std::to_string(rd()));
+    }
+    return h;
+  }();
+  return scope;
+}
+
+// The pid in `suffix` when it is one of this scope's (".<scope>-<pid>-<n>.tmp"), else 0.
+pid_t pid_of_suffix(std::string_view suffix, uint64_t scope) {
+  char own[24];
+  std::snprintf(own, sizeof own, ".%016llx-", static_cast<unsigned long long>(scope));
+  const std::string_view head(own);
+  if (suffix.size() <= head.size() + 4 || suffix.substr(0, head.size()) != head ||
+      suffix.substr(suffix.size() - 4) != ".tmp")
+    return 0;
+  const std::string_view rest = suffix.substr(head.size(), suffix.size() - head.size() - 4);  // <pid>-<n>
+  const size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string_view::npos || dash + 1 == rest.size()) return 0;
+  const auto digits = [](std::string_view v) {
+    return std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (!digits(rest.substr(0, dash)) || !digits(rest.substr(dash + 1)) || dash > 9) return 0;
+  return pid_t(std::stol(std::string(rest.substr(0, dash))));
 }
 
 Status write_parts(const std::filesystem::path& file, int fd, std::span<const std::span<const uint8_t>> parts,
@@ -104,17 +163,32 @@ Status write_file_atomic(const std::filesystem::path& path, const std::string& t
 }
 
 std::string unique_temporary_suffix() {
-  // Drawn once; the pid mixed in at every call, since a forked child keeps the parent's draw.
-  static const uint64_t drawn = [] {
-    std::random_device rd;
-    return uint64_t(rd()) << 32 | rd();
-  }();
-  const uint64_t token = drawn ^ (uint64_t(::getpid()) * 0x9E3779B97F4A7C15ull);
+  // The pid asked at every call: a forked child keeps the parent's statics.
   static std::atomic<uint64_t> serial{0};
-  char suffix[48];
-  std::snprintf(suffix, sizeof suffix, ".%016llx-%llu.tmp", static_cast<unsigned long long>(token),
-                static_cast<unsigned long long>(serial++));
+  char suffix[64];
+  std::snprintf(suffix, sizeof suffix, ".%016llx-%lld-%llu.tmp", static_cast<unsigned long long>(writer_scope()),
+                static_cast<long long>(::getpid()), static_cast<unsigned long long>(serial++));
   return suffix;
+}
+
+size_t remove_dead_temporaries(const std::filesystem::path& dir, const std::string& name) {
+  const uint64_t scope = writer_scope();
+  const pid_t self = ::getpid();
+  size_t removed = 0;
+  // readdir, not directory_iterator: a cache folder holds thousands of entries, and only names
+  // starting with `name` are looked at further.
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return 0;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string_view file(e->d_name);
+    if (file.size() <= name.size() || file.compare(0, name.size(), name) != 0) continue;
+    const pid_t pid = pid_of_suffix(file.substr(name.size()), scope);
+    if (pid <= 0 || pid == self) continue;
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to ask (EPERM: alive)
+    if (::unlinkat(::dirfd(d), e->d_name, 0) == 0) ++removed;
+  }
+  ::closedir(d);
+  return removed;
 }
 
 Status create_sized_temporary(const std::filesystem::path& path, uint64_t size, std::filesystem::path& temp) {

@@ -57,10 +57,19 @@ std::vector<std::pair<uint64_t, uint64_t>> covered_ranges(std::span<const FilePi
 // the message says how far it got and why ("the disk is full after 4096 of 9000 bytes").
 Status write_all(int fd, std::span<const uint8_t> bytes, const std::string& what);
 
-// ".<token>-<n>.tmp": a temporary's suffix no other writer uses, in this process (n counts) or
-// in any other, on this host or another sharing the folder (token: random per process; a pid
-// alone repeats across the nodes of an MPI job writing to shared storage).
+// ".<scope>-<pid>-<n>.tmp": a temporary's suffix no other writer uses, in this process (n counts)
+// or in any other, on this host or another sharing the folder. The scope (16 hex digits) names
+// where the pid means something: the host, its boot and the pid namespace (a pid alone repeats
+// across the nodes of an MPI job writing to shared storage, and across containers).
 std::string unique_temporary_suffix();
+
+// A writer killed mid-write leaves its temporary behind, full-size. Before a file is written,
+// the temporaries of the same name (`dir/<name><suffix>`, suffixes as above) left by writers of
+// this scope whose pid no longer exists (kill(pid, 0) fails with ESRCH) are removed; those of
+// live writers, and of other scopes (another host: its pids cannot be asked), are left alone.
+// write_file_atomic and create_sized_temporary do this for their target; a writer that names
+// its own temporaries calls it itself. Returns how many were removed.
+size_t remove_dead_temporaries(const std::filesystem::path& dir, const std::string& name);
 
 // errno in plain words for file writes: ENOSPC "the disk is full", EDQUOT "the disk quota is
 // exceeded", EROFS "the file system is read-only", EACCES/EPERM "permission denied", EFBIG

@@ -610,7 +610,7 @@ Status decode_hlod_payload(std::span<const uint8_t> bytes, const HlodNode& node,
                             std::to_string(payload_data_bytes(node) + kChecksumBytes) + " (truncated?)");
   const uint64_t body = bytes.size() - kChecksumBytes;
   if (load_u64(bytes.data() + body) != hash_bytes(bytes.data(), body))
-    return refuse(what, "node payload checksum mismatch (file is corrupted)");
+    return refuse(what, "payload checksum mismatch (the file is damaged)");
   HlodPayload p;
   const uint8_t* q = bytes.data();
   std::string why;
@@ -719,13 +719,19 @@ Status HlodFile::open(const std::filesystem::path& path, HlodTree& tree) {
   return Status::success();
 }
 
-Status HlodFile::read_node(const HlodNode& node, HlodPayload& out) const {
+Status HlodFile::read_node(const HlodNode& node, HlodPayload& out) const { return read_node_as(node, path_, out); }
+
+Status HlodFile::read_node(uint32_t index, const HlodNode& node, HlodPayload& out) const {
+  return read_node_as(node, path_ + ": node " + std::to_string(index), out);
+}
+
+Status HlodFile::read_node_as(const HlodNode& node, const std::string& what, HlodPayload& out) const {
   if (fd_ < 0) return Status::error("hlod: no file open");
   if (node.payload_offset > size_ || node.payload_size > size_ - node.payload_offset)
-    return refuse(path_, "node payload lies outside the file");
+    return refuse(what, "node payload lies outside the file");
   std::vector<uint8_t> bytes;
-  if (Status s = read_exactly(fd_, node.payload_offset, node.payload_size, bytes, path_); !s) return s;
-  return decode_hlod_payload(bytes, node, materials_, path_, out);
+  if (Status s = read_exactly(fd_, node.payload_offset, node.payload_size, bytes, what); !s) return s;
+  return decode_hlod_payload(bytes, node, materials_, what, out);
 }
 
 Status read_hlod_tree(const std::filesystem::path& path, HlodTree& out) {
@@ -738,6 +744,13 @@ Status read_hlod_node(const std::filesystem::path& path, const HlodNode& node, H
   HlodTree tree;
   if (Status s = f.open(path, tree); !s) return s;
   return f.read_node(node, out);
+}
+
+Status read_hlod_node(const std::filesystem::path& path, uint32_t index, const HlodNode& node, HlodPayload& out) {
+  HlodFile f;
+  HlodTree tree;
+  if (Status s = f.open(path, tree); !s) return s;
+  return f.read_node(index, node, out);
 }
 
 }  // namespace lod

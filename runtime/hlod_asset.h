@@ -67,10 +67,15 @@ class HlodFile {
 
   // Regular files only (a FIFO never blocks the reader). Reads the head, not the payloads.
   Status open(const std::filesystem::path& path, HlodTree& tree);
+  // Every read checks the payload's checksum. A failure names the file and why; with the
+  // node's index, the node too ("scene.hlod: node 17: payload checksum mismatch ...").
   Status read_node(const HlodNode& node, HlodPayload& out) const;
+  Status read_node(uint32_t index, const HlodNode& node, HlodPayload& out) const;
   bool is_open() const { return fd_ >= 0; }
 
  private:
+  Status read_node_as(const HlodNode& node, const std::string& what, HlodPayload& out) const;
+
   int fd_ = -1;
   uint64_t size_ = 0;
   uint32_t materials_ = 0;  // the tree's material_count, for the runs' ids
@@ -81,6 +86,8 @@ class HlodFile {
 Status read_hlod_tree(const std::filesystem::path& path, HlodTree& out);
 // One node of the file at `path` (the node from read_hlod_tree of the same file).
 Status read_hlod_node(const std::filesystem::path& path, const HlodNode& node, HlodPayload& out);
+// The same, naming node `index` in messages.
+Status read_hlod_node(const std::filesystem::path& path, uint32_t index, const HlodNode& node, HlodPayload& out);
 
 // Bytes a payload with these counts takes in memory (positions, normals, uvs, uv1, colours,
 // indices, runs),

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "lodkit/types.hpp"
@@ -69,6 +70,16 @@ struct HlodDrawFrame {
 struct HlodOpenedFrame {
   uint32_t model = 0;
   uint32_t node = 0;
+};
+
+// A node of an HLOD model that could not be read (a payload failing its checksum, a truncated
+// file, the storage's error); never read again, its parent stays drawn. The message names the
+// file, the node and why: "/cache/scene-1f2e.hlod: node 17: payload checksum mismatch (the file
+// is damaged)". A damaged cache entry is marked bad and rebaked by the next run (it says so).
+struct HlodFailedFrame {
+  uint32_t model = 0;
+  uint32_t node = 0;
+  std::string message;
 };
 
 struct Frame {
@@ -163,6 +174,7 @@ struct Frame {
   uint64_t stream_loads = 0;                  // loads completed so far
   uint64_t stream_evictions = 0;              // nodes evicted so far (least recently used)
   uint64_t stream_failures = 0;               // node reads failed so far (each node once; parent stays drawn)
+  std::vector<HlodFailedFrame> stream_failed; // which: every one so far, in the order they failed
   uint32_t holes = 0;                         // wanted, not drawable, no drawn ancestor: must be 0
 
   // Scene HLOD ([scene_hlod], view 0's cut): merged proxies drawn instead of the static objects

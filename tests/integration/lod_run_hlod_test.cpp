@@ -108,16 +108,23 @@ TEST(LodRunHlod, RefusesAnHlodBlockOfTwoObjects) {
   EXPECT_NE(r.out.find("count = 1"), std::string::npos) << r.out;
 }
 
+// The scene's cached .hlod (written by a first run).
+std::filesystem::path cached_hlod(const std::filesystem::path& cache) {
+  std::filesystem::path file;
+  for (const auto& e : std::filesystem::directory_iterator(cache))
+    if (e.path().extension() == ".hlod") file = e.path();
+  return file;
+}
+
 // A corrupted root payload in the cache: every frame reports the hole (nothing can be drawn),
-// the failed read is counted, nothing crashes; --validate fails the run.
+// the failed read is named, nothing crashes; --validate fails the run. The entry is marked bad,
+// and the next run rebakes it.
 TEST(LodRunHlod, CorruptedRootIsAHoleThatValidateRefuses) {
   const auto dir = lod::test::temp_dir("lodrun-hlod-corrupt");
   const auto cfg = write_mixed_scene(dir, "count = 1\nscale = 10.0\n");
   const auto cache = dir / "cache";
   ASSERT_EQ(run_lod("run --config " + cfg.string() + " --frames 1 --quiet --cache " + cache.string()).code, 0);
-  std::filesystem::path file;
-  for (const auto& e : std::filesystem::directory_iterator(cache))
-    if (e.path().extension() == ".hlod") file = e.path();
+  const std::filesystem::path file = cached_hlod(cache);
   ASSERT_FALSE(file.empty());
   lod::HlodTree tree;
   ASSERT_TRUE(lod::read_hlod_tree(file, tree).ok);
@@ -130,20 +137,80 @@ TEST(LodRunHlod, CorruptedRootIsAHoleThatValidateRefuses) {
     f.seekp(std::streamoff(tree.nodes[0].payload_offset + tree.nodes[0].payload_size / 2));
     f.write(&c, 1);
   }
+  const auto damaged = lod::test::read_bytes(file);
   const auto r = run_lod("run --config " + cfg.string() + " --frames 5 --quiet --cache " + cache.string() + " --json " +
                          (dir / "run.json").string());
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("hlod node reads failed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("hlod read failed: " + file.string() + ": node 0: payload checksum mismatch"), std::string::npos)
+      << r.out;
   const auto j = read_json(dir / "run.json");
   for (const auto& f : j["frames"]) {
     EXPECT_EQ(f["holes"].get<uint64_t>(), 1u);
     EXPECT_EQ(f["hlod_nodes_drawn"].get<uint64_t>(), 0u);
   }
   EXPECT_EQ(j["summary"]["stream_failures"].get<uint64_t>(), 1u);
+  ASSERT_EQ(j["summary"]["stream_failed"].size(), 1u);
   EXPECT_EQ(j["summary"]["total_holes"].get<uint64_t>(), 5u);
+  // The damaged file once more, without its mark (as a .hlod a config names itself would be).
+  lod::test::write_bytes(file, damaged);
+  std::filesystem::remove(file.string() + ".bad");
   const auto v = run_lod("run --config " + cfg.string() + " --frames 5 --validate --quiet --cache " + cache.string());
   EXPECT_EQ(v.code, 3) << v.out;
   EXPECT_NE(v.out.find("1 hlod holes"), std::string::npos) << v.out;
+  const auto again = run_lod("run --config " + cfg.string() + " --frames 5 --validate --quiet --cache " + cache.string());
+  EXPECT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("was marked bad"), std::string::npos) << again.out;
+}
+
+// 5 x 4 KB of the payloads overwritten with 0xff, the head intact: the run names the file, the
+// nodes and the checksum (not a bare count), the rerun rebakes instead of saying "cached", and
+// lod inspect --verify exits 2 on the damaged file naming the nodes, 0 on the rebaked one.
+TEST(LodRunHlod, DamagedPayloadsAreNamedAndTheEntryRebaked) {
+  const auto dir = lod::test::temp_dir("lodrun-hlod-damaged");
+  const auto cfg = write_mixed_scene(dir, "count = 1\nscale = 10.0\n");
+  const auto cache = dir / "cache";
+  ASSERT_EQ(run_lod("run --config " + cfg.string() + " --frames 1 --quiet --cache " + cache.string()).code, 0);
+  const std::filesystem::path file = cached_hlod(cache);
+  ASSERT_FALSE(file.empty());
+  const auto clean = run_lod("inspect --verify " + file.string());
+  EXPECT_EQ(clean.code, 0) << clean.out;
+  EXPECT_NE(clean.out.find("node payloads verified"), std::string::npos) << clean.out;
+
+  lod::HlodTree tree;
+  ASSERT_TRUE(lod::read_hlod_tree(file, tree).ok);
+  std::vector<uint8_t> bytes = lod::test::read_bytes(file);
+  const uint64_t first = tree.nodes[0].payload_offset;  // past the head
+  ASSERT_GT(bytes.size(), first + 5 * 4096);
+  const uint64_t stride = (bytes.size() - first - 4096) / 4;
+  for (uint64_t k = 0; k < 5; ++k) std::fill_n(bytes.begin() + std::ptrdiff_t(first + k * stride), 4096, uint8_t(0xff));
+  lod::test::write_bytes(file, bytes);
+
+  const auto verify = run_lod("inspect --verify " + file.string());
+  EXPECT_EQ(verify.code, 2) << verify.out;
+  EXPECT_NE(verify.out.find(file.string() + ": node 0: payload checksum mismatch"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find("node payloads damaged"), std::string::npos) << verify.out;
+  const auto verify_json = lod::test::printed_json(run_lod("inspect --verify --json " + file.string()));
+  ASSERT_TRUE(verify_json.is_object());
+  EXPECT_FALSE(verify_json["verified"].get<bool>());
+  EXPECT_GE(verify_json["damaged"].size(), 5u) << "each 4 KB block falls in at least one payload";
+
+  const auto r = run_lod("run --config " + cfg.string() + " --frames 5 --quiet --cache " + cache.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("bake big: cached"), std::string::npos) << "the head alone checks out: " << r.out;
+  EXPECT_NE(r.out.find("hlod read failed: " + file.string() + ": node 0: payload checksum mismatch"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("marked bad"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("failed: " + file.string()), std::string::npos) << "the summary names them: " << r.out;
+  EXPECT_TRUE(std::filesystem::exists(file.string() + ".bad"));
+
+  const auto rerun = run_lod("run --config " + cfg.string() + " --frames 5 --validate --quiet --cache " + cache.string());
+  ASSERT_EQ(rerun.code, 0) << rerun.out;
+  EXPECT_EQ(rerun.out.find("bake big: cached"), std::string::npos) << rerun.out;
+  EXPECT_NE(rerun.out.find("bake big: cache file " + file.string() + " was marked bad"), std::string::npos) << rerun.out;
+  EXPECT_EQ(rerun.out.find("hlod read failed"), std::string::npos) << rerun.out;
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".bad"));
+  const auto rebaked = run_lod("inspect --verify " + file.string());
+  EXPECT_EQ(rebaked.code, 0) << rebaked.out;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "jobs/frame_graph.h"
 #include "jobs/hlod_bake.h"
+#include "jobs/hlod_read_failures.h"
 #include "runtime/hlod_asset.h"
 #include "synthetic_scene.h"
 #include "test_support.h"
@@ -142,6 +143,49 @@ TEST(FrameGraphHlod, SlowReadsNeverStallTheNode) {
   std::sort(ms.begin(), ms.end());
   EXPECT_LT(ms[ms.size() / 2], 2.0) << "median hlod node ms";
   EXPECT_LT(ms[ms.size() * 9 / 10], 10.0) << "p90 hlod node ms: a wait would take 20";
+}
+
+// The root's children's payloads overwritten with 0xff behind an intact head: as the camera
+// comes close, each one read fails once, and the frame names it with the file and the checksum
+// (their parent stays drawn); the cache entry is marked bad.
+TEST(FrameGraphHlod, ADamagedPayloadIsNamedInTheFrameAndItsEntryMarkedBad) {
+  const Scene scene = test::synthetic_scene(300, 150);
+  FrameGraphOptions o;
+  o.threads = 2;
+  o.selection.budget = 20000000;
+  auto h = sphere_hlod("fg-hlod-damaged", 64ull << 20);
+  h->cache_entry = {1};
+  const HlodTree& tree = h->trees[0];
+  const HlodNode& root = tree.nodes[0];
+  ASSERT_GT(root.child_count, 0u);
+  std::vector<uint8_t> bytes = test::read_bytes(h->files[0]);
+  std::vector<uint32_t> damaged;
+  for (uint32_t c = 0; c < root.child_count; ++c) damaged.push_back(root.first_child + c);
+  for (const uint32_t n : damaged)
+    std::fill_n(bytes.begin() + std::ptrdiff_t(tree.nodes[n].payload_offset), 64, uint8_t(0xff));
+  test::write_bytes(h->files[0], bytes);
+  o.hlod = h;
+  FrameGraph g(scene, o);
+  Frame f;
+  for (uint32_t n = 0; n < 100; ++n) {
+    g.run(near_origin(n), f);
+    ASSERT_EQ(f.holes, 0u) << "the root is sound";
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_EQ(f.stream_failed.size(), f.stream_failures);
+  ASSERT_GE(f.stream_failed.size(), 1u) << "the cut wanted a child as the camera came close";
+  const std::string file = h->files[0].string();
+  for (const HlodFailedFrame& failed : f.stream_failed) {
+    EXPECT_EQ(failed.model, 0u);
+    EXPECT_NE(std::find(damaged.begin(), damaged.end(), failed.node), damaged.end()) << failed.message;
+    EXPECT_EQ(failed.message.rfind(file + ": node " + std::to_string(failed.node) + ": payload checksum mismatch", 0),
+              0u)
+        << failed.message;
+    EXPECT_NE(failed.message.find("marked bad"), std::string::npos) << failed.message;
+  }
+  std::string why;
+  ASSERT_TRUE(entry_marked_bad(h->files[0], &why));
+  EXPECT_NE(why.find("payload checksum mismatch"), std::string::npos) << why;
 }
 
 TEST(FrameGraphHlod, WithoutHlodModelsTheNodeDrawsNothing) {

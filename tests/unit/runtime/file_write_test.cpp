@@ -1,6 +1,7 @@
 #include "runtime/file_write.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -233,6 +234,84 @@ TEST(FileWrite, TemporarySuffixesDifferWithinAProcessAndInAForkedChild) {
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
   ASSERT_GT(n, 0);
   const std::string theirs(buf, size_t(n));
-  // The token (before the '-') differs, not only the count after it.
-  EXPECT_NE(theirs.substr(0, theirs.find('-')), parent.substr(0, parent.find('-'))) << theirs << " vs " << parent;
+  // The writer (scope and pid, before the last '-') differs, not only the count after it.
+  EXPECT_NE(theirs.substr(0, theirs.rfind('-')), parent.substr(0, parent.rfind('-'))) << theirs << " vs " << parent;
+}
+
+namespace {
+
+// A child that makes `path`'s sized temporary and then either is killed (SIGKILL, as a write cut
+// short) or waits on `hold` until the parent closes it. Its temporary's path is returned.
+std::filesystem::path temporary_of_child(const std::filesystem::path& path, bool killed, pid_t& child, int& hold) {
+  int names[2], wait_fds[2];
+  EXPECT_EQ(pipe(names), 0);
+  EXPECT_EQ(pipe(wait_fds), 0);
+  child = fork();
+  if (child == 0) {
+    close(names[0]);
+    close(wait_fds[1]);
+    std::filesystem::path temp;
+    if (!lod::create_sized_temporary(path, 1 << 16, temp)) _exit(1);
+    const std::string name = temp.string();
+    if (write(names[1], name.data(), name.size()) != ssize_t(name.size())) _exit(1);
+    close(names[1]);
+    if (killed) raise(SIGKILL);
+    char c;
+    while (read(wait_fds[0], &c, 1) > 0) {
+    }
+    _exit(0);
+  }
+  close(names[1]);
+  close(wait_fds[0]);
+  hold = wait_fds[1];
+  std::string name;
+  char buf[512];
+  for (ssize_t n; (n = read(names[0], buf, sizeof buf)) > 0;) name.append(buf, size_t(n));
+  close(names[0]);
+  return name;
+}
+
+}  // namespace
+
+// A writer killed mid-write leaves its full-size temporary; the next write of the same file
+// removes it. A live writer's, another file's and another host's (scope) are left alone.
+TEST(FileWrite, TheNextWriteRemovesADeadWritersTemporaryOfTheSameFile) {
+  const auto dir = lod::test::temp_dir("file_write_dead_temps");
+  const auto path = dir / "entry.hlod";
+  pid_t dead = 0, live = 0;
+  int dead_hold = -1, live_hold = -1;
+  const std::filesystem::path dead_temp = temporary_of_child(path, true, dead, dead_hold);
+  const std::filesystem::path live_temp = temporary_of_child(path, false, live, live_hold);
+  int status = 0;
+  ASSERT_EQ(waitpid(dead, &status, 0), dead);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  close(dead_hold);
+  ASSERT_TRUE(std::filesystem::exists(dead_temp)) << dead_temp;
+  ASSERT_TRUE(std::filesystem::exists(live_temp)) << live_temp;
+  EXPECT_EQ(std::filesystem::file_size(dead_temp), 1u << 16) << "a killed write leaves it full-size";
+
+  // The dead writer's suffix on another file, and under another scope (another host's).
+  const std::string suffix = dead_temp.filename().string().substr(path.filename().string().size());
+  const auto other_file = dir / ("other.hlod" + suffix);
+  std::string foreign = suffix;
+  foreign[1] = foreign[1] == '0' ? '1' : '0';
+  const auto other_scope = dir / ("entry.hlod" + foreign);
+  lod::test::write_text(other_file, "x");
+  lod::test::write_text(other_scope, "x");
+
+  ASSERT_TRUE(lod::write_file_atomic(path, std::string("fresh")));
+  EXPECT_FALSE(std::filesystem::exists(dead_temp)) << "the dead writer's temporary is removed";
+  EXPECT_TRUE(std::filesystem::exists(live_temp)) << "a live writer's is not";
+  EXPECT_TRUE(std::filesystem::exists(other_file)) << "another file's is not";
+  EXPECT_TRUE(std::filesystem::exists(other_scope)) << "another scope's is not";
+  EXPECT_EQ(read_text(path), "fresh");
+
+  close(live_hold);  // the live writer ends without renaming its temporary
+  ASSERT_EQ(waitpid(live, &status, 0), live);
+  std::filesystem::path temp;
+  ASSERT_TRUE(lod::create_sized_temporary(path, 16, temp));  // the other way of writing
+  EXPECT_FALSE(std::filesystem::exists(live_temp)) << "removed once its writer is gone";
+  ASSERT_TRUE(lod::commit_temporary(temp, path));
+  EXPECT_EQ(lod::remove_dead_temporaries(dir, "entry.hlod"), 0u);
+  EXPECT_EQ(leftover_temporaries(dir), 2u) << "the other file's and the other scope's";
 }

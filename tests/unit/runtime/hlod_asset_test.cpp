@@ -345,6 +345,40 @@ TEST(HlodAsset, ReadsTheTreeThenOneNodeAtATime) {
   expect_same(s, again, q);
 }
 
+// A payload overwritten with 0xff behind an intact head: the head still opens, and reading that
+// node (and only it) fails naming the file, the node and the checksum.
+TEST(HlodAsset, ADamagedPayloadNamesTheFileTheNodeAndTheChecksum) {
+  const Sample s = sample();
+  const auto dir = test::temp_dir("hlod_asset_damaged");
+  const auto file = dir / "bunny.hlod";
+  ASSERT_TRUE(write_hlod_asset(file, s.tree, s.payloads));
+  HlodTree t;
+  ASSERT_TRUE(read_hlod_tree(file, t));
+  const uint32_t bad = uint32_t(t.nodes.size() - 1);
+  std::vector<uint8_t> bytes = test::read_bytes(file);
+  std::fill_n(bytes.begin() + std::ptrdiff_t(t.nodes[bad].payload_offset), 16, uint8_t(0xff));
+  test::write_bytes(file, bytes);
+
+  HlodFile f;
+  HlodTree again;
+  ASSERT_TRUE(f.open(file, again)) << "the head is intact";
+  for (uint32_t i = 0; i < again.nodes.size(); ++i) {
+    HlodPayload p;
+    const Status st = f.read_node(i, again.nodes[i], p);
+    if (i != bad) {
+      EXPECT_TRUE(st) << st.message;
+      continue;
+    }
+    ASSERT_FALSE(st);
+    EXPECT_EQ(st.message.rfind(file.string() + ": node " + std::to_string(bad) + ": payload checksum mismatch", 0), 0u)
+        << st.message;
+  }
+  HlodPayload p;
+  const Status alone = read_hlod_node(file, bad, t.nodes[bad], p);
+  EXPECT_NE(alone.message.find(": node " + std::to_string(bad) + ": payload checksum mismatch"), std::string::npos)
+      << alone.message;
+}
+
 TEST(HlodAsset, RefusesTruncationAtEveryLength) {
   for (const Sample& s : samples()) {
   const std::vector<uint8_t> bytes = encode_hlod_asset(s.tree, s.payloads);
