@@ -1,4 +1,4 @@
-// glTF import speed (issue 12 figure: import of a 1M-triangle GLB <= 1.2x the time tinygltf
+// glTF import speed (target: import of a 1M-triangle GLB <= 1.2x the time tinygltf
 // alone takes to parse it). The GLB is made here with the project's writer: a torus of
 // 1,001,112 triangles and 501,972 vertices with POSITION, NORMAL and TEXCOORD_0 (float) and
 // u32 indices, 28 MB.

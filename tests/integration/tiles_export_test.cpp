@@ -1,4 +1,4 @@
-// `lod export --3dtiles DIR FILE.hlod` end to end (issue 12): the tileset passes the 3D Tiles 1.1
+// `lod export --3dtiles DIR FILE.hlod` end to end: the tileset passes the 3D Tiles 1.1
 // JSON schemas (ajv, when ../shared holds them) and the structural checks of
 // validate_3dtiles.js, every GLB the Khronos validator with 0 errors; tiles follow the tree and
 // its measured errors; a non-empty folder is refused (or, with --force, only an earlier export

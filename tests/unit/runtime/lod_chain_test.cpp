@@ -14,7 +14,7 @@ namespace lod {
 namespace {
 
 TEST(LevelOfTriangles, RoundsLog2ToNearestAsR0) {
-  EXPECT_EQ(level_of_triangles(5000), 12);  // R0's examples
+  EXPECT_EQ(level_of_triangles(5000), 12);  // Yu, Liang and Chen's examples
   EXPECT_EQ(level_of_triangles(2000), 11);
   EXPECT_EQ(level_of_triangles(0), 0);
   EXPECT_EQ(level_of_triangles(1), 0);
