@@ -11,7 +11,7 @@
 //                 The last `multi_exact_tail` of the excess over M is lowered with slack 1:
 //                 those steps decide who ends just above or below a level (measured: 5 % keeps
 //                 a cold start under 1/4 of greedy's pops and most of the benefit lost without
-//                 it, README "Selectors").
+//                 it, docs/performance.md).
 //   benefit_cost  Funkhouser-Sequin's benefit/cost greedy (Luebke) with the best-single-object check
 //                 (runtime/benefit_cost_selection.h): raises from the coarsest levels instead of
 //                 lowering from the initial ones, >= 1/2 of the optimal benefit guaranteed. It

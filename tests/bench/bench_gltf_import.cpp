@@ -8,7 +8,7 @@
 //   BM_LodImport       lod::load_gltf: that parse plus every check and the flattening into
 //                      MeshData (positions, normals, uvs, indices, submeshes)
 //   BM_ImportOverParse both in turn, each iteration; counter `cpu_ratio` = ours / tinygltf's
-//                      in thread CPU time, the figure the README quotes (a shared machine's
+//                      in thread CPU time, the figure to quote (a shared machine's
 //                      wall time is noisy; CPU time of one thread is not)
 #include <benchmark/benchmark.h>
 

@@ -464,7 +464,7 @@ TEST(Tiles3dExport, ColouredModelWritesColor0AndTexcoord1InEveryTile) {
 }
 
 // ../shared's spot with its texture (a .mtl naming it) as an HLOD and a tileset: the figures
-// README quotes, and every GLB valid with the texture embedded.
+// docs/performance.md can quote, and every GLB valid with the texture embedded.
 TEST(Tiles3dExport, SpotHlodExportsWithItsTexture) {
   LOD_REQUIRE_SHARED_MESH(spot, "spot.obj");
   const fs::path dir = lod::test::temp_dir("tiles3d-spot");
