@@ -1,4 +1,4 @@
-// lod bake --hlod --distributed: the spelling issue 16 gives for the MPI bake,
+// lod bake --hlod --distributed: the `lod bake` spelling of the MPI bake,
 //   mpirun -np N lod bake MESH... -o DIR --hlod --distributed [--cache C] [--subtrees S] ...
 // Each rank becomes lod-bake-mpi (the executable beside this one) by exec: same pid, so mpirun's
 // rank is the same process and MPI_Init happens there; `lod` itself never links MPI.

@@ -1,4 +1,4 @@
-// lod bake --hlod: one .hlod file per mesh (R1's model HLOD), with progress on stderr.
+// lod bake --hlod: one .hlod file per mesh (Zhou and Tian's model HLOD), with progress on stderr.
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>

@@ -46,7 +46,7 @@ struct BakeArgs {
   bool measure = false;
   bool json = false;
   bool quiet = false;  // nothing but errors (no progress, no table)
-  bool hlod = false;   // write DIR/<name>.hlod (R1's model HLOD) instead of .lod chains
+  bool hlod = false;   // write DIR/<name>.hlod (Zhou and Tian's model HLOD) instead of .lod chains
   int64_t min_verts = 1000;
   // --hlod --distributed: the bake over MPI ranks (lod-bake-mpi); the options only it takes.
   bool distributed = false;

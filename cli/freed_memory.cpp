@@ -1,6 +1,5 @@
 // On the 13.9M-triangle HLOD bake (1 thread per rank) the busiest rank's kernel CPU fell from
-// 1.5-2.9 s to 0.65-1.8 s at 2 ranks, and from 2.2-2.9 s to 0.55-1.3 s at 1, peak RSS no higher
-// (docs/distributed-bake-measurements.md, "Stop 35").
+// 1.5-2.9 s to 0.65-1.8 s at 2 ranks, and from 2.2-2.9 s to 0.55-1.3 s at 1, peak RSS no higher.
 #include "cli/freed_memory.h"
 
 #include <climits>

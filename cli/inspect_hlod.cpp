@@ -30,7 +30,7 @@ nlohmann::json node_json(const HlodTree& tree, size_t i) {
           {"boundary_triangles", n.boundary_triangles}, {"layers", layers}, {"material_runs", n.material_runs}};
 }
 
-// The header's materials (R1: the HLOD file's header holds them), texture URIs as stored.
+// The header's materials (Zhou and Tian: the HLOD file's header holds them), texture URIs as stored.
 nlohmann::json materials_json(const HlodTree& tree) {
   nlohmann::json out = nlohmann::json::array();
   for (const ChainMaterial& m : tree.materials) {

@@ -102,7 +102,7 @@ std::string summary_text(const RunSummary& s);
 
 Status write_json(const std::filesystem::path& file, const std::vector<FrameRecord>& records,
                   const RunSummary& summary);
-// frames.csv, summary.json, graph.dot and the plots: triangles.svg (R0's Fig. 4: in view,
+// frames.csv, summary.json, graph.dot and the plots: triangles.svg (Yu, Liang and Chen's Fig. 4: in view,
 // selected, budget; log scale), drawn.svg (drawn with blends vs M, linear), levels.svg
 // (objects per chain level), level_changes.svg, pixel_error.svg (worst and mean error left)
 // and stage_ms.svg (per-stage milliseconds).

@@ -104,7 +104,7 @@ RankReport decode_report(const std::vector<uint8_t>& b, int rank) {
   return r;
 }
 
-// Measured on the 13.9M-triangle scan, one thread, 2 and 4 ranks on this VM: the node's load
+// Measured on the 13.9M-triangle scan, one thread, 2 and 4 ranks on a 2-core VM: the node's load
 // (parse, clean, the copy into shared memory: fresh pages cost most of it) cost its first rank
 // 0.6-2.2 s more CPU than the others' view of it, against 33 s for the whole bake: 2-7 % of a
 // bake's cost per triangle; 3.5 % is their middle.

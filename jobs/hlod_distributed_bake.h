@@ -1,4 +1,4 @@
-// The HLOD bake spread over ranks (issue 16), one call per rank (an MPI process, say):
+// The HLOD bake spread over ranks, one call per rank (an MPI process, say):
 //
 //   every rank   sees the probe files rank 0 made in the cache and output folders, or the job
 //                stops before any work (check_shared_folders)

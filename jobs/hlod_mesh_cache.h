@@ -1,5 +1,5 @@
 // The mesh as an HLOD build takes it (loaded and cleaned), kept in the distributed bake's cache
-// beside the subtrees under the source's content hash (issue 16): a rerun, and every rank of
+// beside the subtrees under the source's content hash: a rerun, and every rank of
 // it, reads a few arrays instead of parsing and cleaning the file again. Written like a subtree
 // entry (temporary, read back, rename); read as hostile input (sizes, checksum, key, indices).
 #pragma once

@@ -1,4 +1,4 @@
-// Content-addressed cache of whole baked models (issue 16: a scene of many models split over
+// Content-addressed cache of whole baked models (a scene of many models split over
 // ranks), beside the subtree entries on storage every rank sees: DIR/<key, 16 hex digits>.hlod,
 // the model's .hlod exactly as `lod bake --hlod` writes it. An entry appears under its name only
 // complete and verified (the bake's finished file read back and decoded in full, then renamed),

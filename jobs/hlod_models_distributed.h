@@ -1,4 +1,4 @@
-// A scene of many models baked over ranks (issue 16), one call per rank: every model's
+// A scene of many models baked over ranks, one call per rank: every model's
 // DIR/<stem>.hlod, byte-identical to `lod bake --hlod` of its file.
 //
 //   rank 0       estimate every model's triangles from its file's header -> broadcast

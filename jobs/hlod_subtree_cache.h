@@ -1,4 +1,4 @@
-// Content-addressed cache of baked HLOD subtrees (issue 16), a folder on storage every rank
+// Content-addressed cache of baked HLOD subtrees, a folder on storage every rank
 // sees: DIR/<key, 16 hex digits>.hsub, one file per subtree, in runtime/hlod_subtree_entry's
 // format. An entry appears under its name only complete and verified (written to a temporary
 // file, read back and decoded, then renamed), so a rank killed mid-write leaves at worst a

@@ -251,7 +251,7 @@ void read_lod(const Reader& r, const toml::table& root, SceneConfig& c) {
 
 // [visibility] occlusion = true: cull what large nearby objects hide (view 0); occluders =
 // how many objects are rasterised as occluders per frame; occlusion_method = "raster" (default,
-// the faster: README "Occlusion culling") or "embree" (rays through every buffer sample).
+// the faster: docs/performance.md, "Culling") or "embree" (rays through every buffer sample).
 void read_visibility(const Reader& r, const toml::table& root, SceneConfig& c) {
   const toml::table* t = r.table(root, "visibility", "visibility");
   if (!t) return;

@@ -26,10 +26,10 @@ struct ModelConfig {
   // vd_parts = N: the hierarchy is cut into N spatial parts (seams kept at full detail) whose
   // fronts update on separate threads; 1 = one front per object.
   uint32_t vd_parts = 1;
-  // hlod = true: baked to a .hlod (R1's octree of layered nodes) and drawn through its tree,
+  // hlod = true: baked to a .hlod (Zhou and Tian's octree of layered nodes) and drawn through its tree,
   // streamed under [stream]; its [[instances]] block places exactly one object.
   bool hlod = false;
-  uint32_t min_verts = 1000;    // min_verts: the HLOD build's leaf size (R1 Table I)
+  uint32_t min_verts = 1000;    // min_verts: the HLOD build's leaf size (Zhou and Tian, Table I)
 };
 
 // [stream]: the HLOD node pager (jobs/stream_pager.h).
@@ -41,7 +41,7 @@ struct StreamConfig {
 // [scene_hlod]: merged proxies over the static instances (preprocess/scene_hlod_build.h).
 struct SceneHlodConfig {
   bool enabled = false;         // enabled
-  uint32_t min_objects = 2;     // min_objects: a cell with fewer is not split (R1: 2)
+  uint32_t min_objects = 2;     // min_objects: a cell with fewer is not split (Zhou and Tian: 2)
   float reduction = 0.5f;       // reduction: a proxy keeps this fraction of its inputs' triangles
 };
 
@@ -57,7 +57,7 @@ struct InstanceConfig {
   bool on_terrain = false;     // on_terrain = true: y = the [[terrain]]'s height at (x, z) + the box's y (static blocks)
 };
 
-// [[terrain]] (at most one): a height field drawn by ROAM within the same budget (issue 15).
+// [[terrain]] (at most one): a height field drawn by ROAM within the same budget.
 struct TerrainConfig {
   std::filesystem::path file;  // file: "x y z" text, PNG or a GDAL raster (preprocess/height_field_read.h), found like meshes
   GridCoordinates coordinates = GridCoordinates::metres;  // coordinates = "metres" | "lon_lat" | "lat_lon" (text; rasters carry theirs)

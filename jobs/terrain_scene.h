@@ -1,5 +1,5 @@
 // The scene's [[terrain]] made drawable: its height field read, resampled onto ROAM's grid and
-// placed in the world (issue 15).
+// placed in the world.
 #pragma once
 #include <memory>
 

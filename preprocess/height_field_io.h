@@ -1,4 +1,4 @@
-// Height field text input: plain "x y z" samples, one a line, on a regular grid (issue 15).
+// Height field text input: plain "x y z" samples, one a line, on a regular grid.
 //
 // Any sample order; blank lines and lines starting with '#' are skipped. The grid is detected:
 // the distinct x and the distinct y values must each be evenly spaced (within 1 % of the step)

@@ -1,4 +1,4 @@
-// Height fields from 8- and 16-bit PNG heightmaps, decoded by stb_image (issue 15).
+// Height fields from 8- and 16-bit PNG heightmaps, decoded by stb_image.
 //
 // Grey (or grey + alpha) PNGs only: the sample value (0-255 or 0-65535) is the elevation,
 // multiplied by vertical_scale; cells are 1 m unless the scene's cell_size says otherwise. An

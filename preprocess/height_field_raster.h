@@ -1,4 +1,4 @@
-// Height fields from GDAL rasters (issue 15): GeoTIFF, SRTM .hgt, ESRI ASCII grid (.asc) and
+// Height fields from GDAL rasters: GeoTIFF, SRTM .hgt, ESRI ASCII grid (.asc) and
 // every other raster format the installed GDAL reads. GDAL's headers stay in the .cpp.
 //
 // Band 1 is the elevation, read as 32-bit floats and multiplied by vertical_scale. No-data: the

@@ -1,4 +1,4 @@
-// One entry for every elevation file (issue 15), picked by extension: ".txt", ".xyz" and ".gz"
+// One entry for every elevation file, picked by extension: ".txt", ".xyz" and ".gz"
 // -> "x y z" text (height_field_io.h), ".png" -> stb (height_field_png.h), anything else ->
 // GDAL (height_field_raster.h: GeoTIFF, SRTM .hgt, ESRI ASCII .asc, ...). Case-insensitive.
 #pragma once

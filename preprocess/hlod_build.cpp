@@ -1,4 +1,4 @@
-// Model HLOD build (R1 3.1) in three steps (issue 16), each node computed the same whichever
+// Model HLOD build (Zhou and Tian 3.1) in three steps, each node computed the same whichever
 // step it falls in:
 //
 //   (a) plan: the root's cell, then the top of the octree split down to the frontier

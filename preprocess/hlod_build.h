@@ -1,4 +1,4 @@
-// Model HLOD (R1 3.1, Zhou & Tian): an octree over one mesh, built bottom-up into layers.
+// Model HLOD (precomputed HLOD, Zhou and Tian 3.1): an octree over one mesh, built bottom-up into layers.
 //
 //   subdivide:  a cubic cell holding more than min_verts vertices splits into octants; a
 //               triangle whose vertices fall in different octants joins the cell's boundary
@@ -20,7 +20,7 @@
 // Nothing here owns threads: independent subtrees run through options.parallel_for, and the
 // result is byte-identical whatever it does (in parallel, serially, or absent).
 //
-// Split (issue 16): every build is the same three steps, so that a distributed build is the
+// Split: every build is the same three steps, so that a distributed build is the
 // local one by construction: (a) plan: the top of the octree split down to a frontier of
 // subtrees, (b) bake_subtrees: each subtree on its own (whoever bakes it), (c) assemble: the
 // levels above, built from the subtrees' roots, and the breadth-first splice. Each node's
@@ -61,7 +61,7 @@ struct HlodSurfaces {
 };
 
 struct HlodBuildOptions {
-  uint32_t min_verts = 1000;  // a cell with more vertices splits (R1 Table I: 500-1000)
+  uint32_t min_verts = 1000;  // a cell with more vertices splits (Zhou and Tian, Table I: 500-1000)
   // A layer stops above its half rather than make a collapse whose QEM error exceeds this
   // fraction of the node's cell edge: errors then grow with cell size, as the octree's
   // selection expects. 0 = always halve.
@@ -188,7 +188,7 @@ class HlodBuilder {
                         std::vector<float>& errors);
   Status finish_top(const std::vector<HlodSubtree>& baked, const std::vector<float>& errors, HlodAssembly& out,
                     HlodBuildReport* report = nullptr);
-  // How the original is queried (issue 16): each subtree's layers against a BVH of the part of
+  // How the original is queried: each subtree's layers against a BVH of the part of
   // the original near its cell (bake_subtrees), kept for the top's samples in that cell; the
   // top's other samples against a part built near them; and a query a part cannot answer
   // exactly as the whole original would (the nearest found is not provably the nearest)

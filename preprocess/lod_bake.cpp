@@ -1,5 +1,5 @@
 // Baking one model: load -> clean -> simplify to every ratio -> measure each level against
-// level 0 -> fill the LodChain. Levels per R0: l = round(log2 triangles); ratios per R0 by
+// level 0 -> fill the LodChain. Levels as Yu, Liang and Chen: l = round(log2 triangles); their ratios by
 // model size unless the config gives them.
 #include "preprocess/lod_bake.h"
 
@@ -29,7 +29,7 @@ namespace {
 constexpr uint32_t kBakeFormatVersion = 11;  // 11: level 0 keeps authored normals (NRML flag), the vertex hierarchy TEXCOORD_1, colours and those normals (VHAT layout 2); 10: textures embedded in a GLB or data URI kept (IMGS); 9: vertex colours (COL0) and TEXCOORD_1 (TEX1) through the levels, texCoord per texture (MATL layout 2); 8: normal, occlusion, emissive and metallic-roughness textures (MATL layout 1); 7: materials per level (MATL), material boundaries as seams, uv error in QEM's cost; 6: texture coordinates through the levels (TEX0); 5: morph targets repaired in pairs; 4: morph targets (MRPH);
                                              // 3: surface error samples in mesh order
 
-// Up to these sizes a model gets the reference's cow / bunny ratios (R0).
+// Up to these sizes a model gets the reference's cow / bunny ratios (Yu, Liang and Chen).
 constexpr size_t kSmallModelTriangles = 20000;
 constexpr size_t kMediumModelTriangles = 200000;
 

@@ -45,7 +45,7 @@ struct BakeReport {
   std::vector<std::string> notes;  // e.g. a level that stopped above its target, and why
 };
 
-// The reference's ratios (R0) by size: cow-sized 100/50/25/12/6 %, bunny-sized
+// The reference's ratios (Yu, Liang and Chen) by size: cow-sized 100/50/25/12/6 %, bunny-sized
 // 100/50/25/12/6/3 %, armadillo/buddha-sized 100/25/12/6/3/1.5/0.75/0.37/0.18 %.
 std::vector<float> default_ratios(size_t triangles);
 

@@ -1,4 +1,4 @@
-// Scene HLOD build (R1 3.2): an octree over a scene's static objects (a cell with fewer than
+// Scene HLOD build (Zhou and Tian 3.2): an octree over a scene's static objects (a cell with fewer than
 // `min_objects` objects is not split further and is not a node), then, bottom-up, every node's
 // proxy: its child nodes' proxies and its single objects' coarsest drawn levels, placed in
 // world space and merged without boundaries (the objects are separate surfaces), simplified
@@ -31,7 +31,7 @@ struct SceneHlodObjectsIn {
 };
 
 struct SceneHlodSettings {
-  uint32_t min_objects = 2;   // R1: stop when a cell holds fewer than 2 models
+  uint32_t min_objects = 2;   // Zhou and Tian: stop when a cell holds fewer than 2 models
   float reduction = 0.5f;     // a proxy keeps this fraction of its inputs' triangles ...
   // ... unless a collapse would move the surface more than this fraction of the node's bounding
   // radius (QEM's max_error): a proxy of a small group stays close to its objects, one of a

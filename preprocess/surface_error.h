@@ -1,5 +1,5 @@
 // Object-space distance between two triangle surfaces: an approximation of the symmetric
-// Hausdorff distance H(A,B) = max(h(A,B), h(B,A)), h(A,B) = max_a min_b |a - b| (R3),
+// Hausdorff distance H(A,B) = max(h(A,B), h(B,A)), h(A,B) = max_a min_b |a - b|,
 // measured at every vertex plus dense area-weighted surface samples of each mesh, with
 // closest-point queries (Embree; no Embree type appears here).
 #pragma once

@@ -1,6 +1,6 @@
 // Vertex hierarchy builder: passes of independent legal edge collapses on flat arrays.
 //
-// R4 (Berkey & Song, "Dynamic view-dependent LOD"): merge tree, region-of-influence marking,
+// Berkey and Song, "Dynamic View Dependent Level of Detail": merge tree, region-of-influence marking,
 // dependencies = neighbours at collapse time, tv1/tv2 wings. Hoppe 1997 ("View-dependent
 // refinement of progressive meshes"): normal cones, bounding spheres, error per node.
 // Garland & Heckbert 1997: quadrics. Each pass: vertex->face lists from the current faces,

@@ -1,12 +1,12 @@
 // Vertex hierarchy builder for view-dependent LOD.
 //
-// R4 (Berkey & Song): a merge forest from repeated legal edge collapses, each pass collapsing
+// Berkey and Song: a merge forest from repeated legal edge collapses, each pass collapsing
 // an independent set (the region of influence of every collapse, both endpoints' one-rings,
 // is marked until the pass ends) so the forest stays balanced, O(log n) deep. Edges are taken
-// in quadric order (Garland & Heckbert 1997) or, as R4, shortest first. The legality test
+// in quadric order (Garland & Heckbert 1997) or, as Berkey and Song do, shortest first. The legality test
 // (link condition, Dey et al. 1999; no pinch of two borders through an interior edge; no
 // fold-over; wings keep a proper fan) keeps every intermediate mesh a manifold, so a front of
-// the forest with El-Sana & Varshney's dependencies is one too. Unlike R4's own build, open
+// the forest with El-Sana & Varshney's dependencies is one too. Unlike Berkey and Song's own build, open
 // meshes (border planes hold the outline) and several components work; a component is never
 // collapsed below one triangle. Non-manifold vertices are kept as they are (never collapsed).
 #pragma once
@@ -21,7 +21,7 @@ namespace lod {
 
 enum class CollapseOrder : uint8_t {
   quadric,   // QEM cost, optimal placement (fallbacks: endpoints, midpoint)
-  shortest,  // R4: shortest edge first, parent at the midpoint
+  shortest,  // Berkey and Song: shortest edge first, parent at the midpoint
 };
 
 struct HierarchyOptions {

@@ -1,4 +1,4 @@
-// Funkhouser-Sequin's benefit/cost greedy (R2) as a selector (Selector::benefit_cost): from
+// Funkhouser-Sequin's benefit/cost greedy (Luebke's survey) as a selector (Selector::benefit_cost): from
 // every visible object at its coarsest level, repeatedly raise the object whose next step
 // has the most benefit per unit of extra cost, while the budget allows; then compare with the
 // best single object raised alone (the check that guarantees >= 1/2 of the optimum).

@@ -1,6 +1,6 @@
 // Chunked LOD (T. Ulrich, "Rendering Massive Terrains using Chunked Level of Detail Control",
 // SIGGRAPH 2002 course notes): a quadtree of fixed-size patches over the same grid ROAM uses,
-// the baseline issue 15's benchmark compares ROAM with.
+// the baseline the ROAM benchmark compares with.
 //
 // Every node is a (patch + 1)-square regular patch sampling the grid at its node's step (the
 // root the whole grid at the coarsest step, each level halving the step over a quarter of the

@@ -31,7 +31,7 @@ Status write_file_atomic(const std::filesystem::path& path, std::span<const std:
 Status write_new_file_checked(const std::filesystem::path& file, std::span<const uint8_t> bytes,
                               const std::string& what, bool direct = true);
 
-// A file written in pieces, possibly by several processes at once (issue 16: every rank writes
+// A file written in pieces, possibly by several processes at once (every rank writes
 // its own subtrees' payloads into the .hlod): create_sized_temporary makes a temporary of its
 // own beside `path` at the full size; write_pieces opens it by name, writes each piece at its
 // offset (processes on one host taking turns, runtime/host_turn.h) and flushes its own ranges

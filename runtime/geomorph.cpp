@@ -1,4 +1,4 @@
-// Geomorphing: linear blends of positions over time (R3's v(t) = (1 - t) v_i + t v_f).
+// Geomorphing: linear blends of positions over time (v(t) = (1 - t) v_i + t v_f).
 #include "runtime/geomorph.h"
 
 #include <algorithm>

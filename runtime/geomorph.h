@@ -1,4 +1,4 @@
-// Geomorphing (R3; Hoppe 1996/1997): a change of detail blends vertex positions over time,
+// Geomorphing (Hoppe 1996/1997): a change of detail blends vertex positions over time,
 // v(t) = (1 - t) v_i + t v_f, instead of jumping, so no split, collapse or level change pops.
 //
 // View-dependent objects: VertexMorph keeps per hierarchy node where its displayed position

@@ -1,4 +1,4 @@
-// HeightField: elevations on a regular grid of samples, the input of terrain LOD (issue 15).
+// HeightField: elevations on a regular grid of samples, the input of terrain LOD.
 // Row-major: sample (x, y) is heights[y * width + x]; world position of a sample is
 // (x * cell_size_x, heights * vertical_scale, y * cell_size_y), +Y up. Cells need not be square
 // (a geographic grid converted to metres has shorter longitude cells away from the equator).

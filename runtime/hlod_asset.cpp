@@ -31,7 +31,7 @@
 // its version word) and is read as such. Version 1 (positions and normals only, no materials) is
 // refused with a message to rebake.
 // The tree's structure (parents, child ranges, depths, cells) is not stored: it follows from
-// the bits and the root cube, as R1 rebuilds its octree from OctreeCode and NodeDescription.
+// the bits and the root cube, as Zhou and Tian rebuild their octree from OctreeCode and NodeDescription.
 #include "runtime/hlod_asset.h"
 
 #include <fcntl.h>
@@ -183,7 +183,7 @@ bool get_record(const uint8_t* p, uint32_t flags, HlodNode& n, std::string& why)
   return true;
 }
 
-// Parents, child ranges, depths and cells from the bits, breadth-first (R1's rebuild).
+// Parents, child ranges, depths and cells from the bits, breadth-first (Zhou and Tian's rebuild).
 bool rebuild_structure(const uint8_t* code, uint32_t inner, const uint8_t* description, HlodTree& t, std::string& why) {
   const uint32_t count = uint32_t(t.nodes.size());
   HlodNode& root = t.nodes[0];

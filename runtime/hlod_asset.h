@@ -1,4 +1,4 @@
-// The .hlod file (R1 Fig. 6): a header, the octree as breadth-first OctreeCode and
+// The .hlod file (Zhou and Tian, Fig. 6): a header, the octree as breadth-first OctreeCode and
 // NodeDescription bits, per-node metadata and a per-node offset table (all checksummed
 // together: the "head"), then each node's payload with a checksum of its own, so that one
 // node can be read and verified without reading the rest.
@@ -30,7 +30,7 @@ std::vector<uint8_t> encode_hlod_asset(const HlodTree& tree, std::span<const Hlo
 // not built in pieces and copied together); returns how many were appended.
 uint64_t append_hlod_asset(const HlodTree& tree, std::span<const HlodPayload> payloads, std::vector<uint8_t>& out);
 
-// The same in pieces, for a writer that places each payload itself (issue 16: every rank
+// The same in pieces, for a writer that places each payload itself (every rank
 // writes its own subtrees' payloads): the head, whose offset table lays the payloads out back to
 // back in node order with these sizes, and one node's payload (its data, then its checksum).
 std::vector<uint8_t> encode_hlod_head(const HlodTree& tree, std::span<const uint64_t> payload_sizes);

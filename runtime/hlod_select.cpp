@@ -1,6 +1,6 @@
-// HLOD cut selection (R1 3.3): one breadth-first visit of the wanted cut, one pass deciding
+// HLOD cut selection (Zhou and Tian 3.3): one breadth-first visit of the wanted cut, one pass deciding
 // which wanted openings the children's residency allows, one top-down pass emitting the cut,
-// then, over the budget, R0-style undoing (a min-heap of screen-space errors) or the same
+// then, over the budget, undoing as budgeted selection does (a min-heap of screen-space errors) or the same
 // steps refining from the root (a max-heap).
 #include "runtime/hlod_select.h"
 

@@ -1,7 +1,7 @@
-// HLOD cut selection (R1 3.3) with residency ("never a hole", as Cesium's tile selection) and
-// a triangle budget (R0's "undo the least important refinement first").
+// HLOD cut selection (Zhou and Tian 3.3) with residency ("never a hole", as Cesium's tile selection) and
+// a triangle budget (Yu, Liang and Chen's "undo the least important refinement first").
 //
-// The error test, fixed once. R1: a layer of object-space error e is drawn when
+// The error test, fixed once. Zhou and Tian: a layer of object-space error e is drawn when
 //   e <= E = d * (P / N) * tan(theta)
 // with N pixels spanning the angle theta. Here both are taken on the vertical axis from the
 // view centre to its edge: theta = fovy / 2 and N = H / 2, so N / tan(theta) is

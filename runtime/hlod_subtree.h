@@ -1,4 +1,4 @@
-// HlodSubtree: one baked subtree of a model HLOD (issue 16), the unit a build is split into.
+// HlodSubtree: one baked subtree of a model HLOD, the unit a build is split into.
 //
 // A build is (a) the top of the octree down to a frontier, (b) one independent bake per
 // frontier node (this struct), (c) the levels above, built from each subtree's root: its

@@ -1,4 +1,4 @@
-// One baked HLOD subtree as bytes: the entry format of the distributed bake's cache (issue 16).
+// One baked HLOD subtree as bytes: the entry format of the distributed bake's cache.
 // An entry is hostile input like any file: every count is checked against the size before
 // anything is allocated, every index against what it indexes, every byte against a checksum,
 // and the key it was written under against the one asked for. A refused entry leaves the
@@ -25,7 +25,7 @@ std::vector<uint8_t> encode_hlod_subtree(const HlodSubtree& subtree, uint64_t ke
 Status decode_hlod_subtree(std::span<const uint8_t> bytes, uint64_t key, uint64_t mesh_vertices,
                            const std::string& what, HlodSubtree& out);
 
-// The root alone, from an entry's first bytes (issue 16: the levels above need only the
+// The root alone, from an entry's first bytes (the levels above need only the
 // subtrees' roots, so the rank that assembles them reads a few percent of each entry):
 // `prefix` starts the entry of `entry_size` bytes and must hold hlod_subtree_entry_root_bytes
 // of it. `out` gets every node's record, payloads[0] (the root's) and the root's sources and

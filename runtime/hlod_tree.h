@@ -1,4 +1,4 @@
-// HlodTree: one model's hierarchical LOD (R1 3.1): an octree whose every node holds a few
+// HlodTree: one model's hierarchical LOD (Zhou and Tian 3.1): an octree whose every node holds a few
 // layers of its own geometry, finest first, and the boundary patch that joins its children.
 //
 // The tree (this struct) is small and always resident; the nodes' geometry (HlodPayload) is
@@ -21,7 +21,7 @@
 
 namespace lod {
 
-inline constexpr uint32_t kHlodMaxLayers = 3;   // R1: the geometry, then two coarser layers
+inline constexpr uint32_t kHlodMaxLayers = 3;   // Zhou and Tian: the geometry, then two coarser layers
 inline constexpr uint32_t kHlodMaxDepth = 24;
 
 struct HlodLayerInfo {
@@ -99,11 +99,11 @@ inline std::span<const LevelSubmesh> hlod_range_runs(const HlodPayload& p, uint3
 struct HlodTree {
   std::string name;
   uint64_t source_hash = 0;
-  uint32_t min_verts = 1000;             // the build's leaf size (R1 Table I)
+  uint32_t min_verts = 1000;             // the build's leaf size (Zhou and Tian, Table I)
   float box_center[3] = {0, 0, 0};       // the root cell
   float box_half = 0;
   uint64_t source_triangles = 0;         // of the original mesh
-  // Materials (R1's header has them): run material ids are below material_count. `materials`
+  // Materials (Zhou and Tian's header has them): run material ids are below material_count. `materials`
   // holds them (texture URIs relative to texture_base, the source's folder, as a .lod's) or is
   // empty where only the count travels (a subtree entry of the distributed bake).
   uint32_t material_count = 0;

@@ -1,4 +1,4 @@
-// Processes on one host that write into one file take turns (issue 16: every rank writes its
+// Processes on one host that write into one file take turns (every rank writes its
 // payloads into the shared .hlod). The kernel serialises buffered writes into one file anyway
 // (its inode lock), and a writer waiting for that lock spins on its core: at 2 ranks a third of
 // each rank's write phase went to spinning. A turn is an flock on a lock file in this host's

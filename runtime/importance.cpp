@@ -1,4 +1,4 @@
-// Importance (R0, eqs. 4-6): relative distance d = D_nearest / D_current and relative
+// Importance (Yu, Liang and Chen, eqs. 4-6): relative distance d = D_nearest / D_current and relative
 // projected area S = PA_current / PA_smallest over the visible set. f = d * SLC / S is split
 // as weight = d / S (per object, per frame) times the SLC of the step selection considers.
 #include "runtime/importance.h"

@@ -1,4 +1,4 @@
-// Importance (R0): d = D_nearest / D_current, S = PA_current / PA_smallest,
+// Importance (Yu, Liang and Chen): d = D_nearest / D_current, S = PA_current / PA_smallest,
 // SLC(i -> j) = max(l_i, l_j) * |l_i - l_j|, f = d * SLC / S.
 // Split into a measuring pass (parallel, sub-range safe, returns partial minima) and a
 // weighting pass (parallel) once the global minima are known; selection multiplies the

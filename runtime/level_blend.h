@@ -1,4 +1,4 @@
-// Level blends (R3 geomorphing of discrete levels): the per-object state machine that turns
+// Level blends (geomorphing of discrete levels): the per-object state machine that turns
 // a level change into a blend over `seconds`. Per visible entry k (object ids[k]):
 //   - a change from last frame's level restarts the blend from that level; going back to the
 //     level it was leaving, mid-blend, runs the same blend backwards from where it is;

@@ -1,4 +1,4 @@
-// LodChain facts: R0's level l = round(log2(triangles)) and the structural checks every
+// LodChain facts: Yu, Liang and Chen's level l = round(log2(triangles)) and the structural checks every
 // chain passes before the runtime trusts it (asset decode, bake output).
 #include "runtime/lod_chain.h"
 

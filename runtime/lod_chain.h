@@ -23,7 +23,7 @@ struct LodLevel {
   uint32_t index_count = 0;   // 3 per triangle
   uint32_t first_vertex = 0;  // into LodChain::positions (in vertices); indices are level-local
   uint32_t vertex_count = 0;
-  int32_t level = 0;          // l = round(log2(triangles)), R0's level
+  int32_t level = 0;          // l = round(log2(triangles)), Yu, Liang and Chen's level
   float error = 0;            // measured object-space geometric error vs level 0 (max distance)
   float error_rms = 0;        // measured object-space RMS distance vs level 0
   Sphere bounds;              // object space
@@ -74,7 +74,7 @@ struct LodChain {
   VertexTree hierarchy;
 };
 
-// R0: l = log2(M) rounded to the nearest integer (5,000 triangles -> 12, 2,000 -> 11).
+// Yu, Liang and Chen: l = log2(M) rounded to the nearest integer (5,000 triangles -> 12, 2,000 -> 11).
 // Zero triangles gives level 0.
 int32_t level_of_triangles(uint64_t triangles);
 

@@ -1,4 +1,4 @@
-// ROAM: real-time optimally adapting meshes over a height field (issue 15, R3).
+// ROAM: real-time optimally adapting meshes over a height field (Duchaineau et al. 1997).
 // Duchaineau, Wolinsky, Sigeti, Miller, Aldrich, Mineev-Weinstein, "ROAMing Terrain: Real-time
 // Optimally Adapting Meshes", IEEE Visualization 1997: bintree triangles, split with forced
 // splits of the base neighbour, merge of diamonds, nested world-space error bounds (wedgies),

@@ -1,4 +1,4 @@
-// SceneHlodTree: the scene HLOD (R1 3.2): an octree over a scene's static objects whose every
+// SceneHlodTree: the scene HLOD (Zhou and Tian 3.2): an octree over a scene's static objects whose every
 // cell holding two or more of them carries one merged proxy mesh standing for all of them, so
 // that a distant group of many objects is drawn with one mesh in one draw.
 //

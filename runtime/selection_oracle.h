@@ -1,6 +1,6 @@
 // Selection measured: a benefit per object and level, the exact optimum of the multiple-choice
-// knapsack that selection approximates (R2), and Funkhouser-Sequin's benefit/cost greedy, so
-// that R0's heap can be compared with both on the same scenes.
+// knapsack that selection approximates (Luebke's LOD survey), and Funkhouser-Sequin's benefit/cost greedy, so
+// that Yu, Liang and Chen's heap can be compared with both on the same scenes.
 //
 // Benefit of object i at level k: its projected area A_i (pixels^2) times the screen-space
 // error the level removes against its coarsest level L,

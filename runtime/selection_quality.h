@@ -1,5 +1,5 @@
 // Selection quality per frame: what the selected levels are worth and what error they leave.
-// Benefit as the selection oracle defines it (runtime/selection_oracle.h, R2's Funkhouser-
+// Benefit as the selection oracle defines it (runtime/selection_oracle.h, Funkhouser-
 // Sequin benefit): b_i(k) = A_i * (s_i(L) - s_i(k)), A_i the projected area in pixels^2, s_i(k)
 // = error_k * error_scale_i * focal / distance_i the level's error in pixels, L the model's
 // coarsest level. The pixel error s_i(k) is the screen-space error a viewer sees (a culled

@@ -1,4 +1,4 @@
-// Budgeted selection (R0, Fig. 3): while the visible objects cost more than M, lower the
+// SLC selection (Yu, Liang and Chen, Fig. 3): while the visible objects cost more than M, lower the
 // object of highest importance f = (d / S) * SLC(l_cur -> l_next) by one level.
 // Passes: (1) one branch-free streaming loop counts visible objects per chain level (the
 // costs of the initial and of the coarsest levels follow from those counts) and writes each
@@ -31,7 +31,7 @@ inline uint64_t pow2(int32_t l) { return uint64_t{1} << l; }
 
 // SLC of lowering from chain level `at` to `at + 1`. The culled level (0 triangles, l = 0)
 // counts as one level below the one before it: culling saves about what such a step saves,
-// and R0's l_i^2 span would make the heap cull objects before it lowers finer ones.
+// and Yu, Liang and Chen's l_i^2 span would make the heap cull objects before it lowers finer ones.
 inline float step_slc(const int32_t* ls, const uint32_t* tris, uint32_t at) {
   const int32_t to = tris[at + 1] == 0 ? ls[at] - 1 : ls[at + 1];
   return static_cast<float>(span_of_level_changed(ls[at], to));

@@ -1,9 +1,9 @@
-// Time-critical selection under a budget (R0): while the visible objects cost more than M,
+// SLC (span of level changed) selection, Yu, Liang and Chen: while the visible objects cost more than M,
 // take the object of highest importance f = weight * SLC(l_cur -> l_next) from a max-heap,
 // lower it one level, recompute f for its next step and reinsert it. O(m log m).
 // Two selectors share this interface (SelectionParams::selector):
-//   greedy        R0 as published: one level per heap pop.
-//   greedy_multi  R0's future work ("more exploitatively"): a popped object keeps being lowered
+//   greedy        as Yu, Liang and Chen publish it: one level per heap pop.
+//   greedy_multi  the paper's future work ("more exploitatively"): a popped object keeps being lowered
 //                 while its next step's f is at least `multi_level_slack` times the runner-up's
 //                 f (the best key left in the heap), then goes back once. slack = 1 gives
 //                 exactly greedy's levels with fewer pops; below 1 it trades a little benefit
@@ -11,8 +11,8 @@
 //                 The last `multi_exact_tail` of the excess over M is lowered with slack 1:
 //                 those steps decide who ends just above or below a level (measured: 5 % keeps
 //                 a cold start under 1/4 of greedy's pops and most of the benefit lost without
-//                 it, README "Selectors").
-//   benefit_cost  Funkhouser-Sequin's benefit/cost greedy (R2) with the best-single-object check
+//                 it, docs/performance.md).
+//   benefit_cost  Funkhouser-Sequin's benefit/cost greedy (Luebke) with the best-single-object check
 //                 (runtime/benefit_cost_selection.h): raises from the coarsest levels instead of
 //                 lowering from the initial ones, >= 1/2 of the optimal benefit guaranteed. It
 //                 needs each object's benefit weight (the `benefit_weight` argument).
@@ -31,11 +31,11 @@ namespace lod {
 
 enum class BudgetCount : uint8_t {
   triangles,  // sum of selected triangle counts <= M
-  levels,     // R0: sum of 2^l <= M
+  levels,     // Yu, Liang and Chen: sum of 2^l <= M
 };
 
 enum class Selector : uint8_t {
-  greedy,        // R0: one level per pop
+  greedy,        // Yu, Liang and Chen: one level per pop
   greedy_multi,  // several levels per pop (see above)
   benefit_cost,  // Funkhouser-Sequin from the coarsest levels (see above)
 };

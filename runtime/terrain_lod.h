@@ -1,4 +1,4 @@
-// TerrainLod: the terrain ([[terrain]], issue 15) as one object of the frame's triangle budget M.
+// TerrainLod: the terrain ([[terrain]]) as one object of the frame's triangle budget M.
 //
 // ROAM (runtime/roam.h) refines the terrain for view 0 every frame, capped by the terrain's
 // share of M. The share moves by feedback on what the last frame did, as a view-dependent

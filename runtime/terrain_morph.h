@@ -1,4 +1,4 @@
-// Geomorphing of ROAM splits and merges (issue 15), as view-dependent objects geomorph
+// Geomorphing of ROAM splits and merges, as view-dependent objects geomorph
 // (runtime/geomorph.h): a change of detail moves vertices over `duration` seconds instead of
 // popping.
 //

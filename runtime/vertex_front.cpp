@@ -524,7 +524,7 @@ void Updater::end_pending(uint32_t p) {
   }
 }
 
-// Splits v after splitting whatever its dependencies need (R4's forced splits), depth first
+// Splits v after splitting whatever its dependencies need (Berkey and Song's forced splits), depth first
 // on an explicit stack. Forced splits only go to nodes made later in the build, so it ends.
 bool Updater::force_split(uint32_t v) {
   uint32_t depth = 0;

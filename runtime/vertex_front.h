@@ -2,10 +2,10 @@
 // per-frame refine/coarsen update.
 //
 // Hoppe 1997 ("View-dependent refinement of progressive meshes") for the refinement criteria
-// (frustum, normal cone, screen-space error) and forced splits; R4 (Berkey & Song) and
+// (frustum, normal cone, screen-space error) and forced splits; Berkey and Song and
 // El-Sana & Varshney 1999 for the dependencies that keep every front a valid mesh (a node
 // splits, and a pair merges, only when the neighbours it had at build time are active);
-// R2 (Luebke) for temporal coherence and coherent arrays: active vertices and triangles live
+// Luebke's LOD survey for temporal coherence and coherent arrays: active vertices and triangles live
 // in dense arrays kept packed by swaps, so a consumer draws triangles [0, tri_count).
 //
 // Only changed nodes are visited: each active node is filed in calendars of view-motion

@@ -1,4 +1,4 @@
-// VertexTree: a vertex hierarchy (R4's merge forest, Hoppe 1997's vertex hierarchy) for
+// VertexTree: a vertex hierarchy (Berkey and Song's merge forest, Hoppe 1997's vertex hierarchy) for
 // view-dependent LOD, as flat arrays shared by every instance of a model.
 //
 // Nodes 0..leaf_count-1 are the input vertices (leaves); nodes from leaf_count on are parents
@@ -10,8 +10,8 @@
 // base face) and its corners at any front are the active ancestors of its three leaf corners.
 //
 // Per interior node (index i = node - leaf_count): two children, the one or two faces its split
-// creates with their wing vertices (R4's tv1/tv2), the dependency set (its neighbours when it
-// was made by the collapse; R4, El-Sana & Varshney 1999) and the faces incident to it right
+// creates with their wing vertices (Berkey and Song's tv1/tv2), the dependency set (its neighbours when it
+// was made by the collapse; Berkey and Song; El-Sana & Varshney 1999) and the faces incident to it right
 // after the collapse (a superset of its faces at any front on which it is active). Per node:
 // position, a bounding-sphere radius covering its children's, a normal cone and an error.
 #pragma once

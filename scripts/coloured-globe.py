@@ -3,7 +3,7 @@
 # tests/textured_fixture.h's coloured_sphere as glTF (OUT.gltf + OUT.bin): POSITION, TEXCOORD_0,
 # TEXCOORD_1 (0.25 + u / 2, v / 2), COLOR_0 (north red with green = latitude, south blue at alpha
 # 0.5; the equator doubled, a colour seam), 2 x RINGS x SEGMENTS triangles. "uv" writes
-# TEXCOORD_0 only, "none" positions only. 500 1000 is the README's 1M-triangle coloured globe.
+# TEXCOORD_0 only, "none" positions only. 500 1000 gives a 1M-triangle coloured globe.
 import sys, math, struct, json, array
 rings, segs, out = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 mode = sys.argv[4] if len(sys.argv) > 4 else 'all'

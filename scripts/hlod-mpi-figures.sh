@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# hlod-mpi-figures.sh MESH [BUILD_DIR]: issue 16's figures for one mesh, on this machine.
+# hlod-mpi-figures.sh MESH [BUILD_DIR]: the distributed bake's figures for one mesh.
 #   - lod bake --hlod (the local reference bytes, 1 thread)
 #   - lod-bake-mpi at 1, 2 and 4 ranks x 1 thread, each from an empty cache: wall time, per-rank
 #     bake CPU seconds (balance = slowest / mean; and of each rank's whole CPU up to the gather, as

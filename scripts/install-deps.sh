@@ -7,9 +7,9 @@ PKGS=(build-essential cmake ninja-build ccache pkg-config
       libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
       libgtest-dev libgmock-dev libbenchmark-dev libmeshoptimizer-dev
       libtinygltf-dev gltfpack
-      libgdal-dev  # elevation rasters for [[terrain]] (issue 15)
+      libgdal-dev  # elevation rasters for [[terrain]]
       libcgal-demo xvfb xauth libgl1-mesa-dri
-      openmpi-bin libopenmpi-dev  # lod-bake-mpi (issue 16) and its mpirun tests
+      openmpi-bin libopenmpi-dev  # lod-bake-mpi and its mpirun tests
       clang libclang-rt-14-dev)  # clang: libFuzzer targets (scripts/fuzz.sh)
 missing=()
 for p in "${PKGS[@]}"; do

@@ -2,7 +2,7 @@
 # Node tools the test suite runs, pinned, installed into build/node-tools (or $LOD_NODE_TOOLS):
 # the Khronos glTF validator (npm gltf-validator) and ajv + ajv-formats, which check exported
 # 3D Tiles tilesets against the 3D Tiles 1.1 JSON schemas (Cesium's 3d-tiles-validator is not on
-# the npm registry this machine reaches). Idempotent: when the pinned versions are already
+# the npm registry reachable here). Idempotent: when the pinned versions are already
 # there this only checks them and exits. Installs Debian's nodejs + npm when either is
 # missing (needs root or sudo then).
 set -euo pipefail

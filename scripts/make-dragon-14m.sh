@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # make-dragon-14m.sh [BUILD_DIR]: BUILD_DIR/bench-data/dragon-14m.ply, the 871k Stanford dragon
-# (../shared/data/meshes) subdivided twice (13.9M triangles, 265 MB), the mesh of issue 16's
+# (../shared/data/meshes) subdivided twice (13.9M triangles, 265 MB), the mesh of the distributed bake's
 # figures: scripts/hlod-mpi-figures.sh BUILD_DIR/bench-data/dragon-14m.ply BUILD_DIR
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -15,7 +15,7 @@ bool has_warning(const WithWarnings& x, const std::string& part) {
   return false;
 }
 
-// ../shared/data/meshes, or empty when this machine does not have it.
+// ../shared/data/meshes, or empty when it is absent.
 std::filesystem::path shared_meshes();
 // Debian CGAL meshes extracted by the build (cow.off, bunny00.off, ...), or empty.
 std::filesystem::path data_dir();
@@ -30,7 +30,7 @@ std::string sphere_off(int rings, int segments);
 
 }  // namespace lod::test
 
-// Skips the current test with a clear message when a mesh is not on this machine.
+// Skips the current test with a clear message when a mesh is absent.
 #define LOD_REQUIRE_SHARED_MESH(var, name)                                                   \
   const std::filesystem::path var = ::lod::test::shared_meshes() / (name);                  \
   if (::lod::test::shared_meshes().empty() || !std::filesystem::exists(var))                \

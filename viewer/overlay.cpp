@@ -119,7 +119,7 @@ void Overlay::draw(const OverlayFacts& f, ViewerControls& c, bool with_controls)
 
   const bool graphs = ImGui::CollapsingHeader("graphs");
   if (const Frame* fr = f.frame; fr && graphs) {
-    // Level histogram over R0's l = round(log2 tris): only the occupied span.
+    // Level histogram over Yu, Liang and Chen's l = round(log2 tris): only the occupied span.
     size_t lo = kHistogramLevels, hi = 0;
     for (size_t l = 0; l < kHistogramLevels; ++l)
       if (fr->level_histogram[l]) lo = std::min(lo, l), hi = std::max(hi, l);

@@ -1,4 +1,4 @@
-// lod-bake-mpi: the HLOD bake of one mesh, or of a scene of many, spread over MPI ranks (issue 16).
+// lod-bake-mpi: the HLOD bake of one mesh, or of a scene of many, spread over MPI ranks.
 //
 //   mpirun -np 4 lod-bake-mpi MESH... -o DIR --cache DIR [--min-verts N] [--threads N] [--subtrees N]
 //                             [--entry-memory-mb N]

@@ -57,12 +57,12 @@ class FrameRef {
 
 enum class BudgetUnit : uint8_t {
   triangles,  // sum of selected triangles <= M
-  levels,     // R0's sum of 2^l <= M
+  levels,     // Yu, Liang and Chen's sum of 2^l <= M
 };
 
 // Which selector chooses levels under the budget (all meet the same M):
 enum class BudgetSelector : uint8_t {
-  greedy,        // R0's max-heap, one level per pop
+  greedy,        // Yu, Liang and Chen's max-heap, one level per pop
   greedy_multi,  // several levels per pop: far fewer pops on a cold start, about the same benefit
   benefit_cost,  // Funkhouser-Sequin's benefit/cost greedy from the coarsest levels (>= 1/2 of optimal)
 };

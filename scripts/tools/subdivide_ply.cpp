@@ -1,6 +1,6 @@
 // subdivide-ply IN OUT: two 1-to-4 midpoint subdivisions of a binary little-endian PLY (float xyz
 // vertices, uchar/int triangle faces), as bench_hlod_build makes its 14M mesh from the dragon
-// (issue 16 figures: scripts/make-dragon-14m.sh).
+// (the distributed bake's figures: scripts/make-dragon-14m.sh).
 #include <cstdio>
 #include <cstdint>
 #include <cstring>

@@ -1,4 +1,4 @@
-// glTF import speed (issue 12 figure: import of a 1M-triangle GLB <= 1.2x the time tinygltf
+// glTF import speed (target: import of a 1M-triangle GLB <= 1.2x the time tinygltf
 // alone takes to parse it). The GLB is made here with the project's writer: a torus of
 // 1,001,112 triangles and 501,972 vertices with POSITION, NORMAL and TEXCOORD_0 (float) and
 // u32 indices, 28 MB.
@@ -8,7 +8,7 @@
 //   BM_LodImport       lod::load_gltf: that parse plus every check and the flattening into
 //                      MeshData (positions, normals, uvs, indices, submeshes)
 //   BM_ImportOverParse both in turn, each iteration; counter `cpu_ratio` = ours / tinygltf's
-//                      in thread CPU time, the figure the README quotes (a shared machine's
+//                      in thread CPU time, the figure to quote (a shared machine's
 //                      wall time is noisy; CPU time of one thread is not)
 #include <benchmark/benchmark.h>
 

@@ -1,4 +1,4 @@
-// Textured models simplified side by side with meshoptimizer's gltfpack (issue 12 item 6):
+// Textured models simplified side by side with meshoptimizer's gltfpack:
 // `gltfpack -si R -noq` (Debian's gltfpack, run as a process; -noq keeps float attributes so
 // that only the simplification differs) and lodkit's bake (QEM, uvs as attributes, seams
 // simplified along their length) at the triangle count gltfpack reached for each R in 50 %,

@@ -1,4 +1,4 @@
-// Model HLOD build time (issue 11, R1 3.1) on the 871k-triangle Stanford dragon scan
+// Model HLOD build time (precomputed HLOD, Zhou and Tian 3.1) on the 871k-triangle Stanford dragon scan
 // (../shared/data/meshes/stanford-dragon.ply), at 1 thread (the baseline, in the same binary)
 // and 2 threads; optionally the dragon subdivided twice (1-to-4 midpoint, ~14M triangles,
 // generated at run time: BM_HlodBuild14M, run it with --benchmark_filter=14M; with
@@ -9,7 +9,7 @@
 //                            (process CPU seconds per build, all threads), best_s (the
 //                            quietest iteration's wall time: the machine is shared)
 //
-// R1 built the 847k-triangle dragon in 2,212 s. Target (issue 11): < 3 s on 2 threads; 14M < 60 s.
+// Zhou and Tian built the 847k-triangle dragon in 2,212 s. Target: < 3 s on 2 threads; 14M < 60 s.
 // Wall times on a shared machine are noisy: cpu_s says how much of a run was ours.
 #include <benchmark/benchmark.h>
 #include <oneapi/tbb/task_arena.h>
@@ -41,7 +41,7 @@ double process_cpu_seconds() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
-// nullptr when the scan is not on this machine.
+// nullptr when the scan is absent.
 const MeshData* dragon() {
   static const MeshData* mesh = [] () -> const MeshData* {
     const auto file = test::shared_meshes() / "stanford-dragon.ply";
@@ -113,7 +113,7 @@ void BM_HlodBuild14M(benchmark::State& state) { run_build(state, dragon_14m()); 
 BENCHMARK(BM_HlodBuild)->ArgName("threads")->Arg(1)->Arg(2)->Iterations(5)->UseRealTime()->Unit(benchmark::kSecond);
 BENCHMARK(BM_HlodBuild14M)->ArgName("threads")->Arg(2)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
 
-// Console output as usual, then the 2-vs-1-thread ratio and the ratio to R1's 2,212 s.
+// Console output as usual, then the 2-vs-1-thread ratio and the ratio to Zhou and Tian's 2,212 s.
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
@@ -131,7 +131,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
     const auto [mean1, best1] = one->second;
     const auto [mean2, best2] = two->second;
     std::printf("dragon HLOD build, mean: 1 thread %.2f s, 2 threads %.2f s (2 vs 1: %.2fx); best: %.2f s, %.2f s (%.2fx); "
-                "R1's 2,212 s / best 2-thread = %.0fx\n",
+                "Zhou and Tian's 2,212 s / best 2-thread = %.0fx\n",
                 mean1, mean2, mean1 / mean2, best1, best2, best1 / best2, 2212.0 / best2);
   }
 

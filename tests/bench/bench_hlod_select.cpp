@@ -1,6 +1,6 @@
 // Cost of one HLOD cut per frame (select_hlod_cut) on a 10,000-node tree along a moving
 // camera: all resident, partly resident, under a budget that bites, and the worst case where
-// the cut visits every node. Target (issue 11): <= 0.3 ms per frame on the 2-core machine.
+// the cut visits every node. Target: <= 0.3 ms per frame on the 2-core machine.
 // Baseline in the same binary: the breadth-first visit alone at the same views (a loop that
 // only transforms and culls every node's sphere), so the ratio says what the cut logic adds.
 #include <benchmark/benchmark.h>

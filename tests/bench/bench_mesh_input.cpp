@@ -1,5 +1,5 @@
 // What every bake does first, on a 4M-triangle sphere made in code: reading a binary PLY and
-// cleaning it (issue 16: each rank of a distributed bake repeats both, so their time bounds
+// cleaning it (each rank of a distributed bake repeats both, so their time bounds
 // the speed-up); LOD_BENCH_MESH=FILE.ply takes a real mesh instead. Baselines in the same run:
 //   BM_ReadBytes          the file's bytes into memory (the floor for BM_LoadPly)
 //   BM_ReadHashParse      read whole, hashed, parsed: the baseline for BM_LoadPlyHashedStreamed

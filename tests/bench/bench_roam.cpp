@@ -1,4 +1,4 @@
-// ROAM terrain benchmarks (issue 15) on a 1,025 x 1,025 grid: the deal.II step-53 SRTM
+// ROAM terrain benchmarks on a 1,025 x 1,025 grid: the deal.II step-53 SRTM
 // topography (scripts/fetch-topography.sh) resampled bilinearly, or generated ridges + noise
 // when the file is absent. The camera flies a straight line 800 m above the ground at a steady
 // pace (0.05 % of the terrain's side per frame), looking ahead and down, 1280 x 720, 60 degrees.

@@ -1,6 +1,6 @@
 // How good is the selection? On random scenes (tests/unit/runtime/random_knapsack.h: 200
 // objects, budgets from 10 % to 60 % of the way from the coarsest to the finest levels), the
-// benefit of R0's heap (greedy), of the multi-level-per-pop heap (greedy_multi), of the
+// benefit of Yu, Liang and Chen's heap (greedy), of the multi-level-per-pop heap (greedy_multi), of the
 // runtime's Funkhouser-Sequin selector (benefit_cost) and of the oracle's reference greedy
 // (selection_oracle.h) as a fraction of the exact optimum (dynamic programming). Prints the
 // distribution.
@@ -77,7 +77,7 @@ void BM_SelectionQuality(benchmark::State& state) {
 }
 BENCHMARK(BM_SelectionQuality)->Iterations(1)->Unit(benchmark::kSecond);
 
-// R0's bunny-like chains (100/50/25/12/6/3 %) at three sizes.
+// Yu, Liang and Chen's bunny-like chains (100/50/25/12/6/3 %) at three sizes.
 ModelTable bunny_like_table() {
   std::vector<std::vector<test::LevelSpec>> chains;
   for (uint32_t full : {69451u, 5804u, 20000u}) {

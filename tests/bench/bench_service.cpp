@@ -83,7 +83,7 @@ BENCHMARK(BM_StageTransforms)->ArgName("batched")->Arg(0)->Arg(1)->Unit(benchmar
 
 // The service free-runs at 60 Hz on its own thread; the simulation stages 10 % of the objects
 // and commits every 2 ms, timing commit() itself. A consumer thread polls frames every 0.1 ms
-// (not spinning: this machine has two cores for it, the simulation and the LOD thread) and
+// (not spinning: a 2-core machine has two cores for it, the simulation and the LOD thread) and
 // notes when each tick first appears, so commit -> visible is measured to within 0.1 ms.
 void BM_CommitWhileRunning(benchmark::State& state) {
   Sim sim = make_sim(100000, 60);

@@ -1,4 +1,4 @@
-// Side-by-side simplification benchmark on real scans (issue 3): lodkit QEM (both halves in
+// Side-by-side simplification benchmark on real scans: lodkit QEM (both halves in
 // parallel, 2 threads), lodkit aggressive (grid clustering), meshopt_simplify,
 // meshopt_simplifySloppy and OpenMesh's Decimater (ModQuadric + ModNormalFlipping, through
 // preprocess/decimater_chain), all timed in the same run and measured by the same code
@@ -413,7 +413,7 @@ int main(int argc, char** argv) {
 #ifndef LOD_HAVE_MESHOPTIMIZER
   std::printf("meshoptimizer not found at configure time: its columns are skipped\n");
 #endif
-  // The reference's ratios (R0): bunny-sized 50..3 %, large scans 25..0.18 %; 50 % and 1.5 %
+  // The reference's ratios (Yu, Liang and Chen): bunny-sized 50..3 %, large scans 25..0.18 %; 50 % and 1.5 %
   // everywhere so the QEM error criterion (50 % .. 1.5 %) is covered on every mesh.
   const std::vector<double> small = {0.5, 0.25, 0.12, 0.06, 0.03, 0.015};
   const std::vector<double> large = {0.5, 0.25, 0.12, 0.06, 0.03, 0.015, 0.0075, 0.0037, 0.0018};

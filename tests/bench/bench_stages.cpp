@@ -2,9 +2,9 @@
 // baselines in the same binary so figures can be quoted as ratios:
 //   BM_StreamBaseline  reads the four sphere columns and writes one byte per object (the
 //                      memory floor a culling pass cannot beat);
-//   BM_SelectPriorityQueue  the textbook R0 loop on std::priority_queue (allocates, pop + push),
+//   BM_SelectPriorityQueue  the textbook selection loop on std::priority_queue (allocates, pop + push),
 //                      against BM_Select on identical inputs.
-// Scene: R0's three model types plus a bunny, random in a 2 km box, seen from outside it.
+// Scene: Yu, Liang and Chen's three model types plus a bunny, random in a 2 km box, seen from outside it.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -24,7 +24,7 @@ namespace {
 using namespace lod;
 
 ModelTable bench_models() {
-  // Triangle counts of R0's models at its ratios; errors double per level (object units).
+  // Triangle counts of Yu, Liang and Chen's models at its ratios; errors double per level (object units).
   const std::vector<std::pair<double, std::vector<double>>> specs = {
       {5804, {1.0, 0.5, 0.25, 0.12, 0.06}},
       {345944, {0.25, 0.12, 0.06, 0.03, 0.015, 0.0075, 0.0037, 0.0018}},

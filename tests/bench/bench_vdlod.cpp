@@ -1,4 +1,4 @@
-// View-dependent LOD benchmarks (issue 4) on a ~1M-triangle mesh: the Stanford bunny scan
+// View-dependent LOD benchmarks on a ~1M-triangle mesh: the Stanford bunny scan
 // subdivided twice (1-to-4 midpoint), or a generated 1M-triangle sphere when the scan is absent.
 //
 //   BM_HierarchyBuild      build time of the vertex hierarchy (quadric order)

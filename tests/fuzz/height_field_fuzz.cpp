@@ -1,4 +1,4 @@
-// libFuzzer target for the height-field readers (issue 15), built by scripts/fuzz.sh: the first
+// libFuzzer target for the height-field readers, built by scripts/fuzz.sh: the first
 // byte picks the reader (0: PNG through stb, 1: ESRI ASCII grid through GDAL, 2: "x y z" text),
 // the rest is the file. The sample limit is lowered to 2^20 so a grid the readers accept fits
 // the fuzzer's allocation limit, and GDAL may use its ESRI ASCII driver only (some of its other

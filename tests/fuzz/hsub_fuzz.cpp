@@ -1,4 +1,4 @@
-// libFuzzer target for the distributed bake's subtree cache entry (issue 16: runtime/
+// libFuzzer target for the distributed bake's subtree cache entry (runtime/
 // hlod_subtree_entry), built by scripts/fuzz.sh. The custom mutator recomputes the entry
 // header's checksum and the embedded .hlod's head and payload checksums, so the fuzzer reaches
 // the structure, key and vertex checks behind them.

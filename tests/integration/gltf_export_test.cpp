@@ -1,4 +1,4 @@
-// glTF through the `lod` command (issue 12): `lod inspect --export DIR --format glb|gltf|obj|ply`
+// glTF through the `lod` command: `lod inspect --export DIR --format glb|gltf|obj|ply`
 // writes every level; each GLB / glTF passes the Khronos glTF validator (npm gltf-validator,
 // installed by scripts/install-node-tools.sh, run through node) with 0 errors; import -> bake
 // -> export -> import keeps triangle counts and bounds; a scene may name .glb and .lod files.

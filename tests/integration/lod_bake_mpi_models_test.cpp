@@ -1,4 +1,4 @@
-// lod-bake-mpi over a scene of several meshes under mpirun on loopback (issue 16: "a scene of
+// lod-bake-mpi over a scene of several meshes under mpirun on loopback ("a scene of
 // many models is split by models"): at 1, 2 and 4 ranks every DIR/<name>.hlod is the bytes of
 // `lod bake --hlod` of its file; a rank killed mid-run (LOD_MPI_FAIL_AFTER) fails the job, keeps
 // the cache, and the rerun bakes only the missing models into the same bytes; a corrupted or

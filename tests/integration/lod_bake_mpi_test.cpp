@@ -1,4 +1,4 @@
-// lod-bake-mpi under mpirun on loopback (issue 16): at 1, 2 and 4 ranks the file is the bytes
+// lod-bake-mpi under mpirun on loopback: at 1, 2 and 4 ranks the file is the bytes
 // of `lod bake --hlod`; a rank killed mid-run (LOD_MPI_FAIL_AFTER) fails the job, keeps the
 // partial cache, and the rerun bakes only what is missing into the same bytes; corrupted and
 // truncated entries are rebaked; a rank that fails says which subtree and why.
@@ -97,7 +97,7 @@ TEST(LodBakeMpi, SameBytesWithSeveralThreadsPerRankAndThreeRanks) {
   }
 }
 
-// A textured, two-material model (issue 12): uvs, runs and materials, the same bytes at 1, 2
+// A textured, two-material model: uvs, runs and materials, the same bytes at 1, 2
 // and 4 ranks as lod bake --hlod.
 TEST(LodBakeMpi, TexturedModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
   const auto dir = test::temp_dir("lod_bake_mpi_textured");
@@ -116,7 +116,7 @@ TEST(LodBakeMpi, TexturedModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
   }
 }
 
-// Vertex colours and a second uv set (issue 12), with a texture reading TEXCOORD_1: the same
+// Vertex colours and a second uv set, with a texture reading TEXCOORD_1: the same
 // bytes at 1, 2 and 4 ranks as lod bake --hlod, and the tree has both attributes.
 TEST(LodBakeMpi, ColouredModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
   const auto dir = test::temp_dir("lod_bake_mpi_coloured");
@@ -163,7 +163,7 @@ TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes)
   EXPECT_TRUE(j["mesh_cached"].get<bool>()) << "the rerun reads the cleaned mesh the killed run stored";
 }
 
-// Issue 16's own spelling, `mpirun -np N lod bake ... --hlod --distributed`: each rank becomes
+// The `lod bake` spelling of the job, `mpirun -np N lod bake ... --hlod --distributed`: each rank becomes
 // the lod-bake-mpi beside lod; without --cache the cache is OUT/hlod-cache, so the same command
 // run again resumes from it (here: finds every subtree).
 TEST(LodBakeMpi, LodBakeDistributedIsTheSameBakeAndResumesFromItsDefaultCache) {

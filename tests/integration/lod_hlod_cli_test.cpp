@@ -77,7 +77,7 @@ TEST(LodHlodCli, SameFileAtOneAndTwoThreads) {
   const auto globe = lod::test::read_bytes(dir / "1" / "globe.hlod");
   ASSERT_GT(globe.size(), 100000u);
   EXPECT_TRUE(globe == lod::test::read_bytes(dir / "2" / "globe.hlod")) << "the textured model at 1 and 2 threads";
-  // Vertex colours and a second uv set (issue 12): kept, nothing said dropped, the same file.
+  // Vertex colours and a second uv set: kept, nothing said dropped, the same file.
   const fs::path painted = lod::test::write_coloured_gltf(dir / "src", "painted", 48, 96);
   ASSERT_FALSE(painted.empty());
   for (const char* threads : {"1", "2"}) {

@@ -1,4 +1,4 @@
-// `lod export --3dtiles DIR FILE.hlod` end to end (issue 12): the tileset passes the 3D Tiles 1.1
+// `lod export --3dtiles DIR FILE.hlod` end to end: the tileset passes the 3D Tiles 1.1
 // JSON schemas (ajv, when ../shared holds them) and the structural checks of
 // validate_3dtiles.js, every GLB the Khronos validator with 0 errors; tiles follow the tree and
 // its measured errors; a non-empty folder is refused (or, with --force, only an earlier export
@@ -464,7 +464,7 @@ TEST(Tiles3dExport, ColouredModelWritesColor0AndTexcoord1InEveryTile) {
 }
 
 // ../shared's spot with its texture (a .mtl naming it) as an HLOD and a tileset: the figures
-// README quotes, and every GLB valid with the texture embedded.
+// docs/performance.md can quote, and every GLB valid with the texture embedded.
 TEST(Tiles3dExport, SpotHlodExportsWithItsTexture) {
   LOD_REQUIRE_SHARED_MESH(spot, "spot.obj");
   const fs::path dir = lod::test::temp_dir("tiles3d-spot");

@@ -23,8 +23,8 @@ foreach(h ${internal})
     message(FATAL_ERROR "installed a header outside include/lodkit/: ${h}")
   endif()
 endforeach()
-# The tools land in bin/ with the libraries; `lod bake --hlod --distributed` (issue 16's
-# spelling) starts the lod-bake-mpi installed beside it and writes the local bake's bytes.
+# The tools land in bin/ with the libraries; `lod bake --hlod --distributed` (the `lod bake`
+# spelling of the MPI bake) starts the lod-bake-mpi installed beside it and writes the local bake's bytes.
 if(EXISTS ${BUILD_DIR}/lod AND NOT EXISTS ${PREFIX}/bin/lod)
   message(FATAL_ERROR "${PREFIX}/bin/lod was not installed")
 endif()

@@ -182,7 +182,7 @@ TEST(ViewerTextured, ViewDependentGlobeShowsTheTextureAndFactorToo) {
   expect_checker_and_factor(count_hues(shot.image, kPresent), "on the view-dependent cap");
 }
 
-// The same globe as an HLOD model (issue 12): its nodes carry uvs and material runs, so the
+// The same globe as an HLOD model: its nodes carry uvs and material runs, so the
 // picture shows the texture and the factor as the levels do; colour-by-depth shows neither.
 TEST(ViewerTextured, HlodGlobeShowsTheTextureAndFactorColourByDepthDoesNot) {
   LOD_REQUIRE_XVFB();
@@ -281,7 +281,7 @@ Painted count_painted(const Image& img) {
   return n;
 }
 
-// An HLOD model with vertex colours (issue 12): its nodes are drawn with COLOR_0 multiplied into
+// An HLOD model with vertex colours: its nodes are drawn with COLOR_0 multiplied into
 // the base colour, so the picture shows the red north and the blue south; colour-by-depth
 // shows neither.
 TEST(ViewerTextured, HlodNodesShowTheirVertexColoursColourByDepthDoesNot) {

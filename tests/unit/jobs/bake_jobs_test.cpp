@@ -78,7 +78,7 @@ TEST(BakeJobs, BakesEveryModelThenServesThemFromTheCache) {
   }
 }
 
-// A scene's `file` may name a baked asset (issue 12): it is read as is, never rebaked or
+// A scene's `file` may name a baked asset: it is read as is, never rebaked or
 // written to the cache, and a broken one is refused naming the model and the file.
 TEST(BakeJobs, ReadsAModelWhoseFileIsALodAssetAsIs) {
   BakeDir d;

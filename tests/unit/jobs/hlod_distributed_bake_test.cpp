@@ -1,4 +1,4 @@
-// The distributed HLOD bake without MPI (issue 16): the balanced assignment, the subtree cache
+// The distributed HLOD bake without MPI: the balanced assignment, the subtree cache
 // (store, verify, refuse), and whole bakes with one rank and with ranks as threads, whose files
 // must be the local bake's bytes; reruns bake only what the cache lacks.
 #include <gtest/gtest.h>
@@ -590,7 +590,7 @@ TEST(HlodDistributedBake, SourceHashCoversTheFilesAGltfNamesPieceByPiece) {
   EXPECT_NE(got, before) << victim << " is part of the source";
 }
 
-// A textured, two-material sphere (issue 12): the distributed bake writes the local bake's
+// A textured, two-material sphere: the distributed bake writes the local bake's
 // bytes with its uvs, runs and materials, at 1, 2 and 3 ranks, and again from the cleaned mesh
 // (uvs, submeshes and materials) and the subtrees in the cache.
 TEST(HlodDistributedBake, TexturedModelGivesTheLocalBytesAtEveryRankCountAndFromTheCache) {
@@ -651,7 +651,7 @@ TEST(HlodDistributedBake, EmbeddedTextureGivesTheLocalBytesAtEveryRankCountAndFr
   }
 }
 
-// Vertex colours and a second uv set (issue 12) with a material whose occlusion texture reads
+// Vertex colours and a second uv set with a material whose occlusion texture reads
 // TEXCOORD_1: the tree keeps both attributes and the texture, and the distributed bake writes the
 // local bake's bytes at 1, 2 and 3 ranks, and again from the cache (the cleaned mesh keeps them).
 TEST(HlodDistributedBake, ColouredModelGivesTheLocalBytesAtEveryRankCountAndFromTheCache) {

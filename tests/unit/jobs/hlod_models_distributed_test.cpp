@@ -1,4 +1,4 @@
-// A scene of many models over ranks without MPI (issue 16): the plan (split above a rank's
+// A scene of many models over ranks without MPI: the plan (split above a rank's
 // share, the rest whole and balanced), the header estimates, the model cache (store, check,
 // refuse), and whole jobs with ranks as threads, whose every file must be the local bake's
 // bytes; reruns bake only what the cache lacks, a failing store names its model.

@@ -200,7 +200,7 @@ TEST(SceneConfig, ShippedConfigsLoad) {
     if (e.path().extension() != ".toml") continue;
     SceneConfig c;
     const Status s = load_scene_config(e.path(), test::data_dir(), c);
-    // A config may name ../shared scans absent on this machine; anything else is a bug.
+    // A config may name ../shared scans that are absent; anything else is a bug.
     if (!s.ok && s.message.find("not found; tried") != std::string::npos) continue;
     EXPECT_TRUE(s.ok) << s.message;
     loaded += s.ok;

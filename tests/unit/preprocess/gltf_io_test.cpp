@@ -1,6 +1,6 @@
-// glTF 2.0 import (issue 12): files built in code cover every index and attribute component
+// glTF 2.0 import: files built in code cover every index and attribute component
 // type, strides, strips and fans, node transforms, data-URI and external buffers, materials;
-// malformed files (issue 12 item 7) are each refused with a message naming the element.
+// malformed files are each refused with a message naming the element.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -820,7 +820,7 @@ TEST(GltfImport, RefusesAFileWithOnlyLines) {
   expect_refused(s, "mode LINES is not a triangle mode");
 }
 
-// ---- malformed files (issue 12 item 7) -----------------------------------------------------------
+// ---- malformed files -----------------------------------------------------------
 
 TEST(GltfMalformed, RefusesRequiredDracoAndMeshopt) {
   for (const char* ext : {"KHR_draco_mesh_compression", "EXT_meshopt_compression"}) {

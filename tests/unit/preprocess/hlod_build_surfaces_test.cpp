@@ -1,4 +1,4 @@
-// Model HLOD with a textured, two-material input (issue 12): every layer and patch keeps the
+// Model HLOD with a textured, two-material input: every layer and patch keeps the
 // uvs and its triangles' materials, grouped into runs; uv seams and the material boundary stay
 // closed (every random cut crack-free); each material's triangles stay on their half with uvs
 // in their chart; the bytes do not depend on threads or the frontier; a positions-only input
@@ -225,7 +225,7 @@ HlodBuildOptions coloured_options(uint32_t subtrees = 16, const ParallelFor& par
   return o;
 }
 
-// Issue 12: colours and the second uv set ride through QEM like TEXCOORD_0: every layer and
+// Colours and the second uv set ride through QEM like TEXCOORD_0: every layer and
 // patch has them; each vertex keeps its half's colour (the seam holds: no red in the south, no
 // blue in the north), green still follows the latitude, uv1 stays in its chart; the errors are
 // 0 on a leaf's original layer and small elsewhere; cuts stay closed; the file keeps it all.

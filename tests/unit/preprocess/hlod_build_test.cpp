@@ -1,4 +1,4 @@
-// Model HLOD build (R1 3.1): octree limits, the partition of the original triangles, layer
+// Model HLOD build (Zhou and Tian 3.1): octree limits, the partition of the original triangles, layer
 // sizes, monotonic errors, crack-free random cuts, and identical output at any thread count.
 #include <gtest/gtest.h>
 

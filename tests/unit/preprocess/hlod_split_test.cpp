@@ -1,4 +1,4 @@
-// The HLOD build split into plan / subtree bakes / assembly (issue 16): the output never
+// The HLOD build split into plan / subtree bakes / assembly: the output never
 // depends on where the frontier is, which builder baked which subtree, or in which order.
 #include <gtest/gtest.h>
 

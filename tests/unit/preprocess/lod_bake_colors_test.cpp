@@ -1,4 +1,4 @@
-// Vertex colours (COLOR_0) and a second uv set (TEXCOORD_1) through every level (issue 12): a
+// Vertex colours (COLOR_0) and a second uv set (TEXCOORD_1) through every level: a
 // sphere whose halves are red and blue (the equator a colour seam, one position, two colours),
 // with a lightmap-style TEXCOORD_1 and an occlusion texture reading it, baked from a .gltf:
 // every level keeps both, interpolated within the input's range, the colour seam stays closed

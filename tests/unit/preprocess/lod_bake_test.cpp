@@ -257,7 +257,7 @@ TEST(BakeModel, CowChainFollowsTheReference) {
   BakeReport report;
   ASSERT_TRUE(bake_model(cow, "cow", BakeSettings{}, chain, &report, nullptr).ok);
   EXPECT_EQ(report.input_triangles, 5804u);
-  ASSERT_EQ(chain.levels.size(), 5u);  // R0: 100/50/25/12/6 %
+  ASSERT_EQ(chain.levels.size(), 5u);  // Yu, Liang and Chen: 100/50/25/12/6 %
   const std::vector<float> ratios = default_ratios(5804);
   for (size_t i = 0; i < chain.levels.size(); ++i) {
     const double target = ratios[i] * double(chain.levels[0].triangles());

@@ -1,4 +1,4 @@
-// The mesh readers on hostile input (issue 14): regular files only, counts checked against
+// The mesh readers on hostile input: regular files only, counts checked against
 // the file before anything is allocated, BOMs skipped, bad indices reported the same way
 // every run, and thousands of small hostile variants each refused or loaded quickly in
 // bounded memory. Also the PLY/OFF/STL variants the single-pass readers must accept.

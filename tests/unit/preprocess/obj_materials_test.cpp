@@ -1,4 +1,4 @@
-// OBJ with texture coordinates, normals and materials (issue 12): vt / vn / usemtl / mtllib
+// OBJ with texture coordinates, normals and materials: vt / vn / usemtl / mtllib
 // are kept (uvs flipped into glTF's convention, one vertex per distinct v/vt/vn corner,
 // submeshes by usemtl, the .mtl's Kd, d / Tr, map_Kd, Ke / map_Ke and bump), and hostile files are refused
 // naming file:line.

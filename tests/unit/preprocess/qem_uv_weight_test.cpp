@@ -1,7 +1,7 @@
 // Texture-coordinate error in QEM's collapse cost (attribute quadrics): on a textured model,
 // at the same triangle counts, weighting the uv error moves the levels' uvs less from the
 // input vertices they descend from, and keeps the geometric error about where it was.
-// Prints the figures (README, "glTF 2.0"): uv error (largest uv drift, texture units) and
+// Prints the figures: uv error (largest uv drift, texture units) and
 // geometric RMS / max (object units) per level, for each weight.
 #include <gtest/gtest.h>
 

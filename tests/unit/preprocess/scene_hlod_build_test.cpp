@@ -1,4 +1,4 @@
-// Scene HLOD build (R1 3.2): the octree over the objects, the proxies, their error bounds
+// Scene HLOD build (Zhou and Tian 3.2): the octree over the objects, the proxies, their error bounds
 // (checked against the objects' full-detail surfaces), determinism and refused input.
 #include <gtest/gtest.h>
 

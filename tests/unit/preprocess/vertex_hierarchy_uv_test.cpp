@@ -169,7 +169,7 @@ TEST(VertexHierarchyUv, MaterialBoundariesAndUvSeamsArePinnedOnTheTexturedSphere
   for (uint32_t v = t.leaf_count; v < t.node_count(); ++v)
     for (uint32_t r = t.leaf_lo[v]; r < t.leaf_hi[v]; ++r)
       ASSERT_EQ(material[order[r]], material[order[t.leaf_lo[v]]]) << "node " << v;
-  // The price of pinning, printed for the README: roots (never collapsed) and the coarsest front.
+  // The price of pinning, printed: roots (never collapsed) and the coarsest front.
   VertexFront f;
   front_init(f, t, 1);
   front_coarsen_all(f, t);

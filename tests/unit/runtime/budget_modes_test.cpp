@@ -1,6 +1,6 @@
 // Budget modes in the runtime: the culled level (a last ratio of 0) through chain checks, the
 // asset, blends, initial levels and selection; lod.max_distance; the multi-level-per-pop
-// selector against R0's heap and the exact optimum; the per-frame benefit and pixel error.
+// selector against the span-of-level-changed heap and the optimum; the per-frame benefit and pixel error.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -151,7 +151,7 @@ TEST(CulledLevel, SelectionLowersIntoTheCulledLevelLikeAnyOther) {
   EXPECT_EQ(r.coarsest_cost, 0u);
 }
 
-// R0's span from l = 11 to the culled level's l = 0 would be 121, so the heap would cull small
+// The paper's span from l = 11 to the culled level's l = 0 would be 121, so the heap would cull small
 // objects before it lowers a 65k-triangle one; culling counts as one more level instead.
 TEST(CulledLevel, CullingWeighsLikeOneMoreLevel) {
   const ModelTable t = test::table_of({{{65536, 0}, {32768, 1}}, {{2048, 0}, {0, 5}}});
@@ -188,7 +188,7 @@ TEST(MaxDistance, CullsSpheresWhoseNearestPointIsFarther) {
   EXPECT_EQ(a, visible);
 }
 
-// Bunny-like chains (R0's 100/50/25/12/6/3 %) for the selector comparisons.
+// Bunny-like chains (Yu, Liang and Chen's 100/50/25/12/6/3 %) for the selector comparisons.
 ModelTable bunny_like_table() {
   std::vector<std::vector<test::LevelSpec>> chains;
   for (uint32_t full : {69451u, 5804u, 20000u}) {
@@ -276,7 +276,7 @@ TEST(MultiLevelSelector, BothSelectorsAgainstTheOptimum) {
       if (o > 0) worst_greedy = std::min(worst_greedy, g / o), worst_multi = std::min(worst_multi, m / o);
     }
   }
-  EXPECT_GE(worst_greedy, 0.95) << "R0's heap, the issue's figure";
+  EXPECT_GE(worst_greedy, 0.95) << "the span-of-level-changed heap's worst frame";
   EXPECT_GE(worst_multi, 0.90) << "greedy_multi gives up a little benefit for its pops";
   std::printf("worst fraction of the optimum: greedy %.4f, greedy_multi %.4f\n", worst_greedy, worst_multi);
 }

@@ -213,7 +213,7 @@ void expect_closed_cut(const HlodTree& t, const HlodCut& cut, const std::vector<
 // ---- tests ---------------------------------------------------------------------------------
 
 TEST(HlodSelect, ThresholdEqualsCesiumScreenSpaceError) {
-  // R1's E = d * (P / N) * tan(theta) with N = H / 2 and theta = fovy / 2, Cesium's
+  // Zhou and Tian's E = d * (P / N) * tan(theta) with N = H / 2 and theta = fovy / 2, Cesium's
   // sse = e * H / (d * 2 tan(fovy / 2)) <= P: the same test for the same inputs.
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0, 1);

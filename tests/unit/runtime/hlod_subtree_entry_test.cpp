@@ -1,4 +1,4 @@
-// The distributed bake's cache entry (issue 16): a subtree round-trips bit-exactly, and every
+// The distributed bake's cache entry: a subtree round-trips bit-exactly, and every
 // truncation, flipped byte, forged count, wrong key and out-of-mesh vertex is refused.
 #include <gtest/gtest.h>
 
@@ -279,7 +279,7 @@ HlodSubtree textured() {
   return s;
 }
 
-// The textured subtree with a second uv set and vertex colours (issue 12).
+// The textured subtree with a second uv set and vertex colours.
 HlodSubtree coloured() {
   HlodSubtree s = textured();
   for (size_t i = 0; i < s.nodes.size(); ++i) {

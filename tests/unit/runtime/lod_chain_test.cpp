@@ -13,8 +13,8 @@
 namespace lod {
 namespace {
 
-TEST(LevelOfTriangles, RoundsLog2ToNearestAsR0) {
-  EXPECT_EQ(level_of_triangles(5000), 12);  // R0's examples
+TEST(LevelOfTriangles, RoundsLog2ToTheNearestInteger) {
+  EXPECT_EQ(level_of_triangles(5000), 12);  // Yu, Liang and Chen's examples
   EXPECT_EQ(level_of_triangles(2000), 11);
   EXPECT_EQ(level_of_triangles(0), 0);
   EXPECT_EQ(level_of_triangles(1), 0);
@@ -27,7 +27,7 @@ TEST(LevelOfTriangles, RoundsLog2ToNearestAsR0) {
   EXPECT_EQ(level_of_triangles(uint64_t{1} << 40), 40);
 }
 
-TEST(SpanOfLevelChanged, RegeneratesTableIOfR0ForHappyBuddha) {
+TEST(SpanOfLevelChanged, RegeneratesThePapersTableIForHappyBuddha) {
   // The happy buddha's 1,087,716 triangles at 50 % .. 0.37 % give levels 19 .. 12.
   const double ratios[] = {0.5, 0.25, 0.12, 0.06, 0.03, 0.015, 0.0075, 0.0037};
   int32_t levels[8];

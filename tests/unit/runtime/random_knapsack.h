@@ -52,7 +52,7 @@ struct RandomScene {
     if (problem.capacity < coarsest) problem.capacity += 10;
   }
 
-  // R0's heap from every object at full detail (the selection's cold start), with either
+  // Yu, Liang and Chen's heap from every object at full detail (the selection's cold start), with either
   // selector; `pops` gets the heap pops it took.
   std::vector<uint8_t> heap_choice(Selector selector = Selector::greedy, uint32_t* pops = nullptr) const {
     std::vector<uint8_t> levels(model.size(), 0), visible(model.size(), 1);

@@ -1,5 +1,5 @@
 // The selection oracle: the DP optimum is exact (brute force on tiny problems), the greedy
-// keeps its half-of-optimum guarantee, and R0's heap never beats the optimum, on random scenes.
+// keeps its half-of-optimum guarantee, and the SLC heap never beats the optimum, on random scenes.
 #include "runtime/selection_oracle.h"
 
 #include <gtest/gtest.h>

@@ -10,7 +10,7 @@
 namespace lod {
 namespace {
 
-// R0's models: cow 100/50/25/12/6 %, armadillo and buddha 25 % .. 0.18 %.
+// Yu, Liang and Chen's models: cow 100/50/25/12/6 %, armadillo and buddha 25 % .. 0.18 %.
 ModelTable paper_table() {
   auto chain = [](double full, std::vector<double> ratios) {
     std::vector<test::LevelSpec> levels;
