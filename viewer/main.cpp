@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
              "OpenGL 3.3 (headless: xvfb-run -a lod-viewer ...).");
   app.add_option("--config", o.config, "scene config (TOML)")->required();
   app.add_option("--data", o.data_dir, "mesh directory searched after the config's folder");
-  app.add_option("--cache", o.cache_dir, "bake cache (default: LOD_CACHE_DIR, else <data>/../cache)");
+  app.add_option("--cache", o.cache_dir, "bake cache (default: the config's [cache] dir, else LOD_CACHE_DIR, else $XDG_CACHE_HOME/lodkit, else ~/.cache/lodkit)");
   app.add_option("--screenshot", o.screenshot, "render --frames frames along the camera path, write this PNG, exit");
   app.add_option("--frames", o.frames, "frames to render (screenshot default 1; interactive: stop after N)");
   app.add_option("--width", o.width, "window / picture width in pixels");

@@ -4,22 +4,18 @@
 #include <utility>
 #include <vector>
 
+#include "jobs/cache_folder.h"
 #include "jobs/hlod_scene.h"
 #include "jobs/scene_hlod_bake.h"
 #include "jobs/terrain_scene.h"
 
 namespace lod::viewer {
 
-std::filesystem::path default_cache_dir(const std::filesystem::path& data_dir) {
-  if (const char* env = std::getenv("LOD_CACHE_DIR"); env && *env) return env;
-  return data_dir.parent_path() / "cache";
-}
-
 Status load_scene(const std::filesystem::path& config_file, const std::filesystem::path& data_dir,
                   const std::filesystem::path& cache_dir, LoadedScene& out, const ProgressLog& log) {
   const std::filesystem::path data = data_dir.empty() ? default_data_dir() : data_dir;
-  out.cache_dir = cache_dir.empty() ? default_cache_dir(data) : cache_dir;
   if (Status st = load_scene_config(config_file, data, out.config); !st) return st;
+  out.cache_dir = cache_dir_for(cache_dir, out.config.cache_dir);  // the rule lod run and the service follow
   out.hlod = std::make_shared<HlodModels>();
   size_t hlod_baked = 0, hlod_cached = 0;
   if (Status st = bake_hlod_models(out.config, out.cache_dir, log, *out.hlod, &hlod_baked, &hlod_cached); !st)

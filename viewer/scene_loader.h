@@ -26,10 +26,7 @@ struct LoadedScene {
   std::filesystem::path cache_dir;
 };
 
-// LOD_CACHE_DIR when set, else <data_dir>/../cache, as `lod run` does.
-std::filesystem::path default_cache_dir(const std::filesystem::path& data_dir);
-
-// `data_dir` empty = lod::default_data_dir(); `cache_dir` empty = default_cache_dir(data_dir).
+// `data_dir` empty = lod::default_data_dir(); `cache_dir` empty = the config's [cache] dir, else cache_dir_for's default.
 // On failure the status carries the config's or the baker's message unchanged.
 Status load_scene(const std::filesystem::path& config_file, const std::filesystem::path& data_dir,
                   const std::filesystem::path& cache_dir, LoadedScene& out, const ProgressLog& log);

@@ -15,6 +15,7 @@
 // that commit gave it, a level of its chain and a blend weight in [0, 1]; its triangles are the
 // sum of its entries' levels; and a triangle budget holds unless even the coarsest levels
 // exceed it.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -247,6 +248,18 @@ void step_and_check(Host& h, double dt) {
   release_held(h, 2);  // holds up to two frames across steps, as a slow consumer would
 }
 
+// A setter refuses exactly the values its contract excludes, and says why.
+void expect_refusal(int answer, bool should_refuse, const char* what) {
+  if ((answer != 0) != should_refuse) {
+    std::fprintf(stderr, "%s: ", what);
+    violated(should_refuse ? "an invalid value was accepted" : "a valid value was refused");
+  }
+  if (should_refuse && lod_last_error()[0] == '\0') {
+    std::fprintf(stderr, "%s: ", what);
+    violated("a refusal without a message");
+  }
+}
+
 void run_operation(Host& h, Bytes& in) {
   static const double kDt[] = {1.0 / 60, 0.0, 0.5, 1e-9, -1.0, NAN, INFINITY, 1e9};
   switch (in.u8() % 14) {
@@ -304,22 +317,37 @@ void run_operation(Host& h, Bytes& in) {
     case 7: {
       static const uint64_t kBudgets[] = {0, 1, 100, 2000, 20000, 1000000, UINT64_MAX};
       const uint8_t k = in.u8();
-      lod_set_budget(h.service, k < 7 ? kBudgets[k] : uint64_t(k) * 97);
+      const uint64_t budget = k < 7 ? kBudgets[k] : uint64_t(k) * 97;
+      expect_refusal(lod_set_budget(h.service, budget), budget < LOD_MIN_BUDGET, "budget");
       break;
     }
-    case 8:
-      lod_set_pixel_error(h.service, in.number(4.0f));
+    case 8: {
+      const float pixels = in.number(4.0f);
+      expect_refusal(lod_set_pixel_error(h.service, pixels), !(pixels > 0.0f && pixels <= LOD_MAX_PIXEL_ERROR),
+                     "pixel error");
       break;
-    case 9:
-      lod_set_hysteresis(h.service, in.number(1.0f));
+    }
+    case 9: {
+      const float band = in.number(1.0f);
+      expect_refusal(lod_set_hysteresis(h.service, band), !(band >= 0.0f && band <= LOD_MAX_HYSTERESIS), "hysteresis");
       break;
-    case 10:
-      lod_set_blend_seconds(h.service, in.number(1.0f));
+    }
+    case 10: {
+      const float seconds = in.number(1.0f);
+      expect_refusal(lod_set_blend_seconds(h.service, seconds), !(seconds >= 0.0f && seconds <= LOD_MAX_BLEND_SECONDS),
+                     "blend time");
       break;
+    }
     case 11:
     case 12: {
-      h.tick += in.u8() % 4;  // equal ticks are allowed
-      lod_commit(h.service, h.tick);
+      // Mostly forward (equal ticks are allowed); sometimes back, which is refused with the
+      // changes kept staged for the next commit.
+      const uint8_t step = in.u8();
+      const uint64_t tick = step < 224 ? h.tick + step % 4 : h.tick - std::min<uint64_t>(h.tick, step % 8);
+      const bool refused = lod_commit(h.service, tick) != 0;
+      if (refused != (tick < h.tick)) violated("a commit's answer disagrees with its tick", tick, h.tick);
+      if (refused) break;
+      h.tick = tick;
       h.committed = h.staged;
       h.committed_once = true;
       break;
