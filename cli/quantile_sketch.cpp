@@ -61,6 +61,8 @@ double QuantileSketch::percentile(double p) const {
     return i + 1 < v.size() ? v[i] * (1 - t) + v[i + 1] * t : v[i];
   }
   const uint64_t rank = uint64_t(p * double(count_ - 1));  // the value of this rank (0-based) is in bin b
+  if (rank == 0) return min_;
+  if (rank + 1 == count_) return max_;
   uint64_t below = 0;
   for (size_t b = 0; b < binned_.size(); ++b) {
     below += binned_[b];

@@ -47,7 +47,7 @@ std::string svg_line_plot(const std::vector<PlotSeries>& series, const PlotOptio
       hi = std::max(hi, v);
     }
   }
-  if (!(lo <= hi)) lo = 0, hi = 1;
+  if (!(lo <= hi)) lo = opt.log_y ? 1 : 0, hi = opt.log_y ? 10 : 1;  // nothing to draw (no frames): an empty frame
   if (opt.log_y) {
     lo = std::pow(10.0, std::floor(std::log10(lo)));
     hi = std::pow(10.0, std::ceil(std::log10(hi)));
