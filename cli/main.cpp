@@ -1,6 +1,8 @@
 // lod: bake meshes into LOD assets, run the LOD service along a camera path, inspect assets.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 
 #include "cli/commands.h"
@@ -36,7 +38,15 @@ int run_main(int argc, char** argv) {
   run_cmd->add_option("--max-seconds", run.max_seconds,
                       "stop after this many wall seconds of frames (not counting the bake); the files and summary "
                       "hold the frames run")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !(v > 0) || !std::isfinite(v))
+              return "'" + text + "' is not a positive number of seconds";
+            return "";
+          },
+          "SECONDS > 0"));
 
   lod::cli::InspectArgs inspect;
   auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels or an .hlod file's tree");
