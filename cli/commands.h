@@ -18,7 +18,13 @@ struct RunArgs {
   bool quiet = false;
   bool strict_exit = false;  // exit 5 when any frame's coarsest levels exceed M
   double stream_read_delay_ms = 0;  // every HLOD node read sleeps first (measuring slow storage)
+  double max_seconds = 0;    // stop after this many wall seconds of frames (the bake before them not counted); 0 = none
 };
+// Exit codes: 0 all frames run (or stopped by --max-seconds), 1 an error (bad input, a file that
+// cannot be written), 3 --validate found a bad frame, 4 the service lost frames, 5 --strict-exit
+// and a frame over budget, 128 + the signal's number (130 SIGINT, 143 SIGTERM) when a signal
+// stopped it: the frames run so far are in the files and the summary, complete and consistent.
+// Memory does not grow with --frames (docs/lod-run.md).
 int run_command(const RunArgs& args);
 
 struct InspectArgs {

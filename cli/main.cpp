@@ -1,12 +1,17 @@
 // lod: bake meshes into LOD assets, run the LOD service along a camera path, inspect assets.
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
 
 #include "cli/commands.h"
 #include "cli/freed_memory.h"
 #include "cli/huge_page_malloc.h"
 
-int main(int argc, char** argv) {
-  lod::cli::restart_with_huge_page_malloc(argv);
+namespace {
+
+int run_main(int argc, char** argv) {
   CLI::App app{"lodkit: multithreaded level-of-detail runtime"};
   app.require_subcommand(1);
 
@@ -31,6 +36,18 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--stream-read-delay-ms", run.stream_read_delay_ms,
                       "measuring: every HLOD node read sleeps this long first (slow storage)")
       ->check(CLI::Range(0.0, 10000.0));
+  run_cmd->add_option("--max-seconds", run.max_seconds,
+                      "stop after this many wall seconds of frames (not counting the bake); the files and summary "
+                      "hold the frames run")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !(v > 0) || !std::isfinite(v))
+              return "'" + text + "' is not a positive number of seconds";
+            return "";
+          },
+          "SECONDS > 0"));
 
   lod::cli::InspectArgs inspect;
   auto* inspect_cmd = app.add_subcommand("inspect", "print a .lod asset's levels or an .hlod file's tree");
@@ -89,4 +106,20 @@ int main(int argc, char** argv) {
   }
   if (export_cmd->parsed()) return lod::cli::export_command(exp);
   return 2;
+}
+
+}  // namespace
+
+// Exit codes: the subcommand's (cli/commands.h); 1 as well when an exception escapes one
+// (std::bad_alloc, say): "lod: <what>" on stderr instead of an abort.
+int main(int argc, char** argv) {
+  lod::cli::restart_with_huge_page_malloc(argv);
+  try {
+    return run_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lod: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "lod: an unknown exception\n");
+  }
+  return 1;
 }

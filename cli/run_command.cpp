@@ -11,8 +11,11 @@
 #include "cli/budget_shortfall.h"
 #include "cli/commands.h"
 #include "cli/hlod_check.h"
+#include "cli/run_outputs.h"
 #include "cli/run_report.h"
+#include "cli/run_totals.h"
 #include "cli/scene_hlod_check.h"
+#include "cli/stop_signals.h"
 #include "cli/terrain_check.h"
 #include "jobs/bake_jobs.h"
 #include "jobs/cache_folder.h"
@@ -205,6 +208,10 @@ int run_command(const RunArgs& args) {
     }
     config.threads = uint32_t(args.threads);
   }
+  if (!(args.max_seconds >= 0)) {
+    std::fprintf(stderr, "lod run: --max-seconds %g: must be positive\n", args.max_seconds);
+    return 1;
+  }
 
   const std::string cache_dir = cache_dir_for(args.cache_dir, config.cache_dir).string();
   auto log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
@@ -287,15 +294,38 @@ int run_command(const RunArgs& args) {
   bool told_shortfall = false;
   uint64_t told_failures = 0;  // HLOD node reads that failed, each told once  // the first over-budget frame is explained, the summary counts them all
 
-  std::vector<FrameRecord> records;
-  records.reserve(config.frames);
+  // Nothing here grows with the run: each frame's figures go to the files as they come, and
+  // the summary and plots are kept in fixed-size running totals (cli/run_outputs.h).
+  RunOutputs outputs;
+  if (auto st = outputs.open(args.json_file, args.report_dir); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
+  }
+  RunTotals totals;
+  uint64_t recorded = 0, last_frame = 0;
+  FrameRecord last;
+  bool last_printed = true;
+  summary.frames_requested = config.frames;
+  summary.max_seconds = args.max_seconds;
   const uint32_t every = config.frames <= 40 ? 1 : (config.frames + 29) / 30;
   if (!args.quiet) std::printf("%s\n%s\n", table_header().c_str(), table_legend().c_str());
   // Streaming scenes run at rate_hz in wall time: the loader threads get a frame's time per
   // frame, as under a renderer (back to back, frames take microseconds and loads trail far behind).
   const bool paced = !hlod->empty();
   const auto paced_start = std::chrono::steady_clock::now();
+  const auto deadline = paced_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                          std::chrono::duration<double>(args.max_seconds));
+  StopSignals stop_signals;  // SIGINT / SIGTERM end the loop; the files and summary still follow
   for (uint32_t n = 0; n < config.frames; ++n) {
+    if (const int sig = stop_signals.requested()) {
+      summary.stop = RunStop::signal;
+      summary.stop_signal = sig;
+      break;
+    }
+    if (args.max_seconds > 0 && std::chrono::steady_clock::now() >= deadline) {
+      summary.stop = RunStop::max_seconds;
+      break;
+    }
     if (paced) std::this_thread::sleep_until(paced_start + std::chrono::duration<double>(n * dt));
     if (motion.moving() > 0) {
       motion.stage(service, (n + 1) * dt);
@@ -310,7 +340,7 @@ int run_command(const RunArgs& args) {
     const Frame& frame = *held;
     if (args.validate) {
       std::string why;
-      if (!validate_frame(frame, scene, records.empty() ? frame.index : records.back().frame + 1, &why)) {
+      if (!validate_frame(frame, scene, recorded == 0 ? frame.index : last_frame + 1, &why)) {
         std::fprintf(stderr, "lod run --validate: frame %u: %s\n", n, why.c_str());
         return 3;
       }
@@ -348,33 +378,38 @@ int run_command(const RunArgs& args) {
                    frame.stream_failed[told_failures].node == 0 ? "the root: the model is not drawn"
                                                                 : "its parent stays drawn");
     }
-    records.push_back(record_of(frame));
-    if (!args.quiet && (n % every == 0 || n + 1 == config.frames))
-      std::printf("%s\n", table_row(records.back()).c_str());
+    last = record_of(frame);
+    last_frame = last.frame;
+    ++recorded;
+    totals.add(last);
+    if (auto st = outputs.add(last); !st) {
+      std::fprintf(stderr, "lod run: frame %u: %s\n", n, st.message.c_str());
+      return 1;
+    }
+    last_printed = !args.quiet && (n % every == 0 || n + 1 == config.frames);
+    if (last_printed) std::printf("%s\n", table_row(last).c_str());
   }
+  if (!args.quiet && !last_printed) std::printf("%s\n", table_row(last).c_str());  // stopped early
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  summarize(records, summary);
+  totals.fill(summary);
+  summary.plot_frames_per_bucket = outputs.frames_per_bucket();
   if (summary.threads == 0) summary.threads = std::max(1u, std::thread::hardware_concurrency());
   std::printf("%s", summary_text(summary).c_str());
   const auto stats = service.stats();
   if (stats.errors) std::printf("  service errors: %llu frames lost\n", (unsigned long long)stats.errors);
 
-  if (!args.json_file.empty()) {
-    if (auto st = write_json(args.json_file, records, summary); !st) {
-      std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
-      return 1;
-    }
-    std::printf("  json: %s\n", args.json_file.c_str());
+  if (auto st = outputs.finish(summary, FrameGraph::dot()); !st) {
+    std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
+    return 1;
   }
-  if (!args.report_dir.empty()) {
-    if (auto st = write_report(args.report_dir, records, summary, FrameGraph::dot()); !st) {
-      std::fprintf(stderr, "lod run: %s\n", st.message.c_str());
-      return 1;
-    }
+  if (!args.json_file.empty()) std::printf("  json: %s\n", args.json_file.c_str());
+  if (!args.report_dir.empty())
     std::printf("  report: %s/{frames.csv,summary.json,triangles.svg,drawn.svg,levels.svg,level_changes.svg,"
                 "pixel_error.svg,stage_ms.svg,graph.dot}\n",
                 args.report_dir.c_str());
-  }
+  std::fflush(stdout);
+  // Stopped by a signal: the files are whole, the exit code is the shell's for that signal.
+  if (summary.stop == RunStop::signal) return 128 + summary.stop_signal;
   if (stats.errors) return 4;
   if (summary.terrain_failures > 0) {
     std::fprintf(stderr, "lod run --validate: the terrain failed the crack check on %zu frames\n",

@@ -1,30 +1,18 @@
 #include "cli/run_report.h"
 
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "cli/svg_plot.h"
-#include "runtime/file_write.h"
 
 namespace lod::cli {
 namespace {
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const double pos = p * double(v.size() - 1);
-  const size_t i = size_t(pos);
-  const double t = pos - double(i);
-  return i + 1 < v.size() ? v[i] * (1 - t) + v[i + 1] * t : v[i];
-}
-
-Status write_file(const std::filesystem::path& file, const std::string& text) {
-  return write_file_atomic(file, text);
-}
-
 nlohmann::json or_null(bool measured, double value) { return measured ? nlohmann::json(value) : nlohmann::json(); }
+
+}  // namespace
 
 nlohmann::json frame_json(const FrameRecord& r) {
   nlohmann::json levels = nlohmann::json::object();
@@ -83,6 +71,12 @@ nlohmann::json summary_json(const RunSummary& s) {
   for (size_t i = 0; i < kStageCount; ++i) stages[kStageNames[i]] = s.median_stage_ms[i];
   return {{"config", s.config},
           {"frames", s.frames},
+          {"frames_requested", s.frames_requested},
+          {"stopped_by", run_stop_name(s.stop)},
+          {"max_seconds", or_null(s.max_seconds > 0, s.max_seconds)},
+          {"stop_signal", s.stop_signal},
+          {"percentile_relative_error", s.percentile_relative_error},
+          {"plot_frames_per_bucket", s.plot_frames_per_bucket},
           {"over_budget_frames", s.over_budget_frames},
           {"binding_frames", s.binding_frames},
           {"objects", s.objects},
@@ -131,7 +125,14 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"wall_s", s.wall_s}};
 }
 
-}  // namespace
+const char* run_stop_name(RunStop stop) {
+  switch (stop) {
+    case RunStop::max_seconds: return "max_seconds";
+    case RunStop::signal: return "signal";
+    case RunStop::frames: break;
+  }
+  return "frames";
+}
 
 FrameRecord record_of(const Frame& f) {
   FrameRecord r;
@@ -184,84 +185,6 @@ FrameRecord record_of(const Frame& f) {
   return r;
 }
 
-// Min and sum (summarize divides) of the fraction of the optimum over the frames measured.
-void summarize_optimum_fraction(const FrameRecord& r, RunSummary& s) {
-  if (r.benefit_optimum_fraction < 0) return;
-  s.min_benefit_optimum_fraction =
-      s.optimum_frames == 0 ? r.benefit_optimum_fraction : std::min(s.min_benefit_optimum_fraction, r.benefit_optimum_fraction);
-  s.mean_benefit_optimum_fraction += r.benefit_optimum_fraction;
-  ++s.optimum_frames;
-}
-
-void summarize(const std::vector<FrameRecord>& records, RunSummary& s) {
-  s.frames = records.size();
-  s.optimum_frames = 0;
-  s.min_benefit_optimum_fraction = s.mean_benefit_optimum_fraction = 0;
-  s.over_budget_frames = 0;
-  s.binding_frames = 0;
-  std::vector<double> total;
-  std::array<std::vector<double>, kStageCount> stage;
-  double vis = 0, inview = 0, sel = 0, drawn = 0, occluded = 0, culled = 0, benefit = 0, changes = 0, px = 0;
-  s.max_pixel_error = 0;
-  s.max_resident_bytes = s.total_holes = 0;
-  double hlod_nodes = 0, proxies = 0, proxy_objects = 0, draws = 0, terrain_tris = 0;
-  s.max_drawn_over_budget = 0;
-  s.frames_drawn_over_budget = 0;
-  for (const auto& r : records) {
-    s.over_budget_frames += r.over_budget;
-    s.binding_frames += (r.lowered_steps > 0 || r.over_budget);
-    total.push_back(r.total_ms);
-    for (size_t i = 0; i < kStageCount; ++i) stage[i].push_back(r.stage_ms[i]);
-    vis += r.visible;
-    inview += double(r.tris_in_view);
-    sel += double(r.tris_selected);
-    const double d = double(r.tris_selected + r.tris_morph_extra);
-    drawn += d;
-    if (r.budget > 0) s.max_drawn_over_budget = std::max(s.max_drawn_over_budget, d / double(r.budget));
-    s.frames_drawn_over_budget += d > double(r.budget);
-    occluded += r.occluded;
-    culled += r.culled;
-    benefit += r.benefit;
-    summarize_optimum_fraction(r, s);
-    changes += r.level_changes;
-    px += r.pixel_error_mean;
-    s.max_pixel_error = std::max(s.max_pixel_error, double(r.pixel_error_max));
-    s.max_resident_bytes = std::max(s.max_resident_bytes, r.resident_bytes);
-    s.total_holes += r.holes;
-    hlod_nodes += r.hlod_nodes_drawn;
-    proxies += r.scene_proxies;
-    proxy_objects += r.proxy_objects;
-    draws += double(r.draws());
-    terrain_tris += double(r.terrain_tris);
-    s.stream_loads = std::max(s.stream_loads, r.stream_loads);  // counters: the last frame's
-    s.stream_evictions = std::max(s.stream_evictions, r.stream_evictions);
-    s.stream_failures = std::max(s.stream_failures, r.stream_failures);
-  }
-  s.mean_hlod_nodes_drawn = hlod_nodes / std::max<double>(1, double(records.size()));
-  const double n = std::max<double>(1, double(records.size()));
-  s.median_ms = percentile(total, 0.5);
-  s.p99_ms = percentile(total, 0.99);
-  s.max_ms = total.empty() ? 0 : *std::max_element(total.begin(), total.end());
-  double sum = 0;
-  for (double t : total) sum += t;
-  s.mean_ms = sum / n;
-  for (size_t i = 0; i < kStageCount; ++i) s.median_stage_ms[i] = percentile(stage[i], 0.5);
-  s.mean_visible = vis / n;
-  s.mean_tris_in_view = inview / n;
-  s.mean_tris_selected = sel / n;
-  s.mean_tris_drawn = drawn / n;
-  s.mean_occluded = occluded / n;
-  s.mean_culled = culled / n;
-  s.mean_benefit = benefit / n;
-  if (s.optimum_frames > 0) s.mean_benefit_optimum_fraction /= double(s.optimum_frames);
-  s.mean_level_changes = changes / n;
-  s.mean_pixel_error = px / n;
-  s.mean_scene_proxies = proxies / n;
-  s.mean_proxy_objects = proxy_objects / n;
-  s.mean_draws = draws / n;
-  s.mean_terrain_tris = terrain_tris / n;
-}
-
 std::string table_legend() {
   return "  (tris_in_view: the visible objects at full detail; selected: triangles of the chosen levels; budget: M;\n"
          "   over: YES when even the coarsest levels exceed M; lowered: heap pops of selection; *_ms: visibility,\n"
@@ -288,12 +211,29 @@ std::string table_row(const FrameRecord& r) {
 std::string summary_text(const RunSummary& s) {
   std::ostringstream o;
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "summary: %zu frames, %zu objects of %zu models, %u threads, budget M = %llu (%s)\n"
-                "  frame graph: median %.3f ms, p99 %.3f ms, mean %.3f ms, max %.3f ms\n",
-                s.frames, s.objects, s.models, s.threads, (unsigned long long)s.budget, s.budget_count.c_str(),
-                s.median_ms, s.p99_ms, s.mean_ms, s.max_ms);
-  o << buf << "  median per stage:";
+  std::snprintf(buf, sizeof buf, "summary: %zu frames, %zu objects of %zu models, %u threads, budget M = %llu (%s)\n",
+                s.frames, s.objects, s.models, s.threads, (unsigned long long)s.budget, s.budget_count.c_str());
+  o << buf;
+  if (s.stop == RunStop::max_seconds) {
+    std::snprintf(buf, sizeof buf, "  stopped by --max-seconds %g after %zu of %zu frames\n", s.max_seconds, s.frames,
+                  s.frames_requested);
+    o << buf;
+  } else if (s.stop == RunStop::signal) {
+    std::snprintf(buf, sizeof buf, "  stopped by %s after %zu of %zu frames\n",
+                  s.stop_signal == SIGINT ? "SIGINT" : s.stop_signal == SIGTERM ? "SIGTERM" : "a signal", s.frames,
+                  s.frames_requested);
+    o << buf;
+  }
+  std::snprintf(buf, sizeof buf, "  frame graph: median %.3f ms, p99 %.3f ms, mean %.3f ms, max %.3f ms\n", s.median_ms,
+                s.p99_ms, s.mean_ms, s.max_ms);
+  o << buf;
+  if (s.percentile_relative_error > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "  (median, p99 and the medians per stage below are approximate: from a histogram, within %.1f %%)\n",
+                  100 * s.percentile_relative_error);
+    o << buf;
+  }
+  o << "  median per stage:";
   for (size_t i = 0; i < kStageCount; ++i) {
     std::snprintf(buf, sizeof buf, " %s %.3f", kStageNames[i], s.median_stage_ms[i]);
     o << buf;
@@ -357,118 +297,23 @@ std::string summary_text(const RunSummary& s) {
   return o.str();
 }
 
-Status write_json(const std::filesystem::path& file, const std::vector<FrameRecord>& records, const RunSummary& s) {
-  nlohmann::json j;
-  j["frames"] = nlohmann::json::array();
-  for (const auto& r : records) j["frames"].push_back(frame_json(r));
-  j["summary"] = summary_json(s);
-  if (file.has_parent_path()) {
-    std::error_code ec;
-    std::filesystem::create_directories(file.parent_path(), ec);
-  }
-  return write_file(file, j.dump(1) + "\n");
+std::string csv_header() {
+  std::string h =
+      "frame,objects,visible,tris_in_view,tris_selected,tris_drawn,tris_blend_extra,level_cost,budget,coarsest_cost,"
+      "over_budget,lowered_steps,levels_lowered,culled,level_changes,benefit,pixel_error_max,pixel_error_mean";
+  for (size_t i = 0; i < kStageCount; ++i) h += std::string(",") + kStageNames[i] + "_ms";
+  return h + ",total_ms\n";
 }
 
-namespace {
-
-// The plots of what selection did: drawn vs M (linear), objects per level, level changes and
-// the pixel error left.
-Status write_selection_plots(const std::filesystem::path& dir, const std::vector<FrameRecord>& records,
-                             const RunSummary& s) {
-  PlotSeries drawn{"drawn (selected + blends)", "#d62728", {}}, selected{"selected", "#1f77b4", {}},
-      budget{"budget M", "#2ca02c", {}, true};
-  PlotSeries changes{"level changes", "#9467bd", {}}, culled{"culled", "#7f7f7f", {}, true};
-  PlotSeries px_max{"worst", "#d62728", {}}, px_mean{"mean", "#1f77b4", {}};
-  size_t levels_used = 1;
-  for (const auto& r : records) {
-    drawn.values.push_back(double(r.drawn()));
-    selected.values.push_back(double(r.tris_selected));
-    budget.values.push_back(double(r.budget));
-    changes.values.push_back(r.level_changes);
-    culled.values.push_back(r.culled);
-    px_max.values.push_back(r.pixel_error_max);
-    px_mean.values.push_back(r.pixel_error_mean);
-    for (size_t l = 0; l < kMaxLevels; ++l)
-      if (r.chain_levels[l]) levels_used = std::max(levels_used, l + 1);
-  }
-  PlotOptions o;
-  o.title = "Drawn triangles (with level blends) vs the budget (" + s.config + ")";
-  o.y_label = "triangles";
-  if (auto st = write_file(dir / "drawn.svg", svg_line_plot({drawn, selected, budget}, o)); !st) return st;
-
-  static const char* colors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
-                                 "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
-  std::vector<PlotSeries> per_level;
-  for (size_t l = 0; l < levels_used; ++l) {
-    PlotSeries ps{"level " + std::to_string(l), colors[l % 10], {}};
-    for (const auto& r : records) ps.values.push_back(r.chain_levels[l]);
-    per_level.push_back(std::move(ps));
-  }
-  per_level.push_back(culled);
-  o.title = "Objects per chain level (0 = full detail; culled: not drawn)";
-  o.y_label = "objects";
-  if (auto st = write_file(dir / "levels.svg", svg_line_plot(per_level, o)); !st) return st;
-  o.title = "Level changes per frame (objects visible last frame at another level)";
-  o.y_label = "objects";
-  if (auto st = write_file(dir / "level_changes.svg", svg_line_plot({changes}, o)); !st) return st;
-  o.title = "Screen-space error left by the selected levels (view 0)";
-  o.y_label = "pixels";
-  return write_file(dir / "pixel_error.svg", svg_line_plot({px_max, px_mean}, o));
-}
-
-}  // namespace
-
-Status write_report(const std::filesystem::path& dir, const std::vector<FrameRecord>& records, const RunSummary& s,
-                    const std::string& graph_dot) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return Status::error(dir.string() + ": cannot create report directory: " + ec.message());
-
-  std::ostringstream csv;
-  csv << "frame,objects,visible,tris_in_view,tris_selected,tris_drawn,tris_blend_extra,level_cost,budget,coarsest_cost,"
-         "over_budget,lowered_steps,levels_lowered,culled,level_changes,benefit,pixel_error_max,pixel_error_mean";
-  for (size_t i = 0; i < kStageCount; ++i) csv << "," << kStageNames[i] << "_ms";
-  csv << ",total_ms\n";
-  for (const auto& r : records) {
-    csv << r.frame << "," << r.objects << "," << r.visible << "," << r.tris_in_view << "," << r.tris_selected << ","
-        << r.drawn() << "," << r.tris_morph_extra << "," << r.level_cost << "," << r.budget << "," << r.coarsest_cost
-        << "," << (r.over_budget ? 1 : 0) << "," << r.lowered_steps << "," << r.levels_lowered << "," << r.culled << ","
-        << r.level_changes << "," << r.benefit << "," << r.pixel_error_max << "," << r.pixel_error_mean;
-    for (size_t i = 0; i < kStageCount; ++i) csv << "," << r.stage_ms[i];
-    csv << "," << r.total_ms << "\n";
-  }
-  if (auto st = write_file(dir / "frames.csv", csv.str()); !st) return st;
-  if (auto st = write_file(dir / "summary.json", summary_json(s).dump(1) + "\n"); !st) return st;
-  if (auto st = write_file(dir / "graph.dot", graph_dot); !st) return st;
-
-  PlotSeries in_view{"in view (full detail)", "#d62728", {}}, selected{"selected", "#1f77b4", {}},
-      budget{"budget M", "#2ca02c", {}, true};
-  for (const auto& r : records) {
-    in_view.values.push_back(double(r.tris_in_view));
-    selected.values.push_back(double(r.tris_selected));
-    budget.values.push_back(double(r.budget));
-  }
-  PlotOptions tri_opt;
-  tri_opt.title = "Triangles per frame: in view, selected, budget (" + s.config + ")";
-  tri_opt.y_label = "triangles (log)";
-  tri_opt.log_y = true;
-  if (auto st = write_file(dir / "triangles.svg", svg_line_plot({in_view, selected, budget}, tri_opt)); !st) return st;
-  if (auto st = write_selection_plots(dir, records, s); !st) return st;
-
-  static const char* colors[] = {"#7f7f7f", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"};
-  std::vector<PlotSeries> stages;
-  for (size_t i = 0; i < kStageCount; ++i) {
-    PlotSeries ps{kStageNames[i], colors[i % 7], {}};
-    for (const auto& r : records) ps.values.push_back(r.stage_ms[i]);
-    stages.push_back(std::move(ps));
-  }
-  PlotSeries total{"total", "#000000", {}};
-  for (const auto& r : records) total.values.push_back(r.total_ms);
-  stages.push_back(std::move(total));
-  PlotOptions ms_opt;
-  ms_opt.title = "Frame graph milliseconds per stage (" + std::to_string(s.threads) + " threads)";
-  ms_opt.y_label = "ms";
-  return write_file(dir / "stage_ms.svg", svg_line_plot(stages, ms_opt));
+std::string csv_row(const FrameRecord& r) {
+  std::ostringstream csv;  // default stream formatting: 6 significant digits, as the file always had
+  csv << r.frame << "," << r.objects << "," << r.visible << "," << r.tris_in_view << "," << r.tris_selected << ","
+      << r.drawn() << "," << r.tris_morph_extra << "," << r.level_cost << "," << r.budget << "," << r.coarsest_cost
+      << "," << (r.over_budget ? 1 : 0) << "," << r.lowered_steps << "," << r.levels_lowered << "," << r.culled << ","
+      << r.level_changes << "," << r.benefit << "," << r.pixel_error_max << "," << r.pixel_error_mean;
+  for (size_t i = 0; i < kStageCount; ++i) csv << "," << r.stage_ms[i];
+  csv << "," << r.total_ms << "\n";
+  return csv.str();
 }
 
 }  // namespace lod::cli

@@ -1,9 +1,11 @@
-// RunReport: the per-frame figures of `lod run` and what is written from them
-// (terminal table, JSON, CSV, SVG plots).
+// RunReport: the per-frame figures of `lod run` and how each is written: the terminal table,
+// a frame's JSON object and CSV row, the summary's JSON and text. cli/run_outputs.h streams
+// them to the files; cli/run_totals.h sums the frames into the summary.
 #pragma once
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -55,15 +57,27 @@ struct FrameRecord {
 
 FrameRecord record_of(const Frame& frame);
 
+// Why a run ended before its frames were all run (or did not).
+enum class RunStop { frames, max_seconds, signal };
+const char* run_stop_name(RunStop stop);  // "frames", "max_seconds", "signal"
+
 struct RunSummary {
   std::string config;
   size_t frames = 0, over_budget_frames = 0, binding_frames = 0;
+  size_t frames_requested = 0;  // --frames or the config's
+  RunStop stop = RunStop::frames;
+  double max_seconds = 0;       // --max-seconds (0: none)
+  int stop_signal = 0;          // RunStop::signal: SIGINT or SIGTERM
   size_t objects = 0, models = 0;
   uint32_t threads = 0;
   uint64_t budget = 0;
   std::string budget_count;
   double median_ms = 0, p99_ms = 0, mean_ms = 0, max_ms = 0;
   std::array<double, kStageCount> median_stage_ms{};
+  // The percentiles (median, p99, medians per stage) are exact up to QuantileSketch's exact
+  // capacity; past it they come from its histogram, within this relative error (0: exact).
+  double percentile_relative_error = 0;
+  uint64_t plot_frames_per_bucket = 1;  // the plots' min/max buckets (1: every frame drawn)
   double mean_visible = 0, mean_tris_in_view = 0, mean_tris_selected = 0;
   // Drawn = selected + what blends add (triangle budgets): the mean and the worst frame vs M.
   double mean_tris_drawn = 0, max_drawn_over_budget = 0;
@@ -91,22 +105,18 @@ struct RunSummary {
   double wall_s = 0;
 };
 
-// Fills the timing and mean fields of `summary` from the records.
-void summarize(const std::vector<FrameRecord>& records, RunSummary& summary);
-
 // What the per-frame table's columns mean (printed under its header).
 std::string table_legend();
 std::string table_header();
 std::string table_row(const FrameRecord& r);
 std::string summary_text(const RunSummary& s);
 
-Status write_json(const std::filesystem::path& file, const std::vector<FrameRecord>& records,
-                  const RunSummary& summary);
-// frames.csv, summary.json, graph.dot and the plots: triangles.svg (Yu, Liang and Chen's Fig. 4: in view,
-// selected, budget; log scale), drawn.svg (drawn with blends vs M, linear), levels.svg
-// (objects per chain level), level_changes.svg, pixel_error.svg (worst and mean error left)
-// and stage_ms.svg (per-stage milliseconds).
-Status write_report(const std::filesystem::path& dir, const std::vector<FrameRecord>& records,
-                    const RunSummary& summary, const std::string& graph_dot);
+// One frame's object in the --json file's "frames" array, and the "summary" object (also
+// the report's summary.json).
+nlohmann::json frame_json(const FrameRecord& r);
+nlohmann::json summary_json(const RunSummary& s);
+// frames.csv: its header line and one frame's line, each ending in a newline.
+std::string csv_header();
+std::string csv_row(const FrameRecord& r);
 
 }  // namespace lod::cli

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 
@@ -34,17 +35,19 @@ std::string escape(const std::string& s) {
 std::string svg_line_plot(const std::vector<PlotSeries>& series, const PlotOptions& opt) {
   const double left = 80, right = 180, top = 40, bottom = 50;
   const double pw = opt.width - left - right, ph = opt.height - top - bottom;
-  size_t n = 0;
+  // The x range: 0 to the last x of any series (a series without x has x = 0, 1, 2, ...).
+  double x_hi = 0;
+  auto x_of = [](const PlotSeries& s, size_t i) { return s.x.empty() ? double(i) : s.x[i]; };
   double lo = INFINITY, hi = -INFINITY;
   for (const auto& s : series) {
-    n = std::max(n, s.values.size());
+    if (!s.values.empty()) x_hi = std::max(x_hi, x_of(s, s.values.size() - 1));
     for (double v : s.values) {
       if (!std::isfinite(v) || (opt.log_y && v <= 0)) continue;
       lo = std::min(lo, v);
       hi = std::max(hi, v);
     }
   }
-  if (!(lo <= hi)) lo = 0, hi = 1;
+  if (!(lo <= hi)) lo = opt.log_y ? 1 : 0, hi = opt.log_y ? 10 : 1;  // nothing to draw (no frames): an empty frame
   if (opt.log_y) {
     lo = std::pow(10.0, std::floor(std::log10(lo)));
     hi = std::pow(10.0, std::ceil(std::log10(hi)));
@@ -59,7 +62,7 @@ std::string svg_line_plot(const std::vector<PlotSeries>& series, const PlotOptio
                                : (v - lo) / (hi - lo);
     return top + ph * (1 - t);
   };
-  auto xmap = [&](size_t i) { return left + (n > 1 ? pw * double(i) / double(n - 1) : 0); };
+  auto xmap = [&](double x) { return left + (x_hi > 0 ? pw * x / x_hi : 0); };
 
   std::ostringstream o;
   o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << opt.width << "' height='" << opt.height
@@ -81,9 +84,9 @@ std::string svg_line_plot(const std::vector<PlotSeries>& series, const PlotOptio
       << "' stroke='#ddd'/><text x='" << left - 6 << "' y='" << y + 4 << "' text-anchor='end'>" << format_tick(t)
       << "</text>\n";
   }
-  for (int i = 0; i <= 6 && n > 1; ++i) {
-    const size_t idx = (n - 1) * i / 6;
-    o << "<text x='" << xmap(idx) << "' y='" << top + ph + 18 << "' text-anchor='middle'>" << idx << "</text>\n";
+  for (int i = 0; i <= 6 && x_hi > 0; ++i) {
+    const uint64_t at = uint64_t(x_hi) * uint64_t(i) / 6;
+    o << "<text x='" << xmap(double(at)) << "' y='" << top + ph + 18 << "' text-anchor='middle'>" << at << "</text>\n";
   }
   o << "<text x='" << left + pw / 2 << "' y='" << opt.height - 10 << "' text-anchor='middle'>" << escape(opt.x_label)
     << "</text>\n";
@@ -95,7 +98,7 @@ std::string svg_line_plot(const std::vector<PlotSeries>& series, const PlotOptio
       << (s.dashed ? " stroke-dasharray='6,4'" : "") << " points='";
     for (size_t i = 0; i < s.values.size(); ++i) {
       if (!std::isfinite(s.values[i])) continue;
-      o << xmap(i) << "," << ymap(s.values[i]) << " ";
+      o << xmap(x_of(s, i)) << "," << ymap(s.values[i]) << " ";
     }
     o << "'/>\n";
     const double ly = top + 14 + 20.0 * double(k);

@@ -8,8 +8,9 @@ namespace lod::cli {
 struct PlotSeries {
   std::string name;
   std::string color;            // any SVG colour
-  std::vector<double> values;   // one per x step
+  std::vector<double> values;   // one per x step, or one per entry of x
   bool dashed = false;
+  std::vector<double> x;        // empty: value i is at x = i; else the x of every value, ascending
 };
 
 struct PlotOptions {
