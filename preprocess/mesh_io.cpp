@@ -481,9 +481,11 @@ std::vector<std::filesystem::path> obj_external_files(const std::filesystem::pat
   std::vector<std::filesystem::path> out;
   for (const std::string& lib : statement_files(bytes, "mtllib", true)) {
     const std::filesystem::path mtl = dir / lib;
+    std::error_code ec;
+    if (!std::filesystem::exists(mtl, ec)) continue;
+    out.push_back(mtl);  // even when it cannot be read: the key's hashing names what it is
     std::vector<uint8_t> m;
     if (!read_regular_file(mtl, kMaterialFileLimit, m) || first_nul_byte(m) != SIZE_MAX) continue;
-    out.push_back(mtl);
     for (const char* map : {"map_Kd", "map_Ke", "map_Bump", "map_bump", "bump", "norm", "map_Pm", "map_Pr"})
       for (const std::string& image : statement_files(m, map, false)) out.push_back(mtl.parent_path() / image);
   }
