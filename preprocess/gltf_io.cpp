@@ -132,8 +132,12 @@ bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const st
     *err = "external files are not read for input in memory";
     return false;
   }
+  // Images (by their extension) have the texture limit; buffers are bounded by glTF's own.
+  const std::string ext = lower(fs::path(path).extension().string());
+  const bool image = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  const FileLimit limit = image ? kTextureFileLimit : FileLimit{std::numeric_limits<uint32_t>::max(), "a glTF buffer"};
   std::vector<uint8_t> bytes;
-  if (Status s = read_regular_file(path, kInputFileLimit, bytes); !s) {
+  if (Status s = read_regular_file(path, limit, bytes); !s) {
     *err = s.message;
     return false;
   }

@@ -892,9 +892,11 @@ Status check_lod_header(std::span<const uint8_t> head, uint64_t size, const std:
   if (sections_end + kChecksumBytes > size)
     return refuse(what, "truncated: file is " + std::to_string(size) + " bytes, its sections need " +
                             std::to_string(sections_end + kChecksumBytes));
-  if (sections_end + kChecksumBytes < size)
+  // The writer aligns the checksum to 8 bytes: up to 7 bytes of padding come before it.
+  const uint64_t end = (sections_end + 7) / 8 * 8 + kChecksumBytes;
+  if (size > end)
     return refuse(what, "file is " + std::to_string(size) + " bytes, its sections and checksum end at " +
-                            std::to_string(sections_end + kChecksumBytes) + " (bytes after them)");
+                            std::to_string(end) + " (bytes after them)");
   return Status::success();
 }
 

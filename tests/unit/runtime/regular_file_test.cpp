@@ -118,9 +118,10 @@ TEST(RegularFile, TextHeadWithANulByteIsRefused) {
 // is refused for the bytes after its sections, not read whole and found corrupt.
 TEST(RegularFile, SparseMultiGigabyteLodAssetIsRefusedFromItsHeader) {
   const fs::path dir = test::temp_dir("regular-sparse-lod");
-  std::vector<uint8_t> head = {'L', 'O', 'D', 'K', 'I', 'T', 0x1a, '\n'};
-  const uint32_t words[2] = {kLodAssetVersion, 0};  // no sections
-  head.insert(head.end(), reinterpret_cast<const uint8_t*>(words), reinterpret_cast<const uint8_t*>(words) + 8);
+  std::vector<uint8_t> head(16, 0);  // magic, version, no sections
+  std::memcpy(head.data(), "LODKIT\x1a\n", 8);
+  const uint32_t version = kLodAssetVersion;
+  std::memcpy(head.data() + 8, &version, 4);
   sparse_file(dir / "big.lod", head, uint64_t(4) << 30);
   LodChain out;
   out.name = "untouched";
