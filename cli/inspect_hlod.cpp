@@ -4,13 +4,13 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "cli/embedded_images_report.h"
 #include "cli/names.h"
 #include "runtime/hlod_asset.h"
+#include "runtime/regular_file.h"
 
 namespace lod::cli {
 namespace {
@@ -137,11 +137,10 @@ int verify_hlod(const InspectArgs& args) {
 bool is_hlod_file(const std::string& file) {
   // Regular files only: opening a FIFO to peek at it would block (the .lod reader then says
   // what the path is).
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) return false;
-  std::ifstream f(file, std::ios::binary);
-  char magic[8] = {};
-  return f.read(magic, 8) && std::memcmp(magic, "LODHLOD\n", 8) == 0;
+  RegularFile f;
+  std::vector<uint8_t> magic;
+  return open_regular_file(file, kInputFileLimit, f) && f.read_head(8, magic) && magic.size() == 8 &&
+         std::memcmp(magic.data(), "LODHLOD\n", 8) == 0;
 }
 
 int inspect_hlod_command(const InspectArgs& args) {

@@ -15,7 +15,8 @@
 #include "preprocess/material_runs.h"
 #include "preprocess/mesh_clean.h"
 #include "preprocess/mesh_io.h"
-#include "preprocess/mesh_readers.h"  // read_regular_file
+#include "preprocess/mesh_readers.h"  // open_mesh_file
+#include "runtime/regular_file.h"
 #include "runtime/embedded_image.h"
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
@@ -46,9 +47,15 @@ std::vector<EmbeddedImage> kept_embedded_images(std::vector<ChainMaterial>& mate
 
 // Content hash of the mesh file's bytes, mixed with what else decides the output.
 Status hlod_source_hash(const std::filesystem::path& file, uint32_t min_verts, uint64_t& out) {
-  // The mesh readers' own read: a directory, FIFO or device is refused by name, not read.
+  // The mesh readers' own checks first: a directory, FIFO or device is refused by name, and a
+  // file whose head cannot be its format unread.
+  {
+    RegularFile f;
+    uint64_t read_bytes = 0;
+    if (Status s = detail::open_mesh_file(file, f, read_bytes); !s) return s;
+  }
   uint64_t content = 0;
-  if (Status s = detail::hash_regular_file(file, content); !s) return s;
+  if (Status s = hash_regular_file(file, content); !s) return s;
   out = hlod_source_hash_of(file, content, min_verts);
   return Status::success();
 }
@@ -64,7 +71,7 @@ uint64_t hlod_source_hash_of(const std::filesystem::path& file, uint64_t content
     for (const auto& named : ext == ".obj" ? obj_external_files(file) : gltf_external_files(file)) {
       // In 1 MB pieces (a glTF's .bin is the geometry, hundreds of MB on a scan); a missing,
       // empty or unreadable one adds nothing (the load says what is wrong with it).
-      if (uint64_t more = 0; detail::hash_regular_file(named, more, content)) content = more;
+      if (uint64_t more = 0; hash_regular_file(named, more, content)) content = more;
       else content = hash_bytes(nullptr, 0, content);
     }
   const uint64_t settings[2] = {kHlodBuildVersion, min_verts};

@@ -27,6 +27,7 @@
 #include "runtime/file_write.h"
 #include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/material_section.h"
+#include "runtime/regular_file.h"
 
 namespace lod {
 namespace {
@@ -36,24 +37,6 @@ constexpr uint64_t kFixedBytes = 72;
 constexpr uint32_t kFlagUvs = 1;
 constexpr uint32_t kFlagColors = 2;
 constexpr uint32_t kFlagUvs1 = 4;
-
-bool read_whole(const std::filesystem::path& path, std::vector<uint8_t>& out) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return false;
-  struct stat st {};
-  bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
-  if (ok) out.resize(size_t(st.st_size));
-  for (size_t done = 0; ok && done < out.size();) {
-    const ssize_t n = ::pread(fd, out.data() + done, out.size() - done, off_t(done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0)
-      ok = false;
-    else
-      done += size_t(n);
-  }
-  ::close(fd);
-  return ok;
-}
 
 }  // namespace
 
@@ -167,8 +150,10 @@ struct EntryLayout {
   size_t positions = 0, index_words = 0, uvs = 0, uvs1 = 0, colors = 0, rows = 0, materials = 0, images = 0;
 };
 
-std::string read_layout(std::span<const uint8_t> b, uint64_t source_hash, bool check, EntryLayout& l) {
-  if (b.size() < kFixedBytes + 8) return "too short for a cleaned mesh entry (truncated?)";
+// The fixed header (`b`: at least its kFixedBytes when `size` allows them) against the
+// entry's `size`: read before the entry is read whole.
+std::string head_layout(std::span<const uint8_t> b, uint64_t size, EntryLayout& l) {
+  if (size < kFixedBytes + 8 || b.size() < kFixedBytes) return "too short for a cleaned mesh entry (truncated?)";
   if (std::memcmp(b.data(), kMagic, 8) != 0) return "not a cleaned mesh entry (bad magic bytes)";
   if (detail::load_u32(b.data() + 8) != kHlodMeshEntryVersion) return "entry version is not supported";
   l.flags = detail::load_u32(b.data() + 12);
@@ -180,14 +165,19 @@ std::string read_layout(std::span<const uint8_t> b, uint64_t source_hash, bool c
   const uint64_t per_vertex =
       12 + ((l.flags & kFlagUvs) ? 8 : 0) + ((l.flags & kFlagUvs1) ? 8 : 0) + ((l.flags & kFlagColors) ? 16 : 0);
   // Counts against the size before anything is allocated (each bounded first, so the sum cannot overflow).
-  if (l.vertices >= UINT32_MAX || l.indices % 3 != 0 || l.indices > b.size() / 4 || l.submeshes > b.size() / 12 ||
-      l.material_bytes > b.size() || l.image_bytes > b.size() ||
-      b.size() != kFixedBytes + per_vertex * l.vertices + 4 * l.indices + 12 * l.submeshes + l.material_bytes +
-                      l.image_bytes + 8)
+  if (l.vertices >= UINT32_MAX || l.indices % 3 != 0 || l.indices > size / 4 || l.submeshes > size / 12 ||
+      l.material_bytes > size || l.image_bytes > size ||
+      size != kFixedBytes + per_vertex * l.vertices + 4 * l.indices + 12 * l.submeshes + l.material_bytes +
+                  l.image_bytes + 8)
     return "its counts (" + std::to_string(l.vertices) + " vertices, " + std::to_string(l.indices) + " indices, " +
            std::to_string(l.submeshes) + " submeshes, " + std::to_string(l.material_bytes) + " bytes of materials, " +
-           std::to_string(l.image_bytes) + " of images) do not match its " + std::to_string(b.size()) +
+           std::to_string(l.image_bytes) + " of images) do not match its " + std::to_string(size) +
            " bytes (truncated?)";
+  return {};
+}
+
+std::string read_layout(std::span<const uint8_t> b, uint64_t source_hash, bool check, EntryLayout& l) {
+  if (std::string bad = head_layout(b, b.size(), l); !bad.empty()) return bad;
   const size_t body = b.size() - 8;
   if (check && detail::load_u64(b.data() + body) != hash_bytes(b.data(), body)) return "checksum mismatch (corrupted)";
   if (detail::load_u64(b.data() + 16) != source_hash) return "written for another source (a misplaced entry)";
@@ -273,8 +263,18 @@ CacheLookup load_hlod_mesh(const std::filesystem::path& dir, uint64_t source_has
     if (why) *why = path.string() + ": " + reason;
     return CacheLookup::refused;
   };
+  // The header against the entry's size first, then the entry whole.
+  auto refused = [&](const Status& s) {
+    if (why) *why = s.message;  // names the file already
+    return CacheLookup::refused;
+  };
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return refused(s);
   std::vector<uint8_t> b;
-  if (!read_whole(path, b)) return refuse("cannot be read (not a regular file?)");
+  if (Status s = f.read_head(kFixedBytes, b); !s) return refused(s);
+  EntryLayout head;
+  if (std::string bad = head_layout(b, f.size, head); !bad.empty()) return refuse(bad);
+  if (Status s = f.read_all(b); !s) return refused(s);
   EntryLayout l;
   if (std::string bad = read_layout(b, source_hash, true, l); !bad.empty()) return refuse(bad);
   MeshData m;

@@ -3,31 +3,34 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 
 #include "jobs/hlod_read_failures.h"
 #include "runtime/hlod_asset.h"
 #include "runtime/lod_asset.h"  // hash_bytes
+#include "runtime/regular_file.h"
 
 namespace lod {
 namespace {
 
 // The whole file; `opened` false when nothing is there. Anything else unreadable (a folder in
-// its place, an I/O error) is a refusal with its reason.
+// its place, an I/O error) is a refusal with its reason. The tree is read first (its head
+// bounded by the file): the payloads it places must end where the file does before the file
+// is read whole.
 Status read_file(const std::filesystem::path& path, std::vector<uint8_t>& out, bool& opened) {
   std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  opened = std::filesystem::exists(status);
+  opened = std::filesystem::exists(std::filesystem::symlink_status(path, ec));
   if (!opened) return Status::error(path.string() + ": does not exist");
-  if (!std::filesystem::is_regular_file(status)) return Status::error(path.string() + ": is not a regular file");
-  std::ifstream f(path, std::ios::binary | std::ios::ate);
-  const std::streamoff size = f ? std::streamoff(f.tellg()) : std::streamoff(-1);
-  if (size < 0) return Status::error(path.string() + ": cannot be read");
-  out.resize(size_t(size));
-  f.seekg(0);
-  if (!f.read(reinterpret_cast<char*>(out.data()), std::streamsize(out.size())))
-    return Status::error(path.string() + ": read error");
-  return Status::success();
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return s;
+  HlodFile hlod;
+  HlodTree tree;
+  if (Status s = hlod.open(path, tree); !s) return s;
+  uint64_t end = 0;
+  for (const HlodNode& n : tree.nodes) end = std::max(end, n.payload_offset + n.payload_size);
+  if (end != f.size)
+    return Status::error(path.string() + ": its payloads end at " + std::to_string(end) + " of " +
+                         std::to_string(f.size) + " bytes");
+  return f.read_all(out);
 }
 
 }  // namespace

@@ -13,7 +13,6 @@
 #include <condition_variable>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -25,6 +24,7 @@
 #include "jobs/hlod_model_cache.h"
 #include "runtime/byte_order.h"
 #include "runtime/file_write.h"
+#include "runtime/regular_file.h"
 
 namespace lod {
 namespace {
@@ -454,13 +454,11 @@ Status take_reports(Job& j, const std::vector<std::vector<uint8_t>>& reports, Hl
 }  // namespace
 
 uint64_t estimate_mesh_triangles(const std::filesystem::path& mesh_file) {
-  std::error_code ec;
-  const uintmax_t size = std::filesystem::file_size(mesh_file, ec);
-  std::ifstream f(mesh_file, std::ios::binary);
-  if (ec || size == 0 || !f) return 0;
-  std::string head(size_t(std::min<uintmax_t>(size, 16 * 1024)), '\0');
-  f.read(head.data(), std::streamsize(head.size()));
-  head.resize(size_t(f.gcount()));
+  RegularFile file;
+  std::vector<uint8_t> first;
+  if (!open_regular_file(mesh_file, kInputFileLimit, file) || file.size == 0 || !file.read_head(16 * 1024, first)) return 0;
+  const uint64_t size = file.size;
+  const std::string head(first.begin(), first.end());
   const std::string ext = lower(mesh_file.extension().string());
   uint64_t n = 0;
   if (ext == ".ply") n = ply_faces(head);

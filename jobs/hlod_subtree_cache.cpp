@@ -20,6 +20,7 @@
 #include "runtime/file_write.h"
 #include "runtime/hlod_subtree_entry.h"
 #include "runtime/lod_asset.h"  // hash_bytes
+#include "runtime/regular_file.h"
 
 namespace lod {
 namespace {
@@ -37,21 +38,16 @@ bool read_at(int fd, uint64_t offset, std::span<uint8_t> out) {
 }
 
 // The whole file; `opened` false when it does not exist. Anything else unreadable (a folder in
-// its place, an I/O error) is read as no bytes, which the decoder refuses.
+// its place, an I/O error) is read as no bytes, which the decoder refuses. A file whose first
+// bytes are not an entry is not read further: those are enough for the decoder to say why.
 std::vector<uint8_t> read_all(const std::filesystem::path& path, bool& opened) {
   std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  opened = std::filesystem::exists(status);
-  if (!opened || !std::filesystem::is_regular_file(status)) return {};
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return {};
+  opened = std::filesystem::exists(std::filesystem::symlink_status(path, ec));
+  RegularFile f;
   std::vector<uint8_t> bytes;
-  struct stat st {};
-  if (::fstat(fd, &st) == 0 && st.st_size > 0) {
-    bytes.resize(size_t(st.st_size));
-    if (!read_at(fd, 0, bytes)) bytes.clear();
-  }
-  ::close(fd);
+  if (!opened || !open_regular_file(path, kInputFileLimit, f) || !f.read_head(64 * 1024, bytes)) return {};
+  if (hlod_subtree_entry_root_bytes(bytes, f.size) == 0) return bytes;
+  if (!f.read_all(bytes)) return {};
   return bytes;
 }
 
@@ -124,13 +120,12 @@ CacheLookup load_hlod_subtree(const std::filesystem::path& dir, uint64_t key, ui
 Status read_hlod_subtree_entry(const std::filesystem::path& dir, uint64_t key, uint64_t size,
                                std::vector<uint8_t>& bytes) {
   const std::filesystem::path path = hlod_subtree_entry_path(dir, key);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Status::error(path.string() + ": cannot be opened: " + std::strerror(errno));
-  struct stat st {};
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return s;
+  const int fd = f.fd;
   std::string wrong;
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) wrong = "is not a regular file";
-  else if (uint64_t(st.st_size) != size)
-    wrong = "is " + std::to_string(st.st_size) + " bytes, not the " + std::to_string(size) + " this rank had";
+  if (f.size != size)
+    wrong = "is " + std::to_string(f.size) + " bytes, not the " + std::to_string(size) + " this rank had";
   if (wrong.empty()) {
     bytes.clear();  // a buffer reused: nothing copied when it grows
     bytes.resize(size_t(size));
@@ -138,7 +133,6 @@ Status read_hlod_subtree_entry(const std::filesystem::path& dir, uint64_t key, u
     // Read once: its page-cache pages go back at once, for the next read to reuse.
     ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
   }
-  ::close(fd);
   if (wrong.empty()) return Status::success();
   std::vector<uint8_t>().swap(bytes);
   return Status::error(path.string() + ": " + wrong);
@@ -155,24 +149,20 @@ CacheLookup load_hlod_subtree_root(const std::filesystem::path& dir, uint64_t ke
     return CacheLookup::refused;
   };
   if (!std::filesystem::is_regular_file(status)) return refused(path.string() + ": is not a regular file");
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  struct stat st {};
-  if (fd < 0 || ::fstat(fd, &st) != 0) {
-    if (fd >= 0) ::close(fd);
-    return refused(path.string() + ": cannot be read");
-  }
-  const uint64_t size = uint64_t(st.st_size);
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return refused(s.message);
+  const int fd = f.fd;
+  const uint64_t size = f.size;
   // Most roots lie in the first 64 KiB; otherwise each answer names the bytes still wanted.
   std::vector<uint8_t> prefix(size_t(std::min<uint64_t>(size, 64 * 1024)));
   bool read = read_at(fd, 0, prefix);
   for (int step = 0; read && step < 4; ++step) {
     const uint64_t need = hlod_subtree_entry_root_bytes(prefix, size);
-    if (need == 0 || need <= prefix.size()) break;
+    if (need == 0 || need <= prefix.size() || need > size) break;  // the decoder names it
     const size_t have = prefix.size();
     prefix.resize(size_t(need));
     read = read_at(fd, have, std::span<uint8_t>(prefix).subspan(have));
   }
-  ::close(fd);
   if (!read) return refused(path.string() + ": cannot be read (truncated?)");
   if (bytes_read) *bytes_read = prefix.size();
   if (Status s = decode_hlod_subtree_root(prefix, size, key, mesh_vertices, path.string(), out); !s)

@@ -3,13 +3,14 @@
 // written only when the whole file is good.
 #include "jobs/scene_config.h"
 
+#include "runtime/regular_file.h"
+
 #include <toml++/toml.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <initializer_list>
 #include <optional>
 #include <sstream>
@@ -675,17 +676,9 @@ Status load_scene_config(const std::filesystem::path& file, const std::filesyste
                          SceneConfig& out, bool objects_optional) {
   const std::string name = file.string();
   std::error_code ec;
-  const auto kind = std::filesystem::status(file, ec).type();
-  if (kind == std::filesystem::file_type::not_found) return Status::error(name + ": config file not found");
-  if (kind != std::filesystem::file_type::regular) return Status::error(name + ": not a regular file");
-  const uintmax_t size = std::filesystem::file_size(file, ec);
-  if (ec) return Status::error(name + ": cannot read its size: " + ec.message());
-  if (size > kMaxConfigBytes)
-    return Status::error(name + ": " + std::to_string(size) + " bytes; a scene config is at most " +
-                         std::to_string(kMaxConfigBytes) + " bytes");
-  std::ifstream f(file, std::ios::binary);
-  std::string text(size_t(size), '\0');
-  if (!f.read(text.data(), std::streamsize(size))) return Status::error(name + ": cannot be read");
+  if (!std::filesystem::exists(file, ec)) return Status::error(name + ": config file not found");
+  std::string text;
+  if (Status s = read_regular_file(file, kConfigFileLimit, text); !s) return s;
   return parse_scene_config(text, file, data_dir, out, objects_optional);
 }
 

@@ -1,5 +1,6 @@
 // SceneConfig: everything a configs/*.toml file says, parsed and checked.
 #pragma once
+#include "runtime/regular_file.h"
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -108,7 +109,7 @@ Status load_scene_config(const std::filesystem::path& file, const std::filesyste
 
 // The same over a config's text; `file` names it in messages and is where relative mesh paths
 // start. Configs are small: load_scene_config refuses files over kMaxConfigBytes unread.
-inline constexpr uint64_t kMaxConfigBytes = 16u << 20;
+inline constexpr uint64_t kMaxConfigBytes = kConfigFileLimit.max_bytes;
 Status parse_scene_config(std::string_view text, const std::filesystem::path& file,
                           const std::filesystem::path& data_dir, SceneConfig& out, bool objects_optional = false);
 

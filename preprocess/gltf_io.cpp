@@ -132,8 +132,12 @@ bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const st
     *err = "external files are not read for input in memory";
     return false;
   }
+  // Images (by their extension) have the texture limit; buffers are bounded by glTF's own.
+  const std::string ext = lower(fs::path(path).extension().string());
+  const bool image = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  const FileLimit limit = image ? kTextureFileLimit : FileLimit{std::numeric_limits<uint32_t>::max(), "a glTF buffer"};
   std::vector<uint8_t> bytes;
-  if (Status s = read_regular_file(path, bytes); !s) {
+  if (Status s = read_regular_file(path, limit, bytes); !s) {
     *err = s.message;
     return false;
   }
@@ -148,43 +152,22 @@ struct FileBytes {
   size_t size = 0;
 };
 
-// A readable, non-empty regular file is read here; anything else (missing, a directory, a
-// FIFO, a device, unreadable, empty) goes through read_regular_file, which says what it is and
-// never blocks.
+// The file's bytes, as many as open_mesh_file allows (a GLB: what its header declares).
 Status read_file_bytes(const fs::path& path, FileBytes& out) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  struct stat st {};
-  const bool plain = fd >= 0 && ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0 &&
-                     uint64_t(st.st_size) <= std::numeric_limits<size_t>::max() / 2;
-  if (!plain) {
-    if (fd >= 0) ::close(fd);
-    std::vector<uint8_t> bytes;
-    if (Status s = read_regular_file(path, bytes); !s) return s;
-    out.data = std::make_unique_for_overwrite<uint8_t[]>(bytes.size());
-    std::memcpy(out.data.get(), bytes.data(), bytes.size());
-    out.size = bytes.size();
-    return Status::success();
-  }
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  const size_t size = size_t(st.st_size);
+  RegularFile f;
+  uint64_t n = 0;
+  if (Status s = open_mesh_file(path, f, n); !s) return s;
+  if (n > physical_memory_bytes())
+    return Status::error(f.what + ": is " + std::to_string(n) + " bytes, more than this machine's memory");
   try {
-    out.data = std::make_unique_for_overwrite<uint8_t[]>(size);
+    out.data = std::make_unique_for_overwrite<uint8_t[]>(size_t(n));
   } catch (const std::bad_alloc&) {
-    return Status::error(path.string() + ": not enough memory to read its " + std::to_string(size) + " bytes");
+    return Status::error(f.what + ": not enough memory to read its " + std::to_string(n) + " bytes");
   }
-  size_t got = 0;
-  while (got < size) {
-    const ssize_t r = ::read(fd, out.data.get() + got, size - got);
-    if (r < 0 && errno == EINTR) continue;
-    if (r < 0) return Status::error(path.string() + ": read error (" + std::strerror(errno) + ")");
-    if (r == 0) break;  // shrank while reading
-    got += size_t(r);
-  }
-  if (got == 0) return Status::error(path.string() + ": file is empty");
-  out.size = got;
+  Status read;
+  out.size = f.read_at(out.data.get(), size_t(n), 0, read);
+  if (!read) return read;
+  if (out.size == 0) return Status::error(f.what + ": file is empty");
   return Status::success();
 }
 
@@ -1206,7 +1189,7 @@ Status load_gltf_from_memory(const std::string& name, const std::string& extensi
 
 std::vector<std::filesystem::path> gltf_external_files(const std::filesystem::path& path) {
   std::vector<uint8_t> bytes;
-  if (!detail::read_regular_file(path, bytes)) return {};
+  if (!detail::read_mesh_file(path, bytes)) return {};
   size_t begin = 0, size = bytes.size();
   if (size >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) {
     if (!detail::check_glb_container(path.string(), bytes.data(), size)) return {};

@@ -6,12 +6,13 @@
 
 #include "preprocess/tangents.h"
 #include "preprocess/texture_uri.h"
+#include "runtime/regular_file.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <fstream>
+#include <fstream>  // writes only
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -72,17 +73,14 @@ struct Image {
   const char* extension = nullptr;
 };
 
-constexpr uintmax_t kMaxImageBytes = uintmax_t(256) << 20;
-
 // The image's bytes when it is a PNG or JPEG (by its signature), else a reason.
 std::string read_image(const fs::path& file, Image& out) {
   std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) return "not found";
-  const uintmax_t size = fs::file_size(file, ec);
-  if (ec || size > kMaxImageBytes) return "larger than 256 MiB or unreadable";
-  std::ifstream f(file, std::ios::binary);
-  out.bytes.resize(size_t(size));
-  if (!f.read(reinterpret_cast<char*>(out.bytes.data()), std::streamsize(size))) return "unreadable";
+  if (!fs::exists(file, ec)) return "not found";
+  // A regular file of at most 256 MiB (kTextureFileLimit); the reason without the path.
+  if (Status s = read_regular_file(file, kTextureFileLimit, out.bytes); !s)
+    return s.message.rfind(file.string() + ": ", 0) == 0 ? s.message.substr(file.string().size() + 2) : s.message;
+  const size_t size = out.bytes.size();
   static const uint8_t png[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
   if (size >= 8 && std::memcmp(out.bytes.data(), png, 8) == 0) {
     out.mime = "image/png", out.extension = ".png";
@@ -98,7 +96,7 @@ std::string read_image(const fs::path& file, Image& out) {
 std::string copy_image(const EmbeddedImage& embedded, Image& out) {
   const ImageType type = image_type_of(embedded.bytes);
   if (type == ImageType::unknown) return "neither PNG nor JPEG (glTF 2.0 core allows no other image)";
-  if (embedded.bytes.size() > kMaxImageBytes) return "larger than 256 MiB";
+  if (embedded.bytes.size() > kTextureFileLimit.max_bytes) return "larger than 256 MiB";
   out.bytes = embedded.bytes;
   out.mime = mime_type(type), out.extension = file_extension(type);
   return {};

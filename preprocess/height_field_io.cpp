@@ -8,6 +8,8 @@
 #include <sstream>
 #include <vector>
 
+#include "runtime/regular_file.h"
+
 #include <unistd.h>
 
 namespace lod {
@@ -222,11 +224,14 @@ Status read_height_field_text(const std::filesystem::path& path, HeightField& ou
     return Status::error(name +
                          ": gzip'd text is not read; decompress it first (gzip -dc, or "
                          "scripts/fetch-topography.sh, which writes topography.txt)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::error(name + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_height_field_text(text.str(), name, out, options);
+  // A regular file only; text, by its first bytes, before it is read whole.
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return s;
+  if (Status s = check_text_head(f, "height field"); !s) return s;
+  std::vector<uint8_t> bytes;
+  if (Status s = f.read_all(bytes); !s) return s;
+  return parse_height_field_text(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), name, out,
+                                 options);
 }
 
 }  // namespace lod

@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <fstream>
+#include <cstring>
 #include <iterator>
 #include <memory>
 #include <vector>
+
+#include "runtime/regular_file.h"
 
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
@@ -139,9 +141,15 @@ Status parse_height_field_png(std::span<const uint8_t> bytes, const std::string&
 
 Status read_height_field_png(const std::filesystem::path& path, HeightField& out, const HeightFieldOptions& o) {
   const std::string name = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::error(name + ": cannot open");
-  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // A regular file only; its signature is checked before it is read whole.
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return s;
+  std::vector<uint8_t> bytes;
+  if (Status s = f.read_head(8, bytes); !s) return s;
+  static const uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+  if (bytes.size() == 8 && std::memcmp(bytes.data(), kSignature, 8) != 0)
+    return Status::error(name + ": not a PNG file (its first 8 bytes are not the PNG signature)");
+  if (Status s = f.read_all(bytes); !s) return s;
   return parse_height_field_png(bytes, name, out, o);
 }
 

@@ -11,12 +11,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <fstream>
 #include <mutex>
 #include <utility>
 #include <vector>
 
 #include "preprocess/ascii_grid_header.h"
+#include "runtime/regular_file.h"
 
 namespace lod {
 namespace detail {
@@ -149,14 +149,12 @@ Status open_and_read(const std::string& path, const std::string& name, HeightFie
 
 Status read_height_field_raster(const std::filesystem::path& path, HeightField& out, const HeightFieldOptions& o) {
   const std::string name = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return Status::error(name + ": cannot open (no such file)");
-  const uint64_t size = std::filesystem::file_size(path, ec);
-  std::vector<uint8_t> head(std::min<uint64_t>(ec ? 0 : size, kAsciiGridHeadBytes));
-  std::ifstream in(path, std::ios::binary);
-  if (ec || !in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size())))
-    return Status::error(name + ": cannot read");
-  if (Status st = check_ascii_grid_header(head, size, name, o, detail::kBytesPerSample); !st) return st;
+  // A regular file only, its head checked against its size before GDAL opens it.
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return s;
+  std::vector<uint8_t> head;
+  if (Status s = f.read_head(kAsciiGridHeadBytes, head); !s) return s;
+  if (Status st = check_ascii_grid_header(head, f.size, name, o, detail::kBytesPerSample); !st) return st;
   return detail::open_and_read(name, name, out, o);
 }
 

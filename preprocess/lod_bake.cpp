@@ -3,12 +3,14 @@
 // model size unless the config gives them.
 #include "preprocess/lod_bake.h"
 
+#include "preprocess/mesh_readers.h"
+#include "runtime/regular_file.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "preprocess/cluster_simplifier.h"
@@ -307,26 +309,34 @@ std::vector<float> default_ratios(size_t triangles) {
 }
 
 uint64_t bake_key(const std::filesystem::path& mesh_file, const BakeSettings& settings, Status* status) {
-  std::ifstream f(mesh_file, std::ios::binary);
-  if (!f) {
-    if (status) *status = Status::error(mesh_file.string() + ": cannot be opened for reading");
-    return 0;
+  auto fail = [&](Status s) {
+    if (status) *status = std::move(s);
+    return uint64_t{0};
+  };
+  // The file's head is checked against its format first (a FIFO, a device or a sparse file
+  // that cannot be a mesh is refused unread), then its bytes are hashed in pieces.
+  {
+    RegularFile f;
+    uint64_t read_bytes = 0;
+    if (Status s = detail::open_mesh_file(mesh_file, f, read_bytes); !s) return fail(std::move(s));
   }
-  const std::vector<char> bytes{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-  if (f.bad()) {
-    if (status) *status = Status::error(mesh_file.string() + ": read error");
-    return 0;
-  }
-  uint64_t content = hash_bytes(bytes.data(), bytes.size());
+  uint64_t content = 0;
+  if (Status s = hash_regular_file(mesh_file, content); !s) return fail(std::move(s));
   // A .gltf's geometry (and an OBJ's materials) may live in the files it names: they are part
-  // of the content.
+  // of the content. A missing one adds the hash of no bytes (the load says it is missing);
+  // one that is not a regular file is refused by name.
   std::string ext = mesh_file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
     for (const auto& file : ext == ".obj" ? obj_external_files(mesh_file) : gltf_external_files(mesh_file)) {
-      std::ifstream g(file, std::ios::binary);
-      const std::vector<char> more{std::istreambuf_iterator<char>(g), std::istreambuf_iterator<char>()};
-      content = hash_bytes(more.data(), more.size(), content);
+      std::error_code ec;
+      if (!std::filesystem::exists(file, ec)) {
+        content = hash_bytes(nullptr, 0, content);
+        continue;
+      }
+      uint64_t more = 0;
+      if (Status s = hash_regular_file(file, more, content); !s) return fail(std::move(s));
+      content = more;
     }
   // Settings as explicit little records, so padding never enters the hash.
   std::vector<uint8_t> s;

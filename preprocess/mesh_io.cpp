@@ -213,95 +213,72 @@ std::string lower(std::string s) {
 
 }  // namespace
 
-// Opens a regular file for reading. stat first (a directory, FIFO, socket or device is
-// refused by name without opening it), then open with O_NONBLOCK (a FIFO swapped in meanwhile
-// does not block the open) and fstat the descriptor (refused unless still a regular file).
-Status open_regular_file(const fs::path& path, RegularFile& out) {
-  const std::string what = path.string();
-  auto kind = [](mode_t m) -> const char* {
-    if (S_ISDIR(m)) return "is a directory, not a mesh file";
-    if (S_ISFIFO(m)) return "is a FIFO (named pipe), not a regular file";
-    if (S_ISSOCK(m)) return "is a socket, not a regular file";
-    if (S_ISCHR(m) || S_ISBLK(m)) return "is a device, not a regular file";
-    if (!S_ISREG(m)) return "is not a regular file";
-    return nullptr;
-  };
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) {
-    const int e = errno;
-    if (e == ENOENT) return Status::error(what + ": no such file");
-    if (e == ENOTDIR) return Status::error(what + ": no such file (a parent is not a directory)");
-    return Status::error(what + ": cannot be read (" + std::strerror(e) + ")");
-  }
-  if (const char* k = kind(st.st_mode)) return Status::error(what + ": " + k);
-  RegularFile f;
-  f.fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (f.fd < 0) {
-    const int e = errno;
-    return Status::error(what + ": cannot be opened for reading (" + std::strerror(e) + ")");
-  }
-  if (::fstat(f.fd, &st) != 0) return Status::error(what + ": cannot be read (" + std::strerror(errno) + ")");
-  if (const char* k = kind(st.st_mode)) return Status::error(what + ": " + k);
-  if (st.st_size == 0) return Status::error(what + ": file is empty");
-  f.size = uint64_t(st.st_size);
-  out = std::move(f);
-  return Status::success();
+namespace {
+
+// glTF's parser takes 32-bit sizes (tinygltf): a larger .gltf or .glb is refused unread.
+constexpr FileLimit kGltfFileLimit{std::numeric_limits<uint32_t>::max(), "a glTF file"};
+
+const char* text_format(const std::string& ext) {
+  if (ext == ".obj") return "OBJ";
+  if (ext == ".off") return "OFF";
+  if (ext == ".gltf") return "glTF JSON";
+  return nullptr;
 }
 
-RegularFile::~RegularFile() {
-  if (fd >= 0) ::close(fd);
-}
+}  // namespace
 
-size_t RegularFile::read_at(uint8_t* into, size_t n, uint64_t offset, Status& st, const std::string& what) const {
-  size_t got = 0;
-  while (got < n) {
-    const ssize_t r = ::pread(fd, into + got, n - got, off_t(offset + got));
-    if (r < 0 && errno == EINTR) continue;
-    if (r < 0) {
-      st = Status::error(what + ": read error (" + std::strerror(errno) + ")");
-      return got;
+Status open_mesh_file(const fs::path& path, RegularFile& f, uint64_t& read_bytes) {
+  const std::string ext = lower(path.extension().string());
+  const bool gltf = ext == ".gltf" || ext == ".glb";
+  if (Status s = open_regular_file(path, gltf ? kGltfFileLimit : kInputFileLimit, f); !s) return s;
+  read_bytes = f.size;
+  if (f.size == 0) return Status::error(f.what + ": file is empty");
+  if (const char* format = text_format(ext)) return check_text_head(f, format);
+  std::vector<uint8_t> head;
+  if (Status s = f.read_head(84, head); !s) return s;
+  if (ext == ".ply") {
+    // The header is text whatever the format of the body; "ply" is its first line.
+    const bool ply = head.size() >= 4 && std::memcmp(head.data(), "ply", 3) == 0 &&
+                     (head[3] == '\n' || (head[3] == '\r' && head.size() >= 5 && head[4] == '\n'));
+    if (!ply) return Status::error(f.what + ": not a PLY file (first line is not 'ply')");
+  } else if (ext == ".stl") {
+    // Binary (the count at byte 80 and the size agree, or it does not start with "solid"):
+    // what the count declares is all that is read; ASCII: text.
+    uint32_t n = 0;
+    if (head.size() >= 84) std::memcpy(&n, head.data() + 80, 4);
+    const uint64_t binary_bytes = 84 + 50 * uint64_t(n);
+    size_t text = head.size() >= 3 && head[0] == 0xEF && head[1] == 0xBB && head[2] == 0xBF ? 3 : 0;
+    while (text < head.size() && (head[text] == ' ' || head[text] == '\t' || head[text] == '\r' || head[text] == '\n'))
+      ++text;
+    const bool ascii = binary_bytes != f.size && head.size() - text >= 5 && std::memcmp(head.data() + text, "solid", 5) == 0;
+    if (ascii) return check_text_head(f, "ASCII STL");
+    if (head.size() < 84) return Status::success();  // the reader names the short header
+    if (n == 0) return Status::error(f.what + ": has no faces (binary STL declares 0 triangles)");
+    if (binary_bytes > f.size)
+      return Status::error(f.what + ": truncated: binary STL declares " + std::to_string(n) + " triangles (" +
+                           std::to_string(binary_bytes) + " bytes) but the file has " + std::to_string(f.size) + " bytes");
+    read_bytes = binary_bytes;
+  } else if (ext == ".glb") {
+    if (head.size() >= 4 && std::memcmp(head.data(), "glTF", 4) != 0)
+      return Status::error(f.what + ": not a GLB file (the first 4 bytes are not 'glTF')");
+    if (head.size() >= 12) {
+      uint32_t length = 0;
+      std::memcpy(&length, head.data() + 8, 4);
+      if (length > f.size)
+        return Status::error(f.what + ": truncated GLB: the header declares " + std::to_string(length) +
+                             " bytes, the file has " + std::to_string(f.size));
+      if (length >= 12) read_bytes = length;
     }
-    if (r == 0) break;  // shrank while reading
-    got += size_t(r);
   }
-  return got;
-}
-
-Status read_regular_file(const fs::path& path, std::vector<uint8_t>& bytes) {
-  const std::string what = path.string();
-  RegularFile f;
-  if (Status s = open_regular_file(path, f); !s) return s;
-  if (f.size > std::numeric_limits<size_t>::max() / 2)
-    return Status::error(what + ": is too large (" + std::to_string(f.size) + " bytes)");
-  try {
-    bytes.resize(size_t(f.size));
-  } catch (const std::bad_alloc&) {
-    return Status::error(what + ": not enough memory to read its " + std::to_string(f.size) + " bytes");
-  }
-  Status read;
-  bytes.resize(f.read_at(bytes.data(), bytes.size(), 0, read, what));
-  if (!read) return read;
-  if (bytes.empty()) return Status::error(what + ": file is empty");
   return Status::success();
 }
 
-Status hash_regular_file(const fs::path& path, uint64_t& hash, uint64_t seed) {
-  const std::string what = path.string();
+Status read_mesh_file(const fs::path& path, std::vector<uint8_t>& bytes) {
   RegularFile f;
-  if (Status s = open_regular_file(path, f); !s) return s;
-  std::vector<uint8_t> chunk(size_t(1) << 20);  // one small buffer, not the file's size in fresh memory
-  BytesHasher h(seed);
-  uint64_t total = 0;
-  for (;;) {
-    Status read;
-    const size_t got = f.read_at(chunk.data(), chunk.size(), total, read, what);
-    if (!read) return read;
-    h.add(chunk.data(), got);
-    total += got;
-    if (got < chunk.size()) break;
-  }
-  if (total == 0) return Status::error(what + ": file is empty");
-  hash = h.finish();
+  uint64_t n = 0;
+  if (Status s = open_mesh_file(path, f, n); !s) return s;
+  if (Status s = f.read_all(bytes, n); !s) return s;
+  if (bytes.empty()) return Status::error(f.what + ": file is empty");
   return Status::success();
 }
 
@@ -328,7 +305,10 @@ Status obj_materials(const std::string& name, const fs::path& base_dir, ObjAttri
     if (!fs::exists(file, ec))
       return Status::error(here + ": mtllib '" + quote_token(attr.mtllibs[i]) + "' not found (looked for " + file.string() + ")");
     std::vector<uint8_t> bytes;
-    if (Status r = read_regular_file(file, bytes); !r) return Status::error(here + ": mtllib: " + r.message);
+    if (Status r = read_regular_file(file, kMaterialFileLimit, bytes); !r) return Status::error(here + ": mtllib: " + r.message);
+    if (const size_t at = first_nul_byte(bytes); at != SIZE_MAX)
+      return Status::error(here + ": mtllib: " + file.string() + ": holds binary data (a NUL byte at offset " +
+                           std::to_string(at) + "), not MTL text");
     std::string prefix = fs::path(attr.mtllibs[i]).parent_path().generic_string();
     if (!prefix.empty()) prefix += '/';
     if (Status r = read_mtl(file.string(), bytes.data(), bytes.size(), prefix, found, found_names, attr.warnings); !r) return r;
@@ -343,9 +323,12 @@ Status obj_materials(const std::string& name, const fs::path& base_dir, ObjAttri
         if (uri.empty() || base_dir.empty()) continue;
         const fs::path image = base_dir / decode_uri(uri);
         std::error_code ec;
-        if (!fs::is_regular_file(image, ec))
+        if (!fs::exists(image, ec))
           return Status::error(name + ": material '" + quote_token(attr.material_names[m]) + "': " + kStatement[k] + " '" +
                                quote_token(decode_uri(uri)) + "' not found (looked for " + image.string() + ")");
+        if (Status r = check_regular_file(image, kTextureFileLimit); !r)
+          return Status::error(name + ": material '" + quote_token(attr.material_names[m]) + "': " + kStatement[k] +
+                               ": " + r.message);
       }
       continue;
     }
@@ -417,7 +400,7 @@ Status load_mesh(const std::filesystem::path& path, MeshData& out) {
     return Status::error(what + ": unknown mesh format '" + path.extension().string() + "' (expected " + kMeshFormats +
                          ")");
   std::vector<uint8_t> bytes;
-  Status r = read_regular_file(path, bytes);
+  Status r = read_mesh_file(path, bytes);
   if (!r) return r;
   return load_mesh(path, std::move(bytes), out);
 }
@@ -454,7 +437,7 @@ Status load_mesh_hashed(const std::filesystem::path& path, MeshData& out, uint64
     }
   }
   std::vector<uint8_t> bytes;
-  if (Status s = read_regular_file(path, bytes); !s) return s;
+  if (Status s = read_mesh_file(path, bytes); !s) return s;
   BytesHasher hasher;  // hash_bytes, without linking the asset code into the readers
   hasher.add(bytes.data(), bytes.size());
   const uint64_t hash = hasher.finish();
@@ -493,14 +476,16 @@ std::vector<std::string> statement_files(const std::vector<uint8_t>& bytes, std:
 
 std::vector<std::filesystem::path> obj_external_files(const std::filesystem::path& path) {
   std::vector<uint8_t> bytes;
-  if (!detail::read_regular_file(path, bytes)) return {};
+  if (!detail::read_mesh_file(path, bytes)) return {};
   const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   std::vector<std::filesystem::path> out;
   for (const std::string& lib : statement_files(bytes, "mtllib", true)) {
     const std::filesystem::path mtl = dir / lib;
+    std::error_code ec;
+    if (!std::filesystem::exists(mtl, ec)) continue;
+    out.push_back(mtl);  // even when it cannot be read: the key's hashing names what it is
     std::vector<uint8_t> m;
-    if (!detail::read_regular_file(mtl, m)) continue;
-    out.push_back(mtl);
+    if (!read_regular_file(mtl, kMaterialFileLimit, m) || first_nul_byte(m) != SIZE_MAX) continue;
     for (const char* map : {"map_Kd", "map_Ke", "map_Bump", "map_bump", "bump", "norm", "map_Pm", "map_Pr"})
       for (const std::string& image : statement_files(m, map, false)) out.push_back(mtl.parent_path() / image);
   }
@@ -580,13 +565,11 @@ Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
                            ": embedded texture is neither PNG nor JPEG or larger than 256 MiB; written without it");
       return Status::success();
     }
-    std::error_code ec;
     if (!embedded) {
-      const auto size = std::filesystem::file_size(image, ec);
-      if (ec || !std::filesystem::is_regular_file(image, ec) || size > (uintmax_t(256) << 20)) {
+      if (Status r = check_regular_file(image, kTextureFileLimit); !r) {
         if (s.notes)
-          s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + image.string() +
-                             " is missing or larger than 256 MiB; written without it");
+          s.notes->push_back(obj.string() + ": material " + std::to_string(i) + ": texture " + r.message +
+                             "; written without it");
         return Status::success();
       }
     }
@@ -597,7 +580,7 @@ Status write_mtl(const std::filesystem::path& obj, const ObjSurfaces& s) {
     if (known == copied.end()) {
       std::vector<uint8_t> bytes;
       if (embedded) bytes = embedded->bytes;
-      else if (Status r = detail::read_regular_file(image, bytes); !r) return r;
+      else if (Status r = read_regular_file(image, kTextureFileLimit, bytes); !r) return r;
       if (Status w = write_file_atomic(obj.parent_path() / name, bytes); !w) return w;
       copied.push_back(source);
     }

@@ -36,7 +36,8 @@ Status load_mesh_from_memory(const std::string& name, const std::string& extensi
 
 // The files an OBJ's materials name (its mtllib files and their map_Kd / map_Ke / map_Bump /
 // bump / norm / map_Pm / map_Pr images, next to it), so
-// a cache key can cover them too; missing ones are left out (the load says why).
+// a cache key can cover them too; missing ones are left out (the load says why). Files are
+// read through runtime/regular_file.h: what is not a regular file is listed, not read.
 std::vector<std::filesystem::path> obj_external_files(const std::filesystem::path& path);
 
 // Writes positions + triangles as binary PLY (for --export and outside tools).

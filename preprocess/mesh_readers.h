@@ -16,6 +16,7 @@
 
 #include "preprocess/mesh.h"
 #include "runtime/chain_material.h"
+#include "runtime/regular_file.h"
 #include "runtime/status.h"
 
 namespace lod::detail {
@@ -86,30 +87,14 @@ Status finish_obj(const std::string& what, RawPolygons& raw, ObjAttributes& attr
 // the message adds 1 back.
 Status finish_polygons(const std::string& what, RawPolygons& raw, MeshData& out, bool obj_numbering = false);
 
-// Reads a regular file whole (a directory, FIFO, socket or device is refused by name and
-// never blocks); the message names the file.
-Status read_regular_file(const std::filesystem::path& path, std::vector<uint8_t>& bytes);
-
-// A regular file open for reading (open_regular_file's checks), closed when it goes.
-struct RegularFile {
-  int fd = -1;
-  uint64_t size = 0;  // at open
-  RegularFile() = default;
-  RegularFile(RegularFile&& o) noexcept : fd(std::exchange(o.fd, -1)), size(o.size) {}
-  RegularFile& operator=(RegularFile&& o) noexcept {
-    std::swap(fd, o.fd);
-    size = o.size;
-    return *this;
-  }
-  ~RegularFile();
-  // Up to n bytes from `offset` (fewer at the end of the file, or when it shrank); a read error
-  // sets st.
-  size_t read_at(uint8_t* into, size_t n, uint64_t offset, Status& st, const std::string& what) const;
-};
-Status open_regular_file(const std::filesystem::path& path, RegularFile& out);
-
-// The content hash (hash_bytes with `seed`) of a regular file's bytes, read in 1 MB pieces.
-Status hash_regular_file(const std::filesystem::path& path, uint64_t& hash, uint64_t seed = 0);
+// Opens a mesh file (runtime/regular_file.h: a regular file only, nothing blocks) and checks
+// its first bytes against the format its extension names before anything more is read:
+// `read_bytes` is how much of it the reader needs (a binary STL or GLB: what its header
+// declares). A file that cannot be that format is refused from its head ("f.off: holds binary
+// data (a NUL byte at offset 0), not OFF text"), so a sparse multi-GB file is never read whole.
+Status open_mesh_file(const std::filesystem::path& path, RegularFile& f, uint64_t& read_bytes);
+// open_mesh_file, then the bytes it allows.
+Status read_mesh_file(const std::filesystem::path& path, std::vector<uint8_t>& bytes);
 
 // The layout scanners write, binary little-endian PLY with a vertex element of float x, y, z
 // alone and a face element of one uchar-counted list of 32-bit indices, every face a triangle:

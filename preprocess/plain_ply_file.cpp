@@ -22,7 +22,7 @@ struct PlainLayout {
 // The whole of n bytes at `offset`, or false (a short file: the general reader names it).
 bool read_at(const RegularFile& f, uint8_t* into, size_t n, uint64_t offset) {
   Status st;
-  return f.read_at(into, n, offset, st, "") == n && st;
+  return f.read_at(into, n, offset, st) == n && st;
 }
 
 bool count_of(std::string_view word, uint64_t& out) {
@@ -104,7 +104,7 @@ bool hash_tail(const RegularFile& f, uint64_t from, BytesHasher& h) {
   std::vector<uint8_t> chunk(size_t(1) << 20);
   for (;;) {
     Status st;
-    const size_t got = f.read_at(chunk.data(), chunk.size(), from, st, "");
+    const size_t got = f.read_at(chunk.data(), chunk.size(), from, st);
     if (!st) return false;
     h.add(chunk.data(), got);
     from += got;
@@ -117,7 +117,7 @@ bool hash_tail(const RegularFile& f, uint64_t from, BytesHasher& h) {
 Status read_plain_ply_file(const std::filesystem::path& path, RawPolygons& raw, uint64_t& content_hash, bool& handled) {
   handled = false;
   RegularFile f;
-  if (Status s = open_regular_file(path, f); !s) return s;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return s;
   std::vector<uint8_t> head(size_t(std::min<uint64_t>(f.size, 65536)));
   PlainLayout l;
   if (!read_at(f, head.data(), head.size(), 0) ||

@@ -49,6 +49,7 @@
 #include "runtime/lod_asset.h"  // hash_bytes
 #include "runtime/lod_chain.h"
 #include "runtime/material_section.h"
+#include "runtime/regular_file.h"
 #include "runtime/vertex_tree.h"  // kMaxTreeMagnitude
 
 namespace lod {
@@ -690,15 +691,12 @@ HlodFile& HlodFile::operator=(HlodFile&& other) noexcept {
 
 Status HlodFile::open(const std::filesystem::path& path, HlodTree& tree) {
   const std::string what = path.string();
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) return refuse(what, std::string("cannot open: ") + std::strerror(errno));
+  RegularFile file;  // a regular file only, checked before and after the open
+  if (Status s = open_regular_file(path, kInputFileLimit, file); !s) return s;
   HlodFile f;
-  f.fd_ = fd;
+  const int fd = f.fd_ = std::exchange(file.fd, -1);
   f.path_ = what;
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) return refuse(what, std::string("cannot stat: ") + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) return refuse(what, "is not a regular file, not an .hlod file");
-  f.size_ = uint64_t(st.st_size);
+  f.size_ = file.size;
   if (f.size_ < kFixedBytes + kChecksumBytes)
     return refuse(what, "file is " + std::to_string(f.size_) + " bytes, too short for an .hlod file (truncated?)");
   std::vector<uint8_t> fixed;

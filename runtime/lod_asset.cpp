@@ -84,6 +84,7 @@
 #include "runtime/byte_order.h"
 #include "runtime/file_write.h"
 #include "runtime/material_section.h"
+#include "runtime/regular_file.h"
 
 namespace lod {
 
@@ -856,40 +857,60 @@ Status write_lod_asset(const std::filesystem::path& path, const LodChain& chain)
   return write_file_atomic(path, encode_lod_asset(chain));
 }
 
+namespace {
+
+// The header and section table (`head`: the file's first bytes, up to the largest table)
+// against the file's size, before the file is read whole: a file that is not an asset, or
+// whose sections do not end where the file does, is refused from its first bytes.
+Status check_lod_header(std::span<const uint8_t> head, uint64_t size, const std::string& what) {
+  const uint8_t* p = head.data();
+  if (size < kHeaderBytes + kChecksumBytes)
+    return refuse(what, "file is " + std::to_string(size) + " bytes, too short for a lodkit asset (" +
+                            std::to_string(kHeaderBytes + kChecksumBytes) + " at least; truncated?)");
+  if (std::memcmp(p, kMagic, sizeof(kMagic)) != 0) return refuse(what, "not a lodkit asset (bad magic bytes)");
+  const uint32_t version = load_u32(p + 8);
+  if (version != kLodAssetVersion)
+    return refuse(what, "asset version " + std::to_string(version) + " is not supported (this build reads version " +
+                            std::to_string(kLodAssetVersion) + "); re-bake it");
+  const uint32_t section_count = load_u32(p + 12);
+  if (section_count > kMaxSections)
+    return refuse(what, "section count " + std::to_string(section_count) + " exceeds " + std::to_string(kMaxSections) +
+                            " (corrupted header)");
+  const uint64_t table_end = kHeaderBytes + uint64_t{section_count} * kTableEntryBytes;
+  if (table_end + kChecksumBytes > size || table_end > head.size())
+    return refuse(what, "truncated: file is " + std::to_string(size) + " bytes, its section table alone needs " +
+                            std::to_string(table_end + kChecksumBytes));
+  uint64_t sections_end = table_end;
+  for (uint32_t s = 0; s < section_count; ++s) {
+    const uint8_t* e = p + kHeaderBytes + s * kTableEntryBytes;
+    const uint64_t off = load_u64(e + 8), sz = load_u64(e + 16);
+    if (off > size || sz > size - off)
+      return refuse(what, "section " + std::to_string(s) + " '" + tag_name(load_u32(e)) + "' [" + std::to_string(off) +
+                              ", +" + std::to_string(sz) + ") lies outside the " + std::to_string(size) + "-byte file");
+    sections_end = std::max(sections_end, off + sz);
+  }
+  if (sections_end + kChecksumBytes > size)
+    return refuse(what, "truncated: file is " + std::to_string(size) + " bytes, its sections need " +
+                            std::to_string(sections_end + kChecksumBytes));
+  // The writer aligns the checksum to 8 bytes: up to 7 bytes of padding come before it.
+  const uint64_t end = (sections_end + 7) / 8 * 8 + kChecksumBytes;
+  if (size > end)
+    return refuse(what, "file is " + std::to_string(size) + " bytes, its sections and checksum end at " +
+                            std::to_string(end) + " (bytes after them)");
+  return Status::success();
+}
+
+}  // namespace
+
 Status read_lod_asset(const std::filesystem::path& path, LodChain& out) {
-  // Regular files only: opened without blocking (a FIFO named like an asset must not hang the
-  // reader) and checked on the open descriptor, so nothing can swap the file in between.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) return refuse(path.string(), std::string("cannot open: ") + std::strerror(errno));
-  struct FdCloser {
-    int fd;
-    ~FdCloser() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) return refuse(path.string(), std::string("cannot stat: ") + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) {
-    const char* kind = S_ISDIR(st.st_mode)    ? "a directory"
-                       : S_ISFIFO(st.st_mode) ? "a FIFO"
-                       : S_ISSOCK(st.st_mode) ? "a socket"
-                       : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
-                                                                    : "not a regular file";
-    return refuse(path.string(), std::string("is ") + kind + ", not a .lod asset file");
-  }
+  // Regular files only (a FIFO named like an asset must not hang the reader), and the header
+  // first: what it declares must end where the file does before the file is read whole.
+  RegularFile f;
+  if (Status s = open_regular_file(path, kInputFileLimit, f); !s) return s;
   std::vector<uint8_t> bytes;
-  try {
-    bytes.resize(static_cast<size_t>(st.st_size));
-  } catch (const std::bad_alloc&) {
-    return refuse(path.string(), "is " + std::to_string(st.st_size) + " bytes, too large to load");
-  }
-  size_t got = 0;
-  while (got < bytes.size()) {
-    const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) return refuse(path.string(), std::string("read failed: ") + std::strerror(errno));
-    if (n == 0) break;  // shrank while reading: decode reports the truncation
-    got += static_cast<size_t>(n);
-  }
-  bytes.resize(got);
+  if (Status s = f.read_head(kHeaderBytes + kMaxSections * kTableEntryBytes, bytes); !s) return s;
+  if (Status s = check_lod_header(bytes, f.size, path.string()); !s) return s;
+  if (Status s = f.read_all(bytes); !s) return s;
   return decode_lod_asset(bytes, path.string(), out);
 }
 

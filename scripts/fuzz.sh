@@ -40,20 +40,21 @@ FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -f
        -I. -Iinclude -I/usr/include/gdal -I/usr/include/stb -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
               preprocess/obj_reader.cpp preprocess/mtl_reader.cpp preprocess/texture_uri.cpp preprocess/gltf_io.cpp
-              runtime/file_write.cpp runtime/host_turn.cpp runtime/embedded_image.cpp
+              runtime/file_write.cpp runtime/host_turn.cpp runtime/embedded_image.cpp runtime/regular_file.cpp
               preprocess/plain_ply_file.cpp runtime/bytes_hasher.cpp preprocess/mesh_clean.cpp preprocess/material_runs.cpp
               preprocess/first_of_equal.cpp preprocess/cluster_simplifier.cpp
               preprocess/qem_simplifier.cpp preprocess/position_copies.cpp)  # gltf_io compiles tinygltf in;
 # mesh_clean for the clean's checks, material_runs for it, and the simplifiers material_runs calls
 LOD_SOURCES=(runtime/lod_asset.cpp runtime/bytes_hasher.cpp runtime/lod_chain.cpp runtime/embedded_image.cpp runtime/vertex_tree.cpp
-             runtime/vertex_front.cpp runtime/file_write.cpp runtime/host_turn.cpp runtime/model_table.cpp runtime/view.cpp)
+             runtime/vertex_front.cpp runtime/file_write.cpp runtime/host_turn.cpp runtime/model_table.cpp runtime/view.cpp
+             runtime/regular_file.cpp)
 HLOD_SOURCES=(runtime/hlod_asset.cpp runtime/hlod_cut_check.cpp runtime/hlod_select.cpp runtime/lod_asset.cpp runtime/bytes_hasher.cpp
               runtime/lod_chain.cpp runtime/embedded_image.cpp runtime/vertex_tree.cpp runtime/file_write.cpp runtime/host_turn.cpp
-              runtime/model_table.cpp runtime/view.cpp runtime/world_bounds.cpp)
+              runtime/model_table.cpp runtime/view.cpp runtime/world_bounds.cpp runtime/regular_file.cpp)
 HMESH_SOURCES=(jobs/hlod_mesh_cache.cpp "${LOD_SOURCES[@]}")
 HEIGHTMAP_SOURCES=(preprocess/height_field_io.cpp preprocess/height_field_png.cpp preprocess/height_field_raster.cpp preprocess/ascii_grid_header.cpp
-                   runtime/height_field.cpp)  # GDAL itself is Debian's, uninstrumented
-SCENE_SOURCES=(jobs/scene_config.cpp runtime/roam.cpp runtime/height_field.cpp runtime/view.cpp)  # [[terrain]] checks grid sizes
+                   runtime/height_field.cpp runtime/regular_file.cpp runtime/bytes_hasher.cpp)  # GDAL itself is Debian's, uninstrumented
+SCENE_SOURCES=(jobs/scene_config.cpp runtime/roam.cpp runtime/height_field.cpp runtime/view.cpp runtime/regular_file.cpp runtime/bytes_hasher.cpp)  # [[terrain]] checks grid sizes
 # The scene reader links Debian's toml++ library as lodkit does (its header-only mode has debug
 # asserts that the shipped, NDEBUG library does not: "[[[a]]" asserts there, is refused here).
 SCENE_FLAGS=(-DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1)

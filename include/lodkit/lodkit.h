@@ -71,11 +71,19 @@ typedef struct lod_object_options {
 
 /* A scene TOML; [[model]]/[[instances]] optional. NULL on error, with the message. Baked
  * models are cached in the config's [cache] dir, else $LOD_CACHE_DIR, else
- * $XDG_CACHE_HOME/lodkit, else $HOME/.cache/lodkit, else a folder in the temp directory. */
+ * $XDG_CACHE_HOME/lodkit, else $HOME/.cache/lodkit, else a folder in the temp directory.
+ * Files are read only when they are regular files: a FIFO, device, socket or directory given
+ * as the config, a mesh, an asset or a file a mesh names (an OBJ's .mtl, a texture, a glTF
+ * buffer) is refused by name without being opened ("f.off: is a FIFO, not a regular file").
+ * A config is at most 16 MiB, a .mtl 16 MiB, a texture 256 MiB, a .gltf/.glb 4 GiB - 1. */
 lod_service* lod_service_create(const char* config_path, char* error, size_t error_size);
 void lod_service_destroy(lod_service*);
 
-/* A mesh (baked, cached) or a .lod asset; 0 = ok. */
+/* A mesh (baked, cached) or a .lod asset; 0 = ok. Regular files only (see above). A file is
+   checked from its first bytes before it is read or hashed whole: a .lod whose header and
+   sections do not end where the file does, or a mesh whose head cannot be its format (a NUL
+   byte in a text format, a binary STL or GLB declaring more than the file holds), is refused
+   without reading the rest. */
 int lod_model_add(lod_service*, const char* path, lod_model* out, char* error, size_t error_size);
 uint32_t lod_model_level_count(lod_service*, lod_model);
 uint64_t lod_model_level_triangles(lod_service*, lod_model, uint32_t level);

@@ -94,7 +94,7 @@ const std::filesystem::path& ply_file() {
 void BM_ReadBytes(benchmark::State& state) {
   for (auto _ : state) {
     std::vector<uint8_t> bytes;
-    if (!detail::read_regular_file(ply_file(), bytes)) state.SkipWithError("cannot read the bench file");
+    if (!detail::read_mesh_file(ply_file(), bytes)) state.SkipWithError("cannot read the bench file");
     benchmark::DoNotOptimize(bytes.data());
   }
 }
@@ -112,7 +112,7 @@ void BM_LoadPly(benchmark::State& state) {
 void BM_ReadHashParse(benchmark::State& state) {
   for (auto _ : state) {
     std::vector<uint8_t> bytes;
-    if (!detail::read_regular_file(ply_file(), bytes)) state.SkipWithError("cannot read the bench file");
+    if (!detail::read_mesh_file(ply_file(), bytes)) state.SkipWithError("cannot read the bench file");
     const uint64_t hash = hash_bytes(bytes.data(), bytes.size());
     MeshData m;
     if (Status s = load_mesh(ply_file(), std::move(bytes), m); !s) state.SkipWithError(s.message.c_str());

@@ -85,7 +85,7 @@ TEST(MeshReaders, RefusesADevice) {
     fs::remove(link);
     fs::create_symlink(dev, link);
     MeshData m;
-    expect_message(load_mesh(link, m), ": is a device");
+    expect_message(load_mesh(link, m), ": is a character device, not a regular file");
   }
 }
 
