@@ -63,7 +63,7 @@ int run_main(int argc, char** argv) {
   auto* bake_cmd = app.add_subcommand("bake", "bake meshes into .lod assets");
   bake_cmd->add_option("models", bake.models, "mesh files (OBJ, PLY, OFF, STL, glTF: .gltf/.glb)")->required();
   bake_cmd->add_option("-o,--out", bake.out_dir, "output directory")->required();
-  bake_cmd->add_option("--ratios", bake.ratios, "level ratios, 1.0 first (default: by size, as R0)");
+  bake_cmd->add_option("--ratios", bake.ratios, "level ratios, 1.0 first (default: by size)");
   bake_cmd->add_option("--method", bake.method, "qem | extreme | auto")
       ->check(CLI::IsMember({"qem", "extreme", "auto"}));
   bake_cmd->add_option("--threads", bake.threads, "worker threads, 0 = all cores")
@@ -71,7 +71,7 @@ int run_main(int argc, char** argv) {
   bake_cmd->add_flag("--measure", bake.measure, "print each level's measured error");
   bake_cmd->add_flag("--json", bake.json, "print JSON");
   bake_cmd->add_flag("--quiet", bake.quiet, "print nothing but errors");
-  bake_cmd->add_flag("--hlod", bake.hlod, "write an .hlod octree (R1 model HLOD) per mesh instead of a .lod chain");
+  bake_cmd->add_flag("--hlod", bake.hlod, "write an .hlod octree (precomputed model HLOD) per mesh instead of a .lod chain");
   bake_cmd->add_option("--min-verts", bake.min_verts, "--hlod: a cell with more vertices splits (default 1000)")
       ->check(CLI::Range(int64_t{3}, int64_t{100000000}));
   bake_cmd->add_flag("--distributed", bake.distributed,

@@ -18,7 +18,7 @@ class RunPlots {
 
   void add(const FrameRecord& r);
   uint64_t frames_per_bucket() const { return total_ms_.frames_per_bucket(); }
-  // triangles.svg (R0's Fig. 4: in view, selected, budget; log scale), drawn.svg (drawn with
+  // triangles.svg (Yu, Liang and Chen's Fig. 4: in view, selected, budget; log scale), drawn.svg (drawn with
   // blends vs M, linear), levels.svg (objects per chain level), level_changes.svg,
   // pixel_error.svg (worst and mean error left) and stage_ms.svg (per-stage milliseconds).
   Status write(const std::filesystem::path& dir, const RunSummary& s) const;

@@ -1,14 +1,12 @@
 // Failed HLOD node reads: the message, the mark on a cache entry.
 #include "jobs/hlod_read_failures.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <mutex>
 #include <vector>
 
 #include "runtime/file_write.h"
 #include "runtime/hlod_asset.h"
+#include "runtime/regular_file.h"
 
 namespace lod {
 
@@ -27,15 +25,11 @@ bool entry_marked_bad(const std::filesystem::path& entry, std::string* why) {
   std::error_code ec;
   if (!std::filesystem::exists(std::filesystem::symlink_status(mark, ec))) return false;
   if (why) {
-    // The reason is for messages only: a few hundred bytes of it, never blocking on a FIFO.
+    // The reason is for messages only: its first few hundred bytes, from a regular file.
     why->clear();
-    const int fd = ::open(mark.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-    if (fd >= 0) {
-      char buf[512];
-      const ssize_t n = ::read(fd, buf, sizeof buf);
-      ::close(fd);
-      if (n > 0) why->assign(buf, size_t(n));
-    }
+    RegularFile f;
+    std::vector<uint8_t> head;
+    if (open_regular_file(mark, kConfigFileLimit, f) && f.read_head(512, head)) why->assign(head.begin(), head.end());
     while (!why->empty() && (why->back() == '\n' || why->back() == '\r')) why->pop_back();
     if (why->empty()) *why = "no reason recorded";
   }

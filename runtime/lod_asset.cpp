@@ -672,22 +672,33 @@ std::vector<uint8_t> encode_lod_asset(const LodChain& chain) {
   return std::move(w.bytes);
 }
 
-Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what, LodChain& out) {
-  const uint8_t* p = bytes.data();
-  const uint64_t size = bytes.size();
+namespace {
+
+// The fixed header of a `size`-byte file (`head`: at least its first kHeaderBytes when
+// size allows): long enough, the magic bytes, this build's version, a sane section count.
+Status check_fixed_header(const uint8_t* head, uint64_t size, const std::string& what, uint32_t& section_count) {
   if (size < kHeaderBytes + kChecksumBytes)
     return refuse(what, "file is " + std::to_string(size) + " bytes, too short for a lodkit asset (" +
                             std::to_string(kHeaderBytes + kChecksumBytes) + " at least; truncated?)");
-  if (std::memcmp(p, kMagic, sizeof(kMagic)) != 0)
-    return refuse(what, "not a lodkit asset (bad magic bytes)");
-  const uint32_t version = load_u32(p + 8);
+  if (std::memcmp(head, kMagic, sizeof(kMagic)) != 0) return refuse(what, "not a lodkit asset (bad magic bytes)");
+  const uint32_t version = load_u32(head + 8);
   if (version != kLodAssetVersion)
     return refuse(what, "asset version " + std::to_string(version) + " is not supported (this build reads version " +
                             std::to_string(kLodAssetVersion) + "); re-bake it");
-  const uint32_t section_count = load_u32(p + 12);
+  section_count = load_u32(head + 12);
   if (section_count > kMaxSections)
-    return refuse(what, "section count " + std::to_string(section_count) + " exceeds " +
-                            std::to_string(kMaxSections) + " (corrupted header)");
+    return refuse(what, "section count " + std::to_string(section_count) + " exceeds " + std::to_string(kMaxSections) +
+                            " (corrupted header)");
+  return Status::success();
+}
+
+}  // namespace
+
+Status decode_lod_asset(std::span<const uint8_t> bytes, const std::string& what, LodChain& out) {
+  const uint8_t* p = bytes.data();
+  const uint64_t size = bytes.size();
+  uint32_t section_count = 0;
+  if (Status st = check_fixed_header(p, size, what, section_count); !st) return st;
   const uint64_t table_end = kHeaderBytes + uint64_t{section_count} * kTableEntryBytes;
   if (table_end + kChecksumBytes > size)
     return refuse(what, "truncated: file is " + std::to_string(size) + " bytes, its section table alone needs " +
@@ -864,18 +875,8 @@ namespace {
 // whose sections do not end where the file does, is refused from its first bytes.
 Status check_lod_header(std::span<const uint8_t> head, uint64_t size, const std::string& what) {
   const uint8_t* p = head.data();
-  if (size < kHeaderBytes + kChecksumBytes)
-    return refuse(what, "file is " + std::to_string(size) + " bytes, too short for a lodkit asset (" +
-                            std::to_string(kHeaderBytes + kChecksumBytes) + " at least; truncated?)");
-  if (std::memcmp(p, kMagic, sizeof(kMagic)) != 0) return refuse(what, "not a lodkit asset (bad magic bytes)");
-  const uint32_t version = load_u32(p + 8);
-  if (version != kLodAssetVersion)
-    return refuse(what, "asset version " + std::to_string(version) + " is not supported (this build reads version " +
-                            std::to_string(kLodAssetVersion) + "); re-bake it");
-  const uint32_t section_count = load_u32(p + 12);
-  if (section_count > kMaxSections)
-    return refuse(what, "section count " + std::to_string(section_count) + " exceeds " + std::to_string(kMaxSections) +
-                            " (corrupted header)");
+  uint32_t section_count = 0;
+  if (Status st = check_fixed_header(p, size, what, section_count); !st) return st;
   const uint64_t table_end = kHeaderBytes + uint64_t{section_count} * kTableEntryBytes;
   if (table_end + kChecksumBytes > size || table_end > head.size())
     return refuse(what, "truncated: file is " + std::to_string(size) + " bytes, its section table alone needs " +

@@ -7,7 +7,7 @@
 // again with fstat, so a path swapped for a FIFO or device between the two is refused too.
 //
 // Every read is bounded before it starts: the file's size at open is checked against the limit
-// its kind allows (FileLimit), and a file read whole must also fit in this machine's memory.
+// its kind allows (FileLimit), and a file read whole must also fit in the host's physical memory.
 // Readers of formats with a header (.lod, .hlod, binary STL, GLB, PNG) read the header first
 // and check what it declares against the file's size before reading the rest.
 #pragma once
@@ -94,7 +94,7 @@ size_t first_nul_byte(const std::vector<uint8_t>& bytes);
 inline constexpr size_t kTextHeadBytes = 64 * 1024;
 Status check_text_head(const RegularFile& f, const char* format);
 
-// This machine's physical memory in bytes (what a file read whole must fit in).
+// The host's physical memory in bytes (what a file read whole must fit in).
 uint64_t physical_memory_bytes();
 
 }  // namespace lod

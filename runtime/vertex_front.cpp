@@ -745,25 +745,15 @@ FrontView front_view_of(const View& view, const float position[3], float scale, 
 }
 
 FrontView front_view_of(const View& view, const float position[3], float scale, const float rotation[4]) {
-  // The planes are built from the camera's basis in double rather than extracted from the
-  // float clip matrix: extraction leaves the far plane (far / near ~ 1e5) noisy by ~1e-3 of
-  // its distance, and front_update reads frame-to-frame plane motion as view motion.
+  // The planes in double (eye_planes_of): extracting them from the float clip matrix leaves
+  // the far plane (far / near ~ 1e5) noisy by ~1e-3 of its distance, and front_update reads
+  // frame-to-frame plane motion as view motion.
   using V = glm::dvec3;
-  const V eye(view.eye), pos(position[0], position[1], position[2]);
-  V fwd = V(view.target) - eye;
-  fwd = glm::length(fwd) > 0 ? glm::normalize(fwd) : V(0, 0, -1);
-  V right = glm::cross(fwd, V(view.up));
-  if (glm::length(right) < 1e-12) right = glm::cross(fwd, std::abs(fwd.y) < 0.9 ? V(0, 1, 0) : V(1, 0, 0));
-  right = glm::normalize(right);
-  const V up = glm::cross(right, fwd);
-  const double ty = std::tan(0.5 * glm::radians(double(view.fov_y_deg)));
-  const double aspect = double(view.width) / double(view.height > 0 ? view.height : 1);
-  const double hy = std::atan(ty), hx = std::atan(aspect * ty);
-  // World planes n . (p - eye) + c >= 0: left, right, bottom, top, near, far (as frustum_of).
-  const V normals[6] = {std::cos(hx) * right + std::sin(hx) * fwd, -std::cos(hx) * right + std::sin(hx) * fwd,
-                        std::cos(hy) * up + std::sin(hy) * fwd,    -std::cos(hy) * up + std::sin(hy) * fwd,
-                        fwd,                                       -fwd};
-  const double offsets[6] = {0, 0, 0, 0, -double(view.near_plane), double(view.far_plane)};
+  const EyePlanes planes = eye_planes_of(view);
+  const V& eye = planes.eye;
+  const V pos(position[0], position[1], position[2]);
+  const V* normals = planes.normal;
+  const double* offsets = planes.offset;
 
   FrontView out;
   const double inv = scale != 0 ? 1.0 / scale : 1.0;

@@ -39,15 +39,11 @@ glm::mat4 projection_matrix(const View& v) {
   return glm::perspective(glm::radians(v.fov_y_deg), aspect, v.near_plane, v.far_plane);
 }
 
-Frustum frustum_of(const View& v) {
-  // The planes straight from the camera's basis and half-angles, in double: Gribb-Hartmann
-  // over a float clip matrix loses the near plane when far / near is large (its rows nearly
-  // cancel) and the side planes when the field is tiny (1 / tan(fov / 2) swamps the view
-  // row), which let objects far outside the view through. Same planes and order as the
-  // clip-matrix rows: left, right, bottom, top, near, far.
+EyePlanes eye_planes_of(const View& v) {
   using V = glm::dvec3;
-  const V eye(v.eye);
-  V fwd = V(v.target) - eye;
+  EyePlanes out;
+  out.eye = V(v.eye);
+  V fwd = V(v.target) - out.eye;
   fwd = glm::length(fwd) > 0 ? glm::normalize(fwd) : V(0, 0, -1);
   V right = glm::cross(fwd, V(v.up));  // view_matrix's basis and fallbacks
   if (!(glm::length(right) >= 1e-12))
@@ -57,15 +53,21 @@ Frustum frustum_of(const View& v) {
   const double ty = std::tan(0.5 * glm::radians(double(v.fov_y_deg)));
   const double aspect = double(v.width) / double(v.height > 0 ? v.height : 1);
   const double hy = std::atan(ty), hx = std::atan(aspect * ty);
-  // Unit normals pointing inwards; each side plane passes through the eye.
+  // Each side plane passes through the eye.
   const V normals[6] = {std::cos(hx) * right + std::sin(hx) * fwd, -std::cos(hx) * right + std::sin(hx) * fwd,
                         std::cos(hy) * up + std::sin(hy) * fwd,    -std::cos(hy) * up + std::sin(hy) * fwd,
                         fwd,                                       -fwd};
   const double offsets[6] = {0, 0, 0, 0, -double(v.near_plane), double(v.far_plane)};
+  for (int k = 0; k < 6; ++k) out.normal[k] = normals[k], out.offset[k] = offsets[k];
+  return out;
+}
+
+Frustum frustum_of(const View& v) {
+  const EyePlanes e = eye_planes_of(v);
   Frustum f;
   for (int k = 0; k < 6; ++k) {
     // dot(n, p) + w >= 0 inside: w = -dot(n, eye) + the plane's distance from the eye.
-    f.planes[k] = glm::vec4(glm::vec3(normals[k]), static_cast<float>(offsets[k] - glm::dot(normals[k], eye)));
+    f.planes[k] = glm::vec4(glm::vec3(e.normal[k]), static_cast<float>(e.offset[k] - glm::dot(e.normal[k], e.eye)));
   }
   return f;
 }

@@ -7,7 +7,7 @@
 # mutator keeps the checksum valid and resizes one section at a time), the scene config
 # reader (`scene`) and the height-field readers (`heightmap`: PNG through stb, ESRI ASCII grid
 # through GDAL, "x y z" text; the first input byte picks one), and the service itself (`service`:
-# byte-derived sessions through the C API only, checking every frame's invariants; built by CMake
+# byte-derived operation sequences through the C API only, checking every frame's invariants; built by CMake
 # with LOD_SANITIZE=fuzzer in $OUT/service-build, since it links the whole library), built with Debian's clang
 # (-fsanitize=fuzzer,address,undefined; UB aborts), each
 # run for SECONDS (default 600) from the seeds in tests/fuzz/corpus/<target>/ with

@@ -6,7 +6,7 @@
 // steps, and frames acquired, held across steps and released.
 //
 // Seeds: scripts/fuzz.sh runs this binary with LOD_FUZZ_WRITE_SEEDS=DIR first; it writes, in the
-// operation encoding below, a few sessions a host would run (a crowd under a binding budget
+// operation encoding below, a few runs a host would make (a crowd under a binding budget
 // watched by a moving camera, objects coming and going) and exits. Mutation takes them from
 // there: anywhere else the camera may turn, any value a setter may get.
 //
@@ -359,7 +359,7 @@ void run_operation(Host& h, Bytes& in) {
   }
 }
 
-// The operation encoding above, written: the seeds' sessions.
+// The operation encoding above, written: the seeds.
 class Ops {
  public:
   explicit Ops(uint8_t config) { bytes_.push_back(config); }
@@ -407,7 +407,7 @@ void write_seeds(const fs::path& dir) {
     seeds.push_back(churn);
   }
   for (size_t k = 0; k < seeds.size(); ++k) {
-    std::ofstream out(dir / ("session-" + std::to_string(k)), std::ios::binary);
+    std::ofstream out(dir / ("run-" + std::to_string(k)), std::ios::binary);
     out.write(reinterpret_cast<const char*>(seeds[k].bytes().data()), std::streamsize(seeds[k].bytes().size()));
   }
 }
