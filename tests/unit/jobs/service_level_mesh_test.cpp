@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 
+#include "embedded_texture_fixture.h"
 #include "jobs/service.h"
 #include "lodkit/service.hpp"
 #include "runtime/embedded_image.h"
@@ -155,6 +156,40 @@ TEST(ServiceLevelMesh, MaterialsResolveFilesAndEmbeddedImages) {
   EXPECT_NE(s.last_error().find("unknown model 9"), std::string::npos) << s.last_error();
   EXPECT_TRUE(s.materials(9).empty());
   EXPECT_EQ(s.material_count(9), 0u);
+}
+
+// A GLB holding its texture: the material hands over the image's bytes as the file held them,
+// typed by MIME, with no path; the plain material has no texture and glTF's factors.
+TEST(ServiceLevelMesh, GlbEmbeddedImageComesAsBytes) {
+  const fs::path dir = test::temp_dir("service-level-mesh-glb");
+  const std::vector<uint8_t> png = test::checker_png(16, 4);
+  test::write_bytes(dir / "globe.glb", test::embedded_texture_sphere({{"mimeType", "image/png"}}, &png, 24, 48).glb());
+  auto s = baking_service(dir);
+  ModelId model = 0;
+  ASSERT_TRUE(s->add_model(dir / "globe.glb", &model)) << s->last_error();
+  ASSERT_EQ(s->material_count(model), 2u);
+  const Material& cap = s->materials(model)[0];
+  const Material& base = s->materials(model)[1];
+  EXPECT_EQ(cap.name, "cap");
+  EXPECT_TRUE(cap.base_color_texture.path.empty());
+  EXPECT_EQ(std::vector<uint8_t>(cap.base_color_texture.bytes.begin(), cap.base_color_texture.bytes.end()), png);
+  EXPECT_EQ(cap.base_color_texture.mime, "image/png");
+  EXPECT_FLOAT_EQ(cap.metallic, 0.0f);
+  EXPECT_TRUE(base.base_color_texture.empty());
+  EXPECT_FLOAT_EQ(base.base_color[0], 0.8f);
+  EXPECT_TRUE(base.double_sided);
+  for (uint32_t l = 0; l < s->level_count(model); ++l) {
+    const std::optional<LevelMeshView> m = s->level_mesh(model, l);
+    ASSERT_TRUE(m) << s->last_error();
+    if (m->index_count() == 0) continue;  // the culled level
+    EXPECT_EQ(m->uvs.size(), 2u * m->vertex_count) << "level " << l;
+    uint32_t covered = 0;
+    for (const MeshSubmesh& run : m->submeshes) {
+      EXPECT_EQ(run.first_index, covered) << "level " << l;
+      covered += run.index_count;
+    }
+    EXPECT_EQ(covered, m->index_count()) << "level " << l;
+  }
 }
 
 }  // namespace
