@@ -93,6 +93,7 @@ LevelMeshView level_mesh_view(const ModelSurfaces& surfaces, uint32_t model, uin
   v.positions = per_vertex(c.positions, 3);
   v.normals = per_vertex(c.normals, 3);
   v.uvs = per_vertex(c.uvs, 2);
+  v.uvs1 = per_vertex(c.uvs1, 2);
   v.colors = per_vertex(c.colors, 4);
   v.indices = std::span<const uint32_t>(c.indices.data() + l.first_index, l.index_count);
   v.submeshes = std::span<const MeshSubmesh>(surfaces.submeshes.data() + surfaces.first_submesh[level],

@@ -126,10 +126,11 @@ typedef struct lod_mesh {
   const lod_submesh* submeshes;       /* cover the indices in order, without gaps, grouped by material */
 } lod_mesh;
 
-/* A texture: a file (`path`, absolute, NUL-terminated, not checked to exist) or an image the
- * source held in itself (a GLB buffer view or data: URI): its encoded `bytes` (`size` of them)
- * and `mime` ("image/png" or "image/jpeg"). `texcoord`: the uv set it reads (0: lod_mesh.uvs,
- * TEXCOORD_0; 1: TEXCOORD_1). */
+/* A texture: a file (`path`, absolute: the source's folder at bake time joined with the file
+ * it named; NUL-terminated, not checked to exist) or an image the source held in itself (a GLB
+ * buffer view or data: URI): its encoded `bytes` (`size` of them) and `mime` ("image/png" or
+ * "image/jpeg"). A texture the source named by URL ("https://...") is not kept: none. `texcoord`: the uv set it reads (0: lod_mesh.uvs,
+ * TEXCOORD_0; 1: TEXCOORD_1, which only the C++ API's LevelMeshView::uvs1 carries). */
 typedef struct lod_texture {
   const char* path;
   const uint8_t* bytes;

@@ -8,8 +8,8 @@
 // built once per model when the model is added. Calls returning these views are safe from
 // any thread once add_model has returned.
 //
-// Layouts match lodkit.h's lod_submesh, lod_mesh and lod_material field for field where a
-// field exists in both (spans there are pointer + count).
+// MeshSubmesh is laid out exactly like lodkit.h's lod_submesh; lod_mesh and lod_material hold
+// the same fields as pointers and counts, pointing at the same memory.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -33,6 +33,7 @@ struct LevelMeshView {
   std::span<const float> positions;        // 3 per vertex (x y z)
   std::span<const float> normals;          // 3 per vertex, unit length (a source's zero normal stays zero), or empty
   std::span<const float> uvs;              // 2 per vertex, TEXCOORD_0 (glTF: origin top left), or empty
+  std::span<const float> uvs1;             // 2 per vertex, TEXCOORD_1 (lod_mesh has no twin), or empty
   std::span<const float> colors;           // 4 per vertex, linear RGBA, or empty
   std::span<const float> morph_positions;  // 3 per vertex, the vertex at morph = 1; empty for level meshes
   // 3 per triangle, counter-clockwise front faces: the source file's winding, kept by the bake
@@ -48,14 +49,15 @@ struct LevelMeshView {
 
 enum class MaterialAlpha : int { opaque = 0, mask = 1, blend = 2 };  // glTF's alphaMode, values as lod_material's
 
-// A texture: a file (absolute path) or an image the source held in itself (a GLB buffer view,
-// a data: URI) as its encoded bytes and MIME type ("image/png", "image/jpeg"). Neither: no
-// texture. Strings are NUL-terminated (data() may be handed to C).
+// A texture: a file (absolute path: the source's folder at bake time joined with the file it
+// named) or an image the source held in itself (a GLB buffer view, a data: URI) as its encoded
+// bytes and MIME type ("image/png", "image/jpeg"). Neither: no texture (also for a texture the
+// source named by URL). Strings are NUL-terminated (data() may be handed to C).
 struct MaterialTexture {
   std::string_view path;           // file on disk (not checked to exist), or empty
   std::span<const uint8_t> bytes;  // embedded PNG or JPEG, or empty
   std::string_view mime;           // with bytes, else empty
-  uint32_t texcoord = 0;           // uv set it reads: 0 = LevelMeshView::uvs (TEXCOORD_0), 1 = TEXCOORD_1
+  uint32_t texcoord = 0;           // uv set it reads: 0 = LevelMeshView::uvs (TEXCOORD_0), 1 = uvs1
 
   bool empty() const { return path.empty() && bytes.empty(); }
 };
