@@ -1,5 +1,6 @@
 /* lodkit from C99: a service from a scene config, ten objects of its first model in a row,
- * one view, a few driven frames, one frame read. Usage: c_minimal CONFIG.toml */
+ * one view, a few driven frames, one frame read, and the geometry a renderer would draw for
+ * its first entry. Usage: c_minimal CONFIG.toml */
 #include <inttypes.h>
 #include <lodkit/lodkit.h>
 #include <stdio.h>
@@ -24,6 +25,16 @@ int main(int argc, char** argv) {
     lod_frame_info_get(frame, &info);
     printf("visible %" PRIu32 " tris %" PRIu64 "\n", info.visible, info.tris_selected);
     failed = info.tick != 1 || info.objects < 10; /* the frame shows the committed tick */
+    lod_frame_entry entry;
+    lod_mesh mesh;
+    if (!failed && info.visible > 0) { /* the level's arrays, as lodkit holds them (no copy) */
+      failed = lod_frame_entry_get(frame, 0, &entry) != 0 || lod_model_level_mesh(s, 0, entry.level, &mesh) != 0;
+      if (!failed) {
+        printf("entry 0: level %" PRIu32 ", %" PRIu32 " vertices, %" PRIu32 " triangles, %" PRIu32 " materials\n",
+               entry.level, mesh.vertex_count, mesh.index_count / 3, lod_model_material_count(s, 0));
+        failed = mesh.index_count / 3 != lod_model_level_triangles(s, 0, entry.level);
+      }
+    }
     lod_frame_release(s, frame);
   }
   if (failed || !frame) fprintf(stderr, "failed: %s\n", *lod_last_error() ? lod_last_error() : "no [[model]] in the config");

@@ -12,6 +12,8 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -36,6 +38,14 @@ static_assert(offsetof(lod_view, width) == offsetof(lod::Camera, width));
 static_assert(offsetof(lod_view, height) == offsetof(lod::Camera, height));
 static_assert(offsetof(lod_view, near_z) == offsetof(lod::Camera, near_z));
 static_assert(offsetof(lod_view, far_z) == offsetof(lod::Camera, far_z));
+// Level meshes hand the service's submesh runs over in place.
+static_assert(sizeof(lod_submesh) == sizeof(lod::MeshSubmesh) && alignof(lod_submesh) == alignof(lod::MeshSubmesh));
+static_assert(offsetof(lod_submesh, first_index) == offsetof(lod::MeshSubmesh, first_index));
+static_assert(offsetof(lod_submesh, index_count) == offsetof(lod::MeshSubmesh, index_count));
+static_assert(offsetof(lod_submesh, material) == offsetof(lod::MeshSubmesh, material));
+static_assert(std::is_standard_layout_v<lod_submesh> && std::is_standard_layout_v<lod::MeshSubmesh>);
+static_assert(int(lod::MaterialAlpha::opaque) == 0 && int(lod::MaterialAlpha::mask) == 1 &&
+              int(lod::MaterialAlpha::blend) == 2);
 // lodkit.h's ranges are the service's.
 static_assert(LOD_MIN_BUDGET == lod::kMinBudget);
 static_assert(LOD_MAX_PIXEL_ERROR == lod::kMaxPixelError);
@@ -150,6 +160,25 @@ lod::Camera to_camera(const lod_view& v) noexcept {
   return out;
 }
 
+template <class T>
+const T* data_or_null(std::span<const T> a) noexcept {
+  return a.empty() ? nullptr : a.data();
+}
+
+// A string_view the service made from a std::string (so NUL-terminated), NULL when empty.
+const char* c_string_or_null(std::string_view s) noexcept { return s.empty() ? nullptr : s.data(); }
+
+lod_texture to_c(const lod::MaterialTexture& t) noexcept {
+  lod_texture out{};
+  if (t.empty()) return out;
+  out.path = c_string_or_null(t.path);
+  out.bytes = data_or_null(t.bytes);
+  out.size = t.bytes.size();
+  out.mime = c_string_or_null(t.mime);
+  out.texcoord = t.texcoord;
+  return out;
+}
+
 }  // namespace
 
 extern "C" {
@@ -203,6 +232,61 @@ uint32_t lod_model_level_count(lod_service* s, lod_model model) {
 uint64_t lod_model_level_triangles(lod_service* s, lod_model model, uint32_t level) {
   if (!usable(s)) return fail("lod_model_level_triangles: service is NULL"), uint64_t(0);
   return guarded(uint64_t(0), nullptr, 0, [&] { return s->service->level_triangles(model, level); });
+}
+
+int lod_model_level_mesh(lod_service* s, lod_model model, uint32_t level, lod_mesh* out) {
+  if (!usable(s)) return fail("lod_model_level_mesh: service is NULL");
+  if (!out) return fail("lod_model_level_mesh: out is NULL");
+  return guarded(1, nullptr, 0, [&] {
+    const std::optional<lod::LevelMeshView> m = s->service->level_mesh(model, level);
+    if (!m) return fail_from(s, "lod_model_level_mesh: model " + std::to_string(model) + " level " + std::to_string(level));
+    lod_mesh c{};
+    c.id = m->id;
+    c.vertex_count = m->vertex_count;
+    c.index_count = m->index_count();
+    c.positions = data_or_null(m->positions);
+    c.normals = data_or_null(m->normals);
+    c.uvs = data_or_null(m->uvs);
+    c.colors = data_or_null(m->colors);
+    c.morph_positions = data_or_null(m->morph_positions);
+    c.indices = data_or_null(m->indices);
+    c.submesh_count = static_cast<uint32_t>(m->submeshes.size());
+    c.submeshes = reinterpret_cast<const lod_submesh*>(data_or_null(m->submeshes));  // same layout (asserted above)
+    *out = c;
+    return 0;
+  });
+}
+
+uint32_t lod_model_material_count(lod_service* s, lod_model model) {
+  if (!usable(s)) return fail("lod_model_material_count: service is NULL"), 0u;
+  return guarded(0u, nullptr, 0, [&] {
+    if (model >= s->service->model_count()) return fail("lod_model_material_count: unknown model " + std::to_string(model)), 0u;
+    return s->service->material_count(model);
+  });
+}
+
+int lod_model_material(lod_service* s, lod_model model, uint32_t index, lod_material* out) {
+  if (!usable(s)) return fail("lod_model_material: service is NULL");
+  if (!out) return fail("lod_model_material: out is NULL");
+  return guarded(1, nullptr, 0, [&] {
+    const lod::Material* m = s->service->material(model, index);
+    if (!m) return fail_from(s, "lod_model_material: model " + std::to_string(model) + " material " + std::to_string(index));
+    lod_material c{};
+    copy_array(c.base_color, m->base_color);
+    c.metallic = m->metallic;
+    c.roughness = m->roughness;
+    copy_array(c.emissive, m->emissive);
+    c.alpha_mode = static_cast<int>(m->alpha_mode);
+    c.alpha_cutoff = m->alpha_cutoff;
+    c.double_sided = m->double_sided ? 1 : 0;
+    c.base_color_texture = to_c(m->base_color_texture);
+    c.metallic_roughness_texture = to_c(m->metallic_roughness_texture);
+    c.normal_texture = to_c(m->normal_texture);
+    c.occlusion_texture = to_c(m->occlusion_texture);
+    c.emissive_texture = to_c(m->emissive_texture);
+    *out = c;
+    return 0;
+  });
 }
 
 lod_object lod_object_create(lod_service* s, lod_model model, const lod_transform* transform) {

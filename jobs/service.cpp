@@ -109,6 +109,34 @@ uint64_t Service::level_triangles(ModelId model, uint32_t level) const {
   return impl_->chains[model]->levels[level].triangles();
 }
 
+std::optional<LevelMeshView> Service::level_mesh(ModelId model, uint32_t level) const {
+  const std::shared_ptr<const ModelSurfaces> s = impl_->surfaces_of(model);
+  if (!s) return fail("level_mesh: unknown model " + std::to_string(model)), std::nullopt;
+  const size_t levels = s->chain->levels.size();
+  if (level >= levels)
+    return fail("level_mesh: model " + std::to_string(model) + " has levels 0.." + std::to_string(levels - 1) +
+                ", not " + std::to_string(level)),
+           std::nullopt;
+  return level_mesh_view(*s, model, level);  // views into *s, which the service keeps
+}
+
+std::span<const Material> Service::materials(ModelId model) const {
+  const std::shared_ptr<const ModelSurfaces> s = impl_->surfaces_of(model);
+  return s ? std::span<const Material>(s->materials) : std::span<const Material>();
+}
+
+uint32_t Service::material_count(ModelId model) const { return static_cast<uint32_t>(materials(model).size()); }
+
+const Material* Service::material(ModelId model, uint32_t index) const {
+  const std::shared_ptr<const ModelSurfaces> s = impl_->surfaces_of(model);
+  if (!s) return fail("material: unknown model " + std::to_string(model)), nullptr;
+  if (index >= s->materials.size())
+    return fail("material: model " + std::to_string(model) + " has " + std::to_string(s->materials.size()) +
+                " materials, no material " + std::to_string(index)),
+           nullptr;
+  return &s->materials[index];
+}
+
 ObjectHandle Service::create(ModelId model, const Transform& transform, const ObjectOptions& options) {
   const ObjectHandle h = impl_->queue.create(model, impl_->model_count(), transform, options);
   if (h == 0) {

@@ -13,6 +13,7 @@
 #include "jobs/commit_queue.h"
 #include "jobs/frame_graph.h"
 #include "jobs/frame_pool.h"
+#include "jobs/model_surfaces.h"
 #include "lodkit/service.hpp"
 #include "runtime/view.h"
 
@@ -23,8 +24,9 @@ struct Service::Impl {
   FrameGraphOptions graph_options;
   CommitQueue queue;
 
-  mutable std::mutex models_mutex;  // chains, models_version
+  mutable std::mutex models_mutex;  // chains, surfaces, models_version
   std::vector<std::shared_ptr<const LodChain>> chains;
+  std::vector<std::shared_ptr<const ModelSurfaces>> surfaces;  // per model, built when it is added
   uint64_t models_version = 0;
 
   // The LOD side: one frame at a time, on the service thread or step()'s caller.
@@ -62,6 +64,12 @@ struct Service::Impl {
     graph = std::make_unique<FrameGraph>(make_model_set({}), graph_options);
   }
 
+  // Model `model`'s surfaces, or null for an unknown model.
+  std::shared_ptr<const ModelSurfaces> surfaces_of(ModelId model) const {
+    std::lock_guard lock(models_mutex);
+    return model < surfaces.size() ? surfaces[model] : nullptr;
+  }
+
   uint32_t model_count() const {
     std::lock_guard lock(models_mutex);
     return static_cast<uint32_t>(chains.size());
@@ -69,8 +77,10 @@ struct Service::Impl {
 
   ModelId add_chain(LodChain chain) {
     auto c = std::make_shared<const LodChain>(std::move(chain));
+    std::shared_ptr<const ModelSurfaces> s = build_model_surfaces(c);
     std::lock_guard lock(models_mutex);
     chains.push_back(std::move(c));
+    surfaces.push_back(std::move(s));
     ++models_version;
     return static_cast<ModelId>(chains.size() - 1);
   }

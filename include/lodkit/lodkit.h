@@ -88,6 +88,83 @@ int lod_model_add(lod_service*, const char* path, lod_model* out, char* error, s
 uint32_t lod_model_level_count(lod_service*, lod_model);
 uint64_t lod_model_level_triangles(lod_service*, lod_model, uint32_t level);
 
+/* ---- Level geometry and materials, for a renderer ---------------------------------------
+ * Zero-copy views into the service's own immutable arrays. Ownership: every pointer below is
+ * the service's; never free or write through it. Lifetime: valid and unchanged until
+ * lod_service_destroy (models are never removed or changed); arrays the baked model does not
+ * store in this layout (submesh runs, materials, texture paths) are built once per model by
+ * lod_model_add. Threads: safe from any thread, concurrently with frames and object calls,
+ * once lod_model_add has returned. Errors: a NULL service or out pointer, an unknown model, a
+ * level >= lod_model_level_count or a material index >= lod_model_material_count gives a
+ * nonzero return, *out untouched, and a message naming the value in lod_last_error(). */
+
+/* Indices [first_index, first_index + index_count) of a level (level-local: 0 is the level's
+ * first index), whole triangles, drawn with material `material` (-1: the default surface, the
+ * glTF defaults lod_material lists). */
+typedef struct lod_submesh {
+  uint32_t first_index, index_count;
+  int32_t material; /* -1: default surface */
+} lod_submesh;
+
+/* One level of a model, in the model's object space (the source file's units). Arrays with
+ * nothing to hold (the culled level: 0 triangles) are NULL with counts 0. */
+typedef struct lod_mesh {
+  uint64_t id;                        /* nonzero; one id names the same bytes for the service's lifetime
+                                         (unique per model and level within a service) */
+  uint32_t vertex_count, index_count; /* 3 indices per triangle, counter-clockwise front faces (the
+                                         source's winding; glTF, OBJ, PLY, OFF, STL all say CCW);
+                                         index_count / 3 == lod_model_level_triangles */
+  const float* positions;             /* 3 per vertex: x y z */
+  const float* normals;               /* 3 per vertex, unit length (a source's zero normal stays
+                                         zero), or NULL */
+  const float* uvs;                   /* 2 per vertex (TEXCOORD_0, glTF convention: origin top left), or NULL */
+  const float* colors;                /* 4 per vertex, linear RGBA, or NULL */
+  const float* morph_positions;       /* 3 per vertex: the vertex at morph = 1, or NULL (no blend);
+                                         always NULL for level meshes */
+  const uint32_t* indices;            /* each < vertex_count */
+  uint32_t submesh_count;             /* 0: one surface with the default material */
+  const lod_submesh* submeshes;       /* cover the indices in order, without gaps, grouped by material */
+} lod_mesh;
+
+/* A texture: a file (`path`, absolute: the source's folder at bake time joined with the file
+ * it named; NUL-terminated, not checked to exist) or an image the source held in itself (a GLB
+ * buffer view or data: URI): its encoded `bytes` (`size` of them) and `mime` ("image/png" or
+ * "image/jpeg"). A texture the source named by URL ("https://...") is not kept: none. `texcoord`: the uv set it reads (0: lod_mesh.uvs,
+ * TEXCOORD_0; 1: TEXCOORD_1, which only the C++ API's LevelMeshView::uvs1 carries). */
+typedef struct lod_texture {
+  const char* path;
+  const uint8_t* bytes;
+  size_t size;
+  const char* mime;
+  uint32_t texcoord;
+} lod_texture; /* all NULL/0: none */
+
+/* glTF 2.0's metallic-roughness material as the bake read it (from glTF, or OBJ/MTL: Kd is
+ * base_color, map_Kd its texture). What the source did not give has glTF's default: base_color
+ * 1,1,1,1; metallic 1; roughness 1; emissive 0,0,0; alpha_mode opaque; alpha_cutoff 0.5;
+ * single-sided; no textures. Factors are linear, each in [0, 1]. */
+typedef struct lod_material {
+  float base_color[4];  /* linear RGBA factor */
+  float metallic, roughness;
+  float emissive[3];    /* linear RGB factor */
+  int alpha_mode;       /* 0 opaque, 1 mask, 2 blend */
+  float alpha_cutoff;   /* used with mask */
+  int double_sided;     /* nonzero: back faces drawn too */
+  lod_texture base_color_texture;         /* sRGB colour, multiplied by base_color */
+  lod_texture metallic_roughness_texture; /* roughness in G, metalness in B */
+  lod_texture normal_texture;             /* tangent-space normals */
+  lod_texture occlusion_texture;          /* ambient occlusion in R */
+  lod_texture emissive_texture;           /* sRGB emitted colour */
+} lod_material;
+
+/* Level `level` (0 = full detail) of `model` into *out; 0 = ok. Valid while the service lives. */
+int lod_model_level_mesh(lod_service*, lod_model, uint32_t level, lod_mesh* out);
+/* The materials lod_submesh.material indexes; 0 for a model without materials (one default
+ * surface), and 0 with a message for a NULL service or unknown model. */
+uint32_t lod_model_material_count(lod_service*, lod_model);
+/* Material `index` of `model` into *out; 0 = ok. Strings and bytes valid while the service lives. */
+int lod_model_material(lod_service*, lod_model, uint32_t index, lod_material* out);
+
 lod_object lod_object_create(lod_service*, lod_model, const lod_transform*); /* 0 on error */
 int lod_object_destroy(lod_service*, lod_object);                            /* nonzero: stale or unknown */
 int lod_object_set_transform(lod_service*, lod_object, const lod_transform*); /* nonzero: stale or unknown */

@@ -22,11 +22,13 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "lodkit/frame.hpp"
+#include "lodkit/mesh.hpp"
 #include "lodkit/types.hpp"
 
 namespace lod {
@@ -137,6 +139,20 @@ class Service {
   uint32_t model_count() const;
   uint32_t level_count(ModelId model) const;                   // 0 for an unknown model
   uint64_t level_triangles(ModelId model, uint32_t level) const;  // 0 when out of range
+
+  // Geometry and materials for a renderer (lodkit/mesh.hpp): views into the service's own
+  // immutable arrays, never copies, valid and unchanged for the service's lifetime. Safe from
+  // any thread, concurrently with frames and object calls, once add_model has returned.
+  // level_mesh: level `level` (0 = full detail) of `model`; its triangle count is
+  // level_triangles(model, level) (the culled level, 0 triangles: every array empty).
+  // nullopt, with last_error() naming the model or level, when either is out of range.
+  std::optional<LevelMeshView> level_mesh(ModelId model, uint32_t level) const;
+  // The materials MeshSubmesh::material indexes, in the model's order; empty for a model without
+  // materials (one default surface) and for an unknown model.
+  std::span<const Material> materials(ModelId model) const;
+  uint32_t material_count(ModelId model) const;  // materials(model).size()
+  // materials(model)[index], or nullptr with last_error() naming the model or index.
+  const Material* material(ModelId model, uint32_t index) const;
 
   // Objects (staged until commit). 0 / false for an unknown model, a stale or unknown handle,
   // or a transform that is not finite (scale <= 0, zero quaternion).

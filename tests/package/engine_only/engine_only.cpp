@@ -3,12 +3,17 @@
 #include <lodkit/lodkit.hpp>
 
 #include <cstdio>
+#include <optional>
 
 int main(int argc, char** argv) {
   if (argc != 2) return std::fprintf(stderr, "usage: %s FILE.lod\n", argv[0]), 2;
   lod::Service service;
   lod::ModelId model = 0;
   if (!service.add_model(argv[1], &model)) return std::fprintf(stderr, "%s\n", service.last_error().c_str()), 1;
+  // Level geometry for a renderer comes from the engine alone too.
+  const std::optional<lod::LevelMeshView> mesh = service.level_mesh(model, 0);
+  if (!mesh || mesh->triangle_count() != service.level_triangles(model, 0) || mesh->positions.empty())
+    return std::fprintf(stderr, "level_mesh: %s\n", service.last_error().c_str()), 1;
   for (int i = 0; i < 16; ++i) {
     lod::Transform t;
     t.position[0] = 3.0f * float(i);

@@ -1,5 +1,5 @@
 // Texture URIs: percent-encoding both ways and resolution against the source's folder.
-#include "preprocess/texture_uri.h"
+#include "runtime/texture_uri.h"
 
 #include <cctype>
 
