@@ -45,7 +45,7 @@ done
 total=$(python3 -c "import json; print(json.load(open('$out/np2.json'))['subtrees'])")
 quarter=$((total / 4))
 t0=$(now)
-LOD_MPI_FAIL_AFTER=$quarter LOD_MPI_FAIL_RANK=-1 "${mpi[@]}" -np 2 "$build/lod-bake-mpi" "$mesh" -o "$out/resume" \
+LOD_MPI_FAIL_AFTER=$quarter LOD_MPI_FAIL_RANK=-1 "${mpi[@]}" -np 2 "$build/lod-bake-mpi-faults" "$mesh" -o "$out/resume" \
   --cache "$out/cache-resume" --threads 1 --quiet > /dev/null 2> "$out/killed.err" || true
 t1=$(now)
 kept=$(ls "$out/cache-resume" | grep -c '\.hsub$' || true)

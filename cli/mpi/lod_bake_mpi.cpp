@@ -10,7 +10,8 @@
 // rank's share by all ranks as above; each DIR/<name>.hlod is the local bake's bytes and goes
 // through the cache (jobs/hlod_models_distributed.h). A rerun bakes only what the cache lacks.
 //
-// Fault injection for tests: LOD_MPI_FAIL_AFTER=N makes rank LOD_MPI_FAIL_RANK (default: the
+// Fault injection, compiled only into the test build's lod-bake-mpi-faults (LOD_FAULT_INJECTION):
+// LOD_MPI_FAIL_AFTER=N makes rank LOD_MPI_FAIL_RANK (default: the
 // last; -1: every rank) die without a word to MPI once it has stored N cache entries (subtrees,
 // and with several meshes models too), as a killed process would.
 #include <mpi.h>
@@ -124,10 +125,12 @@ HlodRankComm mpi_comm() {
   return c;
 }
 
+#ifdef LOD_FAULT_INJECTION
 long env_number(const char* name, long fallback) {
   const char* v = std::getenv(name);
   return v && *v ? std::strtol(v, nullptr, 10) : fallback;
 }
+#endif
 
 nlohmann::json to_json(const HlodDistributedResult& r, int ranks) {
   nlohmann::json per_rank = nlohmann::json::array();
@@ -214,6 +217,7 @@ nlohmann::json to_json(const HlodModelsResult& r, int ranks) {
 // Several meshes: one .hlod each, the models handed out to the ranks.
 int run_models(const std::vector<std::string>& meshes, const std::string& out_dir, HlodModelsSettings settings,
                bool json, bool quiet, const HlodRankComm& comm) {
+#ifdef LOD_FAULT_INJECTION
   const long fail_after = env_number("LOD_MPI_FAIL_AFTER", -1);
   const long fail_rank = env_number("LOD_MPI_FAIL_RANK", comm.size - 1);
   if (fail_after >= 0 && (fail_rank == comm.rank || fail_rank < 0))
@@ -224,6 +228,7 @@ int run_models(const std::vector<std::string>& meshes, const std::string& out_di
       std::fflush(stderr);
       std::_Exit(3);
     };
+#endif
   const bool talk = !quiet && !json;
   auto log = [&](const std::string& line) {
     const bool progress = line.size() > 11 && line.compare(line.size() - 11, 11, "triangles/s") == 0;
@@ -293,6 +298,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
     return run_models(meshes, out_dir, models, json, quiet, comm);
   }
   const std::string& mesh = meshes.front();
+#ifdef LOD_FAULT_INJECTION
   const long fail_after = env_number("LOD_MPI_FAIL_AFTER", -1);
   const long fail_rank = env_number("LOD_MPI_FAIL_RANK", comm.size - 1);
   if (fail_after >= 0 && (fail_rank == comm.rank || fail_rank < 0))  // LOD_MPI_FAIL_RANK=-1: every rank
@@ -303,6 +309,7 @@ int run(int argc, char** argv, const HlodRankComm& comm) {
       std::fflush(stderr);
       std::_Exit(3);  // no MPI_Finalize: mpirun sees a dead rank and ends the job
     };
+#endif
   const bool talk = !quiet && !json;
   auto log = [&](const std::string& line) {
     const bool progress = line.rfind("subtrees ", 0) == 0;  // the rest: refused entries, failures

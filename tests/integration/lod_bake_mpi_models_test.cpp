@@ -89,7 +89,8 @@ TEST(LodBakeMpiModels, EveryModelHasTheLocalBakesBytesAtOneTwoAndFourRanks) {
 
 TEST(LodBakeMpiModels, KilledRankThenRerunBakesOnlyTheMissingModelsIntoTheSameBytes) {
   const auto dir = test::temp_dir("lod_bake_mpi_models_kill");
-  const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=1 LOD_MPI_FAIL_RANK=1");
+  const test::CliResult killed = test::run_mpi_program(2, LOD_BAKE_MPI_FAULTS_PATH, bake_args(dir / "out", dir / "cache"),
+                                                       "LOD_MPI_FAIL_AFTER=1 LOD_MPI_FAIL_RANK=1");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("injected failure"), std::string::npos) << killed.out;
   const size_t kept = test::cache_entries(dir / "cache", ".hlod").size();
@@ -109,7 +110,8 @@ TEST(LodBakeMpiModels, KilledRankThenRerunBakesOnlyTheMissingModelsIntoTheSameBy
 // takes the whole models from the cache and the boulder's finished subtrees too.
 TEST(LodBakeMpiModels, KilledInASplitModelThenRerunKeepsItsSubtrees) {
   const auto dir = test::temp_dir("lod_bake_mpi_models_kill_split");
-  const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=3 LOD_MPI_FAIL_RANK=0");
+  const test::CliResult killed = test::run_mpi_program(2, LOD_BAKE_MPI_FAULTS_PATH, bake_args(dir / "out", dir / "cache"),
+                                                       "LOD_MPI_FAIL_AFTER=3 LOD_MPI_FAIL_RANK=0");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("subtree"), std::string::npos) << killed.out;
   EXPECT_EQ(test::cache_entries(dir / "cache", ".hlod").size(), 4u) << "the four whole models are finished before the split one";

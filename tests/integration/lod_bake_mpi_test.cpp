@@ -141,7 +141,8 @@ TEST(LodBakeMpi, ColouredModelSameBytesAsTheLocalBakeAtOneTwoAndFourRanks) {
 
 TEST(LodBakeMpi, KilledRankThenRerunBakesOnlyTheMissingSubtreesIntoTheSameBytes) {
   const auto dir = test::temp_dir("lod_bake_mpi_kill");
-  const test::CliResult killed = run_mpi(2, bake_args(dir / "out", dir / "cache"), "LOD_MPI_FAIL_AFTER=4 LOD_MPI_FAIL_RANK=1");
+  const test::CliResult killed = test::run_mpi_program(2, LOD_BAKE_MPI_FAULTS_PATH, bake_args(dir / "out", dir / "cache"),
+                                                       "LOD_MPI_FAIL_AFTER=4 LOD_MPI_FAIL_RANK=1");
   EXPECT_NE(killed.code, 0) << killed.out;
   EXPECT_NE(killed.out.find("injected failure"), std::string::npos) << killed.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "ball.hlod"));
