@@ -39,7 +39,7 @@ mkdir -p "$OUT/obj"
 FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
        -I. -Iinclude -I/usr/include/gdal -I/usr/include/stb -D_USE_MATH_DEFINES -DGLM_FORCE_XYZW_ONLY '-DLOD_DEFAULT_DATA_DIR="/nonexistent"')
 MESH_SOURCES=(preprocess/mesh_io.cpp preprocess/ply_reader.cpp preprocess/off_reader.cpp preprocess/stl_reader.cpp
-              preprocess/obj_reader.cpp preprocess/mtl_reader.cpp preprocess/texture_uri.cpp preprocess/gltf_io.cpp
+              preprocess/obj_reader.cpp preprocess/mtl_reader.cpp runtime/texture_uri.cpp preprocess/gltf_io.cpp
               runtime/file_write.cpp runtime/host_turn.cpp runtime/embedded_image.cpp runtime/regular_file.cpp
               preprocess/plain_ply_file.cpp runtime/bytes_hasher.cpp preprocess/mesh_clean.cpp preprocess/material_runs.cpp
               preprocess/first_of_equal.cpp preprocess/cluster_simplifier.cpp
