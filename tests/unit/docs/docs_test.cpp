@@ -167,7 +167,7 @@ const std::vector<Rule>& work_log_rules() {
       {"an issue number", std::regex(R"(\bissues? #?[0-9]+)", std::regex::icase)},
       {"a measurement round (stop N)", std::regex(R"(\bstops? [0-9]+\b)", std::regex::icase)},
       {"\"session\"", std::regex(R"(\bsessions?\b)", std::regex::icase)},
-      {"\"this branch\", \"this VM\" or \"this machine\"",
+      {"where the work ran (the branch, the VM or the machine) instead of what the code is",
        std::regex(R"(\bthis (branch|vm|machine)\b)", std::regex::icase)},
   };
   return rules;
